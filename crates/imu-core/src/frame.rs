@@ -1,0 +1,71 @@
+//! Frame markers: the navigation frames [`Enu`] and [`Ned`], and the [`Body`] frame.
+//!
+//! Frames are types, so a body-frame vector cannot be added to a navigation-frame one and generic
+//! code (`fn f<N: NavFrame>`) replaces an `is_enu` flag. The front ends pick `Enu` or `Ned` once.
+use crate::vector::Vec3;
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::Enu {}
+    impl Sealed for super::Ned {}
+    impl Sealed for super::Body {}
+}
+
+/// A coordinate frame marker.
+pub trait Frame: sealed::Sealed + Copy + Default + core::fmt::Debug + PartialEq + 'static {
+    /// Short name used in messages and file headers.
+    const NAME: &'static str;
+}
+
+/// A local-level navigation frame (flat Earth).
+pub trait NavFrame: Frame {
+    /// +1 when the frame's z axis points up (ENU), −1 when it points down (NED).
+    const Z_UP: f64;
+
+    /// Gravity vector `g_n` for a gravity magnitude `g_m_s2` (m/s²): ENU `[0, 0, −g]`, NED `[0, 0, +g]`.
+    #[must_use]
+    fn gravity(g_m_s2: f64) -> Vec3<Self> {
+        Vec3::new(0.0, 0.0, -Self::Z_UP * g_m_s2)
+    }
+
+    /// MATLAB imuSensor's default magnetic field, µT, resolved in this frame
+    /// (NED `[27.5550, −2.4169, −16.0849]`).
+    #[must_use]
+    fn default_magnetic_field_ut() -> Vec3<Self>;
+}
+
+/// East-North-Up navigation frame (the default, as in the German seed). Body frame is FLU.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Enu;
+
+/// North-East-Down navigation frame (MATLAB's default). Body frame is FRD.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Ned;
+
+/// The body frame of the moving rigid body (and of the IMU mounted on it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Body;
+
+impl Frame for Enu {
+    const NAME: &'static str = "ENU";
+}
+impl Frame for Ned {
+    const NAME: &'static str = "NED";
+}
+impl Frame for Body {
+    const NAME: &'static str = "body";
+}
+
+impl NavFrame for Enu {
+    const Z_UP: f64 = 1.0;
+    fn default_magnetic_field_ut() -> Vec3<Self> {
+        Vec3::new(-2.4169, 27.5550, 16.0849)
+    }
+}
+
+impl NavFrame for Ned {
+    const Z_UP: f64 = -1.0;
+    fn default_magnetic_field_ut() -> Vec3<Self> {
+        Vec3::new(27.5550, -2.4169, -16.0849)
+    }
+}

@@ -1,0 +1,89 @@
+//! Ideal IMU readings from truth: specific force at a lever arm, body rate, magnetic field.
+//!
+//! `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r` (rigid-body kinematics, seed 000 eq. 9,
+//! with gravity taken out as a real accelerometer senses it), `ω_b` unchanged (the same at every
+//! point of a rigid body), `m_b = C_nbᵀ m_n`.
+use crate::frame::{Body, NavFrame};
+use crate::kinematics::Truth;
+use crate::vector::Vec3;
+
+/// Sign convention of accelerometer output.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AccelSign {
+    /// Specific force `f_b` (a level IMU at rest reads `+g` on its up axis), as real sensors,
+    /// ROS, gnss-ins-sim and Kalibr report.
+    #[default]
+    SpecificForce,
+    /// `−f_b`, gravity minus acceleration, as MATLAB's `imuSensor` outputs.
+    Matlab,
+}
+
+/// Where and how the IMU sits on the body, and the environment it senses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuMount<N> {
+    /// Lever arm `r` from the reference point S to the IMU point I, body frame, m.
+    pub lever_arm_m: Vec3<Body>,
+    /// Accelerometer sign convention.
+    pub accel_sign: AccelSign,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// Earth magnetic field in the navigation frame, µT.
+    pub magnetic_field_ut: Vec3<N>,
+}
+
+impl<N: NavFrame> Default for ImuMount<N> {
+    fn default() -> Self {
+        Self {
+            lever_arm_m: Vec3::zeros(),
+            accel_sign: AccelSign::SpecificForce,
+            gravity_m_s2: 9.81,
+            magnetic_field_ut: N::default_magnetic_field_ut(),
+        }
+    }
+}
+
+/// One ideal reading, body frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IdealReading {
+    /// Accelerometer, m/s² (sign per [`AccelSign`]).
+    pub accel_m_s2: Vec3<Body>,
+    /// Gyroscope, rad/s.
+    pub gyro_rad_s: Vec3<Body>,
+    /// Magnetometer, µT.
+    pub mag_ut: Vec3<Body>,
+}
+
+impl<N: NavFrame> ImuMount<N> {
+    /// Specific force at the IMU point, body frame, m/s² (always the physical sign).
+    #[must_use]
+    pub fn specific_force(&self, truth: &Truth<N>) -> Vec3<Body> {
+        let nav_to_body = truth.attitude.inverse();
+        let w = truth.omega_b_rad_s;
+        let r = self.lever_arm_m;
+        nav_to_body.apply(truth.acceleration_m_s2 - N::gravity(self.gravity_m_s2))
+            + w.cross(&w.cross(&r))
+            + truth.alpha_b_rad_s2.cross(&r)
+    }
+
+    /// The ideal reading of all three sensors for one truth sample.
+    #[must_use]
+    pub fn read(&self, truth: &Truth<N>) -> IdealReading {
+        let f = self.specific_force(truth);
+        IdealReading {
+            accel_m_s2: match self.accel_sign {
+                AccelSign::SpecificForce => f,
+                AccelSign::Matlab => -f,
+            },
+            gyro_rad_s: truth.omega_b_rad_s,
+            mag_ut: truth.attitude.inverse().apply(self.magnetic_field_ut),
+        }
+    }
+
+    /// Ideal readings for a slice of truth samples, written into `out` (same length; extra
+    /// output slots are left untouched).
+    pub fn read_into(&self, truth: &[Truth<N>], out: &mut [IdealReading]) {
+        for (s, o) in truth.iter().zip(out.iter_mut()) {
+            *o = self.read(s);
+        }
+    }
+}

@@ -1,0 +1,92 @@
+//! Truth kinematics per sample: position, velocity, acceleration (navigation frame), attitude,
+//! body rate and body angular acceleration.
+//!
+//! Sources: [`sampled`] (finite differences on caller-owned slices), [`analytic`] (exact, over dual
+//! numbers; `std` feature). Both share [`euler`] (Euler rates → body rate) and [`tangent`]
+//! (attitude aligned with the velocity).
+#[cfg(feature = "std")]
+pub mod analytic;
+mod error;
+pub mod euler;
+pub mod finite_diff;
+pub mod sampled;
+pub mod tangent;
+
+pub use error::KinematicsError;
+
+use crate::frame::{Body, NavFrame};
+use crate::rotation::{EulerZyx, Rotation};
+use crate::vector::Vec3;
+
+/// The true motion of the reference point S and the attitude of the rigid body at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Truth<N> {
+    /// Time, s.
+    pub t_s: f64,
+    /// Position of S in the navigation frame, m.
+    pub position_m: Vec3<N>,
+    /// Velocity of S in the navigation frame, m/s.
+    pub velocity_m_s: Vec3<N>,
+    /// Kinematic acceleration of S in the navigation frame (no gravity), m/s².
+    pub acceleration_m_s2: Vec3<N>,
+    /// Attitude `C_nb`.
+    pub attitude: Rotation<Body, N>,
+    /// The same attitude as z-y-x Euler angles; yaw is unwrapped (continuous) along a path.
+    pub euler: EulerZyx,
+    /// Body rate `ω_b`, rad/s.
+    pub omega_b_rad_s: Vec3<Body>,
+    /// Body angular acceleration `α_b = dω_b/dt`, rad/s².
+    pub alpha_b_rad_s2: Vec3<Body>,
+}
+
+impl<N: NavFrame> Default for Truth<N> {
+    fn default() -> Self {
+        Self {
+            t_s: 0.0,
+            position_m: Vec3::zeros(),
+            velocity_m_s: Vec3::zeros(),
+            acceleration_m_s2: Vec3::zeros(),
+            attitude: Rotation::identity(),
+            euler: EulerZyx::default(),
+            omega_b_rad_s: Vec3::zeros(),
+            alpha_b_rad_s2: Vec3::zeros(),
+        }
+    }
+}
+
+impl<N: NavFrame> Truth<N> {
+    /// True when every field is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.t_s.is_finite()
+            && self.position_m.is_finite()
+            && self.velocity_m_s.is_finite()
+            && self.acceleration_m_s2.is_finite()
+            && self.euler.to_array().iter().all(|a| a.is_finite())
+            && self.omega_b_rad_s.is_finite()
+            && self.alpha_b_rad_s2.is_finite()
+    }
+}
+
+/// Checks that sample times are finite and strictly increasing.
+///
+/// # Errors
+/// [`KinematicsError::NotFinite`] or [`KinematicsError::TimeNotIncreasing`] with the index.
+pub fn check_times(t_s: &[f64]) -> Result<(), KinematicsError> {
+    for (i, &t) in t_s.iter().enumerate() {
+        if !t.is_finite() {
+            return Err(KinematicsError::NotFinite {
+                field: "t_s",
+                index: i,
+            });
+        }
+        if i > 0 && t <= t_s[i - 1] {
+            return Err(KinematicsError::TimeNotIncreasing {
+                index: i,
+                previous_s: t_s[i - 1],
+                t_s: t,
+            });
+        }
+    }
+    Ok(())
+}

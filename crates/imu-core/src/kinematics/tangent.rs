@@ -1,0 +1,110 @@
+//! Tangent attitude: the body x axis along the velocity (seed 000 eqs. 10–13).
+//!
+//! `yaw = atan2(v_y, v_x)`, `pitch = −asin(v_z / |v|)` (written as `−atan2(v_z, |v_h|)`),
+//! `roll = 0`; the same formula in ENU and NED (in NED a climb is nose-up). Where the speed falls
+//! below a threshold the last valid attitude is held with zero rates; leading standstill samples
+//! take the first valid attitude (batch functions backfill them). Yaw is unwrapped so it is
+//! continuous. A vertical velocity (horizontal speed below the threshold while moving) is a
+//! singularity and is refused.
+use crate::kinematics::KinematicsError;
+use crate::math;
+use crate::rotation::EulerZyx;
+
+/// Speeds below this (m/s) count as standstill for the tangent attitude, unless set otherwise.
+pub const DEFAULT_MIN_SPEED_M_S: f64 = 1e-6;
+
+/// Tangent Euler angles with their first and second time derivatives.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TangentAngles {
+    /// Angles, rad (roll is 0).
+    pub euler: EulerZyx,
+    /// First derivatives, rad/s.
+    pub rate: EulerZyx,
+    /// Second derivatives, rad/s².
+    pub accel: EulerZyx,
+}
+
+/// Tangent angles and their derivatives from velocity `v`, acceleration `a` and jerk `j`
+/// (navigation frame, SI), in closed form. Requires a non-zero horizontal speed.
+///
+/// With `h = |v_h|`: `ẏ = (v_x a_y − v_y a_x)/h²`; `θ = atan2(v_z, h)` has
+/// `θ̇ = (h a_z − v_z ḣ)/|v|²`; pitch = −θ. Second derivatives by the quotient rule.
+#[must_use]
+pub fn tangent_angles(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> TangentAngles {
+    let [vx, vy, vz] = v;
+    let [ax, ay, az] = a;
+    let [jx, jy, jz] = j;
+    // Yaw.
+    let d = vx * vx + vy * vy;
+    let n = vx * ay - vy * ax;
+    let n_dot = vx * jy - vy * jx;
+    let d_dot = 2.0 * (vx * ax + vy * ay);
+    let yaw_rate = n / d;
+    let yaw_acc = (n_dot * d - n * d_dot) / (d * d);
+    // Pitch.
+    let h = math::sqrt(d);
+    let h_dot = (vx * ax + vy * ay) / h;
+    let h_ddot = (ax * ax + ay * ay + vx * jx + vy * jy - h_dot * h_dot) / h;
+    let d2 = d + vz * vz;
+    let n2 = h * az - vz * h_dot;
+    let n2_dot = h * jz - vz * h_ddot;
+    let d2_dot = 2.0 * (vx * ax + vy * ay + vz * az);
+    let theta_rate = n2 / d2;
+    let theta_acc = (n2_dot * d2 - n2 * d2_dot) / (d2 * d2);
+    TangentAngles {
+        euler: EulerZyx::new(math::atan2(vy, vx), -math::atan2(vz, h), 0.0),
+        rate: EulerZyx::new(yaw_rate, -theta_rate, 0.0),
+        accel: EulerZyx::new(yaw_acc, -theta_acc, 0.0),
+    }
+}
+
+/// Per-sample tangent attitude with standstill hold and yaw unwrapping.
+#[derive(Clone, Copy, Debug)]
+pub struct TangentTracker {
+    min_speed_m_s: f64,
+    last: Option<EulerZyx>,
+}
+
+impl TangentTracker {
+    /// A tracker that treats speeds below `min_speed_m_s` as standstill.
+    #[must_use]
+    pub const fn new(min_speed_m_s: f64) -> Self {
+        Self {
+            min_speed_m_s,
+            last: None,
+        }
+    }
+
+    /// The tangent attitude at sample `index` from velocity, acceleration and jerk.
+    ///
+    /// Returns `Ok(None)` at a standstill before any valid attitude (the caller backfills), the
+    /// held attitude with zero rates at a later standstill, otherwise the unwrapped angles.
+    ///
+    /// # Errors
+    /// [`KinematicsError::VerticalTangent`] when the velocity is vertical.
+    pub fn update(
+        &mut self,
+        index: usize,
+        v: [f64; 3],
+        a: [f64; 3],
+        j: [f64; 3],
+    ) -> Result<Option<TangentAngles>, KinematicsError> {
+        let speed = math::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if speed < self.min_speed_m_s {
+            return Ok(self.last.map(|euler| TangentAngles {
+                euler,
+                ..TangentAngles::default()
+            }));
+        }
+        let horizontal = math::sqrt(v[0] * v[0] + v[1] * v[1]);
+        if horizontal < self.min_speed_m_s {
+            return Err(KinematicsError::VerticalTangent { index });
+        }
+        let mut angles = tangent_angles(v, a, j);
+        if let Some(last) = self.last {
+            angles.euler.yaw_rad = math::unwrap_near(angles.euler.yaw_rad, last.yaw_rad);
+        }
+        self.last = Some(angles.euler);
+        Ok(Some(angles))
+    }
+}

@@ -1,0 +1,192 @@
+//! Rotations between frames, z-y-x Euler angles, quaternions and direction cosine matrices.
+//!
+//! `Rotation<Body, N>` is `C_nb` (body → navigation). Euler angles are intrinsic z-y-x:
+//! `C_nb = Rz(yaw)·Ry(pitch)·Rx(roll)` with the elementary matrices of seed 000 eq. (2).
+//! Quaternions are Hamilton, scalar first (`[w, x, y, z]`), `v_n = q ⊗ v_b ⊗ q*`; this `q_nb` equals
+//! MATLAB's "frame rotation from navigation to body" orientation.
+use core::marker::PhantomData;
+
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion};
+
+use crate::frame::Frame;
+use crate::math;
+use crate::vector::Vec3;
+
+/// Intrinsic z-y-x Euler angles of a frame relative to another (body relative to navigation), rad.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EulerZyx {
+    /// Rotation about z, applied first, rad.
+    pub yaw_rad: f64,
+    /// Rotation about the once-rotated y axis, rad.
+    pub pitch_rad: f64,
+    /// Rotation about the twice-rotated x axis, rad.
+    pub roll_rad: f64,
+}
+
+impl EulerZyx {
+    /// Angles from yaw, pitch and roll in radians.
+    #[must_use]
+    pub const fn new(yaw_rad: f64, pitch_rad: f64, roll_rad: f64) -> Self {
+        Self {
+            yaw_rad,
+            pitch_rad,
+            roll_rad,
+        }
+    }
+    /// `[yaw, pitch, roll]`.
+    #[must_use]
+    pub const fn to_array(self) -> [f64; 3] {
+        [self.yaw_rad, self.pitch_rad, self.roll_rad]
+    }
+    /// From `[yaw, pitch, roll]`.
+    #[must_use]
+    pub const fn from_array(a: [f64; 3]) -> Self {
+        Self::new(a[0], a[1], a[2])
+    }
+    /// The direction cosine matrix `Rz(yaw)·Ry(pitch)·Rx(roll)`, row-major.
+    #[must_use]
+    pub fn to_dcm(self) -> [[f64; 3]; 3] {
+        let (sy, cy) = (math::sin(self.yaw_rad), math::cos(self.yaw_rad));
+        let (sp, cp) = (math::sin(self.pitch_rad), math::cos(self.pitch_rad));
+        let (sr, cr) = (math::sin(self.roll_rad), math::cos(self.roll_rad));
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    }
+    /// Angles of a direction cosine matrix (row-major), with pitch in [−π/2, π/2] and yaw, roll in
+    /// (−π, π]. At gimbal lock (|pitch| = π/2) roll is set to 0 and yaw absorbs the rotation.
+    #[must_use]
+    pub fn from_dcm(c: &[[f64; 3]; 3]) -> Self {
+        let horiz = math::sqrt(c[2][1] * c[2][1] + c[2][2] * c[2][2]);
+        let pitch = math::atan2(-c[2][0], horiz);
+        if horiz < 1e-12 {
+            // Gimbal lock: only yaw − roll (pitch = +90°) or yaw + roll (−90°) is defined.
+            let yaw = math::atan2(-c[0][1], c[1][1]);
+            Self::new(yaw, pitch, 0.0)
+        } else {
+            Self::new(
+                math::atan2(c[1][0], c[0][0]),
+                pitch,
+                math::atan2(c[2][1], c[2][2]),
+            )
+        }
+    }
+    /// True when `cos(pitch)` is below `tol`, where z-y-x Euler rates are singular.
+    #[must_use]
+    pub fn is_near_gimbal_lock(self, tol: f64) -> bool {
+        math::abs(math::cos(self.pitch_rad)) < tol
+    }
+}
+
+/// Re-resolves vectors from `From` axes into `To` axes.
+///
+/// `Rotation<Body, N>` is `C_nb`: `body_to_nav.apply(f_b)` is `f` in navigation axes. Rotations
+/// compose only when their frames match:
+///
+/// ```compile_fail
+/// use imu_core::{Body, Enu, Ned, Rotation, EulerZyx};
+/// let a = Rotation::<Body, Enu>::from_euler(EulerZyx::default());
+/// let b = Rotation::<Body, Ned>::from_euler(EulerZyx::default());
+/// let _ = a.then(&b); // Enu ≠ Body
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotation<From, To> {
+    q: UnitQuaternion<f64>,
+    frames: PhantomData<(From, To)>,
+}
+
+impl<From: Frame, To: Frame> Default for Rotation<From, To> {
+    fn default() -> Self {
+        Self::identity()
+    }
+}
+
+impl<From: Frame, To: Frame> Rotation<From, To> {
+    /// The identity (the two frames coincide).
+    #[must_use]
+    pub fn identity() -> Self {
+        Self::assume_from_quaternion(UnitQuaternion::identity())
+    }
+    /// Wraps a unit quaternion you know maps `From` onto `To`; the name marks the claim for review.
+    #[must_use]
+    pub fn assume_from_quaternion(q: UnitQuaternion<f64>) -> Self {
+        Self {
+            q,
+            frames: PhantomData,
+        }
+    }
+    /// From `[w, x, y, z]`, normalised; `None` when the norm is zero or not finite.
+    #[must_use]
+    pub fn from_wxyz(q: [f64; 4]) -> Option<Self> {
+        let raw = Quaternion::new(q[0], q[1], q[2], q[3]);
+        let n = raw.norm();
+        if !(n.is_finite() && n > 0.0) {
+            return None;
+        }
+        Some(Self::assume_from_quaternion(UnitQuaternion::new_unchecked(
+            raw / n,
+        )))
+    }
+    /// The rotation with z-y-x Euler angles `e` of `From` relative to `To`.
+    #[must_use]
+    pub fn from_euler(e: EulerZyx) -> Self {
+        // nalgebra applies roll, then pitch, then yaw about fixed axes: Rz·Ry·Rx.
+        Self::assume_from_quaternion(UnitQuaternion::from_euler_angles(
+            e.roll_rad,
+            e.pitch_rad,
+            e.yaw_rad,
+        ))
+    }
+    /// From a direction cosine matrix (row-major) assumed orthonormal.
+    #[must_use]
+    pub fn from_dcm(c: &[[f64; 3]; 3]) -> Self {
+        let m = Matrix3::new(
+            c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2],
+        );
+        let r = nalgebra::Rotation3::from_matrix_unchecked(m);
+        Self::assume_from_quaternion(UnitQuaternion::from_rotation_matrix(&r))
+    }
+    /// The quaternion as `[w, x, y, z]` (Hamilton, scalar first).
+    #[must_use]
+    pub fn to_wxyz(&self) -> [f64; 4] {
+        [self.q.w, self.q.i, self.q.j, self.q.k]
+    }
+    /// The underlying unit quaternion.
+    #[must_use]
+    pub fn quaternion(&self) -> &UnitQuaternion<f64> {
+        &self.q
+    }
+    /// The direction cosine matrix, row-major.
+    #[must_use]
+    pub fn to_dcm(&self) -> [[f64; 3]; 3] {
+        let m = self.q.to_rotation_matrix();
+        let m = m.matrix();
+        [
+            [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
+            [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
+            [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
+        ]
+    }
+    /// z-y-x Euler angles (yaw, roll in (−π, π], pitch in [−π/2, π/2]).
+    #[must_use]
+    pub fn to_euler(&self) -> EulerZyx {
+        EulerZyx::from_dcm(&self.to_dcm())
+    }
+    /// Re-resolves `v` from `From` axes into `To` axes.
+    #[must_use]
+    pub fn apply(&self, v: Vec3<From>) -> Vec3<To> {
+        Vec3::from_nalgebra(self.q * v.as_nalgebra())
+    }
+    /// The inverse rotation (`C_nbᵀ` for `C_nb`).
+    #[must_use]
+    pub fn inverse(&self) -> Rotation<To, From> {
+        Rotation::assume_from_quaternion(self.q.inverse())
+    }
+    /// `self` first, then `next`.
+    #[must_use]
+    pub fn then<Next: Frame>(&self, next: &Rotation<To, Next>) -> Rotation<From, Next> {
+        Rotation::assume_from_quaternion(next.q * self.q)
+    }
+}

@@ -1,0 +1,53 @@
+//! Euler ↔ DCM ↔ quaternion round trips and the sign anchors of DESIGN §2.
+use imu_core::{Body, Enu, EulerZyx, Ned, Rotation, Vec3};
+use proptest::prelude::*;
+
+const ANGLE_TOL_RAD: f64 = 1e-9;
+
+fn wrap(a: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    a - tau * (a / tau).round()
+}
+
+proptest! {
+    #[test]
+    fn euler_dcm_quaternion_round_trip(
+        yaw in -3.1f64..3.1, pitch in -1.55f64..1.55, roll in -3.1f64..3.1
+    ) {
+        let e = EulerZyx::new(yaw, pitch, roll);
+        let r = Rotation::<Body, Enu>::from_euler(e);
+        // The quaternion's DCM is the textbook Rz·Ry·Rx.
+        let (a, b) = (r.to_dcm(), e.to_dcm());
+        for i in 0..3 { for k in 0..3 { prop_assert!((a[i][k] - b[i][k]).abs() < 1e-12); } }
+        // DCM → Euler → the same angles.
+        let back = EulerZyx::from_dcm(&b);
+        prop_assert!(wrap(back.yaw_rad - yaw).abs() < ANGLE_TOL_RAD);
+        prop_assert!((back.pitch_rad - pitch).abs() < ANGLE_TOL_RAD);
+        prop_assert!(wrap(back.roll_rad - roll).abs() < ANGLE_TOL_RAD);
+        // Quaternion → DCM → quaternion (up to sign).
+        let q = r.to_wxyz();
+        let q2 = Rotation::<Body, Enu>::from_dcm(&a).to_wxyz();
+        let dot: f64 = (0..4).map(|k| q[k] * q2[k]).sum();
+        prop_assert!((dot.abs() - 1.0).abs() < 1e-12);
+        // Inverse undoes apply.
+        let v = Vec3::<Body>::new(0.3, -1.2, 2.0);
+        let w = r.inverse().apply(r.apply(v));
+        prop_assert!((w - v).norm() < 1e-12);
+    }
+}
+
+#[test]
+fn yaw_90_in_ned_maps_body_x_to_east() {
+    let c = Rotation::<Body, Ned>::from_euler(EulerZyx::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0));
+    let n = c.apply(Vec3::new(1.0, 0.0, 0.0)).to_array();
+    assert!(n[0].abs() < 1e-15 && (n[1] - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn positive_pitch_turns_body_x_towards_minus_z() {
+    // Ry(+p) turns body x towards −z: nose down in ENU (z up), nose up in NED (z down), as the
+    // right-hand rule dictates; the tangent attitude uses pitch = −asin(v_z/|v|) for this reason.
+    let p = 0.3_f64;
+    let enu = Rotation::<Body, Enu>::from_euler(EulerZyx::new(0.0, p, 0.0));
+    assert!((enu.apply(Vec3::new(1.0, 0.0, 0.0)).z() + p.sin()).abs() < 1e-15);
+}
