@@ -1,1 +1,15 @@
-//! placeholder
+//! # imu-scenario — imukit's std layer, shared by the CLI and the Python package
+//!
+//! Scenario files ([`scenario`]), formula strings with exact derivatives ([`expr`]), tracks
+//! ([`track`]), built-in scenarios ([`builtin`]) and the CSV schema ([`table`]). Units are
+//! converted here and only here; the numerics live in `imu-core`.
+pub mod builtin;
+pub mod error;
+pub mod expr;
+pub mod scenario;
+pub mod table;
+pub mod track;
+
+pub use error::{Error, Result};
+pub use scenario::{Scenario, ScenarioSpec, Simulation};
+pub use table::Table;

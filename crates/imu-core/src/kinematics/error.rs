@@ -59,6 +59,23 @@ pub enum KinematicsError {
     },
 }
 
+impl KinematicsError {
+    /// The sample index the error refers to, when it refers to one.
+    #[must_use]
+    pub fn index(&self) -> Option<usize> {
+        match *self {
+            Self::NotFinite { index, .. }
+            | Self::TimeNotIncreasing { index, .. }
+            | Self::GimbalLock { index, .. }
+            | Self::ZeroQuaternion { index }
+            | Self::VerticalTangent { index } => Some(index),
+            Self::TooFewSamples { .. }
+            | Self::LengthMismatch { .. }
+            | Self::UnsupportedOrder { .. } => None,
+        }
+    }
+}
+
 impl fmt::Display for KinematicsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {

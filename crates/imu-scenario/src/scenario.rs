@@ -1,0 +1,742 @@
+//! Scenario files (TOML, or JSON / Python dicts with the same keys) and their resolution into a
+//! runnable [`Scenario`].
+//!
+//! ```toml
+//! rate_hz = 200.0
+//! duration_s = 1.0          # samples at k/rate_hz for k = 0..=round(duration_s*rate_hz)
+//! nav_frame = "ENU"         # or "NED"
+//! gravity_m_s2 = 9.81
+//! [trajectory]
+//! type = "expression"       # or "samples", "track", "builtin"
+//! constants = { f = 1.0 }
+//! position_m = ["0.8*cos(2*pi*f*t)", "0.8*sin(2*pi*f*t)", "0.3*cos(2*pi*f*t)"]
+//! attitude = "tangent"      # or "level", or yaw_rad = "...", pitch_rad = "...", roll_rad = "..."
+//! [imu]
+//! kind = "accel-gyro-mag"   # or "accel-gyro", "accel-mag"
+//! lever_arm_m = [-0.075, -0.075, 0.025]
+//! accel_sign = "specific-force"   # or "matlab"
+//! magnetic_field_ut = [-2.4169, 27.5550, 16.0849]   # nav frame
+//! ```
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
+use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
+use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
+use imu_core::{
+    AccelSign, Enu, EulerZyx, IdealReading, ImuMount, KinematicsError, NavFrame, Ned, Truth, Vec3,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::builtin;
+use crate::error::{Error, Result, invalid};
+use crate::expr::Expr;
+use crate::table::{ImuKind, Table, read_columns, read_header};
+use crate::track::{Segment, SpeedProfile, Track};
+
+/// The navigation frame, by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NavFrameName {
+    /// East-North-Up (default).
+    #[default]
+    #[serde(alias = "enu")]
+    ENU,
+    /// North-East-Down.
+    #[serde(alias = "ned")]
+    NED,
+}
+
+/// Accelerometer sign convention, by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelSignName {
+    /// Specific force (default).
+    #[default]
+    SpecificForce,
+    /// MATLAB imuSensor's gravity-minus-acceleration.
+    Matlab,
+}
+
+impl From<AccelSignName> for AccelSign {
+    fn from(s: AccelSignName) -> Self {
+        match s {
+            AccelSignName::SpecificForce => Self::SpecificForce,
+            AccelSignName::Matlab => Self::Matlab,
+        }
+    }
+}
+
+/// A formula, or a plain number where a formula is expected.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Formula {
+    /// A formula string of `t`.
+    Text(String),
+    /// A constant.
+    Number(f64),
+}
+
+impl Formula {
+    fn parse(&self, field: &str, constants: &BTreeMap<String, f64>) -> Result<Expr> {
+        let text = match self {
+            Self::Text(s) => s.clone(),
+            Self::Number(v) => format!("({v:e})"),
+        };
+        Expr::parse(&text, constants).map_err(|source| Error::Expression {
+            field: field.into(),
+            source,
+        })
+    }
+}
+
+impl From<&str> for Formula {
+    fn from(s: &str) -> Self {
+        Self::Text(s.into())
+    }
+}
+
+/// A scenario as written in a file (every key optional where a default or a built-in fills it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Sample rate, Hz.
+    pub rate_hz: Option<f64>,
+    /// Duration, s (samples at `k/rate_hz`, `k = 0..=round(duration_s·rate_hz)`).
+    pub duration_s: Option<f64>,
+    /// Navigation frame (default ENU).
+    pub nav_frame: Option<NavFrameName>,
+    /// Gravity magnitude, m/s² (default 9.81).
+    pub gravity_m_s2: Option<f64>,
+    /// The motion.
+    pub trajectory: TrajectorySpec,
+    /// The IMU.
+    #[serde(default)]
+    pub imu: ImuSpec,
+}
+
+/// The `[trajectory]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case")]
+pub enum TrajectorySpec {
+    /// Formula strings of `t`, exact derivatives.
+    Expression(ExpressionSpec),
+    /// Sampled positions and attitudes from a CSV file, finite differences.
+    Samples(SamplesSpec),
+    /// Straights and arcs with a speed profile, exact.
+    Track(TrackSpec),
+    /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
+    Builtin {
+        /// Name, see [`builtin::NAMES`].
+        name: String,
+    },
+}
+
+/// `type = "expression"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpressionSpec {
+    /// Named constants usable in the formulas.
+    #[serde(default)]
+    pub constants: BTreeMap<String, f64>,
+    /// Position formulas `[x, y, z]`, navigation frame, m.
+    pub position_m: [Formula; 3],
+    /// `"tangent"` or `"level"`; leave out when giving angles.
+    pub attitude: Option<String>,
+    /// Yaw formula, rad.
+    pub yaw_rad: Option<Formula>,
+    /// Pitch formula, rad.
+    pub pitch_rad: Option<Formula>,
+    /// Roll formula, rad.
+    pub roll_rad: Option<Formula>,
+    /// Standstill threshold of the tangent attitude, m/s.
+    pub min_speed_m_s: Option<f64>,
+}
+
+/// `type = "samples"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplesSpec {
+    /// CSV file with `t_s, pos_x_m, pos_y_m, pos_z_m` and `yaw_rad, pitch_rad, roll_rad` or
+    /// `q_w, q_x, q_y, q_z`; relative paths are relative to the scenario file.
+    pub file: PathBuf,
+    /// Finite-difference order: 2 (MATLAB gradient), 4, 6 (default) or 8.
+    pub order: Option<usize>,
+    /// `"tangent"` to ignore attitude columns and align with the velocity.
+    pub attitude: Option<String>,
+    /// Standstill threshold of the tangent attitude, m/s.
+    pub min_speed_m_s: Option<f64>,
+}
+
+/// `type = "track"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackSpec {
+    /// Start point, navigation frame, m.
+    #[serde(default)]
+    pub start_m: [f64; 3],
+    /// Start heading from the x axis towards y, rad.
+    #[serde(default)]
+    pub heading_rad: f64,
+    /// Cruise speed, m/s.
+    pub speed_m_s: f64,
+    /// With it, start and end at rest, ramping at this acceleration (m/s²); without, constant speed.
+    pub accel_m_s2: Option<f64>,
+    /// Segments: `{ straight_m = L }` or `{ arc_radius_m = R, arc_angle_rad = A }`.
+    pub segments: Vec<Segment>,
+}
+
+/// The `[imu]` table.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuSpec {
+    /// Sensors simulated (default all three).
+    pub kind: Option<ImuKind>,
+    /// Lever arm from the reference point to the IMU, body frame, m.
+    pub lever_arm_m: Option<[f64; 3]>,
+    /// Accelerometer sign.
+    pub accel_sign: Option<AccelSignName>,
+    /// Magnetic field, navigation frame, µT (default MATLAB's, in the chosen frame).
+    pub magnetic_field_ut: Option<[f64; 3]>,
+}
+
+/// Attitude of an expression motion.
+#[derive(Clone, Debug)]
+pub enum ExpressionAttitude {
+    /// Along the velocity.
+    Tangent,
+    /// Zero angles.
+    Level,
+    /// `[yaw, pitch, roll]` formulas.
+    Euler(Box<[Expr; 3]>),
+}
+
+/// A motion given by formulas of time.
+#[derive(Clone, Debug)]
+pub struct ExpressionMotion {
+    /// `[x, y, z]` formulas, m.
+    pub position: [Expr; 3],
+    /// The attitude.
+    pub attitude: ExpressionAttitude,
+}
+
+impl Motion for ExpressionMotion {
+    fn position<D: Scalar>(&self, t: D) -> [D; 3] {
+        [
+            self.position[0].eval(t),
+            self.position[1].eval(t),
+            self.position[2].eval(t),
+        ]
+    }
+    fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
+        match &self.attitude {
+            ExpressionAttitude::Tangent => None,
+            ExpressionAttitude::Level => Some([D::from(0.0); 3]),
+            ExpressionAttitude::Euler(e) => Some([e[0].eval(t), e[1].eval(t), e[2].eval(t)]),
+        }
+    }
+}
+
+impl ExpressionMotion {
+    /// Parses an [`ExpressionSpec`].
+    ///
+    /// # Errors
+    /// Unparsable formulas (field and column named), conflicting attitude keys.
+    pub fn from_spec(spec: &ExpressionSpec) -> Result<Self> {
+        let c = &spec.constants;
+        let position = [
+            spec.position_m[0].parse("trajectory.position_m[0]", c)?,
+            spec.position_m[1].parse("trajectory.position_m[1]", c)?,
+            spec.position_m[2].parse("trajectory.position_m[2]", c)?,
+        ];
+        let angles = [&spec.yaw_rad, &spec.pitch_rad, &spec.roll_rad];
+        let has_angles = angles.iter().any(|a| a.is_some());
+        let attitude = match (spec.attitude.as_deref(), has_angles) {
+            (Some(_), true) => {
+                return Err(invalid(
+                    "trajectory.attitude",
+                    "give either attitude = \"tangent\"/\"level\" or yaw_rad/pitch_rad/roll_rad, not both",
+                ));
+            }
+            (Some("tangent"), false) => ExpressionAttitude::Tangent,
+            (Some("level") | None, false) => ExpressionAttitude::Level,
+            (Some(other), false) => {
+                return Err(invalid(
+                    "trajectory.attitude",
+                    format!(
+                        "unknown attitude \"{other}\" (use \"tangent\" or \"level\", or give angles)"
+                    ),
+                ));
+            }
+            (None, true) => {
+                let zero = Formula::Number(0.0);
+                let names = [
+                    "trajectory.yaw_rad",
+                    "trajectory.pitch_rad",
+                    "trajectory.roll_rad",
+                ];
+                let e = |k: usize| angles[k].as_ref().unwrap_or(&zero).parse(names[k], c);
+                ExpressionAttitude::Euler(Box::new([e(0)?, e(1)?, e(2)?]))
+            }
+        };
+        Ok(Self { position, attitude })
+    }
+}
+
+/// Attitude of a sampled path, owned.
+#[derive(Clone, Debug)]
+pub enum SampledAttitudeData {
+    /// z-y-x Euler angles.
+    Euler(Vec<EulerZyx>),
+    /// Quaternions `[w, x, y, z]`.
+    Quaternion(Vec<[f64; 4]>),
+    /// Along the velocity.
+    Tangent,
+}
+
+/// Sampled positions and attitudes.
+#[derive(Clone, Debug)]
+pub struct SampledPath {
+    /// Where the samples came from (file path or "arrays"), for messages.
+    pub origin: String,
+    /// Times, s.
+    pub t_s: Vec<f64>,
+    /// Positions, navigation frame, m.
+    pub position_m: Vec<[f64; 3]>,
+    /// Attitude.
+    pub attitude: SampledAttitudeData,
+    /// Finite-difference options.
+    pub options: SampledOptions,
+    /// First data row in the file (2 for a CSV file with a header), 0 for arrays.
+    pub first_row: usize,
+}
+
+impl SampledPath {
+    /// Reads a samples CSV file.
+    ///
+    /// # Errors
+    /// Missing columns, bad values (row and column named), unreadable files.
+    pub fn from_csv(path: &Path, order: usize, tangent: bool, min_speed_m_s: f64) -> Result<Self> {
+        const POS: [&str; 4] = ["t_s", "pos_x_m", "pos_y_m", "pos_z_m"];
+        const EULER: [&str; 3] = ["yaw_rad", "pitch_rad", "roll_rad"];
+        const QUAT: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
+        let header = read_header(path)?;
+        let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+        let mut required: Vec<&str> = POS.to_vec();
+        let kind = if tangent {
+            0
+        } else if has(&EULER) {
+            required.extend(EULER);
+            1
+        } else if has(&QUAT) {
+            required.extend(QUAT);
+            2
+        } else {
+            required.extend(EULER);
+            1
+        };
+        let hint = if kind == 1 && !has(&EULER) {
+            "; attitude needs yaw_rad, pitch_rad, roll_rad or q_w, q_x, q_y, q_z (or set attitude = \"tangent\")"
+        } else {
+            ""
+        };
+        let cols = read_columns(path, &required, hint)?;
+        let n = cols.rows();
+        let zip3 = |a: &[f64], b: &[f64], c: &[f64]| -> Vec<[f64; 3]> {
+            (0..n).map(|i| [a[i], b[i], c[i]]).collect()
+        };
+        let position_m = zip3(
+            cols.get("pos_x_m"),
+            cols.get("pos_y_m"),
+            cols.get("pos_z_m"),
+        );
+        let attitude = match kind {
+            0 => SampledAttitudeData::Tangent,
+            1 => SampledAttitudeData::Euler(
+                zip3(
+                    cols.get("yaw_rad"),
+                    cols.get("pitch_rad"),
+                    cols.get("roll_rad"),
+                )
+                .into_iter()
+                .map(EulerZyx::from_array)
+                .collect(),
+            ),
+            _ => {
+                let (w, x, y, z) = (
+                    cols.get("q_w"),
+                    cols.get("q_x"),
+                    cols.get("q_y"),
+                    cols.get("q_z"),
+                );
+                SampledAttitudeData::Quaternion((0..n).map(|i| [w[i], x[i], y[i], z[i]]).collect())
+            }
+        };
+        Ok(Self {
+            origin: path.display().to_string(),
+            t_s: cols.get("t_s").to_vec(),
+            position_m,
+            attitude,
+            options: SampledOptions {
+                order,
+                min_speed_m_s,
+            },
+            first_row: 2,
+        })
+    }
+
+    /// Truth at the sample times.
+    ///
+    /// # Errors
+    /// The core's refusal, with the file row of the offending sample.
+    pub fn truth<N: NavFrame>(&self) -> Result<Vec<Truth<N>>> {
+        let mut out = vec![Truth::<N>::default(); self.t_s.len()];
+        let attitude = match &self.attitude {
+            SampledAttitudeData::Euler(e) => SampledAttitude::Euler(e),
+            SampledAttitudeData::Quaternion(q) => SampledAttitude::Quaternion(q),
+            SampledAttitudeData::Tangent => SampledAttitude::Tangent,
+        };
+        truth_from_samples(
+            &self.t_s,
+            &self.position_m,
+            attitude,
+            self.options,
+            &mut out,
+        )
+        .map_err(|source| {
+            let context = match source.index() {
+                Some(i) if self.first_row > 0 => {
+                    format!("{}, row {}", self.origin, i + self.first_row)
+                }
+                Some(i) => format!("{}, index {i}", self.origin),
+                None => self.origin.clone(),
+            };
+            Error::Kinematics { context, source }
+        })?;
+        Ok(out)
+    }
+}
+
+/// A trajectory ready to evaluate.
+#[derive(Clone, Debug)]
+pub enum Trajectory {
+    /// Formulas.
+    Expression(ExpressionMotion, AnalyticOptions),
+    /// A track.
+    Track(Track),
+    /// Samples.
+    Samples(SampledPath),
+}
+
+/// The IMU of a scenario, resolved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuSetup {
+    /// Sensors simulated.
+    pub kind: ImuKind,
+    /// Lever arm, body frame, m.
+    pub lever_arm_m: [f64; 3],
+    /// Accelerometer sign.
+    pub accel_sign: AccelSign,
+    /// Magnetic field in the navigation frame, µT; `None` for the frame's default.
+    pub magnetic_field_ut: Option<[f64; 3]>,
+}
+
+impl ImuSetup {
+    /// The core's mount description in frame `N`.
+    #[must_use]
+    pub fn mount<N: NavFrame>(&self, gravity_m_s2: f64) -> ImuMount<N> {
+        ImuMount {
+            lever_arm_m: Vec3::from_array(self.lever_arm_m),
+            accel_sign: self.accel_sign,
+            gravity_m_s2,
+            magnetic_field_ut: self
+                .magnetic_field_ut
+                .map_or_else(N::default_magnetic_field_ut, Vec3::from_array),
+        }
+    }
+}
+
+/// A resolved, runnable scenario.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    /// Sample times, s.
+    pub t_s: Vec<f64>,
+    /// Navigation frame.
+    pub nav_frame: NavFrameName,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// The motion.
+    pub trajectory: Trajectory,
+    /// The IMU.
+    pub imu: ImuSetup,
+}
+
+/// Truth and ideal IMU readings of a scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simulation {
+    /// Truth, [`crate::table::TRUTH_COLUMNS`].
+    pub truth: Table,
+    /// IMU readings, columns per [`ImuKind::columns`].
+    pub imu: Table,
+}
+
+fn finite_positive(field: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a finite number > 0, got {v}"),
+        ))
+    }
+}
+
+fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be finite, got {v:?}")))
+    }
+}
+
+/// Sample times `k/rate_hz`, `k = 0..=round(duration_s·rate_hz)`.
+///
+/// # Errors
+/// Non-positive rate, negative or non-finite duration, more than 10⁹ samples.
+pub fn sample_times(rate_hz: f64, duration_s: f64) -> Result<Vec<f64>> {
+    let rate = finite_positive("rate_hz", rate_hz)?;
+    if !(duration_s.is_finite() && duration_s >= 0.0) {
+        return Err(invalid(
+            "duration_s",
+            format!("must be a finite number ≥ 0, got {duration_s}"),
+        ));
+    }
+    let last = (duration_s * rate).round();
+    if last > 1e9 {
+        return Err(invalid(
+            "duration_s",
+            format!("{duration_s} s at {rate} Hz is more than 10⁹ samples"),
+        ));
+    }
+    Ok((0..=last as u64).map(|k| k as f64 / rate).collect())
+}
+
+impl ScenarioSpec {
+    /// Parses TOML text; `origin` names the file in messages.
+    ///
+    /// # Errors
+    /// [`Error::Scenario`] with the parser's message (key and line).
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
+        toml::from_str(text).map_err(|e| Error::Scenario {
+            origin: origin.into(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Parses JSON text with the same keys (what the Python dicts become).
+    ///
+    /// # Errors
+    /// [`Error::Scenario`] with the parser's message.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        serde_json::from_str(text).map_err(|e| Error::Scenario {
+            origin: origin.into(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Reads a scenario file (`.toml`, or `.json`).
+    ///
+    /// # Errors
+    /// Unreadable or unparsable file.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?;
+        let origin = path.display().to_string();
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            Self::from_json(&text, &origin)
+        } else {
+            Self::from_toml(&text, &origin)
+        }
+    }
+
+    /// Resolves defaults, built-ins, formulas and sample files; relative paths are taken from
+    /// `base_dir`.
+    ///
+    /// # Errors
+    /// Any invalid key, formula or file, named.
+    pub fn resolve(&self, base_dir: &Path) -> Result<Scenario> {
+        let merged;
+        let spec = if let TrajectorySpec::Builtin { name } = &self.trajectory {
+            let b = builtin::spec(name)?;
+            merged = ScenarioSpec {
+                rate_hz: self.rate_hz.or(b.rate_hz),
+                duration_s: self.duration_s.or(b.duration_s),
+                nav_frame: self.nav_frame.or(b.nav_frame),
+                gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
+                trajectory: b.trajectory,
+                imu: ImuSpec {
+                    kind: self.imu.kind.or(b.imu.kind),
+                    lever_arm_m: self.imu.lever_arm_m.or(b.imu.lever_arm_m),
+                    accel_sign: self.imu.accel_sign.or(b.imu.accel_sign),
+                    magnetic_field_ut: self.imu.magnetic_field_ut.or(b.imu.magnetic_field_ut),
+                },
+            };
+            &merged
+        } else {
+            self
+        };
+        let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(9.81);
+        if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
+            return Err(invalid(
+                "gravity_m_s2",
+                format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
+            ));
+        }
+        let imu = ImuSetup {
+            kind: spec.imu.kind.unwrap_or_default(),
+            lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
+            accel_sign: spec.imu.accel_sign.unwrap_or_default().into(),
+            magnetic_field_ut: spec
+                .imu
+                .magnetic_field_ut
+                .map(|m| finite_vec("imu.magnetic_field_ut", m))
+                .transpose()?,
+        };
+        let need = |v: Option<f64>, field: &str| {
+            v.ok_or_else(|| invalid(field, "missing (required for this trajectory type)"))
+        };
+        let (trajectory, t_s) = match &spec.trajectory {
+            TrajectorySpec::Expression(e) => {
+                let min_speed_m_s = e.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let t = sample_times(
+                    need(spec.rate_hz, "rate_hz")?,
+                    need(spec.duration_s, "duration_s")?,
+                )?;
+                (
+                    Trajectory::Expression(
+                        ExpressionMotion::from_spec(e)?,
+                        AnalyticOptions { min_speed_m_s },
+                    ),
+                    t,
+                )
+            }
+            TrajectorySpec::Track(k) => {
+                let speed = match k.accel_m_s2 {
+                    Some(accel_m_s2) => SpeedProfile::Trapezoid {
+                        speed_m_s: k.speed_m_s,
+                        accel_m_s2,
+                    },
+                    None => SpeedProfile::Constant(k.speed_m_s),
+                };
+                let track = Track::new(k.start_m, k.heading_rad, k.segments.clone(), speed)?;
+                let duration = spec.duration_s.unwrap_or_else(|| track.travel_time_s());
+                let t = sample_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                (Trajectory::Track(track), t)
+            }
+            TrajectorySpec::Samples(s) => {
+                let tangent = match s.attitude.as_deref() {
+                    None => false,
+                    Some("tangent") => true,
+                    Some(other) => {
+                        return Err(invalid(
+                            "trajectory.attitude",
+                            format!(
+                                "unknown attitude \"{other}\" for samples (use \"tangent\" or leave it out)"
+                            ),
+                        ));
+                    }
+                };
+                let path = base_dir.join(&s.file);
+                let order = s
+                    .order
+                    .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
+                let min_speed = s.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+                let t = path.t_s.clone();
+                (Trajectory::Samples(path), t)
+            }
+            TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
+        };
+        Ok(Scenario {
+            t_s,
+            nav_frame: spec.nav_frame.unwrap_or_default(),
+            gravity_m_s2,
+            trajectory,
+            imu,
+        })
+    }
+}
+
+/// Exact truth of an analytic motion, with the time of a refused sample in the error.
+fn analytic_truth<M: Motion, N: NavFrame>(
+    m: &M,
+    t_s: &[f64],
+    options: AnalyticOptions,
+    what: &str,
+) -> Result<Vec<Truth<N>>> {
+    let mut out = vec![Truth::<N>::default(); t_s.len()];
+    truth_from_motion(m, t_s, options, &mut out).map_err(|e| with_time(t_s, e, what))?;
+    Ok(out)
+}
+
+fn with_time(t_s: &[f64], source: KinematicsError, what: &str) -> Error {
+    let context = match source.index().and_then(|i| t_s.get(i)) {
+        Some(t) => format!("{what} at t = {t} s"),
+        None => what.to_string(),
+    };
+    Error::Kinematics { context, source }
+}
+
+impl Trajectory {
+    /// Truth at the times `t_s` (ignored for samples, which carry their own times).
+    ///
+    /// # Errors
+    /// The core's refusal, with where and when.
+    pub fn truth<N: NavFrame>(&self, t_s: &[f64]) -> Result<Vec<Truth<N>>> {
+        match self {
+            Self::Expression(m, o) => analytic_truth(m, t_s, *o, "trajectory (expression)"),
+            Self::Track(k) => {
+                analytic_truth(k, t_s, AnalyticOptions::default(), "trajectory (track)")
+            }
+            Self::Samples(s) => s.truth(),
+        }
+    }
+}
+
+impl Scenario {
+    /// Reads and resolves a scenario file.
+    ///
+    /// # Errors
+    /// As [`ScenarioSpec::from_file`] and [`ScenarioSpec::resolve`].
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        ScenarioSpec::from_file(path)?.resolve(base)
+    }
+
+    /// Truth and ideal IMU readings.
+    ///
+    /// # Errors
+    /// The core's refusal, with where and when.
+    pub fn simulate(&self) -> Result<Simulation> {
+        match self.nav_frame {
+            NavFrameName::ENU => self.simulate_in::<Enu>(),
+            NavFrameName::NED => self.simulate_in::<Ned>(),
+        }
+    }
+
+    fn simulate_in<N: NavFrame>(&self) -> Result<Simulation> {
+        let truth = self.trajectory.truth::<N>(&self.t_s)?;
+        let mount = self.imu.mount::<N>(self.gravity_m_s2);
+        let mut readings = vec![IdealReading::default(); truth.len()];
+        mount.read_into(&truth, &mut readings);
+        let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
+        Ok(Simulation {
+            truth: Table::from_truth(&truth),
+            imu: Table::from_readings(&t, &readings, self.imu.kind),
+        })
+    }
+}

@@ -1,0 +1,388 @@
+//! The CSV schema (DESIGN §7) and column tables shared by the CLI and Python.
+//!
+//! A [`Table`] is named columns over row-major `f64` data. CSV output uses shortest round-trip
+//! formatting (`ryu`), so a written file reads back bit for bit, and is written to a temporary file
+//! that is renamed into place only when complete.
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use imu_core::{IdealReading, NavFrame, Truth};
+
+use crate::error::{Error, Result};
+
+/// Truth columns, in order.
+pub const TRUTH_COLUMNS: [&str; 23] = [
+    "t_s",
+    "pos_x_m",
+    "pos_y_m",
+    "pos_z_m",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "vel_z_m_s",
+    "acc_x_m_s2",
+    "acc_y_m_s2",
+    "acc_z_m_s2",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "yaw_rad",
+    "pitch_rad",
+    "roll_rad",
+    "omega_x_rad_s",
+    "omega_y_rad_s",
+    "omega_z_rad_s",
+    "alpha_x_rad_s2",
+    "alpha_y_rad_s2",
+    "alpha_z_rad_s2",
+];
+/// Accelerometer columns of IMU readings.
+pub const ACCEL_COLUMNS: [&str; 3] = ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"];
+/// Gyroscope columns of IMU readings.
+pub const GYRO_COLUMNS: [&str; 3] = ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"];
+/// Magnetometer columns of IMU readings.
+pub const MAG_COLUMNS: [&str; 3] = ["mag_x_ut", "mag_y_ut", "mag_z_ut"];
+
+/// Which sensors an IMU has (MATLAB's `IMUType`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImuKind {
+    /// Accelerometer and gyroscope.
+    AccelGyro,
+    /// Accelerometer and magnetometer.
+    AccelMag,
+    /// All three (the default: the ideal magnetometer costs nothing).
+    #[default]
+    AccelGyroMag,
+}
+
+impl ImuKind {
+    /// True when the kind includes a gyroscope.
+    #[must_use]
+    pub fn has_gyro(self) -> bool {
+        self != Self::AccelMag
+    }
+    /// True when the kind includes a magnetometer.
+    #[must_use]
+    pub fn has_mag(self) -> bool {
+        self != Self::AccelGyro
+    }
+    /// Column names of readings of this kind.
+    #[must_use]
+    pub fn columns(self) -> Vec<&'static str> {
+        let mut c = vec!["t_s"];
+        c.extend(ACCEL_COLUMNS);
+        if self.has_gyro() {
+            c.extend(GYRO_COLUMNS);
+        }
+        if self.has_mag() {
+            c.extend(MAG_COLUMNS);
+        }
+        c
+    }
+}
+
+/// Named columns over row-major data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// Column names.
+    pub columns: Vec<String>,
+    /// Row-major values, `rows × columns.len()`.
+    pub data: Vec<f64>,
+}
+
+impl Table {
+    /// An empty table with these columns.
+    #[must_use]
+    pub fn new(columns: &[&str]) -> Self {
+        Self {
+            columns: columns.iter().map(|c| (*c).to_string()).collect(),
+            data: Vec::new(),
+        }
+    }
+    /// Number of rows.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        if self.columns.is_empty() {
+            0
+        } else {
+            self.data.len() / self.columns.len()
+        }
+    }
+    /// The values of column `name`, if present.
+    #[must_use]
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.columns.iter().position(|c| c == name)?;
+        Some(
+            self.data
+                .iter()
+                .skip(k)
+                .step_by(self.columns.len())
+                .copied()
+                .collect(),
+        )
+    }
+    /// Appends one row (its length must equal the number of columns).
+    pub fn push_row(&mut self, row: &[f64]) {
+        debug_assert_eq!(row.len(), self.columns.len());
+        self.data.extend_from_slice(row);
+    }
+
+    /// Truth samples as a table with [`TRUTH_COLUMNS`].
+    #[must_use]
+    pub fn from_truth<N: NavFrame>(truth: &[Truth<N>]) -> Self {
+        let mut t = Self::new(&TRUTH_COLUMNS);
+        t.data.reserve(truth.len() * TRUTH_COLUMNS.len());
+        for s in truth {
+            t.push_row(&truth_row(s));
+        }
+        t
+    }
+
+    /// Ideal readings with their times as a table with the columns of `kind`.
+    #[must_use]
+    pub fn from_readings(t_s: &[f64], readings: &[IdealReading], kind: ImuKind) -> Self {
+        let mut t = Self::new(&kind.columns());
+        for (ti, r) in t_s.iter().zip(readings) {
+            let mut row = vec![*ti];
+            row.extend(r.accel_m_s2.to_array());
+            if kind.has_gyro() {
+                row.extend(r.gyro_rad_s.to_array());
+            }
+            if kind.has_mag() {
+                row.extend(r.mag_ut.to_array());
+            }
+            t.push_row(&row);
+        }
+        t
+    }
+
+    /// Writes the table as CSV with a header row, atomically (temporary file, then rename).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        let io = |source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let tmp = temporary_path(path);
+        let result = (|| -> std::io::Result<()> {
+            let mut w = BufWriter::new(File::create(&tmp)?);
+            writeln!(w, "{}", self.columns.join(","))?;
+            let mut buf = ryu::Buffer::new();
+            for row in self.data.chunks(self.columns.len().max(1)) {
+                for (k, v) in row.iter().enumerate() {
+                    if k > 0 {
+                        w.write_all(b",")?;
+                    }
+                    w.write_all(buf.format(*v).as_bytes())?;
+                }
+                w.write_all(b"\n")?;
+            }
+            w.into_inner()
+                .map_err(std::io::IntoInnerError::into_error)?
+                .sync_all()?;
+            std::fs::rename(&tmp, path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result.map_err(io)
+    }
+}
+
+/// One truth sample in [`TRUTH_COLUMNS`] order.
+#[must_use]
+pub fn truth_row<N: NavFrame>(s: &Truth<N>) -> [f64; 23] {
+    let [px, py, pz] = s.position_m.to_array();
+    let [vx, vy, vz] = s.velocity_m_s.to_array();
+    let [ax, ay, az] = s.acceleration_m_s2.to_array();
+    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
+    let [wx, wy, wz] = s.omega_b_rad_s.to_array();
+    let [bx, by, bz] = s.alpha_b_rad_s2.to_array();
+    let e = s.euler;
+    [
+        s.t_s,
+        px,
+        py,
+        pz,
+        vx,
+        vy,
+        vz,
+        ax,
+        ay,
+        az,
+        qw,
+        qx,
+        qy,
+        qz,
+        e.yaw_rad,
+        e.pitch_rad,
+        e.roll_rad,
+        wx,
+        wy,
+        wz,
+        bx,
+        by,
+        bz,
+    ]
+}
+
+fn temporary_path(path: &Path) -> PathBuf {
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(".imukit-partial");
+    path.with_file_name(name)
+}
+
+/// Columns read from a CSV file, by name.
+#[derive(Clone, Debug)]
+pub struct CsvColumns {
+    /// The file.
+    pub file: PathBuf,
+    header: HashMap<String, usize>,
+    values: Vec<Vec<f64>>, // per header column, only the requested ones filled
+}
+
+impl CsvColumns {
+    /// True when the header has `name`.
+    #[must_use]
+    pub fn has(&self, name: &str) -> bool {
+        self.header.contains_key(name)
+    }
+    /// The values of a column that was requested when reading.
+    #[must_use]
+    pub fn get(&self, name: &str) -> &[f64] {
+        self.header
+            .get(name)
+            .map_or(&[], |&k| self.values[k].as_slice())
+    }
+    /// Number of data rows.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.values.iter().map(Vec::len).max().unwrap_or(0)
+    }
+}
+
+/// The header of a CSV file (trimmed names).
+///
+/// # Errors
+/// Unreadable or empty file.
+pub fn read_header(path: &Path) -> Result<Vec<String>> {
+    let mut r = reader(path)?;
+    let h = r.headers().map_err(|e| csv_error(path, &e))?;
+    let names: Vec<String> = h.iter().map(|s| s.trim().to_string()).collect();
+    if names.iter().all(String::is_empty) {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "empty file (no header row)".into(),
+        });
+    }
+    Ok(names)
+}
+
+fn reader(path: &Path) -> Result<csv::Reader<File>> {
+    let file = File::open(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    Ok(csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(file))
+}
+
+fn csv_error(path: &Path, e: &csv::Error) -> Error {
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            pos,
+            expected_len,
+            len,
+        } => format!(
+            "row {} has {len} fields, the header has {expected_len} (truncated or malformed file)",
+            pos.as_ref().map_or(0, |p| p.line())
+        ),
+        csv::ErrorKind::Utf8 { pos, .. } => {
+            format!(
+                "row {} is not valid UTF-8",
+                pos.as_ref().map_or(0, |p| p.line())
+            )
+        }
+        _ => e.to_string(),
+    };
+    Error::CsvFormat {
+        file: path.into(),
+        message,
+    }
+}
+
+/// Reads the named columns of a CSV file with a header row; other columns are ignored.
+///
+/// # Errors
+/// Missing columns (all named at once, with `hint`), values that are not finite numbers (file,
+/// row, column), malformed or empty files.
+pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
+    let names = read_header(path)?;
+    let header: HashMap<String, usize> = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (n.clone(), k))
+        .collect();
+    let missing: Vec<String> = required
+        .iter()
+        .filter(|c| !header.contains_key(**c))
+        .map(|c| (*c).to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(Error::MissingColumns {
+            file: path.into(),
+            missing,
+            hint: hint.into(),
+        });
+    }
+    let wanted: Vec<(usize, &str)> = required.iter().map(|c| (header[*c], *c)).collect();
+    let mut values = vec![Vec::new(); names.len()];
+    let mut r = reader(path)?;
+    let mut record = csv::StringRecord::new();
+    loop {
+        match r.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(path, &e)),
+        }
+        let row = record.position().map_or(0, |p| p.line() as usize);
+        for &(k, name) in &wanted {
+            let text = record.get(k).unwrap_or("");
+            let bad = |message: String| Error::CsvValue {
+                file: path.into(),
+                row,
+                column: name.into(),
+                message,
+            };
+            let v: f64 = text
+                .parse()
+                .map_err(|_| bad(format!("not a number: \"{text}\"")))?;
+            if !v.is_finite() {
+                return Err(bad(format!("not a finite number: \"{text}\"")));
+            }
+            values[k].push(v);
+        }
+    }
+    if values.iter().all(Vec::is_empty) {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "no data rows after the header".into(),
+        });
+    }
+    Ok(CsvColumns {
+        file: path.into(),
+        header,
+        values,
+    })
+}
