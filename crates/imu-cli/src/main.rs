@@ -1,1 +1,26 @@
-fn main() {}
+//! `imukit`: IMU simulation and navigation from the command line.
+mod cli;
+mod commands;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let args = cli::Cli::parse();
+    match commands::run(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("imukit: {e}");
+            let mut source = std::error::Error::source(&e);
+            while let Some(s) = source {
+                // The scenario errors already include their sources in their message.
+                if !e.to_string().contains(&s.to_string()) {
+                    eprintln!("  caused by: {s}");
+                }
+                source = s.source();
+            }
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

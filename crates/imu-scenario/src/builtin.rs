@@ -143,3 +143,15 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         }
     })
 }
+
+/// A built-in scenario as TOML text, to edit and run with `imukit simulate`.
+///
+/// # Errors
+/// Unknown name.
+pub fn toml(name: &str) -> Result<String> {
+    let spec = spec(name)?;
+    let body = ::toml::to_string(&spec).map_err(|e| invalid("scenario", e.to_string()))?;
+    Ok(format!(
+        "# imukit built-in scenario \"{name}\" (imukit scenario {name})\n{body}"
+    ))
+}

@@ -1,0 +1,66 @@
+//! `imukit demo`: the built-in default scenario, end to end, into a folder.
+use std::fmt::Write as _;
+use std::path::Path;
+
+use imu_scenario::{Simulation, builtin};
+
+use super::CliError;
+
+pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
+    let io = |source| CliError::Io {
+        path: out_dir.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(out_dir).map_err(io)?;
+    let spec = builtin::spec(name)?;
+    let sim = spec.resolve(out_dir)?.simulate()?;
+    let files = [(
+        "scenario.toml",
+        "the scenario, editable: imukit simulate scenario.toml --out imu.csv",
+    )];
+    let toml_path = out_dir.join(files[0].0);
+    std::fs::write(&toml_path, builtin::toml(name)?).map_err(|source| CliError::Io {
+        path: toml_path.display().to_string(),
+        source,
+    })?;
+    sim.truth.write_csv(&out_dir.join("truth.csv"))?;
+    sim.imu.write_csv(&out_dir.join("imu.csv"))?;
+    let summary = summary(name, &sim);
+    let summary_path = out_dir.join("summary.txt");
+    std::fs::write(&summary_path, &summary).map_err(|source| CliError::Io {
+        path: summary_path.display().to_string(),
+        source,
+    })?;
+    print!("{summary}");
+    println!(
+        "\nWrote scenario.toml, truth.csv, imu.csv and summary.txt to {}",
+        out_dir.display()
+    );
+    Ok(())
+}
+
+fn summary(name: &str, sim: &Simulation) -> String {
+    let t = sim.truth.column("t_s").unwrap_or_default();
+    let mut s = String::new();
+    let _ = writeln!(s, "imukit demo: built-in scenario \"{name}\"");
+    let _ = writeln!(
+        s,
+        "{} samples from {} s to {} s",
+        t.len(),
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(0.0)
+    );
+    let _ = writeln!(
+        s,
+        "{:<16} {:>14} {:>14} {:>14}",
+        "IMU column", "min", "max", "rms"
+    );
+    for c in sim.imu.columns.iter().skip(1) {
+        let v = sim.imu.column(c).unwrap_or_default();
+        let min = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+        let _ = writeln!(s, "{c:<16} {min:>14.6} {max:>14.6} {rms:>14.6}");
+    }
+    s
+}

@@ -1,0 +1,45 @@
+//! One module per subcommand, and the CLI's error type.
+mod demo;
+mod scenario;
+mod simulate;
+
+use crate::cli::{Cli, Command};
+
+/// What went wrong, for the user; `Display` says what and where.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Input or I/O errors from the scenario layer.
+    #[error(transparent)]
+    Scenario(#[from] imu_scenario::Error),
+    /// Other I/O errors (creating folders, writing text).
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+impl CliError {
+    /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Scenario(imu_scenario::Error::Io { .. }) | Self::Io { .. } => 74,
+            Self::Scenario(_) => 65,
+        }
+    }
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Simulate {
+            scenario,
+            out,
+            truth,
+        } => simulate::run(&scenario, &out, truth.as_deref()),
+        Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
+        Command::Scenario { name } => scenario::run(name.as_deref()),
+    }
+}

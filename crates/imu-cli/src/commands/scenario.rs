@@ -1,0 +1,16 @@
+//! `imukit scenario [NAME]`: list built-ins or print one as TOML.
+use imu_scenario::builtin;
+
+use super::CliError;
+
+pub fn run(name: Option<&str>) -> Result<(), CliError> {
+    match name {
+        None => {
+            for n in builtin::NAMES {
+                println!("{n}");
+            }
+        }
+        Some(n) => print!("{}", builtin::toml(n)?),
+    }
+    Ok(())
+}

@@ -1,0 +1,116 @@
+//! The `imukit` binary as a user runs it.
+use std::path::PathBuf;
+use std::process::Command;
+
+fn imukit() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_imukit"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("imukit-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn demo_writes_its_outputs_and_says_where() {
+    let dir = temp_dir("demo");
+    let out = imukit()
+        .args(["demo", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains(&dir.display().to_string()), "{stdout}");
+    for f in ["scenario.toml", "truth.csv", "imu.csv", "summary.txt"] {
+        assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
+    }
+    let imu = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
+    assert_eq!(imu.lines().count(), 2002); // header + 2001 samples at 2 kHz over 1 s
+}
+
+#[test]
+fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
+    let dir = temp_dir("roundtrip");
+    let list = imukit().arg("scenario").output().unwrap();
+    let names = String::from_utf8(list.stdout).unwrap();
+    assert_eq!(names.lines().count(), 5);
+    for name in names.lines() {
+        let toml = imukit().args(["scenario", name]).output().unwrap();
+        assert!(toml.status.success());
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, toml.stdout).unwrap();
+        let out = dir.join(format!("{name}.csv"));
+        let status = imukit()
+            .arg("simulate")
+            .arg(&path)
+            .arg("--out")
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{name}");
+        let direct = imu_scenario::builtin::spec(name)
+            .unwrap()
+            .resolve(&dir)
+            .unwrap()
+            .simulate()
+            .unwrap();
+        let reread =
+            imu_scenario::table::read_columns(&out, &["accel_x_m_s2", "gyro_z_rad_s"], "").unwrap();
+        assert_eq!(
+            reread.get("accel_x_m_s2"),
+            direct.imu.column("accel_x_m_s2").unwrap().as_slice(),
+            "{name}"
+        );
+        assert_eq!(
+            reread.get("gyro_z_rad_s"),
+            direct.imu.column("gyro_z_rad_s").unwrap().as_slice(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn bad_input_exits_non_zero_with_a_located_message_and_no_output_file() {
+    let dir = temp_dir("bad");
+    let scenario = dir.join("bad.toml");
+    std::fs::write(
+        &scenario,
+        "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\nposition_m = [\"t\", \"0\", \"cos(2*pi*q*t)\"]\n",
+    )
+    .unwrap();
+    let out_csv = dir.join("imu.csv");
+    let out = imukit()
+        .arg("simulate")
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out_csv)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(65));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("position_m[2]")
+            && err.contains("unknown variable 'q'")
+            && err.contains("column 10"),
+        "{err}"
+    );
+    assert!(!out_csv.exists());
+    let missing = imukit()
+        .args(["simulate", "/nonexistent/s.toml", "--out"])
+        .arg(&out_csv)
+        .output()
+        .unwrap();
+    assert_eq!(missing.status.code(), Some(74));
+    assert!(
+        String::from_utf8(missing.stderr)
+            .unwrap()
+            .contains("/nonexistent/s.toml")
+    );
+}
