@@ -53,16 +53,33 @@ pub struct IdealReading {
     pub mag_ut: Vec3<Body>,
 }
 
+/// Acceleration-like quantity carried from the reference point S to a point at lever arm `r`
+/// (body frame, m) of a rigid body turning at `ω_b` with `α_b`:
+/// `a_I = a_S + ω_b × (ω_b × r) + α_b × r` (seed 000 eq. 9; centripetal and Euler terms).
+#[must_use]
+pub fn at_lever_arm(
+    a_s: Vec3<Body>,
+    omega_b: Vec3<Body>,
+    alpha_b: Vec3<Body>,
+    r: Vec3<Body>,
+) -> Vec3<Body> {
+    a_s + omega_b.cross(&omega_b.cross(&r)) + alpha_b.cross(&r)
+}
+
 impl<N: NavFrame> ImuMount<N> {
     /// Specific force at the IMU point, body frame, m/s² (always the physical sign).
     #[must_use]
     pub fn specific_force(&self, truth: &Truth<N>) -> Vec3<Body> {
-        let nav_to_body = truth.attitude.inverse();
-        let w = truth.omega_b_rad_s;
-        let r = self.lever_arm_m;
-        nav_to_body.apply(truth.acceleration_m_s2 - N::gravity(self.gravity_m_s2))
-            + w.cross(&w.cross(&r))
-            + truth.alpha_b_rad_s2.cross(&r)
+        let f_s = truth
+            .attitude
+            .inverse()
+            .apply(truth.acceleration_m_s2 - N::gravity(self.gravity_m_s2));
+        at_lever_arm(
+            f_s,
+            truth.omega_b_rad_s,
+            truth.alpha_b_rad_s2,
+            self.lever_arm_m,
+        )
     }
 
     /// The ideal reading of all three sensors for one truth sample.

@@ -1,1 +1,453 @@
+//! Python bindings of imukit (`imukit._core`): convert NumPy input, release the GIL, call the
+//! shared std layer (`imu-scenario`), convert back. No numerics here.
+use std::collections::BTreeMap;
+use std::path::Path;
 
+use imu_core::kinematics::sampled::SampledOptions;
+use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
+use imu_core::{Body, Enu, EulerZyx, Rotation};
+use imu_scenario::arrays;
+use imu_scenario::scenario::{
+    AccelSignName, ExpressionSpec, Formula, ImuSetup, NavFrameName, SampledAttitudeData, parse_name,
+};
+use imu_scenario::table::ImuKind;
+use imu_scenario::{ScenarioSpec, Table};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+create_exception!(
+    _core,
+    ImuError,
+    PyValueError,
+    "imukit refused the input; the message says what and where."
+);
+
+fn refused(e: imu_scenario::Error) -> PyErr {
+    ImuError::new_err(e.to_string())
+}
+
+type TableOut<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>);
+
+fn table_out(py: Python<'_>, t: Table) -> PyResult<TableOut<'_>> {
+    let shape = (t.rows(), t.columns.len());
+    let arr =
+        Array2::from_shape_vec(shape, t.data).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((t.columns, arr.into_pyarray(py)))
+}
+
+fn rows<const K: usize>(name: &str, a: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<[f64; K]>> {
+    let v = a.as_array();
+    if v.ncols() != K {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape (N, {K}), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|k| r[k]))
+        .collect())
+}
+
+fn check_len(name: &str, got: usize, expected: usize) -> PyResult<()> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name} has {got} rows, expected {expected} (one per time)"
+        )))
+    }
+}
+
+fn out3(py: Python<'_>, v: Vec<[f64; 3]>) -> Bound<'_, PyArray2<f64>> {
+    let n = v.len();
+    Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
+        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py))
+}
+
+fn nav(name: &str) -> PyResult<NavFrameName> {
+    parse_name("nav_frame", &name.to_ascii_uppercase()).map_err(refused)
+}
+
+/// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu) tables.
+#[pyfunction]
+#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = "."))]
+fn simulate_text<'py>(
+    py: Python<'py>,
+    text: &str,
+    format: &str,
+    origin: &str,
+    base_dir: &str,
+) -> PyResult<(TableOut<'py>, TableOut<'py>)> {
+    let spec = match format {
+        "toml" => ScenarioSpec::from_toml(text, origin),
+        "json" => ScenarioSpec::from_json(text, origin),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "format must be \"toml\" or \"json\", got {other:?}"
+            )));
+        }
+    }
+    .map_err(refused)?;
+    let base = base_dir.to_string();
+    let sim = py
+        .detach(move || spec.resolve(Path::new(&base))?.simulate())
+        .map_err(refused)?;
+    Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?))
+}
+
+/// Exact truth from formula strings at the times `t_s`.
+#[pyfunction]
+#[pyo3(signature = (t_s, position_m, *, attitude = None, yaw_rad = None, pitch_rad = None, roll_rad = None,
+                    constants = None, nav_frame = "ENU", min_speed_m_s = None))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_expressions<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    position_m: [String; 3],
+    attitude: Option<String>,
+    yaw_rad: Option<String>,
+    pitch_rad: Option<String>,
+    roll_rad: Option<String>,
+    constants: Option<BTreeMap<String, f64>>,
+    nav_frame: &str,
+    min_speed_m_s: Option<f64>,
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array().to_vec();
+    let spec = ExpressionSpec {
+        constants: constants.unwrap_or_default(),
+        position_m: position_m.map(Formula::Text),
+        attitude,
+        yaw_rad: yaw_rad.map(Formula::Text),
+        pitch_rad: pitch_rad.map(Formula::Text),
+        roll_rad: roll_rad.map(Formula::Text),
+        min_speed_m_s,
+    };
+    let nav = nav(nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_expressions(&t, &spec, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Truth from sampled positions and attitude by finite differences.
+#[pyfunction]
+#[pyo3(signature = (t_s, position_m, *, euler_rad = None, quaternion = None, attitude = None, order = 6,
+                    nav_frame = "ENU", min_speed_m_s = None))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_samples<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    position_m: PyReadonlyArray2<'py, f64>,
+    euler_rad: Option<PyReadonlyArray2<'py, f64>>,
+    quaternion: Option<PyReadonlyArray2<'py, f64>>,
+    attitude: Option<&str>,
+    order: usize,
+    nav_frame: &str,
+    min_speed_m_s: Option<f64>,
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array().to_vec();
+    let pos = rows::<3>("position_m", &position_m)?;
+    check_len("position_m", pos.len(), t.len())?;
+    let att = match (euler_rad, quaternion, attitude) {
+        (Some(e), None, None) => {
+            let e = rows::<3>("euler_rad", &e)?;
+            check_len("euler_rad", e.len(), t.len())?;
+            SampledAttitudeData::Euler(e.into_iter().map(EulerZyx::from_array).collect())
+        }
+        (None, Some(q), None) => {
+            let q = rows::<4>("quaternion", &q)?;
+            check_len("quaternion", q.len(), t.len())?;
+            SampledAttitudeData::Quaternion(q)
+        }
+        (None, None, Some("tangent")) => SampledAttitudeData::Tangent,
+        (None, None, Some("level") | None) => {
+            SampledAttitudeData::Euler(vec![EulerZyx::default(); t.len()])
+        }
+        (None, None, Some(other)) => {
+            return Err(PyValueError::new_err(format!(
+                "attitude must be \"tangent\" or \"level\", got {other:?}"
+            )));
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "give at most one of euler_rad, quaternion and attitude",
+            ));
+        }
+    };
+    let options = SampledOptions {
+        order,
+        min_speed_m_s: min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S),
+    };
+    let nav = nav(nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_arrays(t, pos, att, options, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Ideal IMU readings from a truth table (its column names and values).
+#[pyfunction]
+#[pyo3(signature = (columns, values, *, lever_arm_m = [0.0, 0.0, 0.0], accel_sign = "specific-force",
+                    gravity_m_s2 = 9.81, magnetic_field_ut = None, nav_frame = "ENU", kind = "accel-gyro-mag"))]
+#[allow(clippy::too_many_arguments)]
+fn ideal_imu<'py>(
+    py: Python<'py>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+    lever_arm_m: [f64; 3],
+    accel_sign: &str,
+    gravity_m_s2: f64,
+    magnetic_field_ut: Option<[f64; 3]>,
+    nav_frame: &str,
+    kind: &str,
+) -> PyResult<TableOut<'py>> {
+    let v = values.as_array();
+    if v.ncols() != columns.len() {
+        return Err(PyValueError::new_err(format!(
+            "truth has {} columns but {} column names",
+            v.ncols(),
+            columns.len()
+        )));
+    }
+    let table = Table {
+        columns,
+        data: v.iter().copied().collect(),
+    };
+    if let Some(k) = lever_arm_m
+        .iter()
+        .chain(magnetic_field_ut.iter().flatten())
+        .position(|c| !c.is_finite())
+    {
+        let field = if k < 3 {
+            "lever_arm_m"
+        } else {
+            "magnetic_field_ut"
+        };
+        return Err(ImuError::new_err(format!("{field}: must be finite")));
+    }
+    let imu = ImuSetup {
+        kind: parse_name::<ImuKind>("kind", kind).map_err(refused)?,
+        lever_arm_m,
+        accel_sign: parse_name::<AccelSignName>("accel_sign", accel_sign)
+            .map_err(refused)?
+            .into(),
+        magnetic_field_ut,
+    };
+    let nav = nav(nav_frame)?;
+    let out = py
+        .detach(move || arrays::ideal_from_truth(&table, &imu, gravity_m_s2, nav))
+        .map_err(refused)?;
+    table_out(py, out)
+}
+
+/// Tangent z-y-x Euler angles `[yaw, pitch, roll]` of a velocity series.
+#[pyfunction]
+#[pyo3(signature = (velocity_m_s, *, min_speed_m_s = DEFAULT_MIN_SPEED_M_S))]
+fn tangent_euler<'py>(
+    py: Python<'py>,
+    velocity_m_s: PyReadonlyArray2<'py, f64>,
+    min_speed_m_s: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let v = rows::<3>("velocity_m_s", &velocity_m_s)?;
+    let e = py
+        .detach(move || arrays::tangent_euler(&v, min_speed_m_s))
+        .map_err(refused)?;
+    Ok(out3(py, e.into_iter().map(EulerZyx::to_array).collect()))
+}
+
+/// `C_nbᵀ v_n`: navigation-frame vectors resolved in the body frame, per sample.
+#[pyfunction]
+fn nav_to_body<'py>(
+    py: Python<'py>,
+    euler_rad: PyReadonlyArray2<'py, f64>,
+    v_n: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e: Vec<EulerZyx> = rows::<3>("euler_rad", &euler_rad)?
+        .into_iter()
+        .map(EulerZyx::from_array)
+        .collect();
+    let v = rows::<3>("v_n", &v_n)?;
+    check_len("v_n", v.len(), e.len())?;
+    Ok(out3(py, py.detach(move || arrays::nav_to_body(&e, &v))))
+}
+
+/// `a + ω × (ω × r) + α × r` per sample (body frame).
+#[pyfunction]
+fn at_lever_arm<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray2<'py, f64>,
+    omega: PyReadonlyArray2<'py, f64>,
+    alpha: PyReadonlyArray2<'py, f64>,
+    r: [f64; 3],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, w, al) = (
+        rows::<3>("a", &a)?,
+        rows::<3>("omega", &omega)?,
+        rows::<3>("alpha", &alpha)?,
+    );
+    check_len("omega", w.len(), a.len())?;
+    check_len("alpha", al.len(), a.len())?;
+    Ok(out3(
+        py,
+        py.detach(move || arrays::at_lever_arm_series(&a, &w, &al, r)),
+    ))
+}
+
+/// z-y-x Euler angles `[yaw, pitch, roll]` (N, 3) → quaternions `[w, x, y, z]` (N, 4).
+#[pyfunction]
+fn euler_to_quaternion<'py>(
+    py: Python<'py>,
+    euler_rad: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = rows::<3>("euler_rad", &euler_rad)?;
+    let q: Vec<f64> = e
+        .iter()
+        .flat_map(|a| Rotation::<Body, Enu>::from_euler(EulerZyx::from_array(*a)).to_wxyz())
+        .collect();
+    Ok(Array2::from_shape_vec((e.len(), 4), q)
+        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+}
+
+/// Quaternions `[w, x, y, z]` (N, 4) → z-y-x Euler angles `[yaw, pitch, roll]` (N, 3).
+#[pyfunction]
+fn quaternion_to_euler<'py>(
+    py: Python<'py>,
+    quaternion: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q = rows::<4>("quaternion", &quaternion)?;
+    let e = q
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            Rotation::<Body, Enu>::from_wxyz(*q)
+                .map(|r| r.to_euler().to_array())
+                .ok_or_else(|| {
+                    ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
+                })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(out3(py, e))
+}
+
+fn dcm_out(py: Python<'_>, m: Vec<[[f64; 3]; 3]>) -> Bound<'_, PyArray3<f64>> {
+    let n = m.len();
+    Array3::from_shape_vec((n, 3, 3), m.into_iter().flatten().flatten().collect())
+        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py))
+}
+
+fn dcm_in(name: &str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<[[f64; 3]; 3]>> {
+    let v = a.as_array();
+    if v.shape()[1..] != [3, 3] {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape (N, 3, 3), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.outer_iter()
+        .map(|m| std::array::from_fn(|i| std::array::from_fn(|k| m[[i, k]])))
+        .collect())
+}
+
+/// z-y-x Euler angles (N, 3) → direction cosine matrices `C_nb` (N, 3, 3).
+#[pyfunction]
+fn euler_to_dcm<'py>(
+    py: Python<'py>,
+    euler_rad: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let e = rows::<3>("euler_rad", &euler_rad)?;
+    Ok(dcm_out(
+        py,
+        e.into_iter()
+            .map(|a| EulerZyx::from_array(a).to_dcm())
+            .collect(),
+    ))
+}
+
+/// Direction cosine matrices (N, 3, 3) → z-y-x Euler angles (N, 3).
+#[pyfunction]
+fn dcm_to_euler<'py>(
+    py: Python<'py>,
+    dcm: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = dcm_in("dcm", &dcm)?;
+    Ok(out3(
+        py,
+        m.iter().map(|c| EulerZyx::from_dcm(c).to_array()).collect(),
+    ))
+}
+
+/// Quaternions (N, 4) → direction cosine matrices (N, 3, 3).
+#[pyfunction]
+fn quaternion_to_dcm<'py>(
+    py: Python<'py>,
+    quaternion: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let q = rows::<4>("quaternion", &quaternion)?;
+    let m = q
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            Rotation::<Body, Enu>::from_wxyz(*q)
+                .map(|r| r.to_dcm())
+                .ok_or_else(|| {
+                    ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
+                })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(dcm_out(py, m))
+}
+
+/// Direction cosine matrices (N, 3, 3) → quaternions (N, 4).
+#[pyfunction]
+fn dcm_to_quaternion<'py>(
+    py: Python<'py>,
+    dcm: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = dcm_in("dcm", &dcm)?;
+    let q: Vec<f64> = m
+        .iter()
+        .flat_map(|c| Rotation::<Body, Enu>::from_dcm(c).to_wxyz())
+        .collect();
+    Ok(Array2::from_shape_vec((m.len(), 4), q)
+        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+}
+
+/// Names of the built-in scenarios.
+#[pyfunction]
+fn builtin_names() -> Vec<&'static str> {
+    imu_scenario::builtin::NAMES.to_vec()
+}
+
+/// A built-in scenario as TOML text.
+#[pyfunction]
+fn builtin_toml(name: &str) -> PyResult<String> {
+    imu_scenario::builtin::toml(name).map_err(refused)
+}
+
+/// The compiled core of the `imukit` package.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("ImuError", m.py().get_type::<ImuError>())?;
+    m.add_function(wrap_pyfunction!(simulate_text, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_expressions, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(ideal_imu, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent_euler, m)?)?;
+    m.add_function(wrap_pyfunction!(nav_to_body, m)?)?;
+    m.add_function(wrap_pyfunction!(at_lever_arm, m)?)?;
+    m.add_function(wrap_pyfunction!(euler_to_quaternion, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion_to_euler, m)?)?;
+    m.add_function(wrap_pyfunction!(euler_to_dcm, m)?)?;
+    m.add_function(wrap_pyfunction!(dcm_to_euler, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion_to_dcm, m)?)?;
+    m.add_function(wrap_pyfunction!(dcm_to_quaternion, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
+    Ok(())
+}

@@ -108,3 +108,46 @@ impl TangentTracker {
         Ok(Some(angles))
     }
 }
+
+/// Tangent Euler angles for a series of velocities (navigation frame, m/s), written into `out`:
+/// standstill samples hold the last valid attitude, leading ones take the first valid attitude,
+/// and yaw is unwrapped. All zero when the body never moves.
+///
+/// # Errors
+/// [`KinematicsError::VerticalTangent`], [`KinematicsError::NotFinite`],
+/// [`KinematicsError::LengthMismatch`].
+pub fn tangent_series(
+    velocity_m_s: &[[f64; 3]],
+    min_speed_m_s: f64,
+    out: &mut [EulerZyx],
+) -> Result<(), KinematicsError> {
+    if out.len() != velocity_m_s.len() {
+        return Err(KinematicsError::LengthMismatch {
+            field: "output",
+            expected: velocity_m_s.len(),
+            got: out.len(),
+        });
+    }
+    let mut tracker = TangentTracker::new(min_speed_m_s);
+    let mut first_valid = None;
+    for (i, (v, e)) in velocity_m_s.iter().zip(out.iter_mut()).enumerate() {
+        if !v.iter().all(|c| c.is_finite()) {
+            return Err(KinematicsError::NotFinite {
+                field: "velocity_m_s",
+                index: i,
+            });
+        }
+        *e = match tracker.update(i, *v, [0.0; 3], [0.0; 3])? {
+            Some(a) => {
+                first_valid.get_or_insert(i);
+                a.euler
+            }
+            None => EulerZyx::default(),
+        };
+    }
+    if let Some(first) = first_valid {
+        let e = out[first];
+        out[..first].fill(e);
+    }
+    Ok(())
+}

@@ -1,0 +1,294 @@
+"""imukit — fast, exact and reproducible IMU simulation (Python face of the Rust core).
+
+Conventions (the same everywhere in imukit):
+
+* SI units; magnetic field in µT. Names carry their unit (``t_s``, ``position_m``).
+* Navigation frame ``"ENU"`` (default) or ``"NED"``; body frame FLU under ENU, FRD under NED.
+* Attitude ``C_nb`` maps body to navigation: ``v_n = C_nb v_b``. Euler angles are intrinsic
+  z-y-x, given as ``[yaw, pitch, roll]`` columns. Quaternions are Hamilton, scalar first
+  ``[w, x, y, z]``, ``q = q_nb``.
+* Accelerometers report specific force (``+g`` up at rest) unless ``accel_sign="matlab"``.
+
+Results are :class:`Table` objects whose columns are reachable by their CSV names
+(``truth["omega_z_rad_s"]``) as NumPy arrays. Rejected input raises :class:`ImuError`
+(a ``ValueError``) with a message that says what and where.
+"""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+from ._core import ImuError
+
+__all__ = [
+    "ImuError",
+    "Table",
+    "Simulation",
+    "simulate",
+    "builtin_scenarios",
+    "builtin_scenario_toml",
+    "truth_from_expressions",
+    "truth_from_samples",
+    "ideal_imu",
+    "euler_to_quaternion",
+    "quaternion_to_euler",
+    "euler_to_dcm",
+    "dcm_to_euler",
+    "quaternion_to_dcm",
+    "dcm_to_quaternion",
+]
+
+
+class Table:
+    """Named columns over a 2-D float64 array (one row per sample).
+
+    ``table["t_s"]`` is a column (a read-only view), ``table.values`` the whole array,
+    ``table.columns`` the names in order, ``len(table)`` the number of rows.
+    """
+
+    def __init__(self, columns: Sequence[str], values: np.ndarray) -> None:
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 2 or values.shape[1] != len(columns):
+            raise ValueError(f"values must have shape (N, {len(columns)}), got {values.shape}")
+        values.setflags(write=False)
+        self.columns: tuple = tuple(columns)
+        self.values: np.ndarray = values
+        self._index = {c: k for k, c in enumerate(self.columns)}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.values[:, self._index[name]]
+        except KeyError:
+            raise KeyError(f"no column {name!r}; columns: {', '.join(self.columns)}") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._index
+
+    def __len__(self) -> int:
+        return self.values.shape[0]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.columns)
+
+    def keys(self) -> tuple:
+        """Column names."""
+        return self.columns
+
+    def to_dict(self) -> dict:
+        """``{name: column}``."""
+        return {c: self[c] for c in self.columns}
+
+    def __repr__(self) -> str:
+        return f"Table({len(self)} rows: {', '.join(self.columns)})"
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """Truth kinematics and IMU readings of a scenario."""
+
+    truth: Table
+    imu: Table
+
+
+def _table(out) -> Table:
+    columns, values = out
+    return Table(columns, values)
+
+
+def simulate(scenario: Union[str, os.PathLike, Mapping]) -> Simulation:
+    """Runs a scenario: a path to a TOML/JSON scenario file, or a dict with the same keys.
+
+    Relative sample-file paths are taken from the scenario file's folder (for a dict, from the
+    current directory). The numbers equal those of ``imukit simulate`` bit for bit.
+
+    >>> sim = simulate({"trajectory": {"type": "builtin", "name": "static"}})
+    >>> float(sim.imu["accel_z_m_s2"][0])
+    9.81
+    """
+    if isinstance(scenario, Mapping):
+        text = json.dumps(scenario)
+        out = _core.simulate_text(text, format="json", origin="scenario dict", base_dir=os.getcwd())
+    else:
+        path = Path(scenario)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise ImuError(f"{path}: {e.strerror or e}") from None
+        fmt = "json" if path.suffix.lower() == ".json" else "toml"
+        out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent))
+    truth, imu = out
+    return Simulation(truth=_table(truth), imu=_table(imu))
+
+
+def builtin_scenarios() -> list:
+    """Names of the built-in scenarios."""
+    return list(_core.builtin_names())
+
+
+def builtin_scenario_toml(name: str) -> str:
+    """A built-in scenario as an editable TOML text."""
+    return _core.builtin_toml(name)
+
+
+def _times(t_s) -> np.ndarray:
+    t = np.ascontiguousarray(t_s, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"t_s must be one-dimensional, got shape {t.shape}")
+    return t
+
+
+def _rows(name: str, x, width: int, n: Optional[int] = None) -> np.ndarray:
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != width:
+        raise ValueError(f"{name} must have shape (N, {width}), got {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name} has {a.shape[0]} rows, expected {n} (one per time)")
+    return a
+
+
+def _formula(name: str, f) -> Optional[str]:
+    if f is None:
+        return None
+    if isinstance(f, str):
+        return f
+    if isinstance(f, (int, float)):
+        return repr(float(f))
+    from .compat import sympy_to_formula  # sympy is optional
+
+    return sympy_to_formula(f, name)
+
+
+def truth_from_expressions(
+    t_s,
+    position_m: Sequence,
+    *,
+    attitude: Optional[str] = None,
+    yaw_rad=None,
+    pitch_rad=None,
+    roll_rad=None,
+    constants: Optional[Mapping[str, float]] = None,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> Table:
+    """Exact truth from formulas of ``t`` (strings, numbers or sympy expressions).
+
+    ``attitude`` is ``"tangent"`` (body x along the velocity) or ``"level"``; or give
+    ``yaw_rad``/``pitch_rad``/``roll_rad`` formulas (missing ones are 0). Derivatives are exact
+    (dual numbers), so results are at machine precision.
+    """
+    if len(position_m) != 3:
+        raise ValueError(f"position_m must have 3 formulas, got {len(position_m)}")
+    pos = [_formula(f"position_m[{k}]", f) for k, f in enumerate(position_m)]
+    return _table(
+        _core.truth_from_expressions(
+            _times(t_s),
+            pos,
+            attitude=attitude,
+            yaw_rad=_formula("yaw_rad", yaw_rad),
+            pitch_rad=_formula("pitch_rad", pitch_rad),
+            roll_rad=_formula("roll_rad", roll_rad),
+            constants=None if constants is None else {k: float(v) for k, v in constants.items()},
+            nav_frame=nav_frame,
+            min_speed_m_s=min_speed_m_s,
+        )
+    )
+
+
+def truth_from_samples(
+    t_s,
+    position_m,
+    *,
+    euler_rad=None,
+    quaternion=None,
+    attitude: Optional[str] = None,
+    order: int = 6,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> Table:
+    """Truth from sampled positions (N, 3) and attitude by finite differences.
+
+    Attitude: ``euler_rad`` (N, 3) as ``[yaw, pitch, roll]``, or ``quaternion`` (N, 4) as
+    ``[w, x, y, z]``, or ``attitude="tangent"`` / ``"level"`` (default level). ``order`` 2 is
+    MATLAB's ``gradient`` (for comparison with MATLAB scripts); 4, 6 (default) and 8 use
+    Fornberg stencils of that order with one-sided stencils at the ends.
+    """
+    t = _times(t_s)
+    n = t.shape[0]
+    return _table(
+        _core.truth_from_samples(
+            t,
+            _rows("position_m", position_m, 3, n),
+            euler_rad=None if euler_rad is None else _rows("euler_rad", euler_rad, 3, n),
+            quaternion=None if quaternion is None else _rows("quaternion", quaternion, 4, n),
+            attitude=attitude,
+            order=int(order),
+            nav_frame=nav_frame,
+            min_speed_m_s=min_speed_m_s,
+        )
+    )
+
+
+def ideal_imu(
+    truth: Table,
+    *,
+    lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
+    accel_sign: str = "specific-force",
+    gravity_m_s2: float = 9.81,
+    magnetic_field_ut: Optional[Sequence[float]] = None,
+    nav_frame: str = "ENU",
+    kind: str = "accel-gyro-mag",
+) -> Table:
+    """Ideal IMU readings from truth: specific force at the lever arm (body frame, m), body
+    rate, magnetic field (navigation frame, µT; MATLAB's default when ``None``)."""
+    if not isinstance(truth, Table):
+        raise TypeError(f"truth must be an imukit.Table, got {type(truth).__name__}")
+    return _table(
+        _core.ideal_imu(
+            list(truth.columns),
+            np.ascontiguousarray(truth.values),
+            lever_arm_m=[float(v) for v in lever_arm_m],
+            accel_sign=accel_sign,
+            gravity_m_s2=float(gravity_m_s2),
+            magnetic_field_ut=None if magnetic_field_ut is None else [float(v) for v in magnetic_field_ut],
+            nav_frame=nav_frame,
+            kind=kind,
+        )
+    )
+
+
+def euler_to_quaternion(euler_rad) -> np.ndarray:
+    """``[yaw, pitch, roll]`` (N, 3) → ``[w, x, y, z]`` (N, 4), ``q = q_nb``."""
+    return _core.euler_to_quaternion(_rows("euler_rad", np.atleast_2d(euler_rad), 3))
+
+
+def quaternion_to_euler(quaternion) -> np.ndarray:
+    """``[w, x, y, z]`` (N, 4) → ``[yaw, pitch, roll]`` (N, 3)."""
+    return _core.quaternion_to_euler(_rows("quaternion", np.atleast_2d(quaternion), 4))
+
+
+def euler_to_dcm(euler_rad) -> np.ndarray:
+    """``[yaw, pitch, roll]`` (N, 3) → ``C_nb = Rz·Ry·Rx`` (N, 3, 3)."""
+    return _core.euler_to_dcm(_rows("euler_rad", np.atleast_2d(euler_rad), 3))
+
+
+def dcm_to_euler(dcm) -> np.ndarray:
+    """``C_nb`` (N, 3, 3) → ``[yaw, pitch, roll]`` (N, 3)."""
+    m = np.ascontiguousarray(dcm, dtype=np.float64)
+    return _core.dcm_to_euler(m.reshape(1, 3, 3) if m.ndim == 2 else m)
+
+
+def quaternion_to_dcm(quaternion) -> np.ndarray:
+    """``[w, x, y, z]`` (N, 4) → ``C_nb`` (N, 3, 3)."""
+    return _core.quaternion_to_dcm(_rows("quaternion", np.atleast_2d(quaternion), 4))
+
+
+def dcm_to_quaternion(dcm) -> np.ndarray:
+    """``C_nb`` (N, 3, 3) → ``[w, x, y, z]`` (N, 4)."""
+    m = np.ascontiguousarray(dcm, dtype=np.float64)
+    return _core.dcm_to_quaternion(m.reshape(1, 3, 3) if m.ndim == 2 else m)
