@@ -1,5 +1,44 @@
 #!/usr/bin/env bash
-# Runs every test: Rust (workspace) now; Python joins when the bindings land.
+# Runs every test of imukit, Rust and Python, from a fresh clone: sets up what it needs
+# (a Python virtual environment in .venv with maturin, numpy, pytest, sympy; the release CLI;
+# the Python extension), checks formatting, lints and the heap-free core, runs the examples.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+echo "== Python environment (.venv)"
+if [ ! -x .venv/bin/python ]; then
+  "${PYTHON:-python3}" -m venv .venv
+fi
+# shellcheck disable=SC1091
+. .venv/bin/activate
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9"
+
+echo "== Format and lints"
+cargo fmt --all -- --check
+cargo clippy --workspace --all-targets --quiet -- -D warnings
+
+echo "== Heap-free core: builds without std, never names alloc"
+cargo build --quiet -p imu-core --no-default-features --features libm
+if grep -rnE '\balloc::|extern crate alloc' crates/imu-core/src; then
+  echo "imu-core names alloc" >&2
+  exit 1
+fi
+
+echo "== Rust tests"
 cargo test --workspace --exclude imu-py
+
+echo "== Python extension and CLI (release)"
+cargo build --quiet --release -p imu-cli
+maturin develop --quiet --release -m crates/imu-py/Cargo.toml
+
+echo "== Python tests"
+IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md
+
+echo "== Examples"
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+for f in examples/*.toml; do
+  target/release/imukit simulate "$f" --out "$out/$(basename "$f" .toml)_imu.csv" --truth "$out/$(basename "$f" .toml)_truth.csv"
+done
+python examples/seed_error_study.py
+echo "== All tests passed"

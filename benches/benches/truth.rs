@@ -1,1 +1,63 @@
-fn main() {}
+//! Truth + ideal IMU throughput (samples/s) on the seed's figure-8: exact (formula strings over
+//! dual numbers) and sampled (finite differences, order 6, tangent attitude).
+//!
+//! Run: `cargo bench -p imu-benches --bench truth`.
+#![allow(missing_docs)]
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imu_core::kinematics::analytic::{AnalyticOptions, truth_from_motion};
+use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
+use imu_core::{Enu, IdealReading, ImuMount, Truth, Vec3};
+use imu_scenario::builtin;
+use imu_scenario::scenario::{ExpressionMotion, TrajectorySpec, sample_times};
+
+fn figure8() -> ExpressionMotion {
+    match builtin::spec("figure8").expect("built-in").trajectory {
+        TrajectorySpec::Expression(e) => ExpressionMotion::from_spec(&e).expect("parses"),
+        _ => unreachable!("figure8 is an expression trajectory"),
+    }
+}
+
+fn bench_truth(c: &mut Criterion) {
+    let motion = figure8();
+    let mount = ImuMount::<Enu> {
+        lever_arm_m: Vec3::new(-0.075, -0.075, 0.025),
+        ..ImuMount::default()
+    };
+    let mut group = c.benchmark_group("truth_and_ideal_imu/figure8");
+    for seconds in [0.0, 10.0] {
+        let t = sample_times(2000.0, seconds).expect("times");
+        let n = t.len();
+        let mut truth = vec![Truth::<Enu>::default(); n];
+        let mut readings = vec![IdealReading::default(); n];
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_with_input(BenchmarkId::new("exact", n), &t, |b, t| {
+            b.iter(|| {
+                truth_from_motion(&motion, t, AnalyticOptions::default(), &mut truth)
+                    .expect("truth");
+                mount.read_into(&truth, &mut readings);
+            });
+        });
+        if n >= 10 {
+            truth_from_motion(&motion, &t, AnalyticOptions::default(), &mut truth).expect("truth");
+            let pos: Vec<[f64; 3]> = truth.iter().map(|s| s.position_m.to_array()).collect();
+            group.bench_with_input(BenchmarkId::new("sampled_order6", n), &t, |b, t| {
+                b.iter(|| {
+                    truth_from_samples(
+                        t,
+                        &pos,
+                        SampledAttitude::Tangent,
+                        SampledOptions::default(),
+                        &mut truth,
+                    )
+                    .expect("truth");
+                    mount.read_into(&truth, &mut readings);
+                });
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_truth);
+criterion_main!(benches);

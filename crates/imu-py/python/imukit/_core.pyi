@@ -1,0 +1,63 @@
+"""Type stubs of the compiled core (checked with ``python -m mypy.stubtest imukit._core``)."""
+from typing import Optional, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+_Table = tuple[list[str], npt.NDArray[np.float64]]
+
+class ImuError(ValueError): ...
+
+def simulate_text(
+    text: str, *, format: str = "toml", origin: str = "scenario", base_dir: str = "."
+) -> tuple[_Table, _Table]: ...
+def truth_from_expressions(
+    t_s: npt.NDArray[np.float64],
+    position_m: Sequence[str],
+    *,
+    attitude: Optional[str] = None,
+    yaw_rad: Optional[str] = None,
+    pitch_rad: Optional[str] = None,
+    roll_rad: Optional[str] = None,
+    constants: Optional[dict[str, float]] = None,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> _Table: ...
+def truth_from_samples(
+    t_s: npt.NDArray[np.float64],
+    position_m: npt.NDArray[np.float64],
+    *,
+    euler_rad: Optional[npt.NDArray[np.float64]] = None,
+    quaternion: Optional[npt.NDArray[np.float64]] = None,
+    attitude: Optional[str] = None,
+    order: int = 6,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> _Table: ...
+def ideal_imu(
+    columns: Sequence[str],
+    values: npt.NDArray[np.float64],
+    *,
+    lever_arm_m: Sequence[float] = ...,
+    accel_sign: str = "specific-force",
+    gravity_m_s2: float = 9.81,
+    magnetic_field_ut: Optional[Sequence[float]] = None,
+    nav_frame: str = "ENU",
+    kind: str = "accel-gyro-mag",
+) -> _Table: ...
+def tangent_euler(velocity_m_s: npt.NDArray[np.float64], *, min_speed_m_s: float = 1e-6) -> npt.NDArray[np.float64]: ...
+def nav_to_body(euler_rad: npt.NDArray[np.float64], v_n: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def at_lever_arm(
+    a: npt.NDArray[np.float64],
+    omega: npt.NDArray[np.float64],
+    alpha: npt.NDArray[np.float64],
+    r: Sequence[float],
+) -> npt.NDArray[np.float64]: ...
+def euler_to_quaternion(euler_rad: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def quaternion_to_euler(quaternion: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def euler_to_dcm(euler_rad: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def dcm_to_euler(dcm: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def quaternion_to_dcm(quaternion: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def dcm_to_quaternion(dcm: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def builtin_names() -> list[str]: ...
+def builtin_toml(name: str) -> str: ...

@@ -1,0 +1,144 @@
+"""The Python face of imukit: closed-form values, sign anchors, MATLAB gradient parity, errors."""
+import math
+
+import numpy as np
+import pytest
+
+import imukit
+from imukit import ImuError
+
+REL_TOL = 1e-9
+G = 9.81
+
+
+def rel_err(got, expected):
+    scale = max(np.max(np.abs(expected)), 1.0)
+    return float(np.max(np.abs(np.asarray(got) - np.asarray(expected))) / scale)
+
+
+@pytest.mark.parametrize("nav_frame, z_up", [("ENU", 1.0), ("NED", -1.0)])
+def test_level_circle_from_expressions_matches_closed_form(nav_frame, z_up):
+    r, w = 3.0, 0.7
+    t = np.arange(0, 400) * 0.01
+    truth = imukit.truth_from_expressions(
+        t, ["R*cos(w*t)", "R*sin(w*t)", "1.5"], attitude="tangent", constants={"R": r, "w": w}, nav_frame=nav_frame
+    )
+    assert rel_err(truth["vel_x_m_s"], -r * w * np.sin(w * t)) < REL_TOL
+    assert rel_err(truth["acc_y_m_s2"], -r * w * w * np.sin(w * t)) < REL_TOL
+    assert rel_err(truth["omega_z_rad_s"], np.full_like(t, w)) < REL_TOL
+    assert rel_err(truth["yaw_rad"], w * t + math.pi / 2) < REL_TOL
+    lever = [0.2, -0.1, 0.05]
+    imu = imukit.ideal_imu(truth, lever_arm_m=lever, nav_frame=nav_frame)
+    assert rel_err(imu["accel_x_m_s2"], np.full_like(t, -w * w * lever[0])) < REL_TOL
+    assert rel_err(imu["accel_y_m_s2"], np.full_like(t, r * w * w - w * w * lever[1])) < REL_TOL
+    assert rel_err(imu["accel_z_m_s2"], np.full_like(t, z_up * G)) < REL_TOL
+
+
+@pytest.mark.parametrize("nav_frame, up", [("ENU", 1.0), ("NED", -1.0)])
+def test_level_static_imu_reads_plus_g_up_and_the_opposite_in_matlab_mode(nav_frame, up):
+    t = np.linspace(0, 1, 11)
+    truth = imukit.truth_from_expressions(t, [0, 0, 0], attitude="level", nav_frame=nav_frame)
+    sf = imukit.ideal_imu(truth, nav_frame=nav_frame)
+    mat = imukit.ideal_imu(truth, nav_frame=nav_frame, accel_sign="matlab")
+    assert np.all(sf["accel_z_m_s2"] == up * G)
+    assert np.all(mat["accel_z_m_s2"] == -up * G)
+
+
+def test_yaw_90_maps_body_x_to_north():
+    c = imukit.euler_to_dcm([[math.pi / 2, 0.0, 0.0]])[0]
+    np.testing.assert_allclose(c @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(c.T @ [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], atol=1e-15)
+
+
+def test_conversions_round_trip():
+    rng = np.random.default_rng(7)
+    e = np.column_stack([rng.uniform(-3, 3, 50), rng.uniform(-1.5, 1.5, 50), rng.uniform(-3, 3, 50)])
+    q = imukit.euler_to_quaternion(e)
+    np.testing.assert_allclose(imukit.quaternion_to_euler(q), e, atol=1e-12)
+    np.testing.assert_allclose(imukit.quaternion_to_dcm(q), imukit.euler_to_dcm(e), atol=1e-14)
+    q2 = imukit.dcm_to_quaternion(imukit.euler_to_dcm(e))
+    np.testing.assert_allclose(np.abs(np.sum(q * q2, axis=1)), 1.0, atol=1e-12)
+    np.testing.assert_allclose(imukit.dcm_to_euler(imukit.euler_to_dcm(e)), e, atol=1e-12)
+
+
+def matlab_gradient(x, t):
+    """MATLAB gradient(x, t) along the first axis, written out (central inside, one-sided ends)."""
+    g = np.empty_like(x)
+    g[1:-1] = (x[2:] - x[:-2]) / (t[2:] - t[:-2])[:, None]
+    g[0] = (x[1] - x[0]) / (t[1] - t[0])
+    g[-1] = (x[-1] - x[-2]) / (t[-1] - t[-2])
+    return g
+
+
+def test_order_two_matches_matlab_gradient_to_rounding_on_uneven_times():
+    t = np.cumsum(np.r_[0.0, 0.01 + 0.003 * np.sin(np.arange(60))])
+    s = np.column_stack([np.cos(3 * t), np.sin(2 * t) * t, t**2])
+    truth = imukit.truth_from_samples(t, s, attitude="level", order=2)
+    v = np.column_stack([truth[f"vel_{a}_m_s"] for a in "xyz"])
+    a = np.column_stack([truth[f"acc_{a}_m_s2"] for a in "xyz"])
+    v_ref = matlab_gradient(s, t)
+    a_ref = matlab_gradient(v_ref, t)
+    np.testing.assert_allclose(v, v_ref, rtol=0, atol=1e-12 * np.max(np.abs(v_ref)))
+    np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-11 * np.max(np.abs(a_ref)))
+    # On even times it is also numpy.gradient.
+    te = np.arange(40) * 0.01
+    se = np.column_stack([np.cos(3 * te), te**3, te])
+    tr = imukit.truth_from_samples(te, se, attitude="level", order=2)
+    np.testing.assert_allclose(tr["vel_y_m_s"], np.gradient(se[:, 1], te, edge_order=1), rtol=0, atol=1e-12)
+
+
+def test_tilted_circle_samples_at_default_order_are_within_1e8():
+    t = np.arange(201) / 200.0
+    kw = dict(constants={"f": 1.0})
+    pos = ["0.8*cos(2*pi*f*t)", "0.8*sin(2*pi*f*t)", "0.3*cos(2*pi*f*t)"]
+    pitch = "asin(3*sqrt(2)*sin(2*pi*f*t)/sqrt(137 - 9*cos(4*pi*f*t)))"
+    exact = imukit.truth_from_expressions(t, pos, yaw_rad="2*pi*f*t + pi/2", pitch_rad=pitch, **kw)
+    p = np.column_stack([exact[f"pos_{a}_m"] for a in "xyz"])
+    e = np.column_stack([exact["yaw_rad"], exact["pitch_rad"], exact["roll_rad"]])
+    sampled = imukit.truth_from_samples(t, p, euler_rad=e)
+    for c in ["vel_x_m_s", "acc_z_m_s2", "omega_y_rad_s", "alpha_x_rad_s2", "alpha_z_rad_s2"]:
+        assert rel_err(sampled[c], exact[c]) < 1e-8, c
+
+
+def test_errors_are_imu_errors_that_say_what_and_where():
+    t = np.linspace(0, 1, 20)
+    with pytest.raises(ImuError, match=r"unknown function 'sine'.*column 5"):
+        imukit.truth_from_expressions(t, ["0.8*sine(t)", "0", "0"])
+    with pytest.raises(ImuError, match=r"unknown variable 'q'"):
+        imukit.truth_from_expressions(t, ["q*t", "0", "0"])
+    bad = np.column_stack([t, t, t])
+    bad[5, 2] = np.nan
+    with pytest.raises(ImuError, match=r"position_m at sample 5 is not a finite number"):
+        imukit.truth_from_samples(t, bad, attitude="tangent")
+    t2 = t.copy()
+    t2[7] = t2[6]
+    with pytest.raises(ImuError, match=r"sample 7.*does not increase"):
+        imukit.truth_from_samples(t2, np.column_stack([t, t, t]), attitude="tangent")
+    with pytest.raises(ImuError, match=r"too few samples.*need at least 10"):
+        imukit.truth_from_samples(t[:5], np.zeros((5, 3)))
+    with pytest.raises(ValueError, match=r"position_m must have shape \(N, 3\)"):
+        imukit.truth_from_samples(t, np.zeros((20, 2)))
+    with pytest.raises(ValueError, match=r"euler_rad has 19 rows, expected 20"):
+        imukit.truth_from_samples(t, np.zeros((20, 3)), euler_rad=np.zeros((19, 3)))
+    e = np.zeros((20, 3))
+    e[3, 1] = math.pi / 2
+    with pytest.raises(ImuError, match=r"gimbal lock"):
+        imukit.truth_from_samples(t, np.zeros((20, 3)), euler_rad=e)
+    with pytest.raises(ImuError, match=r"nav_frame"):
+        imukit.truth_from_expressions(t, ["t", "0", "0"], nav_frame="NWU")
+    with pytest.raises(ImuError, match=r"accel_sign"):
+        imukit.ideal_imu(imukit.truth_from_expressions(t, ["t", "0", "0"]), accel_sign="up")
+    with pytest.raises(ImuError, match=r"unknown built-in scenario \"nope\""):
+        imukit.simulate({"trajectory": {"type": "builtin", "name": "nope"}})
+    with pytest.raises(ImuError, match=r"no_such.toml"):
+        imukit.simulate("no_such.toml")
+
+
+def test_simulate_dict_and_builtins():
+    assert "figure8" in imukit.builtin_scenarios()
+    sim = imukit.simulate({"rate_hz": 100.0, "trajectory": {"type": "builtin", "name": "platform-turn"}})
+    assert len(sim.imu) == 600
+    np.testing.assert_allclose(sim.imu["gyro_z_rad_s"][100], math.pi / 2, atol=1e-12)
+    assert "mag_x_ut" in sim.imu and "omega_z_rad_s" in sim.truth
+    with pytest.raises(KeyError, match="no column 'nope'"):
+        sim.truth["nope"]
