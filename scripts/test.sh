@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every test of imukit, Rust and Python, from a fresh clone: sets up what it needs
-# (a Python virtual environment in .venv with maturin, numpy, pytest, sympy; the release CLI;
+# (a Python virtual environment in .venv with maturin, numpy, pytest, sympy, mypy; the release CLI;
 # the Python extension), checks formatting, lints and the heap-free core, runs the examples.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +11,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
-python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9"
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8"
 
 echo "== Format and lints"
 cargo fmt --all -- --check
@@ -30,6 +30,9 @@ cargo test --workspace --exclude imu-py
 echo "== Python extension and CLI (release)"
 cargo build --quiet --release -p imu-cli
 maturin develop --quiet --release -m crates/imu-py/Cargo.toml
+
+echo "== Python stubs match the built module"
+python -m mypy.stubtest imukit._core
 
 echo "== Python tests"
 IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md

@@ -320,19 +320,24 @@ fn quaternion_to_euler<'py>(
     py: Python<'py>,
     quaternion: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = rows::<4>("quaternion", &quaternion)?;
-    let e = q
+    let e = rotations(&quaternion)?
+        .iter()
+        .map(|r| r.to_euler().to_array())
+        .collect();
+    Ok(out3(py, e))
+}
+
+/// Rows of `[w, x, y, z]` as rotations; refuses zero or non-finite quaternions by index.
+fn rotations(quaternion: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Rotation<Body, Enu>>> {
+    rows::<4>("quaternion", quaternion)?
         .iter()
         .enumerate()
         .map(|(i, q)| {
-            Rotation::<Body, Enu>::from_wxyz(*q)
-                .map(|r| r.to_euler().to_array())
-                .ok_or_else(|| {
-                    ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
-                })
+            Rotation::from_wxyz(*q).ok_or_else(|| {
+                ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
+            })
         })
-        .collect::<PyResult<Vec<_>>>()?;
-    Ok(out3(py, e))
+        .collect()
 }
 
 fn dcm_out(py: Python<'_>, m: Vec<[[f64; 3]; 3]>) -> Bound<'_, PyArray3<f64>> {
@@ -388,18 +393,10 @@ fn quaternion_to_dcm<'py>(
     py: Python<'py>,
     quaternion: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let q = rows::<4>("quaternion", &quaternion)?;
-    let m = q
+    let m = rotations(&quaternion)?
         .iter()
-        .enumerate()
-        .map(|(i, q)| {
-            Rotation::<Body, Enu>::from_wxyz(*q)
-                .map(|r| r.to_dcm())
-                .ok_or_else(|| {
-                    ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
-                })
-        })
-        .collect::<PyResult<Vec<_>>>()?;
+        .map(Rotation::to_dcm)
+        .collect();
     Ok(dcm_out(py, m))
 }
 

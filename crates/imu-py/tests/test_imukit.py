@@ -59,6 +59,9 @@ def test_conversions_round_trip():
     q2 = imukit.dcm_to_quaternion(imukit.euler_to_dcm(e))
     np.testing.assert_allclose(np.abs(np.sum(q * q2, axis=1)), 1.0, atol=1e-12)
     np.testing.assert_allclose(imukit.dcm_to_euler(imukit.euler_to_dcm(e)), e, atol=1e-12)
+    for f in (imukit.quaternion_to_euler, imukit.quaternion_to_dcm):
+        with pytest.raises(ImuError, match=r"quaternion\[1\] has zero norm"):
+            f([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
 
 
 def matlab_gradient(x, t):

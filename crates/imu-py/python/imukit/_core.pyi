@@ -6,6 +6,25 @@ import numpy.typing as npt
 
 _Table = tuple[list[str], npt.NDArray[np.float64]]
 
+__all__ = [
+    "ImuError",
+    "simulate_text",
+    "truth_from_expressions",
+    "truth_from_samples",
+    "ideal_imu",
+    "tangent_euler",
+    "nav_to_body",
+    "at_lever_arm",
+    "euler_to_quaternion",
+    "quaternion_to_euler",
+    "euler_to_dcm",
+    "dcm_to_euler",
+    "quaternion_to_dcm",
+    "dcm_to_quaternion",
+    "builtin_names",
+    "builtin_toml",
+]
+
 class ImuError(ValueError): ...
 
 def simulate_text(
@@ -45,7 +64,7 @@ def ideal_imu(
     nav_frame: str = "ENU",
     kind: str = "accel-gyro-mag",
 ) -> _Table: ...
-def tangent_euler(velocity_m_s: npt.NDArray[np.float64], *, min_speed_m_s: float = 1e-6) -> npt.NDArray[np.float64]: ...
+def tangent_euler(velocity_m_s: npt.NDArray[np.float64], *, min_speed_m_s: float = ...) -> npt.NDArray[np.float64]: ...
 def nav_to_body(euler_rad: npt.NDArray[np.float64], v_n: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def at_lever_arm(
     a: npt.NDArray[np.float64],
