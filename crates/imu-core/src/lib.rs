@@ -32,6 +32,7 @@ pub mod ideal;
 pub mod kinematics;
 mod math;
 pub mod rotation;
+pub mod sensor;
 pub mod vector;
 
 pub use frame::{Body, Enu, Frame, NavFrame, Ned};

@@ -1,0 +1,75 @@
+use core::fmt;
+
+/// An invalid sensor parameter; `field` is the parameter's name in parameter files.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamError {
+    /// NaN (or infinity where not allowed).
+    NotFinite {
+        /// Parameter name.
+        field: &'static str,
+        /// Axis or coefficient index.
+        index: usize,
+    },
+    /// Must be ≥ 0.
+    Negative {
+        /// Parameter name.
+        field: &'static str,
+        /// Axis index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// Must be > 0.
+    NotPositive {
+        /// Parameter name.
+        field: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// Outside its allowed interval.
+    OutOfRange {
+        /// Parameter name.
+        field: &'static str,
+        /// Axis index.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// Filter coefficients: empty, too many, or a zero leading denominator coefficient.
+    BadFilter {
+        /// What is wrong.
+        reason: &'static str,
+    },
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::NotFinite { field, index } => {
+                write!(f, "{field}[{index}] is not a finite number")
+            }
+            Self::Negative {
+                field,
+                index,
+                value,
+            } => write!(f, "{field}[{index}] must be ≥ 0, got {value}"),
+            Self::NotPositive { field, value } => write!(f, "{field} must be > 0, got {value}"),
+            Self::OutOfRange {
+                field,
+                index,
+                value,
+                min,
+                max,
+            } => {
+                write!(f, "{field}[{index}] must be in [{min}, {max}], got {value}")
+            }
+            Self::BadFilter { reason } => write!(f, "bias_instability_coefficients: {reason}"),
+        }
+    }
+}
+
+impl core::error::Error for ParamError {}

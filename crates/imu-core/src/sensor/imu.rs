@@ -1,0 +1,240 @@
+//! A whole IMU: accelerometer, optional gyroscope and magnetometer, on a mount, in frame `N`.
+use core::fmt;
+
+use crate::frame::{Body, NavFrame};
+use crate::ideal::{AccelSign, ImuMount};
+use crate::kinematics::Truth;
+use crate::rotation::Rotation;
+use crate::sensor::{Environment, NoiseSource, ParamError, SensorModel, SensorParams, SensorState};
+use crate::vector::Vec3;
+
+/// Which sensors besides the accelerometer the IMU has (MATLAB's `IMUType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SensorSet {
+    /// A gyroscope (accel-gyro, accel-gyro-mag).
+    pub gyroscope: bool,
+    /// A magnetometer (accel-mag, accel-gyro-mag).
+    pub magnetometer: bool,
+}
+
+/// What the gyroscope's AccelerationBias multiplies.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GyroAccelerationInput {
+    /// The specific force at the IMU, body frame (physical: a static gyro feels gravity).
+    #[default]
+    BodySpecificForce,
+    /// The raw navigation-frame acceleration input, no gravity, not rotated (MATLAB parity).
+    NavAcceleration,
+}
+
+/// Temperature of each sensor, °C.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Temperatures {
+    /// Accelerometer, °C.
+    pub accel_c: f64,
+    /// Gyroscope, °C.
+    pub gyro_c: f64,
+    /// Magnetometer, °C.
+    pub mag_c: f64,
+}
+
+impl Temperatures {
+    /// All sensors at `t_c`.
+    #[must_use]
+    pub const fn uniform(t_c: f64) -> Self {
+        Self {
+            accel_c: t_c,
+            gyro_c: t_c,
+            mag_c: t_c,
+        }
+    }
+}
+
+impl Default for Temperatures {
+    fn default() -> Self {
+        Self::uniform(25.0)
+    }
+}
+
+/// One reading; the fields of absent sensors are zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImuReading {
+    /// Accelerometer, m/s².
+    pub accel_m_s2: [f64; 3],
+    /// Gyroscope, rad/s.
+    pub gyro_rad_s: [f64; 3],
+    /// Magnetometer, µT.
+    pub mag_ut: [f64; 3],
+}
+
+/// The drifting state of the three sensors.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImuState {
+    /// Accelerometer state.
+    pub accel: SensorState,
+    /// Gyroscope state.
+    pub gyro: SensorState,
+    /// Magnetometer state.
+    pub mag: SensorState,
+}
+
+/// A parameter error with the sensor it belongs to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuParamError {
+    /// `"accelerometer"`, `"gyroscope"` or `"magnetometer"`.
+    pub sensor: &'static str,
+    /// The error.
+    pub source: ParamError,
+}
+
+impl fmt::Display for ImuParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}.{}", self.sensor, self.source)
+    }
+}
+
+impl core::error::Error for ImuParamError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        Some(&self.source)
+    }
+}
+
+/// A validated IMU error model in navigation frame `N`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuModel<N> {
+    /// Lever arm, accelerometer sign, gravity and magnetic field.
+    pub mount: ImuMount<N>,
+    sensors: SensorSet,
+    gyro_acceleration: GyroAccelerationInput,
+    accel: SensorModel,
+    gyro: SensorModel,
+    mag: SensorModel,
+}
+
+impl<N: NavFrame> ImuModel<N> {
+    /// Validates the three parameter sets for `sample_rate_hz`.
+    ///
+    /// # Errors
+    /// [`ImuParamError`] naming the sensor and field.
+    pub fn new(
+        mount: ImuMount<N>,
+        sensors: SensorSet,
+        gyro_acceleration: GyroAccelerationInput,
+        params: [&SensorParams; 3],
+        sample_rate_hz: f64,
+    ) -> Result<Self, ImuParamError> {
+        let build = |sensor: &'static str, p: &SensorParams| {
+            SensorModel::new(p, sample_rate_hz).map_err(|source| ImuParamError { sensor, source })
+        };
+        Ok(Self {
+            mount,
+            sensors,
+            gyro_acceleration,
+            accel: build("accelerometer", params[0])?,
+            gyro: build("gyroscope", params[1])?,
+            mag: build("magnetometer", params[2])?,
+        })
+    }
+
+    /// The sensors present.
+    #[must_use]
+    pub fn sensors(&self) -> SensorSet {
+        self.sensors
+    }
+
+    /// Readings from imukit truth (lever arm and all): the scenario path.
+    pub fn measure(
+        &self,
+        truth: &Truth<N>,
+        temperatures: &Temperatures,
+        state: &mut ImuState,
+        noise: &mut impl NoiseSource,
+    ) -> ImuReading {
+        let f_b = self.mount.specific_force(truth);
+        self.finish(
+            f_b,
+            truth.acceleration_m_s2,
+            truth.omega_b_rad_s,
+            &truth.attitude,
+            temperatures,
+            state,
+            noise,
+        )
+    }
+
+    /// Readings from MATLAB's call shape: navigation-frame acceleration without gravity (m/s²),
+    /// navigation-frame angular velocity (rad/s) and the attitude `C_nb`. As in MATLAB, the IMU
+    /// sits at the reference point (the mount's lever arm is not used here).
+    pub fn measure_nav(
+        &self,
+        acceleration_n: Vec3<N>,
+        angular_velocity_n: Vec3<N>,
+        attitude: &Rotation<Body, N>,
+        temperatures: &Temperatures,
+        state: &mut ImuState,
+        noise: &mut impl NoiseSource,
+    ) -> ImuReading {
+        let nav_to_body = attitude.inverse();
+        let f_b = nav_to_body.apply(acceleration_n - N::gravity(self.mount.gravity_m_s2));
+        let w_b = nav_to_body.apply(angular_velocity_n);
+        self.finish(
+            f_b,
+            acceleration_n,
+            w_b,
+            attitude,
+            temperatures,
+            state,
+            noise,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        &self,
+        f_b: Vec3<Body>,
+        acceleration_n: Vec3<N>,
+        w_b: Vec3<Body>,
+        attitude: &Rotation<Body, N>,
+        temperatures: &Temperatures,
+        state: &mut ImuState,
+        noise: &mut impl NoiseSource,
+    ) -> ImuReading {
+        let accel_in = match self.mount.accel_sign {
+            AccelSign::SpecificForce => f_b,
+            AccelSign::Matlab => -f_b,
+        };
+        let g_input = match self.gyro_acceleration {
+            GyroAccelerationInput::BodySpecificForce => f_b.to_array(),
+            GyroAccelerationInput::NavAcceleration => acceleration_n.to_array(),
+        };
+        let mut reading = ImuReading::default();
+        let env = |t: f64, a: [f64; 3]| Environment {
+            temperature_c: t,
+            acceleration_m_s2: a,
+        };
+        reading.accel_m_s2 = self.accel.measure(
+            accel_in.to_array(),
+            &env(temperatures.accel_c, [0.0; 3]),
+            &mut state.accel,
+            noise,
+        );
+        if self.sensors.gyroscope {
+            reading.gyro_rad_s = self.gyro.measure(
+                w_b.to_array(),
+                &env(temperatures.gyro_c, g_input),
+                &mut state.gyro,
+                noise,
+            );
+        }
+        if self.sensors.magnetometer {
+            let m_b = attitude.inverse().apply(self.mount.magnetic_field_ut);
+            reading.mag_ut = self.mag.measure(
+                m_b.to_array(),
+                &env(temperatures.mag_c, [0.0; 3]),
+                &mut state.mag,
+                noise,
+            );
+        }
+        reading
+    }
+}

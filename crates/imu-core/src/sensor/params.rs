@@ -1,0 +1,242 @@
+//! Error parameters of one sensor triad, as a user writes them (SI units, per axis).
+use crate::sensor::ParamError;
+
+/// Largest number of numerator or denominator coefficients of the bias-instability filter
+/// (filter order up to 7).
+pub const MAX_FILTER_COEFFICIENTS: usize = 8;
+
+/// Power spectral density convention of `noise_density` and `random_walk`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NoiseType {
+    /// Bandwidth `fs`: the datasheet / IEEE-952 / Kalibr convention (imukit's default).
+    #[default]
+    SingleSided,
+    /// Bandwidth `fs/2`: MATLAB's default.
+    DoubleSided,
+}
+
+/// Numerator and denominator of the bias-instability filter (MATLAB `filter(Num, Den, x)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterCoefficients {
+    numerator: [f64; MAX_FILTER_COEFFICIENTS],
+    denominator: [f64; MAX_FILTER_COEFFICIENTS],
+    num_len: usize,
+    den_len: usize,
+}
+
+impl Default for FilterCoefficients {
+    /// MATLAB's default: `Num = [1]`, `Den = [1, −0.5]`.
+    fn default() -> Self {
+        Self::matlab_default()
+    }
+}
+
+impl FilterCoefficients {
+    /// MATLAB's default: `Num = [1]`, `Den = [1, −0.5]`.
+    #[must_use]
+    pub const fn matlab_default() -> Self {
+        let mut numerator = [0.0; MAX_FILTER_COEFFICIENTS];
+        let mut denominator = [0.0; MAX_FILTER_COEFFICIENTS];
+        numerator[0] = 1.0;
+        denominator[0] = 1.0;
+        denominator[1] = -0.5;
+        Self {
+            numerator,
+            denominator,
+            num_len: 1,
+            den_len: 2,
+        }
+    }
+
+    /// Coefficients `numerator` (b₀ … b_m) and `denominator` (a₀ … a_n), a₀ ≠ 0.
+    ///
+    /// # Errors
+    /// Empty or too long lists, non-finite values, a₀ = 0.
+    pub fn new(numerator: &[f64], denominator: &[f64]) -> Result<Self, ParamError> {
+        let too_long = numerator.len() > MAX_FILTER_COEFFICIENTS
+            || denominator.len() > MAX_FILTER_COEFFICIENTS;
+        if numerator.is_empty() || denominator.is_empty() || too_long {
+            return Err(ParamError::BadFilter {
+                reason: "1 to 8 numerator and denominator coefficients needed",
+            });
+        }
+        if let Some(index) = numerator
+            .iter()
+            .chain(denominator)
+            .position(|c| !c.is_finite())
+        {
+            return Err(ParamError::NotFinite {
+                field: "bias_instability_coefficients",
+                index,
+            });
+        }
+        if denominator[0] == 0.0 {
+            return Err(ParamError::BadFilter {
+                reason: "the leading denominator coefficient must not be 0",
+            });
+        }
+        let mut c = Self {
+            numerator: [0.0; MAX_FILTER_COEFFICIENTS],
+            denominator: [0.0; MAX_FILTER_COEFFICIENTS],
+            num_len: numerator.len(),
+            den_len: denominator.len(),
+        };
+        c.numerator[..numerator.len()].copy_from_slice(numerator);
+        c.denominator[..denominator.len()].copy_from_slice(denominator);
+        Ok(c)
+    }
+
+    /// The numerator coefficients.
+    #[must_use]
+    pub fn numerator(&self) -> &[f64] {
+        &self.numerator[..self.num_len]
+    }
+
+    /// The denominator coefficients.
+    #[must_use]
+    pub fn denominator(&self) -> &[f64] {
+        &self.denominator[..self.den_len]
+    }
+}
+
+/// Error parameters of one triad (accelerometer, gyroscope or magnetometer), MATLAB's
+/// `accelparams`/`gyroparams`/`magparams` fields in SI units of the measurand `[u]`
+/// (m/s², rad/s or µT). The default is an ideal sensor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorParams {
+    /// Saturation level, `[u]`, > 0 (may be infinite).
+    pub measurement_range: f64,
+    /// Quantisation step, `[u]`/LSB, ≥ 0 (0: none).
+    pub resolution: f64,
+    /// Constant bias, `[u]`.
+    pub constant_bias: [f64; 3],
+    /// Axes misalignment and scale, percent; `100·I` is perfect alignment.
+    pub axes_misalignment_pct: [[f64; 3]; 3],
+    /// White-noise density, `[u]/√Hz`, ≥ 0.
+    pub noise_density: [f64; 3],
+    /// Bias-instability input amplitude, `[u]`, ≥ 0.
+    pub bias_instability: [f64; 3],
+    /// Bias-instability filter.
+    pub bias_instability_coefficients: FilterCoefficients,
+    /// Random walk, `[u]·√Hz`, ≥ 0.
+    pub random_walk: [f64; 3],
+    /// PSD convention of `noise_density` and `random_walk`.
+    pub noise_type: NoiseType,
+    /// Bias per °C away from 25 °C, `[u]/°C`.
+    pub temperature_bias: [f64; 3],
+    /// Scale-factor error per °C away from 25 °C, %/°C, in [0, 100].
+    pub temperature_scale_factor_pct: [f64; 3],
+    /// Gyroscope only: bias per unit acceleration, `(rad/s)/(m/s²)`.
+    pub acceleration_bias: [f64; 3],
+}
+
+impl Default for SensorParams {
+    fn default() -> Self {
+        Self {
+            measurement_range: f64::INFINITY,
+            resolution: 0.0,
+            constant_bias: [0.0; 3],
+            axes_misalignment_pct: [[100.0, 0.0, 0.0], [0.0, 100.0, 0.0], [0.0, 0.0, 100.0]],
+            noise_density: [0.0; 3],
+            bias_instability: [0.0; 3],
+            bias_instability_coefficients: FilterCoefficients::matlab_default(),
+            random_walk: [0.0; 3],
+            noise_type: NoiseType::SingleSided,
+            temperature_bias: [0.0; 3],
+            temperature_scale_factor_pct: [0.0; 3],
+            acceleration_bias: [0.0; 3],
+        }
+    }
+}
+
+impl SensorParams {
+    /// MATLAB's scalar AxesMisalignment `s`: 100 on the diagonal, `s` elsewhere (percent).
+    #[must_use]
+    pub const fn misalignment_from_scalar(s: f64) -> [[f64; 3]; 3] {
+        [[100.0, s, s], [s, 100.0, s], [s, s, 100.0]]
+    }
+
+    /// MATLAB's 3-vector AxesMisalignment `[a, b, c]`:
+    /// `[[100, b, c], [a, 100, c], [a, b, 100]]` (percent).
+    #[must_use]
+    pub const fn misalignment_from_vector(v: [f64; 3]) -> [[f64; 3]; 3] {
+        let [a, b, c] = v;
+        [[100.0, b, c], [a, 100.0, c], [a, b, 100.0]]
+    }
+
+    /// Checks every field as MATLAB does: densities, instability and random walk ≥ 0; range > 0
+    /// (may be infinite); resolution ≥ 0; temperature scale factor in [0, 100]; no NaN anywhere.
+    ///
+    /// # Errors
+    /// The first offending field, with its axis.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if self.measurement_range.is_nan() || !(self.measurement_range > 0.0) {
+            return Err(ParamError::NotPositive {
+                field: "measurement_range",
+                value: self.measurement_range,
+            });
+        }
+        if !self.resolution.is_finite() {
+            return Err(ParamError::NotFinite {
+                field: "resolution",
+                index: 0,
+            });
+        }
+        if self.resolution < 0.0 {
+            return Err(ParamError::Negative {
+                field: "resolution",
+                index: 0,
+                value: self.resolution,
+            });
+        }
+        let finite = |field: &'static str, v: &[f64; 3]| match v.iter().position(|c| !c.is_finite())
+        {
+            Some(index) => Err(ParamError::NotFinite { field, index }),
+            None => Ok(()),
+        };
+        let non_negative = |field: &'static str, v: &[f64; 3]| {
+            finite(field, v)?;
+            match v.iter().position(|c| *c < 0.0) {
+                Some(index) => Err(ParamError::Negative {
+                    field,
+                    index,
+                    value: v[index],
+                }),
+                None => Ok(()),
+            }
+        };
+        finite("constant_bias", &self.constant_bias)?;
+        for (r, row) in self.axes_misalignment_pct.iter().enumerate() {
+            if let Some(k) = row.iter().position(|c| !c.is_finite()) {
+                return Err(ParamError::NotFinite {
+                    field: "axes_misalignment_pct",
+                    index: 3 * r + k,
+                });
+            }
+        }
+        non_negative("noise_density", &self.noise_density)?;
+        non_negative("bias_instability", &self.bias_instability)?;
+        non_negative("random_walk", &self.random_walk)?;
+        finite("temperature_bias", &self.temperature_bias)?;
+        finite(
+            "temperature_scale_factor_pct",
+            &self.temperature_scale_factor_pct,
+        )?;
+        if let Some(index) = self
+            .temperature_scale_factor_pct
+            .iter()
+            .position(|c| !(0.0..=100.0).contains(c))
+        {
+            let value = self.temperature_scale_factor_pct[index];
+            return Err(ParamError::OutOfRange {
+                field: "temperature_scale_factor_pct",
+                index,
+                value,
+                min: 0.0,
+                max: 100.0,
+            });
+        }
+        finite("acceleration_bias", &self.acceleration_bias)?;
+        Ok(())
+    }
+}

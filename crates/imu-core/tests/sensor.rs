@@ -1,0 +1,565 @@
+//! The sensor error model: each deterministic step against its formula (noise off), seeded
+//! statistics with tolerances from the sample size, chunked = one-shot runs.
+use imu_core::sensor::{
+    Environment, FilterCoefficients, GyroAccelerationInput, ImuModel, ImuState, NoNoise,
+    NoiseSource, NoiseType, ParamError, SeededNormals, SensorModel, SensorParams, SensorSet,
+    SensorState, Temperatures,
+};
+use imu_core::{AccelSign, Body, Enu, EulerZyx, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
+
+const U: [f64; 3] = [1.25, -0.5, 9.81];
+const TOL: f64 = 1e-12;
+
+fn one(params: &SensorParams, u: [f64; 3], env: &Environment) -> [f64; 3] {
+    let model = SensorModel::new(params, 100.0).unwrap();
+    model.measure(u, env, &mut SensorState::default(), &mut NoNoise)
+}
+
+fn close(a: [f64; 3], b: [f64; 3]) {
+    for k in 0..3 {
+        assert!(
+            (a[k] - b[k]).abs() <= TOL * b[k].abs().max(1.0),
+            "{a:?} vs {b:?}"
+        );
+    }
+}
+
+fn matvec(m: [[f64; 3]; 3], u: [f64; 3]) -> [f64; 3] {
+    core::array::from_fn(|i| (m[i][0] * u[0] + m[i][1] * u[1] + m[i][2] * u[2]) / 100.0)
+}
+
+#[test]
+fn ideal_parameters_pass_the_input_through() {
+    assert_eq!(one(&SensorParams::default(), U, &Environment::default()), U);
+}
+
+#[test]
+fn misalignment_in_all_three_forms() {
+    let env = Environment::default();
+    let scalar = SensorParams::misalignment_from_scalar(2.0);
+    assert_eq!(
+        scalar,
+        [[100.0, 2.0, 2.0], [2.0, 100.0, 2.0], [2.0, 2.0, 100.0]]
+    );
+    let vector = SensorParams::misalignment_from_vector([1.0, 2.0, 3.0]);
+    assert_eq!(
+        vector,
+        [[100.0, 2.0, 3.0], [1.0, 100.0, 3.0], [1.0, 2.0, 100.0]]
+    );
+    let full = [[101.0, 0.5, -0.3], [0.2, 99.0, 0.1], [-0.4, 0.6, 100.5]];
+    for m in [scalar, vector, full] {
+        let p = SensorParams {
+            axes_misalignment_pct: m,
+            ..SensorParams::default()
+        };
+        close(one(&p, U, &env), matvec(m, U));
+    }
+}
+
+#[test]
+fn constant_bias_adds() {
+    let p = SensorParams {
+        constant_bias: [0.1, -0.2, 0.3],
+        ..SensorParams::default()
+    };
+    close(
+        one(&p, U, &Environment::default()),
+        [U[0] + 0.1, U[1] - 0.2, U[2] + 0.3],
+    );
+}
+
+#[test]
+fn temperature_bias_and_scale_follow_the_25_degree_reference() {
+    let p = SensorParams {
+        temperature_bias: [0.01, 0.02, -0.03],
+        temperature_scale_factor_pct: [0.02, 0.5, 1.0],
+        constant_bias: [0.1, 0.0, 0.0],
+        ..SensorParams::default()
+    };
+    let env = Environment {
+        temperature_c: 40.0,
+        ..Environment::default()
+    };
+    let expected: [f64; 3] = core::array::from_fn(|i| {
+        (1.0 + 15.0 * p.temperature_scale_factor_pct[i] / 100.0)
+            * (U[i] + p.constant_bias[i] + 15.0 * p.temperature_bias[i])
+    });
+    close(one(&p, U, &env), expected);
+    // At 25 °C both vanish.
+    close(
+        one(&p, U, &Environment::default()),
+        [U[0] + 0.1, U[1], U[2]],
+    );
+}
+
+#[test]
+fn acceleration_bias_multiplies_the_environment_acceleration() {
+    let p = SensorParams {
+        acceleration_bias: [1e-3, 2e-3, 3e-3],
+        ..SensorParams::default()
+    };
+    let env = Environment {
+        temperature_c: 25.0,
+        acceleration_m_s2: [1.0, 2.0, -9.81],
+    };
+    close(one(&p, [0.0; 3], &env), [1e-3, 4e-3, -3e-3 * 9.81]);
+}
+
+#[test]
+fn saturation_clips_at_the_range() {
+    let p = SensorParams {
+        measurement_range: 5.0,
+        ..SensorParams::default()
+    };
+    assert_eq!(
+        one(&p, [7.0, -7.0, 4.5], &Environment::default()),
+        [5.0, -5.0, 4.5]
+    );
+}
+
+#[test]
+fn quantisation_rounds_half_away_from_zero_after_saturation() {
+    let r = 0.25;
+    let p = SensorParams {
+        resolution: r,
+        measurement_range: 1.3,
+        ..SensorParams::default()
+    };
+    // 0.625 = 2.5 steps → 3 steps; −0.625 → −3 steps; 1.4 saturates to 1.3 then rounds to 1.25.
+    assert_eq!(
+        one(&p, [0.625, -0.625, 1.4], &Environment::default()),
+        [0.75, -0.75, 1.25]
+    );
+}
+
+#[test]
+fn parameters_are_validated_with_the_field_named() {
+    let bad = |p: SensorParams| SensorModel::new(&p, 100.0).unwrap_err();
+    let d = SensorParams::default();
+    assert_eq!(
+        bad(SensorParams {
+            noise_density: [0.1, -1.0, 0.0],
+            ..d
+        }),
+        ParamError::Negative {
+            field: "noise_density",
+            index: 1,
+            value: -1.0
+        }
+    );
+    assert_eq!(
+        bad(SensorParams {
+            measurement_range: 0.0,
+            ..d
+        }),
+        ParamError::NotPositive {
+            field: "measurement_range",
+            value: 0.0
+        }
+    );
+    assert!(matches!(
+        bad(SensorParams {
+            measurement_range: f64::NAN,
+            ..d
+        }),
+        ParamError::NotPositive { .. }
+    ));
+    assert_eq!(
+        bad(SensorParams {
+            constant_bias: [0.0, 0.0, f64::NAN],
+            ..d
+        }),
+        ParamError::NotFinite {
+            field: "constant_bias",
+            index: 2
+        }
+    );
+    assert!(matches!(
+        bad(SensorParams {
+            temperature_scale_factor_pct: [0.0, 101.0, 0.0],
+            ..d
+        }),
+        ParamError::OutOfRange { index: 1, .. }
+    ));
+    assert!(matches!(
+        bad(SensorParams {
+            resolution: -1.0,
+            ..d
+        }),
+        ParamError::Negative {
+            field: "resolution",
+            ..
+        }
+    ));
+    assert!(FilterCoefficients::new(&[1.0], &[0.0, 1.0]).is_err());
+    assert!(FilterCoefficients::new(&[], &[1.0]).is_err());
+    assert!(SensorModel::new(&d, 0.0).is_err());
+    let msg = bad(SensorParams {
+        random_walk: [-2.0, 0.0, 0.0],
+        ..d
+    })
+    .to_string();
+    assert_eq!(msg, "random_walk[0] must be ≥ 0, got -2");
+    // Infinite range is allowed.
+    assert!(
+        SensorModel::new(
+            &SensorParams {
+                measurement_range: f64::INFINITY,
+                ..d
+            },
+            100.0
+        )
+        .is_ok()
+    );
+}
+
+/// Mean and variance of a sample.
+fn moments(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    (
+        mean,
+        x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0),
+    )
+}
+
+fn series(params: &SensorParams, rate: f64, n: usize, seed: u64) -> Vec<[f64; 3]> {
+    let model = SensorModel::new(params, rate).unwrap();
+    let mut state = SensorState::default();
+    let mut noise = SeededNormals::new(seed);
+    (0..n)
+        .map(|_| model.measure([0.0; 3], &Environment::default(), &mut state, &mut noise))
+        .collect()
+}
+
+#[test]
+fn white_noise_standard_deviation_per_noise_type() {
+    // σ = N·√β with β = fs (single-sided) or fs/2 (double-sided). For n normal samples the
+    // sample variance has relative standard deviation √(2/(n−1)); allow 5 of those.
+    let (rate, n) = (200.0, 100_000);
+    for (noise_type, beta) in [
+        (NoiseType::SingleSided, rate),
+        (NoiseType::DoubleSided, rate / 2.0),
+    ] {
+        let p = SensorParams {
+            noise_density: [0.01, 0.02, 0.03],
+            noise_type,
+            ..SensorParams::default()
+        };
+        let y = series(&p, rate, n, 11);
+        for axis in 0..3 {
+            let x: Vec<f64> = y.iter().map(|r| r[axis]).collect();
+            let (mean, var) = moments(&x);
+            let sigma2 = (p.noise_density[axis] * beta.sqrt()).powi(2);
+            let tol = 5.0 * (2.0 / (n as f64 - 1.0)).sqrt();
+            assert!(
+                (var / sigma2 - 1.0).abs() < tol,
+                "{noise_type:?} axis {axis}: {var} vs {sigma2}"
+            );
+            assert!(mean.abs() < 5.0 * (sigma2 / n as f64).sqrt());
+        }
+    }
+}
+
+#[test]
+fn random_walk_variance_grows_linearly() {
+    // Var(x_k) = k·K²/β. Over M independent runs the sample variance at step k has relative
+    // standard deviation √(2/(M−1)); 3 axes give 3M samples.
+    let (rate, k_steps, runs) = (100.0, 400, 3000);
+    let k_rw = 0.05;
+    let p = SensorParams {
+        random_walk: [k_rw; 3],
+        ..SensorParams::default()
+    };
+    let model = SensorModel::new(&p, rate).unwrap();
+    let mut at = [Vec::new(), Vec::new()];
+    for run in 0..runs {
+        let mut state = SensorState::default();
+        let mut noise = SeededNormals::for_run(5, run);
+        for step in 1..=k_steps {
+            let y = model.measure([0.0; 3], &Environment::default(), &mut state, &mut noise);
+            if step == k_steps / 4 {
+                at[0].extend(y);
+            }
+            if step == k_steps {
+                at[1].extend(y);
+            }
+        }
+    }
+    let m = (3 * runs) as f64;
+    let tol = 5.0 * (2.0 / (m - 1.0)).sqrt();
+    for (samples, k) in at.iter().zip([k_steps / 4, k_steps]) {
+        let (_, var) = moments(samples);
+        let expected = k as f64 * k_rw * k_rw / rate;
+        assert!(
+            (var / expected - 1.0).abs() < tol,
+            "step {k}: {var} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn bias_instability_with_matlabs_default_filter_has_variance_four_thirds_b_squared() {
+    // y_k = 0.5·y_{k−1} + B·n_k is AR(1) with φ = 0.5: Var = B²/(1 − φ²) = 4B²/3. The sample
+    // variance of an AR(1) series of length n has relative sd ≈ √(2(1+φ²)/((1−φ²)n)).
+    let n = 200_000;
+    let b = 0.02;
+    let p = SensorParams {
+        bias_instability: [b; 3],
+        ..SensorParams::default()
+    };
+    let y = series(&p, 100.0, n, 3);
+    let phi2: f64 = 0.25;
+    let tol = 5.0 * (2.0 * (1.0 + phi2) / ((1.0 - phi2) * n as f64)).sqrt();
+    for axis in 0..3 {
+        let x: Vec<f64> = y.iter().map(|r| r[axis]).collect();
+        let (_, var) = moments(&x);
+        assert!(
+            (var / (4.0 * b * b / 3.0) - 1.0).abs() < tol,
+            "axis {axis}: {var}"
+        );
+        // Lag-1 autocorrelation is φ = 0.5.
+        let (mean, _) = moments(&x);
+        let c1: f64 = x
+            .windows(2)
+            .map(|w| (w[0] - mean) * (w[1] - mean))
+            .sum::<f64>()
+            / (n as f64 - 1.0);
+        assert!(
+            (c1 / var - 0.5).abs() < 0.02,
+            "axis {axis}: rho1 = {}",
+            c1 / var
+        );
+    }
+}
+
+#[test]
+fn higher_order_filters_match_a_direct_recursion() {
+    let coeffs = FilterCoefficients::new(&[0.5, 0.25, 0.125], &[2.0, -0.4, 0.1, 0.05]).unwrap();
+    let p = SensorParams {
+        bias_instability: [1.0; 3],
+        bias_instability_coefficients: coeffs,
+        ..SensorParams::default()
+    };
+    let model = SensorModel::new(&p, 100.0).unwrap();
+    let mut state = SensorState::default();
+    let mut noise = SeededNormals::new(9);
+    let mut replay = SeededNormals::new(9);
+    let (b, a) = ([0.5, 0.25, 0.125], [2.0, -0.4, 0.1, 0.05]);
+    let (mut xs, mut ys) = (Vec::<f64>::new(), Vec::<f64>::new());
+    for _ in 0..200 {
+        let y = model.measure([0.0; 3], &Environment::default(), &mut state, &mut noise)[0];
+        let draws: Vec<f64> = (0..9).map(|_| replay.standard_normal()).collect();
+        xs.push(draws[0]);
+        let n = xs.len() - 1;
+        let mut acc = 0.0;
+        for (k, bk) in b.iter().enumerate() {
+            if n >= k {
+                acc += bk * xs[n - k];
+            }
+        }
+        for (k, ak) in a.iter().enumerate().skip(1) {
+            if n >= k {
+                acc -= ak * ys[n - k];
+            }
+        }
+        ys.push(acc / a[0]);
+        assert!((y - ys[n]).abs() < 1e-12, "sample {n}: {y} vs {}", ys[n]);
+    }
+}
+
+fn full_params() -> SensorParams {
+    SensorParams {
+        measurement_range: 50.0,
+        resolution: 1e-4,
+        constant_bias: [0.1, 0.2, 0.3],
+        axes_misalignment_pct: SensorParams::misalignment_from_scalar(1.0),
+        noise_density: [1e-3; 3],
+        bias_instability: [1e-3; 3],
+        random_walk: [1e-4; 3],
+        temperature_bias: [1e-3; 3],
+        temperature_scale_factor_pct: [0.01; 3],
+        acceleration_bias: [1e-4; 3],
+        ..SensorParams::default()
+    }
+}
+
+#[test]
+fn a_run_split_into_chunks_equals_one_call() {
+    let p = full_params();
+    let imu = ImuModel::<Enu>::new(
+        ImuMount::default(),
+        SensorSet {
+            gyroscope: true,
+            magnetometer: true,
+        },
+        GyroAccelerationInput::BodySpecificForce,
+        [&p, &p, &p],
+        100.0,
+    )
+    .unwrap();
+    let truth = Truth::<Enu>::default();
+    let temps = Temperatures::uniform(30.0);
+    let run = |chunks: &[usize]| {
+        let mut state = ImuState::default();
+        let mut noise = SeededNormals::new(77);
+        let mut out = Vec::new();
+        for &len in chunks {
+            // Each chunk continues from the state and stream the previous one left.
+            let (mut s, mut nz) = (state, noise.clone());
+            for _ in 0..len {
+                out.push(imu.measure(&truth, &temps, &mut s, &mut nz));
+            }
+            state = s;
+            noise = nz;
+        }
+        out
+    };
+    assert_eq!(run(&[1000]), run(&[1, 333, 500, 166]));
+}
+
+#[test]
+fn seeds_give_identical_streams_and_runs_differ() {
+    let draw = |mut n: SeededNormals| (0..5).map(|_| n.standard_normal()).collect::<Vec<_>>();
+    assert_eq!(draw(SeededNormals::new(1)), draw(SeededNormals::new(1)));
+    assert_ne!(
+        draw(SeededNormals::for_run(1, 0)),
+        draw(SeededNormals::for_run(1, 1))
+    );
+    assert_eq!(
+        draw(SeededNormals::for_run(1, 7)),
+        draw(SeededNormals::for_run(1, 7))
+    );
+}
+
+fn profiles_case<N: NavFrame>() {
+    // A static IMU, yawed and tilted, noise off: MATLAB call shape and truth path agree with the
+    // formulas in both accelerometer signs and both g-sensitivity inputs.
+    let e = EulerZyx::new(0.4, 0.1, -0.2);
+    let att = Rotation::<Body, N>::from_euler(e);
+    let g_n = N::gravity(9.81);
+    let f_b = att.inverse().apply(-g_n).to_array();
+    let m_b = att
+        .inverse()
+        .apply(N::default_magnetic_field_ut())
+        .to_array();
+    let gyro = SensorParams {
+        acceleration_bias: [0.01, 0.02, 0.03],
+        ..SensorParams::default()
+    };
+    let ideal = SensorParams::default();
+    for (sign, input) in [
+        (
+            AccelSign::SpecificForce,
+            GyroAccelerationInput::BodySpecificForce,
+        ),
+        (AccelSign::Matlab, GyroAccelerationInput::NavAcceleration),
+    ] {
+        let mount = ImuMount::<N> {
+            accel_sign: sign,
+            ..ImuMount::default()
+        };
+        let imu = ImuModel::new(
+            mount,
+            SensorSet {
+                gyroscope: true,
+                magnetometer: true,
+            },
+            input,
+            [&ideal, &gyro, &ideal],
+            100.0,
+        )
+        .unwrap();
+        let k = if sign == AccelSign::Matlab { -1.0 } else { 1.0 };
+        let r = imu.measure_nav(
+            Vec3::zeros(),
+            Vec3::zeros(),
+            &att,
+            &Temperatures::default(),
+            &mut ImuState::default(),
+            &mut NoNoise,
+        );
+        close(r.accel_m_s2, f_b.map(|c| k * c));
+        close(r.mag_ut, m_b);
+        let g_sens = match input {
+            GyroAccelerationInput::BodySpecificForce => {
+                [0.01 * f_b[0], 0.02 * f_b[1], 0.03 * f_b[2]]
+            }
+            GyroAccelerationInput::NavAcceleration => [0.0; 3], // at rest the nav acceleration is zero
+        };
+        close(r.gyro_rad_s, g_sens);
+        let truth = Truth::<N> {
+            attitude: att,
+            euler: e,
+            ..Truth::default()
+        };
+        let r2 = imu.measure(
+            &truth,
+            &Temperatures::default(),
+            &mut ImuState::default(),
+            &mut NoNoise,
+        );
+        close(r2.accel_m_s2, r.accel_m_s2);
+        close(r2.gyro_rad_s, r.gyro_rad_s);
+    }
+}
+
+#[test]
+fn both_profiles_and_frames_follow_the_formulas_enu() {
+    profiles_case::<Enu>();
+}
+
+#[test]
+fn both_profiles_and_frames_follow_the_formulas_ned() {
+    profiles_case::<Ned>();
+}
+
+#[test]
+fn matlab_spec_sheet_accelerometer_example_deterministic_part() {
+    // MATLAB imuSensor page: MeasurementRange 19.62, Resolution 0.00059875, ConstantBias 0.4905,
+    // AxesMisalignment 2, NoiseDensity 0.003924 (off here), TemperatureBias
+    // [0.34335 0.34335 0.5886], TemperatureScaleFactor 0.02; at 35 °C, level at rest, NED.
+    let p = SensorParams {
+        measurement_range: 19.62,
+        resolution: 0.00059875,
+        constant_bias: [0.4905; 3],
+        axes_misalignment_pct: SensorParams::misalignment_from_scalar(2.0),
+        temperature_bias: [0.34335, 0.34335, 0.5886],
+        temperature_scale_factor_pct: [0.02; 3],
+        noise_type: NoiseType::DoubleSided,
+        ..SensorParams::default()
+    };
+    let mount = ImuMount::<Ned> {
+        accel_sign: AccelSign::Matlab,
+        ..ImuMount::default()
+    };
+    let imu = ImuModel::new(
+        mount,
+        SensorSet {
+            gyroscope: false,
+            magnetometer: false,
+        },
+        GyroAccelerationInput::NavAcceleration,
+        [&p, &SensorParams::default(), &SensorParams::default()],
+        100.0,
+    )
+    .unwrap();
+    let r = imu.measure_nav(
+        Vec3::zeros(),
+        Vec3::zeros(),
+        &Rotation::identity(),
+        &Temperatures::uniform(35.0),
+        &mut ImuState::default(),
+        &mut NoNoise,
+    );
+    let u = [0.0, 0.0, 9.81]; // MATLAB: gravity minus acceleration, NED
+    let expected: [f64; 3] = core::array::from_fn(|i| {
+        let m = SensorParams::misalignment_from_scalar(2.0)[i];
+        let bulk = (m[0] * u[0] + m[1] * u[1] + m[2] * u[2]) / 100.0 + 0.4905;
+        let y = (1.0 + 10.0 * 0.02 / 100.0) * (bulk + 10.0 * p.temperature_bias[i]);
+        let y = y.clamp(-19.62, 19.62);
+        0.00059875 * (y / 0.00059875).round()
+    });
+    close(r.accel_m_s2, expected);
+    assert_eq!(r.gyro_rad_s, [0.0; 3]);
+}
