@@ -170,7 +170,7 @@ impl SensorParams {
     /// # Errors
     /// The first offending field, with its axis.
     pub fn validate(&self) -> Result<(), ParamError> {
-        if self.measurement_range.is_nan() || !(self.measurement_range > 0.0) {
+        if self.measurement_range.is_nan() || self.measurement_range <= 0.0 {
             return Err(ParamError::NotPositive {
                 field: "measurement_range",
                 value: self.measurement_range,
