@@ -27,6 +27,7 @@ extern crate std;
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");
 
+pub mod allan;
 pub mod frame;
 pub mod ideal;
 pub mod kinematics;

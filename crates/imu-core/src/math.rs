@@ -32,3 +32,20 @@ pub(crate) fn unwrap_near(angle: f64, reference: f64) -> f64 {
     let two_pi = 2.0 * core::f64::consts::PI;
     angle + two_pi * round((reference - angle) / two_pi)
 }
+
+#[inline]
+pub(crate) fn exp(x: f64) -> f64 {
+    Float::exp(x)
+}
+#[inline]
+pub(crate) fn ln(x: f64) -> f64 {
+    Float::ln(x)
+}
+#[inline]
+pub(crate) fn powf(x: f64, y: f64) -> f64 {
+    Float::powf(x, y)
+}
+#[inline]
+pub(crate) fn ceil(x: f64) -> f64 {
+    Float::ceil(x)
+}

@@ -338,7 +338,7 @@ fn higher_order_filters_match_a_direct_recursion() {
     let coeffs = FilterCoefficients::new(&[0.5, 0.25, 0.125], &[2.0, -0.4, 0.1, 0.05]).unwrap();
     let p = SensorParams {
         bias_instability: [1.0; 3],
-        bias_instability_coefficients: coeffs,
+        bias_instability_model: imu_core::sensor::BiasInstabilityModel::Filter(coeffs),
         ..SensorParams::default()
     };
     let model = SensorModel::new(&p, 100.0).unwrap();

@@ -24,6 +24,9 @@ pub use error::ParamError;
 pub use imu::{
     GyroAccelerationInput, ImuModel, ImuParamError, ImuReading, ImuState, SensorSet, Temperatures,
 };
+pub use model::MAX_FLICKER_SECTIONS;
 pub use model::{Environment, SensorModel, SensorState};
 pub use noise::{NoNoise, NoiseSource, SeededNormals};
-pub use params::{FilterCoefficients, MAX_FILTER_COEFFICIENTS, NoiseType, SensorParams};
+pub use params::{
+    BiasInstabilityModel, FilterCoefficients, MAX_FILTER_COEFFICIENTS, NoiseType, SensorParams,
+};

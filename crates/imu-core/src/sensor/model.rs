@@ -1,8 +1,131 @@
 //! One validated sensor triad and its drifting state.
 use crate::math;
-use crate::sensor::{MAX_FILTER_COEFFICIENTS, NoiseSource, NoiseType, ParamError, SensorParams};
+use crate::sensor::{
+    BiasInstabilityModel, MAX_FILTER_COEFFICIENTS, NoiseSource, NoiseType, ParamError, SensorParams,
+};
 
-const FILTER_STATE: usize = MAX_FILTER_COEFFICIENTS - 1;
+/// Largest number of first-order sections of the flicker bias-instability model.
+pub const MAX_FLICKER_SECTIONS: usize = 16;
+const FILTER_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
+
+/// The bias-instability generator, ready to step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum BiasFilter {
+    /// MATLAB `filter(b, a, ·)`, coefficients normalised by a₀, transposed direct form II.
+    Iir {
+        b: [f64; MAX_FILTER_COEFFICIENTS],
+        a: [f64; MAX_FILTER_COEFFICIENTS],
+        len: usize,
+    },
+    /// Cascade of `(1 − ζ z⁻¹)/(1 − φ z⁻¹)` sections times a gain (flicker noise).
+    Cascade {
+        zero: [f64; MAX_FLICKER_SECTIONS],
+        pole: [f64; MAX_FLICKER_SECTIONS],
+        sections: usize,
+        gain: f64,
+    },
+}
+
+impl BiasFilter {
+    fn new(model: &BiasInstabilityModel, sample_rate_hz: f64) -> Self {
+        match model {
+            BiasInstabilityModel::Filter(c) => {
+                let (num, den) = (c.numerator(), c.denominator());
+                let mut b = [0.0; MAX_FILTER_COEFFICIENTS];
+                let mut a = [0.0; MAX_FILTER_COEFFICIENTS];
+                for (k, v) in num.iter().enumerate() {
+                    b[k] = v / den[0];
+                }
+                for (k, v) in den.iter().enumerate() {
+                    a[k] = v / den[0];
+                }
+                Self::Iir {
+                    b,
+                    a,
+                    len: num.len().max(den.len()),
+                }
+            }
+            BiasInstabilityModel::Flicker {
+                tau_min_s,
+                tau_max_s,
+            } => flicker(*tau_min_s, *tau_max_s, sample_rate_hz),
+        }
+    }
+
+    fn step(&self, x: f64, z: &mut [f64; FILTER_STATE]) -> f64 {
+        match self {
+            Self::Iir { b, a, len } => {
+                let n = *len;
+                let y = b[0] * x + if n > 1 { z[0] } else { 0.0 };
+                for k in 1..n {
+                    let next = if k + 1 < n { z[k] } else { 0.0 };
+                    z[k - 1] = b[k] * x + next - a[k] * y;
+                }
+                y
+            }
+            Self::Cascade {
+                zero,
+                pole,
+                sections,
+                gain,
+            } => {
+                let mut v = x;
+                for i in 0..*sections {
+                    let y = v - zero[i] * z[i] + pole[i] * z[MAX_FLICKER_SECTIONS + i];
+                    z[i] = v;
+                    z[MAX_FLICKER_SECTIONS + i] = y;
+                    v = y;
+                }
+                gain * v
+            }
+        }
+    }
+}
+
+/// Designs the flicker cascade: poles and zeros alternate, log-spaced two per decade between
+/// `f_lo = 0.02/τ_max` and `f_hi = min(fs/4, 20/τ_min)` (continuous-time, mapped by `z = e^{sT}`),
+/// so `|H|² ∝ 1/f` in between; the gain makes the two-sided PSD of the output for input `B·n`
+/// equal `B²/(2πf)`, whose Allan deviation is `√(2 ln 2/π)·B ≈ 0.664·B` (IEEE 952, Annex C).
+fn flicker(tau_min_s: f64, tau_max_s: f64, fs: f64) -> BiasFilter {
+    let two_pi = 2.0 * core::f64::consts::PI;
+    let f_hi = (fs / 4.0).min(20.0 / tau_min_s);
+    let f_lo = (0.02 / tau_max_s).min(f_hi / 10.0);
+    let ratio = f_hi / f_lo;
+    let sections = (math::ceil(2.0 * math::ln(ratio) / math::ln(10.0)) as usize)
+        .clamp(1, MAX_FLICKER_SECTIONS);
+    let r = math::powf(ratio, 1.0 / sections as f64);
+    let mut zero = [0.0; MAX_FLICKER_SECTIONS];
+    let mut pole = [0.0; MAX_FLICKER_SECTIONS];
+    for i in 0..sections {
+        let p = f_lo * math::powf(r, i as f64);
+        pole[i] = math::exp(-two_pi * p / fs);
+        zero[i] = math::exp(-two_pi * p * math::sqrt(r) / fs);
+    }
+    // |H(e^{jω})|² of the cascade, with 1 − cos ω written as 2 sin²(ω/2) for precision.
+    let h2 = |f: f64| {
+        let s = math::sin(core::f64::consts::PI * f / fs);
+        let s2 = 2.0 * s * s;
+        (0..sections).fold(1.0, |acc, i| {
+            let (q, p) = (zero[i], pole[i]);
+            acc * ((1.0 - q) * (1.0 - q) + 2.0 * q * s2) / ((1.0 - p) * (1.0 - p) + 2.0 * p * s2)
+        })
+    };
+    const POINTS: usize = 48;
+    let (a, b) = (math::ln(f_lo * r), math::ln(f_hi / r));
+    let mean_log_gain2 = (0..POINTS)
+        .map(|j| {
+            let f = math::exp(a + (b - a) * j as f64 / (POINTS - 1) as f64);
+            math::ln(fs / (two_pi * f * h2(f)))
+        })
+        .sum::<f64>()
+        / POINTS as f64;
+    BiasFilter::Cascade {
+        zero,
+        pole,
+        sections,
+        gain: math::sqrt(math::exp(mean_log_gain2)),
+    }
+}
 
 /// The conditions of one sample that the error model depends on besides the true value.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,9 +177,7 @@ pub struct SensorModel {
     bias: [f64; 3],
     white_sigma: [f64; 3],
     bias_instability: [f64; 3],
-    b: [f64; MAX_FILTER_COEFFICIENTS],
-    a: [f64; MAX_FILTER_COEFFICIENTS],
-    filter_len: usize,
+    bias_filter: BiasFilter,
     random_walk_sigma: [f64; 3],
     temperature_bias: [f64; 3],
     temperature_scale: [f64; 3],
@@ -83,17 +204,6 @@ impl SensorModel {
             NoiseType::DoubleSided => sample_rate_hz / 2.0,
         };
         let root = math::sqrt(bandwidth);
-        let coeffs = params.bias_instability_coefficients;
-        let (num, den) = (coeffs.numerator(), coeffs.denominator());
-        let a0 = den[0];
-        let mut b = [0.0; MAX_FILTER_COEFFICIENTS];
-        let mut a = [0.0; MAX_FILTER_COEFFICIENTS];
-        for (k, c) in num.iter().enumerate() {
-            b[k] = c / a0;
-        }
-        for (k, c) in den.iter().enumerate() {
-            a[k] = c / a0;
-        }
         Ok(Self {
             misalignment: params
                 .axes_misalignment_pct
@@ -101,9 +211,7 @@ impl SensorModel {
             bias: params.constant_bias,
             white_sigma: params.noise_density.map(|n| n * root),
             bias_instability: params.bias_instability,
-            b,
-            a,
-            filter_len: num.len().max(den.len()),
+            bias_filter: BiasFilter::new(&params.bias_instability_model, sample_rate_hz),
             random_walk_sigma: params.random_walk.map(|k| k / root),
             temperature_bias: params.temperature_bias,
             temperature_scale: params.temperature_scale_factor_pct.map(|s| s / 100.0),
@@ -129,8 +237,9 @@ impl SensorModel {
         core::array::from_fn(|i| {
             let m = &self.misalignment[i];
             let bulk = m[0] * u[0] + m[1] * u[1] + m[2] * u[2] + self.bias[i];
-            let instability =
-                self.filter_step(self.bias_instability[i] * n_bi[i], &mut state.filter[i]);
+            let instability = self
+                .bias_filter
+                .step(self.bias_instability[i] * n_bi[i], &mut state.filter[i]);
             state.random_walk[i] += self.random_walk_sigma[i] * n_rw[i];
             let drift = instability + self.white_sigma[i] * n_white[i] + state.random_walk[i];
             let environment = dt_c * self.temperature_bias[i]
@@ -138,17 +247,6 @@ impl SensorModel {
             let y = (1.0 + dt_c * self.temperature_scale[i]) * (bulk + drift + environment);
             self.quantise(self.saturate(y))
         })
-    }
-
-    /// One step of MATLAB `filter(b, a, x)` in transposed direct form II (persistent state `z`).
-    fn filter_step(&self, x: f64, z: &mut [f64; FILTER_STATE]) -> f64 {
-        let n = self.filter_len;
-        let y = self.b[0] * x + if n > 1 { z[0] } else { 0.0 };
-        for k in 1..n {
-            let next = if k + 1 < n { z[k] } else { 0.0 };
-            z[k - 1] = self.b[k] * x + next - self.a[k] * y;
-        }
-        y
     }
 
     fn saturate(&self, y: f64) -> f64 {

@@ -99,6 +99,30 @@ impl FilterCoefficients {
     }
 }
 
+/// How the bias-instability drift is generated from `BiasInstability·n`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BiasInstabilityModel {
+    /// MATLAB's `filter(Num, Den, ·)` (default `Num = [1]`, `Den = [1, −0.5]`). Note that this
+    /// default is an AR(1) process with a 2-sample correlation: under Allan analysis it looks like
+    /// extra white noise, not a flat floor.
+    Filter(FilterCoefficients),
+    /// Flicker (1/f) noise whose Allan deviation is `0.664·BiasInstability` for τ between
+    /// `tau_min_s` and `tau_max_s` (the datasheet's bias-instability floor), from a cascade of
+    /// first-order pole-zero sections (two per decade) driven by one normal per axis.
+    Flicker {
+        /// Shortest τ of the floor, s (> 0).
+        tau_min_s: f64,
+        /// Longest τ of the floor, s (> `tau_min_s`).
+        tau_max_s: f64,
+    },
+}
+
+impl Default for BiasInstabilityModel {
+    fn default() -> Self {
+        Self::Filter(FilterCoefficients::matlab_default())
+    }
+}
+
 /// Error parameters of one triad (accelerometer, gyroscope or magnetometer), MATLAB's
 /// `accelparams`/`gyroparams`/`magparams` fields in SI units of the measurand `[u]`
 /// (m/s², rad/s or µT). The default is an ideal sensor.
@@ -116,8 +140,8 @@ pub struct SensorParams {
     pub noise_density: [f64; 3],
     /// Bias-instability input amplitude, `[u]`, ≥ 0.
     pub bias_instability: [f64; 3],
-    /// Bias-instability filter.
-    pub bias_instability_coefficients: FilterCoefficients,
+    /// How the bias instability is generated (MATLAB's filter by default).
+    pub bias_instability_model: BiasInstabilityModel,
     /// Random walk, `[u]·√Hz`, ≥ 0.
     pub random_walk: [f64; 3],
     /// PSD convention of `noise_density` and `random_walk`.
@@ -139,7 +163,7 @@ impl Default for SensorParams {
             axes_misalignment_pct: [[100.0, 0.0, 0.0], [0.0, 100.0, 0.0], [0.0, 0.0, 100.0]],
             noise_density: [0.0; 3],
             bias_instability: [0.0; 3],
-            bias_instability_coefficients: FilterCoefficients::matlab_default(),
+            bias_instability_model: BiasInstabilityModel::default(),
             random_walk: [0.0; 3],
             noise_type: NoiseType::SingleSided,
             temperature_bias: [0.0; 3],
@@ -237,6 +261,27 @@ impl SensorParams {
             });
         }
         finite("acceleration_bias", &self.acceleration_bias)?;
+        if let BiasInstabilityModel::Flicker {
+            tau_min_s,
+            tau_max_s,
+        } = self.bias_instability_model
+        {
+            if !(tau_min_s.is_finite() && tau_min_s > 0.0) {
+                return Err(ParamError::NotPositive {
+                    field: "bias_instability_tau_min_s",
+                    value: tau_min_s,
+                });
+            }
+            if !(tau_max_s.is_finite() && tau_max_s > tau_min_s) {
+                return Err(ParamError::OutOfRange {
+                    field: "bias_instability_tau_max_s",
+                    index: 0,
+                    value: tau_max_s,
+                    min: tau_min_s,
+                    max: f64::INFINITY,
+                });
+            }
+        }
         Ok(())
     }
 }
