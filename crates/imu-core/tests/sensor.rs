@@ -563,3 +563,46 @@ fn matlab_spec_sheet_accelerometer_example_deterministic_part() {
     close(r.accel_m_s2, expected);
     assert_eq!(r.gyro_rad_s, [0.0; 3]);
 }
+
+#[test]
+fn gauss_markov_bias_has_the_set_standard_deviation_and_correlation_time() {
+    // Steady-state variance B²; lag-1 correlation φ = exp(−1/(fs·T)). Start from zero, so skip
+    // 10 correlation times; the sample variance of an AR(1) series of length n has relative sd
+    // ≈ √(2(1+φ²)/((1−φ²)n)).
+    let (fs, t_corr, b) = (50.0, 0.2, 0.03);
+    let p = SensorParams {
+        bias_instability: [b; 3],
+        bias_instability_model: imu_core::sensor::BiasInstabilityModel::GaussMarkov {
+            correlation_time_s: t_corr,
+        },
+        ..SensorParams::default()
+    };
+    let y = series(&p, fs, 210_000, 21);
+    let x: Vec<f64> = y[100..].iter().map(|r| r[1]).collect();
+    let phi: f64 = (-1.0 / (fs * t_corr)).exp();
+    let (mean, var) = moments(&x);
+    let tol = 5.0 * (2.0 * (1.0 + phi * phi) / ((1.0 - phi * phi) * x.len() as f64)).sqrt();
+    assert!(
+        (var / (b * b) - 1.0).abs() < tol,
+        "{var} vs {} (tol {tol})",
+        b * b
+    );
+    let c1: f64 = x
+        .windows(2)
+        .map(|w| (w[0] - mean) * (w[1] - mean))
+        .sum::<f64>()
+        / (x.len() as f64 - 1.0);
+    assert!((c1 / var - phi).abs() < 0.01, "rho1 {} vs {phi}", c1 / var);
+    assert!(
+        SensorModel::new(
+            &SensorParams {
+                bias_instability_model: imu_core::sensor::BiasInstabilityModel::GaussMarkov {
+                    correlation_time_s: 0.0
+                },
+                ..SensorParams::default()
+            },
+            fs
+        )
+        .is_err()
+    );
+}

@@ -49,6 +49,15 @@ impl BiasFilter {
                 tau_min_s,
                 tau_max_s,
             } => flicker(*tau_min_s, *tau_max_s, sample_rate_hz),
+            BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
+                let phi = math::exp(-1.0 / (sample_rate_hz * correlation_time_s));
+                let mut b = [0.0; MAX_FILTER_COEFFICIENTS];
+                let mut a = [0.0; MAX_FILTER_COEFFICIENTS];
+                b[0] = math::sqrt(1.0 - phi * phi);
+                a[0] = 1.0;
+                a[1] = -phi;
+                Self::Iir { b, a, len: 2 }
+            }
         }
     }
 

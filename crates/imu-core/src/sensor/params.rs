@@ -115,6 +115,12 @@ pub enum BiasInstabilityModel {
         /// Longest τ of the floor, s (> `tau_min_s`).
         tau_max_s: f64,
     },
+    /// First-order Gauss–Markov with the given correlation time (gnss-ins-sim style): steady-state
+    /// standard deviation `BiasInstability`, `x_k = φ x_{k−1} + √(1−φ²)·B·n`, `φ = e^{−1/(fs·T)}`.
+    GaussMarkov {
+        /// Correlation time, s (> 0).
+        correlation_time_s: f64,
+    },
 }
 
 impl Default for BiasInstabilityModel {
@@ -261,6 +267,15 @@ impl SensorParams {
             });
         }
         finite("acceleration_bias", &self.acceleration_bias)?;
+        if let BiasInstabilityModel::GaussMarkov { correlation_time_s } =
+            self.bias_instability_model
+            && !(correlation_time_s.is_finite() && correlation_time_s > 0.0)
+        {
+            return Err(ParamError::NotPositive {
+                field: "bias_instability_correlation_time_s",
+                value: correlation_time_s,
+            });
+        }
         if let BiasInstabilityModel::Flicker {
             tau_min_s,
             tau_max_s,
