@@ -231,14 +231,14 @@ fn ideal_imu<'py>(
         };
         return Err(ImuError::new_err(format!("{field}: must be finite")));
     }
-    let imu = ImuSetup {
-        kind: parse_name::<ImuKind>("kind", kind).map_err(refused)?,
+    let imu = ImuSetup::ideal(
+        parse_name::<ImuKind>("kind", kind).map_err(refused)?,
         lever_arm_m,
-        accel_sign: parse_name::<AccelSignName>("accel_sign", accel_sign)
+        parse_name::<AccelSignName>("accel_sign", accel_sign)
             .map_err(refused)?
             .into(),
         magnetic_field_ut,
-    };
+    );
     let nav = nav(nav_frame)?;
     let out = py
         .detach(move || arrays::ideal_from_truth(&table, &imu, gravity_m_s2, nav))

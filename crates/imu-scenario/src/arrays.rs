@@ -134,6 +134,10 @@ pub fn ideal_from_truth(
         let mut readings = vec![IdealReading::default(); truth.len()];
         mount.read_into(&truth, &mut readings);
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
+        let readings: Vec<_> = readings
+            .iter()
+            .map(crate::sensors::ideal_as_reading)
+            .collect();
         Ok(Table::from_readings(&t, &readings, imu.kind))
     }
     in_frame(

@@ -7,7 +7,10 @@ pub mod arrays;
 pub mod builtin;
 pub mod error;
 pub mod expr;
+pub mod params;
+pub mod presets;
 pub mod scenario;
+pub mod sensors;
 pub mod table;
 pub mod track;
 

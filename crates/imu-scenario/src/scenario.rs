@@ -23,16 +23,17 @@ use std::path::{Path, PathBuf};
 use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
-use imu_core::{
-    AccelSign, Enu, EulerZyx, IdealReading, ImuMount, KinematicsError, NavFrame, Ned, Truth, Vec3,
-};
+use imu_core::{AccelSign, Enu, EulerZyx, ImuMount, KinematicsError, NavFrame, Ned, Truth, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::builtin;
 use crate::error::{Error, Result, invalid};
 use crate::expr::Expr;
+use crate::params::Profile;
+use crate::sensors::{SensorKeys, SensorSetup, TemperatureSpec};
 use crate::table::{ImuKind, Table, read_columns, read_header};
 use crate::track::{Segment, SpeedProfile, Track};
+use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
 
 /// The navigation frame, by name.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -197,6 +198,71 @@ pub struct ImuSpec {
     pub accel_sign: Option<AccelSignName>,
     /// Magnetic field, navigation frame, µT (default MATLAB's, in the chosen frame).
     pub magnetic_field_ut: Option<[f64; 3]>,
+    /// `"default"` or `"matlab"` conventions.
+    pub profile: Option<Profile>,
+    /// Seed of the noise stream (default 0).
+    pub seed: Option<u64>,
+    /// Sensor temperature, °C, or a CSV file of a temperature profile.
+    pub temperature_c: Option<TemperatureSpec>,
+    /// A preset of a real part (`imukit presets`).
+    pub preset: Option<String>,
+    /// A parameter file: imukit TOML/JSON or MATLAB `loadparams` JSON.
+    pub params: Option<PathBuf>,
+    /// The part to take from a MATLAB JSON file holding several.
+    pub part: Option<String>,
+    /// Accelerometer parameters (override the preset or file key by key).
+    pub accelerometer: Option<serde_json::Value>,
+    /// Gyroscope parameters.
+    pub gyroscope: Option<serde_json::Value>,
+    /// Magnetometer parameters.
+    pub magnetometer: Option<serde_json::Value>,
+}
+
+impl ImuSpec {
+    /// Keys of `self`, falling back to `other`'s where `self` has none.
+    #[must_use]
+    pub fn or(&self, other: &Self) -> Self {
+        Self {
+            kind: self.kind.or(other.kind),
+            lever_arm_m: self.lever_arm_m.or(other.lever_arm_m),
+            accel_sign: self.accel_sign.or(other.accel_sign),
+            magnetic_field_ut: self.magnetic_field_ut.or(other.magnetic_field_ut),
+            profile: self.profile.or(other.profile),
+            seed: self.seed.or(other.seed),
+            temperature_c: self
+                .temperature_c
+                .clone()
+                .or_else(|| other.temperature_c.clone()),
+            preset: self.preset.clone().or_else(|| other.preset.clone()),
+            params: self.params.clone().or_else(|| other.params.clone()),
+            part: self.part.clone().or_else(|| other.part.clone()),
+            accelerometer: self
+                .accelerometer
+                .clone()
+                .or_else(|| other.accelerometer.clone()),
+            gyroscope: self.gyroscope.clone().or_else(|| other.gyroscope.clone()),
+            magnetometer: self
+                .magnetometer
+                .clone()
+                .or_else(|| other.magnetometer.clone()),
+        }
+    }
+
+    fn sensor_keys(&self) -> SensorKeys<'_> {
+        SensorKeys {
+            profile: self.profile,
+            seed: self.seed,
+            temperature_c: self.temperature_c.as_ref(),
+            preset: self.preset.as_deref(),
+            params: self.params.as_deref(),
+            part: self.part.as_deref(),
+            tables: [
+                self.accelerometer.as_ref(),
+                self.gyroscope.as_ref(),
+                self.magnetometer.as_ref(),
+            ],
+        }
+    }
 }
 
 /// Attitude of an expression motion.
@@ -428,7 +494,7 @@ pub enum Trajectory {
 }
 
 /// The IMU of a scenario, resolved.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ImuSetup {
     /// Sensors simulated.
     pub kind: ImuKind,
@@ -438,9 +504,84 @@ pub struct ImuSetup {
     pub accel_sign: AccelSign,
     /// Magnetic field in the navigation frame, µT; `None` for the frame's default.
     pub magnetic_field_ut: Option<[f64; 3]>,
+    /// Sensor errors, profile, seed, temperature (ideal by default).
+    pub sensors: SensorSetup,
 }
 
 impl ImuSetup {
+    /// An IMU without sensor errors.
+    #[must_use]
+    pub fn ideal(
+        kind: ImuKind,
+        lever_arm_m: [f64; 3],
+        accel_sign: AccelSign,
+        magnetic_field_ut: Option<[f64; 3]>,
+    ) -> Self {
+        Self {
+            kind,
+            lever_arm_m,
+            accel_sign,
+            magnetic_field_ut,
+            sensors: SensorSetup::default(),
+        }
+    }
+
+    /// The validated error model in frame `N` at `sample_rate_hz`.
+    ///
+    /// # Errors
+    /// Invalid parameters, with sensor and field.
+    pub fn model<N: NavFrame>(
+        &self,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+    ) -> Result<ImuModel<N>> {
+        let set = SensorSet {
+            gyroscope: self.kind.has_gyro(),
+            magnetometer: self.kind.has_mag(),
+        };
+        let p = &self.sensors.params;
+        ImuModel::new(
+            self.mount::<N>(gravity_m_s2),
+            set,
+            self.sensors.gyro_acceleration,
+            [&p.accelerometer, &p.gyroscope, &p.magnetometer],
+            sample_rate_hz,
+        )
+        .map_err(|e| invalid("imu", e.to_string()))
+    }
+
+    /// Sensor readings for `truth`: the single run (`run = None`, stream `SeededNormals::new(seed)`)
+    /// or Monte Carlo run `r` (`SeededNormals::for_run(seed, r)`).
+    ///
+    /// # Errors
+    /// Invalid parameters.
+    pub fn readings<N: NavFrame>(
+        &self,
+        truth: &[Truth<N>],
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+        run: Option<u64>,
+    ) -> Result<Vec<ImuReading>> {
+        let model = self.model::<N>(gravity_m_s2, sample_rate_hz)?;
+        let seed = self.sensors.seed;
+        let mut noise = run.map_or_else(
+            || SeededNormals::new(seed),
+            |r| SeededNormals::for_run(seed, r),
+        );
+        let mut state = ImuState::default();
+        Ok(truth
+            .iter()
+            .map(|s| {
+                model.measure(
+                    s,
+                    &self.sensors.temperature.at(s.t_s),
+                    &mut state,
+                    &mut noise,
+                )
+            })
+            .collect())
+    }
+
     /// The core's mount description in frame `N`.
     #[must_use]
     pub fn mount<N: NavFrame>(&self, gravity_m_s2: f64) -> ImuMount<N> {
@@ -460,6 +601,8 @@ impl ImuSetup {
 pub struct Scenario {
     /// Sample times, s.
     pub t_s: Vec<f64>,
+    /// Sample rate of the sensor error model, Hz (`rate_hz`, or the mean rate of a samples file).
+    pub sample_rate_hz: f64,
     /// Navigation frame.
     pub nav_frame: NavFrameName,
     /// Gravity magnitude, m/s².
@@ -578,12 +721,7 @@ impl ScenarioSpec {
                 nav_frame: self.nav_frame.or(b.nav_frame),
                 gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
                 trajectory: b.trajectory,
-                imu: ImuSpec {
-                    kind: self.imu.kind.or(b.imu.kind),
-                    lever_arm_m: self.imu.lever_arm_m.or(b.imu.lever_arm_m),
-                    accel_sign: self.imu.accel_sign.or(b.imu.accel_sign),
-                    magnetic_field_ut: self.imu.magnetic_field_ut.or(b.imu.magnetic_field_ut),
-                },
+                imu: self.imu.or(&b.imu),
             };
             &merged
         } else {
@@ -596,15 +734,21 @@ impl ScenarioSpec {
                 format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
             ));
         }
+        let sensors = SensorSetup::resolve(&spec.imu.sensor_keys(), base_dir)?;
+        let accel_sign = spec
+            .imu
+            .accel_sign
+            .map_or(sensors.profile.accel_sign(), AccelSign::from);
         let imu = ImuSetup {
             kind: spec.imu.kind.unwrap_or_default(),
             lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
-            accel_sign: spec.imu.accel_sign.unwrap_or_default().into(),
+            accel_sign,
             magnetic_field_ut: spec
                 .imu
                 .magnetic_field_ut
                 .map(|m| finite_vec("imu.magnetic_field_ut", m))
                 .transpose()?,
+            sensors,
         };
         let need = |v: Option<f64>, field: &str| {
             v.ok_or_else(|| invalid(field, "missing (required for this trajectory type)"))
@@ -661,8 +805,14 @@ impl ScenarioSpec {
             }
             TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
         };
+        let sample_rate_hz = match spec.rate_hz {
+            Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
+            _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s[t_s.len() - 1] - t_s[0]),
+            _ => spec.rate_hz.unwrap_or(1.0),
+        };
         Ok(Scenario {
             t_s,
+            sample_rate_hz,
             nav_frame: spec.nav_frame.unwrap_or_default(),
             gravity_m_s2,
             trajectory,
@@ -723,21 +873,34 @@ impl Scenario {
     /// The core's refusal, with where and when.
     pub fn simulate(&self) -> Result<Simulation> {
         match self.nav_frame {
-            NavFrameName::ENU => self.simulate_in::<Enu>(),
-            NavFrameName::NED => self.simulate_in::<Ned>(),
+            NavFrameName::ENU => self.simulate_in::<Enu>(None),
+            NavFrameName::NED => self.simulate_in::<Ned>(None),
         }
     }
 
-    fn simulate_in<N: NavFrame>(&self) -> Result<Simulation> {
+    fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
         let truth = self.trajectory.truth::<N>(&self.t_s)?;
-        let mount = self.imu.mount::<N>(self.gravity_m_s2);
-        let mut readings = vec![IdealReading::default(); truth.len()];
-        mount.read_into(&truth, &mut readings);
+        let readings = self
+            .imu
+            .readings(&truth, self.gravity_m_s2, self.sample_rate_hz, run)?;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         Ok(Simulation {
             truth: Table::from_truth(&truth),
             imu: Table::from_readings(&t, &readings, self.imu.kind),
         })
+    }
+
+    /// Truth and readings of Monte Carlo run `run`: the noise stream is
+    /// `SeededNormals::for_run(seed, run)`, so a run's numbers do not depend on how many runs
+    /// there are or which thread computes them.
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`].
+    pub fn simulate_run(&self, run: u64) -> Result<Simulation> {
+        match self.nav_frame {
+            NavFrameName::ENU => self.simulate_in::<Enu>(Some(run)),
+            NavFrameName::NED => self.simulate_in::<Ned>(Some(run)),
+        }
     }
 }
 

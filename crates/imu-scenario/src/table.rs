@@ -8,7 +8,8 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use imu_core::{IdealReading, NavFrame, Truth};
+use imu_core::sensor::ImuReading;
+use imu_core::{NavFrame, Truth};
 
 use crate::error::{Error, Result};
 
@@ -141,18 +142,18 @@ impl Table {
         t
     }
 
-    /// Ideal readings with their times as a table with the columns of `kind`.
+    /// Readings with their times as a table with the columns of `kind`.
     #[must_use]
-    pub fn from_readings(t_s: &[f64], readings: &[IdealReading], kind: ImuKind) -> Self {
+    pub fn from_readings(t_s: &[f64], readings: &[ImuReading], kind: ImuKind) -> Self {
         let mut t = Self::new(&kind.columns());
         for (ti, r) in t_s.iter().zip(readings) {
             let mut row = vec![*ti];
-            row.extend(r.accel_m_s2.to_array());
+            row.extend(r.accel_m_s2);
             if kind.has_gyro() {
-                row.extend(r.gyro_rad_s.to_array());
+                row.extend(r.gyro_rad_s);
             }
             if kind.has_mag() {
-                row.extend(r.mag_ut.to_array());
+                row.extend(r.mag_ut);
             }
             t.push_row(&row);
         }

@@ -1,0 +1,609 @@
+//! Sensor parameter files: imukit's own (TOML or JSON, every key with its unit) and MATLAB's
+//! `loadparams` JSON, read as MATLAB reads it.
+//!
+//! imukit's keys, with `U` the measurand's unit — `m_s2` (accelerometer), `rad_s` (gyroscope),
+//! `ut` (magnetometer):
+//!
+//! | key | meaning | value |
+//! |---|---|---|
+//! | `measurement_range_U` | saturation | number or `"inf"` |
+//! | `resolution_U` | quantisation step per LSB | number |
+//! | `constant_bias_U` | bias | number or `[x, y, z]` |
+//! | `axes_misalignment_pct` | misalignment, % | number s, `[a, b, c]` or 3×3 (MATLAB's forms) |
+//! | `noise_density_U_per_rt_hz` | white noise density | number or 3-vector |
+//! | `bias_instability_U` | bias instability | number or 3-vector |
+//! | `bias_instability_numerator`, `bias_instability_denominator` | MATLAB's filter | lists |
+//! | `bias_instability_flicker_tau_s` | flicker floor 0.664·B over `[τ_min, τ_max]` | 2 numbers |
+//! | `bias_instability_correlation_time_s` | Gauss–Markov instead | number |
+//! | `random_walk_U_rt_hz` | rate random walk, U·√Hz | number or 3-vector |
+//! | `noise_type` | `"single-sided"` (default) or `"double-sided"` | string |
+//! | `temperature_bias_U_per_c` | bias per °C from 25 °C | number or 3-vector |
+//! | `temperature_scale_factor_pct_per_c` | scale factor per °C, % | number or 3-vector |
+//! | `acceleration_bias_rad_s_per_m_s2` | gyroscope g-sensitivity | number or 3-vector |
+//!
+//! MATLAB's names (`MeasurementRange`, `Resolution`, `ConstantBias`, `AxesMisalignment`,
+//! `NoiseDensity`, `BiasInstability`, `BiasInstabilityCoefficients` with `Numerator` and
+//! `Denominator`, `RandomWalk`, `NoiseType`, `TemperatureBias`, `TemperatureScaleFactor`,
+//! `AccelerationBias`) are accepted in the same tables, in SI units as MATLAB takes them.
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use imu_core::AccelSign;
+use imu_core::sensor::{
+    BiasInstabilityModel, FilterCoefficients, GyroAccelerationInput, NoiseType, SensorParams,
+};
+use serde_json::Value;
+
+use crate::error::{Error, Result, invalid};
+
+/// The three sensors of an IMU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sensor {
+    /// Accelerometer (m/s²).
+    Accelerometer,
+    /// Gyroscope (rad/s).
+    Gyroscope,
+    /// Magnetometer (µT).
+    Magnetometer,
+}
+
+impl Sensor {
+    /// All three, in the order of the random-number draws.
+    pub const ALL: [Self; 3] = [Self::Accelerometer, Self::Gyroscope, Self::Magnetometer];
+
+    /// Table name in parameter files (`accelerometer`, …).
+    #[must_use]
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::Accelerometer => "accelerometer",
+            Self::Gyroscope => "gyroscope",
+            Self::Magnetometer => "magnetometer",
+        }
+    }
+
+    /// MATLAB's name (`Accelerometer`, …).
+    #[must_use]
+    pub fn matlab_key(self) -> &'static str {
+        match self {
+            Self::Accelerometer => "Accelerometer",
+            Self::Gyroscope => "Gyroscope",
+            Self::Magnetometer => "Magnetometer",
+        }
+    }
+
+    /// Unit suffix of the measurand in key names.
+    #[must_use]
+    pub fn unit(self) -> &'static str {
+        match self {
+            Self::Accelerometer => "m_s2",
+            Self::Gyroscope => "rad_s",
+            Self::Magnetometer => "ut",
+        }
+    }
+}
+
+/// Parameters of the three sensors.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImuParams {
+    /// Accelerometer.
+    pub accelerometer: SensorParams,
+    /// Gyroscope.
+    pub gyroscope: SensorParams,
+    /// Magnetometer.
+    pub magnetometer: SensorParams,
+}
+
+impl ImuParams {
+    /// The parameters of `sensor`.
+    #[must_use]
+    pub fn get(&self, sensor: Sensor) -> &SensorParams {
+        match sensor {
+            Sensor::Accelerometer => &self.accelerometer,
+            Sensor::Gyroscope => &self.gyroscope,
+            Sensor::Magnetometer => &self.magnetometer,
+        }
+    }
+
+    /// The parameters of `sensor`, mutable.
+    pub fn get_mut(&mut self, sensor: Sensor) -> &mut SensorParams {
+        match sensor {
+            Sensor::Accelerometer => &mut self.accelerometer,
+            Sensor::Gyroscope => &mut self.gyroscope,
+            Sensor::Magnetometer => &mut self.magnetometer,
+        }
+    }
+}
+
+/// Conventions that differ between imukit's defaults and MATLAB's imuSensor.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Profile {
+    /// Single-sided noise densities, specific-force sign, gyro g-sensitivity to the body-frame
+    /// specific force.
+    #[default]
+    Default,
+    /// MATLAB imuSensor: double-sided, gravity-minus-acceleration sign, g-sensitivity to the raw
+    /// navigation-frame acceleration, bias-instability filter `[1], [1, −0.5]`.
+    Matlab,
+}
+
+impl Profile {
+    /// The noise type a sensor gets when its table does not say.
+    #[must_use]
+    pub fn noise_type(self) -> NoiseType {
+        match self {
+            Self::Default => NoiseType::SingleSided,
+            Self::Matlab => NoiseType::DoubleSided,
+        }
+    }
+    /// The accelerometer sign when the scenario does not say.
+    #[must_use]
+    pub fn accel_sign(self) -> AccelSign {
+        match self {
+            Self::Default => AccelSign::SpecificForce,
+            Self::Matlab => AccelSign::Matlab,
+        }
+    }
+    /// What the gyroscope's AccelerationBias multiplies.
+    #[must_use]
+    pub fn gyro_acceleration(self) -> GyroAccelerationInput {
+        match self {
+            Self::Default => GyroAccelerationInput::BodySpecificForce,
+            Self::Matlab => GyroAccelerationInput::NavAcceleration,
+        }
+    }
+}
+
+fn as_number(v: &Value, field: &str) -> Result<f64> {
+    match v {
+        Value::Number(n) => n.as_f64().ok_or_else(|| invalid(field, "not a number")),
+        Value::String(s)
+            if matches!(s.to_ascii_lowercase().as_str(), "inf" | "infinity" | "+inf") =>
+        {
+            Ok(f64::INFINITY)
+        }
+        // TOML's nan arrives here as null (JSON has no NaN).
+        Value::Null => Err(invalid(field, "not a finite number (NaN)")),
+        other => Err(invalid(field, format!("expected a number, got {other}"))),
+    }
+}
+
+fn finite_number(v: &Value, field: &str) -> Result<f64> {
+    let x = as_number(v, field)?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(invalid(field, "must be finite"))
+    }
+}
+
+/// A number (same on every axis) or a 3-vector.
+fn triple(v: &Value, field: &str) -> Result<[f64; 3]> {
+    match v {
+        Value::Array(a) if a.len() == 3 => Ok([
+            finite_number(&a[0], &format!("{field}[0]"))?,
+            finite_number(&a[1], &format!("{field}[1]"))?,
+            finite_number(&a[2], &format!("{field}[2]"))?,
+        ]),
+        Value::Array(a) => Err(invalid(
+            field,
+            format!("expected a number or 3 numbers, got {} values", a.len()),
+        )),
+        other => Ok([finite_number(other, field)?; 3]),
+    }
+}
+
+/// MATLAB's AxesMisalignment forms: scalar, 3-vector or 3×3, percent.
+fn misalignment(v: &Value, field: &str) -> Result<[[f64; 3]; 3]> {
+    match v {
+        Value::Array(rows) if rows.len() == 3 && rows.iter().all(Value::is_array) => {
+            let mut m = [[0.0; 3]; 3];
+            for (i, row) in rows.iter().enumerate() {
+                m[i] = triple(row, &format!("{field}[{i}]"))?;
+            }
+            Ok(m)
+        }
+        Value::Array(_) => Ok(SensorParams::misalignment_from_vector(triple(v, field)?)),
+        other => Ok(SensorParams::misalignment_from_scalar(finite_number(
+            other, field,
+        )?)),
+    }
+}
+
+fn list(v: &Value, field: &str) -> Result<Vec<f64>> {
+    match v {
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .map(|(k, x)| finite_number(x, &format!("{field}[{k}]")))
+            .collect(),
+        other => Ok(vec![finite_number(other, field)?]),
+    }
+}
+
+fn noise_type(v: &Value, field: &str) -> Result<NoiseType> {
+    match v.as_str().map(str::to_ascii_lowercase).as_deref() {
+        Some("single-sided") => Ok(NoiseType::SingleSided),
+        Some("double-sided") => Ok(NoiseType::DoubleSided),
+        _ => Err(invalid(
+            field,
+            format!("expected \"single-sided\" or \"double-sided\", got {v}"),
+        )),
+    }
+}
+
+/// Parses one sensor table (imukit's or MATLAB's keys) onto `base`; `prefix` names the table in
+/// messages (e.g. `imu.gyroscope`); `default_noise` is the noise type when the table has none
+/// (`None` keeps `base`'s).
+///
+/// # Errors
+/// Unknown keys (the known ones listed), bad values, invalid parameters — each named.
+pub fn parse_sensor(
+    table: &Value,
+    sensor: Sensor,
+    prefix: &str,
+    default_noise: Option<NoiseType>,
+    base: SensorParams,
+) -> Result<SensorParams> {
+    let Value::Object(map) = table else {
+        return Err(invalid(prefix, "expected a table of parameters"));
+    };
+    let u = sensor.unit();
+    let key = |name: &str| format!("{name}_{u}");
+    let mut p = base;
+    let mut noise_set = false;
+    let mut numerator: Option<Vec<f64>> = None;
+    let mut denominator: Option<Vec<f64>> = None;
+    let mut flicker: Option<[f64; 2]> = None;
+    let mut correlation: Option<f64> = None;
+    let known = [
+        key("measurement_range"),
+        key("resolution"),
+        key("constant_bias"),
+        "axes_misalignment_pct".into(),
+        format!("noise_density_{u}_per_rt_hz"),
+        key("bias_instability"),
+        "bias_instability_numerator".into(),
+        "bias_instability_denominator".into(),
+        "bias_instability_flicker_tau_s".into(),
+        "bias_instability_correlation_time_s".into(),
+        format!("random_walk_{u}_rt_hz"),
+        "noise_type".into(),
+        format!("temperature_bias_{u}_per_c"),
+        "temperature_scale_factor_pct_per_c".into(),
+        "acceleration_bias_rad_s_per_m_s2".into(),
+    ];
+    for (k, v) in map {
+        let field = format!("{prefix}.{k}");
+        let own = known.iter().position(|n| n == k);
+        match (own, k.as_str()) {
+            (Some(0), _) | (_, "MeasurementRange") => p.measurement_range = as_number(v, &field)?,
+            (Some(1), _) | (_, "Resolution") => p.resolution = finite_number(v, &field)?,
+            (Some(2), _) | (_, "ConstantBias") => p.constant_bias = triple(v, &field)?,
+            (Some(3), _) | (_, "AxesMisalignment") => {
+                p.axes_misalignment_pct = misalignment(v, &field)?
+            }
+            (Some(4), _) | (_, "NoiseDensity") => p.noise_density = triple(v, &field)?,
+            (Some(5), _) | (_, "BiasInstability") => p.bias_instability = triple(v, &field)?,
+            (Some(6), _) => numerator = Some(list(v, &field)?),
+            (Some(7), _) => denominator = Some(list(v, &field)?),
+            (_, "BiasInstabilityCoefficients") => {
+                let get = |name: &str| {
+                    v.get(name)
+                        .map(|x| list(x, &format!("{field}.{name}")))
+                        .transpose()
+                };
+                numerator = get("Numerator")?;
+                denominator = get("Denominator")?;
+                if numerator.is_none() || denominator.is_none() {
+                    return Err(invalid(field, "needs Numerator and Denominator"));
+                }
+            }
+            (Some(8), _) => {
+                let l = list(v, &field)?;
+                if l.len() != 2 {
+                    return Err(invalid(field, "expected [tau_min_s, tau_max_s]"));
+                }
+                flicker = Some([l[0], l[1]]);
+            }
+            (Some(9), _) => correlation = Some(finite_number(v, &field)?),
+            (Some(10), _) | (_, "RandomWalk") => p.random_walk = triple(v, &field)?,
+            (Some(11), _) | (_, "NoiseType") => {
+                p.noise_type = noise_type(v, &field)?;
+                noise_set = true;
+            }
+            (Some(12), _) | (_, "TemperatureBias") => p.temperature_bias = triple(v, &field)?,
+            (Some(13), _) | (_, "TemperatureScaleFactor") => {
+                p.temperature_scale_factor_pct = triple(v, &field)?
+            }
+            (Some(14), _) | (_, "AccelerationBias") if sensor == Sensor::Gyroscope => {
+                p.acceleration_bias = triple(v, &field)?;
+            }
+            _ => {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "unknown parameter (known for the {}: {})",
+                        sensor.key(),
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    if let (false, Some(n)) = (noise_set, default_noise) {
+        p.noise_type = n;
+    }
+    let chosen = [
+        numerator.is_some() || denominator.is_some(),
+        flicker.is_some(),
+        correlation.is_some(),
+    ];
+    if chosen.iter().filter(|c| **c).count() > 1 {
+        return Err(invalid(
+            format!("{prefix}.bias_instability"),
+            "give one of the filter coefficients, bias_instability_flicker_tau_s or bias_instability_correlation_time_s",
+        ));
+    }
+    if numerator.is_some() || denominator.is_some() {
+        let num = numerator.unwrap_or_else(|| vec![1.0]);
+        let den = denominator.unwrap_or_else(|| vec![1.0, -0.5]);
+        let c = FilterCoefficients::new(&num, &den).map_err(|e| {
+            invalid(
+                format!("{prefix}.bias_instability_coefficients"),
+                e.to_string(),
+            )
+        })?;
+        p.bias_instability_model = BiasInstabilityModel::Filter(c);
+    }
+    if let Some([tau_min_s, tau_max_s]) = flicker {
+        p.bias_instability_model = BiasInstabilityModel::Flicker {
+            tau_min_s,
+            tau_max_s,
+        };
+    }
+    if let Some(correlation_time_s) = correlation {
+        p.bias_instability_model = BiasInstabilityModel::GaussMarkov { correlation_time_s };
+    }
+    p.validate().map_err(|e| invalid(prefix, e.to_string()))?;
+    Ok(p)
+}
+
+/// A parameter file's content: the three sensors (missing ones ideal) and its description.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ParamFile {
+    /// Parameters.
+    pub params: ImuParams,
+    /// Which sensors the file described.
+    pub present: [bool; 3],
+    /// `name`, `grade`, `source` and other descriptive strings from the file.
+    pub info: BTreeMap<String, String>,
+}
+
+const INFO_KEYS: [&str; 4] = ["name", "grade", "source", "notes"];
+
+/// Parses an imukit parameter document (`[accelerometer]`, `[gyroscope]`, `[magnetometer]`
+/// tables and descriptive strings) given as a JSON value.
+///
+/// # Errors
+/// As [`parse_sensor`]; unknown top-level keys.
+pub fn parse_param_document(doc: &Value, origin: &str, profile: Profile) -> Result<ParamFile> {
+    let Value::Object(map) = doc else {
+        return Err(invalid(
+            origin,
+            "expected a table with accelerometer, gyroscope, magnetometer",
+        ));
+    };
+    let mut out = ParamFile::default();
+    for (k, v) in map {
+        if let Some(i) = Sensor::ALL
+            .iter()
+            .position(|s| s.key() == k || s.matlab_key() == k)
+        {
+            let s = Sensor::ALL[i];
+            let noise = Some(profile.noise_type());
+            *out.params.get_mut(s) = parse_sensor(
+                v,
+                s,
+                &format!("{origin}: {k}"),
+                noise,
+                SensorParams::default(),
+            )?;
+            out.present[i] = true;
+        } else if INFO_KEYS.contains(&k.as_str()) {
+            out.info.insert(
+                k.clone(),
+                v.as_str().map_or_else(|| v.to_string(), str::to_string),
+            );
+        } else {
+            return Err(invalid(
+                format!("{origin}: {k}"),
+                "unknown key (expected accelerometer, gyroscope, magnetometer, name, grade, source, notes)",
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a parameter file: imukit TOML or JSON, or a MATLAB `loadparams` JSON (a part name
+/// holding `Accelerometer`/`Gyroscope`/`Magnetometer`); `part` picks one of several parts.
+///
+/// # Errors
+/// Unreadable file, syntax errors with their line, unknown parts and keys, invalid values.
+pub fn read_param_file(path: &Path, part: Option<&str>, profile: Profile) -> Result<ParamFile> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    let origin = path.display().to_string();
+    let is_json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let doc: Value = if is_json {
+        serde_json::from_str(&text).map_err(|e| Error::Scenario {
+            origin: origin.clone(),
+            message: e.to_string(),
+        })?
+    } else {
+        toml::from_str(&text).map_err(|e| Error::Scenario {
+            origin: origin.clone(),
+            message: e.to_string(),
+        })?
+    };
+    parse_any_document(&doc, &origin, part, profile)
+}
+
+/// Parses either document shape: imukit's, or MATLAB's part-name → sensors.
+///
+/// # Errors
+/// As [`read_param_file`].
+pub fn parse_any_document(
+    doc: &Value,
+    origin: &str,
+    part: Option<&str>,
+    profile: Profile,
+) -> Result<ParamFile> {
+    let Value::Object(map) = doc else {
+        return Err(invalid(origin, "expected a table"));
+    };
+    let is_sensor_key = |k: &str| {
+        Sensor::ALL
+            .iter()
+            .any(|s| s.key() == k || s.matlab_key() == k)
+            || INFO_KEYS.contains(&k)
+    };
+    if map.keys().all(|k| is_sensor_key(k)) {
+        return parse_param_document(doc, origin, profile);
+    }
+    // MATLAB loadparams: { "PartName": { "Accelerometer": {...}, ... }, ... }
+    let parts: Vec<&String> = map.keys().collect();
+    let name = match part {
+        Some(p) => map.get_key_value(p).map(|(k, _)| k).ok_or_else(|| {
+            invalid(
+                origin,
+                format!(
+                    "no part \"{p}\" (parts: {})",
+                    parts
+                        .iter()
+                        .map(|s| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })?,
+        None if parts.len() == 1 => parts[0],
+        None => {
+            return Err(invalid(
+                origin,
+                format!(
+                    "the file holds several parts; choose one with part = \"…\" ({})",
+                    parts
+                        .iter()
+                        .map(|s| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+    };
+    let mut file = parse_param_document(&map[name], &format!("{origin}: {name}"), profile)?;
+    file.info
+        .entry("name".into())
+        .or_insert_with(|| name.clone());
+    Ok(file)
+}
+
+fn fmt3(v: [f64; 3]) -> String {
+    if v[0] == v[1] && v[1] == v[2] {
+        fmt1(v[0])
+    } else {
+        format!("[{}, {}, {}]", fmt1(v[0]), fmt1(v[1]), fmt1(v[2]))
+    }
+}
+
+fn fmt1(x: f64) -> String {
+    if x.is_infinite() {
+        "\"inf\"".into()
+    } else {
+        ryu::Buffer::new().format(x).to_string()
+    }
+}
+
+/// Writes parameters as an imukit TOML parameter file (every field, units in the keys).
+#[must_use]
+pub fn to_toml(file: &ParamFile) -> String {
+    let mut s = String::new();
+    for k in INFO_KEYS {
+        if let Some(v) = file.info.get(k) {
+            s += &format!("{k} = {}\n", toml::Value::String(v.clone()));
+        }
+    }
+    for (i, sensor) in Sensor::ALL.iter().enumerate() {
+        if !file.present[i] {
+            continue;
+        }
+        let p = file.params.get(*sensor);
+        let u = sensor.unit();
+        s += &format!("\n[{}]\n", sensor.key());
+        s += &format!("measurement_range_{u} = {}\n", fmt1(p.measurement_range));
+        s += &format!("resolution_{u} = {}\n", fmt1(p.resolution));
+        s += &format!("constant_bias_{u} = {}\n", fmt3(p.constant_bias));
+        let m = p.axes_misalignment_pct;
+        s += &format!(
+            "axes_misalignment_pct = [{}, {}, {}]\n",
+            fmt3_full(m[0]),
+            fmt3_full(m[1]),
+            fmt3_full(m[2])
+        );
+        s += &format!("noise_density_{u}_per_rt_hz = {}\n", fmt3(p.noise_density));
+        s += &format!("bias_instability_{u} = {}\n", fmt3(p.bias_instability));
+        match p.bias_instability_model {
+            BiasInstabilityModel::Filter(c) => {
+                let l = |v: &[f64]| v.iter().map(|x| fmt1(*x)).collect::<Vec<_>>().join(", ");
+                s += &format!("bias_instability_numerator = [{}]\n", l(c.numerator()));
+                s += &format!("bias_instability_denominator = [{}]\n", l(c.denominator()));
+            }
+            BiasInstabilityModel::Flicker {
+                tau_min_s,
+                tau_max_s,
+            } => {
+                s += &format!(
+                    "bias_instability_flicker_tau_s = [{}, {}]\n",
+                    fmt1(tau_min_s),
+                    fmt1(tau_max_s)
+                );
+            }
+            BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
+                s += &format!(
+                    "bias_instability_correlation_time_s = {}\n",
+                    fmt1(correlation_time_s)
+                );
+            }
+        }
+        s += &format!("random_walk_{u}_rt_hz = {}\n", fmt3(p.random_walk));
+        let nt = match p.noise_type {
+            NoiseType::SingleSided => "single-sided",
+            NoiseType::DoubleSided => "double-sided",
+        };
+        s += &format!("noise_type = \"{nt}\"\n");
+        s += &format!(
+            "temperature_bias_{u}_per_c = {}\n",
+            fmt3(p.temperature_bias)
+        );
+        s += &format!(
+            "temperature_scale_factor_pct_per_c = {}\n",
+            fmt3(p.temperature_scale_factor_pct)
+        );
+        if *sensor == Sensor::Gyroscope {
+            s += &format!(
+                "acceleration_bias_rad_s_per_m_s2 = {}\n",
+                fmt3(p.acceleration_bias)
+            );
+        }
+    }
+    s
+}
+
+fn fmt3_full(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", fmt1(v[0]), fmt1(v[1]), fmt1(v[2]))
+}
