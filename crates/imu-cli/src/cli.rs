@@ -25,6 +25,26 @@ pub enum Command {
         /// Where to write the truth (CSV).
         #[arg(long)]
         truth: Option<PathBuf>,
+        /// Monte Carlo: this many runs, in parallel on all cores, one output per run
+        /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
+        #[arg(long)]
+        runs: Option<u64>,
+    },
+    /// Lists the sensor presets, or prints one as a parameter file.
+    Presets {
+        /// Name of a preset.
+        name: Option<String>,
+    },
+    /// Allan deviation of IMU columns (octave τ) with N, K and B identified.
+    Allan {
+        /// IMU readings CSV (with `t_s`).
+        input: PathBuf,
+        /// Columns to analyse (default: every gyro and accel column present).
+        #[arg(long = "column")]
+        columns: Vec<String>,
+        /// Where to write `tau_s, adev_<column>…` (CSV).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Runs a built-in scenario (default: the seed's figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings and a summary into a folder.

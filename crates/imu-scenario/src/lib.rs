@@ -3,6 +3,7 @@
 //! Scenario files ([`scenario`]), formula strings with exact derivatives ([`expr`]), tracks
 //! ([`track`]), built-in scenarios ([`builtin`]) and the CSV schema ([`table`]). Units are
 //! converted here and only here; the numerics live in `imu-core`.
+pub mod analysis;
 pub mod arrays;
 pub mod builtin;
 pub mod error;

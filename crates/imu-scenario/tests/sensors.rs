@@ -188,7 +188,10 @@ fn temperature_profile_file_drives_temperature_bias() {
 
 #[test]
 fn parameter_files_round_trip_through_toml() {
-    let mut file = ParamFile { present: [true, true, true], ..ParamFile::default() };
+    let mut file = ParamFile {
+        present: [true, true, true],
+        ..ParamFile::default()
+    };
     file.info.insert("name".into(), "test part".into());
     file.params.accelerometer = SensorParams {
         measurement_range: 78.4,

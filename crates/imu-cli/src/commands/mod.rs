@@ -1,5 +1,7 @@
 //! One module per subcommand, and the CLI's error type.
+mod allan;
 mod demo;
+mod presets;
 mod scenario;
 mod simulate;
 
@@ -38,8 +40,15 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             scenario,
             out,
             truth,
-        } => simulate::run(&scenario, &out, truth.as_deref()),
+            runs,
+        } => simulate::run(&scenario, &out, truth.as_deref(), runs),
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
+        Command::Presets { name } => presets::run(name.as_deref()),
+        Command::Allan {
+            input,
+            columns,
+            out,
+        } => allan::run(&input, &columns, &out),
     }
 }

@@ -1,23 +1,84 @@
-//! `imukit simulate SCENARIO --out IMU.csv [--truth TRUTH.csv]`.
-use std::path::Path;
+//! `imukit simulate SCENARIO --out IMU.csv [--truth TRUTH.csv] [--runs N]`.
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use imu_scenario::Scenario;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 
 use super::CliError;
 
-pub fn run(scenario: &Path, out: &Path, truth: Option<&Path>) -> Result<(), CliError> {
-    let sim = Scenario::from_file(scenario)?.simulate()?;
-    sim.imu.write_csv(out)?;
-    if let Some(t) = truth {
-        sim.truth.write_csv(t)?;
+pub fn run(
+    scenario: &Path,
+    out: &Path,
+    truth: Option<&Path>,
+    runs: Option<u64>,
+) -> Result<(), CliError> {
+    let sc = Scenario::from_file(scenario)?;
+    let Some(runs) = runs else {
+        let sim = sc.simulate()?;
+        sim.imu.write_csv(out)?;
+        if let Some(t) = truth {
+            sim.truth.write_csv(t)?;
+        }
+        eprintln!(
+            "imukit: {} samples; IMU readings in {}{}",
+            sim.imu.rows(),
+            out.display(),
+            truth
+                .map(|t| format!(", truth in {}", t.display()))
+                .unwrap_or_default()
+        );
+        return Ok(());
+    };
+    if runs == 0 {
+        return Err(imu_scenario::Error::Invalid {
+            field: "--runs".into(),
+            message: "must be ≥ 1".into(),
+        }
+        .into());
     }
+    let progress = ProgressBar::new(runs);
+    progress.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let done = AtomicU64::new(0);
+    let digits = (runs - 1).max(1).to_string().len().max(4);
+    (0..runs)
+        .into_par_iter()
+        .try_for_each(|r| -> Result<(), CliError> {
+            let sim = sc.simulate_run(r)?;
+            sim.imu.write_csv(&run_path(out, r, digits))?;
+            if r == 0
+                && let Some(t) = truth
+            {
+                sim.truth.write_csv(t)?;
+            }
+            done.fetch_add(1, Ordering::Relaxed);
+            progress.inc(1);
+            Ok(())
+        })?;
+    progress.finish_and_clear();
     eprintln!(
-        "imukit: {} samples; IMU readings in {}{}",
-        sim.imu.rows(),
-        out.display(),
-        truth
-            .map(|t| format!(", truth in {}", t.display()))
-            .unwrap_or_default()
+        "imukit: {} runs of {} samples; IMU readings in {} … {}",
+        done.load(Ordering::Relaxed),
+        sc.t_s.len(),
+        run_path(out, 0, digits).display(),
+        run_path(out, runs - 1, digits).display()
     );
     Ok(())
+}
+
+/// `dir/imu.csv`, run 7 → `dir/imu_run0007.csv`.
+fn run_path(out: &Path, run: u64, digits: usize) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "imu".into());
+    let ext = out
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}_run{run:0digits$}{ext}"))
 }

@@ -1,0 +1,56 @@
+//! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
+use std::path::Path;
+
+use imu_scenario::analysis::{allan, mean_rate};
+use imu_scenario::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
+
+use super::CliError;
+
+pub fn run(input: &Path, columns: &[String], out: &Path) -> Result<(), CliError> {
+    let header = read_header(input)?;
+    let chosen: Vec<String> = if columns.is_empty() {
+        GYRO_COLUMNS
+            .iter()
+            .chain(&ACCEL_COLUMNS)
+            .filter(|c| header.iter().any(|h| h == *c))
+            .map(|c| (*c).to_string())
+            .collect()
+    } else {
+        columns.to_vec()
+    };
+    let mut required: Vec<&str> = vec!["t_s"];
+    required.extend(chosen.iter().map(String::as_str));
+    let hint = if chosen.is_empty() {
+        "; no gyro_* or accel_* columns: name columns with --column"
+    } else {
+        ""
+    };
+    let data = read_columns(input, &required, hint)?;
+    let rate = mean_rate(data.get("t_s"))?;
+    let series: Vec<(String, Vec<f64>)> = chosen
+        .iter()
+        .map(|c| (c.clone(), data.get(c).to_vec()))
+        .collect();
+    let result = allan(&series, rate)?;
+    result.table.write_csv(out)?;
+    println!(
+        "{:<16} {:>14} {:>14} {:>14}",
+        "column", "N (·/√Hz)", "B", "K (·√Hz)"
+    );
+    let show = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |x| format!("{x:.4e}"));
+    for (name, id) in &result.noise {
+        println!(
+            "{name:<16} {:>14} {:>14} {:>14}",
+            show(id.noise_density),
+            show(id.bias_instability),
+            show(id.random_walk)
+        );
+    }
+    println!(
+        "\nAllan deviation of {} columns at {} τ values ({rate} Hz) written to {}",
+        series.len(),
+        result.table.rows(),
+        out.display()
+    );
+    Ok(())
+}
