@@ -49,6 +49,29 @@ accel_sign = "matlab"
 """,
     "builtin.toml": '[trajectory]\ntype = "builtin"\nname = "rounded-rectangle"\n',
     "samples.toml": '[trajectory]\ntype = "samples"\nfile = "truth_in.csv"\norder = 4\n',
+    "noisy.toml": """
+rate_hz = 100.0
+duration_s = 20.0
+[trajectory]
+type = "builtin"
+name = "figure8"
+[imu]
+seed = 42
+profile = "matlab"
+temperature_c = 31.5
+[imu.accelerometer]
+noise_density_m_s2_per_rt_hz = 0.003
+bias_instability_m_s2 = 0.001
+random_walk_m_s2_rt_hz = 0.0001
+resolution_m_s2 = 0.0005
+[imu.gyroscope]
+noise_density_rad_s_per_rt_hz = 1e-4
+bias_instability_rad_s = 1e-5
+bias_instability_flicker_tau_s = [1, 100]
+acceleration_bias_rad_s_per_m_s2 = 1e-4
+[imu.magnetometer]
+noise_density_ut_per_rt_hz = 0.1
+""",
 }
 
 
@@ -78,3 +101,36 @@ def test_cli_demo_runs_with_no_arguments(tmp_path):
     header, values = read_csv(tmp_path / "imukit-demo" / "imu.csv")
     sim = imukit.simulate(tmp_path / "imukit-demo" / "scenario.toml")
     assert np.array_equal(values, sim.imu.values)
+
+
+def test_monte_carlo_runs_match_python_runs(tmp_path):
+    scenario = tmp_path / "noisy.toml"
+    scenario.write_text(SCENARIOS["noisy.toml"])
+    out = tmp_path / "mc" / "imu.csv"
+    out.parent.mkdir()
+    subprocess.run([imukit_bin(), "simulate", str(scenario), "--out", str(out), "--runs", "3"], check=True, capture_output=True)
+    for r in range(3):
+        header, values = read_csv(out.parent / f"imu_run{r:04d}.csv")
+        sim = imukit.simulate(scenario, run=r)
+        assert np.array_equal(values.view(np.uint64), sim.imu.values.view(np.uint64)), r
+    a, b = imukit.simulate(scenario, run=0), imukit.simulate(scenario, run=1)
+    assert not np.array_equal(a.imu.values, b.imu.values)
+
+
+def test_cli_allan_reads_what_python_computes(tmp_path):
+    scenario = tmp_path / "static.toml"
+    scenario.write_text('rate_hz = 100.0\nduration_s = 600.0\n[trajectory]\ntype = "builtin"\nname = "static"\n'
+                        '[imu]\nseed = 3\n[imu.gyroscope]\nnoise_density_rad_s_per_rt_hz = 2e-3\n')
+    imu_csv, adev_csv = tmp_path / "imu.csv", tmp_path / "adev.csv"
+    subprocess.run([imukit_bin(), "simulate", str(scenario), "--out", str(imu_csv)], check=True, capture_output=True)
+    result = subprocess.run([imukit_bin(), "allan", str(imu_csv), "--column", "gyro_z_rad_s", "--out", str(adev_csv)],
+                            check=True, capture_output=True, text=True)
+    assert "gyro_z_rad_s" in result.stdout
+    header, values = read_csv(adev_csv)
+    assert header == ["tau_s", "adev_gyro_z_rad_s"]
+    sim = imukit.simulate(scenario)
+    tau, adev = imukit.allan_deviation(sim.imu["gyro_z_rad_s"], 100.0)
+    np.testing.assert_allclose(values[:, 0], tau, rtol=1e-12)
+    np.testing.assert_allclose(values[:, 1], adev, rtol=1e-12)
+    n = imukit.identify_noise(tau, adev)["noise_density"]
+    assert abs(n / 2e-3 - 1) < 0.1

@@ -218,12 +218,20 @@ const SLOPE_TOLERANCE: f64 = 0.15;
 
 /// Fits a line of slope `target` through every segment of the curve whose slope is within
 /// [`SLOPE_TOLERANCE`] of it, averaging the intercepts with weights `1/τ` (proportional to the
-/// number of clusters, so the best-determined part of the curve counts most).
+/// number of clusters, so the best-determined part of the curve counts most). On curves of more
+/// than 6 points the two segments of largest τ are left out: at octave τ they rest on fewer than
+/// about 8 independent clusters, and their chance slopes would otherwise be read as noise terms.
 fn fit(tau: &[f64], adev: &[f64], target: f64) -> Option<AllanLine> {
     use num_traits::Float;
     let (mut sum_w, mut sum_wb) = (0.0, 0.0);
     let mut best: Option<(f64, usize)> = None;
-    for i in 0..tau.len().saturating_sub(1) {
+    let segments = tau.len().saturating_sub(1);
+    let usable = if tau.len() > 6 {
+        segments - 2
+    } else {
+        segments
+    };
+    for i in 0..usable {
         if !(adev[i] > 0.0 && adev[i + 1] > 0.0 && tau[i] > 0.0 && tau[i + 1] > tau[i]) {
             continue;
         }

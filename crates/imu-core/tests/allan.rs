@@ -85,6 +85,11 @@ fn white_noise_round_trip_recovers_n() {
     let n = id.noise_density.expect("a −½ slope");
     assert!((n / n_density - 1.0).abs() < 0.10, "N = {n}");
     assert!(id.random_walk.is_none());
+    assert!(
+        id.bias_instability.is_none(),
+        "white noise has no floor: {:?}",
+        id.bias_line
+    );
 }
 
 #[test]

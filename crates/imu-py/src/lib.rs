@@ -3,18 +3,22 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use imu_core::Ned;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
+use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, Temperatures};
 use imu_core::{Body, Enu, EulerZyx, Rotation};
-use imu_scenario::arrays;
+use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
     AccelSignName, ExpressionSpec, Formula, ImuSetup, NavFrameName, SampledAttitudeData, parse_name,
 };
+use imu_scenario::sensors::{SensorKeys, SensorSetup};
 use imu_scenario::table::ImuKind;
 use imu_scenario::{ScenarioSpec, Table};
+use imu_scenario::{analysis, arrays, presets};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
-    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
 };
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -76,13 +80,14 @@ fn nav(name: &str) -> PyResult<NavFrameName> {
 
 /// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu) tables.
 #[pyfunction]
-#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = "."))]
+#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None))]
 fn simulate_text<'py>(
     py: Python<'py>,
     text: &str,
     format: &str,
     origin: &str,
     base_dir: &str,
+    run: Option<u64>,
 ) -> PyResult<(TableOut<'py>, TableOut<'py>)> {
     let spec = match format {
         "toml" => ScenarioSpec::from_toml(text, origin),
@@ -96,7 +101,13 @@ fn simulate_text<'py>(
     .map_err(refused)?;
     let base = base_dir.to_string();
     let sim = py
-        .detach(move || spec.resolve(Path::new(&base))?.simulate())
+        .detach(move || {
+            let sc = spec.resolve(Path::new(&base))?;
+            match run {
+                Some(r) => sc.simulate_run(r),
+                None => sc.simulate(),
+            }
+        })
         .map_err(refused)?;
     Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?))
 }
@@ -415,6 +426,261 @@ fn dcm_to_quaternion<'py>(
         .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
 }
 
+/// The navigation-frame generic model behind `ImuSensor`.
+enum Model {
+    Enu(ImuModel<Enu>),
+    Ned(ImuModel<Ned>),
+}
+
+/// MATLAB-shaped IMU simulator (see the Python class `imukit.ImuSensor`).
+#[pyclass(module = "imukit._core", name = "ImuSensor")]
+struct PyImuSensor {
+    model: Model,
+    kind: ImuKind,
+    state: ImuState,
+    noise: SeededNormals,
+    seed: u64,
+    temperature: Temperatures,
+}
+
+fn json(name: &str, text: Option<String>) -> PyResult<Option<serde_json::Value>> {
+    text.map(|t| {
+        serde_json::from_str(&t).map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
+    })
+    .transpose()
+}
+
+#[pymethods]
+impl PyImuSensor {
+    #[new]
+    #[pyo3(signature = (imu_type = "accel-gyro", *, reference_frame = "NED", sample_rate = 100.0, temperature = 25.0,
+                        magnetic_field = None, accelerometer = None, gyroscope = None, magnetometer = None,
+                        preset = None, seed = 0, profile = "matlab", accel_sign = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        imu_type: &str,
+        reference_frame: &str,
+        sample_rate: f64,
+        temperature: f64,
+        magnetic_field: Option<[f64; 3]>,
+        accelerometer: Option<String>,
+        gyroscope: Option<String>,
+        magnetometer: Option<String>,
+        preset: Option<String>,
+        seed: u64,
+        profile: &str,
+        accel_sign: Option<&str>,
+    ) -> PyResult<Self> {
+        let kind = parse_name::<ImuKind>("imu_type", imu_type).map_err(refused)?;
+        let profile = parse_name::<Profile>("profile", profile).map_err(refused)?;
+        let tables = [
+            json("accelerometer", accelerometer)?,
+            json("gyroscope", gyroscope)?,
+            json("magnetometer", magnetometer)?,
+        ];
+        let keys = SensorKeys {
+            profile: Some(profile),
+            seed: Some(seed),
+            preset: preset.as_deref(),
+            tables: [tables[0].as_ref(), tables[1].as_ref(), tables[2].as_ref()],
+            ..SensorKeys::default()
+        };
+        let sensors = SensorSetup::resolve(&keys, Path::new(".")).map_err(refused)?;
+        if !temperature.is_finite() {
+            return Err(ImuError::new_err("temperature: must be finite"));
+        }
+        let sign = match accel_sign {
+            Some(s) => parse_name::<AccelSignName>("accel_sign", s)
+                .map_err(refused)?
+                .into(),
+            None => profile.accel_sign(),
+        };
+        let setup = ImuSetup {
+            sensors,
+            ..ImuSetup::ideal(kind, [0.0; 3], sign, magnetic_field)
+        };
+        let model = match nav(reference_frame)? {
+            NavFrameName::ENU => {
+                Model::Enu(setup.model::<Enu>(9.81, sample_rate).map_err(refused)?)
+            }
+            NavFrameName::NED => {
+                Model::Ned(setup.model::<Ned>(9.81, sample_rate).map_err(refused)?)
+            }
+        };
+        Ok(Self {
+            model,
+            kind,
+            state: ImuState::default(),
+            noise: SeededNormals::new(seed),
+            seed,
+            temperature: Temperatures::uniform(temperature),
+        })
+    }
+
+    /// Readings for nav-frame acceleration (N, 3), angular velocity (N, 3) and attitude
+    /// quaternions `q_nb` (N, 4) or `C_nb` matrices (N, 3, 3); returns (N, 9) rows of
+    /// accel, gyro, mag (absent sensors zero). State and noise stream carry over between calls.
+    #[pyo3(signature = (acceleration, angular_velocity, *, quaternion = None, dcm = None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        acceleration: PyReadonlyArray2<'py, f64>,
+        angular_velocity: PyReadonlyArray2<'py, f64>,
+        quaternion: Option<PyReadonlyArray2<'py, f64>>,
+        dcm: Option<PyReadonlyArray3<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let a = rows::<3>("acceleration", &acceleration)?;
+        let w = rows::<3>("angular_velocity", &angular_velocity)?;
+        check_len("angular_velocity", w.len(), a.len())?;
+        let attitude: Vec<Rotation<Body, Enu>> = match (quaternion, dcm) {
+            (Some(q), None) => rotations(&q)?,
+            (None, Some(m)) => dcm_in("orientation", &m)?
+                .iter()
+                .map(Rotation::from_dcm)
+                .collect(),
+            _ => {
+                return Err(PyValueError::new_err(
+                    "give the orientation as quaternions or as matrices",
+                ));
+            }
+        };
+        check_len("orientation", attitude.len(), a.len())?;
+        let n = a.len();
+        let (model, state, noise, temps) = (
+            &self.model,
+            &mut self.state,
+            &mut self.noise,
+            self.temperature,
+        );
+        let out = py.detach(move || {
+            let mut out = vec![ImuReading::default(); n];
+            match model {
+                Model::Enu(m) => {
+                    m.measure_nav_into(&a, &w, &attitude, &temps, state, noise, &mut out)
+                }
+                Model::Ned(m) => {
+                    let att: Vec<Rotation<Body, Ned>> = attitude
+                        .iter()
+                        .map(|r| Rotation::assume_from_quaternion(*r.quaternion()))
+                        .collect();
+                    m.measure_nav_into(&a, &w, &att, &temps, state, noise, &mut out);
+                }
+            }
+            out
+        });
+        let flat: Vec<f64> = out
+            .iter()
+            .flat_map(|r| r.accel_m_s2.into_iter().chain(r.gyro_rad_s).chain(r.mag_ut))
+            .collect();
+        Ok(Array2::from_shape_vec((n, 9), flat)
+            .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+    }
+
+    /// Back to the initial state and the start of the seeded noise stream.
+    fn reset(&mut self) {
+        self.state = ImuState::default();
+        self.noise = SeededNormals::new(self.seed);
+    }
+
+    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
+    #[getter]
+    fn imu_type(&self) -> &'static str {
+        match self.kind {
+            ImuKind::AccelGyro => "accel-gyro",
+            ImuKind::AccelMag => "accel-mag",
+            ImuKind::AccelGyroMag => "accel-gyro-mag",
+        }
+    }
+
+    /// Temperature of all sensors, °C.
+    #[getter]
+    fn get_temperature(&self) -> f64 {
+        self.temperature.accel_c
+    }
+
+    #[setter]
+    fn set_temperature(&mut self, t: f64) -> PyResult<()> {
+        if !t.is_finite() {
+            return Err(ImuError::new_err("temperature: must be finite"));
+        }
+        self.temperature = Temperatures::uniform(t);
+        Ok(())
+    }
+}
+
+/// Overlapping Allan deviation of each column of `x` (N,) or (N, k) at octave τ:
+/// returns `(tau_s, adev)` with `adev` of shape (T,) or (T, k).
+#[pyfunction]
+fn allan_deviation<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    sample_rate_hz: f64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let v = x.as_array();
+    let series: Vec<(String, Vec<f64>)> = (0..v.ncols())
+        .map(|k| (format!("column {k}"), v.column(k).to_vec()))
+        .collect();
+    let result = py
+        .detach(move || analysis::allan(&series, sample_rate_hz))
+        .map_err(refused)?;
+    let t = result.table;
+    let tau = t.column("tau_s").unwrap_or_default();
+    let cols = t.columns.len() - 1;
+    let adev: Vec<f64> = t
+        .data
+        .chunks(t.columns.len())
+        .flat_map(|r| r[1..].to_vec())
+        .collect();
+    let adev = Array2::from_shape_vec((tau.len(), cols), adev)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((PyArray1::from_vec(py, tau), adev.into_pyarray(py)))
+}
+
+/// N, K, B and the fitted lines of an Allan curve, as a dict.
+#[pyfunction]
+fn identify_noise<'py>(
+    py: Python<'py>,
+    tau_s: PyReadonlyArray1<'py, f64>,
+    adev: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let (tau, a) = (tau_s.as_array().to_vec(), adev.as_array().to_vec());
+    check_len("adev", a.len(), tau.len())?;
+    let id = imu_core::allan::identify_noise(&tau, &a);
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("noise_density", id.noise_density)?;
+    d.set_item("bias_instability", id.bias_instability)?;
+    d.set_item("random_walk", id.random_walk)?;
+    for (name, line) in [
+        ("white_line", id.white_line),
+        ("random_walk_line", id.random_walk_line),
+        ("bias_line", id.bias_line),
+    ] {
+        d.set_item(name, line.map(|l| (l.slope, l.intercept)))?;
+    }
+    Ok(d)
+}
+
+/// Names of the sensor presets.
+#[pyfunction]
+fn preset_names() -> Vec<&'static str> {
+    presets::names()
+}
+
+/// A preset as an imukit parameter file (TOML text).
+#[pyfunction]
+fn preset_toml(name: &str) -> PyResult<&'static str> {
+    presets::text(name).map_err(refused)
+}
+
+/// A parameter file (imukit TOML/JSON or MATLAB loadparams JSON) as imukit TOML text.
+#[pyfunction]
+#[pyo3(signature = (path, *, part = None))]
+fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<String> {
+    read_param_file(Path::new(path), part, Profile::Default)
+        .map(|f| to_toml(&f))
+        .map_err(refused)
+}
+
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -444,6 +710,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dcm_to_euler, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion_to_dcm, m)?)?;
     m.add_function(wrap_pyfunction!(dcm_to_quaternion, m)?)?;
+    m.add_class::<PyImuSensor>()?;
+    m.add_function(wrap_pyfunction!(allan_deviation, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     Ok(())

@@ -188,6 +188,32 @@ impl<N: NavFrame> ImuModel<N> {
         )
     }
 
+    /// [`ImuModel::measure_nav`] over slices (MATLAB's batch call), written into `out`; stops at
+    /// the shortest of the slices.
+    #[allow(clippy::too_many_arguments)]
+    pub fn measure_nav_into(
+        &self,
+        acceleration_n: &[[f64; 3]],
+        angular_velocity_n: &[[f64; 3]],
+        attitude: &[Rotation<Body, N>],
+        temperatures: &Temperatures,
+        state: &mut ImuState,
+        noise: &mut impl NoiseSource,
+        out: &mut [ImuReading],
+    ) {
+        let inputs = acceleration_n.iter().zip(angular_velocity_n).zip(attitude);
+        for (((a, w), q), o) in inputs.zip(out.iter_mut()) {
+            *o = self.measure_nav(
+                Vec3::from_array(*a),
+                Vec3::from_array(*w),
+                q,
+                temperatures,
+                state,
+                noise,
+            );
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn finish(
         &self,

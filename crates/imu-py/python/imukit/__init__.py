@@ -31,6 +31,12 @@ __all__ = [
     "Table",
     "Simulation",
     "simulate",
+    "ImuSensor",
+    "allan_deviation",
+    "identify_noise",
+    "presets",
+    "preset_params",
+    "loadparams",
     "builtin_scenarios",
     "builtin_scenario_toml",
     "truth_from_expressions",
@@ -101,11 +107,13 @@ def _table(out) -> Table:
     return Table(columns, values)
 
 
-def simulate(scenario: Union[str, os.PathLike, Mapping]) -> Simulation:
+def simulate(scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] = None) -> Simulation:
     """Runs a scenario: a path to a TOML/JSON scenario file, or a dict with the same keys.
 
-    Relative sample-file paths are taken from the scenario file's folder (for a dict, from the
-    current directory). The numbers equal those of ``imukit simulate`` bit for bit.
+    Relative file paths are taken from the scenario file's folder (for a dict, from the current
+    directory). The numbers equal those of ``imukit simulate`` bit for bit. ``run=r`` gives
+    Monte Carlo run ``r`` (noise drawn from (seed, r)), the same as file ``r`` of
+    ``imukit simulate --runs``.
 
     >>> sim = simulate({"trajectory": {"type": "builtin", "name": "static"}})
     >>> float(sim.imu["accel_z_m_s2"][0])
@@ -113,7 +121,7 @@ def simulate(scenario: Union[str, os.PathLike, Mapping]) -> Simulation:
     """
     if isinstance(scenario, Mapping):
         text = json.dumps(scenario)
-        out = _core.simulate_text(text, format="json", origin="scenario dict", base_dir=os.getcwd())
+        out = _core.simulate_text(text, format="json", origin="scenario dict", base_dir=os.getcwd(), run=run)
     else:
         path = Path(scenario)
         try:
@@ -121,7 +129,7 @@ def simulate(scenario: Union[str, os.PathLike, Mapping]) -> Simulation:
         except OSError as e:
             raise ImuError(f"{path}: {e.strerror or e}") from None
         fmt = "json" if path.suffix.lower() == ".json" else "toml"
-        out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent))
+        out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run)
     truth, imu = out
     return Simulation(truth=_table(truth), imu=_table(imu))
 
@@ -292,3 +300,147 @@ def dcm_to_quaternion(dcm) -> np.ndarray:
     """``C_nb`` (N, 3, 3) → ``[w, x, y, z]`` (N, 4)."""
     m = np.ascontiguousarray(dcm, dtype=np.float64)
     return _core.dcm_to_quaternion(m.reshape(1, 3, 3) if m.ndim == 2 else m)
+
+
+def _params_json(name: str, params) -> Optional[str]:
+    if params is None:
+        return None
+    if isinstance(params, Mapping):
+        return json.dumps({k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in params.items()})
+    raise TypeError(f"{name} must be a dict of parameters (imukit or MATLAB names), got {type(params).__name__}")
+
+
+class ImuSensor:
+    """An IMU simulator shaped like MATLAB's ``imuSensor``.
+
+    >>> imu = ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=100,
+    ...                 gyroscope={"NoiseDensity": 1e-4}, seed=67)
+    >>> accel, gyro, mag = imu(np.zeros((5, 3)), np.zeros((5, 3)), np.tile([1.0, 0, 0, 0], (5, 1)))
+    >>> accel[0].tolist()    # MATLAB's sign: gravity minus acceleration, NED
+    [0.0, 0.0, 9.81]
+
+    Parameters are dicts with MATLAB's property names (``MeasurementRange``, ``NoiseDensity``,
+    ``BiasInstabilityCoefficients={"Numerator": …, "Denominator": …}``, …, SI units) or imukit's
+    unit-suffixed keys (``noise_density_rad_s_per_rt_hz``, …); ``preset="NAME"`` starts from a
+    preset. ``profile="matlab"`` (the default here, as the class mirrors MATLAB) uses MATLAB's
+    conventions: double-sided noise densities, gravity-minus-acceleration accelerometer sign,
+    gyroscope AccelerationBias on the raw nav-frame acceleration; ``profile="default"`` uses
+    imukit's (single-sided, specific force, body-frame g-sensitivity).
+
+    Calling ``imu(acc, ang_vel, orientation)`` takes nav-frame acceleration without gravity
+    (N, 3), nav-frame angular velocity (N, 3), and the orientation as quaternions
+    ``[w, x, y, z]`` (N, 4) — MATLAB's navigation-to-body frame rotation, imukit's ``q_nb`` — or as
+    MATLAB rotation matrices (N, 3, 3), which rotate navigation-frame vectors into the body frame
+    (``C_nbᵀ``). It returns ``(accel, gyro)``, ``(accel, mag)`` or ``(accel, gyro, mag)`` per
+    ``imu_type``. The drift state and the seeded noise stream carry over between calls (so one
+    call of 2N samples equals two calls of N); ``reset()`` starts over.
+    """
+
+    def __init__(
+        self,
+        imu_type: str = "accel-gyro",
+        *,
+        reference_frame: str = "NED",
+        sample_rate: float = 100.0,
+        temperature: float = 25.0,
+        magnetic_field: Optional[Sequence[float]] = None,
+        accelerometer: Optional[Mapping] = None,
+        gyroscope: Optional[Mapping] = None,
+        magnetometer: Optional[Mapping] = None,
+        preset: Optional[str] = None,
+        seed: int = 0,
+        profile: str = "matlab",
+        accel_sign: Optional[str] = None,
+    ) -> None:
+        self._imu = _core.ImuSensor(
+            imu_type,
+            reference_frame=reference_frame,
+            sample_rate=float(sample_rate),
+            temperature=float(temperature),
+            magnetic_field=None if magnetic_field is None else [float(v) for v in magnetic_field],
+            accelerometer=_params_json("accelerometer", accelerometer),
+            gyroscope=_params_json("gyroscope", gyroscope),
+            magnetometer=_params_json("magnetometer", magnetometer),
+            preset=preset,
+            seed=int(seed),
+            profile=profile,
+            accel_sign=accel_sign,
+        )
+
+    @property
+    def imu_type(self) -> str:
+        return self._imu.imu_type
+
+    @property
+    def temperature(self) -> float:
+        """Temperature of the sensors, °C (may be changed between calls)."""
+        return self._imu.temperature
+
+    @temperature.setter
+    def temperature(self, value: float) -> None:
+        self._imu.temperature = float(value)
+
+    def __call__(self, acc, ang_vel, orientation):
+        a = _rows("acc", np.atleast_2d(acc), 3)
+        w = _rows("ang_vel", np.atleast_2d(ang_vel), 3, a.shape[0])
+        o = np.ascontiguousarray(orientation, dtype=np.float64)
+        if o.ndim == 1 and o.shape == (4,) or o.ndim == 2 and o.shape == (3, 3):
+            o = o[None]
+        if o.ndim == 2 and o.shape[1] == 4:
+            out = self._imu.step(a, w, quaternion=_rows("orientation", o, 4, a.shape[0]))
+        elif o.ndim == 3 and o.shape[1:] == (3, 3):
+            if o.shape[0] != a.shape[0]:
+                raise ValueError(f"orientation has {o.shape[0]} matrices, expected {a.shape[0]}")
+            # MATLAB's rotation matrices take navigation-frame vectors to the body frame: C_nbᵀ.
+            out = self._imu.step(a, w, dcm=np.ascontiguousarray(np.swapaxes(o, 1, 2)))
+        else:
+            raise ValueError(f"orientation must have shape (N, 4) or (N, 3, 3), got {o.shape}")
+        accel, gyro, mag = out[:, 0:3], out[:, 3:6], out[:, 6:9]
+        return {"accel-gyro": (accel, gyro), "accel-mag": (accel, mag)}.get(self.imu_type, (accel, gyro, mag))
+
+    def reset(self) -> None:
+        """Back to the initial drift state and the start of the noise stream."""
+        self._imu.reset()
+
+
+def allan_deviation(x, sample_rate_hz: float):
+    """Overlapping Allan deviation of rate data at octave τ (MATLAB ``allanvar`` formula).
+
+    ``x`` is (N,) or (N, k); returns ``(tau_s, adev)`` with ``adev`` (T,) or (T, k).
+    """
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    if a.ndim not in (1, 2):
+        raise ValueError(f"x must be (N,) or (N, k), got shape {a.shape}")
+    tau, adev = _core.allan_deviation(a.reshape(a.shape[0], -1), float(sample_rate_hz))
+    return tau, (adev[:, 0] if a.ndim == 1 else adev)
+
+
+def identify_noise(tau_s, adev) -> dict:
+    """N (at τ = 1 s on the −½ line), K (at τ = 3 s on the +½ line) and B (floor / 0.664) of an
+    Allan curve, with the fitted lines as ``(slope, log10 intercept)``; ``None`` where absent."""
+    return _core.identify_noise(np.ascontiguousarray(tau_s, dtype=np.float64), np.ascontiguousarray(adev, dtype=np.float64))
+
+
+def presets() -> list:
+    """Names of the sensor presets (``imukit presets`` lists them with grade and source)."""
+    return list(_core.preset_names())
+
+
+def _toml_to_dict(text: str) -> dict:
+    try:
+        import tomllib
+    except ImportError:  # Python < 3.11
+        import tomli as tomllib  # type: ignore[no-redef]
+    return tomllib.loads(text)
+
+
+def preset_params(name: str) -> dict:
+    """A preset as a dict: ``name``, ``grade``, ``source`` and ``accelerometer``/``gyroscope``/
+    ``magnetometer`` tables with imukit's unit-suffixed keys (usable as ``ImuSensor`` arguments)."""
+    return _toml_to_dict(_core.preset_toml(name))
+
+
+def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dict:
+    """Reads a parameter file — imukit TOML/JSON, or MATLAB ``loadparams`` JSON (``part`` picks one
+    of several parts) — into a dict like :func:`preset_params`."""
+    return _toml_to_dict(_core.load_params_toml(str(path), part=part))

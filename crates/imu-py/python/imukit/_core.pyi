@@ -1,5 +1,5 @@
 """Type stubs of the compiled core (checked with ``python -m mypy.stubtest imukit._core``)."""
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence, final
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +21,12 @@ __all__ = [
     "dcm_to_euler",
     "quaternion_to_dcm",
     "dcm_to_quaternion",
+    "ImuSensor",
+    "allan_deviation",
+    "identify_noise",
+    "preset_names",
+    "preset_toml",
+    "load_params_toml",
     "builtin_names",
     "builtin_toml",
 ]
@@ -28,7 +34,7 @@ __all__ = [
 class ImuError(ValueError): ...
 
 def simulate_text(
-    text: str, *, format: str = "toml", origin: str = "scenario", base_dir: str = "."
+    text: str, *, format: str = "toml", origin: str = "scenario", base_dir: str = ".", run: Optional[int] = None
 ) -> tuple[_Table, _Table]: ...
 def truth_from_expressions(
     t_s: npt.NDArray[np.float64],
@@ -80,3 +86,45 @@ def quaternion_to_dcm(quaternion: npt.NDArray[np.float64]) -> npt.NDArray[np.flo
 def dcm_to_quaternion(dcm: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def builtin_names() -> list[str]: ...
 def builtin_toml(name: str) -> str: ...
+
+@final
+class ImuSensor:
+    def __new__(
+        cls,
+        imu_type: str = "accel-gyro",
+        *,
+        reference_frame: str = "NED",
+        sample_rate: float = 100.0,
+        temperature: float = 25.0,
+        magnetic_field: Optional[Sequence[float]] = None,
+        accelerometer: Optional[str] = None,
+        gyroscope: Optional[str] = None,
+        magnetometer: Optional[str] = None,
+        preset: Optional[str] = None,
+        seed: int = 0,
+        profile: str = "matlab",
+        accel_sign: Optional[str] = None,
+    ) -> ImuSensor: ...
+    def step(
+        self,
+        acceleration: npt.NDArray[np.float64],
+        angular_velocity: npt.NDArray[np.float64],
+        *,
+        quaternion: Optional[npt.NDArray[np.float64]] = None,
+        dcm: Optional[npt.NDArray[np.float64]] = None,
+    ) -> npt.NDArray[np.float64]: ...
+    def reset(self) -> None: ...
+    @property
+    def imu_type(self) -> str: ...
+    @property
+    def temperature(self) -> float: ...
+    @temperature.setter
+    def temperature(self, t: float) -> None: ...
+
+def allan_deviation(
+    x: npt.NDArray[np.float64], sample_rate_hz: float
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def identify_noise(tau_s: npt.NDArray[np.float64], adev: npt.NDArray[np.float64]) -> dict[str, Any]: ...
+def preset_names() -> list[str]: ...
+def preset_toml(name: str) -> str: ...
+def load_params_toml(path: str, *, part: Optional[str] = None) -> str: ...

@@ -1,0 +1,137 @@
+"""imukit.ImuSensor (MATLAB-shaped), Allan analysis, presets and parameter files from Python."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+import imukit
+from imukit import ImuError
+
+NED_FIELD = [27.5550, -2.4169, -16.0849]
+
+
+def level(n):
+    return np.zeros((n, 3)), np.zeros((n, 3)), np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+
+
+def test_stationary_accel_gyro_mag_reads_gravity_and_the_field():
+    imu = imukit.ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=100)
+    accel, gyro, mag = imu(*level(10))
+    np.testing.assert_array_equal(accel, np.tile([0.0, 0.0, 9.81], (10, 1)))
+    np.testing.assert_array_equal(gyro, 0.0)
+    np.testing.assert_allclose(mag, np.tile(NED_FIELD, (10, 1)), atol=1e-12)
+    enu = imukit.ImuSensor("accel-mag", reference_frame="ENU", profile="default")
+    a, m = enu(*level(3))
+    np.testing.assert_array_equal(a[:, 2], 9.81)  # specific force: +g up
+    np.testing.assert_allclose(m[0], [-2.4169, 27.5550, 16.0849], atol=1e-12)
+
+
+def test_rotating_platform_turns_the_field_in_the_body_frame():
+    n = 600
+    t = np.arange(n) / 100.0
+    yaw = np.where(t < 4, math.pi / 2 * t, 2 * math.pi + math.pi * (t - 4))
+    q = imukit.euler_to_quaternion(np.column_stack([yaw, np.zeros(n), np.zeros(n)]))
+    w = np.column_stack([np.zeros(n), np.zeros(n), np.where(t < 4, math.pi / 2, math.pi)])
+    imu = imukit.ImuSensor("accel-mag", reference_frame="NED")
+    _, mag = imu(np.zeros((n, 3)), w, q)
+    c, s = np.cos(yaw), np.sin(yaw)
+    np.testing.assert_allclose(mag[:, 0], c * NED_FIELD[0] + s * NED_FIELD[1], atol=1e-9)
+    np.testing.assert_allclose(mag[:, 1], -s * NED_FIELD[0] + c * NED_FIELD[1], atol=1e-9)
+
+
+def test_quaternions_and_matlab_rotation_matrices_agree():
+    rng = np.random.default_rng(3)
+    e = np.column_stack([rng.uniform(-3, 3, 20), rng.uniform(-1.2, 1.2, 20), rng.uniform(-3, 3, 20)])
+    q = imukit.euler_to_quaternion(e)
+    nav_to_body = np.swapaxes(imukit.euler_to_dcm(e), 1, 2)  # MATLAB's rotation matrices
+    acc = rng.normal(size=(20, 3))
+    w = rng.normal(size=(20, 3))
+    a = imukit.ImuSensor("accel-gyro-mag", seed=1, gyroscope={"NoiseDensity": 0.01})
+    b = imukit.ImuSensor("accel-gyro-mag", seed=1, gyroscope={"NoiseDensity": 0.01})
+    for x, y in zip(a(acc, w, q), b(acc, w, nav_to_body)):
+        np.testing.assert_allclose(x, y, atol=1e-12)
+
+
+def test_state_carries_between_calls_and_reset_starts_over():
+    params = dict(accelerometer={"NoiseDensity": 0.01, "BiasInstability": 0.002, "RandomWalk": 0.001},
+                  gyroscope={"NoiseDensity": 1e-3, "RandomWalk": 1e-4}, seed=5)
+    one = imukit.ImuSensor("accel-gyro", **params)
+    two = imukit.ImuSensor("accel-gyro", **params)
+    acc, w, q = level(1000)
+    a1, g1 = one(acc, w, q)
+    parts = [two(acc[i:j], w[i:j], q[i:j]) for i, j in [(0, 1), (1, 400), (400, 1000)]]
+    np.testing.assert_array_equal(a1, np.vstack([p[0] for p in parts]))
+    np.testing.assert_array_equal(g1, np.vstack([p[1] for p in parts]))
+    one.reset()
+    a2, _ = one(acc, w, q)
+    np.testing.assert_array_equal(a1, a2)
+
+
+def test_matlab_spec_sheet_accelerometer_deterministic_part():
+    spec = {"MeasurementRange": 19.62, "Resolution": 0.00059875, "ConstantBias": 0.4905, "AxesMisalignment": 2,
+            "NoiseDensity": 0.0, "TemperatureBias": [0.34335, 0.34335, 0.5886], "TemperatureScaleFactor": 0.02}
+    imu = imukit.ImuSensor("accel-gyro", accelerometer=spec, temperature=35)
+    accel, _ = imu(*level(1))
+    u = np.array([0.0, 0.0, 9.81])
+    m = np.full((3, 3), 2.0) + np.eye(3) * 98.0
+    y = (1 + 10 * 0.02 / 100) * (m @ u / 100 + 0.4905 + 10 * np.array([0.34335, 0.34335, 0.5886]))
+    np.testing.assert_allclose(accel[0], 0.00059875 * np.round(np.clip(y, -19.62, 19.62) / 0.00059875), atol=1e-12)
+
+
+def test_noise_density_convention_per_profile():
+    # MATLAB profile: double-sided, σ = N·√(fs/2); default profile: single-sided, σ = N·√fs.
+    n, fs, nd = 100_000, 200.0, 0.01
+    acc, w, q = level(n)
+    for profile, beta in [("matlab", fs / 2), ("default", fs)]:
+        imu = imukit.ImuSensor("accel-gyro", sample_rate=fs, gyroscope={"NoiseDensity": nd}, profile=profile, seed=9)
+        _, gyro = imu(acc, w, q)
+        ratio = gyro.var(axis=0, ddof=1) / (nd**2 * beta)
+        assert np.all(np.abs(ratio - 1) < 5 * math.sqrt(2 / (n - 1))), (profile, ratio)
+
+
+def test_allan_round_trip_recovers_the_white_noise_density():
+    nd, fs = 2e-3, 100.0
+    imu = imukit.ImuSensor("accel-gyro", sample_rate=fs, profile="default", gyroscope={"noise_density_rad_s_per_rt_hz": nd}, seed=2)
+    _, gyro = imu(*level(200_000))
+    tau, adev = imukit.allan_deviation(gyro, fs)
+    assert adev.shape == (len(tau), 3)
+    for k in range(3):
+        got = imukit.identify_noise(tau, adev[:, k])["noise_density"]
+        assert abs(got / nd - 1) < 0.10, got
+    tau1, adev1 = imukit.allan_deviation(gyro[:, 0], fs)
+    np.testing.assert_array_equal(adev1, adev[:, 0])
+
+
+def test_presets_and_parameter_files(tmp_path):
+    assert "ideal" in imukit.presets()
+    ideal = imukit.preset_params("ideal")
+    assert ideal["grade"] == "ideal" and "gyroscope" in ideal
+    path = tmp_path / "matlab.json"
+    path.write_text(json.dumps({"MyPart": {"Gyroscope": {"NoiseDensity": 0.001, "MeasurementRange": "inf"}}}))
+    p = imukit.loadparams(path)
+    assert p["name"] == "MyPart"
+    assert p["gyroscope"]["noise_density_rad_s_per_rt_hz"] == 0.001
+    assert p["gyroscope"]["measurement_range_rad_s"] == "inf"
+    imu = imukit.ImuSensor("accel-gyro", gyroscope=p["gyroscope"], profile="default", seed=3)
+    _, g = imu(*level(10))
+    assert np.all(np.isfinite(g)) and np.any(g != 0)
+
+
+def test_bad_parameters_raise_imu_errors_naming_the_field(tmp_path):
+    with pytest.raises(ImuError, match=r"imu.gyroscope.*noise_density\[0\] must be ≥ 0"):
+        imukit.ImuSensor(gyroscope={"NoiseDensity": -1})
+    with pytest.raises(ImuError, match=r"MeasurementRange|measurement_range must be > 0"):
+        imukit.ImuSensor(accelerometer={"MeasurementRange": 0})
+    with pytest.raises(ImuError, match=r"unknown preset \"nope\""):
+        imukit.ImuSensor(preset="nope")
+    with pytest.raises(ImuError, match=r"unknown parameter"):
+        imukit.ImuSensor(gyroscope={"Noise": 1})
+    with pytest.raises(ImuError, match=r"imu_type"):
+        imukit.ImuSensor("accel-baro")
+    bad = tmp_path / "bad.json"
+    bad.write_text('{\n "P": {\n  "Gyroscope": {"NoiseDensity": 0.1,}\n }\n}\n')
+    with pytest.raises(ImuError, match=r"bad.json.*line 3"):
+        imukit.loadparams(bad)
+    with pytest.raises(ValueError, match=r"orientation must have shape"):
+        imukit.ImuSensor()(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 5)))
