@@ -608,6 +608,9 @@ impl PyImuSensor {
     }
 }
 
+/// `(tau_s, adev)`.
+type AllanOut<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// Overlapping Allan deviation of each column of `x` (N,) or (N, k) at octave τ:
 /// returns `(tau_s, adev)` with `adev` of shape (T,) or (T, k).
 #[pyfunction]
@@ -615,7 +618,7 @@ fn allan_deviation<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,
     sample_rate_hz: f64,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<AllanOut<'py>> {
     let v = x.as_array();
     let series: Vec<(String, Vec<f64>)> = (0..v.ncols())
         .map(|k| (format!("column {k}"), v.column(k).to_vec()))
