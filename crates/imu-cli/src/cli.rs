@@ -35,6 +35,14 @@ pub enum Command {
         /// Name of a preset.
         name: Option<String>,
     },
+    /// Converts a datasheet figure to imukit's SI parameter units (single-sided densities,
+    /// g = 9.80665 m/s²), e.g. `imukit convert 0.15 "°/√h"`.
+    Convert {
+        /// The value.
+        value: f64,
+        /// Its unit (°/√h, °/h, °/s/√Hz, µg/√Hz, m/s/√h, mg, ppm, …).
+        unit: String,
+    },
     /// Allan deviation of IMU columns (octave τ) with N, K and B identified.
     Allan {
         /// IMU readings CSV (with `t_s`).

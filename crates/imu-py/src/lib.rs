@@ -663,6 +663,13 @@ fn identify_noise<'py>(
     Ok(d)
 }
 
+/// A datasheet figure in imukit's SI units: `(value, unit, fitting parameters)`.
+#[pyfunction]
+fn convert(value: f64, unit: &str) -> PyResult<(f64, &'static str, &'static str)> {
+    let c = imu_scenario::units::convert(value, unit).map_err(refused)?;
+    Ok((c.value, c.unit, c.fits))
+}
+
 /// Names of the sensor presets.
 #[pyfunction]
 fn preset_names() -> Vec<&'static str> {
@@ -716,6 +723,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyImuSensor>()?;
     m.add_function(wrap_pyfunction!(allan_deviation, m)?)?;
     m.add_function(wrap_pyfunction!(identify_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(convert, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;

@@ -135,3 +135,14 @@ def test_bad_parameters_raise_imu_errors_naming_the_field(tmp_path):
         imukit.loadparams(bad)
     with pytest.raises(ValueError, match=r"orientation must have shape"):
         imukit.ImuSensor()(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 5)))
+
+
+def test_convert_datasheet_units():
+    v, unit, fits = imukit.convert(0.15, "°/√h")
+    assert unit == "rad/s/√Hz" and "noise_density" in fits
+    assert abs(v - 0.15 * math.pi / 180 / 60) < 1e-18
+    assert "mpu-6050" in imukit.presets()
+    mpu = imukit.preset_params("mpu-6050")
+    assert abs(mpu["gyroscope"]["noise_density_rad_s_per_rt_hz"] - imukit.convert(0.005, "°/s/√Hz")[0]) < 1e-9
+    with pytest.raises(ImuError, match="unknown unit"):
+        imukit.convert(1, "furlongs")

@@ -14,6 +14,7 @@ pub mod scenario;
 pub mod sensors;
 pub mod table;
 pub mod track;
+pub mod units;
 
 pub use error::{Error, Result};
 pub use scenario::{Scenario, ScenarioSpec, Simulation};

@@ -352,3 +352,79 @@ fn ideal_preset_changes_nothing() {
     assert_eq!(plain, ideal);
     assert!(presets::names().contains(&"ideal"));
 }
+
+#[test]
+fn every_preset_loads_validates_and_cites_its_source() {
+    assert!(presets::names().len() >= 9, "{:?}", presets::names());
+    for name in presets::names() {
+        let file = presets::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        for key in ["name", "grade", "source"] {
+            assert!(
+                file.info.get(key).is_some_and(|v| !v.is_empty()),
+                "{name}: {key}"
+            );
+        }
+        // Presets state datasheet (single-sided) densities.
+        for s in [
+            file.params.accelerometer,
+            file.params.gyroscope,
+            file.params.magnetometer,
+        ] {
+            assert_eq!(s.noise_type, NoiseType::SingleSided, "{name}");
+            s.validate().unwrap();
+        }
+        // Case-insensitive lookup, and a scenario can use it.
+        assert!(presets::text(&name.to_uppercase()).is_ok());
+        let sim = run(
+            &format!("{STATIC_NED}[imu]\npreset = \"{name}\"\nseed = 1\n"),
+            Path::new("."),
+        )
+        .unwrap();
+        assert!(sim.imu.data.iter().all(|v| v.is_finite()), "{name}");
+    }
+}
+
+#[test]
+fn preset_numbers_match_their_datasheet_figures() {
+    use imu_scenario::units::{convert, datasheet_bias_instability};
+    let rel = |a: f64, b: f64| (a - b).abs() <= 1e-5 * b.abs();
+    let mpu = presets::load("mpu-6050").unwrap().params;
+    assert!(rel(
+        mpu.gyroscope.noise_density[0],
+        convert(0.005, "°/s/√Hz").unwrap().value
+    ));
+    assert!(rel(
+        mpu.accelerometer.noise_density[0],
+        convert(400.0, "µg/√Hz").unwrap().value
+    ));
+    assert!(rel(
+        mpu.gyroscope.acceleration_bias[0],
+        convert(0.1, "°/s/g").unwrap().value
+    ));
+    assert!(rel(
+        mpu.accelerometer.constant_bias[2],
+        convert(80.0, "mg").unwrap().value
+    ));
+    let stim = presets::load("stim300").unwrap().params;
+    assert!(rel(
+        stim.gyroscope.noise_density[0],
+        convert(0.15, "°/√h").unwrap().value
+    ));
+    assert!(rel(
+        stim.accelerometer.noise_density[0],
+        convert(0.06, "m/s/√h").unwrap().value
+    ));
+    assert!(rel(
+        stim.gyroscope.bias_instability[0],
+        datasheet_bias_instability(convert(0.5, "°/h").unwrap().value)
+    ));
+    let hg = presets::load("hg9900").unwrap().params;
+    assert!(rel(
+        hg.gyroscope.noise_density[0],
+        convert(0.002, "°/√h").unwrap().value
+    ));
+    assert!(rel(
+        hg.accelerometer.constant_bias[0],
+        convert(25.0, "µg").unwrap().value
+    ));
+}

@@ -45,6 +45,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
         Command::Presets { name } => presets::run(name.as_deref()),
+        Command::Convert { value, unit } => {
+            let c = imu_scenario::units::convert(value, &unit)?;
+            println!("{} {}   ({})", c.value, c.unit, c.fits);
+            Ok(())
+        }
         Command::Allan {
             input,
             columns,

@@ -35,6 +35,7 @@ __all__ = [
     "allan_deviation",
     "identify_noise",
     "presets",
+    "convert",
     "preset_params",
     "loadparams",
     "builtin_scenarios",
@@ -419,6 +420,15 @@ def identify_noise(tau_s, adev) -> dict:
     """N (at τ = 1 s on the −½ line), K (at τ = 3 s on the +½ line) and B (floor / 0.664) of an
     Allan curve, with the fitted lines as ``(slope, log10 intercept)``; ``None`` where absent."""
     return _core.identify_noise(np.ascontiguousarray(tau_s, dtype=np.float64), np.ascontiguousarray(adev, dtype=np.float64))
+
+
+def convert(value: float, unit: str) -> tuple:
+    """A datasheet figure in imukit's SI parameter units: ``(value, unit, parameters it fits)``.
+
+    Densities are single-sided (datasheet convention), g = 9.80665 m/s²:
+    ``convert(0.15, "°/√h")`` → ``(4.3633e-05, "rad/s/√Hz", "gyroscope noise_density (angle random walk)")``.
+    """
+    return _core.convert(float(value), unit)
 
 
 def presets() -> list:
