@@ -1,0 +1,76 @@
+//! Throughput (samples/s) of the full accel-gyro-mag error model with every term on: bias,
+//! misalignment, white noise, bias instability (MATLAB filter and flicker), random walk,
+//! temperature, g-sensitivity, saturation, quantisation; 27 normals per sample.
+//!
+//! Run: `cargo bench -p imu-benches --bench sensor`.
+#![allow(missing_docs)]
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imu_core::sensor::{
+    BiasInstabilityModel, GyroAccelerationInput, ImuModel, ImuReading, ImuState, SeededNormals,
+    SensorParams, SensorSet, Temperatures,
+};
+use imu_core::{Enu, ImuMount, Truth};
+
+fn every_term(model: BiasInstabilityModel) -> SensorParams {
+    SensorParams {
+        measurement_range: 1e3,
+        resolution: 1e-5,
+        constant_bias: [0.01, -0.02, 0.03],
+        axes_misalignment_pct: SensorParams::misalignment_from_vector([0.1, 0.2, 0.3]),
+        noise_density: [1e-3; 3],
+        bias_instability: [1e-4; 3],
+        bias_instability_model: model,
+        random_walk: [1e-5; 3],
+        temperature_bias: [1e-4; 3],
+        temperature_scale_factor_pct: [0.01; 3],
+        acceleration_bias: [1e-4; 3],
+        ..SensorParams::default()
+    }
+}
+
+fn bench_sensor(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sensor_model/accel-gyro-mag");
+    let truth = Truth::<Enu>::default();
+    for (label, bi) in [
+        ("matlab_filter", BiasInstabilityModel::default()),
+        (
+            "flicker",
+            BiasInstabilityModel::Flicker {
+                tau_min_s: 1.0,
+                tau_max_s: 1000.0,
+            },
+        ),
+    ] {
+        let p = every_term(bi);
+        let model = ImuModel::new(
+            ImuMount::<Enu>::default(),
+            SensorSet {
+                gyroscope: true,
+                magnetometer: true,
+            },
+            GyroAccelerationInput::BodySpecificForce,
+            [&p, &p, &p],
+            100.0,
+        )
+        .expect("valid parameters");
+        let temps = Temperatures::uniform(30.0);
+        for n in [1usize, 100_000] {
+            let mut out = vec![ImuReading::default(); n];
+            group.throughput(Throughput::Elements(n as u64));
+            group.bench_function(BenchmarkId::new(label, n), |b| {
+                let mut state = ImuState::default();
+                let mut noise = SeededNormals::new(1);
+                b.iter(|| {
+                    for o in out.iter_mut() {
+                        *o = model.measure(&truth, &temps, &mut state, &mut noise);
+                    }
+                });
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_sensor);
+criterion_main!(benches);
