@@ -44,4 +44,6 @@ for f in examples/*.toml; do
   target/release/imukit simulate "$f" --out "$out/$(basename "$f" .toml)_imu.csv" --truth "$out/$(basename "$f" .toml)_truth.csv"
 done
 python examples/seed_error_study.py
+python examples/matlab_imusensor.py
+python examples/allan_study.py
 echo "== All tests passed"

@@ -1,0 +1,42 @@
+"""Allan round trip on a datasheet preset: simulate a static STIM300 for six hours, compute the
+Allan deviation of its gyroscope and read the angle random walk and bias instability back,
+next to the datasheet's figures (0.15 °/√h, 0.5 °/h).
+
+Run: python examples/allan_study.py
+"""
+import math
+
+import numpy as np
+
+import imukit
+
+FS = 100.0
+HOURS = 6.0
+
+
+def main():
+    sim = imukit.simulate({
+        "rate_hz": FS,
+        "duration_s": HOURS * 3600.0,
+        "trajectory": {"type": "builtin", "name": "static"},
+        "imu": {"preset": "stim300", "seed": 11, "kind": "accel-gyro",
+                "gyroscope": {"constant_bias_rad_s": 0.0}},
+    })
+    gyro = np.column_stack([sim.imu[f"gyro_{a}_rad_s"] for a in "xyz"])
+    tau, adev = imukit.allan_deviation(gyro, FS)
+    deg = 180 / math.pi
+    print(f"STIM300 preset, static, {HOURS:g} h at {FS:g} Hz")
+    print(f"{'axis':<5} {'ARW (°/√h)':>12} {'floor, white removed (°/h)':>28} {'raw curve minimum (°/h)':>25}")
+    reliable = tau <= HOURS * 3600 / 10  # at least ~10 clusters
+    for k, axis in enumerate("xyz"):
+        n = imukit.identify_noise(tau, adev[:, k])
+        arw = n["noise_density"] * deg * 60
+        floor = n["bias_instability"] * 0.664 * deg * 3600
+        raw_min = np.min(adev[reliable, k]) * deg * 3600
+        print(f"{axis:<5} {arw:>12.4f} {floor:>28.3f} {raw_min:>25.3f}")
+    print("datasheet: ARW 0.15 °/√h, bias instability 0.5 °/h (the Allan minimum of a 20 h test)")
+    print("The raw minimum lies above the floor where the white noise has not yet averaged out.")
+
+
+if __name__ == "__main__":
+    main()
