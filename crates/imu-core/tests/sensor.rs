@@ -606,3 +606,40 @@ fn gauss_markov_bias_has_the_set_standard_deviation_and_correlation_time() {
         .is_err()
     );
 }
+
+#[test]
+fn quantisation_carry_keeps_the_sum_of_readings_within_one_lsb_of_the_sum_of_inputs() {
+    let r = 0.01;
+    let u = [0.0031, -0.0047, 0.0199];
+    for carry in [false, true] {
+        let p = SensorParams {
+            resolution: r,
+            quantization_carry: carry,
+            ..SensorParams::default()
+        };
+        let model = SensorModel::new(&p, 100.0).unwrap();
+        let mut state = SensorState::default();
+        let n = 1000;
+        let mut sums = [0.0; 3];
+        for _ in 0..n {
+            let y = model.measure(u, &Environment::default(), &mut state, &mut NoNoise);
+            for k in 0..3 {
+                assert!(
+                    ((y[k] / r) - (y[k] / r).round()).abs() < 1e-9,
+                    "on the grid"
+                );
+                sums[k] += y[k];
+            }
+        }
+        for k in 0..3 {
+            let err = (sums[k] - n as f64 * u[k]).abs();
+            if carry {
+                assert!(err <= r + 1e-9, "axis {k}: {err}");
+            } else {
+                // Plain rounding: 0.0031 → 0, −0.0047 → 0, 0.0199 → 0.02, every sample.
+                let plain = (u[k] / r).round() * r;
+                assert!((sums[k] - n as f64 * plain).abs() < 1e-9);
+            }
+        }
+    }
+}

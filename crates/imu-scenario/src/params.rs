@@ -20,6 +20,7 @@
 //! | `temperature_bias_U_per_c` | bias per °C from 25 °C | number or 3-vector |
 //! | `temperature_scale_factor_pct_per_c` | scale factor per °C, % | number or 3-vector |
 //! | `acceleration_bias_rad_s_per_m_s2` | gyroscope g-sensitivity | number or 3-vector |
+//! | `quantization_carry` | carry quantisation residuals to the next sample | `true`/`false` |
 //!
 //! MATLAB's names (`MeasurementRange`, `Resolution`, `ConstantBias`, `AxesMisalignment`,
 //! `NoiseDensity`, `BiasInstability`, `BiasInstabilityCoefficients` with `Numerator` and
@@ -272,6 +273,7 @@ pub fn parse_sensor(
         format!("temperature_bias_{u}_per_c"),
         "temperature_scale_factor_pct_per_c".into(),
         "acceleration_bias_rad_s_per_m_s2".into(),
+        "quantization_carry".into(),
     ];
     for (k, v) in map {
         let field = format!("{prefix}.{k}");
@@ -315,6 +317,11 @@ pub fn parse_sensor(
             (Some(12), _) | (_, "TemperatureBias") => p.temperature_bias = triple(v, &field)?,
             (Some(13), _) | (_, "TemperatureScaleFactor") => {
                 p.temperature_scale_factor_pct = triple(v, &field)?
+            }
+            (Some(15), _) => {
+                p.quantization_carry = v.as_bool().ok_or_else(|| {
+                    invalid(field.clone(), format!("expected true or false, got {v}"))
+                })?;
             }
             (Some(14), _) | (_, "AccelerationBias") if sensor == Sensor::Gyroscope => {
                 p.acceleration_bias = triple(v, &field)?;
@@ -599,6 +606,9 @@ pub fn to_toml(file: &ParamFile) -> String {
                 "acceleration_bias_rad_s_per_m_s2 = {}\n",
                 fmt3(p.acceleration_bias)
             );
+        }
+        if p.quantization_carry {
+            s += "quantization_carry = true\n";
         }
     }
     s

@@ -211,6 +211,8 @@ fn parameter_files_round_trip_through_toml() {
     };
     file.params.gyroscope = SensorParams {
         acceleration_bias: [1e-4; 3],
+        resolution: 1e-4,
+        quantization_carry: true,
         bias_instability_model: BiasInstabilityModel::GaussMarkov {
             correlation_time_s: 300.0,
         },

@@ -160,6 +160,7 @@ impl Default for Environment {
 pub struct SensorState {
     filter: [[f64; FILTER_STATE]; 3],
     random_walk: [f64; 3],
+    quantization_residual: [f64; 3],
 }
 
 impl Default for SensorState {
@@ -167,6 +168,7 @@ impl Default for SensorState {
         Self {
             filter: [[0.0; FILTER_STATE]; 3],
             random_walk: [0.0; 3],
+            quantization_residual: [0.0; 3],
         }
     }
 }
@@ -193,6 +195,7 @@ pub struct SensorModel {
     acceleration_bias: [f64; 3],
     range: f64,
     resolution: f64,
+    quantization_carry: bool,
 }
 
 impl SensorModel {
@@ -227,6 +230,7 @@ impl SensorModel {
             acceleration_bias: params.acceleration_bias,
             range: params.measurement_range,
             resolution: params.resolution,
+            quantization_carry: params.quantization_carry,
         })
     }
 
@@ -254,7 +258,15 @@ impl SensorModel {
             let environment = dt_c * self.temperature_bias[i]
                 + self.acceleration_bias[i] * env.acceleration_m_s2[i];
             let y = (1.0 + dt_c * self.temperature_scale[i]) * (bulk + drift + environment);
-            self.quantise(self.saturate(y))
+            let y = self.saturate(y);
+            if self.quantization_carry && self.resolution > 0.0 {
+                let carried = y + state.quantization_residual[i];
+                let q = self.quantise(carried);
+                state.quantization_residual[i] = carried - q;
+                q
+            } else {
+                self.quantise(y)
+            }
         })
     }
 

@@ -158,6 +158,9 @@ pub struct SensorParams {
     pub temperature_scale_factor_pct: [f64; 3],
     /// Gyroscope only: bias per unit acceleration, `(rad/s)/(m/s²)`.
     pub acceleration_bias: [f64; 3],
+    /// Carry each sample's quantisation residual into the next (sigma-delta style), so sums of
+    /// readings track sums of inputs to within one LSB; off in MATLAB.
+    pub quantization_carry: bool,
 }
 
 impl Default for SensorParams {
@@ -175,6 +178,7 @@ impl Default for SensorParams {
             temperature_bias: [0.0; 3],
             temperature_scale_factor_pct: [0.0; 3],
             acceleration_bias: [0.0; 3],
+            quantization_carry: false,
         }
     }
 }
