@@ -9,6 +9,7 @@ pub mod builtin;
 pub mod error;
 pub mod expr;
 pub mod params;
+pub mod perturb;
 pub mod presets;
 pub mod scenario;
 pub mod sensors;

@@ -29,7 +29,8 @@ use serde::{Deserialize, Serialize};
 use crate::builtin;
 use crate::error::{Error, Result, invalid};
 use crate::expr::Expr;
-use crate::params::Profile;
+use crate::params::{ImuParams, Profile};
+use crate::perturb::{PerturbationSpec, perturbed};
 use crate::sensors::{SensorKeys, SensorSetup, TemperatureSpec};
 use crate::table::{ImuKind, Table, read_columns, read_header};
 use crate::track::{Segment, SpeedProfile, Track};
@@ -216,6 +217,8 @@ pub struct ImuSpec {
     pub gyroscope: Option<serde_json::Value>,
     /// Magnetometer parameters.
     pub magnetometer: Option<serde_json::Value>,
+    /// Monte Carlo perturbations of parameters, drawn per run.
+    pub perturbations: Option<Vec<PerturbationSpec>>,
 }
 
 impl ImuSpec {
@@ -245,6 +248,10 @@ impl ImuSpec {
                 .magnetometer
                 .clone()
                 .or_else(|| other.magnetometer.clone()),
+            perturbations: self
+                .perturbations
+                .clone()
+                .or_else(|| other.perturbations.clone()),
         }
     }
 
@@ -261,6 +268,7 @@ impl ImuSpec {
                 self.gyroscope.as_ref(),
                 self.magnetometer.as_ref(),
             ],
+            perturbations: self.perturbations.as_deref().unwrap_or(&[]),
         }
     }
 }
@@ -535,11 +543,19 @@ impl ImuSetup {
         gravity_m_s2: f64,
         sample_rate_hz: f64,
     ) -> Result<ImuModel<N>> {
+        self.model_with::<N>(&self.sensors.params, gravity_m_s2, sample_rate_hz)
+    }
+
+    fn model_with<N: NavFrame>(
+        &self,
+        p: &ImuParams,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+    ) -> Result<ImuModel<N>> {
         let set = SensorSet {
             gyroscope: self.kind.has_gyro(),
             magnetometer: self.kind.has_mag(),
         };
-        let p = &self.sensors.params;
         ImuModel::new(
             self.mount::<N>(gravity_m_s2),
             set,
@@ -562,8 +578,9 @@ impl ImuSetup {
         sample_rate_hz: f64,
         run: Option<u64>,
     ) -> Result<Vec<ImuReading>> {
-        let model = self.model::<N>(gravity_m_s2, sample_rate_hz)?;
         let seed = self.sensors.seed;
+        let params = perturbed(&self.sensors.params, &self.sensors.perturbations, seed, run)?;
+        let model = self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?;
         let mut noise = run.map_or_else(
             || SeededNormals::new(seed),
             |r| SeededNormals::for_run(seed, r),

@@ -10,6 +10,11 @@
 //! preset = "ideal"             # or params = "my_imu.toml" / "matlab_params.json" (part = "…")
 //! [imu.gyroscope]              # inline tables override the preset or file key by key
 //! noise_density_rad_s_per_rt_hz = 1e-4
+//! [[imu.perturbations]]        # Monte Carlo: drawn per run (see `perturb`)
+//! parameter = "gyroscope.constant_bias_rad_s"
+//! distribution = "normal"
+//! mean = 0.0
+//! std = 0.01
 //! ```
 use std::path::{Path, PathBuf};
 
@@ -19,6 +24,7 @@ use serde_json::Value;
 
 use crate::error::{Result, invalid};
 use crate::params::{ImuParams, Profile, Sensor, parse_sensor, read_param_file};
+use crate::perturb::{Perturbation, PerturbationSpec};
 use crate::presets;
 use crate::table::read_columns;
 
@@ -139,6 +145,8 @@ pub struct SensorSetup {
     pub seed: u64,
     /// Temperatures over time.
     pub temperature: Temperature,
+    /// Monte Carlo perturbations of the parameters.
+    pub perturbations: Vec<Perturbation>,
 }
 
 impl Default for SensorSetup {
@@ -149,6 +157,7 @@ impl Default for SensorSetup {
             gyro_acceleration: Profile::Default.gyro_acceleration(),
             seed: 0,
             temperature: Temperature::default(),
+            perturbations: Vec::new(),
         }
     }
 }
@@ -170,6 +179,8 @@ pub struct SensorKeys<'a> {
     pub part: Option<&'a str>,
     /// Inline tables, accelerometer, gyroscope, magnetometer.
     pub tables: [Option<&'a Value>; 3],
+    /// `perturbations`.
+    pub perturbations: &'a [PerturbationSpec],
 }
 
 impl SensorSetup {
@@ -235,6 +246,12 @@ impl SensorSetup {
             gyro_acceleration: profile.gyro_acceleration(),
             seed: keys.seed.unwrap_or(0),
             temperature,
+            perturbations: keys
+                .perturbations
+                .iter()
+                .enumerate()
+                .map(|(i, p)| Perturbation::from_spec(p, i))
+                .collect::<Result<_>>()?,
         })
     }
 }

@@ -430,3 +430,103 @@ fn preset_numbers_match_their_datasheet_figures() {
         convert(25.0, "µg").unwrap().value
     ));
 }
+
+fn first_reading(sc: &imu_scenario::Scenario, run: u64, column: &str) -> f64 {
+    sc.simulate_run(run).unwrap().imu.column(column).unwrap()[0]
+}
+
+#[test]
+fn perturbations_draw_per_run_with_the_stated_distributions() {
+    // Noise-free static IMU: the reading is the perturbed parameter itself.
+    let text = format!(
+        "{STATIC_NED}[imu]\nseed = 3\n\
+         [[imu.perturbations]]\nparameter = \"gyroscope.constant_bias_rad_s\"\ndistribution = \"normal\"\nmean = 0.01\nstd = 0.002\n\
+         [[imu.perturbations]]\nparameter = \"accelerometer.constant_bias_m_s2\"\ndistribution = \"uniform\"\nlower = -0.1\nupper = 0.3\n\
+         [[imu.perturbations]]\nparameter = \"magnetometer.constant_bias_ut\"\ndistribution = \"selection\"\nvalues = [1.0, 2.0]\nprobabilities = [0.25, 0.75]\n\
+         [[imu.perturbations]]\nparameter = \"gyroscope.temperature_scale_factor_pct_per_c\"\ndistribution = \"truncated-normal\"\nmean = 0.0\nstd = 1.0\nlower = 0.0\nupper = 0.5\n"
+    );
+    let sc = ScenarioSpec::from_toml(&text, "t")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let runs = 400u64;
+    let (mut g, mut a, mut twos) = (vec![], vec![], 0);
+    for r in 0..runs {
+        let sim = sc.simulate_run(r).unwrap();
+        g.push(sim.imu.column("gyro_x_rad_s").unwrap()[0]);
+        a.push(sim.imu.column("accel_y_m_s2").unwrap()[0]);
+        let m = sim.imu.column("mag_x_ut").unwrap()[0] - 27.555;
+        assert!((m - 1.0).abs() < 1e-9 || (m - 2.0).abs() < 1e-9, "{m}");
+        twos += usize::from((m - 2.0).abs() < 1e-9);
+    }
+    let n = runs as f64;
+    let mean = g.iter().sum::<f64>() / n;
+    let sd = (g.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    assert!((mean - 0.01).abs() < 5.0 * 0.002 / n.sqrt(), "{mean}");
+    assert!((sd / 0.002 - 1.0).abs() < 5.0 * (0.5 / n).sqrt(), "{sd}");
+    assert!(a.iter().all(|v| (-0.1..=0.3).contains(v)));
+    let a_mean = a.iter().sum::<f64>() / n;
+    assert!(
+        (a_mean - 0.1).abs() < 5.0 * (0.4 / 12f64.sqrt()) / n.sqrt(),
+        "{a_mean}"
+    );
+    let p2 = twos as f64 / n;
+    assert!((p2 - 0.75).abs() < 5.0 * (0.75 * 0.25 / n).sqrt(), "{p2}");
+    // Deterministic per run, independent of the other runs.
+    assert_eq!(
+        first_reading(&sc, 17, "gyro_x_rad_s"),
+        first_reading(&sc, 17, "gyro_x_rad_s")
+    );
+    assert_ne!(
+        first_reading(&sc, 17, "gyro_x_rad_s"),
+        first_reading(&sc, 18, "gyro_x_rad_s")
+    );
+    // Per axis, independent draws.
+    let sim = sc.simulate_run(5).unwrap();
+    assert_ne!(
+        sim.imu.column("gyro_x_rad_s").unwrap()[0],
+        sim.imu.column("gyro_y_rad_s").unwrap()[0]
+    );
+}
+
+#[test]
+fn bad_perturbations_are_refused() {
+    let dir = Path::new(".");
+    let p = |body: &str| format!("{STATIC_NED}[imu]\n[[imu.perturbations]]\n{body}");
+    let e = err(
+        &p("parameter = \"gyroscope.bias\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"),
+        dir,
+    );
+    assert!(
+        e.contains("imu.perturbations[0].parameter") && e.contains("cannot perturb \"bias\""),
+        "{e}"
+    );
+    let e = err(
+        &p("parameter = \"gyroscope.constant_bias_rad_s\"\ndistribution = \"cauchy\"\n"),
+        dir,
+    );
+    assert!(e.contains("unknown distribution \"cauchy\""), "{e}");
+    let e = err(
+        &p("parameter = \"gyroscope.constant_bias_rad_s\"\ndistribution = \"normal\"\nmean = 0\n"),
+        dir,
+    );
+    assert!(e.contains("needs std"), "{e}");
+    let e = err(
+        &p(
+            "parameter = \"accelerometer.constant_bias_m_s2\"\ndistribution = \"selection\"\nvalues = [1, 2]\nprobabilities = [0.5, 0.6]\n",
+        ),
+        dir,
+    );
+    assert!(e.contains("add up to 1"), "{e}");
+    // A draw that makes a density negative names the run.
+    let e = err(
+        &p(
+            "parameter = \"gyroscope.noise_density_rad_s_per_rt_hz\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n",
+        ),
+        dir,
+    );
+    assert!(
+        e.contains("noise_density") && e.contains("must be ≥ 0"),
+        "{e}"
+    );
+}
