@@ -643,3 +643,31 @@ fn quantisation_carry_keeps_the_sum_of_readings_within_one_lsb_of_the_sum_of_inp
         }
     }
 }
+
+#[test]
+fn increments_integrate_each_interval() {
+    use imu_core::sensor::increments::trapezoid;
+    // Linear in time: exact. ω(t) = 0.5 + 2t on [0, 1] at 10 Hz: Δθ_k = 0.5·Δt + (t_k² − t_{k−1}²).
+    let t: Vec<f64> = (0..11).map(|k| k as f64 * 0.1).collect();
+    let x: Vec<[f64; 3]> = t.iter().map(|&s| [0.5 + 2.0 * s, -1.0, 3.0 * s]).collect();
+    let mut d = vec![[9.9; 3]; t.len()];
+    trapezoid(&t, &x, &mut d);
+    assert_eq!(d[0], [0.0; 3]);
+    for k in 1..t.len() {
+        let exact = 0.5 * 0.1 + (t[k] * t[k] - t[k - 1] * t[k - 1]);
+        assert!(
+            (d[k][0] - exact).abs() < 1e-15 && (d[k][1] + 0.1).abs() < 1e-15,
+            "{k}"
+        );
+    }
+    // Smooth signal: the summed increments converge to the integral at second order.
+    let err = |n: usize| {
+        let t: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+        let x: Vec<[f64; 3]> = t.iter().map(|&s| [s.sin(), 0.0, 0.0]).collect();
+        let mut d = vec![[0.0; 3]; t.len()];
+        trapezoid(&t, &x, &mut d);
+        (d.iter().map(|v| v[0]).sum::<f64>() - (1.0 - 1f64.cos())).abs()
+    };
+    let order = (err(50) / err(100)).log2();
+    assert!((order - 2.0).abs() < 0.05, "{order}");
+}

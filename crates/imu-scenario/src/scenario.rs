@@ -32,7 +32,7 @@ use crate::expr::Expr;
 use crate::params::{ImuParams, Profile};
 use crate::perturb::{PerturbationSpec, perturbed};
 use crate::sensors::{SensorKeys, SensorSetup, TemperatureSpec};
-use crate::table::{ImuKind, Table, read_columns, read_header};
+use crate::table::{ImuKind, ImuOutput, Table, read_columns, read_header};
 use crate::track::{Segment, SpeedProfile, Track};
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
 
@@ -193,6 +193,8 @@ pub struct TrackSpec {
 pub struct ImuSpec {
     /// Sensors simulated (default all three).
     pub kind: Option<ImuKind>,
+    /// `"rates"` (default) or `"increments"` (Δv, Δθ per interval).
+    pub output: Option<ImuOutput>,
     /// Lever arm from the reference point to the IMU, body frame, m.
     pub lever_arm_m: Option<[f64; 3]>,
     /// Accelerometer sign.
@@ -227,6 +229,7 @@ impl ImuSpec {
     pub fn or(&self, other: &Self) -> Self {
         Self {
             kind: self.kind.or(other.kind),
+            output: self.output.or(other.output),
             lever_arm_m: self.lever_arm_m.or(other.lever_arm_m),
             accel_sign: self.accel_sign.or(other.accel_sign),
             magnetic_field_ut: self.magnetic_field_ut.or(other.magnetic_field_ut),
@@ -506,6 +509,8 @@ pub enum Trajectory {
 pub struct ImuSetup {
     /// Sensors simulated.
     pub kind: ImuKind,
+    /// Rates or increments.
+    pub output: ImuOutput,
     /// Lever arm, body frame, m.
     pub lever_arm_m: [f64; 3],
     /// Accelerometer sign.
@@ -527,6 +532,7 @@ impl ImuSetup {
     ) -> Self {
         Self {
             kind,
+            output: ImuOutput::Rates,
             lever_arm_m,
             accel_sign,
             magnetic_field_ut,
@@ -758,6 +764,7 @@ impl ScenarioSpec {
             .map_or(sensors.profile.accel_sign(), AccelSign::from);
         let imu = ImuSetup {
             kind: spec.imu.kind.unwrap_or_default(),
+            output: spec.imu.output.unwrap_or_default(),
             lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
             accel_sign,
             magnetic_field_ut: spec
@@ -903,7 +910,10 @@ impl Scenario {
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         Ok(Simulation {
             truth: Table::from_truth(&truth),
-            imu: Table::from_readings(&t, &readings, self.imu.kind),
+            imu: match self.imu.output {
+                ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
+                ImuOutput::Increments => Table::from_increments(&t, &readings, self.imu.kind),
+            },
         })
     }
 

@@ -45,6 +45,22 @@ pub const ACCEL_COLUMNS: [&str; 3] = ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m
 pub const GYRO_COLUMNS: [&str; 3] = ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"];
 /// Magnetometer columns of IMU readings.
 pub const MAG_COLUMNS: [&str; 3] = ["mag_x_ut", "mag_y_ut", "mag_z_ut"];
+/// Velocity-increment columns (`output = "increments"`).
+pub const DV_COLUMNS: [&str; 3] = ["dv_x_m_s", "dv_y_m_s", "dv_z_m_s"];
+/// Angle-increment columns (`output = "increments"`).
+pub const DTHETA_COLUMNS: [&str; 3] = ["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"];
+
+/// What the accelerometer and gyroscope columns hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImuOutput {
+    /// Specific force (m/s²) and angular rate (rad/s) at each sample.
+    #[default]
+    Rates,
+    /// Δv (m/s) and Δθ (rad) integrated over the interval ending at each sample (trapezoid of
+    /// the readings; zero at the first sample); the magnetometer stays instantaneous.
+    Increments,
+}
 
 /// Which sensors an IMU has (MATLAB's `IMUType`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -138,6 +154,39 @@ impl Table {
         t.data.reserve(truth.len() * TRUTH_COLUMNS.len());
         for s in truth {
             t.push_row(&truth_row(s));
+        }
+        t
+    }
+
+    /// Readings as Δv/Δθ increments ([`ImuOutput::Increments`]).
+    #[must_use]
+    pub fn from_increments(t_s: &[f64], readings: &[ImuReading], kind: ImuKind) -> Self {
+        use imu_core::sensor::increments::trapezoid;
+        let n = readings.len();
+        let (mut dv, mut dtheta) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let accel: Vec<[f64; 3]> = readings.iter().map(|r| r.accel_m_s2).collect();
+        let gyro: Vec<[f64; 3]> = readings.iter().map(|r| r.gyro_rad_s).collect();
+        trapezoid(t_s, &accel, &mut dv);
+        trapezoid(t_s, &gyro, &mut dtheta);
+        let mut columns = vec!["t_s"];
+        columns.extend(DV_COLUMNS);
+        if kind.has_gyro() {
+            columns.extend(DTHETA_COLUMNS);
+        }
+        if kind.has_mag() {
+            columns.extend(MAG_COLUMNS);
+        }
+        let mut t = Self::new(&columns);
+        for k in 0..n {
+            let mut row = vec![t_s[k]];
+            row.extend(dv[k]);
+            if kind.has_gyro() {
+                row.extend(dtheta[k]);
+            }
+            if kind.has_mag() {
+                row.extend(readings[k].mag_ut);
+            }
+            t.push_row(&row);
         }
         t
     }

@@ -530,3 +530,33 @@ fn bad_perturbations_are_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn increments_output_integrates_each_interval() {
+    let text = "rate_hz = 100.0\nduration_s = 6.0\n[trajectory]\ntype = \"builtin\"\nname = \"platform-turn\"\n[imu]\noutput = \"increments\"\n";
+    let sim = run(text, Path::new(".")).unwrap();
+    assert_eq!(
+        &sim.imu.columns[..7],
+        [
+            "t_s",
+            "dv_x_m_s",
+            "dv_y_m_s",
+            "dv_z_m_s",
+            "dtheta_x_rad",
+            "dtheta_y_rad",
+            "dtheta_z_rad"
+        ]
+    );
+    let dz = sim.imu.column("dtheta_z_rad").unwrap();
+    let dv = sim.imu.column("dv_z_m_s").unwrap();
+    assert_eq!(dz[0], 0.0);
+    // 360° in 4 s then 360° in 2 s: the increments add up to 4π over 6 s, less the half interval
+    // the trapezoid spends across the rate step at t = 4 s.
+    let total: f64 = dz.iter().sum();
+    assert!(
+        (total - 4.0 * std::f64::consts::PI).abs() < 0.5 * 0.01 * std::f64::consts::PI + 1e-9,
+        "{total}"
+    );
+    assert!((dz[100] - std::f64::consts::FRAC_PI_2 * 0.01).abs() < 1e-12);
+    assert!(dv[1..].iter().all(|v| (v + 9.81 * 0.01).abs() < 1e-12)); // NED at rest: −g·Δt on z
+}

@@ -16,6 +16,7 @@
 //! validated model; [`SensorState`] holds what drifts, so one model serves many runs.
 mod error;
 mod imu;
+pub mod increments;
 mod model;
 mod noise;
 mod params;
