@@ -123,9 +123,15 @@ def test_cli_allan_reads_what_python_computes(tmp_path):
                         '[imu]\nseed = 3\n[imu.gyroscope]\nnoise_density_rad_s_per_rt_hz = 2e-3\n')
     imu_csv, adev_csv = tmp_path / "imu.csv", tmp_path / "adev.csv"
     subprocess.run([imukit_bin(), "simulate", str(scenario), "--out", str(imu_csv)], check=True, capture_output=True)
-    result = subprocess.run([imukit_bin(), "allan", str(imu_csv), "--column", "gyro_z_rad_s", "--out", str(adev_csv)],
-                            check=True, capture_output=True, text=True)
+    svg = tmp_path / "adev.svg"
+    result = subprocess.run([imukit_bin(), "allan", str(imu_csv), "--column", "gyro_z_rad_s", "--out", str(adev_csv),
+                             "--plot", str(svg)], check=True, capture_output=True, text=True)
     assert "gyro_z_rad_s" in result.stdout
+    figure = svg.read_text()
+    assert figure.lstrip().startswith("<svg") and figure.rstrip().endswith("</svg>")
+    assert "Allan deviation" in figure and "gyro_z_rad_s" in figure
+    assert figure.count("<polyline") >= 2  # the curve and at least one fitted line
+    assert not list(tmp_path.glob("*.imukit-partial"))
     header, values = read_csv(adev_csv)
     assert header == ["tau_s", "adev_gyro_z_rad_s"]
     sim = imukit.simulate(scenario)

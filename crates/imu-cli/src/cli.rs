@@ -53,6 +53,9 @@ pub enum Command {
         /// Where to write `tau_s, adev_<column>…` (CSV).
         #[arg(long)]
         out: PathBuf,
+        /// Also draw the curves with the fitted lines into this SVG file.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Runs a built-in scenario (default: the seed's figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings and a summary into a folder.

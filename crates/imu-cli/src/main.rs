@@ -1,6 +1,7 @@
 //! `imukit`: IMU simulation and navigation from the command line.
 mod cli;
 mod commands;
+mod plot;
 
 use std::process::ExitCode;
 

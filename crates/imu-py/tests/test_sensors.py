@@ -146,3 +146,19 @@ def test_convert_datasheet_units():
     assert abs(mpu["gyroscope"]["noise_density_rad_s_per_rt_hz"] - imukit.convert(0.005, "°/s/√Hz")[0]) < 1e-9
     with pytest.raises(ImuError, match="unknown unit"):
         imukit.convert(1, "furlongs")
+
+
+def test_parameter_classes_mirror_matlabs_accelparams():
+    accel = imukit.AccelParams(measurement_range=19.62, resolution=0.00059875, constant_bias=0.4905,
+                               axes_misalignment=2, noise_density=0.0, temperature_bias=[0.34335, 0.34335, 0.5886],
+                               temperature_scale_factor=0.02)
+    gyro = imukit.GyroParams(acceleration_bias=1e-4, bias_instability=0.0,
+                             bias_instability_coefficients=([1.0], [1.0, -0.5]))
+    assert accel.to_dict()["MeasurementRange"] == 19.62
+    assert gyro.to_dict()["BiasInstabilityCoefficients"] == {"Numerator": [1.0], "Denominator": [1.0, -0.5]}
+    a = imukit.ImuSensor("accel-gyro", accelerometer=accel, gyroscope=gyro, temperature=35)
+    b = imukit.ImuSensor("accel-gyro", accelerometer=accel.to_dict(), gyroscope=gyro.to_dict(), temperature=35)
+    for x, y in zip(a(*level(5)), b(*level(5))):
+        np.testing.assert_array_equal(x, y)
+    with pytest.raises(TypeError, match="AccelParams"):
+        imukit.ImuSensor(accelerometer=[1, 2, 3])

@@ -6,7 +6,12 @@ use imu_scenario::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header
 
 use super::CliError;
 
-pub fn run(input: &Path, columns: &[String], out: &Path) -> Result<(), CliError> {
+pub fn run(
+    input: &Path,
+    columns: &[String],
+    out: &Path,
+    plot: Option<&Path>,
+) -> Result<(), CliError> {
     let header = read_header(input)?;
     let chosen: Vec<String> = if columns.is_empty() {
         GYRO_COLUMNS
@@ -33,6 +38,9 @@ pub fn run(input: &Path, columns: &[String], out: &Path) -> Result<(), CliError>
         .collect();
     let result = allan(&series, rate)?;
     result.table.write_csv(out)?;
+    if let Some(p) = plot {
+        crate::plot::allan_svg(p, &result)?;
+    }
     println!(
         "{:<16} {:>14} {:>14} {:>14}",
         "column", "N (·/√Hz)", "B", "K (·√Hz)"
@@ -45,6 +53,9 @@ pub fn run(input: &Path, columns: &[String], out: &Path) -> Result<(), CliError>
             show(id.bias_instability),
             show(id.random_walk)
         );
+    }
+    if let Some(p) = plot {
+        println!("\nFigure written to {}", p.display());
     }
     println!(
         "\nAllan deviation of {} columns at {} τ values ({rate} Hz) written to {}",

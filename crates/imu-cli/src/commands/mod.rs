@@ -13,6 +13,14 @@ pub enum CliError {
     /// Input or I/O errors from the scenario layer.
     #[error(transparent)]
     Scenario(#[from] imu_scenario::Error),
+    /// A figure could not be drawn or written.
+    #[error("{path}: {message}")]
+    Plot {
+        /// The figure file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
     /// Other I/O errors (creating folders, writing text).
     #[error("{path}: {source}")]
     Io {
@@ -27,7 +35,9 @@ impl CliError {
     /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Scenario(imu_scenario::Error::Io { .. }) | Self::Io { .. } => 74,
+            Self::Scenario(imu_scenario::Error::Io { .. })
+            | Self::Io { .. }
+            | Self::Plot { .. } => 74,
             Self::Scenario(_) => 65,
         }
     }
@@ -54,6 +64,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             input,
             columns,
             out,
-        } => allan::run(&input, &columns, &out),
+            plot,
+        } => allan::run(&input, &columns, &out, plot.as_deref()),
     }
 }

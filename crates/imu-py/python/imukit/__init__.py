@@ -32,6 +32,9 @@ __all__ = [
     "Simulation",
     "simulate",
     "ImuSensor",
+    "AccelParams",
+    "GyroParams",
+    "MagParams",
     "allan_deviation",
     "identify_noise",
     "presets",
@@ -303,12 +306,77 @@ def dcm_to_quaternion(dcm) -> np.ndarray:
     return _core.dcm_to_quaternion(m.reshape(1, 3, 3) if m.ndim == 2 else m)
 
 
+@dataclass
+class _SensorParams:
+    """MATLAB's accelparams/gyroparams/magparams properties (SI units); ``None`` leaves a property
+    at its neutral value. ``axes_misalignment`` takes MATLAB's forms (scalar, 3-vector, 3×3, %);
+    ``bias_instability_coefficients`` is ``(numerator, denominator)``."""
+
+    measurement_range: Optional[float] = None
+    resolution: Optional[float] = None
+    constant_bias: Optional[object] = None
+    axes_misalignment: Optional[object] = None
+    noise_density: Optional[object] = None
+    bias_instability: Optional[object] = None
+    bias_instability_coefficients: Optional[tuple] = None
+    random_walk: Optional[object] = None
+    noise_type: Optional[str] = None
+    temperature_bias: Optional[object] = None
+    temperature_scale_factor: Optional[object] = None
+
+    _MATLAB = {
+        "measurement_range": "MeasurementRange", "resolution": "Resolution", "constant_bias": "ConstantBias",
+        "axes_misalignment": "AxesMisalignment", "noise_density": "NoiseDensity",
+        "bias_instability": "BiasInstability", "random_walk": "RandomWalk", "noise_type": "NoiseType",
+        "temperature_bias": "TemperatureBias", "temperature_scale_factor": "TemperatureScaleFactor",
+        "acceleration_bias": "AccelerationBias",
+    }
+
+    def to_dict(self) -> dict:
+        """The parameters under MATLAB's property names (what ``ImuSensor`` and scenario files take)."""
+        out = {}
+        for field, value in self.__dict__.items():
+            if value is None:
+                continue
+            if field == "bias_instability_coefficients":
+                num, den = value
+                out["BiasInstabilityCoefficients"] = {"Numerator": list(np.atleast_1d(num).astype(float)),
+                                                      "Denominator": list(np.atleast_1d(den).astype(float))}
+            else:
+                v = np.asarray(value, dtype=float).tolist() if not isinstance(value, str) else value
+                out[self._MATLAB[field]] = v
+        return out
+
+
+@dataclass
+class AccelParams(_SensorParams):
+    """Accelerometer parameters, MATLAB's ``accelparams`` (m/s² units)."""
+
+
+@dataclass
+class GyroParams(_SensorParams):
+    """Gyroscope parameters, MATLAB's ``gyroparams`` (rad/s units), with ``acceleration_bias``
+    in (rad/s)/(m/s²)."""
+
+    acceleration_bias: Optional[object] = None
+
+
+@dataclass
+class MagParams(_SensorParams):
+    """Magnetometer parameters, MATLAB's ``magparams`` (µT units)."""
+
+
 def _params_json(name: str, params) -> Optional[str]:
     if params is None:
         return None
+    if isinstance(params, _SensorParams):
+        params = params.to_dict()
     if isinstance(params, Mapping):
         return json.dumps({k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in params.items()})
-    raise TypeError(f"{name} must be a dict of parameters (imukit or MATLAB names), got {type(params).__name__}")
+    raise TypeError(
+        f"{name} must be AccelParams/GyroParams/MagParams or a dict of parameters (imukit or MATLAB names), "
+        f"got {type(params).__name__}"
+    )
 
 
 class ImuSensor:
