@@ -68,10 +68,21 @@ fn check_len(name: &str, got: usize, expected: usize) -> PyResult<()> {
     }
 }
 
-fn out3(py: Python<'_>, v: Vec<[f64; 3]>) -> Bound<'_, PyArray2<f64>> {
+/// A row-major (rows, cols) array from flat data.
+fn array2(
+    py: Python<'_>,
+    rows: usize,
+    cols: usize,
+    data: Vec<f64>,
+) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    Array2::from_shape_vec((rows, cols), data)
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+fn out3(py: Python<'_>, v: Vec<[f64; 3]>) -> PyResult<Bound<'_, PyArray2<f64>>> {
     let n = v.len();
-    Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
-        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py))
+    array2(py, n, 3, v.into_iter().flatten().collect())
 }
 
 fn nav(name: &str) -> PyResult<NavFrameName> {
@@ -269,7 +280,7 @@ fn tangent_euler<'py>(
     let e = py
         .detach(move || arrays::tangent_euler(&v, min_speed_m_s))
         .map_err(refused)?;
-    Ok(out3(py, e.into_iter().map(EulerZyx::to_array).collect()))
+    out3(py, e.into_iter().map(EulerZyx::to_array).collect())
 }
 
 /// `C_nbᵀ v_n`: navigation-frame vectors resolved in the body frame, per sample.
@@ -285,7 +296,7 @@ fn nav_to_body<'py>(
         .collect();
     let v = rows::<3>("v_n", &v_n)?;
     check_len("v_n", v.len(), e.len())?;
-    Ok(out3(py, py.detach(move || arrays::nav_to_body(&e, &v))))
+    out3(py, py.detach(move || arrays::nav_to_body(&e, &v)))
 }
 
 /// `a + ω × (ω × r) + α × r` per sample (body frame).
@@ -304,10 +315,10 @@ fn at_lever_arm<'py>(
     );
     check_len("omega", w.len(), a.len())?;
     check_len("alpha", al.len(), a.len())?;
-    Ok(out3(
+    out3(
         py,
         py.detach(move || arrays::at_lever_arm_series(&a, &w, &al, r)),
-    ))
+    )
 }
 
 /// z-y-x Euler angles `[yaw, pitch, roll]` (N, 3) → quaternions `[w, x, y, z]` (N, 4).
@@ -321,8 +332,7 @@ fn euler_to_quaternion<'py>(
         .iter()
         .flat_map(|a| Rotation::<Body, Enu>::from_euler(EulerZyx::from_array(*a)).to_wxyz())
         .collect();
-    Ok(Array2::from_shape_vec((e.len(), 4), q)
-        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+    array2(py, e.len(), 4, q)
 }
 
 /// Quaternions `[w, x, y, z]` (N, 4) → z-y-x Euler angles `[yaw, pitch, roll]` (N, 3).
@@ -335,7 +345,7 @@ fn quaternion_to_euler<'py>(
         .iter()
         .map(|r| r.to_euler().to_array())
         .collect();
-    Ok(out3(py, e))
+    out3(py, e)
 }
 
 /// Rows of `[w, x, y, z]` as rotations; refuses zero or non-finite quaternions by index.
@@ -351,10 +361,11 @@ fn rotations(quaternion: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Rotation<Bo
         .collect()
 }
 
-fn dcm_out(py: Python<'_>, m: Vec<[[f64; 3]; 3]>) -> Bound<'_, PyArray3<f64>> {
+fn dcm_out(py: Python<'_>, m: Vec<[[f64; 3]; 3]>) -> PyResult<Bound<'_, PyArray3<f64>>> {
     let n = m.len();
     Array3::from_shape_vec((n, 3, 3), m.into_iter().flatten().flatten().collect())
-        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py))
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 fn dcm_in(name: &str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<[[f64; 3]; 3]>> {
@@ -377,12 +388,12 @@ fn euler_to_dcm<'py>(
     euler_rad: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let e = rows::<3>("euler_rad", &euler_rad)?;
-    Ok(dcm_out(
+    dcm_out(
         py,
         e.into_iter()
             .map(|a| EulerZyx::from_array(a).to_dcm())
             .collect(),
-    ))
+    )
 }
 
 /// Direction cosine matrices (N, 3, 3) → z-y-x Euler angles (N, 3).
@@ -392,10 +403,10 @@ fn dcm_to_euler<'py>(
     dcm: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let m = dcm_in("dcm", &dcm)?;
-    Ok(out3(
+    out3(
         py,
         m.iter().map(|c| EulerZyx::from_dcm(c).to_array()).collect(),
-    ))
+    )
 }
 
 /// Quaternions (N, 4) → direction cosine matrices (N, 3, 3).
@@ -408,7 +419,7 @@ fn quaternion_to_dcm<'py>(
         .iter()
         .map(Rotation::to_dcm)
         .collect();
-    Ok(dcm_out(py, m))
+    dcm_out(py, m)
 }
 
 /// Direction cosine matrices (N, 3, 3) → quaternions (N, 4).
@@ -422,8 +433,7 @@ fn dcm_to_quaternion<'py>(
         .iter()
         .flat_map(|c| Rotation::<Body, Enu>::from_dcm(c).to_wxyz())
         .collect();
-    Ok(Array2::from_shape_vec((m.len(), 4), q)
-        .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+    array2(py, m.len(), 4, q)
 }
 
 /// The navigation-frame generic model behind `ImuSensor`.
@@ -572,8 +582,7 @@ impl PyImuSensor {
             .iter()
             .flat_map(|r| r.accel_m_s2.into_iter().chain(r.gyro_rad_s).chain(r.mag_ut))
             .collect();
-        Ok(Array2::from_shape_vec((n, 9), flat)
-            .map_or_else(|_| unreachable!(), |a| a.into_pyarray(py)))
+        array2(py, n, 9, flat)
     }
 
     /// Back to the initial state and the start of the seeded noise stream.
