@@ -34,6 +34,7 @@ pub mod kinematics;
 mod math;
 pub mod rotation;
 pub mod sensor;
+pub mod strapdown;
 pub mod vector;
 
 pub use frame::{Body, Enu, Frame, NavFrame, Ned};

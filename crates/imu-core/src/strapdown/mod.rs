@@ -1,0 +1,5 @@
+//! Dead reckoning and strapdown navigation from IMU data.
+//!
+//! [`planar`]: a cart in a plane with two accelerometers and a yaw gyro (seed 001), with the
+//! exercise's own update rules kept verbatim and a consistent second-order default.
+pub mod planar;
