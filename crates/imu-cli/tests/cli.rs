@@ -40,7 +40,7 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
     let dir = temp_dir("roundtrip");
     let list = imukit().arg("scenario").output().unwrap();
     let names = String::from_utf8(list.stdout).unwrap();
-    assert_eq!(names.lines().count(), 5);
+    assert_eq!(names.lines().count(), 6);
     for name in names.lines() {
         let toml = imukit().args(["scenario", name]).output().unwrap();
         assert!(toml.status.success());

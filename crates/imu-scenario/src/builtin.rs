@@ -7,6 +7,7 @@
 //! | `rounded-rectangle` | 1 m × 1 m square with 0.1 m corner radius at 0.8 m/s, 2 kHz, one lap | seed 000, "Abgerundetes Viereck" |
 //! | `static` | level IMU at rest, 100 Hz, 10 s | — |
 //! | `platform-turn` | NED platform turning 360° in 4 s, then 360° in 2 s, 100 Hz, 600 samples | MATLAB imuSensor page (seed 003) |
+//! | `cart` | planar cart on a closed rail (20 m straights, 5 m half turns to the left) from [100, 100], starting and stopping at rest (2 m/s, 0.5 m/s²), 50 Hz | seed 001's exercise |
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_PI_2;
 
@@ -130,6 +131,26 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
                 ),
             );
             s.nav_frame = Some(NavFrameName::NED);
+            s
+        }
+        "cart" => {
+            let half_turn = Segment::Arc {
+                arc_radius_m: 5.0,
+                arc_angle_rad: std::f64::consts::PI,
+            };
+            let straight = Segment::Straight { straight_m: 20.0 };
+            let mut s = base(
+                50.0,
+                None,
+                TrajectorySpec::Track(TrackSpec {
+                    start_m: [100.0, 100.0, 0.0],
+                    heading_rad: 0.0,
+                    speed_m_s: 2.0,
+                    accel_m_s2: Some(0.5),
+                    segments: vec![straight, half_turn, straight, half_turn],
+                }),
+            );
+            s.imu.kind = Some(crate::table::ImuKind::AccelGyro);
             s
         }
         _ => {

@@ -10,6 +10,7 @@ pub mod error;
 pub mod expr;
 pub mod params;
 pub mod perturb;
+pub mod planar;
 pub mod presets;
 pub mod scenario;
 pub mod sensors;
