@@ -18,12 +18,13 @@ use crate::scenario::{
 use crate::track::Segment;
 
 /// Names of the built-in scenarios.
-pub const NAMES: [&str; 5] = [
+pub const NAMES: [&str; 6] = [
     "figure8",
     "tilted-circle",
     "rounded-rectangle",
     "static",
     "platform-turn",
+    "cart",
 ];
 
 /// The default scenario of `imukit demo`.
