@@ -30,6 +30,40 @@ pub enum Command {
         #[arg(long)]
         runs: Option<u64>,
     },
+    /// Dead reckoning of IMU data into a trajectory (planar: `--planar`).
+    Integrate {
+        /// IMU data: planar CSV (`t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s`) or the
+        /// exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
+        input: PathBuf,
+        /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
+        #[arg(long)]
+        planar: bool,
+        /// Planar scheme: `trapezoid` (second order, default) or `exercise` (seed 001's rules).
+        #[arg(long, default_value = "trapezoid")]
+        scheme: String,
+        /// Initial position X, Y, m (the exercise's [100, 100] by default).
+        #[arg(long, num_args = 2, value_names = ["X", "Y"], default_values_t = [100.0, 100.0])]
+        position0: Vec<f64>,
+        /// Initial heading, rad from nav X, counter-clockwise.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        heading0: f64,
+        /// Initial velocity in the navigation frame, m/s.
+        #[arg(long, num_args = 2, value_names = ["VX", "VY"], default_values_t = [0.0, 0.0], allow_negative_numbers = true)]
+        velocity0: Vec<f64>,
+        /// Where to write the trajectory (CSV).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Seed 001's exercise end to end: the built-in cart's clean and erroneous `.dat` files,
+    /// dead-reckoned with both schemes, and a plot of the trajectories (start and end marked).
+    Exercise {
+        /// Output folder.
+        #[arg(long, default_value = "imukit-exercise")]
+        out_dir: PathBuf,
+        /// Seed of the sensor errors.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Lists the sensor presets, or prints one as a parameter file.
     Presets {
         /// Name of a preset.

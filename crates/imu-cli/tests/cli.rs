@@ -114,3 +114,101 @@ fn bad_input_exits_non_zero_with_a_located_message_and_no_output_file() {
             .contains("/nonexistent/s.toml")
     );
 }
+
+#[test]
+fn exercise_writes_the_datasets_trajectories_and_figure() {
+    let dir = temp_dir("exercise");
+    let out = imukit()
+        .args(["exercise", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "inertial_data.dat",
+        "inertial_data_errors.dat",
+        "truth.csv",
+        "inertial_data_exercise.csv",
+        "inertial_data_trapezoid.csv",
+        "inertial_data_errors_exercise.csv",
+        "inertial_data_errors_trapezoid.csv",
+        "summary.txt",
+    ] {
+        assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
+    }
+    let svg = std::fs::read_to_string(dir.join("trajectories.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.matches("<polyline").count() >= 5, "five trajectories");
+    // The clean data through the default scheme closes the lap near the start.
+    let nav = imu_scenario::table::read_columns(
+        &dir.join("inertial_data_trapezoid.csv"),
+        &["pos_x_m", "pos_y_m"],
+        "",
+    )
+    .unwrap();
+    let (x, y) = (nav.get("pos_x_m"), nav.get("pos_y_m"));
+    assert!((x[x.len() - 1] - 100.0).hypot(y[y.len() - 1] - 100.0) < 0.5);
+    // The same file through `imukit integrate` gives the same trajectory.
+    let again = dir.join("again.csv");
+    let status = imukit()
+        .arg("integrate")
+        .arg(dir.join("inertial_data.dat"))
+        .args(["--planar", "--scheme", "trapezoid", "--out"])
+        .arg(&again)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert_eq!(
+        std::fs::read(&again).unwrap(),
+        std::fs::read(dir.join("inertial_data_trapezoid.csv")).unwrap()
+    );
+}
+
+#[test]
+fn integrate_refuses_bad_input_with_its_line() {
+    let dir = temp_dir("integrate");
+    std::fs::write(dir.join("bad.dat"), "0 0 0 0\n0.1 0 0 0 9\n").unwrap();
+    let out = imukit()
+        .arg("integrate")
+        .arg(dir.join("bad.dat"))
+        .args(["--planar", "--out"])
+        .arg(dir.join("n.csv"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(65));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("bad.dat") && err.contains("line 2") && err.contains("found 5"),
+        "{err}"
+    );
+    std::fs::write(dir.join("rep.dat"), "0 0 0 0\n0.1 0 0 0\n0.1 0 0 0\n").unwrap();
+    let out = imukit()
+        .arg("integrate")
+        .arg(dir.join("rep.dat"))
+        .args(["--planar", "--out"])
+        .arg(dir.join("n.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("sample 2") && err.contains("does not increase"),
+        "{err}"
+    );
+    assert!(!dir.join("n.csv").exists());
+    let out = imukit()
+        .arg("integrate")
+        .arg(dir.join("rep.dat"))
+        .args(["--planar", "--scheme", "euler", "--out"])
+        .arg(dir.join("n.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("unknown scheme \"euler\"")
+    );
+}

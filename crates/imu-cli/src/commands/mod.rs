@@ -1,6 +1,8 @@
 //! One module per subcommand, and the CLI's error type.
 mod allan;
 mod demo;
+mod exercise;
+mod integrate;
 mod presets;
 mod scenario;
 mod simulate;
@@ -55,6 +57,18 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
         Command::Presets { name } => presets::run(name.as_deref()),
+        Command::Integrate {
+            input,
+            planar,
+            scheme,
+            position0,
+            heading0,
+            velocity0,
+            out,
+        } => integrate::run(
+            &input, planar, &scheme, &position0, heading0, &velocity0, &out,
+        ),
+        Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
             let c = imu_scenario::units::convert(value, &unit)?;
             println!("{} {}   ({})", c.value, c.unit, c.fits);
