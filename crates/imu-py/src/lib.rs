@@ -7,6 +7,7 @@ use imu_core::Ned;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, Temperatures};
+use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
 use imu_core::{Body, Enu, EulerZyx, Rotation};
 use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
@@ -15,7 +16,7 @@ use imu_scenario::scenario::{
 use imu_scenario::sensors::{SensorKeys, SensorSetup};
 use imu_scenario::table::ImuKind;
 use imu_scenario::{ScenarioSpec, Table};
-use imu_scenario::{analysis, arrays, presets};
+use imu_scenario::{analysis, arrays, planar, presets};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
@@ -700,6 +701,81 @@ fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<String> {
         .map_err(refused)
 }
 
+/// Planar dead reckoning of (t, a_x, a_y, ω_z) into a navigation table.
+#[pyfunction]
+#[pyo3(signature = (t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s, *, scheme = "trapezoid",
+                    position0_m = [100.0, 100.0], heading0_rad = 0.0, velocity0_m_s = [0.0, 0.0]))]
+#[allow(clippy::too_many_arguments)]
+fn planar_dead_reckon<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    accel_x_m_s2: PyReadonlyArray1<'py, f64>,
+    accel_y_m_s2: PyReadonlyArray1<'py, f64>,
+    gyro_z_rad_s: PyReadonlyArray1<'py, f64>,
+    scheme: &str,
+    position0_m: [f64; 2],
+    heading0_rad: f64,
+    velocity0_m_s: [f64; 2],
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array();
+    let (ax, ay, wz) = (
+        accel_x_m_s2.as_array(),
+        accel_y_m_s2.as_array(),
+        gyro_z_rad_s.as_array(),
+    );
+    for (name, len) in [
+        ("accel_x_m_s2", ax.len()),
+        ("accel_y_m_s2", ay.len()),
+        ("gyro_z_rad_s", wz.len()),
+    ] {
+        check_len(name, len, t.len())?;
+    }
+    let samples: Vec<PlanarSample> = (0..t.len())
+        .map(|i| PlanarSample {
+            t_s: t[i],
+            accel_x_m_s2: ax[i],
+            accel_y_m_s2: ay[i],
+            gyro_z_rad_s: wz[i],
+        })
+        .collect();
+    let scheme = match scheme {
+        "trapezoid" => PlanarScheme::Trapezoid,
+        "exercise" => PlanarScheme::Exercise,
+        other => {
+            return Err(ImuError::new_err(format!(
+                "scheme: unknown scheme \"{other}\" (trapezoid, exercise)"
+            )));
+        }
+    };
+    let (s, c) = heading0_rad.sin_cos();
+    let initial = PlanarState {
+        t_s: samples.first().map_or(0.0, |x| x.t_s),
+        position_m: position0_m,
+        heading_rad: heading0_rad,
+        velocity_nav_m_s: velocity0_m_s,
+        velocity_body_m_s: [
+            c * velocity0_m_s[0] + s * velocity0_m_s[1],
+            -s * velocity0_m_s[0] + c * velocity0_m_s[1],
+        ],
+    };
+    let table = py
+        .detach(move || planar::integrate(&samples, scheme, initial))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Planar IMU samples from a CSV or `.dat` file, as a table with `t_s, accel_x_m_s2,
+/// accel_y_m_s2, gyro_z_rad_s`.
+#[pyfunction]
+fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
+    let samples = planar::read_planar(Path::new(path)).map_err(refused)?;
+    let mut t = Table::new(&planar::PLANAR_COLUMNS);
+    for s in &samples {
+        t.push_row(&[s.t_s, s.accel_x_m_s2, s.accel_y_m_s2, s.gyro_z_rad_s]);
+    }
+    table_out(py, t)
+}
+
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -736,6 +812,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(planar_dead_reckon, m)?)?;
+    m.add_function(wrap_pyfunction!(read_planar, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     Ok(())

@@ -41,6 +41,8 @@ __all__ = [
     "convert",
     "preset_params",
     "loadparams",
+    "planar_dead_reckon",
+    "read_planar",
     "builtin_scenarios",
     "builtin_scenario_toml",
     "truth_from_expressions",
@@ -522,3 +524,35 @@ def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dic
     """Reads a parameter file — imukit TOML/JSON, or MATLAB ``loadparams`` JSON (``part`` picks one
     of several parts) — into a dict like :func:`preset_params`."""
     return _toml_to_dict(_core.load_params_toml(str(path), part=part))
+
+
+def planar_dead_reckon(
+    t_s,
+    accel_x_m_s2,
+    accel_y_m_s2,
+    gyro_z_rad_s,
+    *,
+    scheme: str = "trapezoid",
+    position0_m: Sequence[float] = (100.0, 100.0),
+    heading0_rad: float = 0.0,
+    velocity0_m_s: Sequence[float] = (0.0, 0.0),
+) -> Table:
+    """Planar dead reckoning of a cart (seed 001): body x forward, y left, ω_z counter-clockwise.
+
+    ``scheme="trapezoid"`` (second order, default) or ``"exercise"`` (the exercise's rules
+    verbatim; its rotation turns increments by −α, which mirrors left turns into right turns).
+    The defaults are the exercise's initial conditions (X₀ = [100, 100], α₀ = 0, v₀ = 0). Returns
+    ``t_s, pos_x_m, pos_y_m, yaw_rad, vel_x_m_s, vel_y_m_s, body_vel_x_m_s, body_vel_y_m_s``.
+    """
+    col = lambda name, x: np.ascontiguousarray(x, dtype=np.float64).ravel()  # noqa: E731
+    return _table(_core.planar_dead_reckon(
+        _times(t_s), col("accel_x_m_s2", accel_x_m_s2), col("accel_y_m_s2", accel_y_m_s2),
+        col("gyro_z_rad_s", gyro_z_rad_s), scheme=scheme,
+        position0_m=[float(v) for v in position0_m], heading0_rad=float(heading0_rad),
+        velocity0_m_s=[float(v) for v in velocity0_m_s]))
+
+
+def read_planar(path: Union[str, os.PathLike]) -> Table:
+    """Planar IMU data from a CSV (``t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s``) or the
+    exercise's whitespace ``.dat`` file (t, a_x, a_y, ω_z)."""
+    return _table(_core.read_planar(str(path)))

@@ -28,6 +28,8 @@ __all__ = [
     "preset_names",
     "preset_toml",
     "load_params_toml",
+    "planar_dead_reckon",
+    "read_planar",
     "builtin_names",
     "builtin_toml",
 ]
@@ -130,3 +132,15 @@ def preset_names() -> list[str]: ...
 def preset_toml(name: str) -> str: ...
 def load_params_toml(path: str, *, part: Optional[str] = None) -> str: ...
 def convert(value: float, unit: str) -> tuple[float, str, str]: ...
+def planar_dead_reckon(
+    t_s: npt.NDArray[np.float64],
+    accel_x_m_s2: npt.NDArray[np.float64],
+    accel_y_m_s2: npt.NDArray[np.float64],
+    gyro_z_rad_s: npt.NDArray[np.float64],
+    *,
+    scheme: str = "trapezoid",
+    position0_m: Sequence[float] = ...,
+    heading0_rad: float = 0.0,
+    velocity0_m_s: Sequence[float] = ...,
+) -> _Table: ...
+def read_planar(path: str) -> _Table: ...
