@@ -1,0 +1,327 @@
+//! 3D strapdown for the CLI and Python, and errors of an estimate against truth.
+//!
+//! IMU input: rates (`accel_*_m_s2`, `gyro_*_rad_s`, turned into increments by the trapezoid) or
+//! increments (`dv_*_m_s`, `dtheta_*_rad`). The accelerometer columns must hold specific force
+//! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
+//! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
+//! yaw_rad, pitch_rad, roll_rad`.
+use imu_core::strapdown::step::{
+    NavState, StrapdownOptions, strapdown_increments, strapdown_rates,
+};
+use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+
+use crate::error::{Result, invalid};
+use crate::scenario::NavFrameName;
+use crate::table::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
+
+/// Navigation output columns.
+pub const NAV_COLUMNS: [&str; 14] = [
+    "t_s",
+    "pos_x_m",
+    "pos_y_m",
+    "pos_z_m",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "vel_z_m_s",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "yaw_rad",
+    "pitch_rad",
+    "roll_rad",
+];
+
+/// Error columns of [`compare`].
+pub const ERROR_COLUMNS: [&str; 9] = [
+    "t_s",
+    "pos_err_x_m",
+    "pos_err_y_m",
+    "pos_err_z_m",
+    "pos_err_m",
+    "vel_err_x_m_s",
+    "vel_err_y_m_s",
+    "vel_err_z_m_s",
+    "att_err_rad",
+];
+
+/// The initial state of a 3D integration, frame-free (default: at rest at the origin, level).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitialState {
+    /// Position, navigation frame, m.
+    pub position_m: [f64; 3],
+    /// Velocity, navigation frame, m/s.
+    pub velocity_m_s: [f64; 3],
+    /// Attitude quaternion `q_nb` `[w, x, y, z]`.
+    pub quaternion: [f64; 4],
+}
+
+impl Default for InitialState {
+    fn default() -> Self {
+        Self {
+            position_m: [0.0; 3],
+            velocity_m_s: [0.0; 3],
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+impl InitialState {
+    /// From position, velocity and z-y-x Euler angles.
+    #[must_use]
+    pub fn from_euler(position_m: [f64; 3], velocity_m_s: [f64; 3], euler: EulerZyx) -> Self {
+        Self {
+            position_m,
+            velocity_m_s,
+            quaternion: Rotation::<imu_core::Body, Enu>::from_euler(euler).to_wxyz(),
+        }
+    }
+
+    /// The first row of a truth (or navigation) table.
+    ///
+    /// # Errors
+    /// Missing columns or an empty table.
+    pub fn from_table(t: &Table) -> Result<Self> {
+        let first = |c: &str| {
+            t.column(c)
+                .and_then(|v| v.first().copied())
+                .ok_or_else(|| invalid("initial state", format!("the truth file has no {c} value")))
+        };
+        Ok(Self {
+            position_m: [first("pos_x_m")?, first("pos_y_m")?, first("pos_z_m")?],
+            velocity_m_s: [
+                first("vel_x_m_s")?,
+                first("vel_y_m_s")?,
+                first("vel_z_m_s")?,
+            ],
+            quaternion: [first("q_w")?, first("q_x")?, first("q_y")?, first("q_z")?],
+        })
+    }
+}
+
+/// What to integrate and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavSetup {
+    /// Navigation frame.
+    pub nav_frame: NavFrameName,
+    /// Algorithm options (gravity, coning, sculling).
+    pub options: StrapdownOptions,
+    /// Sign of the accelerometer columns.
+    pub accel_sign: AccelSign,
+}
+
+impl Default for NavSetup {
+    fn default() -> Self {
+        Self {
+            nav_frame: NavFrameName::ENU,
+            options: StrapdownOptions::default(),
+            accel_sign: AccelSign::SpecificForce,
+        }
+    }
+}
+
+fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
+    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
+    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
+}
+
+/// Integrates an IMU table (rates or increments) from `initial`.
+///
+/// # Errors
+/// Missing columns (both layouts named), invalid initial quaternion, non-finite values or
+/// non-increasing times (sample index named).
+pub fn integrate(imu: &Table, initial: &InitialState, setup: &NavSetup) -> Result<Table> {
+    match setup.nav_frame {
+        NavFrameName::ENU => integrate_in::<Enu>(imu, initial, setup),
+        NavFrameName::NED => integrate_in::<Ned>(imu, initial, setup),
+    }
+}
+
+fn integrate_in<N: NavFrame>(
+    imu: &Table,
+    initial: &InitialState,
+    setup: &NavSetup,
+) -> Result<Table> {
+    let t = imu
+        .column("t_s")
+        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
+        invalid(
+            "initial state",
+            "the quaternion has zero norm or is not finite",
+        )
+    })?;
+    let s0 = NavState::<N> {
+        t_s: t.first().copied().unwrap_or(0.0),
+        attitude,
+        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
+        position_m: Vec3::from_array(initial.position_m),
+    };
+    let flip = |v: Vec<[f64; 3]>| match setup.accel_sign {
+        AccelSign::SpecificForce => v,
+        AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
+    };
+    let mut out = vec![NavState::<N>::default(); t.len()];
+    let result = if let (Some(f), Some(w)) =
+        (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
+    {
+        strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
+    } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
+    {
+        strapdown_increments(&t, &dth, &flip(dv), s0, setup.options, &mut out)
+    } else {
+        return Err(invalid(
+            "IMU data",
+            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
+        ));
+    };
+    result.map_err(|e| invalid("IMU data", e.to_string()))?;
+    let mut table = Table::new(&NAV_COLUMNS);
+    let mut last_yaw: Option<f64> = None;
+    for s in &out {
+        let [qw, qx, qy, qz] = s.attitude.to_wxyz();
+        let mut e = s.attitude.to_euler();
+        if let Some(y) = last_yaw {
+            let tau = std::f64::consts::TAU;
+            e.yaw_rad += tau * ((y - e.yaw_rad) / tau).round();
+        }
+        last_yaw = Some(e.yaw_rad);
+        let [px, py, pz] = s.position_m.to_array();
+        let [vx, vy, vz] = s.velocity_m_s.to_array();
+        table.push_row(&[
+            s.t_s,
+            px,
+            py,
+            pz,
+            vx,
+            vy,
+            vz,
+            qw,
+            qx,
+            qy,
+            qz,
+            e.yaw_rad,
+            e.pitch_rad,
+            e.roll_rad,
+        ]);
+    }
+    Ok(table)
+}
+
+/// Errors of an estimate against truth, both tables with `t_s`, positions, velocities and
+/// quaternions, on the estimate's times (truth linearly interpolated in position and velocity,
+/// its attitude by quaternion slerp).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// Per sample ([`ERROR_COLUMNS`]).
+    pub table: Table,
+    /// RMS of the position error norm, m.
+    pub position_rms_m: f64,
+    /// Final position error norm, m.
+    pub position_final_m: f64,
+    /// RMS of the velocity error norm, m/s.
+    pub velocity_rms_m_s: f64,
+    /// Final velocity error norm, m/s.
+    pub velocity_final_m_s: f64,
+    /// RMS of the attitude error angle, rad.
+    pub attitude_rms_rad: f64,
+    /// Final attitude error angle, rad.
+    pub attitude_final_rad: f64,
+}
+
+/// Compares an estimate with truth (see [`Comparison`]).
+///
+/// # Errors
+/// Missing columns; estimate times outside the truth's time span.
+pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
+    let col = |t: &Table, what: &str, c: &str| {
+        t.column(c)
+            .ok_or_else(|| invalid(what, format!("missing column {c}")))
+    };
+    let names = [
+        "pos_x_m",
+        "pos_y_m",
+        "pos_z_m",
+        "vel_x_m_s",
+        "vel_y_m_s",
+        "vel_z_m_s",
+        "q_w",
+        "q_x",
+        "q_y",
+        "q_z",
+    ];
+    let tt = col(truth, "truth", "t_s")?;
+    let te = col(estimate, "estimate", "t_s")?;
+    let tv: Vec<Vec<f64>> = names
+        .iter()
+        .map(|c| col(truth, "truth", c))
+        .collect::<Result<_>>()?;
+    let ev: Vec<Vec<f64>> = names
+        .iter()
+        .map(|c| col(estimate, "estimate", c))
+        .collect::<Result<_>>()?;
+    if tt.is_empty() || te.is_empty() {
+        return Err(invalid("compare", "empty table"));
+    }
+    let (t0, t1) = (tt[0], tt[tt.len() - 1]);
+    let mut table = Table::new(&ERROR_COLUMNS);
+    let (mut sp, mut sv, mut sa) = (0.0, 0.0, 0.0);
+    let (mut fp, mut fv, mut fa) = (0.0, 0.0, 0.0);
+    for (i, &t) in te.iter().enumerate() {
+        if t < t0 - 1e-9 || t > t1 + 1e-9 {
+            return Err(invalid(
+                "compare",
+                format!(
+                    "estimate time {t} s (row {}) is outside the truth's {t0}…{t1} s",
+                    i + 2
+                ),
+            ));
+        }
+        // Bracketing truth samples ka ≤ t ≤ kb (a single-row truth brackets with itself).
+        let (ka, kb) = if tt.len() == 1 {
+            (0, 0)
+        } else {
+            let k = tt.partition_point(|&x| x <= t).clamp(1, tt.len() - 1);
+            (k - 1, k)
+        };
+        let w = if kb == ka || tt[kb] == tt[ka] {
+            0.0
+        } else {
+            ((t - tt[ka]) / (tt[kb] - tt[ka])).clamp(0.0, 1.0)
+        };
+        let lerp = |c: usize| tv[c][ka] + w * (tv[c][kb] - tv[c][ka]);
+        let dp: [f64; 3] = std::array::from_fn(|j| ev[j][i] - lerp(j));
+        let dv: [f64; 3] = std::array::from_fn(|j| ev[3 + j][i] - lerp(3 + j));
+        let q = |v: &Vec<Vec<f64>>, r: usize| {
+            Rotation::<imu_core::Body, Enu>::from_wxyz([v[6][r], v[7][r], v[8][r], v[9][r]])
+        };
+        let (qa, qb, qe) = match (q(&tv, ka), q(&tv, kb), q(&ev, i)) {
+            (Some(a), Some(b), Some(e)) => (a, b, e),
+            _ => {
+                return Err(invalid(
+                    "compare",
+                    format!("zero quaternion near estimate row {}", i + 2),
+                ));
+            }
+        };
+        let qt = qa.quaternion().slerp(qb.quaternion(), w);
+        let att = qe.quaternion().angle_to(&qt);
+        let (np, nv) = (
+            dp.iter().map(|x| x * x).sum::<f64>().sqrt(),
+            dv.iter().map(|x| x * x).sum::<f64>().sqrt(),
+        );
+        table.push_row(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], att]);
+        (sp, sv, sa) = (sp + np * np, sv + nv * nv, sa + att * att);
+        (fp, fv, fa) = (np, nv, att);
+    }
+    let n = te.len() as f64;
+    Ok(Comparison {
+        table,
+        position_rms_m: (sp / n).sqrt(),
+        position_final_m: fp,
+        velocity_rms_m_s: (sv / n).sqrt(),
+        velocity_final_m_s: fv,
+        attitude_rms_rad: (sa / n).sqrt(),
+        attitude_final_rad: fa,
+    })
+}

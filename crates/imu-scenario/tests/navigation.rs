@@ -1,0 +1,85 @@
+//! Simulate → integrate → compare, through the tables the CLI and Python use.
+use std::path::Path;
+
+use imu_core::AccelSign;
+use imu_scenario::ScenarioSpec;
+use imu_scenario::navigation::{InitialState, NavSetup, compare, integrate};
+use imu_scenario::scenario::NavFrameName;
+
+fn scenario(extra_imu: &str, frame: &str) -> imu_scenario::Simulation {
+    let text = format!(
+        "rate_hz = 400.0\nduration_s = 10.0\nnav_frame = \"{frame}\"\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"5*cos(0.5*t)\", \"5*sin(0.5*t)\", \"0.3*t\"]\n\
+         yaw_rad = \"0.5*t + pi/2\"\npitch_rad = \"0.05\"\nroll_rad = \"0.4*sin(1.7*t)\"\n[imu]\n{extra_imu}"
+    );
+    ScenarioSpec::from_toml(&text, "t")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+        .simulate()
+        .unwrap()
+}
+
+#[test]
+fn rates_and_increments_round_trip_in_both_frames_and_signs() {
+    for frame in ["ENU", "NED"] {
+        let sim = scenario("", frame);
+        let init = InitialState::from_table(&sim.truth).unwrap();
+        let setup = NavSetup {
+            nav_frame: if frame == "ENU" {
+                NavFrameName::ENU
+            } else {
+                NavFrameName::NED
+            },
+            ..NavSetup::default()
+        };
+        let nav = integrate(&sim.imu, &init, &setup).unwrap();
+        let c = compare(&sim.truth, &nav).unwrap();
+        assert!(
+            c.position_final_m < 1e-3 && c.attitude_final_rad < 1e-5,
+            "{frame}: {c:?}"
+        );
+        // MATLAB's sign, flipped back, gives the same numbers.
+        let matlab = scenario("accel_sign = \"matlab\"\n", frame);
+        let nav_m = integrate(
+            &matlab.imu,
+            &init,
+            &NavSetup {
+                accel_sign: AccelSign::Matlab,
+                ..setup
+            },
+        )
+        .unwrap();
+        assert_eq!(nav_m, nav);
+        // Increments (trapezoid of the same readings) give the same trajectory to rounding.
+        let inc = scenario("output = \"increments\"\n", frame);
+        let nav_i = integrate(&inc.imu, &init, &setup).unwrap();
+        let d = compare(&nav, &nav_i).unwrap();
+        assert!(d.position_final_m < 1e-9, "{d:?}");
+    }
+}
+
+#[test]
+fn compare_reports_zero_against_itself_and_refuses_times_outside_the_truth() {
+    let sim = scenario("", "ENU");
+    let c = compare(&sim.truth, &sim.truth).unwrap();
+    assert_eq!((c.position_rms_m, c.velocity_final_m_s), (0.0, 0.0));
+    assert!(c.attitude_rms_rad < 1e-7);
+    let mut shifted = sim.truth.clone();
+    let w = shifted.columns.len();
+    for r in 0..shifted.rows() {
+        shifted.data[r * w] += 20.0;
+    }
+    let e = compare(&sim.truth, &shifted).unwrap_err().to_string();
+    assert!(e.contains("outside the truth"), "{e}");
+    let e = integrate(
+        &imu_scenario::Table::new(&["t_s", "accel_x_m_s2"]),
+        &InitialState::default(),
+        &NavSetup::default(),
+    );
+    assert!(
+        e.unwrap_err()
+            .to_string()
+            .contains("dtheta_x/y/z_rad (increments)")
+    );
+}
