@@ -30,29 +30,60 @@ pub enum Command {
         #[arg(long)]
         runs: Option<u64>,
     },
-    /// Dead reckoning of IMU data into a trajectory (planar: `--planar`).
+    /// Strapdown navigation (3D) or planar dead reckoning (`--planar`) of IMU data.
     Integrate {
-        /// IMU data: planar CSV (`t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s`) or the
-        /// exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
+        /// IMU data. 3D: CSV with rates (`accel_*_m_s2`, `gyro_*_rad_s`) or increments
+        /// (`dv_*_m_s`, `dtheta_*_rad`). Planar: CSV (`t_s, accel_x_m_s2, accel_y_m_s2,
+        /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
         input: PathBuf,
+        /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
+        /// origin unless --position0/--velocity0/--euler0 say otherwise).
+        #[arg(long)]
+        init: Option<PathBuf>,
+        /// 3D: navigation frame of the data (ENU or NED).
+        #[arg(long, default_value = "ENU")]
+        nav_frame: String,
+        /// 3D: gravity magnitude, m/s².
+        #[arg(long, default_value_t = 9.81)]
+        gravity: f64,
+        /// 3D: sign of the accelerometer columns (`specific-force` or `matlab`).
+        #[arg(long, default_value = "specific-force")]
+        accel_sign: String,
+        /// 3D: switch off the coning and sculling corrections (for comparison).
+        #[arg(long)]
+        no_corrections: bool,
+        /// 3D: initial attitude yaw, pitch, roll, rad.
+        #[arg(long, num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_negative_numbers = true)]
+        euler0: Option<Vec<f64>>,
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
         planar: bool,
         /// Planar scheme: `trapezoid` (second order, default) or `exercise` (seed 001's rules).
         #[arg(long, default_value = "trapezoid")]
         scheme: String,
-        /// Initial position X, Y, m (the exercise's [100, 100] by default).
-        #[arg(long, num_args = 2, value_names = ["X", "Y"], default_values_t = [100.0, 100.0])]
-        position0: Vec<f64>,
-        /// Initial heading, rad from nav X, counter-clockwise.
+        /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
+        #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]
+        position0: Option<Vec<f64>>,
+        /// Planar: initial heading, rad from nav X, counter-clockwise.
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         heading0: f64,
-        /// Initial velocity in the navigation frame, m/s.
-        #[arg(long, num_args = 2, value_names = ["VX", "VY"], default_values_t = [0.0, 0.0], allow_negative_numbers = true)]
-        velocity0: Vec<f64>,
+        /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
+        #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]
+        velocity0: Option<Vec<f64>>,
         /// Where to write the trajectory (CSV).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Errors of an estimate against truth over time (position, velocity, attitude), with RMS
+    /// and final values printed.
+    Compare {
+        /// Truth CSV (`t_s, pos_*, vel_*, q_*`).
+        truth: PathBuf,
+        /// Estimate CSV with the same columns (e.g. from `imukit integrate`).
+        estimate: PathBuf,
+        /// Where to write the errors over time (CSV).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Seed 001's exercise end to end: the built-in cart's clean and erroneous `.dat` files,
     /// dead-reckoned with both schemes, and a plot of the trajectories (start and end marked).

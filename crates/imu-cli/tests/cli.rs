@@ -212,3 +212,85 @@ fn integrate_refuses_bad_input_with_its_line() {
             .contains("unknown scheme \"euler\"")
     );
 }
+
+#[test]
+fn simulate_integrate_compare_closes_the_loop() {
+    let dir = temp_dir("loop");
+    std::fs::write(
+        dir.join("helix.toml"),
+        "rate_hz = 400.0\nduration_s = 10.0\nnav_frame = \"NED\"\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"5*cos(0.5*t)\", \"5*sin(0.5*t)\", \"-0.3*t\"]\nyaw_rad = \"0.5*t + pi/2\"\n\
+         pitch_rad = \"0.05\"\nroll_rad = \"0.4*sin(1.7*t)\"\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let out = imukit().current_dir(&dir).args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    run(&[
+        "simulate",
+        "helix.toml",
+        "--out",
+        "imu.csv",
+        "--truth",
+        "truth.csv",
+    ]);
+    run(&[
+        "integrate",
+        "imu.csv",
+        "--init",
+        "truth.csv",
+        "--nav-frame",
+        "NED",
+        "--out",
+        "nav.csv",
+    ]);
+    let report = run(&["compare", "truth.csv", "nav.csv", "--out", "err.csv"]);
+    assert!(
+        report.contains("position") && report.contains("attitude"),
+        "{report}"
+    );
+    let err =
+        imu_scenario::table::read_columns(&dir.join("err.csv"), &["pos_err_m", "att_err_rad"], "")
+            .unwrap();
+    let last = |c: &str| *err.get(c).last().unwrap();
+    assert!(
+        last("pos_err_m") < 1e-3 && last("att_err_rad") < 1e-5,
+        "{} {}",
+        last("pos_err_m"),
+        last("att_err_rad")
+    );
+    // Integrating in the wrong frame is visibly wrong (gravity the other way).
+    run(&[
+        "integrate",
+        "imu.csv",
+        "--init",
+        "truth.csv",
+        "--nav-frame",
+        "ENU",
+        "--out",
+        "wrong.csv",
+    ]);
+    run(&["compare", "truth.csv", "wrong.csv", "--out", "err2.csv"]);
+    let err2 =
+        imu_scenario::table::read_columns(&dir.join("err2.csv"), &["pos_err_m"], "").unwrap();
+    assert!(*err2.get("pos_err_m").last().unwrap() > 100.0);
+    // Missing columns are named.
+    std::fs::write(dir.join("few.csv"), "t_s,accel_x_m_s2\n0,0\n0.1,0\n").unwrap();
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["integrate", "few.csv", "--out", "n.csv"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(65));
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("gyro_x/y/z_rad_s")
+    );
+}

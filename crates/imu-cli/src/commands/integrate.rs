@@ -1,75 +1,164 @@
-//! `imukit integrate IMU --planar [--scheme trapezoid|exercise] --out NAV.csv`.
+//! `imukit integrate IMU [--planar] … --out NAV.csv`.
 use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
-use imu_scenario::planar::{integrate, read_planar};
+use imu_core::strapdown::step::StrapdownOptions;
+use imu_core::{AccelSign, EulerZyx};
+use imu_scenario::navigation::{InitialState, NavSetup, integrate};
+use imu_scenario::planar::read_planar;
+use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
+use imu_scenario::table::{read_columns, read_header};
+use imu_scenario::{Error, Table};
 
 use super::CliError;
+
+/// Arguments shared by the planar and the 3D integration.
+pub struct Common<'a> {
+    pub input: &'a Path,
+    pub out: &'a Path,
+    pub position0: Option<&'a [f64]>,
+    pub velocity0: Option<&'a [f64]>,
+}
+
+/// 3D options.
+pub struct Options3d<'a> {
+    pub init: Option<&'a Path>,
+    pub nav_frame: &'a str,
+    pub gravity: f64,
+    pub accel_sign: &'a str,
+    pub corrections: bool,
+    pub euler0: Option<&'a [f64]>,
+}
+
+fn invalid(field: &str, message: String) -> CliError {
+    Error::Invalid {
+        field: field.into(),
+        message,
+    }
+    .into()
+}
+
+fn vector<const K: usize>(
+    flag: &str,
+    v: Option<&[f64]>,
+    default: [f64; K],
+) -> Result<[f64; K], CliError> {
+    match v {
+        None => Ok(default),
+        Some(v) if v.len() == K => Ok(std::array::from_fn(|i| v[i])),
+        Some(v) => Err(invalid(
+            flag,
+            format!("expected {K} numbers, got {}", v.len()),
+        )),
+    }
+}
 
 /// Parses a planar scheme name.
 pub fn scheme(name: &str) -> Result<PlanarScheme, CliError> {
     match name {
         "trapezoid" => Ok(PlanarScheme::Trapezoid),
         "exercise" => Ok(PlanarScheme::Exercise),
-        other => Err(imu_scenario::Error::Invalid {
-            field: "--scheme".into(),
-            message: format!("unknown scheme \"{other}\" (trapezoid, exercise)"),
-        }
-        .into()),
+        other => Err(invalid(
+            "--scheme",
+            format!("unknown scheme \"{other}\" (trapezoid, exercise)"),
+        )),
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-pub fn run(
-    input: &Path,
-    planar: bool,
-    scheme_name: &str,
-    position0: &[f64],
-    heading0: f64,
-    velocity0: &[f64],
-    out: &Path,
-) -> Result<(), CliError> {
-    if !planar {
-        return Err(imu_scenario::Error::Invalid {
-            field: "integrate".into(),
-            message: "3D strapdown is not available yet; use --planar for planar dead reckoning"
-                .into(),
-        }
-        .into());
-    }
+pub fn planar(c: &Common<'_>, scheme_name: &str, heading0: f64) -> Result<(), CliError> {
     let scheme = scheme(scheme_name)?;
-    let samples = read_planar(input)?;
-    let v_body = {
-        let (s, c) = heading0.sin_cos();
-        [
-            c * velocity0[0] + s * velocity0[1],
-            -s * velocity0[0] + c * velocity0[1],
-        ]
-    };
+    let samples = read_planar(c.input)?;
+    let p0 = vector("--position0", c.position0, [100.0, 100.0])?;
+    let v0 = vector("--velocity0", c.velocity0, [0.0, 0.0])?;
+    let (s, co) = heading0.sin_cos();
     let initial = PlanarState {
         t_s: samples.first().map_or(0.0, |s| s.t_s),
-        position_m: [position0[0], position0[1]],
+        position_m: p0,
         heading_rad: heading0,
-        velocity_nav_m_s: [velocity0[0], velocity0[1]],
-        velocity_body_m_s: v_body,
+        velocity_nav_m_s: v0,
+        velocity_body_m_s: [co * v0[0] + s * v0[1], -s * v0[0] + co * v0[1]],
     };
-    let nav = integrate(&samples, scheme, initial).map_err(|e| imu_scenario::Error::Invalid {
-        field: input.display().to_string(),
-        message: e.to_string(),
-    })?;
-    nav.write_csv(out)?;
-    let (x, y) = (
-        nav.column("pos_x_m").unwrap_or_default(),
-        nav.column("pos_y_m").unwrap_or_default(),
-    );
+    let nav = imu_scenario::planar::integrate(&samples, scheme, initial)
+        .map_err(|e| invalid(&c.input.display().to_string(), e.to_string()))?;
+    nav.write_csv(c.out)?;
+    report(&nav, &format!("{scheme_name} scheme"), c.out);
+    Ok(())
+}
+
+/// Reads every numeric column of a CSV into a table.
+fn read_table(path: &Path) -> Result<Table, CliError> {
+    let header = read_header(path)?;
+    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let cols = read_columns(path, &names, "")?;
+    let rows = cols.rows();
+    let mut t = Table::new(&names);
+    for r in 0..rows {
+        let row: Vec<f64> = names.iter().map(|n| cols.get(n)[r]).collect();
+        t.push_row(&row);
+    }
+    Ok(t)
+}
+
+pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
+    let nav_frame: NavFrameName = parse_name("--nav-frame", &o.nav_frame.to_ascii_uppercase())?;
+    let sign: AccelSign = parse_name::<AccelSignName>("--accel-sign", o.accel_sign)?.into();
+    if !(o.gravity.is_finite() && o.gravity >= 0.0) {
+        return Err(invalid(
+            "--gravity",
+            format!("must be a finite number ≥ 0, got {}", o.gravity),
+        ));
+    }
+    let mut initial = match o.init {
+        Some(p) => InitialState::from_table(&read_table(p)?)?,
+        None => InitialState::default(),
+    };
+    if let Some(p) = c.position0 {
+        initial.position_m = vector("--position0", Some(p), [0.0; 3])?;
+    }
+    if let Some(v) = c.velocity0 {
+        initial.velocity_m_s = vector("--velocity0", Some(v), [0.0; 3])?;
+    }
+    if let Some(e) = o.euler0 {
+        let e = vector("--euler0", Some(e), [0.0; 3])?;
+        initial = InitialState::from_euler(
+            initial.position_m,
+            initial.velocity_m_s,
+            EulerZyx::from_array(e),
+        );
+    }
+    let imu = read_table(c.input)?;
+    let setup = NavSetup {
+        nav_frame,
+        options: StrapdownOptions {
+            gravity_m_s2: o.gravity,
+            coning: o.corrections,
+            sculling: o.corrections,
+        },
+        accel_sign: sign,
+    };
+    let nav = integrate(&imu, &initial, &setup)
+        .map_err(|e| invalid(&c.input.display().to_string(), e.to_string()))?;
+    nav.write_csv(c.out)?;
+    report(&nav, "strapdown", c.out);
+    Ok(())
+}
+
+fn report(nav: &Table, what: &str, out: &Path) {
+    let last = |c: &str| {
+        nav.column(c)
+            .and_then(|v| v.last().copied())
+            .unwrap_or(f64::NAN)
+    };
+    let z = if nav.columns.iter().any(|c| c == "pos_z_m") {
+        format!(", {:.3}", last("pos_z_m"))
+    } else {
+        String::new()
+    };
     eprintln!(
-        "imukit: {} samples, {scheme_name} scheme; start ({:.3}, {:.3}) m, end ({:.3}, {:.3}) m; trajectory in {}",
+        "imukit: {} samples, {what}; end position ({:.3}, {:.3}{z}) m; trajectory in {}",
         nav.rows(),
-        x.first().copied().unwrap_or(0.0),
-        y.first().copied().unwrap_or(0.0),
-        x.last().copied().unwrap_or(0.0),
-        y.last().copied().unwrap_or(0.0),
+        last("pos_x_m"),
+        last("pos_y_m"),
         out.display()
     );
-    Ok(())
 }

@@ -1,5 +1,6 @@
 //! One module per subcommand, and the CLI's error type.
 mod allan;
+mod compare;
 mod demo;
 mod exercise;
 mod integrate;
@@ -59,15 +60,44 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Presets { name } => presets::run(name.as_deref()),
         Command::Integrate {
             input,
+            init,
+            nav_frame,
+            gravity,
+            accel_sign,
+            no_corrections,
+            euler0,
             planar,
             scheme,
             position0,
             heading0,
             velocity0,
             out,
-        } => integrate::run(
-            &input, planar, &scheme, &position0, heading0, &velocity0, &out,
-        ),
+        } => {
+            let common = integrate::Common {
+                input: &input,
+                out: &out,
+                position0: position0.as_deref(),
+                velocity0: velocity0.as_deref(),
+            };
+            if planar {
+                integrate::planar(&common, &scheme, heading0)
+            } else {
+                let opts = integrate::Options3d {
+                    init: init.as_deref(),
+                    nav_frame: &nav_frame,
+                    gravity,
+                    accel_sign: &accel_sign,
+                    corrections: !no_corrections,
+                    euler0: euler0.as_deref(),
+                };
+                integrate::three_d(&common, &opts)
+            }
+        }
+        Command::Compare {
+            truth,
+            estimate,
+            out,
+        } => compare::run(&truth, &estimate, out.as_deref()),
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
             let c = imu_scenario::units::convert(value, &unit)?;
