@@ -8,6 +8,7 @@ use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, Temperatures};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
+use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{Body, Enu, EulerZyx, Rotation};
 use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
@@ -16,7 +17,7 @@ use imu_scenario::scenario::{
 use imu_scenario::sensors::{SensorKeys, SensorSetup};
 use imu_scenario::table::ImuKind;
 use imu_scenario::{ScenarioSpec, Table};
-use imu_scenario::{analysis, arrays, planar, presets};
+use imu_scenario::{analysis, arrays, navigation, planar, presets};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
@@ -776,6 +777,97 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
     table_out(py, t)
 }
 
+/// 3D strapdown of an IMU table (rates or increments) from an initial state.
+#[pyfunction]
+#[pyo3(signature = (columns, values, *, position0_m, velocity0_m_s, quaternion0, nav_frame = "ENU",
+                    gravity_m_s2 = 9.81, coning = true, sculling = true, accel_sign = "specific-force"))]
+#[allow(clippy::too_many_arguments)]
+fn strapdown<'py>(
+    py: Python<'py>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+    position0_m: [f64; 3],
+    velocity0_m_s: [f64; 3],
+    quaternion0: [f64; 4],
+    nav_frame: &str,
+    gravity_m_s2: f64,
+    coning: bool,
+    sculling: bool,
+    accel_sign: &str,
+) -> PyResult<TableOut<'py>> {
+    let v = values.as_array();
+    if v.ncols() != columns.len() {
+        return Err(PyValueError::new_err(format!(
+            "imu has {} columns but {} column names",
+            v.ncols(),
+            columns.len()
+        )));
+    }
+    let table = Table {
+        columns,
+        data: v.iter().copied().collect(),
+    };
+    let initial = navigation::InitialState {
+        position_m: position0_m,
+        velocity_m_s: velocity0_m_s,
+        quaternion: quaternion0,
+    };
+    if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
+        return Err(ImuError::new_err(format!(
+            "gravity_m_s2: must be a finite number ≥ 0, got {gravity_m_s2}"
+        )));
+    }
+    let setup = navigation::NavSetup {
+        nav_frame: nav(nav_frame)?,
+        options: StrapdownOptions {
+            gravity_m_s2,
+            coning,
+            sculling,
+        },
+        accel_sign: parse_name::<AccelSignName>("accel_sign", accel_sign)
+            .map_err(refused)?
+            .into(),
+    };
+    let out = py
+        .detach(move || navigation::integrate(&table, &initial, &setup))
+        .map_err(refused)?;
+    table_out(py, out)
+}
+
+/// Errors of an estimate against truth: (error table, summary dict).
+#[pyfunction]
+fn compare<'py>(
+    py: Python<'py>,
+    truth_columns: Vec<String>,
+    truth: PyReadonlyArray2<'py, f64>,
+    estimate_columns: Vec<String>,
+    estimate: PyReadonlyArray2<'py, f64>,
+) -> PyResult<(TableOut<'py>, Bound<'py, pyo3::types::PyDict>)> {
+    let t = Table {
+        columns: truth_columns,
+        data: truth.as_array().iter().copied().collect(),
+    };
+    let e = Table {
+        columns: estimate_columns,
+        data: estimate.as_array().iter().copied().collect(),
+    };
+    let c = py
+        .detach(move || navigation::compare(&t, &e))
+        .map_err(refused)?;
+    let d = pyo3::types::PyDict::new(py);
+    for (k, v) in [
+        ("position_rms_m", c.position_rms_m),
+        ("position_final_m", c.position_final_m),
+        ("velocity_rms_m_s", c.velocity_rms_m_s),
+        ("velocity_final_m_s", c.velocity_final_m_s),
+        ("attitude_rms_rad", c.attitude_rms_rad),
+        ("attitude_final_rad", c.attitude_final_rad),
+    ] {
+        d.set_item(k, v)?;
+    }
+    Ok((table_out(py, c.table)?, d))
+}
+
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -814,6 +906,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
     m.add_function(wrap_pyfunction!(planar_dead_reckon, m)?)?;
     m.add_function(wrap_pyfunction!(read_planar, m)?)?;
+    m.add_function(wrap_pyfunction!(strapdown, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     Ok(())

@@ -41,6 +41,8 @@ __all__ = [
     "convert",
     "preset_params",
     "loadparams",
+    "strapdown",
+    "compare",
     "planar_dead_reckon",
     "read_planar",
     "builtin_scenarios",
@@ -556,3 +558,53 @@ def read_planar(path: Union[str, os.PathLike]) -> Table:
     """Planar IMU data from a CSV (``t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s``) or the
     exercise's whitespace ``.dat`` file (t, a_x, a_y, ω_z)."""
     return _table(_core.read_planar(str(path)))
+
+
+def strapdown(
+    imu: Table,
+    *,
+    initial: Optional[Union[Table, Mapping]] = None,
+    nav_frame: str = "ENU",
+    gravity_m_s2: float = 9.81,
+    coning: bool = True,
+    sculling: bool = True,
+    accel_sign: str = "specific-force",
+) -> Table:
+    """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
+    increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
+    rotation-vector attitude step, two-sample coning and sculling corrections and gravity.
+
+    ``initial`` is a truth ``Table`` (its first row is used) or a dict with ``position_m``,
+    ``velocity_m_s`` and ``quaternion`` (``[w, x, y, z]``) or ``euler_rad`` (``[yaw, pitch, roll]``);
+    by default at rest, level, at the origin. Returns ``t_s, pos_*, vel_*, q_*, yaw_rad, pitch_rad,
+    roll_rad``.
+    """
+    if not isinstance(imu, Table):
+        raise TypeError(f"imu must be an imukit.Table, got {type(imu).__name__}")
+    pos, vel, quat = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]
+    if isinstance(initial, Table):
+        pos = [float(initial[f"pos_{a}_m"][0]) for a in "xyz"]
+        vel = [float(initial[f"vel_{a}_m_s"][0]) for a in "xyz"]
+        quat = [float(initial[c][0]) for c in ("q_w", "q_x", "q_y", "q_z")]
+    elif isinstance(initial, Mapping):
+        pos = [float(v) for v in initial.get("position_m", pos)]
+        vel = [float(v) for v in initial.get("velocity_m_s", vel)]
+        if "euler_rad" in initial:
+            quat = euler_to_quaternion([initial["euler_rad"]])[0].tolist()
+        else:
+            quat = [float(v) for v in initial.get("quaternion", quat)]
+    elif initial is not None:
+        raise TypeError("initial must be a truth Table or a dict")
+    return _table(_core.strapdown(
+        list(imu.columns), np.ascontiguousarray(imu.values), position0_m=pos, velocity0_m_s=vel, quaternion0=quat,
+        nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
+        accel_sign=accel_sign))
+
+
+def compare(truth: Table, estimate: Table):
+    """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``,
+    a Table (``t_s, pos_err_*_m, pos_err_m, vel_err_*_m_s, att_err_rad``) and a dict of RMS and
+    final values (``position_rms_m``, ``position_final_m``, …, ``attitude_final_rad``)."""
+    table, summary = _core.compare(list(truth.columns), np.ascontiguousarray(truth.values),
+                                   list(estimate.columns), np.ascontiguousarray(estimate.values))
+    return _table(table), dict(summary)

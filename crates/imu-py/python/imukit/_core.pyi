@@ -30,6 +30,8 @@ __all__ = [
     "load_params_toml",
     "planar_dead_reckon",
     "read_planar",
+    "strapdown",
+    "compare",
     "builtin_names",
     "builtin_toml",
 ]
@@ -144,3 +146,22 @@ def planar_dead_reckon(
     velocity0_m_s: Sequence[float] = ...,
 ) -> _Table: ...
 def read_planar(path: str) -> _Table: ...
+def strapdown(
+    columns: Sequence[str],
+    values: npt.NDArray[np.float64],
+    *,
+    position0_m: Sequence[float],
+    velocity0_m_s: Sequence[float],
+    quaternion0: Sequence[float],
+    nav_frame: str = "ENU",
+    gravity_m_s2: float = 9.81,
+    coning: bool = True,
+    sculling: bool = True,
+    accel_sign: str = "specific-force",
+) -> _Table: ...
+def compare(
+    truth_columns: Sequence[str],
+    truth: npt.NDArray[np.float64],
+    estimate_columns: Sequence[str],
+    estimate: npt.NDArray[np.float64],
+) -> tuple[_Table, dict[str, float]]: ...
