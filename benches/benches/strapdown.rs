@@ -1,0 +1,62 @@
+//! Throughput (samples/s) of the 3D strapdown step (coning, sculling, gravity, trapezoidal
+//! position) on rate input, and of planar dead reckoning.
+//!
+//! Run: `cargo bench -p imu-benches --bench strapdown`.
+#![allow(missing_docs)]
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imu_core::Enu;
+use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
+use imu_core::strapdown::step::{NavState, StrapdownOptions, strapdown_rates};
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("strapdown");
+    for n in [2usize, 100_000] {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let gyro: Vec<[f64; 3]> = t
+            .iter()
+            .map(|s| [0.3 * s.sin(), 0.2, -0.1 * s.cos()])
+            .collect();
+        let accel: Vec<[f64; 3]> = t.iter().map(|s| [0.5 * s.cos(), 0.1, 9.81]).collect();
+        let mut out = vec![NavState::<Enu>::default(); n];
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_function(BenchmarkId::new("3d_rates", n), |b| {
+            b.iter(|| {
+                strapdown_rates(
+                    &t,
+                    &gyro,
+                    &accel,
+                    NavState::default(),
+                    StrapdownOptions::default(),
+                    &mut out,
+                )
+                .expect("valid")
+            });
+        });
+        let planar: Vec<PlanarSample> = t
+            .iter()
+            .map(|&s| PlanarSample {
+                t_s: s,
+                accel_x_m_s2: 0.1,
+                accel_y_m_s2: 0.2 * s.sin(),
+                gyro_z_rad_s: 0.05,
+            })
+            .collect();
+        let mut pout = vec![PlanarState::default(); n];
+        group.bench_function(BenchmarkId::new("planar_trapezoid", n), |b| {
+            b.iter(|| {
+                dead_reckon(
+                    &planar,
+                    PlanarScheme::Trapezoid,
+                    PlanarState::default(),
+                    &mut pout,
+                )
+                .expect("valid")
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
