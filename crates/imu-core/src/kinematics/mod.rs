@@ -6,6 +6,7 @@
 //! (attitude aligned with the velocity).
 #[cfg(feature = "std")]
 pub mod analytic;
+pub mod body_rates;
 mod error;
 pub mod euler;
 pub mod finite_diff;
