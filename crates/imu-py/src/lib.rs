@@ -12,7 +12,8 @@ use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{Body, Enu, EulerZyx, Rotation};
 use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
-    AccelSignName, ExpressionSpec, Formula, ImuSetup, NavFrameName, SampledAttitudeData, parse_name,
+    AccelSignName, BodyRatesData, ExpressionSpec, Formula, ImuSetup, NavFrameName,
+    SampledAttitudeData, parse_name,
 };
 use imu_scenario::sensors::{SensorKeys, SensorSetup};
 use imu_scenario::table::ImuKind;
@@ -868,6 +869,41 @@ fn compare<'py>(
     Ok((table_out(py, c.table)?, d))
 }
 
+/// Truth from body-frame acceleration and angular velocity (MATLAB kinematicTrajectory).
+#[pyfunction]
+#[pyo3(signature = (t_s, accel_body_m_s2, omega_body_rad_s, *, position0_m = [0.0; 3],
+                    velocity0_m_s = [0.0; 3], euler0_rad = [0.0; 3], nav_frame = "ENU"))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_body_rates<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    accel_body_m_s2: PyReadonlyArray2<'py, f64>,
+    omega_body_rad_s: PyReadonlyArray2<'py, f64>,
+    position0_m: [f64; 3],
+    velocity0_m_s: [f64; 3],
+    euler0_rad: [f64; 3],
+    nav_frame: &str,
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array().to_vec();
+    let a = rows::<3>("accel_body_m_s2", &accel_body_m_s2)?;
+    let w = rows::<3>("omega_body_rad_s", &omega_body_rad_s)?;
+    check_len("accel_body_m_s2", a.len(), t.len())?;
+    check_len("omega_body_rad_s", w.len(), t.len())?;
+    let data = BodyRatesData {
+        accel_body_m_s2: a,
+        omega_body_rad_s: w,
+        alpha_body_rad_s2: None,
+        position0_m,
+        velocity0_m_s,
+        euler0_rad,
+    };
+    let nav = nav(nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_body_rates(&t, data, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -908,6 +944,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_planar, m)?)?;
     m.add_function(wrap_pyfunction!(strapdown, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_body_rates, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     Ok(())

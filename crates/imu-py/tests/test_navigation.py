@@ -32,3 +32,18 @@ def test_initial_state_from_a_dict_and_errors():
         imukit.strapdown(imu, nav_frame="XYZ")
     with pytest.raises(TypeError):
         imukit.strapdown(imu.values)
+
+
+def test_body_rates_reproduce_matlabs_rotating_platform():
+    fs = 100
+    t = np.arange(600) / fs
+    w = np.zeros((600, 3))
+    w[:400, 2] = np.pi / 2
+    w[400:, 2] = np.pi
+    truth = imukit.truth_from_body_rates(t, np.zeros((600, 3)), w, nav_frame="NED")
+    yaw = np.where(t <= 4, np.pi / 2 * t, 2 * np.pi + np.pi * (t - 4))
+    np.testing.assert_allclose(truth["yaw_rad"], yaw, atol=1e-11)
+    imu = imukit.ideal_imu(truth, nav_frame="NED", kind="accel-mag")
+    np.testing.assert_allclose(imu["accel_z_m_s2"], -9.81, atol=1e-12)
+    with pytest.raises(ValueError, match="omega_body_rad_s has 5 rows"):
+        imukit.truth_from_body_rates(t, np.zeros((600, 3)), np.zeros((5, 3)))

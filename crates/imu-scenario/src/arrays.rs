@@ -198,3 +198,20 @@ pub fn at_lever_arm_series(
         })
         .collect()
 }
+
+/// Truth from body-frame acceleration and angular velocity arrays (MATLAB kinematicTrajectory).
+///
+/// # Errors
+/// As [`imu_core::kinematics::body_rates::truth_from_body_rates`], with array indices.
+pub fn truth_from_body_rates(
+    t_s: &[f64],
+    data: crate::scenario::BodyRatesData,
+    nav: NavFrameName,
+) -> Result<Table> {
+    let traj = Trajectory::BodyRates(data);
+    in_frame(
+        nav,
+        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
+        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+    )
+}

@@ -21,9 +21,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
+use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
-use imu_core::{AccelSign, Enu, EulerZyx, ImuMount, KinematicsError, NavFrame, Ned, Truth, Vec3};
+use imu_core::{
+    AccelSign, Enu, EulerZyx, ImuMount, KinematicsError, NavFrame, Ned, Rotation, Truth, Vec3,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::builtin;
@@ -126,6 +129,9 @@ pub enum TrajectorySpec {
     Samples(SamplesSpec),
     /// Straights and arcs with a speed profile, exact.
     Track(TrackSpec),
+    /// Body-frame acceleration and angular velocity integrated to a trajectory (MATLAB's
+    /// kinematicTrajectory).
+    BodyRates(BodyRatesSpec),
     /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
     Builtin {
         /// Name, see [`builtin::NAMES`].
@@ -167,6 +173,49 @@ pub struct SamplesSpec {
     pub attitude: Option<String>,
     /// Standstill threshold of the tangent attitude, m/s.
     pub min_speed_m_s: Option<f64>,
+}
+
+/// `type = "body-rates"`: formulas of `t` or a CSV file of body-frame acceleration (kinematic,
+/// no gravity) and angular velocity.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyRatesSpec {
+    /// Named constants usable in the formulas.
+    #[serde(default)]
+    pub constants: BTreeMap<String, f64>,
+    /// Body acceleration formulas `[x, y, z]`, m/s² (default 0).
+    pub acceleration_body_m_s2: Option<[Formula; 3]>,
+    /// Body angular velocity formulas `[x, y, z]`, rad/s (default 0).
+    pub angular_velocity_body_rad_s: Option<[Formula; 3]>,
+    /// Or a CSV with `t_s, acc_body_x_m_s2, acc_body_y_m_s2, acc_body_z_m_s2, omega_x_rad_s,
+    /// omega_y_rad_s, omega_z_rad_s` (relative to the scenario file).
+    pub file: Option<PathBuf>,
+    /// Initial position, navigation frame, m.
+    #[serde(default)]
+    pub position0_m: [f64; 3],
+    /// Initial velocity, navigation frame, m/s.
+    #[serde(default)]
+    pub velocity0_m_s: [f64; 3],
+    /// Initial attitude `[yaw, pitch, roll]`, rad.
+    #[serde(default)]
+    pub euler0_rad: [f64; 3],
+}
+
+/// Body rates resolved to samples.
+#[derive(Clone, Debug)]
+pub struct BodyRatesData {
+    /// Body acceleration per sample, m/s².
+    pub accel_body_m_s2: Vec<[f64; 3]>,
+    /// Body angular velocity per sample, rad/s.
+    pub omega_body_rad_s: Vec<[f64; 3]>,
+    /// Exact angular acceleration (formulas), or `None` to difference `ω`.
+    pub alpha_body_rad_s2: Option<Vec<[f64; 3]>>,
+    /// Initial position, velocity, attitude.
+    pub position0_m: [f64; 3],
+    /// Initial velocity.
+    pub velocity0_m_s: [f64; 3],
+    /// Initial Euler angles.
+    pub euler0_rad: [f64; 3],
 }
 
 /// `type = "track"`.
@@ -502,6 +551,8 @@ pub enum Trajectory {
     Track(Track),
     /// Samples.
     Samples(SampledPath),
+    /// Body rates.
+    BodyRates(BodyRatesData),
 }
 
 /// The IMU of a scenario, resolved.
@@ -827,6 +878,10 @@ impl ScenarioSpec {
                 let t = path.t_s.clone();
                 (Trajectory::Samples(path), t)
             }
+            TrajectorySpec::BodyRates(b) => {
+                let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
+                (Trajectory::BodyRates(data), t)
+            }
             TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
         };
         let sample_rate_hz = match spec.rate_hz {
@@ -843,6 +898,93 @@ impl ScenarioSpec {
             imu,
         })
     }
+}
+
+/// Samples of a `body-rates` trajectory: formulas at `k/rate_hz`, or a CSV file.
+fn body_rates(
+    b: &BodyRatesSpec,
+    rate_hz: Option<f64>,
+    duration_s: Option<f64>,
+    base_dir: &Path,
+) -> Result<(Vec<f64>, BodyRatesData)> {
+    let mut data = BodyRatesData {
+        accel_body_m_s2: Vec::new(),
+        omega_body_rad_s: Vec::new(),
+        alpha_body_rad_s2: None,
+        position0_m: finite_vec("trajectory.position0_m", b.position0_m)?,
+        velocity0_m_s: finite_vec("trajectory.velocity0_m_s", b.velocity0_m_s)?,
+        euler0_rad: finite_vec("trajectory.euler0_rad", b.euler0_rad)?,
+    };
+    if let Some(file) = &b.file {
+        if b.acceleration_body_m_s2.is_some() || b.angular_velocity_body_rad_s.is_some() {
+            return Err(invalid(
+                "trajectory.file",
+                "give either a file or formulas, not both",
+            ));
+        }
+        const COLS: [&str; 7] = [
+            "t_s",
+            "acc_body_x_m_s2",
+            "acc_body_y_m_s2",
+            "acc_body_z_m_s2",
+            "omega_x_rad_s",
+            "omega_y_rad_s",
+            "omega_z_rad_s",
+        ];
+        let cols = read_columns(&base_dir.join(file), &COLS, "")?;
+        let n = cols.rows();
+        let g = |c: usize, i: usize| cols.get(COLS[c])[i];
+        data.accel_body_m_s2 = (0..n).map(|i| [g(1, i), g(2, i), g(3, i)]).collect();
+        data.omega_body_rad_s = (0..n).map(|i| [g(4, i), g(5, i), g(6, i)]).collect();
+        return Ok((cols.get("t_s").to_vec(), data));
+    }
+    let rate =
+        rate_hz.ok_or_else(|| invalid("rate_hz", "missing (required for body-rate formulas)"))?;
+    let duration = duration_s
+        .ok_or_else(|| invalid("duration_s", "missing (required for body-rate formulas)"))?;
+    let t = sample_times(rate, duration)?;
+    let zero = || {
+        [
+            Formula::Number(0.0),
+            Formula::Number(0.0),
+            Formula::Number(0.0),
+        ]
+    };
+    let parse = |f: &[Formula; 3], key: &str| -> Result<Vec<Expr>> {
+        (0..3)
+            .map(|k| f[k].parse(&format!("trajectory.{key}[{k}]"), &b.constants))
+            .collect()
+    };
+    let acc = parse(
+        b.acceleration_body_m_s2.as_ref().unwrap_or(&zero()),
+        "acceleration_body_m_s2",
+    )?;
+    let w = parse(
+        b.angular_velocity_body_rad_s.as_ref().unwrap_or(&zero()),
+        "angular_velocity_body_rad_s",
+    )?;
+    let mut alpha = Vec::with_capacity(t.len());
+    for (i, &ti) in t.iter().enumerate() {
+        let a: [f64; 3] = std::array::from_fn(|k| acc[k].eval(ti));
+        let wd: [num_dual::Dual64; 3] =
+            std::array::from_fn(|k| w[k].eval(num_dual::Dual64::new(ti, 1.0)));
+        if !a
+            .iter()
+            .chain(wd.iter().map(|d| &d.re))
+            .chain(wd.iter().map(|d| &d.eps))
+            .all(|v| v.is_finite())
+        {
+            return Err(invalid(
+                "trajectory",
+                format!("body-rate formulas are not finite at t = {ti} s (sample {i})"),
+            ));
+        }
+        data.accel_body_m_s2.push(a);
+        data.omega_body_rad_s.push(wd.map(|d| d.re));
+        alpha.push(wd.map(|d| d.eps));
+    }
+    data.alpha_body_rad_s2 = Some(alpha);
+    Ok((t, data))
 }
 
 /// Exact truth of an analytic motion, with the time of a refused sample in the error.
@@ -877,6 +1019,25 @@ impl Trajectory {
                 analytic_truth(k, t_s, AnalyticOptions::default(), "trajectory (track)")
             }
             Self::Samples(s) => s.truth(),
+            Self::BodyRates(b) => {
+                let start = BodyRateStart {
+                    position_m: Vec3::from_array(b.position0_m),
+                    velocity_m_s: Vec3::from_array(b.velocity0_m_s),
+                    attitude: Rotation::from_euler(EulerZyx::from_array(b.euler0_rad)),
+                };
+                let mut out = vec![Truth::<N>::default(); t_s.len()];
+                truth_from_body_rates(
+                    t_s,
+                    &b.accel_body_m_s2,
+                    &b.omega_body_rad_s,
+                    b.alpha_body_rad_s2.as_deref(),
+                    start,
+                    imu_core::kinematics::finite_diff::DEFAULT_ORDER,
+                    &mut out,
+                )
+                .map_err(|e| with_time(t_s, e, "trajectory (body rates)"))?;
+                Ok(out)
+            }
         }
     }
 }

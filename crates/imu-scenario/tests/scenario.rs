@@ -308,3 +308,59 @@ fn builtin_defaults_can_be_overridden_by_the_file() {
     assert_eq!(sim.imu.columns.len(), 7);
     let _: &Table = &sim.truth;
 }
+
+#[test]
+fn body_rate_scenarios_reproduce_matlabs_platform_from_formulas_and_files() {
+    let dir = temp_dir("bodyrates");
+    let text = "rate_hz = 100.0\nduration_s = 5.99\nnav_frame = \"NED\"\n[trajectory]\ntype = \"body-rates\"\n\
+                angular_velocity_body_rad_s = [0, 0, \"piecewise(t < 3.995, pi/2, pi)\"]\n";
+    let formulas = run_toml(text, &dir).unwrap();
+    let builtin = builtin::spec("platform-turn")
+        .unwrap()
+        .resolve(&dir)
+        .unwrap()
+        .simulate()
+        .unwrap();
+    let (a, b) = (
+        formulas.truth.column("yaw_rad").unwrap(),
+        builtin.truth.column("yaw_rad").unwrap(),
+    );
+    assert_eq!(a.len(), 600);
+    for k in 0..600 {
+        assert!((a[k] - b[k]).abs() < 1e-11, "k = {k}: {} vs {}", a[k], b[k]);
+    }
+    assert_eq!(
+        formulas.imu.column("gyro_z_rad_s"),
+        builtin.imu.column("gyro_z_rad_s")
+    );
+    // The same rates from a CSV file.
+    let mut csv = String::from(
+        "t_s,acc_body_x_m_s2,acc_body_y_m_s2,acc_body_z_m_s2,omega_x_rad_s,omega_y_rad_s,omega_z_rad_s\n",
+    );
+    for k in 0..600 {
+        let w = if k < 400 {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            std::f64::consts::PI
+        };
+        csv += &format!("{},0,0,0,0,0,{}\n", k as f64 / 100.0, w);
+    }
+    std::fs::write(dir.join("rates.csv"), csv).unwrap();
+    let file = run_toml(
+        "nav_frame = \"NED\"\n[trajectory]\ntype = \"body-rates\"\nfile = \"rates.csv\"\n",
+        &dir,
+    )
+    .unwrap();
+    let c = file.truth.column("yaw_rad").unwrap();
+    for k in 0..600 {
+        assert!((c[k] - b[k]).abs() < 1e-11, "k = {k}");
+    }
+    let e = err_text(run_toml(
+        "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"body-rates\"\nangular_velocity_body_rad_s = [0, 0, \"w*t\"]\n",
+        &dir,
+    ));
+    assert!(
+        e.contains("angular_velocity_body_rad_s[2]") && e.contains("unknown variable 'w'"),
+        "{e}"
+    );
+}

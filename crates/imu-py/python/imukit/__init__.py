@@ -49,6 +49,7 @@ __all__ = [
     "builtin_scenario_toml",
     "truth_from_expressions",
     "truth_from_samples",
+    "truth_from_body_rates",
     "ideal_imu",
     "euler_to_quaternion",
     "quaternion_to_euler",
@@ -608,3 +609,24 @@ def compare(truth: Table, estimate: Table):
     table, summary = _core.compare(list(truth.columns), np.ascontiguousarray(truth.values),
                                    list(estimate.columns), np.ascontiguousarray(estimate.values))
     return _table(table), dict(summary)
+
+
+def truth_from_body_rates(
+    t_s,
+    accel_body_m_s2,
+    omega_body_rad_s,
+    *,
+    position0_m: Sequence[float] = (0.0, 0.0, 0.0),
+    velocity0_m_s: Sequence[float] = (0.0, 0.0, 0.0),
+    euler0_rad: Sequence[float] = (0.0, 0.0, 0.0),
+    nav_frame: str = "ENU",
+) -> Table:
+    """Truth from body-frame acceleration (kinematic, no gravity) and angular velocity, as MATLAB's
+    ``kinematicTrajectory`` builds it: exact rotation-vector attitude step,
+    ``p ← p + vΔt + ½aΔt²``, the state before each update at each sample (first order)."""
+    t = _times(t_s)
+    n = t.shape[0]
+    return _table(_core.truth_from_body_rates(
+        t, _rows("accel_body_m_s2", accel_body_m_s2, 3, n), _rows("omega_body_rad_s", omega_body_rad_s, 3, n),
+        position0_m=[float(v) for v in position0_m], velocity0_m_s=[float(v) for v in velocity0_m_s],
+        euler0_rad=[float(v) for v in euler0_rad], nav_frame=nav_frame))

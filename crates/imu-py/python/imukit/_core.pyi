@@ -32,6 +32,7 @@ __all__ = [
     "read_planar",
     "strapdown",
     "compare",
+    "truth_from_body_rates",
     "builtin_names",
     "builtin_toml",
 ]
@@ -165,3 +166,13 @@ def compare(
     estimate_columns: Sequence[str],
     estimate: npt.NDArray[np.float64],
 ) -> tuple[_Table, dict[str, float]]: ...
+def truth_from_body_rates(
+    t_s: npt.NDArray[np.float64],
+    accel_body_m_s2: npt.NDArray[np.float64],
+    omega_body_rad_s: npt.NDArray[np.float64],
+    *,
+    position0_m: Sequence[float] = ...,
+    velocity0_m_s: Sequence[float] = ...,
+    euler0_rad: Sequence[float] = ...,
+    nav_frame: str = "ENU",
+) -> _Table: ...
