@@ -904,6 +904,38 @@ fn truth_from_body_rates<'py>(
     table_out(py, table)
 }
 
+/// Exact truth at `t_s` of a waypoint trajectory (cubic spline through the waypoints).
+#[pyfunction]
+#[pyo3(signature = (t_s, time_s, position_m, *, velocity_m_s = None, euler_rad = None, nav_frame = "ENU"))]
+fn truth_from_waypoints<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    time_s: PyReadonlyArray1<'py, f64>,
+    position_m: PyReadonlyArray2<'py, f64>,
+    velocity_m_s: Option<PyReadonlyArray2<'py, f64>>,
+    euler_rad: Option<PyReadonlyArray2<'py, f64>>,
+    nav_frame: &str,
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array().to_vec();
+    let knots = time_s.as_array().to_vec();
+    let p = rows::<3>("position_m", &position_m)?;
+    let v = velocity_m_s
+        .as_ref()
+        .map(|v| rows::<3>("velocity_m_s", v))
+        .transpose()?;
+    let e = euler_rad
+        .as_ref()
+        .map(|e| rows::<3>("euler_rad", e))
+        .transpose()?;
+    let w = imu_scenario::waypoints::Waypoints::new(&knots, &p, v.as_deref(), e.as_deref())
+        .map_err(refused)?;
+    let nav = nav(nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_waypoints(&t, w, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -945,6 +977,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(strapdown, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_body_rates, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_waypoints, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     Ok(())

@@ -47,3 +47,12 @@ def test_body_rates_reproduce_matlabs_rotating_platform():
     np.testing.assert_allclose(imu["accel_z_m_s2"], -9.81, atol=1e-12)
     with pytest.raises(ValueError, match="omega_body_rad_s has 5 rows"):
         imukit.truth_from_body_rates(t, np.zeros((600, 3)), np.zeros((5, 3)))
+
+
+def test_waypoints_pass_through_their_positions():
+    knots = np.array([0.0, 2.0, 3.5, 6.0])
+    p = np.array([[0, 0, 0], [10, 1, 0.5], [12, 6, 1], [5, 9, 1.5]], dtype=float)
+    truth = imukit.truth_from_waypoints(knots, knots, p)
+    np.testing.assert_allclose(np.column_stack([truth[f"pos_{a}_m"] for a in "xyz"]), p, atol=1e-12)
+    with pytest.raises(ImuError, match="at least 2 waypoints"):
+        imukit.truth_from_waypoints([0.0], [0.0], [[0, 0, 0]])

@@ -215,3 +215,20 @@ pub fn truth_from_body_rates(
         || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
     )
 }
+
+/// Exact truth at `t_s` of a waypoint trajectory.
+///
+/// # Errors
+/// As [`crate::waypoints::Waypoints::new`]; the core's refusal.
+pub fn truth_from_waypoints(
+    t_s: &[f64],
+    waypoints: crate::waypoints::Waypoints,
+    nav: NavFrameName,
+) -> Result<Table> {
+    let traj = Trajectory::Waypoints(waypoints);
+    in_frame(
+        nav,
+        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
+        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+    )
+}

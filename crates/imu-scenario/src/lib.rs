@@ -18,6 +18,7 @@ pub mod sensors;
 pub mod table;
 pub mod track;
 pub mod units;
+pub mod waypoints;
 
 pub use error::{Error, Result};
 pub use scenario::{Scenario, ScenarioSpec, Simulation};

@@ -37,6 +37,7 @@ use crate::perturb::{PerturbationSpec, perturbed};
 use crate::sensors::{SensorKeys, SensorSetup, TemperatureSpec};
 use crate::table::{ImuKind, ImuOutput, Table, read_columns, read_header};
 use crate::track::{Segment, SpeedProfile, Track};
+use crate::waypoints::Waypoints;
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
 
 /// The navigation frame, by name.
@@ -132,6 +133,8 @@ pub enum TrajectorySpec {
     /// Body-frame acceleration and angular velocity integrated to a trajectory (MATLAB's
     /// kinematicTrajectory).
     BodyRates(BodyRatesSpec),
+    /// Positions at times through a cubic spline (MATLAB's waypointTrajectory).
+    Waypoints(WaypointsSpec),
     /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
     Builtin {
         /// Name, see [`builtin::NAMES`].
@@ -199,6 +202,20 @@ pub struct BodyRatesSpec {
     /// Initial attitude `[yaw, pitch, roll]`, rad.
     #[serde(default)]
     pub euler0_rad: [f64; 3],
+}
+
+/// `type = "waypoints"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaypointsSpec {
+    /// Waypoint times, s (increasing).
+    pub time_s: Vec<f64>,
+    /// Waypoint positions `[x, y, z]`, navigation frame, m.
+    pub position_m: Vec<[f64; 3]>,
+    /// Velocities: two rows (start, end: clamped spline) or one per waypoint (Hermite).
+    pub velocity_m_s: Option<Vec<[f64; 3]>>,
+    /// Attitude `[yaw, pitch, roll]` per waypoint, rad; without it the attitude is tangent.
+    pub euler_rad: Option<Vec<[f64; 3]>>,
 }
 
 /// Body rates resolved to samples.
@@ -549,6 +566,8 @@ pub enum Trajectory {
     Expression(ExpressionMotion, AnalyticOptions),
     /// A track.
     Track(Track),
+    /// Waypoints.
+    Waypoints(Waypoints),
     /// Samples.
     Samples(SampledPath),
     /// Body rates.
@@ -878,6 +897,17 @@ impl ScenarioSpec {
                 let t = path.t_s.clone();
                 (Trajectory::Samples(path), t)
             }
+            TrajectorySpec::Waypoints(w) => {
+                let path = Waypoints::new(
+                    &w.time_s,
+                    &w.position_m,
+                    w.velocity_m_s.as_deref(),
+                    w.euler_rad.as_deref(),
+                )?;
+                let duration = spec.duration_s.unwrap_or(path.end_s);
+                let t = sample_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                (Trajectory::Waypoints(path), t)
+            }
             TrajectorySpec::BodyRates(b) => {
                 let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
                 (Trajectory::BodyRates(data), t)
@@ -1019,6 +1049,9 @@ impl Trajectory {
                 analytic_truth(k, t_s, AnalyticOptions::default(), "trajectory (track)")
             }
             Self::Samples(s) => s.truth(),
+            Self::Waypoints(w) => {
+                analytic_truth(w, t_s, AnalyticOptions::default(), "trajectory (waypoints)")
+            }
             Self::BodyRates(b) => {
                 let start = BodyRateStart {
                     position_m: Vec3::from_array(b.position0_m),

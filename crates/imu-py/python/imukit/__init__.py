@@ -50,6 +50,7 @@ __all__ = [
     "truth_from_expressions",
     "truth_from_samples",
     "truth_from_body_rates",
+    "truth_from_waypoints",
     "ideal_imu",
     "euler_to_quaternion",
     "quaternion_to_euler",
@@ -630,3 +631,16 @@ def truth_from_body_rates(
         t, _rows("accel_body_m_s2", accel_body_m_s2, 3, n), _rows("omega_body_rad_s", omega_body_rad_s, 3, n),
         position0_m=[float(v) for v in position0_m], velocity0_m_s=[float(v) for v in velocity0_m_s],
         euler0_rad=[float(v) for v in euler0_rad], nav_frame=nav_frame))
+
+
+def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_rad=None, nav_frame: str = "ENU") -> Table:
+    """Exact truth at ``t_s`` of a waypoint trajectory (like MATLAB's waypointTrajectory): a natural
+    cubic spline through ``position_m`` (N, 3) at ``time_s`` (N,), clamped to ``velocity_m_s`` when it
+    has 2 rows (start, end) or a Hermite curve when it has one row per waypoint; the attitude is
+    tangent, or a spline through ``euler_rad`` (N, 3) ``[yaw, pitch, roll]``."""
+    knots = _times(time_s)
+    n = knots.shape[0]
+    return _table(_core.truth_from_waypoints(
+        _times(t_s), knots, _rows("position_m", position_m, 3, n),
+        velocity_m_s=None if velocity_m_s is None else _rows("velocity_m_s", velocity_m_s, 3),
+        euler_rad=None if euler_rad is None else _rows("euler_rad", euler_rad, 3, n), nav_frame=nav_frame))

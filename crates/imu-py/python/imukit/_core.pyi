@@ -33,6 +33,7 @@ __all__ = [
     "strapdown",
     "compare",
     "truth_from_body_rates",
+    "truth_from_waypoints",
     "builtin_names",
     "builtin_toml",
 ]
@@ -174,5 +175,14 @@ def truth_from_body_rates(
     position0_m: Sequence[float] = ...,
     velocity0_m_s: Sequence[float] = ...,
     euler0_rad: Sequence[float] = ...,
+    nav_frame: str = "ENU",
+) -> _Table: ...
+def truth_from_waypoints(
+    t_s: npt.NDArray[np.float64],
+    time_s: npt.NDArray[np.float64],
+    position_m: npt.NDArray[np.float64],
+    *,
+    velocity_m_s: Optional[npt.NDArray[np.float64]] = None,
+    euler_rad: Optional[npt.NDArray[np.float64]] = None,
     nav_frame: str = "ENU",
 ) -> _Table: ...
