@@ -129,7 +129,7 @@ fn bad_waypoints_are_refused() {
             &[0.0, 1.0],
             &[[0.0; 3]; 2],
             None,
-            Some(&[[0.0, 1.5707963267948966, 0.0]; 2])
+            Some(&[[0.0, std::f64::consts::FRAC_PI_2, 0.0]; 2])
         ))
         .contains("gimbal")
     );
