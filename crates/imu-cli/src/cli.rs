@@ -58,9 +58,13 @@ pub enum Command {
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
         planar: bool,
-        /// Planar scheme: `trapezoid` (second order, default) or `exercise` (seed 001's rules).
-        #[arg(long, default_value = "trapezoid")]
-        scheme: String,
+        /// Planar: `trapezoid` (default) or `exercise` (seed 001's rules). 3D: `coning` (default;
+        /// coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
+        #[arg(long)]
+        scheme: Option<String>,
+        /// 3D `rk4`: RK4 steps per sample interval.
+        #[arg(long, default_value_t = 4)]
+        substeps: usize,
         /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
         #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]
         position0: Option<Vec<f64>>,

@@ -265,6 +265,23 @@ fn simulate_integrate_compare_closes_the_loop() {
         last("pos_err_m"),
         last("att_err_rad")
     );
+    // The fourth-order scheme closes the loop far tighter.
+    run(&[
+        "integrate",
+        "imu.csv",
+        "--init",
+        "truth.csv",
+        "--nav-frame",
+        "NED",
+        "--scheme",
+        "rk4",
+        "--out",
+        "nav4.csv",
+    ]);
+    run(&["compare", "truth.csv", "nav4.csv", "--out", "err4.csv"]);
+    let err4 =
+        imu_scenario::table::read_columns(&dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
+    assert!(*err4.get("pos_err_m").last().unwrap() < 1e-6);
     // Integrating in the wrong frame is visibly wrong (gravity the other way).
     run(&[
         "integrate",

@@ -781,7 +781,8 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 /// 3D strapdown of an IMU table (rates or increments) from an initial state.
 #[pyfunction]
 #[pyo3(signature = (columns, values, *, position0_m, velocity0_m_s, quaternion0, nav_frame = "ENU",
-                    gravity_m_s2 = 9.81, coning = true, sculling = true, accel_sign = "specific-force"))]
+                    gravity_m_s2 = 9.81, coning = true, sculling = true, accel_sign = "specific-force",
+                    scheme = "coning", substeps = 4))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
     py: Python<'py>,
@@ -795,7 +796,19 @@ fn strapdown<'py>(
     coning: bool,
     sculling: bool,
     accel_sign: &str,
+    scheme: &str,
+    substeps: usize,
 ) -> PyResult<TableOut<'py>> {
+    let scheme = match scheme {
+        "coning" => navigation::NavScheme::ConingSculling,
+        "rk4" if substeps >= 1 => navigation::NavScheme::Rk4 { substeps },
+        "rk4" => return Err(ImuError::new_err("substeps: must be ≥ 1")),
+        other => {
+            return Err(ImuError::new_err(format!(
+                "scheme: unknown scheme \"{other}\" (coning, rk4)"
+            )));
+        }
+    };
     let v = values.as_array();
     if v.ncols() != columns.len() {
         return Err(PyValueError::new_err(format!(
@@ -819,6 +832,7 @@ fn strapdown<'py>(
         )));
     }
     let setup = navigation::NavSetup {
+        scheme,
         nav_frame: nav(nav_frame)?,
         options: StrapdownOptions {
             gravity_m_s2,

@@ -18,6 +18,11 @@ def test_simulate_strapdown_compare_round_trip():
     errors, summary = imukit.compare(sim.truth, nav)
     assert summary["position_final_m"] < 1e-3 and summary["attitude_final_rad"] < 1e-5
     assert errors["pos_err_m"][-1] == pytest.approx(summary["position_final_m"])
+    rk4 = imukit.strapdown(sim.imu, initial=sim.truth, scheme="rk4")
+    _, fine = imukit.compare(sim.truth, rk4)
+    assert fine["position_final_m"] < 1e-6
+    with pytest.raises(ImuError, match="unknown scheme"):
+        imukit.strapdown(sim.imu, scheme="euler")
     bare = imukit.strapdown(sim.imu, initial=sim.truth, coning=False, sculling=False)
     _, worse = imukit.compare(sim.truth, bare)
     assert worse["position_final_m"] > 10 * summary["position_final_m"]

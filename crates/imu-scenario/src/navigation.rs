@@ -5,6 +5,7 @@
 //! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
 //! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
 //! yaw_rad, pitch_rad, roll_rad`.
+use imu_core::strapdown::rk4::strapdown_rates_rk4;
 use imu_core::strapdown::step::{
     NavState, StrapdownOptions, strapdown_increments, strapdown_rates,
 };
@@ -99,6 +100,21 @@ impl InitialState {
     }
 }
 
+/// The 3D integration scheme.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NavScheme {
+    /// DESIGN §6: exact rotation-vector step, two-sample coning and sculling, trapezoidal
+    /// position; rates or increments; second order.
+    #[default]
+    ConingSculling,
+    /// RK4 with `substeps` per interval and quintic interpolation of the rate samples; rates only;
+    /// fourth order (see `imu_core::strapdown::rk4`).
+    Rk4 {
+        /// RK4 steps per sample interval.
+        substeps: usize,
+    },
+}
+
 /// What to integrate and how.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavSetup {
@@ -108,6 +124,8 @@ pub struct NavSetup {
     pub options: StrapdownOptions,
     /// Sign of the accelerometer columns.
     pub accel_sign: AccelSign,
+    /// Integration scheme.
+    pub scheme: NavScheme,
 }
 
 impl Default for NavSetup {
@@ -116,6 +134,7 @@ impl Default for NavSetup {
             nav_frame: NavFrameName::ENU,
             options: StrapdownOptions::default(),
             accel_sign: AccelSign::SpecificForce,
+            scheme: NavScheme::ConingSculling,
         }
     }
 }
@@ -165,9 +184,28 @@ fn integrate_in<N: NavFrame>(
     let result = if let (Some(f), Some(w)) =
         (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
     {
-        strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
+        match setup.scheme {
+            NavScheme::ConingSculling => {
+                strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
+            }
+            NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
+                &t,
+                &w,
+                &flip(f),
+                s0,
+                setup.options.gravity_m_s2,
+                substeps,
+                &mut out,
+            ),
+        }
     } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
     {
+        if setup.scheme != NavScheme::ConingSculling {
+            return Err(invalid(
+                "IMU data",
+                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+            ));
+        }
         strapdown_increments(&t, &dth, &flip(dv), s0, setup.options, &mut out)
     } else {
         return Err(invalid(

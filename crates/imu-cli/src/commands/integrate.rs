@@ -4,7 +4,7 @@ use std::path::Path;
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{AccelSign, EulerZyx};
-use imu_scenario::navigation::{InitialState, NavSetup, integrate};
+use imu_scenario::navigation::{InitialState, NavScheme, NavSetup, integrate};
 use imu_scenario::planar::read_planar;
 use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
 use imu_scenario::table::{read_columns, read_header};
@@ -28,6 +28,8 @@ pub struct Options3d<'a> {
     pub accel_sign: &'a str,
     pub corrections: bool,
     pub euler0: Option<&'a [f64]>,
+    pub scheme: &'a str,
+    pub substeps: usize,
 }
 
 fn invalid(field: &str, message: String) -> CliError {
@@ -127,7 +129,21 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         );
     }
     let imu = read_table(c.input)?;
+    let scheme = match o.scheme {
+        "coning" => NavScheme::ConingSculling,
+        "rk4" if o.substeps >= 1 => NavScheme::Rk4 {
+            substeps: o.substeps,
+        },
+        "rk4" => return Err(invalid("--substeps", "must be ≥ 1".into())),
+        other => {
+            return Err(invalid(
+                "--scheme",
+                format!("unknown 3D scheme \"{other}\" (coning, rk4)"),
+            ));
+        }
+    };
     let setup = NavSetup {
+        scheme,
         nav_frame,
         options: StrapdownOptions {
             gravity_m_s2: o.gravity,

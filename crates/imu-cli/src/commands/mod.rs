@@ -68,6 +68,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             euler0,
             planar,
             scheme,
+            substeps,
             position0,
             heading0,
             velocity0,
@@ -80,7 +81,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 velocity0: velocity0.as_deref(),
             };
             if planar {
-                integrate::planar(&common, &scheme, heading0)
+                integrate::planar(&common, scheme.as_deref().unwrap_or("trapezoid"), heading0)
             } else {
                 let opts = integrate::Options3d {
                     init: init.as_deref(),
@@ -89,6 +90,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     accel_sign: &accel_sign,
                     corrections: !no_corrections,
                     euler0: euler0.as_deref(),
+                    scheme: scheme.as_deref().unwrap_or("coning"),
+                    substeps,
                 };
                 integrate::three_d(&common, &opts)
             }

@@ -2,6 +2,8 @@
 //!
 //! [`planar`]: a cart in a plane with two accelerometers and a yaw gyro (seed 001), with the
 //! exercise's own update rules kept verbatim and a consistent second-order default.
-//! [`step`]: 3D strapdown with coning and sculling in a flat-Earth local-level frame.
+//! [`step`]: 3D strapdown with coning and sculling in a flat-Earth local-level frame (second order);
+//! [`rk4`]: a fourth-order alternative for rate samples.
 pub mod planar;
+pub mod rk4;
 pub mod step;

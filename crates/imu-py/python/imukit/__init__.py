@@ -571,6 +571,8 @@ def strapdown(
     coning: bool = True,
     sculling: bool = True,
     accel_sign: str = "specific-force",
+    scheme: str = "coning",
+    substeps: int = 4,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
     increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
@@ -580,6 +582,9 @@ def strapdown(
     ``velocity_m_s`` and ``quaternion`` (``[w, x, y, z]``) or ``euler_rad`` (``[yaw, pitch, roll]``);
     by default at rest, level, at the origin. Returns ``t_s, pos_*, vel_*, q_*, yaw_rad, pitch_rad,
     roll_rad``.
+
+    ``scheme="coning"`` (default, DESIGN §6, second order; rates or increments) or ``"rk4"``
+    (fourth order: RK4 with ``substeps`` per interval on quintic-interpolated rates; rates only).
     """
     if not isinstance(imu, Table):
         raise TypeError(f"imu must be an imukit.Table, got {type(imu).__name__}")
@@ -600,7 +605,7 @@ def strapdown(
     return _table(_core.strapdown(
         list(imu.columns), np.ascontiguousarray(imu.values), position0_m=pos, velocity0_m_s=vel, quaternion0=quat,
         nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
-        accel_sign=accel_sign))
+        accel_sign=accel_sign, scheme=scheme, substeps=int(substeps)))
 
 
 def compare(truth: Table, estimate: Table):

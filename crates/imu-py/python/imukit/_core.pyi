@@ -160,6 +160,8 @@ def strapdown(
     coning: bool = True,
     sculling: bool = True,
     accel_sign: str = "specific-force",
+    scheme: str = "coning",
+    substeps: int = 4,
 ) -> _Table: ...
 def compare(
     truth_columns: Sequence[str],
