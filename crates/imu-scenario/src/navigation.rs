@@ -139,6 +139,36 @@ impl Default for NavSetup {
     }
 }
 
+/// Intervals longer than this many median intervals count as gaps in the data.
+pub const MAX_GAP_FACTOR: f64 = 2.5;
+
+/// Refuses a gap in sample times: an interval longer than [`MAX_GAP_FACTOR`] median intervals
+/// (missing samples would be bridged silently by the integration). `first_row` is the file row of
+/// sample 0 (2 below a CSV header), for the message.
+///
+/// # Errors
+/// [`crate::Error::Invalid`] naming the rows and the intervals.
+pub fn check_gaps(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
+    if t_s.len() < 3 {
+        return Ok(());
+    }
+    let mut dt: Vec<f64> = t_s.windows(2).map(|w| w[1] - w[0]).collect();
+    let gaps: Vec<(usize, f64)> = dt.iter().copied().enumerate().collect();
+    dt.sort_by(f64::total_cmp);
+    let median = dt[dt.len() / 2];
+    if let Some((i, d)) = gaps.into_iter().find(|(_, d)| *d > MAX_GAP_FACTOR * median) {
+        return Err(invalid(
+            what,
+            format!(
+                "gap in the sample times between rows {} and {} ({d} s, the median interval is {median} s)",
+                i + first_row,
+                i + 1 + first_row
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
     let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
     Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
@@ -164,6 +194,17 @@ fn integrate_in<N: NavFrame>(
     let t = imu
         .column("t_s")
         .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1] || t[i].is_nan()) {
+        return Err(invalid(
+            "IMU data",
+            format!(
+                "time at row {} does not increase after row {}",
+                i + 2,
+                i + 1
+            ),
+        ));
+    }
+    check_gaps(&t, "IMU data", 2)?;
     let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
         invalid(
             "initial state",

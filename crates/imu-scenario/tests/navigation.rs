@@ -126,3 +126,33 @@ fn rk4_recovers_the_figure8_to_a_micrometre_after_60_s_at_1_khz() {
     .to_string();
     assert!(e.contains("needs rates"), "{e}");
 }
+
+#[test]
+fn gaps_and_disorder_in_the_times_are_named() {
+    let sim = scenario("", "ENU");
+    let init = InitialState::from_table(&sim.truth).unwrap();
+    // Drop samples 100..110: a gap between rows 101 and 102 of the file (header is row 1).
+    let w = sim.imu.columns.len();
+    let mut gappy = imu_scenario::Table::new(
+        &sim.imu
+            .columns
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    for r in (0..sim.imu.rows()).filter(|r| !(100..110).contains(r)) {
+        gappy.push_row(&sim.imu.data[r * w..(r + 1) * w]);
+    }
+    let e = integrate(&gappy, &init, &NavSetup::default())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("gap") && e.contains("rows 101 and 102"), "{e}");
+    let mut swapped = sim.imu.clone();
+    swapped.data[5 * w] = swapped.data[4 * w];
+    let e = integrate(&swapped, &init, &NavSetup::default())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("row 7 does not increase"), "{e}");
+}
