@@ -212,7 +212,7 @@ pub struct WaypointsSpec {
     pub time_s: Vec<f64>,
     /// Waypoint positions `[x, y, z]`, navigation frame, m.
     pub position_m: Vec<[f64; 3]>,
-    /// Velocities: two rows (start, end: clamped spline) or one per waypoint (Hermite).
+    /// Velocities: two rows (start, end: clamped spline) or one per waypoint (quintic Hermite, C²).
     pub velocity_m_s: Option<Vec<[f64; 3]>>,
     /// Attitude `[yaw, pitch, roll]` per waypoint, rad; without it the attitude is tangent.
     pub euler_rad: Option<Vec<[f64; 3]>>,

@@ -1,9 +1,10 @@
 //! Waypoint trajectories (like MATLAB's waypointTrajectory): positions at times → a smooth path.
 //!
 //! Each coordinate is a cubic spline through the waypoints: natural (zero second derivative at
-//! both ends, C² everywhere) by default, clamped to given start and end velocities when
-//! `velocity_m_s` gives them for the first and last waypoint, or a cubic Hermite curve (C¹) through
-//! given velocities at every waypoint. The attitude is either tangent to the path or a natural
+//! both ends, C² everywhere) by default, or clamped to given start and end velocities when
+//! `velocity_m_s` gives them for the first and last waypoint. With a velocity at every waypoint
+//! each interval is a quintic Hermite polynomial matching position, velocity and an acceleration
+//! taken from a natural spline through the velocities, so the path is still C². The attitude is either tangent to the path or a natural
 //! cubic spline through Euler angles given at the waypoints (unwrapped). Splines are evaluated over
 //! dual numbers, so velocity, acceleration, body rate and angular acceleration are exact for the
 //! spline. Outside the waypoints' time span the body stands at the first/last waypoint (a step
@@ -12,14 +13,14 @@ use imu_core::kinematics::analytic::{Motion, Scalar};
 
 use crate::error::{Result, invalid};
 
-/// A piecewise cubic in time: on `[t_i, t_{i+1}]`, `c0 + c1 s + c2 s² + c3 s³` with `s = t − t_i`.
+/// A piecewise polynomial in time (degree ≤ 5): on `[t_i, t_{i+1}]`, `Σ c_j s^j` with `s = t − t_i`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PiecewiseCubic {
+pub struct PiecewisePolynomial {
     knots: Vec<f64>,
-    coeffs: Vec<[f64; 4]>,
+    coeffs: Vec<[f64; 6]>,
 }
 
-impl PiecewiseCubic {
+impl PiecewisePolynomial {
     /// A cubic spline through `(t_i, y_i)`: natural, or clamped with `(start, end)` slopes.
     #[must_use]
     pub fn spline(t: &[f64], y: &[f64], clamped: Option<(f64, f64)>) -> Self {
@@ -65,6 +66,8 @@ impl PiecewiseCubic {
                     (y[i + 1] - y[i]) / hi - hi * (2.0 * m[i] + m[i + 1]) / 6.0,
                     m[i] / 2.0,
                     (m[i + 1] - m[i]) / (6.0 * hi),
+                    0.0,
+                    0.0,
                 ]
             })
             .collect();
@@ -74,18 +77,33 @@ impl PiecewiseCubic {
         }
     }
 
-    /// A cubic Hermite curve through `(t_i, y_i)` with slopes `v_i`.
+    /// A quintic Hermite curve through `(t_i, y_i)` with slopes `v_i`; the second derivatives at
+    /// the knots are the slopes of a natural cubic spline through `(t_i, v_i)`, so the curve is C².
     #[must_use]
-    pub fn hermite(t: &[f64], y: &[f64], v: &[f64]) -> Self {
+    pub fn quintic_hermite(t: &[f64], y: &[f64], v: &[f64]) -> Self {
+        let vs = Self::spline(t, v, None);
+        let acc: Vec<f64> = (0..t.len())
+            .map(|i| {
+                let seg = i.min(t.len() - 2);
+                let c = vs.coeffs[seg];
+                let s = t[i] - t[seg];
+                c[1] + 2.0 * c[2] * s + 3.0 * c[3] * s * s
+            })
+            .collect();
         let coeffs = (0..t.len() - 1)
             .map(|i| {
                 let h = t[i + 1] - t[i];
-                let dy = y[i + 1] - y[i];
+                let (p0, p1, v0, v1, a0, a1) = (y[i], y[i + 1], v[i], v[i + 1], acc[i], acc[i + 1]);
+                let (h2, h3) = (h * h, h * h * h);
                 [
-                    y[i],
-                    v[i],
-                    (3.0 * dy / h - 2.0 * v[i] - v[i + 1]) / h,
-                    (v[i] + v[i + 1] - 2.0 * dy / h) / (h * h),
+                    p0,
+                    v0,
+                    a0 / 2.0,
+                    (20.0 * (p1 - p0) - (8.0 * v1 + 12.0 * v0) * h - (3.0 * a0 - a1) * h2)
+                        / (2.0 * h3),
+                    (30.0 * (p0 - p1) + (14.0 * v1 + 16.0 * v0) * h + (3.0 * a0 - 2.0 * a1) * h2)
+                        / (2.0 * h3 * h),
+                    (12.0 * (p1 - p0) - 6.0 * (v1 + v0) * h + (a1 - a0) * h2) / (2.0 * h3 * h2),
                 ]
             })
             .collect();
@@ -109,8 +127,8 @@ impl PiecewiseCubic {
         };
         let i = self.knots.partition_point(|&k| k <= tr).clamp(1, n - 1) - 1;
         let s = t - self.knots[i];
-        let [c0, c1, c2, c3] = self.coeffs[i];
-        ((s * c3 + c2) * s + c1) * s + c0
+        let [c0, c1, c2, c3, c4, c5] = self.coeffs[i];
+        ((((s * c5 + c4) * s + c3) * s + c2) * s + c1) * s + c0
     }
 }
 
@@ -120,13 +138,13 @@ pub enum WaypointAttitude {
     /// Along the velocity.
     Tangent,
     /// Splines of yaw, pitch, roll.
-    Euler(Box<[PiecewiseCubic; 3]>),
+    Euler(Box<[PiecewisePolynomial; 3]>),
 }
 
 /// A waypoint trajectory; implements [`Motion`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Waypoints {
-    position: [PiecewiseCubic; 3],
+    position: [PiecewisePolynomial; 3],
     attitude: WaypointAttitude,
     /// Time of the last waypoint, s.
     pub end_s: f64,
@@ -176,14 +194,14 @@ impl Waypoints {
         finite("position_m", position_m)?;
         let col = |rows: &[[f64; 3]], k: usize| rows.iter().map(|r| r[k]).collect::<Vec<f64>>();
         let position = match velocity_m_s {
-            None => {
-                std::array::from_fn(|k| PiecewiseCubic::spline(time_s, &col(position_m, k), None))
-            }
+            None => std::array::from_fn(|k| {
+                PiecewisePolynomial::spline(time_s, &col(position_m, k), None)
+            }),
             Some(v) => {
                 finite("velocity_m_s", v)?;
                 if v.len() == 2 {
                     std::array::from_fn(|k| {
-                        PiecewiseCubic::spline(
+                        PiecewisePolynomial::spline(
                             time_s,
                             &col(position_m, k),
                             Some((v[0][k], v[1][k])),
@@ -191,7 +209,11 @@ impl Waypoints {
                     })
                 } else if v.len() == n {
                     std::array::from_fn(|k| {
-                        PiecewiseCubic::hermite(time_s, &col(position_m, k), &col(v, k))
+                        PiecewisePolynomial::quintic_hermite(
+                            time_s,
+                            &col(position_m, k),
+                            &col(v, k),
+                        )
                     })
                 } else {
                     return Err(invalid(
@@ -229,7 +251,7 @@ impl Waypoints {
                     }
                 }
                 WaypointAttitude::Euler(Box::new(std::array::from_fn(|k| {
-                    PiecewiseCubic::spline(time_s, &col(&unwrapped, k), None)
+                    PiecewisePolynomial::spline(time_s, &col(&unwrapped, k), None)
                 })))
             }
         };

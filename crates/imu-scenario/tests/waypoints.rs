@@ -75,8 +75,17 @@ fn given_velocities_are_met_clamped_and_hermite() {
     assert!((ends[1].velocity_m_s - imu_core::Vec3::new(-1.0, 0.5, 0.0)).norm() < 1e-12);
     let v: Vec<[f64; 3]> = (0..5).map(|i| [i as f64, 1.0 - i as f64, 0.2]).collect();
     let hermite = Waypoints::new(&T, &P, Some(&v), None).unwrap();
-    for (s, vi) in truth(&hermite, &T).iter().zip(&v) {
+    for ((s, vi), p) in truth(&hermite, &T).iter().zip(&v).zip(P) {
         assert!((s.velocity_m_s - imu_core::Vec3::from_array(*vi)).norm() < 1e-12);
+        assert!((s.position_m - imu_core::Vec3::from_array(p)).norm() < 1e-12);
+    }
+    // Still C²: position, velocity and acceleration continuous across interior knots.
+    for &k in &T[1..4] {
+        let pair = truth(&hermite, &[k - 1e-9, k + 1e-9]);
+        assert!(
+            (pair[0].acceleration_m_s2 - pair[1].acceleration_m_s2).norm() < 1e-6,
+            "knot {k}"
+        );
     }
 }
 

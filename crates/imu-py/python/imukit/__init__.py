@@ -641,8 +641,9 @@ def truth_from_body_rates(
 def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_rad=None, nav_frame: str = "ENU") -> Table:
     """Exact truth at ``t_s`` of a waypoint trajectory (like MATLAB's waypointTrajectory): a natural
     cubic spline through ``position_m`` (N, 3) at ``time_s`` (N,), clamped to ``velocity_m_s`` when it
-    has 2 rows (start, end) or a Hermite curve when it has one row per waypoint; the attitude is
-    tangent, or a spline through ``euler_rad`` (N, 3) ``[yaw, pitch, roll]``."""
+    has 2 rows (start, end) or through all of them when it has one row per waypoint; the attitude is
+    tangent, or a spline through ``euler_rad`` (N, 3) ``[yaw, pitch, roll]``. With one velocity row per
+    waypoint each interval is a quintic Hermite polynomial, so the path stays C²."""
     knots = _times(time_s)
     n = knots.shape[0]
     return _table(_core.truth_from_waypoints(
