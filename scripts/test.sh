@@ -46,4 +46,6 @@ done
 python examples/seed_error_study.py
 python examples/matlab_imusensor.py
 python examples/allan_study.py
+python examples/navigation_round_trip.py
+target/release/imukit exercise --out-dir "$out/exercise"
 echo "== All tests passed"
