@@ -33,6 +33,21 @@ pub const NAV_COLUMNS: [&str; 14] = [
     "roll_rad",
 ];
 
+/// Columns [`compare`] reads from truth and estimate.
+pub const STATE_COLUMNS: [&str; 11] = [
+    "t_s",
+    "pos_x_m",
+    "pos_y_m",
+    "pos_z_m",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "vel_z_m_s",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+];
+
 /// Error columns of [`compare`].
 pub const ERROR_COLUMNS: [&str; 9] = [
     "t_s",
@@ -317,18 +332,7 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
         t.column(c)
             .ok_or_else(|| invalid(what, format!("missing column {c}")))
     };
-    let names = [
-        "pos_x_m",
-        "pos_y_m",
-        "pos_z_m",
-        "vel_x_m_s",
-        "vel_y_m_s",
-        "vel_z_m_s",
-        "q_w",
-        "q_x",
-        "q_y",
-        "q_z",
-    ];
+    let names = &STATE_COLUMNS[1..];
     let tt = col(truth, "truth", "t_s")?;
     let te = col(estimate, "estimate", "t_s")?;
     let tv: Vec<Vec<f64>> = names

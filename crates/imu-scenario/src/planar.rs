@@ -3,14 +3,12 @@
 //! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
 //! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
 
 use crate::error::{Error, Result, invalid};
-use crate::table::{Table, read_columns};
+use crate::table::{Table, read_columns, write_atomically, write_rows};
 
 /// Planar IMU columns of a CSV file.
 pub const PLANAR_COLUMNS: [&str; 4] = ["t_s", "accel_x_m_s2", "accel_y_m_s2", "gyro_z_rad_s"];
@@ -142,39 +140,11 @@ pub fn samples_from_table(t: &Table) -> Result<Vec<PlanarSample>> {
 /// # Errors
 /// [`Error::Io`].
 pub fn write_dat(path: &Path, samples: &[PlanarSample]) -> Result<()> {
-    let mut name = path
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
-    name.push(".imukit-partial");
-    let tmp = path.with_file_name(name);
-    let result = (|| -> std::io::Result<()> {
-        let mut w = BufWriter::new(File::create(&tmp)?);
-        let mut b = ryu::Buffer::new();
-        for s in samples {
-            for (k, v) in [s.t_s, s.accel_x_m_s2, s.accel_y_m_s2, s.gyro_z_rad_s]
-                .iter()
-                .enumerate()
-            {
-                if k > 0 {
-                    w.write_all(b" ")?;
-                }
-                w.write_all(b.format(*v).as_bytes())?;
-            }
-            w.write_all(b"\n")?;
-        }
-        w.into_inner()
-            .map_err(std::io::IntoInnerError::into_error)?
-            .sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(|source| Error::Io {
-        path: path.into(),
-        source,
-    })
+    let data: Vec<f64> = samples
+        .iter()
+        .flat_map(|s| [s.t_s, s.accel_x_m_s2, s.accel_y_m_s2, s.gyro_z_rad_s])
+        .collect();
+    write_atomically(path, |w| write_rows(w, &data, 4, b" "))
 }
 
 /// Dead reckoning of planar samples into a navigation table ([`PLANAR_NAV_COLUMNS`]).

@@ -214,34 +214,62 @@ impl Table {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
-        let io = |source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let tmp = temporary_path(path);
-        let result = (|| -> std::io::Result<()> {
-            let mut w = BufWriter::new(File::create(&tmp)?);
+        write_atomically(path, |w| {
             writeln!(w, "{}", self.columns.join(","))?;
-            let mut buf = ryu::Buffer::new();
-            for row in self.data.chunks(self.columns.len().max(1)) {
-                for (k, v) in row.iter().enumerate() {
-                    if k > 0 {
-                        w.write_all(b",")?;
-                    }
-                    w.write_all(buf.format(*v).as_bytes())?;
-                }
-                w.write_all(b"\n")?;
-            }
-            w.into_inner()
-                .map_err(std::io::IntoInnerError::into_error)?
-                .sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result.map_err(io)
+            write_rows(w, &self.data, self.columns.len().max(1), b",")
+        })
     }
+}
+
+/// Writes a file through `fill` into a temporary name beside it, renamed into place only when
+/// complete (no half-written file left looking complete); the temporary file is removed on error.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn write_atomically(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let tmp = temporary_path(path);
+    let result = (|| -> std::io::Result<()> {
+        let mut w = BufWriter::new(File::create(&tmp)?);
+        fill(&mut w)?;
+        w.into_inner()
+            .map_err(std::io::IntoInnerError::into_error)?
+            .sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Writes row-major `data` in rows of `width`, values in shortest round-trip form separated by
+/// `separator`.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_rows(
+    w: &mut impl Write,
+    data: &[f64],
+    width: usize,
+    separator: &[u8],
+) -> std::io::Result<()> {
+    let mut buf = ryu::Buffer::new();
+    for row in data.chunks(width) {
+        for (k, v) in row.iter().enumerate() {
+            if k > 0 {
+                w.write_all(separator)?;
+            }
+            w.write_all(buf.format(*v).as_bytes())?;
+        }
+        w.write_all(b"\n")?;
+    }
+    Ok(())
 }
 
 /// One truth sample in [`TRUTH_COLUMNS`] order.

@@ -2,25 +2,13 @@
 use std::path::Path;
 
 use imu_scenario::Table;
-use imu_scenario::navigation::compare;
+use imu_scenario::navigation::{STATE_COLUMNS, compare};
 use imu_scenario::table::read_columns;
 
 use super::CliError;
 
 fn read(path: &Path) -> Result<Table, CliError> {
-    let wanted = [
-        "t_s",
-        "pos_x_m",
-        "pos_y_m",
-        "pos_z_m",
-        "vel_x_m_s",
-        "vel_y_m_s",
-        "vel_z_m_s",
-        "q_w",
-        "q_x",
-        "q_y",
-        "q_z",
-    ];
+    let wanted = STATE_COLUMNS;
     let cols = read_columns(
         path,
         &wanted,

@@ -9,7 +9,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::frame::NavFrame;
 use crate::rotation::Rotation;
-use crate::strapdown::step::{NavState, StrapdownError};
+use crate::strapdown::step::{NavState, StrapdownError, check_lengths};
 use crate::vector::Vec3;
 
 type State = (Quaternion<f64>, Vector3<f64>, Vector3<f64>);
@@ -55,19 +55,14 @@ pub fn strapdown_rates_rk4<N: NavFrame>(
     out: &mut [NavState<N>],
 ) -> Result<(), StrapdownError> {
     let n = t_s.len();
-    for (field, got) in [
-        ("gyro_rad_s", gyro_rad_s.len()),
-        ("accel_m_s2", accel_m_s2.len()),
-        ("output", out.len()),
-    ] {
-        if got != n {
-            return Err(StrapdownError::LengthMismatch {
-                field,
-                expected: n,
-                got,
-            });
-        }
-    }
+    check_lengths(
+        n,
+        &[
+            ("gyro_rad_s", gyro_rad_s.len()),
+            ("accel_m_s2", accel_m_s2.len()),
+            ("output", out.len()),
+        ],
+    )?;
     if n < NODES {
         return Err(StrapdownError::LengthMismatch {
             field: "samples (RK4 needs at least 6)",

@@ -110,6 +110,21 @@ impl core::fmt::Display for StrapdownError {
 
 impl core::error::Error for StrapdownError {}
 
+/// Checks that every `(field, length)` equals `n`.
+pub(crate) fn check_lengths(
+    n: usize,
+    lengths: &[(&'static str, usize)],
+) -> Result<(), StrapdownError> {
+    match lengths.iter().find(|(_, got)| *got != n) {
+        Some(&(field, got)) => Err(StrapdownError::LengthMismatch {
+            field,
+            expected: n,
+            got,
+        }),
+        None => Ok(()),
+    }
+}
+
 fn finite3(v: &[f64; 3]) -> bool {
     v.iter().all(|c| c.is_finite())
 }
@@ -259,19 +274,14 @@ pub fn strapdown_rates<N: NavFrame>(
     out: &mut [NavState<N>],
 ) -> Result<(), StrapdownError> {
     let n = t_s.len();
-    for (field, got) in [
-        ("gyro_rad_s", gyro_rad_s.len()),
-        ("accel_m_s2", accel_m_s2.len()),
-        ("output", out.len()),
-    ] {
-        if got != n {
-            return Err(StrapdownError::LengthMismatch {
-                field,
-                expected: n,
-                got,
-            });
-        }
-    }
+    check_lengths(
+        n,
+        &[
+            ("gyro_rad_s", gyro_rad_s.len()),
+            ("accel_m_s2", accel_m_s2.len()),
+            ("output", out.len()),
+        ],
+    )?;
     let mut nav = RateStrapdown::new(initial, options);
     for i in 0..n {
         out[i] = nav.step(t_s[i], gyro_rad_s[i], accel_m_s2[i])?;
@@ -293,19 +303,14 @@ pub fn strapdown_increments<N: NavFrame>(
     out: &mut [NavState<N>],
 ) -> Result<(), StrapdownError> {
     let n = t_s.len();
-    for (field, got) in [
-        ("dtheta_rad", dtheta_rad.len()),
-        ("dv_m_s", dv_m_s.len()),
-        ("output", out.len()),
-    ] {
-        if got != n {
-            return Err(StrapdownError::LengthMismatch {
-                field,
-                expected: n,
-                got,
-            });
-        }
-    }
+    check_lengths(
+        n,
+        &[
+            ("dtheta_rad", dtheta_rad.len()),
+            ("dv_m_s", dv_m_s.len()),
+            ("output", out.len()),
+        ],
+    )?;
     if n == 0 {
         return Ok(());
     }
