@@ -122,7 +122,7 @@ pub enum Command {
         /// Where to write `tau_s, adev_<column>…` (CSV).
         #[arg(long)]
         out: PathBuf,
-        /// Also draw the curves with the fitted lines into this SVG file.
+        /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).
         #[arg(long)]
         plot: Option<PathBuf>,
     },
@@ -140,5 +140,38 @@ pub enum Command {
     Scenario {
         /// Name of a built-in scenario.
         name: Option<String>,
+    },
+    /// Default figures of imukit CSV files (truth, IMU readings, navigation output, Allan
+    /// table, errors; the kind is recognised from the columns). Several files of one kind are
+    /// overlaid, the second and later dashed (truth vs estimate).
+    Plot {
+        /// The CSV files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The figure file (`.svg` or `.png`).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Animates the body moving along its path from a truth CSV: a box turned by the attitude,
+    /// the reference point and the IMU point at the lever arm marked, the trail drawn.
+    Animate {
+        /// Truth CSV (`t_s, pos_*_m, q_*`, as `imukit simulate --truth` writes).
+        truth: PathBuf,
+        /// The animation file: `.gif`, or `.html` (a self-contained page, no network needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// Box length, width and height along body x, y, z, m (default: a tenth of the path's
+        /// extent long).
+        #[arg(long, num_args = 3, value_names = ["L", "W", "H"])]
+        body: Option<Vec<f64>>,
+        /// Lever arm of the IMU point from the reference point, body frame, m.
+        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true)]
+        lever_arm: Option<Vec<f64>>,
+        /// Frames per second.
+        #[arg(long, default_value_t = 20.0)]
+        fps: f64,
+        /// Seconds of motion per second of animation (default: the animation lasts 4 to 12 s).
+        #[arg(long)]
+        speed: Option<f64>,
     },
 }

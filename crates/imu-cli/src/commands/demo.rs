@@ -5,6 +5,8 @@ use std::path::Path;
 use imu_scenario::{Simulation, builtin};
 
 use super::CliError;
+use crate::plot::animate::{AnimateOptions, animate};
+use crate::plot::plot_files;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let io = |source| CliError::Io {
@@ -25,6 +27,19 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     })?;
     sim.truth.write_csv(&out_dir.join("truth.csv"))?;
     sim.imu.write_csv(&out_dir.join("imu.csv"))?;
+    plot_files(&[out_dir.join("truth.csv")], &out_dir.join("truth.png"))?;
+    plot_files(&[out_dir.join("imu.csv")], &out_dir.join("imu.png"))?;
+    let lever_arm_m = spec.imu.lever_arm_m.unwrap_or([0.0; 3]);
+    let opts = AnimateOptions {
+        lever_arm_m,
+        ..AnimateOptions::default()
+    };
+    animate(
+        &sim.truth,
+        "truth.csv",
+        &out_dir.join("animation.html"),
+        &opts,
+    )?;
     let summary = summary(name, &sim);
     let summary_path = out_dir.join("summary.txt");
     std::fs::write(&summary_path, &summary).map_err(|source| CliError::Io {
@@ -33,7 +48,8 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     })?;
     print!("{summary}");
     println!(
-        "\nWrote scenario.toml, truth.csv, imu.csv and summary.txt to {}",
+        "\nWrote scenario.toml, truth.csv, imu.csv, summary.txt, the figures truth.png and imu.png \
+         and the animation animation.html (open it in a browser) to {}",
         out_dir.display()
     );
     Ok(())

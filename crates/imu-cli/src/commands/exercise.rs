@@ -7,7 +7,7 @@ use imu_scenario::planar::{integrate, samples_from_table, write_dat};
 use imu_scenario::{Table, builtin};
 
 use super::CliError;
-use crate::plot::{Trace, trajectories_svg};
+use crate::plot::{Trace, trajectories_figure};
 
 /// Sensor errors of the exercise's second file: the ICM-42688-P preset's noise plus modest
 /// turn-on biases, so the erroneous trajectory drifts visibly but stays on the page.
@@ -82,7 +82,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
         "\nThe exercise's rotation R = [[cos α, sin α], [−sin α, cos α]] turns increments by −α: with the\n\
          left-turning rail it mirrors the trajectory about the start heading (see imukit's docs)."
     );
-    trajectories_svg(
+    trajectories_figure(
         &out_dir.join("trajectories.svg"),
         "Seed 001 exercise: dead reckoning of the cart",
         &traces,

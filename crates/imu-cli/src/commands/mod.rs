@@ -4,6 +4,7 @@ mod compare;
 mod demo;
 mod exercise;
 mod integrate;
+mod plot;
 mod presets;
 mod scenario;
 mod simulate;
@@ -113,5 +114,21 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             plot,
         } => allan::run(&input, &columns, &out, plot.as_deref()),
+        Command::Plot { files, out } => plot::plot(&files, &out),
+        Command::Animate {
+            truth,
+            out,
+            body,
+            lever_arm,
+            fps,
+            speed,
+        } => plot::animate(
+            &truth,
+            &out,
+            body.as_deref(),
+            lever_arm.as_deref(),
+            fps,
+            speed,
+        ),
     }
 }

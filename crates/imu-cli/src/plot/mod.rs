@@ -1,0 +1,116 @@
+//! Figures written by the CLI. plotters draws every figure as SVG; a `.png` path gets the SVG
+//! rasterised by resvg with the embedded DejaVu Sans, so PNGs look the same on every machine. Files are written to a
+//! temporary name and renamed when complete.
+mod allan;
+pub mod animate;
+mod figures;
+mod panels;
+
+use std::path::Path;
+
+pub use allan::allan_figure;
+pub use figures::{plot_files, read_table};
+pub use panels::{Trace, trajectories_figure};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::commands::CliError;
+
+/// The series colours (matplotlib's tab10 order).
+pub const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// The stride that leaves at most `max` of `len` points.
+#[must_use]
+pub fn stride_for(len: usize, max: usize) -> usize {
+    len.div_ceil(max.max(1)).max(1)
+}
+
+/// Every `stride`-th item and the last.
+#[must_use]
+pub fn every<T: Copy>(v: &[T], stride: usize) -> Vec<T> {
+    let mut out: Vec<T> = v.iter().copied().step_by(stride.max(1)).collect();
+    if v.len() > 1 && !(v.len() - 1).is_multiple_of(stride.max(1)) {
+        out.extend(v.last().copied());
+    }
+    out
+}
+
+/// A drawing error as text.
+pub fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// Draws a `width × height` figure with `draw` and writes it to `path` as SVG or PNG (by
+/// extension).
+pub fn write_figure(
+    path: &Path,
+    width: u32,
+    height: u32,
+    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<(), CliError> {
+    let fail = |message: String| CliError::Plot {
+        path: path.display().to_string(),
+        message,
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(err(e)))?;
+        draw(&root).map_err(fail)?;
+        root.present().map_err(|e| fail(err(e)))?;
+    }
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let bytes = match ext.as_deref() {
+        Some("svg") => svg.into_bytes(),
+        Some("png") => rasterise(&svg, width, height)
+            .map_err(fail)?
+            .encode_png()
+            .map_err(|e| fail(err(e)))?,
+        _ => return Err(fail("the figure file must end in .svg or .png".into())),
+    };
+    imu_scenario::table::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))?;
+    Ok(())
+}
+
+/// The fonts of every PNG: DejaVu Sans as the sans-serif family, loaded once.
+fn fonts() -> std::sync::Arc<resvg::usvg::fontdb::Database> {
+    static FONTS: std::sync::OnceLock<std::sync::Arc<resvg::usvg::fontdb::Database>> =
+        std::sync::OnceLock::new();
+    FONTS
+        .get_or_init(|| {
+            let mut db = resvg::usvg::fontdb::Database::new();
+            db.load_font_data(dejavu::sans::regular().to_vec());
+            db.set_sans_serif_family("DejaVu Sans");
+            std::sync::Arc::new(db)
+        })
+        .clone()
+}
+
+/// Rasterises SVG text into a pixmap.
+pub fn rasterise(svg: &str, width: u32, height: u32) -> Result<resvg::tiny_skia::Pixmap, String> {
+    let options = resvg::usvg::Options {
+        fontdb: fonts(),
+        ..resvg::usvg::Options::default()
+    };
+    let tree = resvg::usvg::Tree::from_str(svg, &options).map_err(err)?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(width, height).ok_or("empty figure size")?;
+    pixmap.fill(resvg::tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::default(),
+        &mut pixmap.as_mut(),
+    );
+    Ok(pixmap)
+}

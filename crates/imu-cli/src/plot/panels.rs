@@ -1,0 +1,296 @@
+//! Panels: time series, trajectories in the plane (equal scales) and in 3D, start ● and end ✕.
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{COLORS, err, every, stride_for, write_figure};
+use crate::commands::CliError;
+
+/// One line of a time-series panel.
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// Points (x, y).
+    pub points: Vec<(f64, f64)>,
+    /// Colour index.
+    pub color: usize,
+    /// Dashed (overlays of a second file).
+    pub dashed: bool,
+}
+
+/// A time-series panel.
+pub struct Panel {
+    /// Title.
+    pub title: String,
+    /// x-axis label with unit.
+    pub x_label: String,
+    /// y-axis label with unit.
+    pub y_label: String,
+    /// The lines.
+    pub series: Vec<Series>,
+}
+
+/// At most this many points of a line are drawn (every k-th point and the last): more cannot be
+/// seen at these sizes and make the files large.
+const MAX_POINTS: usize = 1500;
+
+/// Every k-th item and the last, so at most `MAX_POINTS` remain.
+fn thin<T: Copy>(v: Vec<T>) -> Vec<T> {
+    every(&v, stride_for(v.len(), MAX_POINTS))
+}
+
+fn finite(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect()
+}
+
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        0.5 * lo.abs().max(1e-9)
+    };
+    (lo - pad, hi + pad)
+}
+
+/// Draws a time-series panel into `area`.
+pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> Result<(), String> {
+    let all: Vec<(f64, f64)> = panel
+        .series
+        .iter()
+        .flat_map(|s| finite(&s.points))
+        .collect();
+    let (x0, x1) = range(all.iter().map(|p| p.0));
+    let (y0, y1) = range(all.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, ("sans-serif", 16))
+        .margin(8)
+        .x_label_area_size(32)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style(("sans-serif", 11))
+        .draw()
+        .map_err(err)?;
+    for s in &panel.series {
+        let color = COLORS[s.color % COLORS.len()];
+        let pts = thin(finite(&s.points));
+        let drawn = if s.dashed {
+            chart.draw_series(DashedLineSeries::new(pts, 5, 4, color.stroke_width(2)))
+        } else {
+            chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+        };
+        drawn
+            .map_err(err)?
+            .label(s.label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)
+}
+
+/// One trajectory: a name and its points (x, y, z).
+pub struct Trace {
+    /// Legend text.
+    pub name: String,
+    /// Points, m.
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+impl Trace {
+    /// The `pos_x_m`, `pos_y_m` (and `pos_z_m` if present) columns of a table.
+    #[must_use]
+    pub fn from_table(name: &str, t: &imu_scenario::Table) -> Self {
+        let (x, y) = (
+            t.column("pos_x_m").unwrap_or_default(),
+            t.column("pos_y_m").unwrap_or_default(),
+        );
+        let z = t.column("pos_z_m").unwrap_or_else(|| vec![0.0; x.len()]);
+        Self {
+            name: name.to_string(),
+            points: (0..x.len()).map(|i| (x[i], y[i], z[i])).collect(),
+        }
+    }
+}
+
+/// Draws trajectories seen from above (X east/north…, equal scales), start ● and end ✕.
+pub fn draw_plan_view(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    title: &str,
+    traces: &[Trace],
+) -> Result<(), String> {
+    let pts = |t: &Trace| -> Vec<(f64, f64)> {
+        thin(finite(
+            &t.points.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+        ))
+    };
+    let all: Vec<(f64, f64)> = traces.iter().flat_map(pts).collect();
+    let (x0, x1) = range(all.iter().map(|p| p.0));
+    let (y0, y1) = range(all.iter().map(|p| p.1));
+    let (w, h) = area.dim_in_pixel();
+    let aspect = f64::from(w.max(1)) / f64::from(h.max(1));
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let half_y = (0.5 * (y1 - y0)).max(0.5 * (x1 - x0) / aspect).max(1e-9);
+    let half_x = half_y * aspect;
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(8)
+        .x_label_area_size(32)
+        .y_label_area_size(56)
+        .build_cartesian_2d(cx - half_x..cx + half_x, cy - half_y..cy + half_y)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .label_style(("sans-serif", 11))
+        .draw()
+        .map_err(err)?;
+    for (k, t) in traces.iter().enumerate() {
+        let color = COLORS[k % COLORS.len()];
+        let p = pts(t);
+        chart
+            .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(t.name.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        if let (Some(first), Some(last)) = (p.first(), p.last()) {
+            chart
+                .draw_series([Circle::new(*first, 6, color.filled())])
+                .map_err(err)?;
+            chart
+                .draw_series([Cross::new(*last, 7, color.stroke_width(3))])
+                .map_err(err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    area.draw(&Text::new("● start   ✕ end", (8, 6), ("sans-serif", 12)))
+        .map_err(err)
+}
+
+/// Draws trajectories in 3D (isometric view), start ● and end ✕.
+pub fn draw_3d(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    title: &str,
+    traces: &[Trace],
+) -> Result<(), String> {
+    let all: Vec<(f64, f64, f64)> = traces
+        .iter()
+        .flat_map(|t| t.points.iter().copied())
+        .filter(|p| p.0.is_finite() && p.1.is_finite() && p.2.is_finite())
+        .collect();
+    let (x0, x1) = range(all.iter().map(|p| p.0));
+    let (y0, y1) = range(all.iter().map(|p| p.1));
+    let (z0, z1) = range(all.iter().map(|p| p.2));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(8)
+        .build_cartesian_3d(x0..x1, z0..z1, y0..y1)
+        .map_err(err)?;
+    chart.with_projection(|mut p| {
+        p.pitch = 0.5;
+        p.yaw = 0.6;
+        p.scale = 0.8;
+        p.into_matrix()
+    });
+    chart
+        .configure_axes()
+        .label_style(("sans-serif", 10))
+        .draw()
+        .map_err(err)?;
+    for (k, t) in traces.iter().enumerate() {
+        let color = COLORS[k % COLORS.len()];
+        let p: Vec<(f64, f64, f64)> = thin(
+            t.points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite() && p.2.is_finite())
+                .map(|p| (p.0, p.2, p.1))
+                .collect(),
+        );
+        chart
+            .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(t.name.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        if let (Some(first), Some(last)) = (p.first(), p.last()) {
+            chart
+                .draw_series([Circle::new(*first, 6, color.filled())])
+                .map_err(err)?;
+            chart
+                .draw_series([Cross::new(*last, 7, color.stroke_width(3))])
+                .map_err(err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    area.draw(&Text::new(
+        "● start   ✕ end   (z up the page)",
+        (8, 6),
+        ("sans-serif", 12),
+    ))
+    .map_err(err)
+}
+
+/// True when the traces leave the plane noticeably (z range above 1 % of the horizontal range).
+#[must_use]
+pub fn is_3d(traces: &[Trace]) -> bool {
+    let all: Vec<(f64, f64, f64)> = traces
+        .iter()
+        .flat_map(|t| t.points.iter().copied())
+        .collect();
+    let span = |f: fn(&(f64, f64, f64)) -> f64| {
+        let (lo, hi) = all
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+        if lo.is_finite() { hi - lo } else { 0.0 }
+    };
+    let horizontal = span(|p| p.0).max(span(|p| p.1));
+    span(|p| p.2) > 0.01 * horizontal.max(1e-12)
+}
+
+/// A figure of trajectories in the plane, start and end marked (the exercise's figure).
+pub fn trajectories_figure(path: &Path, title: &str, traces: &[Trace]) -> Result<(), CliError> {
+    write_figure(path, 900, 640, |root| draw_plan_view(root, title, traces))
+}
