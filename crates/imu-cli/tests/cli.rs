@@ -28,7 +28,15 @@ fn demo_writes_its_outputs_and_says_where() {
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(stdout.contains(&dir.display().to_string()), "{stdout}");
-    for f in ["scenario.toml", "truth.csv", "imu.csv", "summary.txt"] {
+    for f in [
+        "scenario.toml",
+        "truth.csv",
+        "imu.csv",
+        "summary.txt",
+        "truth.png",
+        "imu.png",
+        "animation.html",
+    ] {
         assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
     }
     let imu = std::fs::read_to_string(dir.join("imu.csv")).unwrap();

@@ -4,7 +4,7 @@ use std::path::Path;
 use imu_scenario::analysis::AllanResult;
 use plotters::prelude::*;
 
-use super::{COLORS, err, write_figure};
+use super::{COLORS, draw_legend, err, key, write_figure};
 use crate::commands::CliError;
 
 /// Draws `result` (one curve per column) into `path` (SVG or PNG).
@@ -64,9 +64,7 @@ pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), CliError> {
                 .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
                 .map_err(err)?
                 .label(name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+                .legend(key(color));
             chart
                 .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))
                 .map_err(err)?;
@@ -85,12 +83,6 @@ pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), CliError> {
                     .map_err(err)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(err)
+        draw_legend(&mut chart)
     })
 }

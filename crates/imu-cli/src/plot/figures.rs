@@ -26,6 +26,13 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// Whether files of the two kinds share a figure: one kind, or truth and navigation output
+    /// (truth vs estimate).
+    fn overlays(self, other: Self) -> bool {
+        let motion = |k: Self| matches!(k, Self::Truth | Self::Navigation);
+        self == other || (motion(self) && motion(other))
+    }
+
     fn name(self) -> &'static str {
         match self {
             Self::Truth => "truth",
@@ -150,11 +157,11 @@ pub fn plot_files(paths: &[PathBuf], out: &Path) -> Result<(), CliError> {
                 t.columns.join(", ")
             ),
         })?;
-        if kind.is_some_and(|prev| prev != k) {
+        if kind.is_some_and(|prev: Kind| !prev.overlays(k)) {
             return Err(Error::Invalid {
                 field: p.display().to_string(),
                 message: format!(
-                    "is {}, but the first file is {}: overlay files of one kind",
+                    "is {}, but the first file is {}: overlay files of one kind (or truth and navigation output)",
                     k.name(),
                     kind.map_or("", Kind::name)
                 ),

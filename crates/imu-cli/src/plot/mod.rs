@@ -11,7 +11,7 @@ use std::path::Path;
 pub use allan::allan_figure;
 pub use figures::{plot_files, read_table};
 pub use panels::{Trace, trajectories_figure};
-use plotters::coord::Shift;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
 use crate::commands::CliError;
@@ -42,6 +42,28 @@ pub fn every<T: Copy>(v: &[T], stride: usize) -> Vec<T> {
         out.extend(v.last().copied());
     }
     out
+}
+
+/// A series' legend key: a short line in its colour.
+pub fn key(color: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + LEGEND_KEY_PX, y)], color.stroke_width(2))
+}
+
+/// Length of a legend key, pixels.
+pub const LEGEND_KEY_PX: i32 = 18;
+
+/// Draws the legend of `chart`'s labelled series in its upper right corner.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)
 }
 
 /// A drawing error as text.

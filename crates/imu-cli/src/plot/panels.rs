@@ -4,7 +4,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{COLORS, err, every, stride_for, write_figure};
+use super::{COLORS, draw_legend, err, every, key, stride_for, write_figure};
 use crate::commands::CliError;
 
 /// One line of a time-series panel.
@@ -97,18 +97,9 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         drawn
             .map_err(err)?
             .label(s.label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            .legend(key(color));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 11))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)
+    draw_legend(&mut chart)
 }
 
 /// One trajectory: a name and its points (x, y, z).
@@ -175,9 +166,7 @@ pub fn draw_plan_view(
             .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
             .map_err(err)?
             .label(t.name.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            .legend(key(color));
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])
@@ -187,14 +176,7 @@ pub fn draw_plan_view(
                 .map_err(err)?;
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 11))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
+    draw_legend(&mut chart)?;
     area.draw(&Text::new("● start   ✕ end", (8, 6), ("sans-serif", 12)))
         .map_err(err)
 }
@@ -242,9 +224,7 @@ pub fn draw_3d(
             .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
             .map_err(err)?
             .label(t.name.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            .legend(key(color));
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])
@@ -254,14 +234,7 @@ pub fn draw_3d(
                 .map_err(err)?;
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 11))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
+    draw_legend(&mut chart)?;
     area.draw(&Text::new(
         "● start   ✕ end   (z up the page)",
         (8, 6),

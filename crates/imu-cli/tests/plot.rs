@@ -1,0 +1,263 @@
+//! `imukit plot` and `imukit animate` as a user runs them: every kind of CSV to SVG and PNG,
+//! overlays, the GIF and the HTML animation, and bad input. Images are checked for validity,
+//! size and the number of series drawn, not for pixels.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+fn imukit(args: &[&str], paths: &[&Path]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_imukit"));
+    c.args(args);
+    for p in paths {
+        c.arg(p);
+    }
+    c.output().unwrap()
+}
+
+fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A folder with the demo's truth and IMU readings, a 3D navigation of them, its errors, and an
+/// Allan table of a noisy static IMU; made once.
+fn data() -> &'static PathBuf {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!("imukit-plot-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        ok(&imukit(&["demo", "--out-dir"], &[&d]));
+        let (imu, truth, nav) = (d.join("imu.csv"), d.join("truth.csv"), d.join("nav.csv"));
+        ok(&imukit(&["integrate"], &[&imu, Path::new("--init"), &truth, Path::new("--out"), &nav]));
+        ok(&imukit(&["compare"], &[&truth, &nav, Path::new("--out"), &d.join("errors.csv")]));
+        let scenario = d.join("static.toml");
+        std::fs::write(
+            &scenario,
+            "rate_hz = 100.0\nduration_s = 200.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+             [imu]\npreset = \"mpu-6050\"\nseed = 7\n",
+        )
+        .unwrap();
+        let still = d.join("static_imu.csv");
+        ok(&imukit(&["simulate"], &[&scenario, Path::new("--out"), &still]));
+        ok(&imukit(&["allan"], &[&still, Path::new("--out"), &d.join("allan.csv")]));
+        d
+    })
+}
+
+/// Width and height from a PNG's IHDR chunk, after checking the signature.
+fn png_size(path: &Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+    assert_eq!(&b[12..16], b"IHDR");
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+/// The SVG's size and its number of series: legend keys, one per series, are the polylines of
+/// exactly two points 18 px apart horizontally.
+fn svg_series(path: &Path) -> ((u32, u32), usize) {
+    let s = std::fs::read_to_string(path).unwrap();
+    let attr = |name: &str| -> u32 {
+        let i = s.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+        s[i..].split('"').next().unwrap().parse().unwrap()
+    };
+    let series = s
+        .split("<polyline")
+        .skip(1)
+        .filter(|p| {
+            let i = p.find("points=\"").unwrap() + 8;
+            let pts: Vec<Vec<f64>> = p[i..]
+                .split('"')
+                .next()
+                .unwrap()
+                .split_whitespace()
+                .map(|xy| xy.split(',').map(|v| v.parse().unwrap()).collect())
+                .collect();
+            pts.len() == 2 && pts[1][0] - pts[0][0] == 18.0 && pts[1][1] == pts[0][1]
+        })
+        .count();
+    ((attr("width"), attr("height")), series)
+}
+
+/// Plots `files` into `name`.svg and `name`.png; returns the SVG's size and series count.
+fn plot(files: &[&str], name: &str) -> ((u32, u32), usize) {
+    let d = data();
+    let inputs: Vec<PathBuf> = files.iter().map(|f| d.join(f)).collect();
+    let mut svg = ((0, 0), 0);
+    for ext in ["svg", "png"] {
+        let out = d.join(format!("{name}.{ext}"));
+        let mut paths: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+        paths.extend([Path::new("--out"), &out]);
+        let o = imukit(&["plot"], &paths);
+        ok(&o);
+        assert!(String::from_utf8_lossy(&o.stdout).contains(&out.display().to_string()));
+        if ext == "svg" {
+            svg = svg_series(&out);
+        } else {
+            assert_eq!(png_size(&out), svg.0, "{name}: the PNG has the SVG's size");
+        }
+    }
+    svg
+}
+
+#[test]
+fn truth_has_the_trajectory_and_six_panels_of_three() {
+    // 7 cells (trajectory + position, velocity, acceleration, attitude, rate, angular
+    // acceleration) in 2 columns of 560 × 320 px.
+    assert_eq!(plot(&["truth.csv"], "truth"), ((1120, 1280), 1 + 6 * 3));
+}
+
+#[test]
+fn truth_and_navigation_overlay_every_series() {
+    // Navigation output has position, velocity and attitude: those panels get both files,
+    // acceleration, rate and angular acceleration only the truth's.
+    let ((w, h), n) = plot(&["truth.csv", "nav.csv"], "overlay");
+    assert_eq!((w, h), (1120, 1280));
+    assert_eq!(n, 2 + 3 * 3 * 2 + 3 * 3);
+}
+
+#[test]
+fn imu_readings_have_accelerometer_gyroscope_and_magnetometer() {
+    assert_eq!(plot(&["imu.csv"], "imu"), ((560, 960), 3 * 3));
+}
+
+#[test]
+fn errors_have_position_velocity_and_attitude_panels() {
+    assert_eq!(plot(&["errors.csv"], "errors"), ((560, 960), 4 + 3 + 1));
+}
+
+#[test]
+fn allan_table_has_one_curve_per_column() {
+    let table = std::fs::read_to_string(data().join("allan.csv")).unwrap();
+    let curves = table
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .filter(|c| c.starts_with("adev_"))
+        .count();
+    assert_eq!(curves, 6);
+    assert_eq!(plot(&["allan.csv"], "allan"), ((900, 600), curves));
+}
+
+#[test]
+fn gif_animation_has_one_frame_per_twentieth_of_a_second_of_animation() {
+    let d = data();
+    let out = d.join("anim.gif");
+    let o = imukit(
+        &["animate"],
+        &[
+            &d.join("truth.csv"),
+            Path::new("--out"),
+            &out,
+            Path::new("--speed"),
+            Path::new("0.5"),
+        ],
+    );
+    ok(&o);
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(&out).unwrap())
+        .unwrap();
+    assert_eq!((decoder.width(), decoder.height()), (560, 420));
+    let mut frames = 0;
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!(frame.delay, 5, "20 frames/s");
+        frames += 1;
+    }
+    // 1 s of motion at 0.5× real time and 20 frames/s: frames at 0, 1/40 s, …, 1 s.
+    assert_eq!(frames, 41);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("41 frames"));
+}
+
+#[test]
+fn html_animation_is_self_contained_with_every_frame() {
+    let d = data();
+    let out = d.join("anim.html");
+    let o = imukit(
+        &["animate"],
+        &[
+            &d.join("truth.csv"),
+            Path::new("--out"),
+            &out,
+            Path::new("--body"),
+            Path::new("0.2"),
+            Path::new("0.1"),
+            Path::new("0.05"),
+            Path::new("--fps"),
+            Path::new("10"),
+        ],
+    );
+    ok(&o);
+    let page = std::fs::read_to_string(&out).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>") && page.trim_end().ends_with("</html>"));
+    assert!(page.contains("<canvas") && page.contains("<script>"));
+    assert!(
+        !page.contains("http") && !page.contains(" src="),
+        "no network"
+    );
+    assert!(page.contains("const BODY = [0.2,0.1,0.05]"));
+    // 1 s of motion, 4 s of animation by default (0.25× real time), 10 frames/s: 41 frames.
+    let frames = page
+        .split("const FRAMES = [")
+        .nth(1)
+        .unwrap()
+        .split("];")
+        .next()
+        .unwrap();
+    assert_eq!(frames.matches('[').count(), 41);
+}
+
+#[test]
+fn bad_input_is_refused_with_what_and_where_and_no_file_written() {
+    let d = data();
+    let unknown = d.join("unknown.csv");
+    std::fs::write(&unknown, "a,b\n1,2\n").unwrap();
+    let empty = d.join("empty.csv");
+    std::fs::write(&empty, "").unwrap();
+    let out = d.join("refused.png");
+    let cases: [(&[&Path], &str); 5] = [
+        (&[&unknown], "unknown kind of CSV (columns: a, b)"),
+        (&[&empty], "empty file"),
+        (
+            &[&d.join("truth.csv"), &d.join("imu.csv")],
+            "overlay files of one kind",
+        ),
+        (&[&d.join("missing.csv")], "missing.csv"),
+        (
+            &[
+                &d.join("truth.csv"),
+                Path::new("--out"),
+                &d.join("figure.jpg"),
+            ],
+            ".svg or .png",
+        ),
+    ];
+    for (inputs, expected) in cases {
+        let mut paths = inputs.to_vec();
+        if !expected.contains(".svg") {
+            paths.extend([Path::new("--out"), &out]);
+        }
+        let o = imukit(&["plot"], &paths);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(expected), "{err}");
+        assert!(!out.exists());
+    }
+    let o = imukit(
+        &["animate"],
+        &[&d.join("imu.csv"), Path::new("--out"), &d.join("a.gif")],
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("imu.csv: no pos_x_m column"));
+    let o = imukit(
+        &["animate"],
+        &[&d.join("truth.csv"), Path::new("--out"), &d.join("a.mp4")],
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains(".gif or .html"));
+    assert!(!d.join("a.gif").exists() && !d.join("a.mp4").exists());
+}
