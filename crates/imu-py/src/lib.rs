@@ -10,6 +10,7 @@ use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, Temperatur
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{Body, Enu, EulerZyx, Rotation};
+use imu_scenario::figures::{self, TableKind};
 use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
     AccelSignName, BodyRatesData, ExpressionSpec, Formula, ImuSetup, NavFrameName,
@@ -962,6 +963,68 @@ fn builtin_toml(name: &str) -> PyResult<String> {
     imu_scenario::builtin::toml(name).map_err(refused)
 }
 
+/// Every column of an imukit CSV file.
+#[pyfunction]
+fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
+    let t = imu_scenario::table::read_table(Path::new(path)).map_err(refused)?;
+    table_out(py, t)
+}
+
+/// The kind key of a table with these columns (`truth`, `imu`, `navigation`, `allan`,
+/// `errors`), or `None`.
+#[pyfunction]
+fn table_kind(columns: Vec<String>) -> Option<&'static str> {
+    TableKind::detect(&columns).map(TableKind::key)
+}
+
+/// A panel for Python: `(title, y_label, scale, [(column, label)])`.
+type PanelOut = (String, String, f64, Vec<(String, String)>);
+
+/// The default panels of a kind.
+#[pyfunction]
+fn figure_panels(kind: &str) -> PyResult<Vec<PanelOut>> {
+    let kind = TableKind::from_key(kind).map_err(refused)?;
+    Ok(kind
+        .panels()
+        .into_iter()
+        .map(|p| {
+            (
+                p.title.to_string(),
+                p.y_label.to_string(),
+                p.scale,
+                p.columns,
+            )
+        })
+        .collect())
+}
+
+/// The samples each animation frame shows and the speed (seconds of motion per second).
+#[pyfunction]
+#[pyo3(signature = (t_s, fps, speed=None))]
+fn frame_plan(
+    t_s: PyReadonlyArray1<'_, f64>,
+    fps: f64,
+    speed: Option<f64>,
+) -> PyResult<(Vec<usize>, f64)> {
+    let t = t_s
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let plan = figures::frame_plan(t, fps, speed, "t_s").map_err(refused)?;
+    Ok((plan.indices, plan.speed))
+}
+
+/// The default body box (length, width, height) for a path of this extent, m.
+#[pyfunction]
+fn default_body_m(extent_m: f64) -> [f64; 3] {
+    figures::default_body_m(extent_m)
+}
+
+/// Whether a path (N, 3) is drawn in 3D.
+#[pyfunction]
+fn leaves_plane(points: PyReadonlyArray2<'_, f64>) -> PyResult<bool> {
+    Ok(figures::leaves_plane(&rows::<3>("points", &points)?))
+}
+
 /// The compiled core of the `imukit` package.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -994,5 +1057,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(truth_from_waypoints, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(table_kind, m)?)?;
+    m.add_function(wrap_pyfunction!(figure_panels, m)?)?;
+    m.add_function(wrap_pyfunction!(frame_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(default_body_m, m)?)?;
+    m.add_function(wrap_pyfunction!(leaves_plane, m)?)?;
     Ok(())
 }

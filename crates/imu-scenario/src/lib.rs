@@ -8,6 +8,7 @@ pub mod arrays;
 pub mod builtin;
 pub mod error;
 pub mod expr;
+pub mod figures;
 pub mod navigation;
 pub mod params;
 pub mod perturb;

@@ -400,6 +400,21 @@ fn csv_error(path: &Path, e: &csv::Error) -> Error {
     }
 }
 
+/// Reads every column of a CSV file with a header row.
+///
+/// # Errors
+/// As [`read_columns`]: values that are not finite numbers, malformed or empty files.
+pub fn read_table(path: &Path) -> Result<Table> {
+    let header = read_header(path)?;
+    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let cols = read_columns(path, &names, "")?;
+    let mut t = Table::new(&names);
+    for r in 0..cols.rows() {
+        t.push_row(&names.iter().map(|n| cols.get(n)[r]).collect::<Vec<_>>());
+    }
+    Ok(t)
+}
+
 /// Reads the named columns of a CSV file with a header row; other columns are ignored.
 ///
 /// # Errors

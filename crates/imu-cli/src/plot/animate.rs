@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use imu_core::{Body, Enu, Rotation, Vec3};
+use imu_scenario::figures::{FramePlan, default_body_m, frame_plan};
 use imu_scenario::{Error, Table};
 use plotters::prelude::*;
 
@@ -57,7 +58,7 @@ struct Pose {
     q: [f64; 4],
 }
 
-/// Reads the poses, checking times (finite, increasing), positions and quaternions per row.
+/// Reads the poses, checking positions and quaternions per row (times: [`frame_plan`]).
 fn poses(truth: &Table, source: &str) -> Result<Vec<Pose>, Error> {
     let bad = |at: String, message: String| Error::Invalid { field: at, message };
     let col = |c: &str| {
@@ -73,9 +74,6 @@ fn poses(truth: &Table, source: &str) -> Result<Vec<Pose>, Error> {
         col("pos_z_m")?,
     );
     let (qw, qx, qy, qz) = (col("q_w")?, col("q_x")?, col("q_y")?, col("q_z")?);
-    if t.len() < 2 {
-        return Err(bad(source.into(), "needs at least 2 rows".into()));
-    }
     let mut out = Vec::with_capacity(t.len());
     for i in 0..t.len() {
         let row = format!("{source}, row {}", i + 2);
@@ -87,28 +85,12 @@ fn poses(truth: &Table, source: &str) -> Result<Vec<Pose>, Error> {
                 "time, position and quaternion must be finite numbers".into(),
             ));
         }
-        if i > 0 && t[i] <= t[i - 1] {
-            let message = format!("t_s = {} does not increase (previous {})", t[i], t[i - 1]);
-            return Err(bad(row, message));
-        }
         let q = Rotation::<Body, Enu>::from_wxyz(q)
             .ok_or_else(|| bad(row.clone(), "the quaternion is zero".into()))?
             .to_wxyz();
         out.push(Pose { t: t[i], p, q });
     }
     Ok(out)
-}
-
-/// The pose shown in each frame: the last sample at or before the frame's time.
-fn frame_indices(poses: &[Pose], fps: f64, speed: f64) -> Vec<usize> {
-    let (t0, t1) = (poses[0].t, poses[poses.len() - 1].t);
-    let n = (((t1 - t0) / speed * fps).floor() as usize + 1).max(2);
-    (0..n)
-        .map(|k| {
-            let t = (t0 + k as f64 * speed / fps).min(t1);
-            poses.partition_point(|p| p.t <= t).saturating_sub(1)
-        })
-        .collect()
 }
 
 /// A body-frame point `c_b` carried by `pose` into the navigation frame.
@@ -168,11 +150,6 @@ impl Scene {
             message: message.into(),
         };
         let finite3 = |v: [f64; 3]| v.iter().all(|x| x.is_finite());
-        if !(opts.fps.is_finite() && opts.fps > 0.0)
-            || opts.speed.is_some_and(|s| !(s.is_finite() && s > 0.0))
-        {
-            return Err(bad("--fps/--speed", "must be positive"));
-        }
         if opts
             .body_m
             .is_some_and(|b| !(finite3(b) && b.iter().all(|v| *v > 0.0)))
@@ -183,6 +160,11 @@ impl Scene {
             return Err(bad("--lever-arm", "must be finite"));
         }
         let poses = poses(truth, source)?;
+        let times: Vec<f64> = poses.iter().map(|p| p.t).collect();
+        let FramePlan {
+            indices: frames,
+            speed,
+        } = frame_plan(&times, opts.fps, opts.speed, source)?;
         let raw: [(f64, f64); 3] = core::array::from_fn(|k| {
             poses
                 .iter()
@@ -192,19 +174,11 @@ impl Scene {
                 })
         });
         let extent = raw.iter().map(|(lo, hi)| hi - lo).fold(0.0_f64, f64::max);
-        let body = opts.body_m.unwrap_or_else(|| {
-            let l = if extent > 0.0 { 0.1 * extent } else { 1.0 };
-            [l, 0.5 * l, 0.25 * l]
-        });
+        let body = opts.body_m.unwrap_or_else(|| default_body_m(extent));
         let pad = body
             .iter()
             .chain(&opts.lever_arm_m)
             .fold(0.0_f64, |m, v| m.max(v.abs()));
-        let duration = poses[poses.len() - 1].t - poses[0].t;
-        let speed = opts
-            .speed
-            .unwrap_or_else(|| duration / duration.clamp(4.0, 12.0));
-        let frames = frame_indices(&poses, opts.fps, speed);
         let stride = stride_for(poses.len(), PATH_POINTS);
         Ok(Self {
             frames,

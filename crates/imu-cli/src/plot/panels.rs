@@ -246,21 +246,11 @@ pub fn draw_3d(
 /// True when the traces leave the plane noticeably (z range above 1 % of the horizontal range).
 #[must_use]
 pub fn is_3d(traces: &[Trace]) -> bool {
-    let all: Vec<(f64, f64, f64)> = traces
+    let all: Vec<[f64; 3]> = traces
         .iter()
-        .flat_map(|t| t.points.iter().copied())
+        .flat_map(|t| t.points.iter().map(|p| [p.0, p.1, p.2]))
         .collect();
-    let span = |f: fn(&(f64, f64, f64)) -> f64| {
-        let (lo, hi) = all
-            .iter()
-            .map(f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-        if lo.is_finite() { hi - lo } else { 0.0 }
-    };
-    let horizontal = span(|p| p.0).max(span(|p| p.1));
-    span(|p| p.2) > 0.01 * horizontal.max(1e-12)
+    imu_scenario::figures::leaves_plane(&all)
 }
 
 /// A figure of trajectories in the plane, start and end marked (the exercise's figure).
