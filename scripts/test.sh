@@ -35,7 +35,7 @@ echo "== Python stubs match the built module"
 python -m mypy.stubtest imukit._core
 
 echo "== Python tests"
-IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md
+IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py
 
 echo "== Examples"
 out=$(mktemp -d)

@@ -45,6 +45,7 @@ __all__ = [
     "compare",
     "planar_dead_reckon",
     "read_planar",
+    "read_csv",
     "builtin_scenarios",
     "builtin_scenario_toml",
     "truth_from_expressions",
@@ -142,6 +143,12 @@ def simulate(scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] =
         out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run)
     truth, imu = out
     return Simulation(truth=_table(truth), imu=_table(imu))
+
+
+def read_csv(path: Union[str, os.PathLike]) -> Table:
+    """Every column of an imukit CSV file (truth, IMU readings, navigation output, errors, Allan
+    table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
+    return _table(_core.read_csv(str(path)))
 
 
 def builtin_scenarios() -> list:

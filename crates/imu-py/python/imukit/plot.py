@@ -1,0 +1,270 @@
+"""Figures of imukit results with matplotlib (an optional extra: ``pip install "imukit[plot]"``).
+
+The figures are those of ``imukit plot`` and ``imukit animate``: the same kinds of table are
+recognised from their columns and get the same panels (the layout comes from the Rust core),
+drawn here by matplotlib. Every function returns the matplotlib object, for the caller to show,
+adjust or save (``fig.savefig("truth.png")``, ``anim.save("body.gif", writer="pillow")``).
+
+* :func:`figure` — the default figure of one or more tables or CSV files of one kind (truth,
+  IMU readings, navigation output, Allan table, errors); later ones are dashed (truth vs estimate).
+* :func:`trajectory` — paths in the plane (equal scales) or in 3D, start ● and end ✕ marked.
+* :func:`allan` — Allan deviation on log axes with the fitted −½, 0, +½ lines dashed.
+* :func:`animate` — the body as a box moving and turning along its path, the reference point and
+  the IMU point at the lever arm marked, the trail drawn.
+
+>>> import matplotlib; matplotlib.use("Agg")
+>>> import imukit, imukit.plot
+>>> sim = imukit.simulate({"trajectory": {"type": "builtin", "name": "figure8"}})
+>>> fig = imukit.plot.figure(sim.truth)
+>>> [ax.get_title() for ax in fig.axes][:3]
+['Trajectory', 'Position', 'Velocity']
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_csv
+
+__all__ = ["figure", "trajectory", "allan", "animate", "kind"]
+
+TableLike = Union[Table, str, os.PathLike]
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "imukit.plot needs matplotlib: pip install \"imukit[plot]\" (or pip install matplotlib)"
+        ) from e
+    return plt
+
+
+def _load(items: Sequence[TableLike], labels: Optional[Sequence[str]]) -> list:
+    if not items:
+        raise ValueError("give at least one table or CSV file")
+    if labels is not None and len(labels) != len(items):
+        raise ValueError(f"{len(labels)} labels for {len(items)} tables")
+    out = []
+    for i, item in enumerate(items):
+        if isinstance(item, Table):
+            name, table = f"table {i + 1}", item
+        elif isinstance(item, (str, os.PathLike)):
+            name, table = Path(item).stem, read_csv(item)
+        else:
+            raise TypeError(f"item {i}: expected an imukit.Table or a CSV path, got {type(item).__name__}")
+        out.append((labels[i] if labels is not None else name, table))
+    return out
+
+
+def kind(table: Table, source: str = "table") -> str:
+    """The kind of an imukit table from its columns: ``truth``, ``imu``, ``navigation``,
+    ``allan`` or ``errors``; :class:`ImuError` for anything else."""
+    k = _core.table_kind(list(table.columns))
+    if k is None:
+        raise ImuError(
+            f"{source}: unknown kind of table (columns: {', '.join(table.columns)}); imukit plots truth, "
+            "IMU readings, navigation output, Allan deviation and error tables"
+        )
+    return k
+
+
+def _kinds(tables: list) -> str:
+    first = None
+    motion = {"truth", "navigation"}
+    for name, t in tables:
+        k = kind(t, name)
+        if first is not None and k != first and not {k, first} <= motion:
+            raise ImuError(f"{name}: is {k}, but the first table is {first}: overlay tables of one kind "
+                           "(or truth and navigation output)")
+        first = first or k
+    assert first is not None
+    return first
+
+
+def _points(t: Table) -> np.ndarray:
+    z = t["pos_z_m"] if "pos_z_m" in t else np.zeros(len(t))
+    return np.column_stack([t["pos_x_m"], t["pos_y_m"], z])
+
+
+def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: Any = None) -> Any:
+    """Paths of truth or navigation tables (``pos_*_m``): seen from above with equal scales when
+    they stay in a plane, in 3D otherwise; start ● and end ✕ marked. Returns the figure."""
+    loaded = _load(tables, labels)
+    paths = [(name, _points(t)) for name, t in loaded]
+    three_d = _core.leaves_plane(np.ascontiguousarray(np.vstack([p for _, p in paths])))
+    if ax is None:
+        fig = _pyplot().figure(figsize=(6.4, 4.8))
+        ax = fig.add_subplot(projection="3d" if three_d else None)
+    for k, (name, p) in enumerate(paths):
+        colour = f"C{k}"
+        if three_d:
+            ax.plot(p[:, 0], p[:, 1], p[:, 2], color=colour, label=name)
+            ax.scatter(*p[0], color=colour, marker="o", s=40)
+            ax.scatter(*p[-1], color=colour, marker="x", s=60)
+        else:
+            ax.plot(p[:, 0], p[:, 1], color=colour, label=name)
+            ax.plot(*p[0, :2], color=colour, marker="o", linestyle="none")
+            ax.plot(*p[-1, :2], color=colour, marker="x", markersize=9, mew=2, linestyle="none")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if three_d:
+        ax.set_zlabel("z (m)")
+        ax.set_title("Trajectory")
+    else:
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title("Trajectory (top view)")
+    ax.legend(title="● start  ✕ end", fontsize="small")
+    return ax.figure
+
+
+def allan(tau_s: Union[Table, TableLike, np.ndarray], adev: Optional[np.ndarray] = None, *,
+          labels: Optional[Sequence[str]] = None, ax: Any = None) -> Any:
+    """Allan deviation on log axes with the lines fitted by :func:`imukit.identify_noise` dashed.
+
+    Give ``tau_s`` and ``adev`` ((T,) or (T, k)) as from :func:`imukit.allan_deviation`, or an
+    Allan table / CSV (``tau_s, adev_*``) alone. Returns the figure."""
+    if adev is None:
+        (_, table), = _load([tau_s], None)  # type: ignore[list-item]
+        if kind(table) != "allan":
+            raise ImuError("allan() needs tau_s and adev, or an Allan table (tau_s, adev_*)")
+        cols = [c for c in table.columns if c.startswith("adev_")]
+        tau = table["tau_s"]
+        curves = np.column_stack([table[c] for c in cols])
+        names = list(labels) if labels is not None else [c[len("adev_"):] for c in cols]
+    else:
+        tau = np.asarray(tau_s, dtype=np.float64)
+        curves = np.asarray(adev, dtype=np.float64).reshape(tau.shape[0], -1)
+        names = list(labels) if labels is not None else [f"column {k}" for k in range(curves.shape[1])]
+    if len(names) != curves.shape[1]:
+        raise ValueError(f"{len(names)} labels for {curves.shape[1]} curves")
+    if ax is None:
+        fig = _pyplot().figure(figsize=(7.5, 5.0))
+        ax = fig.add_subplot()
+    for k, name in enumerate(names):
+        colour = f"C{k}"
+        ax.loglog(tau, curves[:, k], "o-", color=colour, markersize=3, label=name)
+        fit = identify_noise(tau, curves[:, k])
+        for key in ("white_line", "bias_line", "random_walk_line"):
+            if fit.get(key) is not None:
+                slope, log_intercept = fit[key]
+                ax.loglog(tau, 10.0 ** log_intercept * tau ** slope, "--", color=colour, alpha=0.6, linewidth=1)
+    ax.set_xlabel("τ (s)")
+    ax.set_ylabel("σ(τ) (unit of the column)")
+    ax.set_title("Allan deviation")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax.figure
+
+
+def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
+    """The default figure of imukit tables or CSV files of one kind (or truth and navigation
+    output together): the trajectory and the time-series panels of ``imukit plot``, later tables
+    dashed. Returns the figure."""
+    loaded = _load(tables, labels)
+    k = _kinds(loaded)
+    if k == "allan":
+        if len(loaded) > 1:
+            raise ImuError("overlay Allan curves by passing tau_s and a (T, k) adev to allan()")
+        return allan(loaded[0][1], labels=None)
+    panels = [p for p in _core.figure_panels(k)
+              if any(c in t for _, t in loaded for c, _ in p[3])]
+    with_path = k in ("truth", "navigation")
+    cells = len(panels) + int(with_path)
+    ncols = 2 if cells > 3 else 1
+    nrows = -(-cells // ncols)
+    plt = _pyplot()
+    fig = plt.figure(figsize=(5.6 * ncols, 3.2 * nrows), layout="constrained")
+    index = 1
+    if with_path:
+        points = np.vstack([_points(t) for _, t in loaded])
+        three_d = _core.leaves_plane(np.ascontiguousarray(points))
+        ax = fig.add_subplot(nrows, ncols, index, projection="3d" if three_d else None)
+        trajectory(*[t for _, t in loaded], labels=[n for n, _ in loaded], ax=ax)
+        index += 1
+    for title, y_label, scale, columns in panels:
+        ax = fig.add_subplot(nrows, ncols, index)
+        index += 1
+        for f, (name, t) in enumerate(loaded):
+            for c_k, (column, label) in enumerate(columns):
+                if column in t and "t_s" in t:
+                    text = f"{label} ({name})" if len(loaded) > 1 else label
+                    ax.plot(t["t_s"], t[column] * scale, color=f"C{c_k}", linestyle="-" if f == 0 else "--", label=text)
+        ax.set_title(title)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(y_label)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small", loc="upper right")
+    return fig
+
+
+def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
+            lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = 20.0,
+            speed: Optional[float] = None) -> Any:
+    """The body moving along its path, as ``imukit animate`` draws it: a box of ``body_m``
+    (length, width, height along body x, y, z; by default a tenth of the path's extent long)
+    turned by the truth's attitude, its nose face red, the reference point (yellow) and the IMU
+    point at ``lever_arm_m`` (violet), the trail blue. ``fps`` frames per second, ``speed``
+    seconds of motion per second (by default the animation lasts 4 to 12 s).
+
+    Returns a ``matplotlib.animation.FuncAnimation``; ``anim.save("body.gif", writer="pillow")``
+    writes it."""
+    from matplotlib.animation import FuncAnimation
+
+    (name, t), = _load([truth], None)
+    for c in ("t_s", "pos_x_m", "pos_y_m", "pos_z_m", "q_w", "q_x", "q_y", "q_z"):
+        if c not in t:
+            raise ImuError(f"{name}: no {c} column: animate needs a truth table (t_s, pos_*_m, q_*)")
+    lever = np.asarray(lever_arm_m, dtype=np.float64)
+    if lever.shape != (3,) or not np.all(np.isfinite(lever)):
+        raise ValueError("lever_arm_m must be 3 finite numbers")
+    frames, speed_used = _core.frame_plan(np.ascontiguousarray(t["t_s"]), float(fps), speed)
+    p = _points(t)
+    extent = float(np.max(np.ptp(p, axis=0)))
+    body = np.asarray(_core.default_body_m(extent) if body_m is None else body_m, dtype=np.float64)
+    if body.shape != (3,) or not np.all(body > 0):
+        raise ValueError("body_m must be 3 positive numbers (length, width, height)")
+    dcm = quaternion_to_dcm(np.column_stack([t["q_w"], t["q_x"], t["q_y"], t["q_z"]])[frames])
+    half = body / 2.0
+    corners = np.array([[(-1) ** (1 + (i & 1)) * half[0], (-1) ** (1 + ((i >> 1) & 1)) * half[1],
+                         (-1) ** (1 + ((i >> 2) & 1)) * half[2]] for i in range(8)])
+    edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)]
+    nose = [1, 3, 7, 5]
+
+    fig = _pyplot().figure(figsize=(6.4, 4.8))
+    ax = fig.add_subplot(projection="3d")
+    pad = float(max(np.max(body), np.max(np.abs(lever))))
+    lo, hi = p.min(axis=0) - pad, p.max(axis=0) + pad
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    ax.plot(p[:, 0], p[:, 1], p[:, 2], color="0.75", linewidth=1)
+    (trail,) = ax.plot([], [], [], color="C0", linewidth=2)
+    box = [ax.plot([], [], [], color="C3", linewidth=2)[0] for _ in edges]
+    (face,) = ax.plot([], [], [], color="C3", linewidth=4, alpha=0.5)
+    (ref,) = ax.plot([], [], [], "o", color="#e6be00", markersize=7)
+    (imu,) = ax.plot([], [], [], "o", color="C4", markersize=6)
+    title = ax.set_title("")
+
+    def draw(k: int):
+        i = frames[k]
+        c = p[i] + corners @ dcm[k].T
+        for line, (a, b) in zip(box, edges):
+            line.set_data_3d(c[[a, b], 0], c[[a, b], 1], c[[a, b], 2])
+        ring = nose + nose[:1]
+        face.set_data_3d(c[ring, 0], c[ring, 1], c[ring, 2])
+        trail.set_data_3d(p[: i + 1, 0], p[: i + 1, 1], p[: i + 1, 2])
+        ref.set_data_3d([p[i, 0]], [p[i, 1]], [p[i, 2]])
+        m = p[i] + dcm[k] @ lever
+        imu.set_data_3d([m[0]], [m[1]], [m[2]])
+        title.set_text(f"t = {t['t_s'][i]:.2f} s · {speed_used:g}× real time")
+        return [trail, face, ref, imu, *box]
+
+    return FuncAnimation(fig, draw, frames=len(frames), interval=1000.0 / fps, blit=False)
