@@ -8,6 +8,12 @@ _Table = tuple[list[str], npt.NDArray[np.float64]]
 
 __all__ = [
     "ImuError",
+    "read_csv",
+    "table_kind",
+    "figure_panels",
+    "frame_plan",
+    "default_body_m",
+    "leaves_plane",
     "simulate_text",
     "truth_from_expressions",
     "truth_from_samples",
