@@ -1,12 +1,16 @@
 """MATLAB's imuSensor examples, ported line by line to imukit.ImuSensor.
 
-Run: python examples/matlab_imusensor.py
+Run: python examples/matlab_imusensor.py [--figures DIR]
+Figure (matplotlib): the rotating platform's accelerometer and magnetometer readings.
 """
+import argparse
 import math
+from pathlib import Path
 
 import numpy as np
 
 import imukit
+import imukit.plot
 
 
 def stationary():
@@ -17,7 +21,7 @@ def stationary():
     print("stationary: accel", accel[0], "gyro", gyro[0], "mag", mag[0])
 
 
-def rotating_platform():
+def rotating_platform(figures: Path):
     # kinematicTrajectory: 360° in 4 s then 360° in 2 s about z, NED, 100 Hz
     fs = 100
     n = 6 * fs
@@ -37,6 +41,16 @@ def rotating_platform():
     heading = np.degrees(np.unwrap(np.arctan2(-mag[:, 1], mag[:, 0])))
     print(f"rotating platform: heading from the magnetometer went from {heading[0]:.1f}° to {heading[-1]:.1f}°")
 
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+    columns = ["t_s", *(f"accel_{a}_m_s2" for a in "xyz"), *(f"mag_{a}_ut" for a in "xyz")]
+    readings = imukit.Table(columns, np.column_stack([t, accel, mag]))
+    figures.mkdir(parents=True, exist_ok=True)
+    imukit.plot.figure(readings, labels=["imuSensor"]).savefig(figures / "matlab_rotating_platform.png", dpi=80)
+    print(f"figure matlab_rotating_platform.png written to {figures}")
+
 
 def spec_sheet_accelerometer():
     imu = imukit.ImuSensor(
@@ -50,6 +64,9 @@ def spec_sheet_accelerometer():
 
 
 if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--figures", default="imukit-figures", help="folder for the figures (default: %(default)s)")
+    args = parser.parse_args()
     stationary()
-    rotating_platform()
+    rotating_platform(Path(args.figures))
     spec_sheet_accelerometer()

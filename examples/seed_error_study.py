@@ -5,9 +5,10 @@ symbolic result. imukit reproduces that with ``order=2`` and shows its default (
 Errors are printed relative to each quantity's largest exact magnitude, and, as the seed plots
 them, relative to max |v| in percent.
 
-Run: python examples/seed_error_study.py [--plot FIGURE.png]   (the plot needs matplotlib)
+Run: python examples/seed_error_study.py [--figures DIR]   (the figure needs matplotlib)
 """
 import argparse
+from pathlib import Path
 
 import numpy as np
 
@@ -26,7 +27,7 @@ def stack(table, pattern):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--plot", help="write the error curves to this image (needs matplotlib)")
+    parser.add_argument("--figures", default="imukit-figures", help="folder for the figures (default: %(default)s)")
     args = parser.parse_args()
 
     t = np.arange(0, 1.0 + 1e-12, 0.005)  # the seed's t_start:t_step:t_stop
@@ -52,21 +53,22 @@ def main():
     print("order 2 without the two end samples at each side: "
           + ", ".join(f"{n} {e:.2e}" for n, e in interior.items()))
 
-    if args.plot:
-        import matplotlib
+    import matplotlib
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex=True)
-        for ax, (name, _) in zip(axes.flat, QUANTITIES):
-            for order, style in ((2, "-"), (6, "--")):
-                ax.semilogy(t, np.maximum(errors[(order, name)], 1e-18), style)
-            ax.set_title(f"|error| of {name} (solid: order 2, dashed: order 6)")
-            ax.set_xlabel("t in s")
-        fig.tight_layout()
-        fig.savefig(args.plot, dpi=100)
-        print(f"figure written to {args.plot}")
+    fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex=True)
+    for ax, (name, _) in zip(axes.flat, QUANTITIES):
+        for order, style in ((2, "-"), (6, "--")):
+            ax.semilogy(t, np.maximum(errors[(order, name)], 1e-18), style)
+        ax.set_title(f"|error| of {name} (solid: order 2, dashed: order 6)")
+        ax.set_xlabel("t in s")
+    fig.tight_layout()
+    out = Path(args.figures)
+    out.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out / "seed_error_study.png", dpi=80)
+    print(f"figure seed_error_study.png written to {out}")
 
 
 if __name__ == "__main__":

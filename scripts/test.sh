@@ -41,11 +41,13 @@ echo "== Examples"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for f in examples/*.toml; do
-  target/release/imukit simulate "$f" --out "$out/$(basename "$f" .toml)_imu.csv" --truth "$out/$(basename "$f" .toml)_truth.csv"
+  name=$(basename "$f" .toml)
+  target/release/imukit simulate "$f" --out "$out/${name}_imu.csv" --truth "$out/${name}_truth.csv"
+  target/release/imukit plot "$out/${name}_truth.csv" --out "$out/${name}_truth.png"
+  target/release/imukit plot "$out/${name}_imu.csv" --out "$out/${name}_imu.png"
 done
-python examples/seed_error_study.py
-python examples/matlab_imusensor.py
-python examples/allan_study.py
-python examples/navigation_round_trip.py
+for f in seed_error_study matlab_imusensor allan_study navigation_round_trip; do
+  python "examples/$f.py" --figures "$out/figures"
+done
 target/release/imukit exercise --out-dir "$out/exercise"
 echo "== All tests passed"

@@ -143,7 +143,7 @@ pub enum Command {
     },
     /// Default figures of imukit CSV files (truth, IMU readings, navigation output, Allan
     /// table, errors; the kind is recognised from the columns). Several files of one kind are
-    /// overlaid, the second and later dashed (truth vs estimate).
+    /// overlaid, the second dashed, the third dotted (truth vs estimates).
     Plot {
         /// The CSV files.
         #[arg(required = true)]

@@ -42,7 +42,7 @@ fn panel(files: &[(String, Table)], spec: &PanelSpec) -> Option<Panel> {
                         .zip(ys.iter().map(|y| y * spec.scale))
                         .collect(),
                     color: k,
-                    dashed: f > 0,
+                    style: f,
                 });
             }
         }

@@ -15,8 +15,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Colour index.
     pub color: usize,
-    /// Dashed (overlays of a second file).
-    pub dashed: bool,
+    /// Line style: 0 solid (the first file), 1 dashed, 2 dotted, 3 long dashes (later files).
+    pub style: usize,
 }
 
 /// A time-series panel.
@@ -89,10 +89,12 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
     for s in &panel.series {
         let color = COLORS[s.color % COLORS.len()];
         let pts = thin(finite(&s.points));
-        let drawn = if s.dashed {
-            chart.draw_series(DashedLineSeries::new(pts, 5, 4, color.stroke_width(2)))
-        } else {
-            chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+        let stroke = color.stroke_width(2);
+        let drawn = match s.style % 4 {
+            0 => chart.draw_series(LineSeries::new(pts, stroke)),
+            1 => chart.draw_series(DashedLineSeries::new(pts, 6, 4, stroke)),
+            2 => chart.draw_series(DashedLineSeries::new(pts, 2, 3, stroke)),
+            _ => chart.draw_series(DashedLineSeries::new(pts, 12, 4, stroke)),
         };
         drawn
             .map_err(err)?

@@ -6,7 +6,7 @@ drawn here by matplotlib. Every function returns the matplotlib object, for the 
 adjust or save (``fig.savefig("truth.png")``, ``anim.save("body.gif", writer="pillow")``).
 
 * :func:`figure` — the default figure of one or more tables or CSV files of one kind (truth,
-  IMU readings, navigation output, Allan table, errors); later ones are dashed (truth vs estimate).
+  IMU readings, navigation output, Allan table, errors); later ones dashed, dotted, … (truth vs estimate).
 * :func:`trajectory` — paths in the plane (equal scales) or in 3D, start ● and end ✕ marked.
 * :func:`allan` — Allan deviation on log axes with the fitted −½, 0, +½ lines dashed.
 * :func:`animate` — the body as a box moving and turning along its path, the reference point and
@@ -32,6 +32,8 @@ from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_cs
 __all__ = ["figure", "trajectory", "allan", "animate", "kind"]
 
 TableLike = Union[Table, str, os.PathLike]
+# Line styles of the first, second, … overlaid table (as `imukit plot` draws them).
+_STYLES = ("-", "--", ":", "-.")
 
 
 def _pyplot() -> Any:
@@ -164,7 +166,7 @@ def allan(tau_s: Union[Table, TableLike, np.ndarray], adev: Optional[np.ndarray]
 def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
-    dashed. Returns the figure."""
+    dashed, dotted, …. Returns the figure."""
     loaded = _load(tables, labels)
     k = _kinds(loaded)
     if k == "allan":
@@ -193,7 +195,7 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
             for c_k, (column, label) in enumerate(columns):
                 if column in t and "t_s" in t:
                     text = f"{label} ({name})" if len(loaded) > 1 else label
-                    ax.plot(t["t_s"], t[column] * scale, color=f"C{c_k}", linestyle="-" if f == 0 else "--", label=text)
+                    ax.plot(t["t_s"], t[column] * scale, color=f"C{c_k}", linestyle=_STYLES[f % 4], label=text)
         ax.set_title(title)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(y_label)
