@@ -151,6 +151,9 @@ pub enum Command {
         /// The figure file (`.svg` or `.png`).
         #[arg(long)]
         out: PathBuf,
+        /// Navigation frame of the positions (ENU or NED; NED paths are drawn east, north, up).
+        #[arg(long, default_value = "ENU")]
+        nav_frame: String,
     },
     /// Animates the body moving along its path from a truth CSV: a box turned by the attitude,
     /// the reference point and the IMU point at the lever arm marked, the trail drawn.
@@ -173,5 +176,8 @@ pub enum Command {
         /// Seconds of motion per second of animation (default: the animation lasts 4 to 12 s).
         #[arg(long)]
         speed: Option<f64>,
+        /// Navigation frame of the truth (ENU or NED; NED is drawn turned so that up is up).
+        #[arg(long, default_value = "ENU")]
+        nav_frame: String,
     },
 }

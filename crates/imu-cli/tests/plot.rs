@@ -261,3 +261,68 @@ fn bad_input_is_refused_with_what_and_where_and_no_file_written() {
     assert!(String::from_utf8_lossy(&o.stderr).contains(".gif or .html"));
     assert!(!d.join("a.gif").exists() && !d.join("a.mp4").exists());
 }
+
+#[test]
+fn ned_truth_is_animated_east_north_up() {
+    let d = data();
+    let scenario = d.join("ned.toml");
+    std::fs::write(
+        &scenario,
+        "nav_frame = \"NED\"\nrate_hz = 10.0\nduration_s = 4.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"t\", \"2*t\", \"-3*t\"]\nattitude = \"level\"\n",
+    )
+    .unwrap();
+    let (imu, truth, out) = (
+        d.join("ned_imu.csv"),
+        d.join("ned_truth.csv"),
+        d.join("ned.html"),
+    );
+    ok(&imukit(
+        &["simulate"],
+        &[
+            &scenario,
+            Path::new("--out"),
+            &imu,
+            Path::new("--truth"),
+            &truth,
+        ],
+    ));
+    ok(&imukit(
+        &["animate"],
+        &[
+            &truth,
+            Path::new("--out"),
+            &out,
+            Path::new("--nav-frame"),
+            Path::new("NED"),
+        ],
+    ));
+    let page = std::fs::read_to_string(&out).unwrap();
+    let frames = page
+        .split("const FRAMES = [[")
+        .nth(1)
+        .unwrap()
+        .split("]];")
+        .next()
+        .unwrap();
+    let last: Vec<f64> = frames
+        .split("],[")
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    // t = 4 s: NED (4, 8, −12) drawn as east 8, north 4, up 12; level body: q = NED→ENU turn.
+    assert_eq!(last[0], 4.0);
+    let p = &last[2..5];
+    assert!(
+        (p[0] - 8.0).abs() < 1e-9 && (p[1] - 4.0).abs() < 1e-9 && (p[2] - 12.0).abs() < 1e-9,
+        "{p:?}"
+    );
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let q = &last[5..9];
+    assert!(
+        q[0].abs() < 1e-9 && (q[1].abs() - h).abs() < 1e-9 && (q[2].abs() - h).abs() < 1e-9,
+        "{q:?}"
+    );
+}

@@ -190,3 +190,15 @@ impl<From: Frame, To: Frame> Rotation<From, To> {
         Rotation::assume_from_quaternion(next.q * self.q)
     }
 }
+
+impl Rotation<crate::frame::Ned, crate::frame::Enu> {
+    /// The change of axes NED → ENU: `(e, n, u) = (y, x, −z)` of the NED vector (a rotation by
+    /// π about the horizontal axis halfway between north and east).
+    #[must_use]
+    pub fn ned_to_enu() -> Self {
+        let h = core::f64::consts::FRAC_1_SQRT_2;
+        Self::assume_from_quaternion(UnitQuaternion::new_unchecked(Quaternion::new(
+            0.0, h, h, 0.0,
+        )))
+    }
+}

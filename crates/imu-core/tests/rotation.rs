@@ -51,3 +51,18 @@ fn positive_pitch_turns_body_x_towards_minus_z() {
     let enu = Rotation::<Body, Enu>::from_euler(EulerZyx::new(0.0, p, 0.0));
     assert!((enu.apply(Vec3::new(1.0, 0.0, 0.0)).z() + p.sin()).abs() < 1e-15);
 }
+
+#[test]
+fn ned_to_enu_swaps_north_and_east_and_flips_down_to_up() {
+    let r = Rotation::<Ned, Enu>::ned_to_enu();
+    let v = r.apply(Vec3::<Ned>::new(1.0, 2.0, 3.0)).to_array();
+    assert_eq!(v.map(|x| (x * 1e12).round() / 1e12), [2.0, 1.0, -3.0]);
+    // A body heading east with yaw π/2 in NED heads east (yaw 0) in ENU.
+    let east_ned =
+        Rotation::<Body, Ned>::from_euler(EulerZyx::new(core::f64::consts::FRAC_PI_2, 0.0, 0.0));
+    let nose = east_ned
+        .then(&r)
+        .apply(Vec3::<Body>::new(1.0, 0.0, 0.0))
+        .to_array();
+    assert!((nose[0] - 1.0).abs() < 1e-12 && nose[1].abs() < 1e-12 && nose[2].abs() < 1e-12);
+}

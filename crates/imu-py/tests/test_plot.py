@@ -118,3 +118,18 @@ def test_bad_input_is_refused_with_what_and_where(sim, tmp_path):
         ip.animate(imukit.Table(sim.truth.columns, t))
     with pytest.raises(ValueError, match="body_m"):
         ip.animate(sim.truth, body_m=(0.1, -1.0, 0.1))
+
+
+def test_ned_truth_is_drawn_east_north_up(tmp_path):
+    sim = imukit.simulate({"nav_frame": "NED", "rate_hz": 50.0, "duration_s": 2.0,
+                           "trajectory": {"type": "expression", "position_m": ["t", "2*t", "-3*t"],
+                                          "attitude": "level"}})
+    anim = ip.animate(sim.truth, nav_frame="NED", fps=5.0)
+    path = anim._fig.axes[0].get_lines()[0].get_data_3d()  # the grey path
+    t = sim.truth["t_s"]
+    np.testing.assert_allclose(path[0], 2 * t)   # east = NED y
+    np.testing.assert_allclose(path[1], t)       # north = NED x
+    np.testing.assert_allclose(path[2], 3 * t)   # up = −NED z: the body climbs
+    anim.save(tmp_path / "ned.gif", writer="pillow", fps=5)
+    with pytest.raises(imukit.ImuError, match="nav_frame"):
+        ip.animate(sim.truth, nav_frame="XYZ")

@@ -7,6 +7,7 @@ use imu_scenario::{Simulation, builtin};
 use super::CliError;
 use crate::plot::animate::{AnimateOptions, animate};
 use crate::plot::plot_files;
+use imu_scenario::scenario::NavFrameName;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let io = |source| CliError::Io {
@@ -27,11 +28,17 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     })?;
     sim.truth.write_csv(&out_dir.join("truth.csv"))?;
     sim.imu.write_csv(&out_dir.join("imu.csv"))?;
-    plot_files(&[out_dir.join("truth.csv")], &out_dir.join("truth.png"))?;
-    plot_files(&[out_dir.join("imu.csv")], &out_dir.join("imu.png"))?;
+    let ned = spec.nav_frame == Some(NavFrameName::NED);
+    plot_files(
+        &[out_dir.join("truth.csv")],
+        &out_dir.join("truth.png"),
+        ned,
+    )?;
+    plot_files(&[out_dir.join("imu.csv")], &out_dir.join("imu.png"), ned)?;
     let lever_arm_m = spec.imu.lever_arm_m.unwrap_or([0.0; 3]);
     let opts = AnimateOptions {
         lever_arm_m,
+        ned,
         ..AnimateOptions::default()
     };
     animate(

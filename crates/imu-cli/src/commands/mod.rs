@@ -114,7 +114,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             plot,
         } => allan::run(&input, &columns, &out, plot.as_deref()),
-        Command::Plot { files, out } => plot::plot(&files, &out),
+        Command::Plot {
+            files,
+            out,
+            nav_frame,
+        } => plot::plot(&files, &out, &nav_frame),
         Command::Animate {
             truth,
             out,
@@ -122,13 +126,16 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             lever_arm,
             fps,
             speed,
-        } => plot::animate(
-            &truth,
-            &out,
-            body.as_deref(),
-            lever_arm.as_deref(),
-            fps,
-            speed,
-        ),
+            nav_frame,
+        } => {
+            let opts = plot::options(
+                body.as_deref(),
+                lever_arm.as_deref(),
+                fps,
+                speed,
+                &nav_frame,
+            )?;
+            plot::animate(&truth, &out, &opts)
+        }
     }
 }

@@ -4,32 +4,44 @@ use std::path::{Path, PathBuf};
 use crate::plot::animate::{self as anim, AnimateOptions};
 use crate::plot::{plot_files, read_table};
 
+use imu_scenario::scenario::{NavFrameName, parse_name};
+
 use super::CliError;
 
-pub fn plot(files: &[PathBuf], out: &Path) -> Result<(), CliError> {
-    plot_files(files, out)?;
+pub fn plot(files: &[PathBuf], out: &Path, nav_frame: &str) -> Result<(), CliError> {
+    plot_files(files, out, is_ned(nav_frame)?)?;
     println!("Wrote {}", out.display());
     Ok(())
 }
 
-pub fn animate(
-    truth: &Path,
-    out: &Path,
+/// Whether `--nav-frame` names NED (else ENU).
+fn is_ned(nav_frame: &str) -> Result<bool, CliError> {
+    let frame: NavFrameName = parse_name("--nav-frame", &nav_frame.to_ascii_uppercase())?;
+    Ok(frame == NavFrameName::NED)
+}
+
+/// The animation options from the command line.
+pub fn options(
     body: Option<&[f64]>,
     lever_arm: Option<&[f64]>,
     fps: f64,
     speed: Option<f64>,
-) -> Result<(), CliError> {
+    nav_frame: &str,
+) -> Result<AnimateOptions, CliError> {
     let three = |v: &[f64]| [v[0], v[1], v[2]];
-    let opts = AnimateOptions {
+    Ok(AnimateOptions {
         body_m: body.map(three),
         lever_arm_m: lever_arm.map_or([0.0; 3], three),
         fps,
         speed,
+        ned: is_ned(nav_frame)?,
         ..AnimateOptions::default()
-    };
+    })
+}
+
+pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), CliError> {
     let table = read_table(truth)?;
-    let info = anim::animate(&table, &truth.display().to_string(), out, &opts)?;
+    let info = anim::animate(&table, &truth.display().to_string(), out, opts)?;
     println!(
         "Wrote {} ({} frames at {} frames/s, {}× real time)",
         out.display(),

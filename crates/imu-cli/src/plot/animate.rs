@@ -7,7 +7,7 @@
 //! second of animation (by default chosen so the animation lasts at most about 12 s).
 use std::path::Path;
 
-use imu_core::{Body, Enu, Rotation, Vec3};
+use imu_core::{Body, Enu, Ned, Rotation, Vec3};
 use imu_scenario::figures::{FramePlan, default_body_m, frame_plan};
 use imu_scenario::{Error, Table};
 use plotters::prelude::*;
@@ -29,6 +29,8 @@ pub struct AnimateOptions {
     pub speed: Option<f64>,
     /// Image size, pixels.
     pub size: (u32, u32),
+    /// The truth is in NED (drawn turned into ENU so that up is up); else ENU.
+    pub ned: bool,
 }
 
 impl Default for AnimateOptions {
@@ -38,6 +40,7 @@ impl Default for AnimateOptions {
             lever_arm_m: [0.0; 3],
             fps: 20.0,
             speed: None,
+            ned: false,
             size: (560, 420),
         }
     }
@@ -58,8 +61,9 @@ struct Pose {
     q: [f64; 4],
 }
 
-/// Reads the poses, checking positions and quaternions per row (times: [`frame_plan`]).
-fn poses(truth: &Table, source: &str) -> Result<Vec<Pose>, Error> {
+/// Reads the poses, checking positions and quaternions per row (times: [`frame_plan`]); NED
+/// poses are turned into ENU ones (the body axes stay those of the data).
+fn poses(truth: &Table, source: &str, ned: bool) -> Result<Vec<Pose>, Error> {
     let bad = |at: String, message: String| Error::Invalid { field: at, message };
     let col = |c: &str| {
         truth.column(c).ok_or_else(|| {
@@ -85,10 +89,24 @@ fn poses(truth: &Table, source: &str) -> Result<Vec<Pose>, Error> {
                 "time, position and quaternion must be finite numbers".into(),
             ));
         }
-        let q = Rotation::<Body, Enu>::from_wxyz(q)
-            .ok_or_else(|| bad(row.clone(), "the quaternion is zero".into()))?
-            .to_wxyz();
-        out.push(Pose { t: t[i], p, q });
+        let r = Rotation::<Body, Ned>::from_wxyz(q)
+            .ok_or_else(|| bad(row.clone(), "the quaternion is zero".into()))?;
+        let pose = if ned {
+            let to_enu = Rotation::<Ned, Enu>::ned_to_enu();
+            let p = to_enu.apply(Vec3::from_array(p)).to_array();
+            Pose {
+                t: t[i],
+                p,
+                q: r.then(&to_enu).to_wxyz(),
+            }
+        } else {
+            Pose {
+                t: t[i],
+                p,
+                q: r.to_wxyz(),
+            }
+        };
+        out.push(pose);
     }
     Ok(out)
 }
@@ -159,7 +177,7 @@ impl Scene {
         if !finite3(opts.lever_arm_m) {
             return Err(bad("--lever-arm", "must be finite"));
         }
-        let poses = poses(truth, source)?;
+        let poses = poses(truth, source, opts.ned)?;
         let times: Vec<f64> = poses.iter().map(|p| p.t).collect();
         let FramePlan {
             indices: frames,

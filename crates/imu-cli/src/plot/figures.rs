@@ -55,11 +55,12 @@ fn panel(files: &[(String, Table)], spec: &PanelSpec) -> Option<Panel> {
     })
 }
 
-/// Draws the default figure for `paths` (all of one kind) into `out` (SVG or PNG).
+/// Draws the default figure for `paths` (all of one kind) into `out` (SVG or PNG); with `ned`
+/// the trajectory is drawn east, north, up.
 ///
 /// # Errors
 /// Unreadable or empty files, unknown kinds of CSV, files of different kinds, drawing errors.
-pub fn plot_files(paths: &[PathBuf], out: &Path) -> Result<(), CliError> {
+pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliError> {
     if paths.is_empty() {
         return Err(Error::Invalid {
             field: "plot".into(),
@@ -99,7 +100,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path) -> Result<(), CliError> {
     let traces: Vec<Trace> = if kind.has_trajectory() {
         files
             .iter()
-            .map(|(name, t)| Trace::from_table(name, t))
+            .map(|(name, t)| Trace::from_table(name, t, ned))
             .collect()
     } else {
         Vec::new()

@@ -113,17 +113,27 @@ pub struct Trace {
 }
 
 impl Trace {
-    /// The `pos_x_m`, `pos_y_m` (and `pos_z_m` if present) columns of a table.
+    /// The `pos_x_m`, `pos_y_m` (and `pos_z_m` if present) columns of a table; NED positions
+    /// become east, north, up.
     #[must_use]
-    pub fn from_table(name: &str, t: &imu_scenario::Table) -> Self {
+    pub fn from_table(name: &str, t: &imu_scenario::Table, ned: bool) -> Self {
         let (x, y) = (
             t.column("pos_x_m").unwrap_or_default(),
             t.column("pos_y_m").unwrap_or_default(),
         );
         let z = t.column("pos_z_m").unwrap_or_else(|| vec![0.0; x.len()]);
+        let points = (0..x.len())
+            .map(|i| {
+                if ned {
+                    (y[i], x[i], -z[i])
+                } else {
+                    (x[i], y[i], z[i])
+                }
+            })
+            .collect();
         Self {
             name: name.to_string(),
-            points: (0..x.len()).map(|i| (x[i], y[i], z[i])).collect(),
+            points,
         }
     }
 }

@@ -88,16 +88,28 @@ def _kinds(tables: list) -> str:
     return first
 
 
-def _points(t: Table) -> np.ndarray:
+def _ned(nav_frame: str) -> bool:
+    if nav_frame.upper() not in ("ENU", "NED"):
+        raise ImuError(f"nav_frame: unknown frame {nav_frame!r}; ENU or NED")
+    return nav_frame.upper() == "NED"
+
+
+def _points(t: Table, ned: bool = False) -> np.ndarray:
+    """Positions (N, 3); NED ones as east, north, up."""
     z = t["pos_z_m"] if "pos_z_m" in t else np.zeros(len(t))
+    if ned:
+        return np.column_stack([t["pos_y_m"], t["pos_x_m"], -z])
     return np.column_stack([t["pos_x_m"], t["pos_y_m"], z])
 
 
-def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: Any = None) -> Any:
+def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: Any = None,
+               nav_frame: str = "ENU") -> Any:
     """Paths of truth or navigation tables (``pos_*_m``): seen from above with equal scales when
-    they stay in a plane, in 3D otherwise; start ● and end ✕ marked. Returns the figure."""
+    they stay in a plane, in 3D otherwise; start ● and end ✕ marked; ``nav_frame="NED"`` paths
+    are drawn east, north, up. Returns the figure."""
     loaded = _load(tables, labels)
-    paths = [(name, _points(t)) for name, t in loaded]
+    ned = _ned(nav_frame)
+    paths = [(name, _points(t, ned)) for name, t in loaded]
     three_d = _core.leaves_plane(np.ascontiguousarray(np.vstack([p for _, p in paths])))
     if ax is None:
         fig = _pyplot().figure(figsize=(6.4, 4.8))
@@ -163,10 +175,10 @@ def allan(tau_s: Union[Table, TableLike, np.ndarray], adev: Optional[np.ndarray]
     return ax.figure
 
 
-def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
+def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU") -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
-    dashed, dotted, …. Returns the figure."""
+    dashed, dotted, …; ``nav_frame="NED"`` paths are drawn east, north, up. Returns the figure."""
     loaded = _load(tables, labels)
     k = _kinds(loaded)
     if k == "allan":
@@ -183,10 +195,10 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
     fig = plt.figure(figsize=(5.6 * ncols, 3.2 * nrows), layout="constrained")
     index = 1
     if with_path:
-        points = np.vstack([_points(t) for _, t in loaded])
+        points = np.vstack([_points(t, _ned(nav_frame)) for _, t in loaded])
         three_d = _core.leaves_plane(np.ascontiguousarray(points))
         ax = fig.add_subplot(nrows, ncols, index, projection="3d" if three_d else None)
-        trajectory(*[t for _, t in loaded], labels=[n for n, _ in loaded], ax=ax)
+        trajectory(*[t for _, t in loaded], labels=[n for n, _ in loaded], ax=ax, nav_frame=nav_frame)
         index += 1
     for title, y_label, scale, columns in panels:
         ax = fig.add_subplot(nrows, ncols, index)
@@ -206,12 +218,13 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None) -> Any:
 
 def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
             lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = 20.0,
-            speed: Optional[float] = None) -> Any:
+            speed: Optional[float] = None, nav_frame: str = "ENU") -> Any:
     """The body moving along its path, as ``imukit animate`` draws it: a box of ``body_m``
     (length, width, height along body x, y, z; by default a tenth of the path's extent long)
     turned by the truth's attitude, its nose face red, the reference point (yellow) and the IMU
     point at ``lever_arm_m`` (violet), the trail blue. ``fps`` frames per second, ``speed``
-    seconds of motion per second (by default the animation lasts 4 to 12 s).
+    seconds of motion per second (by default the animation lasts 4 to 12 s). A ``nav_frame="NED"``
+    truth is drawn turned into east, north, up (the body axes stay those of the data).
 
     Returns a ``matplotlib.animation.FuncAnimation``; ``anim.save("body.gif", writer="pillow")``
     writes it."""
@@ -225,12 +238,15 @@ def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
     if lever.shape != (3,) or not np.all(np.isfinite(lever)):
         raise ValueError("lever_arm_m must be 3 finite numbers")
     frames, speed_used = _core.frame_plan(np.ascontiguousarray(t["t_s"]), float(fps), speed)
-    p = _points(t)
+    ned = _ned(nav_frame)
+    p = _points(t, ned)
     extent = float(np.max(np.ptp(p, axis=0)))
     body = np.asarray(_core.default_body_m(extent) if body_m is None else body_m, dtype=np.float64)
     if body.shape != (3,) or not np.all(body > 0):
         raise ValueError("body_m must be 3 positive numbers (length, width, height)")
     dcm = quaternion_to_dcm(np.column_stack([t["q_w"], t["q_x"], t["q_y"], t["q_z"]])[frames])
+    if ned:  # the body axes stay those of the data: C_enu,b = C_enu,ned · C_ned,b
+        dcm = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]) @ dcm
     half = body / 2.0
     corners = np.array([[(-1) ** (1 + (i & 1)) * half[0], (-1) ** (1 + ((i >> 1) & 1)) * half[1],
                          (-1) ** (1 + ((i >> 2) & 1)) * half[2]] for i in range(8)])
