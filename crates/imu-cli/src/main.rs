@@ -1,7 +1,5 @@
 //! `imukit`: IMU simulation and navigation from the command line.
-mod cli;
-mod commands;
-mod plot;
+use imu_cli::{cli, commands};
 
 use std::process::ExitCode;
 
