@@ -11,7 +11,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
-python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5"
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1"
 
 echo "== Format and lints"
 cargo fmt --all -- --check
@@ -35,7 +35,7 @@ echo "== Python stubs match the built module"
 python -m mypy.stubtest imukit._core
 
 echo "== Python tests"
-IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py
+IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py
 
 echo "== Examples"
 out=$(mktemp -d)

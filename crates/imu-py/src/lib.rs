@@ -970,6 +970,39 @@ fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
     table_out(py, t)
 }
 
+/// Writes a table as an imukit CSV (shortest round-trip numbers, atomically).
+#[pyfunction]
+fn write_csv(
+    py: Python<'_>,
+    path: &str,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'_, f64>,
+) -> PyResult<()> {
+    let v = values.as_array();
+    if v.ncols() != columns.len() {
+        return Err(PyValueError::new_err(format!(
+            "values have {} columns, the header {}",
+            v.ncols(),
+            columns.len()
+        )));
+    }
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let mut t = Table::new(&names);
+    for row in v.rows() {
+        t.push_row(&row.to_vec());
+    }
+    py.detach(move || t.write_csv(Path::new(path)))
+        .map_err(refused)
+}
+
+/// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).
+#[pyfunction]
+fn run_path(out: &str, run: u64, runs: u64) -> String {
+    imu_scenario::table::run_path(Path::new(out), run, runs)
+        .display()
+        .to_string()
+}
+
 /// The kind key of a table with these columns (`truth`, `imu`, `navigation`, `allan`,
 /// `errors`), or `None`.
 #[pyfunction]
@@ -1058,6 +1091,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(run_path, m)?)?;
     m.add_function(wrap_pyfunction!(table_kind, m)?)?;
     m.add_function(wrap_pyfunction!(figure_panels, m)?)?;
     m.add_function(wrap_pyfunction!(frame_plan, m)?)?;

@@ -347,6 +347,21 @@ impl CsvColumns {
     }
 }
 
+/// The file of Monte Carlo run `run` of `runs`: `dir/imu.csv`, run 7 → `dir/imu_run0007.csv`
+/// (at least 4 digits, more when `runs` needs them).
+#[must_use]
+pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
+    let digits = runs.saturating_sub(1).max(1).to_string().len().max(4);
+    let stem = out
+        .file_stem()
+        .map_or_else(|| "imu".into(), |s| s.to_string_lossy().into_owned());
+    let ext = out
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}_run{run:0digits$}{ext}"))
+}
+
 /// The header of a CSV file (trimmed names).
 ///
 /// # Errors

@@ -1,8 +1,9 @@
 //! `imukit simulate SCENARIO --out IMU.csv [--truth TRUTH.csv] [--runs N]`.
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imu_scenario::Scenario;
+use imu_scenario::table::run_path;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -44,12 +45,11 @@ pub fn run(
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let done = AtomicU64::new(0);
-    let digits = (runs - 1).max(1).to_string().len().max(4);
     (0..runs)
         .into_par_iter()
         .try_for_each(|r| -> Result<(), CliError> {
             let sim = sc.simulate_run(r)?;
-            sim.imu.write_csv(&run_path(out, r, digits))?;
+            sim.imu.write_csv(&run_path(out, r, runs))?;
             if r == 0
                 && let Some(t) = truth
             {
@@ -64,21 +64,8 @@ pub fn run(
         "imukit: {} runs of {} samples; IMU readings in {} … {}",
         done.load(Ordering::Relaxed),
         sc.t_s.len(),
-        run_path(out, 0, digits).display(),
-        run_path(out, runs - 1, digits).display()
+        run_path(out, 0, runs).display(),
+        run_path(out, runs - 1, runs).display()
     );
     Ok(())
-}
-
-/// `dir/imu.csv`, run 7 → `dir/imu_run0007.csv`.
-fn run_path(out: &Path, run: u64, digits: usize) -> PathBuf {
-    let stem = out
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "imu".into());
-    let ext = out
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    out.with_file_name(format!("{stem}_run{run:0digits$}{ext}"))
 }

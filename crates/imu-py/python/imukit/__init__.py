@@ -31,6 +31,8 @@ __all__ = [
     "Table",
     "Simulation",
     "simulate",
+    "monte_carlo",
+    "MonteCarlo",
     "ImuSensor",
     "AccelParams",
     "GyroParams",
@@ -657,3 +659,6 @@ def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_ra
         _times(t_s), knots, _rows("position_m", position_m, 3, n),
         velocity_m_s=None if velocity_m_s is None else _rows("velocity_m_s", velocity_m_s, 3),
         euler_rad=None if euler_rad is None else _rows("euler_rad", euler_rad, 3, n), nav_frame=nav_frame))
+
+
+from ._monte_carlo import MonteCarlo, monte_carlo  # noqa: E402  (needs Table above)
