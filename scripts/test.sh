@@ -11,7 +11,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
-python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1"
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1" "scipy>=1.7"
 
 echo "== Format and lints"
 cargo fmt --all -- --check
@@ -50,4 +50,7 @@ for f in seed_error_study matlab_imusensor allan_study navigation_round_trip; do
   python "examples/$f.py" --figures "$out/figures"
 done
 target/release/imukit exercise --out-dir "$out/exercise"
+
+echo "== NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"
+IMUKIT_BIN="$PWD/target/release/imukit" python benches/compare_numpy.py --sizes 1e4
 echo "== All tests passed"

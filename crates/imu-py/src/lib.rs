@@ -6,10 +6,10 @@ use std::path::Path;
 use imu_core::Ned;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
-use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, Temperatures};
+use imu_core::sensor::{ImuModel, ImuState, SeededNormals, Temperatures};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
-use imu_core::{Body, Enu, EulerZyx, Rotation};
+use imu_core::{Body, Enu, EulerZyx, NavFrame, Rotation, Vec3};
 use imu_scenario::figures::{self, TableKind};
 use imu_scenario::params::{Profile, read_param_file, to_toml};
 use imu_scenario::scenario::{
@@ -22,7 +22,8 @@ use imu_scenario::{ScenarioSpec, Table};
 use imu_scenario::{analysis, arrays, navigation, planar, presets};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3,
 };
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -440,6 +441,70 @@ fn dcm_to_quaternion<'py>(
     array2(py, m.len(), 4, q)
 }
 
+/// A contiguous (N, K) float array as one flat slice, row after row.
+fn flat_rows<'a, const K: usize>(
+    name: &str,
+    a: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<&'a [f64]> {
+    let shape = a.as_array().shape().to_vec();
+    if shape[1] != K {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape (N, {K}), got {shape:?}"
+        )));
+    }
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name} must be C-contiguous")))
+}
+
+/// The orientation of each sample as the caller gave it.
+enum Orientation<'a> {
+    /// `[w, x, y, z]` rows, flat.
+    Quaternions(&'a [f64]),
+    /// MATLAB rotation matrices (nav → body, `C_nbᵀ`) already read.
+    Matrices(&'a [[[f64; 3]; 3]]),
+}
+
+impl Orientation<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Self::Quaternions(q) => q.len() / 4,
+            Self::Matrices(m) => m.len(),
+        }
+    }
+
+    fn at<N: NavFrame>(&self, i: usize) -> Rotation<Body, N> {
+        match self {
+            Self::Quaternions(q) => {
+                let c = &q[4 * i..4 * i + 4];
+                Rotation::from_wxyz([c[0], c[1], c[2], c[3]]).unwrap_or_default()
+            }
+            Self::Matrices(m) => Rotation::from_dcm(&m[i]),
+        }
+    }
+}
+
+/// MATLAB's batch call: nav-frame inputs row by row into `out` (accel, gyro, mag per row), with
+/// no intermediate buffers.
+#[allow(clippy::too_many_arguments)]
+fn measure_rows<N: NavFrame>(
+    model: &ImuModel<N>,
+    a: &[f64],
+    w: &[f64],
+    orientation: &Orientation<'_>,
+    temps: &Temperatures,
+    state: &mut ImuState,
+    noise: &mut SeededNormals,
+    out: &mut [f64],
+) {
+    for (i, o) in out.chunks_exact_mut(9).enumerate() {
+        let v = |x: &[f64]| Vec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        let r = model.measure_nav(v(a), v(w), &orientation.at::<N>(i), temps, state, noise);
+        o[..3].copy_from_slice(&r.accel_m_s2);
+        o[3..6].copy_from_slice(&r.gyro_rad_s);
+        o[6..].copy_from_slice(&r.mag_ut);
+    }
+}
+
 /// The navigation-frame generic model behind `ImuSensor`.
 enum Model {
     Enu(ImuModel<Enu>),
@@ -543,50 +608,53 @@ impl PyImuSensor {
         quaternion: Option<PyReadonlyArray2<'py, f64>>,
         dcm: Option<PyReadonlyArray3<'py, f64>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let a = rows::<3>("acceleration", &acceleration)?;
-        let w = rows::<3>("angular_velocity", &angular_velocity)?;
-        check_len("angular_velocity", w.len(), a.len())?;
-        let attitude: Vec<Rotation<Body, Enu>> = match (quaternion, dcm) {
-            (Some(q), None) => rotations(&q)?,
-            (None, Some(m)) => dcm_in("orientation", &m)?
-                .iter()
-                .map(Rotation::from_dcm)
-                .collect(),
+        let a = flat_rows::<3>("acceleration", &acceleration)?;
+        let w = flat_rows::<3>("angular_velocity", &angular_velocity)?;
+        check_len("angular_velocity", w.len() / 3, a.len() / 3)?;
+        let n = a.len() / 3;
+        // The orientation stays in the caller's array; each sample's rotation is made in the loop.
+        let dcm_rows;
+        let orientation = match (&quaternion, &dcm) {
+            (Some(q), None) => {
+                let q = flat_rows::<4>("quaternion", q)?;
+                if let Some(i) = q.chunks_exact(4).position(|c| {
+                    Rotation::<Body, Enu>::from_wxyz([c[0], c[1], c[2], c[3]]).is_none()
+                }) {
+                    return Err(ImuError::new_err(format!(
+                        "quaternion[{i}] has zero norm or is not finite"
+                    )));
+                }
+                Orientation::Quaternions(q)
+            }
+            (None, Some(m)) => {
+                dcm_rows = dcm_in("orientation", m)?;
+                Orientation::Matrices(&dcm_rows)
+            }
             _ => {
                 return Err(PyValueError::new_err(
                     "give the orientation as quaternions or as matrices",
                 ));
             }
         };
-        check_len("orientation", attitude.len(), a.len())?;
-        let n = a.len();
-        let (model, state, noise, temps) = (
-            &self.model,
-            &mut self.state,
-            &mut self.noise,
-            self.temperature,
-        );
-        let out = py.detach(move || {
-            let mut out = vec![ImuReading::default(); n];
-            match model {
-                Model::Enu(m) => {
-                    m.measure_nav_into(&a, &w, &attitude, &temps, state, noise, &mut out)
-                }
-                Model::Ned(m) => {
-                    let att: Vec<Rotation<Body, Ned>> = attitude
-                        .iter()
-                        .map(|r| Rotation::assume_from_quaternion(*r.quaternion()))
-                        .collect();
-                    m.measure_nav_into(&a, &w, &att, &temps, state, noise, &mut out);
-                }
-            }
-            out
-        });
-        let flat: Vec<f64> = out
-            .iter()
-            .flat_map(|r| r.accel_m_s2.into_iter().chain(r.gyro_rad_s).chain(r.mag_ut))
-            .collect();
-        array2(py, n, 9, flat)
+        check_len("orientation", orientation.len(), n)?;
+        let out = PyArray2::<f64>::zeros(py, [n, 9], false);
+        {
+            let mut guard = out.readwrite();
+            let o = guard
+                .as_slice_mut()
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            let (model, state, noise, temps) = (
+                &self.model,
+                &mut self.state,
+                &mut self.noise,
+                self.temperature,
+            );
+            py.detach(|| match model {
+                Model::Enu(m) => measure_rows(m, a, w, &orientation, &temps, state, noise, o),
+                Model::Ned(m) => measure_rows(m, a, w, &orientation, &temps, state, noise, o),
+            });
+        }
+        Ok(out)
     }
 
     /// Back to the initial state and the start of the seeded noise stream.

@@ -1,0 +1,215 @@
+"""imukit against a hand-vectorised NumPy implementation of the same pipeline, timed in one run.
+
+The pipeline: sampled positions and Euler angles (a figure-8 with a banking, pitching body) →
+truth by differentiation (MATLAB ``gradient``, imukit ``order=2``) → specific force and body rate
+→ MATLAB imuSensor's full error model on accelerometer, gyroscope and magnetometer (bias,
+misalignment, white noise, bias-instability filter, random walk, temperature bias and scale,
+gyroscope acceleration bias, saturation, quantisation; double-sided densities, MATLAB's signs).
+
+The NumPy reference is written as a competent NumPy user would (whole-array operations, SciPy's
+``lfilter`` for the bias-instability filter). Before timing, the two are checked to agree: to
+rounding with the noise terms at zero, and in distribution with noise (the white, random-walk and
+bias-instability parts have the variances theory gives, in both).
+
+Run (prints a table of time ratios; one core: both sides are single-threaded):
+    python benches/compare_numpy.py                     # N = 10⁴ … 10⁶
+    python benches/compare_numpy.py --sizes 1e4 1e5 1e6 1e7
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.signal import lfilter
+
+import imukit
+
+FS = 100.0
+G = 9.81
+TEMPERATURE = 35.0
+MAG_NED = np.array([27.5550, -2.4169, -16.0849])
+
+
+def params(noise: bool) -> dict:
+    """MATLAB property values of the three sensors; the noise terms zeroed when ``noise`` is off."""
+    k = 1.0 if noise else 0.0
+    common = dict(AxesMisalignment=[[100.0, 0.2, -0.1], [0.3, 100.0, 0.1], [-0.2, 0.1, 100.0]],
+                  TemperatureScaleFactor=[0.02, 0.03, 0.01])
+    return {
+        "accelerometer": dict(common, MeasurementRange=200.0, Resolution=1e-6, ConstantBias=[0.05, -0.03, 0.02],
+                              NoiseDensity=3e-3 * k, BiasInstability=2e-3 * k, RandomWalk=1e-4 * k,
+                              TemperatureBias=[1e-3, 2e-3, 3e-3]),
+        "gyroscope": dict(common, MeasurementRange=40.0, Resolution=1e-7, ConstantBias=[1e-3, -2e-3, 5e-4],
+                          NoiseDensity=1e-4 * k, BiasInstability=5e-5 * k, RandomWalk=1e-6 * k,
+                          TemperatureBias=[1e-4, 1e-4, 2e-4], AccelerationBias=[1e-4, 2e-4, 3e-4]),
+        "magnetometer": dict(common, MeasurementRange=1000.0, Resolution=1e-3, ConstantBias=[0.5, -0.4, 0.3],
+                             NoiseDensity=0.05 * k, BiasInstability=0.02 * k, RandomWalk=1e-3 * k,
+                             TemperatureBias=[0.01, 0.02, 0.03]),
+    }
+
+
+def trajectory(n: int):
+    """The sampled input: times, NED positions and z-y-x Euler angles (smooth, no wrap)."""
+    t = np.arange(n) / FS
+    w = 2 * np.pi / 20.0
+    p = np.column_stack([10 * np.sin(w * t), 5 * np.sin(2 * w * t), -2 + 0.5 * np.sin(3 * w * t)])
+    e = np.column_stack([0.8 * np.sin(w * t), 0.2 * np.sin(2 * w * t), 0.3 * np.sin(w * t + 0.5)])
+    return t, p, e
+
+
+# --- The NumPy reference -------------------------------------------------------------------
+
+def dcm_nb(e: np.ndarray) -> np.ndarray:
+    """C_nb = Rz(yaw) Ry(pitch) Rx(roll), (N, 3, 3)."""
+    cy, sy = np.cos(e[:, 0]), np.sin(e[:, 0])
+    cp, sp = np.cos(e[:, 1]), np.sin(e[:, 1])
+    cr, sr = np.cos(e[:, 2]), np.sin(e[:, 2])
+    return np.stack([
+        np.stack([cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr], axis=-1),
+        np.stack([sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], axis=-1),
+        np.stack([-sp, cp * sr, cp * cr], axis=-1),
+    ], axis=1)
+
+
+def matlab_round(x: np.ndarray) -> np.ndarray:
+    return np.sign(x) * np.floor(np.abs(x) + 0.5)
+
+
+def sensor(u, p, normals, accel_n=None):
+    """MATLAB imuSensor's steps 2–7 for one sensor on body-frame input ``u`` (N, 3)."""
+    beta = FS / 2.0  # double-sided
+    m = np.asarray(p["AxesMisalignment"]) / 100.0
+    y = u @ m.T + np.asarray(p["ConstantBias"])
+    n_bi, n_w, n_rw = normals[:, 0:3], normals[:, 3:6], normals[:, 6:9]
+    y += lfilter([1.0], [1.0, -0.5], p["BiasInstability"] * n_bi, axis=0)
+    y += p["NoiseDensity"] * np.sqrt(beta) * n_w
+    y += np.cumsum(p["RandomWalk"] / np.sqrt(beta) * n_rw, axis=0)
+    y += (TEMPERATURE - 25.0) * np.asarray(p["TemperatureBias"])
+    if accel_n is not None:
+        y += np.asarray(p["AccelerationBias"]) * accel_n
+    y *= 1.0 + (TEMPERATURE - 25.0) * np.asarray(p["TemperatureScaleFactor"]) / 100.0
+    r = p["MeasurementRange"]
+    y = np.clip(y, -r, r)
+    return p["Resolution"] * matlab_round(y / p["Resolution"])
+
+
+def numpy_pipeline(t, pos, euler, prm, normals):
+    vel = np.gradient(pos, t, axis=0, edge_order=1)
+    acc = np.gradient(vel, t, axis=0, edge_order=1)
+    de = np.gradient(euler, t, axis=0, edge_order=1)
+    sp, cp = np.sin(euler[:, 1]), np.cos(euler[:, 1])
+    sr, cr = np.sin(euler[:, 2]), np.cos(euler[:, 2])
+    omega_b = np.column_stack([de[:, 2] - de[:, 0] * sp,
+                               de[:, 1] * cr + de[:, 0] * cp * sr,
+                               -de[:, 1] * sr + de[:, 0] * cp * cr])
+    c = dcm_nb(euler)
+    f_b = np.einsum("nji,nj->ni", c, -acc + np.array([0.0, 0.0, G]))  # R (−a + g ĝ), NED
+    m_b = np.einsum("nji,j->ni", c, MAG_NED)
+    return (sensor(f_b, prm["accelerometer"], normals[:, 0:9]),
+            sensor(omega_b, prm["gyroscope"], normals[:, 9:18], accel_n=acc),
+            sensor(m_b, prm["magnetometer"], normals[:, 18:27]))
+
+
+# --- imukit ---------------------------------------------------------------------------------
+
+def imukit_pipeline(t, pos, euler, prm, seed=1):
+    truth = imukit.truth_from_samples(t, pos, euler_rad=euler, order=2, nav_frame="NED")
+    q = truth.values[:, 10:14]
+    acc = truth.values[:, 7:10]
+    omega_n = np.einsum("nij,nj->ni", imukit.quaternion_to_dcm(q), truth.values[:, 17:20])
+    imu = imukit.ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=FS, temperature=TEMPERATURE,
+                           seed=seed, magnetic_field=MAG_NED, **prm)
+    return imu(acc, omega_n, q)
+
+
+def check_agreement(n: int) -> None:
+    t, pos, euler = trajectory(n)
+    quiet = params(noise=False)
+    ours = imukit_pipeline(t, pos, euler, quiet)
+    ref = numpy_pipeline(t, pos, euler, quiet, np.zeros((n, 27)))
+    for name, a, b, res in zip(("accel", "gyro", "mag"), ours, ref, (1e-6, 1e-7, 1e-3)):
+        # Equal to rounding; a reading may sit one resolution step apart where the rounded
+        # value lies within rounding error of a half step.
+        diff = np.abs(a - b)
+        assert np.all(diff <= res * (1 + 1e-9)), f"{name}: max difference {diff.max():.3e}"
+        assert np.mean(diff > 0) < 1e-3, f"{name}: {np.mean(diff > 0):.2%} of readings differ"
+    # With noise: the drift (readings minus the noise-free ones) has theory's variance in both.
+    noisy = params(noise=True)
+    ours_n = imukit_pipeline(t, pos, euler, noisy, seed=7)
+    ref_n = numpy_pipeline(t, pos, euler, noisy, np.random.default_rng(7).standard_normal((n, 27)))
+    for k, name in enumerate(("accelerometer", "gyroscope", "magnetometer")):
+        p = noisy[name]
+        scale = 1.0 + (TEMPERATURE - 25.0) * np.asarray(p["TemperatureScaleFactor"]) / 100.0
+        # Increments of the drift remove the random walk's growth: white + AR(1) bias instability
+        # + one random-walk step, each independent.
+        var_w = p["NoiseDensity"] ** 2 * FS / 2
+        var_bi = p["BiasInstability"] ** 2 / (1 - 0.25)  # stationary AR(1), pole 0.5
+        lag1_bi = 0.5 * var_bi
+        var_rw = p["RandomWalk"] ** 2 / (FS / 2)
+        expected = scale ** 2 * (2 * var_w + 2 * (var_bi - lag1_bi) + var_rw)
+        for label, noisy_out, quiet_out in (("imukit", ours_n[k], ours[k]), ("numpy", ref_n[k], ref[k])):
+            d = np.diff(noisy_out - quiet_out, axis=0)[n // 10:]
+            var = d.var(axis=0)
+            # Increments are MA(1)-correlated: allow 8/√n relative (> 5 standard errors).
+            assert np.all(np.abs(var / expected - 1) < 8 / np.sqrt(len(d))), f"{name} {label}: {var / expected}"
+
+
+def best_of(f, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        start = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def cli_time(t, pos, euler, prm, work: Path) -> float:
+    """`imukit simulate` on the same samples, from CSV in to CSV out (parsing and writing included)."""
+    binary = os.environ.get("IMUKIT_BIN") or shutil.which("imukit") or str(
+        Path(__file__).resolve().parents[1] / "target" / "release" / "imukit")
+    samples = work / "samples.csv"
+    header = "t_s,pos_x_m,pos_y_m,pos_z_m,yaw_rad,pitch_rad,roll_rad"
+    np.savetxt(samples, np.column_stack([t, pos, euler]), delimiter=",", header=header, comments="", fmt="%.17g")
+    scenario = {
+        "rate_hz": FS, "nav_frame": "NED",
+        "trajectory": {"type": "samples", "file": str(samples), "order": 2},
+        "imu": {"kind": "accel-gyro-mag", "profile": "matlab", "seed": 1, "temperature_c": TEMPERATURE,
+                "magnetic_field_ut": MAG_NED.tolist(), **prm},
+    }
+    spec = work / "scenario.json"
+    spec.write_text(json.dumps(scenario))
+    out = work / "imu.csv"
+    return best_of(lambda: subprocess.run([binary, "simulate", str(spec), "--out", str(out)], check=True,
+                                          capture_output=True), 1)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
+    parser.add_argument("--no-cli", action="store_true", help="leave out the CLI column")
+    args = parser.parse_args()
+    check_agreement(20_000)
+    print("agreement: noise-free outputs equal to rounding; drift variances match theory in both")
+    prm = params(noise=True)
+    print(f"{'N':>10} {'NumPy / imukit (Python)':>24} {'NumPy / imukit (CLI, CSV in+out)':>34}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for size in args.sizes:
+            n = int(size)
+            t, pos, euler = trajectory(n)
+            repeat = 3 if n <= 1_000_000 else 1
+            t_np = best_of(lambda: numpy_pipeline(t, pos, euler, prm,
+                                                  np.random.default_rng(1).standard_normal((n, 27))), repeat)
+            t_py = best_of(lambda: imukit_pipeline(t, pos, euler, prm), repeat)
+            cli = "" if args.no_cli else f"{t_np / cli_time(t, pos, euler, prm, Path(tmp)):>34.2f}"
+            print(f"{n:>10} {t_np / t_py:>24.2f} {cli}")
+
+
+if __name__ == "__main__":
+    main()
