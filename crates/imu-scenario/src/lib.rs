@@ -16,6 +16,7 @@ pub mod planar;
 pub mod presets;
 pub mod scenario;
 pub mod sensors;
+pub mod stream;
 pub mod table;
 pub mod track;
 pub mod units;

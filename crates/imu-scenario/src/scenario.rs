@@ -654,25 +654,33 @@ impl ImuSetup {
         sample_rate_hz: f64,
         run: Option<u64>,
     ) -> Result<Vec<ImuReading>> {
+        Ok(self
+            .reading_stream(gravity_m_s2, sample_rate_hz, run)?
+            .measure(truth))
+    }
+
+    /// The sensors as a stream: [`ReadingStream::measure`] over consecutive chunks of truth
+    /// gives the readings of one call over all of it (state and noise carry over).
+    ///
+    /// # Errors
+    /// Invalid (perturbed) parameters.
+    pub fn reading_stream<N: NavFrame>(
+        &self,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+        run: Option<u64>,
+    ) -> Result<ReadingStream<'_, N>> {
         let seed = self.sensors.seed;
         let params = perturbed(&self.sensors.params, &self.sensors.perturbations, seed, run)?;
-        let model = self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?;
-        let mut noise = run.map_or_else(
-            || SeededNormals::new(seed),
-            |r| SeededNormals::for_run(seed, r),
-        );
-        let mut state = ImuState::default();
-        Ok(truth
-            .iter()
-            .map(|s| {
-                model.measure(
-                    s,
-                    &self.sensors.temperature.at(s.t_s),
-                    &mut state,
-                    &mut noise,
-                )
-            })
-            .collect())
+        Ok(ReadingStream {
+            model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
+            noise: run.map_or_else(
+                || SeededNormals::new(seed),
+                |r| SeededNormals::for_run(seed, r),
+            ),
+            state: ImuState::default(),
+            setup: self,
+        })
     }
 
     /// The core's mount description in frame `N`.
@@ -686,6 +694,29 @@ impl ImuSetup {
                 .magnetic_field_ut
                 .map_or_else(N::default_magnetic_field_ut, Vec3::from_array),
         }
+    }
+}
+
+/// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
+#[derive(Debug)]
+pub struct ReadingStream<'a, N: NavFrame> {
+    model: ImuModel<N>,
+    noise: SeededNormals,
+    state: ImuState,
+    setup: &'a ImuSetup,
+}
+
+impl<N: NavFrame> ReadingStream<'_, N> {
+    /// The readings of the next samples of truth.
+    pub fn measure(&mut self, truth: &[Truth<N>]) -> Vec<ImuReading> {
+        truth
+            .iter()
+            .map(|s| {
+                let temperatures = self.setup.sensors.temperature.at(s.t_s);
+                self.model
+                    .measure(s, &temperatures, &mut self.state, &mut self.noise)
+            })
+            .collect()
     }
 }
 
@@ -1029,7 +1060,7 @@ fn analytic_truth<M: Motion, N: NavFrame>(
     Ok(out)
 }
 
-fn with_time(t_s: &[f64], source: KinematicsError, what: &str) -> Error {
+pub(crate) fn with_time(t_s: &[f64], source: KinematicsError, what: &str) -> Error {
     let context = match source.index().and_then(|i| t_s.get(i)) {
         Some(t) => format!("{what} at t = {t} s"),
         None => what.to_string(),

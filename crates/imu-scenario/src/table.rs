@@ -215,9 +215,25 @@ impl Table {
     /// [`Error::Io`] naming the file.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         write_atomically(path, |w| {
-            writeln!(w, "{}", self.columns.join(","))?;
-            write_rows(w, &self.data, self.columns.len().max(1), b",")
+            self.write_header(w)?;
+            self.write_body(w)
         })
+    }
+
+    /// Writes the CSV header row.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn write_header(&self, w: &mut impl Write) -> std::io::Result<()> {
+        writeln!(w, "{}", self.columns.join(","))
+    }
+
+    /// Writes the rows as CSV (shortest round-trip numbers), without the header.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn write_body(&self, w: &mut impl Write) -> std::io::Result<()> {
+        write_rows(w, &self.data, self.columns.len().max(1), b",")
     }
 }
 
@@ -230,22 +246,78 @@ pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<()> {
-    let tmp = temporary_path(path);
-    let result = (|| -> std::io::Result<()> {
-        let mut w = BufWriter::new(File::create(&tmp)?);
-        fill(&mut w)?;
-        w.into_inner()
-            .map_err(std::io::IntoInnerError::into_error)?
-            .sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    let mut file = AtomicFile::create(path)?;
+    fill(file.writer()).map_err(|source| file.error(source))?;
+    file.commit()
+}
+
+/// A file written under a temporary name beside its path and renamed into place by
+/// [`AtomicFile::commit`]; dropped uncommitted (an error on the way), the temporary file is
+/// removed, so no half-written file is ever left looking complete.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    writer: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn create(path: &Path) -> Result<Self> {
+        let tmp = temporary_path(path);
+        let file = File::create(&tmp).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp,
+            writer: Some(BufWriter::new(file)),
+        })
     }
-    result.map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+
+    /// The buffered writer.
+    ///
+    /// # Panics
+    /// Never: the writer exists until `commit` consumes the file.
+    pub fn writer(&mut self) -> &mut BufWriter<File> {
+        self.writer.as_mut().expect("the writer lives until commit")
+    }
+
+    /// An I/O error of this file.
+    #[must_use]
+    pub fn error(&self, source: std::io::Error) -> Error {
+        Error::Io {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    /// Flushes, syncs and renames the file into place.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file (the temporary file is then removed).
+    pub fn commit(mut self) -> Result<()> {
+        let result = (|| -> std::io::Result<()> {
+            if let Some(w) = self.writer.take() {
+                w.into_inner()
+                    .map_err(std::io::IntoInnerError::into_error)?
+                    .sync_all()?;
+            }
+            std::fs::rename(&self.tmp, &self.path)
+        })();
+        result.map_err(|source| self.error(source))
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Committed files were renamed away; anything left is incomplete.
+        let _ = std::fs::remove_file(&self.tmp);
+    }
 }
 
 /// Writes row-major `data` in rows of `width`, values in shortest round-trip form separated by

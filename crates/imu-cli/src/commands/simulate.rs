@@ -17,14 +17,11 @@ pub fn run(
 ) -> Result<(), CliError> {
     let sc = Scenario::from_file(scenario)?;
     let Some(runs) = runs else {
-        let sim = sc.simulate()?;
-        sim.imu.write_csv(out)?;
-        if let Some(t) = truth {
-            sim.truth.write_csv(t)?;
-        }
+        // Streamed: chunks are written as they are made, so memory does not grow with duration.
+        sc.stream_to_csv(None, out, truth)?;
         eprintln!(
             "imukit: {} samples; IMU readings in {}{}",
-            sim.imu.rows(),
+            sc.t_s.len(),
             out.display(),
             truth
                 .map(|t| format!(", truth in {}", t.display()))
@@ -48,13 +45,7 @@ pub fn run(
     (0..runs)
         .into_par_iter()
         .try_for_each(|r| -> Result<(), CliError> {
-            let sim = sc.simulate_run(r)?;
-            sim.imu.write_csv(&run_path(out, r, runs))?;
-            if r == 0
-                && let Some(t) = truth
-            {
-                sim.truth.write_csv(t)?;
-            }
+            sc.stream_to_csv(Some(r), &run_path(out, r, runs), truth.filter(|_| r == 0))?;
             done.fetch_add(1, Ordering::Relaxed);
             progress.inc(1);
             Ok(())

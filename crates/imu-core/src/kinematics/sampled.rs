@@ -232,7 +232,7 @@ fn tangent_path<N: NavFrame>(
 }
 
 /// Gives leading standstill samples (before `first_valid`) the first valid tangent attitude.
-pub(crate) fn backfill_standstill<N: NavFrame>(out: &mut [Truth<N>], first_valid: Option<usize>) {
+pub fn backfill_standstill<N: NavFrame>(out: &mut [Truth<N>], first_valid: Option<usize>) {
     if let Some(first) = first_valid {
         let euler = out[first].euler;
         for s in &mut out[..first] {
