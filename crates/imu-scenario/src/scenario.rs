@@ -723,8 +723,8 @@ impl<N: NavFrame> ReadingStream<'_, N> {
 /// A resolved, runnable scenario.
 #[derive(Clone, Debug)]
 pub struct Scenario {
-    /// Sample times, s.
-    pub t_s: Vec<f64>,
+    /// Sample times.
+    pub t_s: SampleTimes,
     /// Sample rate of the sensor error model, Hz (`rate_hz`, or the mean rate of a samples file).
     pub sample_rate_hz: f64,
     /// Navigation frame.
@@ -770,6 +770,15 @@ fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
 /// # Errors
 /// Non-positive rate, negative or non-finite duration, more than 10⁹ samples.
 pub fn sample_times(rate_hz: f64, duration_s: f64) -> Result<Vec<f64>> {
+    Ok(regular_times(rate_hz, duration_s)?.to_vec())
+}
+
+/// The regular grid `k / rate_hz`, `k = 0..=round(duration_s · rate_hz)`, kept as a rule.
+///
+/// # Errors
+/// A rate that is not finite and positive, a negative or non-finite duration, more than 10⁹
+/// samples.
+pub fn regular_times(rate_hz: f64, duration_s: f64) -> Result<SampleTimes> {
     let rate = finite_positive("rate_hz", rate_hz)?;
     if !(duration_s.is_finite() && duration_s >= 0.0) {
         return Err(invalid(
@@ -784,7 +793,60 @@ pub fn sample_times(rate_hz: f64, duration_s: f64) -> Result<Vec<f64>> {
             format!("{duration_s} s at {rate} Hz is more than 10⁹ samples"),
         ));
     }
-    Ok((0..=last as u64).map(|k| k as f64 / rate).collect())
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let count = last as usize + 1;
+    Ok(SampleTimes::Regular {
+        rate_hz: rate,
+        count,
+    })
+}
+
+/// The sample times of a scenario: a regular grid computed on demand (long runs do not hold
+/// their times) or the times listed in a file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SampleTimes {
+    /// `k / rate_hz` for `k = 0..count`.
+    Regular {
+        /// Sample rate, Hz.
+        rate_hz: f64,
+        /// Number of samples.
+        count: usize,
+    },
+    /// Times read from a file, s.
+    Listed(Vec<f64>),
+}
+
+impl SampleTimes {
+    /// Number of samples.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Regular { count, .. } => *count,
+            Self::Listed(t) => t.len(),
+        }
+    }
+
+    /// True when there are no samples.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Time of sample `k`, s (`k < len()`).
+    #[must_use]
+    pub fn at(&self, k: usize) -> f64 {
+        match self {
+            #[allow(clippy::cast_precision_loss)]
+            Self::Regular { rate_hz, .. } => k as f64 / rate_hz,
+            Self::Listed(t) => t[k],
+        }
+    }
+
+    /// All times, s.
+    #[must_use]
+    pub fn to_vec(&self) -> Vec<f64> {
+        (0..self.len()).map(|k| self.at(k)).collect()
+    }
 }
 
 impl ScenarioSpec {
@@ -881,7 +943,7 @@ impl ScenarioSpec {
         let (trajectory, t_s) = match &spec.trajectory {
             TrajectorySpec::Expression(e) => {
                 let min_speed_m_s = e.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
-                let t = sample_times(
+                let t = regular_times(
                     need(spec.rate_hz, "rate_hz")?,
                     need(spec.duration_s, "duration_s")?,
                 )?;
@@ -903,7 +965,7 @@ impl ScenarioSpec {
                 };
                 let track = Track::new(k.start_m, k.heading_rad, k.segments.clone(), speed)?;
                 let duration = spec.duration_s.unwrap_or_else(|| track.travel_time_s());
-                let t = sample_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
                 (Trajectory::Track(track), t)
             }
             TrajectorySpec::Samples(s) => {
@@ -925,7 +987,7 @@ impl ScenarioSpec {
                     .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
                 let min_speed = s.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
                 let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
-                let t = path.t_s.clone();
+                let t = SampleTimes::Listed(path.t_s.clone());
                 (Trajectory::Samples(path), t)
             }
             TrajectorySpec::Waypoints(w) => {
@@ -936,18 +998,18 @@ impl ScenarioSpec {
                     w.euler_rad.as_deref(),
                 )?;
                 let duration = spec.duration_s.unwrap_or(path.end_s);
-                let t = sample_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
                 (Trajectory::Waypoints(path), t)
             }
             TrajectorySpec::BodyRates(b) => {
                 let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
-                (Trajectory::BodyRates(data), t)
+                (Trajectory::BodyRates(data), SampleTimes::Listed(t))
             }
             TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
         };
         let sample_rate_hz = match spec.rate_hz {
             Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
-            _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s[t_s.len() - 1] - t_s[0]),
+            _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s.at(t_s.len() - 1) - t_s.at(0)),
             _ => spec.rate_hz.unwrap_or(1.0),
         };
         Ok(Scenario {
@@ -1128,7 +1190,7 @@ impl Scenario {
     }
 
     fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
-        let truth = self.trajectory.truth::<N>(&self.t_s)?;
+        let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
         let readings = self
             .imu
             .readings(&truth, self.gravity_m_s2, self.sample_rate_hz, run)?;

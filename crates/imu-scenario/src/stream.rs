@@ -2,9 +2,9 @@
 //! numbers as [`Scenario::simulate`] bit for bit, written as they are made.
 //!
 //! Analytic trajectories (expression, track, waypoints, and the built-ins made of them) are
-//! evaluated sample by sample with the core's [`AnalyticStepper`], so memory does not grow with
-//! the duration (only the sample times, 8 bytes per sample, are held, and the leading standstill
-//! of a tangent attitude until the body first moves). Sampled and body-rate trajectories are read
+//! evaluated sample by sample with the core's [`AnalyticStepper`] at times computed on demand, so
+//! memory does not grow with the duration (only the leading standstill of a tangent attitude is
+//! held until the body first moves). Sampled and body-rate trajectories are read
 //! and differentiated or integrated whole, as they come from files, then streamed.
 use std::path::Path;
 
@@ -14,7 +14,7 @@ use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
-use crate::scenario::{NavFrameName, Scenario, Trajectory, with_time};
+use crate::scenario::{NavFrameName, SampleTimes, Scenario, Trajectory, with_time};
 use crate::table::{AtomicFile, ImuOutput, Table};
 
 /// Samples per streamed chunk.
@@ -144,7 +144,7 @@ impl Scenario {
                 &mut emit,
             ),
             Trajectory::Samples(_) | Trajectory::BodyRates(_) => {
-                let truth = self.trajectory.truth::<N>(t_s)?;
+                let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;
                 truth.chunks(STREAM_CHUNK).try_for_each(&mut emit)
             }
         }
@@ -157,15 +157,17 @@ impl Scenario {
 fn motion_chunks<M: Motion, N: NavFrame>(
     motion: &M,
     options: AnalyticOptions,
-    t_s: &[f64],
+    t_s: &SampleTimes,
     what: &str,
     emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
 ) -> Result<()> {
     let mut stepper = AnalyticStepper::new(motion, options);
     let mut buffer: Vec<Truth<N>> = Vec::with_capacity(STREAM_CHUNK);
     let mut moving = false;
-    for &t in t_s {
-        let (truth, valid) = stepper.step::<N>(t).map_err(|e| with_time(t_s, e, what))?;
+    for k in 0..t_s.len() {
+        let (truth, valid) = stepper
+            .step::<N>(t_s.at(k))
+            .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
         buffer.push(truth);
         if valid && !moving {
             moving = true;
