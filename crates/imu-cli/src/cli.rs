@@ -127,7 +127,8 @@ pub enum Command {
         plot: Option<PathBuf>,
     },
     /// Runs a built-in scenario (default: the seed's figure-8 with its lever arm) and writes the
-    /// scenario, truth, IMU readings and a summary into a folder.
+    /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
+    /// and a summary into a folder.
     Demo {
         /// Output folder.
         #[arg(long, default_value = "imukit-demo")]
