@@ -6,14 +6,20 @@
 //! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
 //! yaw_rad, pitch_rad, roll_rad`.
 use imu_core::strapdown::rk4::strapdown_rates_rk4;
+use std::io::Write;
+use std::path::Path;
+
 use imu_core::strapdown::step::{
-    NavState, StrapdownOptions, strapdown_increments, strapdown_rates,
+    NavState, RateStrapdown, Strapdown, StrapdownError, StrapdownOptions, strapdown_increments,
+    strapdown_rates,
 };
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
 use crate::scenario::NavFrameName;
-use crate::table::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
+use crate::table::{
+    ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table, write_rows,
+};
 
 /// Navigation output columns.
 pub const NAV_COLUMNS: [&str; 14] = [
@@ -113,6 +119,38 @@ impl InitialState {
             quaternion: [first("q_w")?, first("q_x")?, first("q_y")?, first("q_z")?],
         })
     }
+
+    /// The first row of a truth CSV file (read alone: memory does not grow with the file).
+    ///
+    /// # Errors
+    /// Missing columns, a bad first row (file, row, column), an empty file.
+    pub fn from_csv(path: &Path) -> Result<Self> {
+        const COLS: [&str; 10] = [
+            "pos_x_m",
+            "pos_y_m",
+            "pos_z_m",
+            "vel_x_m_s",
+            "vel_y_m_s",
+            "vel_z_m_s",
+            "q_w",
+            "q_x",
+            "q_y",
+            "q_z",
+        ];
+        let mut rows = CsvRows::open(path, &COLS, "the initial state comes from a truth CSV")?;
+        let mut r = [0.0; 10];
+        if rows.next_row(&mut r)?.is_none() {
+            return Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        }
+        Ok(Self {
+            position_m: [r[0], r[1], r[2]],
+            velocity_m_s: [r[3], r[4], r[5]],
+            quaternion: [r[6], r[7], r[8], r[9]],
+        })
+    }
 }
 
 /// The 3D integration scheme.
@@ -167,21 +205,33 @@ pub fn check_gaps(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
     if t_s.len() < 3 {
         return Ok(());
     }
-    let mut dt: Vec<f64> = t_s.windows(2).map(|w| w[1] - w[0]).collect();
-    let gaps: Vec<(usize, f64)> = dt.iter().copied().enumerate().collect();
-    dt.sort_by(f64::total_cmp);
-    let median = dt[dt.len() / 2];
-    if let Some((i, d)) = gaps.into_iter().find(|(_, d)| *d > MAX_GAP_FACTOR * median) {
-        return Err(invalid(
-            what,
-            format!(
-                "gap in the sample times between rows {} and {} ({d} s, the median interval is {median} s)",
-                i + first_row,
-                i + 1 + first_row
-            ),
-        ));
+    let median = median_interval(t_s);
+    let found = t_s
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .enumerate()
+        .find(|(_, d)| *d > MAX_GAP_FACTOR * median);
+    match found {
+        Some((i, d)) => Err(gap_error(what, i + first_row, d, median)),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// The median interval of increasing times (at least 2).
+fn median_interval(t_s: &[f64]) -> f64 {
+    let mut dt: Vec<f64> = t_s.windows(2).map(|w| w[1] - w[0]).collect();
+    dt.sort_by(f64::total_cmp);
+    dt[dt.len() / 2]
+}
+
+fn gap_error(what: &str, row: usize, d: f64, median: f64) -> crate::Error {
+    invalid(
+        what,
+        format!(
+            "gap in the sample times between rows {row} and {} ({d} s, the median interval is {median} s)",
+            row + 1
+        ),
+    )
 }
 
 fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
@@ -273,33 +323,38 @@ fn integrate_in<N: NavFrame>(
     let mut table = Table::new(&NAV_COLUMNS);
     let mut last_yaw: Option<f64> = None;
     for s in &out {
-        let [qw, qx, qy, qz] = s.attitude.to_wxyz();
-        let mut e = s.attitude.to_euler();
-        if let Some(y) = last_yaw {
-            let tau = std::f64::consts::TAU;
-            e.yaw_rad += tau * ((y - e.yaw_rad) / tau).round();
-        }
-        last_yaw = Some(e.yaw_rad);
-        let [px, py, pz] = s.position_m.to_array();
-        let [vx, vy, vz] = s.velocity_m_s.to_array();
-        table.push_row(&[
-            s.t_s,
-            px,
-            py,
-            pz,
-            vx,
-            vy,
-            vz,
-            qw,
-            qx,
-            qy,
-            qz,
-            e.yaw_rad,
-            e.pitch_rad,
-            e.roll_rad,
-        ]);
+        table.push_row(&nav_row(s, &mut last_yaw));
     }
     Ok(table)
+}
+
+/// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
+fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14] {
+    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
+    let mut e = s.attitude.to_euler();
+    if let Some(y) = *last_yaw {
+        let tau = std::f64::consts::TAU;
+        e.yaw_rad += tau * ((y - e.yaw_rad) / tau).round();
+    }
+    *last_yaw = Some(e.yaw_rad);
+    let [px, py, pz] = s.position_m.to_array();
+    let [vx, vy, vz] = s.velocity_m_s.to_array();
+    [
+        s.t_s,
+        px,
+        py,
+        pz,
+        vx,
+        vy,
+        vz,
+        qw,
+        qx,
+        qy,
+        qz,
+        e.yaw_rad,
+        e.pitch_rad,
+        e.roll_rad,
+    ]
 }
 
 /// Errors of an estimate against truth, both tables with `t_s`, positions, velocities and
@@ -406,5 +461,189 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
         velocity_final_m_s: fv,
         attitude_rms_rad: (sa / n).sqrt(),
         attitude_final_rad: fa,
+    })
+}
+
+/// Rows a streamed integration reads ahead to set the reference interval of the gap check (the
+/// median of their intervals; files this short are checked exactly as [`integrate`] checks).
+pub const GAP_WINDOW: usize = 1001;
+
+/// What a streamed integration wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavSummary {
+    /// Rows written.
+    pub rows: usize,
+    /// The last position, m.
+    pub end_position_m: [f64; 3],
+}
+
+/// Integrates the IMU CSV file `input` into the navigation CSV `out` ([`NAV_COLUMNS`]), the
+/// same numbers as [`integrate`]. The coning/sculling scheme streams (memory does not grow with
+/// the file; gaps are judged against the median interval of the first [`GAP_WINDOW`] rows); the
+/// RK4 scheme, which interpolates over neighbouring samples, reads the file whole. `out`
+/// appears only when complete.
+///
+/// # Errors
+/// As [`integrate`], CSV errors naming file, row and column, and I/O errors.
+pub fn integrate_csv(
+    input: &Path,
+    initial: &InitialState,
+    setup: &NavSetup,
+    out: &Path,
+) -> Result<NavSummary> {
+    if setup.scheme != NavScheme::ConingSculling {
+        let nav = integrate(&crate::table::read_table(input)?, initial, setup)?;
+        nav.write_csv(out)?;
+        let last = |c: &str| nav.column(c).and_then(|v| v.last().copied()).unwrap_or(0.0);
+        return Ok(NavSummary {
+            rows: nav.rows(),
+            end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
+        });
+    }
+    match setup.nav_frame {
+        NavFrameName::ENU => integrate_csv_in::<Enu>(input, initial, setup, out),
+        NavFrameName::NED => integrate_csv_in::<Ned>(input, initial, setup, out),
+    }
+}
+
+/// The per-sample integrator of a streamed file.
+enum Stepper<N> {
+    Rates(RateStrapdown<N>),
+    Increments { nav: Strapdown<N>, started: bool },
+}
+
+impl<N: NavFrame> Stepper<N> {
+    /// `force` is the accelerometer column (rates) or Δv, `turn` the gyroscope column or Δθ.
+    fn step(
+        &mut self,
+        t_s: f64,
+        force: [f64; 3],
+        turn: [f64; 3],
+    ) -> core::result::Result<NavState<N>, StrapdownError> {
+        match self {
+            Self::Rates(r) => r.step(t_s, turn, force),
+            Self::Increments { nav, started } if !*started => {
+                *started = true;
+                Ok(*nav.state())
+            }
+            Self::Increments { nav, .. } => nav.step(t_s, turn, force),
+        }
+    }
+}
+
+fn integrate_csv_in<N: NavFrame>(
+    input: &Path,
+    initial: &InitialState,
+    setup: &NavSetup,
+    out: &Path,
+) -> Result<NavSummary> {
+    let header = crate::table::read_header(input)?;
+    let has_all = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+    let rates = has_all(&ACCEL_COLUMNS) && has_all(&GYRO_COLUMNS);
+    let (force, turn) = if rates {
+        (ACCEL_COLUMNS, GYRO_COLUMNS)
+    } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
+        (DV_COLUMNS, DTHETA_COLUMNS)
+    } else {
+        return Err(invalid(
+            "IMU data",
+            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
+        ));
+    };
+    let mut columns = vec!["t_s"];
+    columns.extend(force);
+    columns.extend(turn);
+    let mut rows = CsvRows::open(input, &columns, "")?;
+    let mut row = [0.0; 7];
+    let mut ahead: Vec<[f64; 7]> = Vec::with_capacity(GAP_WINDOW + 1);
+    while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {
+        ahead.push(row);
+    }
+    if ahead.is_empty() {
+        return Err(crate::Error::CsvFormat {
+            file: input.into(),
+            message: "no data rows after the header".into(),
+        });
+    }
+    let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
+    let median = if times.len() > 2 {
+        Some(median_interval(&times))
+    } else {
+        None
+    };
+    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
+        invalid(
+            "initial state",
+            "the quaternion has zero norm or is not finite",
+        )
+    })?;
+    let s0 = NavState::<N> {
+        t_s: times[0],
+        attitude,
+        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
+        position_m: Vec3::from_array(initial.position_m),
+    };
+    let mut stepper = if rates {
+        Stepper::Rates(RateStrapdown::new(s0, setup.options))
+    } else {
+        Stepper::Increments {
+            nav: Strapdown::new(s0, setup.options),
+            started: false,
+        }
+    };
+    let sign = match setup.accel_sign {
+        AccelSign::SpecificForce => 1.0,
+        AccelSign::Matlab => -1.0,
+    };
+    let mut file = AtomicFile::create(out)?;
+    file.writer()
+        .write_all(NAV_COLUMNS.join(",").as_bytes())
+        .and_then(|()| file.writer().write_all(b"\n"))
+        .map_err(|e| file.error(e))?;
+    let (mut last_yaw, mut previous_t, mut end) = (None, None::<f64>, s0);
+    let mut i = 0usize;
+    let mut process = |r: &[f64; 7], file: &mut AtomicFile| -> Result<()> {
+        let t = r[0];
+        if let Some(p) = previous_t {
+            if t <= p {
+                return Err(invalid(
+                    "IMU data",
+                    format!(
+                        "time at row {} does not increase after row {}",
+                        i + 2,
+                        i + 1
+                    ),
+                ));
+            }
+            if let Some(m) = median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
+                return Err(gap_error("IMU data", i + 1, t - p, m));
+            }
+        }
+        previous_t = Some(t);
+        let f = [sign * r[1], sign * r[2], sign * r[3]];
+        let state = stepper
+            .step(t, f, [r[4], r[5], r[6]])
+            .map_err(|e| invalid("IMU data", e.to_string()))?;
+        write_rows(
+            file.writer(),
+            &nav_row(&state, &mut last_yaw),
+            NAV_COLUMNS.len(),
+            b",",
+        )
+        .map_err(|e| file.error(e))?;
+        end = state;
+        i += 1;
+        Ok(())
+    };
+    for r in &ahead {
+        process(r, &mut file)?;
+    }
+    while rows.next_row(&mut row)?.is_some() {
+        process(&row, &mut file)?;
+    }
+    file.commit()?;
+    Ok(NavSummary {
+        rows: i,
+        end_position_m: end.position_m.to_array(),
     })
 }

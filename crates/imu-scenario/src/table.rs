@@ -508,50 +508,18 @@ pub fn read_table(path: &Path) -> Result<Table> {
 /// Missing columns (all named at once, with `hint`), values that are not finite numbers (file,
 /// row, column), malformed or empty files.
 pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
+    let mut rows = CsvRows::open(path, required, hint)?;
     let names = read_header(path)?;
     let header: HashMap<String, usize> = names
         .iter()
         .enumerate()
         .map(|(k, n)| (n.clone(), k))
         .collect();
-    let missing: Vec<String> = required
-        .iter()
-        .filter(|c| !header.contains_key(**c))
-        .map(|c| (*c).to_string())
-        .collect();
-    if !missing.is_empty() {
-        return Err(Error::MissingColumns {
-            file: path.into(),
-            missing,
-            hint: hint.into(),
-        });
-    }
-    let wanted: Vec<(usize, &str)> = required.iter().map(|c| (header[*c], *c)).collect();
     let mut values = vec![Vec::new(); names.len()];
-    let mut r = reader(path)?;
-    let mut record = csv::StringRecord::new();
-    loop {
-        match r.read_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => return Err(csv_error(path, &e)),
-        }
-        let row = record.position().map_or(0, |p| p.line() as usize);
-        for &(k, name) in &wanted {
-            let text = record.get(k).unwrap_or("");
-            let bad = |message: String| Error::CsvValue {
-                file: path.into(),
-                row,
-                column: name.into(),
-                message,
-            };
-            let v: f64 = text
-                .parse()
-                .map_err(|_| bad(format!("not a number: \"{text}\"")))?;
-            if !v.is_finite() {
-                return Err(bad(format!("not a finite number: \"{text}\"")));
-            }
-            values[k].push(v);
+    let mut row = vec![0.0; required.len()];
+    while rows.next_row(&mut row)?.is_some() {
+        for (name, v) in required.iter().zip(&row) {
+            values[header[*name]].push(*v);
         }
     }
     if values.iter().all(Vec::is_empty) {
@@ -565,4 +533,82 @@ pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvCol
         header,
         values,
     })
+}
+
+/// The named columns of a CSV file, row by row (memory does not grow with the file).
+#[derive(Debug)]
+pub struct CsvRows {
+    path: PathBuf,
+    reader: csv::Reader<File>,
+    record: csv::StringRecord,
+    /// (field index, column name) of each requested column, in request order.
+    wanted: Vec<(usize, String)>,
+}
+
+impl CsvRows {
+    /// Opens `path` and checks that its header has every column of `required`.
+    ///
+    /// # Errors
+    /// Missing columns (all named at once, with `hint`), unreadable or empty files.
+    pub fn open(path: &Path, required: &[&str], hint: &str) -> Result<Self> {
+        let names = read_header(path)?;
+        let missing: Vec<String> = required
+            .iter()
+            .filter(|c| !names.iter().any(|n| n == **c))
+            .map(|c| (*c).to_string())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::MissingColumns {
+                file: path.into(),
+                missing,
+                hint: hint.into(),
+            });
+        }
+        let wanted = required
+            .iter()
+            .map(|c| {
+                (
+                    names.iter().position(|n| n == *c).unwrap_or(0),
+                    (*c).to_string(),
+                )
+            })
+            .collect();
+        Ok(Self {
+            path: path.into(),
+            reader: reader(path)?,
+            record: csv::StringRecord::new(),
+            wanted,
+        })
+    }
+
+    /// Parses the next data row into `out` (the requested columns in order) and returns its
+    /// file line, or `None` at the end of the file.
+    ///
+    /// # Errors
+    /// Values that are not finite numbers (file, row, column), malformed rows.
+    pub fn next_row(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
+        match self.reader.read_record(&mut self.record) {
+            Ok(false) => return Ok(None),
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(&self.path, &e)),
+        }
+        let row = self.record.position().map_or(0, |p| p.line() as usize);
+        for ((k, name), slot) in self.wanted.iter().zip(out.iter_mut()) {
+            let text = self.record.get(*k).unwrap_or("");
+            let bad = |message: String| Error::CsvValue {
+                file: self.path.clone(),
+                row,
+                column: name.clone(),
+                message,
+            };
+            let v: f64 = text
+                .parse()
+                .map_err(|_| bad(format!("not a number: \"{text}\"")))?;
+            if !v.is_finite() {
+                return Err(bad(format!("not a finite number: \"{text}\"")));
+            }
+            *slot = v;
+        }
+        Ok(Some(row))
+    }
 }

@@ -156,3 +156,53 @@ fn gaps_and_disorder_in_the_times_are_named() {
         .unwrap_or_default();
     assert!(e.contains("row 7 does not increase"), "{e}");
 }
+
+#[test]
+fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
+    use imu_scenario::navigation::{GAP_WINDOW, integrate_csv};
+    let dir = std::env::temp_dir().join(format!("imukit-nav-stream-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // 4001 rows: the gap check's look-ahead window and the rest.
+    for (extra, frame, sign) in [
+        ("", "ENU", AccelSign::SpecificForce),
+        ("output = \"increments\"\n", "NED", AccelSign::SpecificForce),
+        ("accel_sign = \"matlab\"\n", "ENU", AccelSign::Matlab),
+    ] {
+        let sim = scenario(extra, frame);
+        assert!(sim.imu.rows() > 2 * GAP_WINDOW);
+        let init = InitialState::from_table(&sim.truth).unwrap();
+        let setup = NavSetup {
+            nav_frame: if frame == "ENU" {
+                NavFrameName::ENU
+            } else {
+                NavFrameName::NED
+            },
+            accel_sign: sign,
+            ..NavSetup::default()
+        };
+        let (input, out) = (dir.join("imu.csv"), dir.join("nav.csv"));
+        sim.imu.write_csv(&input).unwrap();
+        let summary = integrate_csv(&input, &init, &setup, &out).unwrap();
+        let whole = integrate(&sim.imu, &init, &setup).unwrap();
+        let streamed = imu_scenario::table::read_table(&out).unwrap();
+        assert_eq!(summary.rows, whole.rows());
+        assert!(
+            streamed == whole,
+            "{extra} {frame}: streamed output differs"
+        );
+    }
+    // A gap after the look-ahead window is found, named by its rows, and no output is left.
+    let sim = scenario("", "ENU");
+    let mut gappy = sim.imu.clone();
+    let w = gappy.columns.len();
+    for r in 3000..gappy.rows() {
+        gappy.data[r * w] += 0.1;
+    }
+    let (input, out) = (dir.join("gappy.csv"), dir.join("gappy_nav.csv"));
+    gappy.write_csv(&input).unwrap();
+    let e =
+        integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap_err();
+    assert!(e.to_string().contains("between rows 3001 and 3002"), "{e}");
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

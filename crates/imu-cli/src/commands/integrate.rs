@@ -4,10 +4,9 @@ use std::path::Path;
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{AccelSign, EulerZyx};
-use imu_scenario::navigation::{InitialState, NavScheme, NavSetup, integrate};
+use imu_scenario::navigation::{InitialState, NavScheme, NavSetup, integrate_csv};
 use imu_scenario::planar::read_planar;
 use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
-use imu_scenario::table::{read_columns, read_header};
 use imu_scenario::{Error, Table};
 
 use super::CliError;
@@ -87,20 +86,6 @@ pub fn planar(c: &Common<'_>, scheme_name: &str, heading0: f64) -> Result<(), Cl
     Ok(())
 }
 
-/// Reads every numeric column of a CSV into a table.
-fn read_table(path: &Path) -> Result<Table, CliError> {
-    let header = read_header(path)?;
-    let names: Vec<&str> = header.iter().map(String::as_str).collect();
-    let cols = read_columns(path, &names, "")?;
-    let rows = cols.rows();
-    let mut t = Table::new(&names);
-    for r in 0..rows {
-        let row: Vec<f64> = names.iter().map(|n| cols.get(n)[r]).collect();
-        t.push_row(&row);
-    }
-    Ok(t)
-}
-
 pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     let nav_frame: NavFrameName = parse_name("--nav-frame", &o.nav_frame.to_ascii_uppercase())?;
     let sign: AccelSign = parse_name::<AccelSignName>("--accel-sign", o.accel_sign)?.into();
@@ -111,7 +96,7 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         ));
     }
     let mut initial = match o.init {
-        Some(p) => InitialState::from_table(&read_table(p)?)?,
+        Some(p) => InitialState::from_csv(p)?,
         None => InitialState::default(),
     };
     if let Some(p) = c.position0 {
@@ -128,7 +113,6 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
             EulerZyx::from_array(e),
         );
     }
-    let imu = read_table(c.input)?;
     let scheme = match o.scheme {
         "coning" => NavScheme::ConingSculling,
         "rk4" if o.substeps >= 1 => NavScheme::Rk4 {
@@ -152,10 +136,17 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         },
         accel_sign: sign,
     };
-    let nav = integrate(&imu, &initial, &setup)
-        .map_err(|e| invalid(&c.input.display().to_string(), e.to_string()))?;
-    nav.write_csv(c.out)?;
-    report(&nav, "strapdown", c.out);
+    // Streamed for the coning scheme: memory does not grow with the input file.
+    let summary = integrate_csv(c.input, &initial, &setup, c.out).map_err(|e| match e {
+        Error::Invalid { .. } => invalid(&c.input.display().to_string(), e.to_string()),
+        other => other.into(),
+    })?;
+    let [x, y, z] = summary.end_position_m;
+    eprintln!(
+        "imukit: {} samples, strapdown; end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
+        summary.rows,
+        c.out.display()
+    );
     Ok(())
 }
 
