@@ -73,6 +73,13 @@ def test_imu_errors_and_allan_figures_from_files(sim, tmp_path):
     assert fig.axes[0].get_xscale() == "log" and fig.axes[0].get_yscale() == "log"
 
 
+def test_plain_arrays_by_column_name_plot_like_tables(sim):
+    arrays = {c: np.array(sim.imu[c]) for c in sim.imu.columns}
+    assert lines(ip.figure(arrays)) == lines(ip.figure(sim.imu)) == [3, 3, 3]
+    with pytest.raises(ValueError, match="one length"):
+        ip.figure({"t_s": np.zeros(3), "gyro_z_rad_s": np.zeros(4)})
+
+
 def test_planar_paths_are_drawn_from_above_with_equal_scales():
     t = np.linspace(0.0, 10.0, 101)
     table = imukit.Table(["t_s", "pos_x_m", "pos_y_m", "yaw_rad"],

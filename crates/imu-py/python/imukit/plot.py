@@ -5,6 +5,8 @@ recognised from their columns and get the same panels (the layout comes from the
 drawn here by matplotlib. Every function returns the matplotlib object, for the caller to show,
 adjust or save (``fig.savefig("truth.png")``, ``anim.save("body.gif", writer="pillow")``).
 
+Tables, CSV paths and dicts of NumPy arrays keyed by imukit's column names are all accepted.
+
 * :func:`figure` — the default figure of one or more tables or CSV files of one kind (truth,
   IMU readings, navigation output, Allan table, errors); later ones dashed, dotted, … (truth vs estimate).
 * :func:`trajectory` — paths in the plane (equal scales) or in 3D, start ● and end ✕ marked.
@@ -23,7 +25,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -31,7 +33,7 @@ from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_cs
 
 __all__ = ["figure", "trajectory", "allan", "animate", "kind"]
 
-TableLike = Union[Table, str, os.PathLike]
+TableLike = Union[Table, str, os.PathLike, Mapping[str, Any]]
 # Line styles of the first, second, … overlaid table (as `imukit plot` draws them).
 _STYLES = ("-", "--", ":", "-.")
 
@@ -57,8 +59,16 @@ def _load(items: Sequence[TableLike], labels: Optional[Sequence[str]]) -> list:
             name, table = f"table {i + 1}", item
         elif isinstance(item, (str, os.PathLike)):
             name, table = Path(item).stem, read_csv(item)
+        elif isinstance(item, Mapping):  # plain arrays by column name
+            columns = list(item)
+            try:
+                values = np.column_stack([np.asarray(item[c], dtype=np.float64) for c in columns])
+            except ValueError as e:
+                raise ValueError(f"item {i}: the arrays must be 1-D and of one length ({e})") from None
+            name, table = f"table {i + 1}", Table(columns, values)
         else:
-            raise TypeError(f"item {i}: expected an imukit.Table or a CSV path, got {type(item).__name__}")
+            raise TypeError(f"item {i}: expected an imukit.Table, a CSV path or a dict of arrays, "
+                            f"got {type(item).__name__}")
         out.append((labels[i] if labels is not None else name, table))
     return out
 
