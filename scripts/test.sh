@@ -17,10 +17,20 @@ echo "== Format and lints"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 
-echo "== Heap-free core: builds without std, never names alloc"
+echo "== Heap-free core: builds without std, never names alloc or std, no std-only dependency"
 cargo build --quiet -p imu-core --no-default-features --features libm
-if grep -rnE '\balloc::|extern crate alloc' crates/imu-core/src; then
-  echo "imu-core names alloc" >&2
+# A bare-metal target has no std and no allocator: the core must build there.
+if rustup target add thumbv7em-none-eabihf >/dev/null 2>&1; then
+  cargo build --quiet -p imu-core --no-default-features --features libm --target thumbv7em-none-eabihf
+else
+  echo "(rustup could not add thumbv7em-none-eabihf here; the host no_std build above stands in)"
+fi
+if cargo tree -p imu-core -e normal --prefix none | grep -E '^num-dual '; then
+  echo "imu-core depends on a std-only crate" >&2
+  exit 1
+fi
+if grep -rnE '\balloc::|extern crate (alloc|std)|\bstd::' crates/imu-core/src; then
+  echo "imu-core names alloc or std" >&2
   exit 1
 fi
 

@@ -5,9 +5,9 @@
 #![allow(missing_docs)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use imu_core::kinematics::analytic::{AnalyticOptions, truth_from_motion};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::{Enu, IdealReading, ImuMount, Truth, Vec3};
+use imu_scenario::analytic::{AnalyticOptions, truth_from_motion};
 use imu_scenario::builtin;
 use imu_scenario::scenario::{ExpressionMotion, TrajectorySpec, sample_times};
 

@@ -15,14 +15,11 @@
 //!   (a level IMU at rest reads `+g` on its up axis); [`AccelSign::Matlab`] reports `−f_b`.
 //!
 //! The crate is `#![no_std]` and never allocates: batch functions write into slices the caller
-//! owns, per-sample steppers keep their state in plain structs. Float math comes from `std`
-//! (default feature) or `libm`. The `std` feature also adds exact analytic trajectories
-//! evaluated over dual numbers ([`kinematics::analytic`]).
+//! owns, per-sample steppers keep their state in plain structs; nothing here links `alloc`. Float
+//! math comes from `std` (default feature) or `libm`. Exact analytic trajectories over dual
+//! numbers, which need the standard library, are in `imu_scenario::analytic`.
 #![no_std]
 #![forbid(unsafe_code)]
-
-#[cfg(feature = "std")]
-extern crate std;
 
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");

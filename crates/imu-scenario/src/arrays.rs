@@ -1,7 +1,7 @@
 //! The array-level API behind the Python functions: plain slices in, [`Table`]s out, with errors
 //! that name the argument and index.
+use crate::analytic::AnalyticOptions;
 use imu_core::ideal::at_lever_arm;
-use imu_core::kinematics::analytic::AnalyticOptions;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::tangent_series;
 use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth, Vec3};

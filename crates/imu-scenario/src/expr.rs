@@ -14,7 +14,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use imu_core::kinematics::analytic::Scalar;
+use crate::analytic::Scalar;
 
 /// A parse error, with the 1-based character column where it was found.
 #[derive(Clone, Debug, PartialEq, Eq)]

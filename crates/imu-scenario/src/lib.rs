@@ -4,6 +4,7 @@
 //! ([`track`]), built-in scenarios ([`builtin`]) and the CSV schema ([`table`]). Units are
 //! converted here and only here; the numerics live in `imu-core`.
 pub mod analysis;
+pub mod analytic;
 pub mod arrays;
 pub mod builtin;
 pub mod error;

@@ -20,7 +20,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
+use crate::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;

@@ -8,7 +8,7 @@
 //! and differentiated or integrated whole, as they come from files, then streamed.
 use std::path::Path;
 
-use imu_core::kinematics::analytic::{AnalyticOptions, AnalyticStepper, Motion};
+use crate::analytic::{AnalyticOptions, AnalyticStepper, Motion};
 use imu_core::kinematics::sampled::backfill_standstill;
 use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};

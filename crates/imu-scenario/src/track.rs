@@ -5,7 +5,7 @@
 //! towards +heading (left in ENU). The distance along the track follows either a constant speed
 //! (moving from the first sample) or a trapezoid that starts and ends at rest with a given
 //! acceleration. After the end of the track the body stands still at its end.
-use imu_core::kinematics::analytic::{Motion, Scalar};
+use crate::analytic::{Motion, Scalar};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};

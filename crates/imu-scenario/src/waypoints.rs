@@ -9,7 +9,7 @@
 //! dual numbers, so velocity, acceleration, body rate and angular acceleration are exact for the
 //! spline. Outside the waypoints' time span the body stands at the first/last waypoint (a step
 //! in velocity unless the end velocity is zero).
-use imu_core::kinematics::analytic::{Motion, Scalar};
+use crate::analytic::{Motion, Scalar};
 
 use crate::error::{Result, invalid};
 

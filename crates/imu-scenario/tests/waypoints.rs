@@ -1,9 +1,9 @@
 //! Waypoint trajectories: through the waypoints, C² joins, end conditions, velocities, attitude.
 use std::path::Path;
 
-use imu_core::kinematics::analytic::{AnalyticOptions, truth_from_motion};
 use imu_core::{Enu, Truth};
 use imu_scenario::ScenarioSpec;
+use imu_scenario::analytic::{AnalyticOptions, truth_from_motion};
 use imu_scenario::waypoints::Waypoints;
 
 const T: [f64; 5] = [0.0, 2.0, 3.5, 6.0, 8.0];

@@ -37,3 +37,10 @@ pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3
         -pdd * sr - pd * rd * cr + ydd * cp * cr - yd * pd * sp * cr - yd * rd * cp * sr,
     )
 }
+
+/// `angle` plus the multiple of 2π that brings it closest to `reference` (rad): yaw unwrapping
+/// for callers that evaluate attitudes sample by sample.
+#[must_use]
+pub fn unwrap_near(angle: f64, reference: f64) -> f64 {
+    math::unwrap_near(angle, reference)
+}

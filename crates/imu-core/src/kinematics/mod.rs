@@ -1,11 +1,10 @@
 //! Truth kinematics per sample: position, velocity, acceleration (navigation frame), attitude,
 //! body rate and body angular acceleration.
 //!
-//! Sources: [`sampled`] (finite differences on caller-owned slices), [`analytic`] (exact, over dual
-//! numbers; `std` feature). Both share [`euler`] (Euler rates → body rate) and [`tangent`]
-//! (attitude aligned with the velocity).
-#[cfg(feature = "std")]
-pub mod analytic;
+//! Sources: [`sampled`] (finite differences on caller-owned slices) and [`body_rates`]
+//! (integration of body-frame rates). Exact truth over dual numbers is `imu_scenario::analytic`
+//! (dual numbers need the standard library); it uses [`euler`] (Euler rates → body rate),
+//! [`tangent`] (attitude aligned with the velocity) and [`sampled::backfill_standstill`] from here.
 pub mod body_rates;
 mod error;
 pub mod euler;

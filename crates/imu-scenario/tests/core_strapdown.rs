@@ -1,11 +1,11 @@
 //! 3D strapdown: stationary, bias growth, classic coning (closed form), and round trips.
-use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::strapdown::step::{
     NavState, RateStrapdown, StrapdownError, StrapdownOptions, strapdown_increments,
     strapdown_rates,
 };
 use imu_core::{Body, Enu, IdealReading, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
+use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 
 const G: f64 = 9.81;
 

@@ -1,9 +1,9 @@
 //! Body-rate trajectories (MATLAB kinematicTrajectory): exact cases, MATLAB's platform example,
 //! and inverting the ideal IMU of a trajectory.
 use imu_core::kinematics::KinematicsError;
-use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};
 use imu_core::{Enu, Ned, Truth, Vec3};
+use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 
 #[test]
 fn constant_acceleration_and_rate_are_integrated_exactly() {

@@ -1,8 +1,8 @@
 //! Sampled input (finite differences) against the exact truth of the seed's tilted circle.
 use imu_core::kinematics::KinematicsError;
-use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::{Enu, EulerZyx, Truth};
+use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 
 /// Seed 000's tilted circle (f = 1 Hz) with its explicit Euler angles (its Figure 3 example).
 struct TiltedCircle;

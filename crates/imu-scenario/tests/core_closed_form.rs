@@ -1,7 +1,7 @@
 //! Exact sources against closed-form truth and IMU values (≤ 1e-9 relative to the largest
 //! magnitude of each quantity), in ENU and NED.
-use imu_core::kinematics::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::{AccelSign, Body, Enu, EulerZyx, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
+use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use num_dual::{Dual2, DualStruct};
 
 const REL_TOL: f64 = 1e-9;

@@ -1,4 +1,9 @@
-//! Exact truth from analytic motions evaluated over dual numbers (`std` feature).
+//! Exact truth from analytic motions evaluated over dual numbers.
+//!
+//! This lives in the std layer, not in `imu-core`: `num-dual` needs the standard library, and
+//! the core builds and runs without it (and without a heap). The stepper feeds the core's
+//! heap-free pieces (body rate from Euler rates, the tangent-attitude tracker, the standstill
+//! backfill) with exact derivatives.
 //!
 //! A [`Motion`] gives the position of the reference point S and, optionally, z-y-x Euler angles as
 //! functions of time, generic over the scalar (any [`num_dual::DualNum`] with `f64` primitive, and
@@ -7,7 +12,7 @@
 //! number, so every derivative is exact to rounding: the counterpart of seed 000's `'sym'` option.
 //!
 //! ```
-//! use imu_core::kinematics::analytic::{truth_from_motion, AnalyticOptions, Motion, Scalar};
+//! use imu_scenario::analytic::{truth_from_motion, AnalyticOptions, Motion, Scalar};
 //! use imu_core::{Enu, Truth};
 //!
 //! /// A level circle of radius 2 m at 0.5 rad/s, nose along the path.
@@ -28,13 +33,11 @@
 //! ```
 use num_dual::{Dual2, Dual3, DualNum, DualStruct};
 
-use crate::frame::NavFrame;
-use crate::kinematics::euler::{body_angular_acceleration, body_rate};
-use crate::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
-use crate::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
-use crate::kinematics::{KinematicsError, Truth, check_times};
-use crate::rotation::{EulerZyx, Rotation};
-use crate::vector::Vec3;
+use imu_core::kinematics::euler::{body_angular_acceleration, body_rate, unwrap_near};
+use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
+use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
+use imu_core::kinematics::{KinematicsError, Truth, check_times};
+use imu_core::{EulerZyx, NavFrame, Rotation, Vec3};
 
 /// The scalar a [`Motion`] is evaluated over: `f64` or a dual number with `f64` parts.
 pub trait Scalar: DualNum<Primitive = f64> + Copy {}
@@ -130,7 +133,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                     });
                 }
                 if let Some(last) = self.last_yaw {
-                    euler.yaw_rad = crate::math::unwrap_near(euler.yaw_rad, last);
+                    euler.yaw_rad = unwrap_near(euler.yaw_rad, last);
                 }
                 self.last_yaw = Some(euler.yaw_rad);
                 (euler, ang(|d| d.v1), ang(|d| d.v2))
