@@ -39,20 +39,9 @@ pub const NAV_COLUMNS: [&str; 14] = [
     "roll_rad",
 ];
 
-/// Columns [`compare`] reads from truth and estimate.
-pub const STATE_COLUMNS: [&str; 11] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "pos_z_m",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "vel_z_m_s",
-    "q_w",
-    "q_x",
-    "q_y",
-    "q_z",
-];
+/// Columns [`compare`] reads from truth and estimate: the navigation columns up to the
+/// quaternion.
+pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
 
 /// Error columns of [`compare`].
 pub const ERROR_COLUMNS: [&str; 9] = [

@@ -494,10 +494,25 @@ fn csv_error(path: &Path, e: &csv::Error) -> Error {
 pub fn read_table(path: &Path) -> Result<Table> {
     let header = read_header(path)?;
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
-    let cols = read_columns(path, &names, "")?;
-    let mut t = Table::new(&names);
-    for r in 0..cols.rows() {
-        t.push_row(&names.iter().map(|n| cols.get(n)[r]).collect::<Vec<_>>());
+    read_table_columns(path, &names, "")
+}
+
+/// Reads the named columns of a CSV file as a table with those columns, in that order.
+///
+/// # Errors
+/// As [`read_columns`].
+pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Table> {
+    let mut rows = CsvRows::open(path, names, hint)?;
+    let mut t = Table::new(names);
+    let mut row = vec![0.0; names.len()];
+    while rows.next_row(&mut row)?.is_some() {
+        t.push_row(&row);
+    }
+    if t.rows() == 0 {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "no data rows after the header".into(),
+        });
     }
     Ok(t)
 }
@@ -509,13 +524,13 @@ pub fn read_table(path: &Path) -> Result<Table> {
 /// row, column), malformed or empty files.
 pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
     let mut rows = CsvRows::open(path, required, hint)?;
-    let names = read_header(path)?;
-    let header: HashMap<String, usize> = names
+    let header: HashMap<String, usize> = rows
+        .names
         .iter()
         .enumerate()
         .map(|(k, n)| (n.clone(), k))
         .collect();
-    let mut values = vec![Vec::new(); names.len()];
+    let mut values = vec![Vec::new(); header.len()];
     let mut row = vec![0.0; required.len()];
     while rows.next_row(&mut row)?.is_some() {
         for (name, v) in required.iter().zip(&row) {
@@ -541,6 +556,8 @@ pub struct CsvRows {
     path: PathBuf,
     reader: csv::Reader<File>,
     record: csv::StringRecord,
+    /// The header's column names.
+    names: Vec<String>,
     /// (field index, column name) of each requested column, in request order.
     wanted: Vec<(usize, String)>,
 }
@@ -577,6 +594,7 @@ impl CsvRows {
             path: path.into(),
             reader: reader(path)?,
             record: csv::StringRecord::new(),
+            names,
             wanted,
         })
     }

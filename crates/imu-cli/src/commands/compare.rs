@@ -3,23 +3,13 @@ use std::path::Path;
 
 use imu_scenario::Table;
 use imu_scenario::navigation::{STATE_COLUMNS, compare};
-use imu_scenario::table::read_columns;
+use imu_scenario::table::read_table_columns;
 
 use super::CliError;
 
 fn read(path: &Path) -> Result<Table, CliError> {
-    let wanted = STATE_COLUMNS;
-    let cols = read_columns(
-        path,
-        &wanted,
-        "; truth and estimate need t_s, pos_*, vel_*, q_*",
-    )?;
-    let mut t = Table::new(&wanted);
-    for r in 0..cols.rows() {
-        let row: Vec<f64> = wanted.iter().map(|c| cols.get(c)[r]).collect();
-        t.push_row(&row);
-    }
-    Ok(t)
+    let hint = "; truth and estimate need t_s, pos_*, vel_*, q_*";
+    Ok(read_table_columns(path, STATE_COLUMNS, hint)?)
 }
 
 pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliError> {

@@ -2,7 +2,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::plot::animate::{self as anim, AnimateOptions};
-use crate::plot::{plot_files, read_table};
+use crate::plot::plot_files;
+use imu_scenario::table::read_table;
 
 use imu_scenario::scenario::{NavFrameName, parse_name};
 

@@ -10,11 +10,6 @@ use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, i
 use super::{allan_figure, write_figure};
 use crate::commands::CliError;
 
-/// Reads every column of a CSV file.
-pub fn read_table(path: &Path) -> Result<Table, CliError> {
-    Ok(imu_scenario::table::read_table(path)?)
-}
-
 fn stem(p: &Path) -> String {
     p.file_stem().map_or_else(
         || p.display().to_string(),
@@ -71,7 +66,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliErr
     let mut files = Vec::new();
     let mut kind: Option<TableKind> = None;
     for p in paths {
-        let t = read_table(p)?;
+        let t = imu_scenario::table::read_table(p)?;
         let k = TableKind::of(&t.columns, &p.display().to_string())?;
         if let Some(first) = kind.filter(|first| !first.overlays(k)) {
             return Err(Error::Invalid {

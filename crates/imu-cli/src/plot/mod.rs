@@ -9,7 +9,7 @@ mod panels;
 use std::path::Path;
 
 pub use allan::allan_figure;
-pub use figures::{plot_files, read_table};
+pub use figures::plot_files;
 pub use panels::{Trace, trajectories_figure};
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
