@@ -1,9 +1,11 @@
 //! Body-rate trajectories (MATLAB kinematicTrajectory): exact cases, MATLAB's platform example,
 //! and inverting the ideal IMU of a trajectory.
+mod common;
+
 use imu_core::kinematics::KinematicsError;
 use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};
 use imu_core::{Enu, Ned, Truth, Vec3};
-use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
+use imu_scenario::analytic::{AnalyticOptions, truth_from_motion};
 
 #[test]
 fn constant_acceleration_and_rate_are_integrated_exactly() {
@@ -71,26 +73,17 @@ fn matlab_platform_example_turns_360_in_4_s_then_in_2_s() {
     }
 }
 
-struct Helix;
-impl Motion for Helix {
-    fn position<D: Scalar>(&self, t: D) -> [D; 3] {
-        let a = t * 0.5;
-        [a.cos() * 5.0, a.sin() * 5.0, t * 0.3]
-    }
-    fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
-        Some([
-            t * 0.5 + std::f64::consts::FRAC_PI_2,
-            D::from(0.05),
-            (t * 1.7).sin() * 0.4,
-        ])
-    }
-}
-
 fn inversion_error(rate: f64) -> f64 {
     let n = (10.0 * rate) as usize;
     let t: Vec<f64> = (0..=n).map(|k| k as f64 / rate).collect();
     let mut truth = vec![Truth::<Enu>::default(); t.len()];
-    truth_from_motion(&Helix, &t, AnalyticOptions::default(), &mut truth).unwrap();
+    truth_from_motion(
+        &common::RollingHelix,
+        &t,
+        AnalyticOptions::default(),
+        &mut truth,
+    )
+    .unwrap();
     // The kinematic acceleration and body rate an ideal IMU implies (specific force + gravity).
     let acc_b: Vec<[f64; 3]> = truth
         .iter()

@@ -5,7 +5,8 @@ use imu_core::strapdown::step::{
     strapdown_rates,
 };
 use imu_core::{Body, Enu, IdealReading, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
-use imu_scenario::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
+
+mod common;
 
 const G: f64 = 9.81;
 
@@ -167,31 +168,13 @@ fn coning_correction_removes_the_coning_drift() {
     assert!(with < 1e-2 * without, "{with} vs {without}");
 }
 
-/// A helix with sinusoidal roll (yaw along the helix).
-struct RollingHelix;
-impl Motion for RollingHelix {
-    fn position<D: Scalar>(&self, t: D) -> [D; 3] {
-        let a = t * 0.5;
-        [a.cos() * 5.0, a.sin() * 5.0, t * 0.3]
-    }
-    fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
-        Some([
-            t * 0.5 + std::f64::consts::FRAC_PI_2,
-            D::from(0.05),
-            (t * 1.7).sin() * 0.4,
-        ])
-    }
-}
-
 fn helix_error(rate: f64, seconds: f64) -> f64 {
-    let n = (rate * seconds) as usize;
-    let t: Vec<f64> = (0..=n).map(|k| k as f64 / rate).collect();
-    let mut truth = vec![Truth::<Enu>::default(); t.len()];
-    truth_from_motion(&RollingHelix, &t, AnalyticOptions::default(), &mut truth).unwrap();
-    let mount = ImuMount::<Enu>::default();
-    let r: Vec<IdealReading> = truth.iter().map(|s| mount.read(s)).collect();
-    let gyro: Vec<[f64; 3]> = r.iter().map(|x| x.gyro_rad_s.to_array()).collect();
-    let acc: Vec<[f64; 3]> = r.iter().map(|x| x.accel_m_s2.to_array()).collect();
+    let common::HelixData {
+        t,
+        truth,
+        gyro,
+        accel: acc,
+    } = common::helix(rate, seconds);
     let s0 = NavState {
         t_s: 0.0,
         attitude: truth[0].attitude,
@@ -253,14 +236,12 @@ fn bad_strapdown_input_is_refused_with_its_index() {
 
 fn helix_error_rk4(rate: f64, seconds: f64, substeps: usize) -> f64 {
     use imu_core::strapdown::rk4::strapdown_rates_rk4;
-    let n = (rate * seconds) as usize;
-    let t: Vec<f64> = (0..=n).map(|k| k as f64 / rate).collect();
-    let mut truth = vec![Truth::<Enu>::default(); t.len()];
-    truth_from_motion(&RollingHelix, &t, AnalyticOptions::default(), &mut truth).unwrap();
-    let mount = ImuMount::<Enu>::default();
-    let r: Vec<IdealReading> = truth.iter().map(|s| mount.read(s)).collect();
-    let gyro: Vec<[f64; 3]> = r.iter().map(|x| x.gyro_rad_s.to_array()).collect();
-    let acc: Vec<[f64; 3]> = r.iter().map(|x| x.accel_m_s2.to_array()).collect();
+    let common::HelixData {
+        t,
+        truth,
+        gyro,
+        accel: acc,
+    } = common::helix(rate, seconds);
     let s0 = NavState {
         t_s: 0.0,
         attitude: truth[0].attitude,
