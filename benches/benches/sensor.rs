@@ -67,6 +67,19 @@ fn bench_sensor(c: &mut Criterion) {
                     }
                 });
             });
+            group.bench_function(BenchmarkId::new(format!("{label}/no_noise"), n), |b| {
+                let mut state = ImuState::default();
+                b.iter(|| {
+                    for o in out.iter_mut() {
+                        *o = model.measure(
+                            &truth,
+                            &temps,
+                            &mut state,
+                            &mut imu_core::sensor::NoNoise,
+                        );
+                    }
+                });
+            });
         }
     }
     group.finish();

@@ -57,6 +57,7 @@ pub struct IdealReading {
 /// (body frame, m) of a rigid body turning at `ω_b` with `α_b`:
 /// `a_I = a_S + ω_b × (ω_b × r) + α_b × r` (seed 000 eq. 9; centripetal and Euler terms).
 #[must_use]
+#[inline]
 pub fn at_lever_arm(
     a_s: Vec3<Body>,
     omega_b: Vec3<Body>,

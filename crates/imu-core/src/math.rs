@@ -21,9 +21,23 @@ pub(crate) fn sqrt(x: f64) -> f64 {
 pub(crate) fn abs(x: f64) -> f64 {
     Float::abs(x)
 }
+/// `x` rounded to the nearest integer, halves away from zero: bit for bit `f64::round` (signed
+/// zeros, NaN and infinities included) without its library call on targets that lack a rounding
+/// instruction (x86-64 before SSE4.1, the portable baseline), where the call cost the sensor
+/// model 15 % of its time.
+///
+/// For `a = |x| < 2⁵²`, `(a + 2⁵²) − 2⁵²` is `a` rounded to nearest with ties to even (the sum's
+/// last bit is the units place); `a − r` is exact (Sterbenz, or `r = 0`), so a tie that went down
+/// is seen as `+½` and moved up. Branch-free, because in noisy data the halves fall at random.
+/// Larger magnitudes are integers already.
 #[inline]
 pub(crate) fn round(x: f64) -> f64 {
-    Float::round(x)
+    const TWO_POW_52: f64 = 4_503_599_627_370_496.0;
+    let a = abs(x);
+    let r = (a + TWO_POW_52) - TWO_POW_52;
+    let r = Float::copysign(r + f64::from(u8::from(a - r >= 0.5)), x);
+    // A select, not an early return, so that the compiler can keep it branch-free.
+    if a < TWO_POW_52 { r } else { x }
 }
 
 /// Adds the multiple of 2π to `angle` that brings it closest to `reference` (angle unwrapping).
@@ -48,4 +62,69 @@ pub(crate) fn powf(x: f64, y: f64) -> f64 {
 #[inline]
 pub(crate) fn ceil(x: f64) -> f64 {
     Float::ceil(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The library rounding this module's `round` replaces.
+    fn reference(x: f64) -> f64 {
+        Float::round(x)
+    }
+
+    fn same_bits(x: f64) {
+        let (got, want) = (round(x), reference(x));
+        assert!(
+            got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+            "round({x:e}) = {got:e}, library {want:e}"
+        );
+    }
+
+    #[test]
+    fn round_matches_the_library_on_edges() {
+        let half_below = 0.5 - f64::EPSILON / 4.0; // 0.49999999999999994
+        let two52 = 4_503_599_627_370_496.0;
+        for x in [
+            0.0,
+            0.5,
+            1.5,
+            2.5,
+            half_below,
+            1.0 - f64::EPSILON / 2.0,
+            two52 - 0.5,
+            two52 - 1.5,
+            two52,
+            two52 + 1.0,
+            9.3e18,
+            1e300,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NAN,
+        ] {
+            same_bits(x);
+            same_bits(-x);
+        }
+    }
+
+    #[test]
+    fn round_matches_the_library_on_a_million_bit_patterns() {
+        // SplitMix64 over raw bit patterns (every exponent) and over values near halves.
+        let mut z: u64 = 0x1234_5678_9ABC_DEF0;
+        let mut next = || {
+            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut v = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            v = (v ^ (v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            v ^ (v >> 31)
+        };
+        for _ in 0..500_000 {
+            same_bits(f64::from_bits(next()));
+            let k = (next() % 2_000_001) as f64 - 1e6;
+            let ulps = (next() % 7) as i64 - 3;
+            let h = k + 0.5;
+            same_bits(f64::from_bits((h.to_bits() as i64 + ulps) as u64));
+        }
+    }
 }

@@ -61,6 +61,24 @@ impl BiasFilter {
         }
     }
 
+    /// [`Self::step`] on the three axes, each with its own state.
+    #[inline]
+    fn step3(&self, x: [f64; 3], z: &mut [[f64; FILTER_STATE]; 3]) -> [f64; 3] {
+        match self {
+            // First order (MATLAB's default and Gauss–Markov): the general recursion unrolled,
+            // the same operations in the same order.
+            Self::Iir { b, a, len: 2 } => {
+                let mut y = [0.0; 3];
+                for i in 0..3 {
+                    y[i] = b[0] * x[i] + z[i][0];
+                    z[i][0] = b[1] * x[i] + 0.0 - a[1] * y[i];
+                }
+                y
+            }
+            _ => [0, 1, 2].map(|i| self.step(x[i], &mut z[i])),
+        }
+    }
+
     fn step(&self, x: f64, z: &mut [f64; FILTER_STATE]) -> f64 {
         match self {
             Self::Iir { b, a, len } => {
@@ -236,6 +254,7 @@ impl SensorModel {
 
     /// One reading from the ideal input `u` (sensor frame); advances `state`; draws exactly nine
     /// standard normals from `noise` (bias instability ×3, white ×3, random walk ×3).
+    #[inline]
     pub fn measure(
         &self,
         u: [f64; 3],
@@ -243,31 +262,55 @@ impl SensorModel {
         state: &mut SensorState,
         noise: &mut impl NoiseSource,
     ) -> [f64; 3] {
-        let n_bi: [f64; 3] = core::array::from_fn(|_| noise.standard_normal());
-        let n_white: [f64; 3] = core::array::from_fn(|_| noise.standard_normal());
-        let n_rw: [f64; 3] = core::array::from_fn(|_| noise.standard_normal());
+        let normals: [f64; 9] = core::array::from_fn(|_| noise.standard_normal());
+        self.measure_drawn(u, env, state, &normals)
+    }
+
+    /// [`Self::measure`] with the sample's nine standard normals already drawn, in the order
+    /// `measure` draws them.
+    ///
+    /// Written as index loops over the axes, stage by stage: the iterator and closure forms of
+    /// the same arithmetic measured 1.5× slower here (they change what the compiler inlines).
+    #[inline]
+    #[allow(clippy::needless_range_loop)]
+    pub fn measure_drawn(
+        &self,
+        u: [f64; 3],
+        env: &Environment,
+        state: &mut SensorState,
+        normals: &[f64; 9],
+    ) -> [f64; 3] {
+        let n_bi = [normals[0], normals[1], normals[2]];
+        let n_white = [normals[3], normals[4], normals[5]];
+        let n_rw = [normals[6], normals[7], normals[8]];
         let dt_c = env.temperature_c - 25.0;
-        core::array::from_fn(|i| {
+        let mut y = [0.0; 3];
+        for i in 0..3 {
             let m = &self.misalignment[i];
-            let bulk = m[0] * u[0] + m[1] * u[1] + m[2] * u[2] + self.bias[i];
-            let instability = self
-                .bias_filter
-                .step(self.bias_instability[i] * n_bi[i], &mut state.filter[i]);
+            y[i] = m[0] * u[0] + m[1] * u[1] + m[2] * u[2] + self.bias[i];
+        }
+        let instability = self.bias_filter.step3(
+            [0, 1, 2].map(|i| self.bias_instability[i] * n_bi[i]),
+            &mut state.filter,
+        );
+        for i in 0..3 {
             state.random_walk[i] += self.random_walk_sigma[i] * n_rw[i];
-            let drift = instability + self.white_sigma[i] * n_white[i] + state.random_walk[i];
+            let drift = instability[i] + self.white_sigma[i] * n_white[i] + state.random_walk[i];
             let environment = dt_c * self.temperature_bias[i]
                 + self.acceleration_bias[i] * env.acceleration_m_s2[i];
-            let y = (1.0 + dt_c * self.temperature_scale[i]) * (bulk + drift + environment);
-            let y = self.saturate(y);
-            if self.quantization_carry && self.resolution > 0.0 {
-                let carried = y + state.quantization_residual[i];
-                let q = self.quantise(carried);
-                state.quantization_residual[i] = carried - q;
-                q
-            } else {
-                self.quantise(y)
+            y[i] = self
+                .saturate((1.0 + dt_c * self.temperature_scale[i]) * (y[i] + drift + environment));
+        }
+        if self.quantization_carry && self.resolution > 0.0 {
+            for i in 0..3 {
+                let carried = y[i] + state.quantization_residual[i];
+                y[i] = self.quantise(carried);
+                state.quantization_residual[i] = carried - y[i];
             }
-        })
+        } else {
+            y = y.map(|v| self.quantise(v));
+        }
+        y
     }
 
     fn saturate(&self, y: f64) -> f64 {

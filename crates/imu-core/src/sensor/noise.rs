@@ -40,6 +40,7 @@ impl SeededNormals {
 }
 
 impl NoiseSource for SeededNormals {
+    #[inline]
     fn standard_normal(&mut self) -> f64 {
         StandardNormal.sample(&mut self.rng)
     }
