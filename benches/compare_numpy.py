@@ -11,9 +11,15 @@ The NumPy reference is written as a competent NumPy user would (whole-array oper
 rounding with the noise terms at zero, and in distribution with noise (the white, random-walk and
 bias-instability parts have the variances theory gives, in both).
 
-Run (prints a table of time ratios; one core: both sides are single-threaded):
+Two comparisons per size: the whole pipeline (truth by differentiation + error model), and the
+error model alone on prepared inputs (NumPy: body-frame inputs, its normals included; imukit:
+MATLAB's call shape into a reused output buffer, the rotations to the body frame included).
+``--rust`` also runs the criterion bench of the same call in Rust and prints the Python/Rust
+time ratio at 10⁶ samples.
+
+Run (prints tables of time ratios; one core: both sides are single-threaded):
     python benches/compare_numpy.py                     # N = 10⁴ … 10⁶
-    python benches/compare_numpy.py --sizes 1e4 1e5 1e6 1e7
+    python benches/compare_numpy.py --sizes 1e4 1e5 1e6 1e7 --rust
 """
 from __future__ import annotations
 
@@ -25,6 +31,7 @@ import subprocess
 import tempfile
 import time
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 from scipy.signal import lfilter
@@ -129,6 +136,42 @@ def imukit_pipeline(t, pos, euler, prm, seed=1):
     return imu(acc, omega_n, q)
 
 
+def model_inputs(t, pos, euler):
+    """The error model's inputs, prepared outside the timing: the NumPy reference's body-frame
+    specific force, body rate and field, and the nav-frame arrays imukit's MATLAB-shaped call
+    takes (C-contiguous)."""
+    truth = imukit.truth_from_samples(t, pos, euler_rad=euler, order=2, nav_frame="NED")
+    v = truth.values
+    q = np.ascontiguousarray(v[:, 10:14])
+    acc = np.ascontiguousarray(v[:, 7:10])
+    c = imukit.quaternion_to_dcm(q)
+    omega_n = np.einsum("nij,nj->ni", c, v[:, 17:20])
+    f_b = np.einsum("nji,nj->ni", c, -acc + np.array([0.0, 0.0, G]))
+    m_b = np.einsum("nji,j->ni", c, MAG_NED)
+    return (acc, omega_n, q), (f_b, np.ascontiguousarray(v[:, 17:20]), m_b, acc)
+
+
+def numpy_model(f_b, omega_b, m_b, acc, prm, rng_seed=1):
+    """The NumPy reference's error model alone (its normals included)."""
+    normals = np.random.default_rng(rng_seed).standard_normal((len(f_b), 27))
+    return (sensor(f_b, prm["accelerometer"], normals[:, 0:9]),
+            sensor(omega_b, prm["gyroscope"], normals[:, 9:18], accel_n=acc),
+            sensor(m_b, prm["magnetometer"], normals[:, 18:27]))
+
+
+def rust_matlab_call_ns_per_sample() -> Optional[float]:
+    """Criterion's estimate for the same call in Rust (`--bench sensor`, `matlab_call`, 10⁶
+    samples, output buffer reused), run now; None where cargo is not available."""
+    root = Path(__file__).resolve().parents[1]
+    if shutil.which("cargo") is None:
+        return None
+    subprocess.run(["cargo", "bench", "-q", "-p", "imu-benches", "--bench", "sensor", "--", "matlab_call"],
+                   cwd=root, check=True, capture_output=True)
+    est = root / "target" / "criterion" / "sensor_model_matlab_call" / "accel-gyro-mag" / "1000000" / "new"
+    mean_ns = json.loads((est / "estimates.json").read_text())["mean"]["point_estimate"]
+    return mean_ns / 1e6
+
+
 def check_agreement(n: int) -> None:
     t, pos, euler = trajectory(n)
     quiet = params(noise=False)
@@ -194,11 +237,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
     parser.add_argument("--no-cli", action="store_true", help="leave out the CLI column")
+    parser.add_argument("--rust", action="store_true",
+                        help="also run the Rust criterion bench of the same call and compare at 10⁶")
     args = parser.parse_args()
     check_agreement(20_000)
     print("agreement: noise-free outputs equal to rounding; drift variances match theory in both")
     prm = params(noise=True)
-    print(f"{'N':>10} {'NumPy / imukit (Python)':>24} {'NumPy / imukit (CLI, CSV in+out)':>34}")
+    print("time ratios, NumPy / imukit (> 1: imukit is faster); one core on both sides")
+    print(f"{'N':>10} {'pipeline, Python':>17} {'pipeline, CLI (CSV in+out)':>27} {'error model, Python':>20}")
+    python_model_s = {}
     with tempfile.TemporaryDirectory() as tmp:
         for size in args.sizes:
             n = int(size)
@@ -207,8 +254,33 @@ def main() -> None:
             t_np = best_of(lambda: numpy_pipeline(t, pos, euler, prm,
                                                   np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_py = best_of(lambda: imukit_pipeline(t, pos, euler, prm), repeat)
-            cli = "" if args.no_cli else f"{t_np / cli_time(t, pos, euler, prm, Path(tmp)):>34.2f}"
-            print(f"{n:>10} {t_np / t_py:>24.2f} {cli}")
+            cli = "" if args.no_cli else f"{t_np / cli_time(t, pos, euler, prm, Path(tmp)):>27.2f}"
+            ours_in, ref_in = model_inputs(t, pos, euler)
+            imu = imukit.ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=FS,
+                                   temperature=TEMPERATURE, seed=1, magnetic_field=MAG_NED, **prm)
+            out = np.empty((n, 9))
+            imu(*ours_in, out=out)  # the buffer's pages are touched once, as in a chunked run
+            t_model_np = best_of(lambda: numpy_model(*ref_in, prm), repeat)
+            t_model_py = best_of(lambda: imu(*ours_in, out=out), repeat)
+            python_model_s[n] = t_model_py
+            print(f"{n:>10} {t_np / t_py:>17.2f} {cli:>27} {t_model_np / t_model_py:>20.2f}")
+    if args.rust:
+        rust = rust_matlab_call_ns_per_sample()
+        n = 1_000_000
+        if rust is None:
+            print("Rust comparison left out: cargo not found")
+        else:
+            if n not in python_model_s:
+                t, pos, euler = trajectory(n)
+                ours_in, _ = model_inputs(t, pos, euler)
+                imu = imukit.ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=FS,
+                                       temperature=TEMPERATURE, seed=1, magnetic_field=MAG_NED, **prm)
+                out = np.empty((n, 9))
+                imu(*ours_in, out=out)
+                python_model_s[n] = best_of(lambda: imu(*ours_in, out=out), 3)
+            py_ns = python_model_s[n] / n * 1e9
+            print(f"error model at 10⁶ samples: Python call / Rust (criterion matlab_call) = "
+                  f"{py_ns / rust:.2f} (target ≤ 1.20)")
 
 
 if __name__ == "__main__":

@@ -10,7 +10,7 @@ use imu_core::sensor::{
     BiasInstabilityModel, GyroAccelerationInput, ImuModel, ImuReading, ImuState, SeededNormals,
     SensorParams, SensorSet, Temperatures,
 };
-use imu_core::{Enu, ImuMount, Truth};
+use imu_core::{Body, Enu, EulerZyx, ImuMount, Ned, Rotation, Truth};
 
 fn every_term(model: BiasInstabilityModel) -> SensorParams {
     SensorParams {
@@ -85,5 +85,47 @@ fn bench_sensor(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_sensor);
+/// MATLAB's batch call shape (`ImuModel::measure_nav_into`: nav-frame acceleration and angular
+/// velocity, attitude quaternions) on 10⁶ varying samples, output buffer reused: the Rust figure
+/// that the Python `ImuSensor` call is compared with (`benches/compare_numpy.py`).
+fn bench_matlab_call(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sensor_model/matlab_call");
+    let p = every_term(BiasInstabilityModel::default());
+    let model = ImuModel::new(
+        ImuMount::<Ned>::default(),
+        SensorSet {
+            gyroscope: true,
+            magnetometer: true,
+        },
+        GyroAccelerationInput::NavAcceleration,
+        [&p, &p, &p],
+        100.0,
+    )
+    .expect("valid parameters");
+    let n = 1_000_000;
+    let t = |k: usize| k as f64 * 0.01;
+    let acc: Vec<[f64; 3]> = (0..n)
+        .map(|k| [t(k).sin(), (2.0 * t(k)).cos(), 0.1])
+        .collect();
+    let omega: Vec<[f64; 3]> = (0..n).map(|k| [0.1, 0.2 * t(k).cos(), 0.3]).collect();
+    let attitude: Vec<Rotation<Body, Ned>> = (0..n)
+        .map(|k| Rotation::from_euler(EulerZyx::new(0.3 * t(k), 0.2, 0.1 * t(k).sin())))
+        .collect();
+    let temps = Temperatures::uniform(30.0);
+    let mut out = vec![ImuReading::default(); n];
+    group.throughput(Throughput::Elements(n as u64));
+    group.sample_size(10);
+    group.bench_function(BenchmarkId::new("accel-gyro-mag", n), |b| {
+        let mut state = ImuState::default();
+        let mut noise = SeededNormals::new(1);
+        b.iter(|| {
+            model.measure_nav_into(
+                &acc, &omega, &attitude, &temps, &mut state, &mut noise, &mut out,
+            );
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_sensor, bench_matlab_call);
 criterion_main!(benches);

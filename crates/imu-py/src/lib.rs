@@ -23,7 +23,7 @@ use imu_scenario::{analysis, arrays, navigation, planar, presets};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -472,19 +472,21 @@ impl Orientation<'_> {
         }
     }
 
-    fn at<N: NavFrame>(&self, i: usize) -> Rotation<Body, N> {
+    /// Sample `i`'s rotation; `None` for a quaternion of zero norm or not finite.
+    fn at<N: NavFrame>(&self, i: usize) -> Option<Rotation<Body, N>> {
         match self {
             Self::Quaternions(q) => {
                 let c = &q[4 * i..4 * i + 4];
-                Rotation::from_wxyz([c[0], c[1], c[2], c[3]]).unwrap_or_default()
+                Rotation::from_wxyz([c[0], c[1], c[2], c[3]])
             }
-            Self::Matrices(m) => Rotation::from_dcm(&m[i]),
+            Self::Matrices(m) => Some(Rotation::from_dcm(&m[i])),
         }
     }
 }
 
 /// MATLAB's batch call: nav-frame inputs row by row into `out` (accel, gyro, mag per row), with
-/// no intermediate buffers.
+/// no intermediate buffers and no separate validation pass. A bad quaternion stops the call
+/// with its index, `state` and `noise` as they were before the call.
 #[allow(clippy::too_many_arguments)]
 fn measure_rows<N: NavFrame>(
     model: &ImuModel<N>,
@@ -495,14 +497,20 @@ fn measure_rows<N: NavFrame>(
     state: &mut ImuState,
     noise: &mut SeededNormals,
     out: &mut [f64],
-) {
+) -> Result<(), usize> {
+    let (start_state, start_noise) = (*state, noise.clone());
     for (i, o) in out.chunks_exact_mut(9).enumerate() {
+        let Some(attitude) = orientation.at::<N>(i) else {
+            (*state, *noise) = (start_state, start_noise);
+            return Err(i);
+        };
         let v = |x: &[f64]| Vec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-        let r = model.measure_nav(v(a), v(w), &orientation.at::<N>(i), temps, state, noise);
+        let r = model.measure_nav(v(a), v(w), &attitude, temps, state, noise);
         o[..3].copy_from_slice(&r.accel_m_s2);
         o[3..6].copy_from_slice(&r.gyro_rad_s);
         o[6..].copy_from_slice(&r.mag_ut);
     }
+    Ok(())
 }
 
 /// The navigation-frame generic model behind `ImuSensor`.
@@ -599,7 +607,9 @@ impl PyImuSensor {
     /// Readings for nav-frame acceleration (N, 3), angular velocity (N, 3) and attitude
     /// quaternions `q_nb` (N, 4) or `C_nb` matrices (N, 3, 3); returns (N, 9) rows of
     /// accel, gyro, mag (absent sensors zero). State and noise stream carry over between calls.
-    #[pyo3(signature = (acceleration, angular_velocity, *, quaternion = None, dcm = None))]
+    /// `out`, a C-contiguous writeable (N, 9) float64 array, receives the rows instead of a new
+    /// array (a buffer reused across chunks is not page-faulted again).
+    #[pyo3(signature = (acceleration, angular_velocity, *, quaternion = None, dcm = None, out = None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -607,6 +617,7 @@ impl PyImuSensor {
         angular_velocity: PyReadonlyArray2<'py, f64>,
         quaternion: Option<PyReadonlyArray2<'py, f64>>,
         dcm: Option<PyReadonlyArray3<'py, f64>>,
+        out: Option<Bound<'py, PyArray2<f64>>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let a = flat_rows::<3>("acceleration", &acceleration)?;
         let w = flat_rows::<3>("angular_velocity", &angular_velocity)?;
@@ -615,17 +626,7 @@ impl PyImuSensor {
         // The orientation stays in the caller's array; each sample's rotation is made in the loop.
         let dcm_rows;
         let orientation = match (&quaternion, &dcm) {
-            (Some(q), None) => {
-                let q = flat_rows::<4>("quaternion", q)?;
-                if let Some(i) = q.chunks_exact(4).position(|c| {
-                    Rotation::<Body, Enu>::from_wxyz([c[0], c[1], c[2], c[3]]).is_none()
-                }) {
-                    return Err(ImuError::new_err(format!(
-                        "quaternion[{i}] has zero norm or is not finite"
-                    )));
-                }
-                Orientation::Quaternions(q)
-            }
+            (Some(q), None) => Orientation::Quaternions(flat_rows::<4>("quaternion", q)?),
             (None, Some(m)) => {
                 dcm_rows = dcm_in("orientation", m)?;
                 Orientation::Matrices(&dcm_rows)
@@ -637,12 +638,24 @@ impl PyImuSensor {
             }
         };
         check_len("orientation", orientation.len(), n)?;
-        let out = PyArray2::<f64>::zeros(py, [n, 9], false);
+        let out = match out {
+            Some(o) if o.shape() == [n, 9] => o,
+            Some(o) => {
+                return Err(PyValueError::new_err(format!(
+                    "out must have shape ({n}, 9), got ({}, {})",
+                    o.shape()[0],
+                    o.shape()[1]
+                )));
+            }
+            None => PyArray2::<f64>::zeros(py, [n, 9], false),
+        };
         {
-            let mut guard = out.readwrite();
+            let mut guard = out
+                .try_readwrite()
+                .map_err(|e| PyValueError::new_err(format!("out: {e}")))?;
             let o = guard
                 .as_slice_mut()
-                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                .map_err(|e| PyValueError::new_err(format!("out must be C-contiguous: {e}")))?;
             let (model, state, noise, temps) = (
                 &self.model,
                 &mut self.state,
@@ -652,7 +665,10 @@ impl PyImuSensor {
             py.detach(|| match model {
                 Model::Enu(m) => measure_rows(m, a, w, &orientation, &temps, state, noise, o),
                 Model::Ned(m) => measure_rows(m, a, w, &orientation, &temps, state, noise, o),
-            });
+            })
+            .map_err(|i| {
+                ImuError::new_err(format!("quaternion[{i}] has zero norm or is not finite"))
+            })?;
         }
         Ok(out)
     }

@@ -68,6 +68,46 @@ def test_state_carries_between_calls_and_reset_starts_over():
     np.testing.assert_array_equal(a1, a2)
 
 
+def test_out_buffer_is_written_in_place_and_reused_across_chunks():
+    params = dict(accelerometer={"NoiseDensity": 0.01, "BiasInstability": 0.002},
+                  gyroscope={"NoiseDensity": 1e-3, "RandomWalk": 1e-4}, seed=8)
+    rng = np.random.default_rng(4)
+    acc, w = rng.normal(size=(900, 3)), rng.normal(size=(900, 3))
+    q = imukit.euler_to_quaternion(rng.uniform(-1, 1, size=(900, 3)))
+    whole = imukit.ImuSensor("accel-gyro-mag", **params)(acc, w, q)
+    chunked = imukit.ImuSensor("accel-gyro-mag", **params)
+    buf = np.full((300, 9), np.nan)
+    for k in range(3):
+        rows = slice(300 * k, 300 * (k + 1))
+        accel, gyro, mag = chunked(acc[rows], w[rows], q[rows], out=buf)
+        assert np.shares_memory(accel, buf) and np.shares_memory(mag, buf)
+        np.testing.assert_array_equal(buf[:, 0:3], whole[0][rows])
+        np.testing.assert_array_equal(buf[:, 3:6], whole[1][rows])
+        np.testing.assert_array_equal(buf[:, 6:9], whole[2][rows])
+    acc2 = imukit.ImuSensor("accel-gyro", seed=1)
+    with pytest.raises(ValueError, match=r"out must have shape \(300, 9\), got \(299, 9\)"):
+        acc2(acc[:300], w[:300], q[:300], out=np.zeros((299, 9)))
+    with pytest.raises(ValueError, match="C-contiguous float64"):
+        acc2(acc[:300], w[:300], q[:300], out=np.zeros((300, 9), dtype=np.float32))
+    with pytest.raises(ValueError, match="C-contiguous float64"):
+        acc2(acc[:300], w[:300], q[:300], out=np.zeros((9, 300)).T)
+    frozen = np.zeros((300, 9))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="not writeable"):
+        acc2(acc[:300], w[:300], q[:300], out=frozen)
+
+
+def test_a_bad_quaternion_is_named_and_leaves_the_state_as_before():
+    imu = imukit.ImuSensor("accel-gyro", seed=2, accelerometer={"NoiseDensity": 0.1})
+    acc, w, q = level(10)
+    q[6] = [np.nan, 0, 0, 0]
+    with pytest.raises(ImuError, match=r"quaternion\[6\]"):
+        imu(acc, w, q)
+    a_after, _ = imu(*level(10))
+    a_fresh, _ = imukit.ImuSensor("accel-gyro", seed=2, accelerometer={"NoiseDensity": 0.1})(*level(10))
+    np.testing.assert_array_equal(a_after, a_fresh)
+
+
 def test_matlab_spec_sheet_accelerometer_deterministic_part():
     spec = {"MeasurementRange": 19.62, "Resolution": 0.00059875, "ConstantBias": 0.4905, "AxesMisalignment": 2,
             "NoiseDensity": 0.0, "TemperatureBias": [0.34335, 0.34335, 0.5886], "TemperatureScaleFactor": 0.02}

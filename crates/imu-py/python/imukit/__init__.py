@@ -179,6 +179,15 @@ def _rows(name: str, x, width: int, n: Optional[int] = None) -> np.ndarray:
     return a
 
 
+def _out(out: Optional[np.ndarray]) -> Optional[np.ndarray]:
+    """A caller's output buffer, checked to be one the readings can be written into in place."""
+    if out is None:
+        return None
+    if not isinstance(out, np.ndarray) or out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ValueError("out must be a C-contiguous float64 numpy array of shape (N, 9)")
+    return out
+
+
 def _formula(name: str, f) -> Optional[str]:
     if f is None:
         return None
@@ -418,6 +427,11 @@ class ImuSensor:
     (``C_nbᵀ``). It returns ``(accel, gyro)``, ``(accel, mag)`` or ``(accel, gyro, mag)`` per
     ``imu_type``. The drift state and the seeded noise stream carry over between calls (so one
     call of 2N samples equals two calls of N); ``reset()`` starts over.
+
+    ``out=`` takes a C-contiguous float64 (N, 9) array (accelerometer, gyroscope, magnetometer
+    columns; absent sensors zero) that the readings are written into, and the returned arrays
+    are views of it: a long run processed in chunks then reuses one buffer instead of
+    allocating (and page-faulting) a new one per chunk.
     """
 
     def __init__(
@@ -464,22 +478,22 @@ class ImuSensor:
     def temperature(self, value: float) -> None:
         self._imu.temperature = float(value)
 
-    def __call__(self, acc, ang_vel, orientation):
+    def __call__(self, acc, ang_vel, orientation, *, out: Optional[np.ndarray] = None):
         a = _rows("acc", np.atleast_2d(acc), 3)
         w = _rows("ang_vel", np.atleast_2d(ang_vel), 3, a.shape[0])
         o = np.ascontiguousarray(orientation, dtype=np.float64)
         if o.ndim == 1 and o.shape == (4,) or o.ndim == 2 and o.shape == (3, 3):
             o = o[None]
         if o.ndim == 2 and o.shape[1] == 4:
-            out = self._imu.step(a, w, quaternion=_rows("orientation", o, 4, a.shape[0]))
+            rows = self._imu.step(a, w, quaternion=_rows("orientation", o, 4, a.shape[0]), out=_out(out))
         elif o.ndim == 3 and o.shape[1:] == (3, 3):
             if o.shape[0] != a.shape[0]:
                 raise ValueError(f"orientation has {o.shape[0]} matrices, expected {a.shape[0]}")
             # MATLAB's rotation matrices take navigation-frame vectors to the body frame: C_nbᵀ.
-            out = self._imu.step(a, w, dcm=np.ascontiguousarray(np.swapaxes(o, 1, 2)))
+            rows = self._imu.step(a, w, dcm=np.ascontiguousarray(np.swapaxes(o, 1, 2)), out=_out(out))
         else:
             raise ValueError(f"orientation must have shape (N, 4) or (N, 3, 3), got {o.shape}")
-        accel, gyro, mag = out[:, 0:3], out[:, 3:6], out[:, 6:9]
+        accel, gyro, mag = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
         return {"accel-gyro": (accel, gyro), "accel-mag": (accel, mag)}.get(self.imu_type, (accel, gyro, mag))
 
     def reset(self) -> None:

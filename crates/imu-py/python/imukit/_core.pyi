@@ -127,6 +127,7 @@ class ImuSensor:
         *,
         quaternion: Optional[npt.NDArray[np.float64]] = None,
         dcm: Optional[npt.NDArray[np.float64]] = None,
+        out: Optional[npt.NDArray[np.float64]] = None,
     ) -> npt.NDArray[np.float64]: ...
     def reset(self) -> None: ...
     @property
