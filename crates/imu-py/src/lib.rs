@@ -956,12 +956,12 @@ fn compare<'py>(
         .map_err(refused)?;
     let d = pyo3::types::PyDict::new(py);
     for (k, v) in [
-        ("position_rms_m", c.position_rms_m),
-        ("position_final_m", c.position_final_m),
-        ("velocity_rms_m_s", c.velocity_rms_m_s),
-        ("velocity_final_m_s", c.velocity_final_m_s),
-        ("attitude_rms_rad", c.attitude_rms_rad),
-        ("attitude_final_rad", c.attitude_final_rad),
+        ("position_rms_m", c.summary.position_rms_m),
+        ("position_final_m", c.summary.position_final_m),
+        ("velocity_rms_m_s", c.summary.velocity_rms_m_s),
+        ("velocity_final_m_s", c.summary.velocity_final_m_s),
+        ("attitude_rms_rad", c.summary.attitude_rms_rad),
+        ("attitude_final_rad", c.summary.attitude_final_rad),
     ] {
         d.set_item(k, v)?;
     }

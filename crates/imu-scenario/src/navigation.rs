@@ -5,7 +5,10 @@
 //! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
 //! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
 //! yaw_rad, pitch_rad, roll_rad`.
-use imu_core::strapdown::rk4::strapdown_rates_rk4;
+use imu_core::strapdown::rk4::{
+    NODES, RateWindow, Rk4Strapdown, strapdown_rates_rk4, window_start,
+};
+use std::collections::VecDeque;
 use std::io::Write;
 use std::path::Path;
 
@@ -353,6 +356,15 @@ fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14
 pub struct Comparison {
     /// Per sample ([`ERROR_COLUMNS`]).
     pub table: Table,
+    /// RMS and final values.
+    pub summary: ErrorSummary,
+}
+
+/// RMS and final error norms of a comparison.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ErrorSummary {
+    /// Rows compared.
+    pub rows: usize,
     /// RMS of the position error norm, m.
     pub position_rms_m: f64,
     /// Final position error norm, m.
@@ -367,90 +379,154 @@ pub struct Comparison {
     pub attitude_final_rad: f64,
 }
 
+/// One row of a state table in [`STATE_COLUMNS`] order: `t_s`, position, velocity, `q_wxyz`.
+type StateRow = [f64; 11];
+
 /// Compares an estimate with truth (see [`Comparison`]).
 ///
 /// # Errors
-/// Missing columns; estimate times outside the truth's time span.
+/// Missing columns; estimate times outside the truth's time span or going back.
 pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
-    let col = |t: &Table, what: &str, c: &str| {
-        t.column(c)
-            .ok_or_else(|| invalid(what, format!("missing column {c}")))
+    let rows = |t: &Table, what: &str| -> Result<Vec<StateRow>> {
+        let cols: Vec<Vec<f64>> = STATE_COLUMNS
+            .iter()
+            .map(|c| {
+                t.column(c)
+                    .ok_or_else(|| invalid(what, format!("missing column {c}")))
+            })
+            .collect::<Result<_>>()?;
+        Ok((0..t.rows())
+            .map(|r| std::array::from_fn(|c| cols[c][r]))
+            .collect())
     };
-    let names = &STATE_COLUMNS[1..];
-    let tt = col(truth, "truth", "t_s")?;
-    let te = col(estimate, "estimate", "t_s")?;
-    let tv: Vec<Vec<f64>> = names
-        .iter()
-        .map(|c| col(truth, "truth", c))
-        .collect::<Result<_>>()?;
-    let ev: Vec<Vec<f64>> = names
-        .iter()
-        .map(|c| col(estimate, "estimate", c))
-        .collect::<Result<_>>()?;
-    if tt.is_empty() || te.is_empty() {
+    let (tr, er) = (rows(truth, "truth")?, rows(estimate, "estimate")?);
+    let (mut ti, mut ei) = (tr.iter(), er.iter());
+    let mut table = Table::new(&ERROR_COLUMNS);
+    let summary = compare_rows(
+        |row| Ok(ti.next().map(|r| *row = *r).is_some()),
+        |row| Ok(ei.next().map(|r| *row = *r).is_some()),
+        |e| {
+            table.push_row(e);
+            Ok(())
+        },
+    )?;
+    Ok(Comparison { table, summary })
+}
+
+/// [`compare`] on two CSV files, streamed (memory does not grow with the files); the errors
+/// over time go to `out` ([`ERROR_COLUMNS`]), which appears only when complete.
+///
+/// # Errors
+/// As [`compare`], CSV errors naming file, row and column, and I/O errors.
+pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+    let hint = "; truth and estimate need t_s, pos_*, vel_*, q_*";
+    let mut truth_rows = CsvRows::open(truth, STATE_COLUMNS, hint)?;
+    let mut estimate_rows = CsvRows::open(estimate, STATE_COLUMNS, hint)?;
+    let mut file = out.map(AtomicFile::create).transpose()?;
+    if let Some(f) = file.as_mut() {
+        f.writer()
+            .write_all(ERROR_COLUMNS.join(",").as_bytes())
+            .and_then(|()| f.writer().write_all(b"\n"))
+            .map_err(|e| f.error(e))?;
+    }
+    let summary = compare_rows(
+        |row| Ok(truth_rows.next_row(row)?.is_some()),
+        |row| Ok(estimate_rows.next_row(row)?.is_some()),
+        |e| match file.as_mut() {
+            Some(f) => write_rows(f.writer(), e, ERROR_COLUMNS.len(), b",").map_err(|x| f.error(x)),
+            None => Ok(()),
+        },
+    )?;
+    file.map_or(Ok(()), AtomicFile::commit)?;
+    Ok(summary)
+}
+
+/// The comparison of two row streams in time order: for each estimate row the truth rows that
+/// bracket its time (a single-row truth brackets with itself; times beyond the last truth row
+/// use the last two), errors handed to `sink`.
+fn compare_rows(
+    mut truth: impl FnMut(&mut StateRow) -> Result<bool>,
+    mut estimate: impl FnMut(&mut StateRow) -> Result<bool>,
+    mut sink: impl FnMut(&[f64; 9]) -> Result<()>,
+) -> Result<ErrorSummary> {
+    let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
+    if !truth(&mut a)? {
         return Err(invalid("compare", "empty table"));
     }
-    let (t0, t1) = (tt[0], tt[tt.len() - 1]);
-    let mut table = Table::new(&ERROR_COLUMNS);
+    let t0 = a[0];
+    let mut truth_ended = !truth(&mut b)?;
+    if truth_ended {
+        b = a;
+    }
+    let mut e = [0.0; 11];
+    let mut s = ErrorSummary::default();
     let (mut sp, mut sv, mut sa) = (0.0, 0.0, 0.0);
-    let (mut fp, mut fv, mut fa) = (0.0, 0.0, 0.0);
-    for (i, &t) in te.iter().enumerate() {
-        if t < t0 - 1e-9 || t > t1 + 1e-9 {
+    let mut previous_t = f64::NEG_INFINITY;
+    while estimate(&mut e)? {
+        let (t, row) = (e[0], s.rows + 2);
+        if t < previous_t {
             return Err(invalid(
                 "compare",
-                format!(
-                    "estimate time {t} s (row {}) is outside the truth's {t0}…{t1} s",
-                    i + 2
-                ),
+                format!("estimate time {t} s (row {row}) goes back from {previous_t} s"),
             ));
         }
-        // Bracketing truth samples ka ≤ t ≤ kb (a single-row truth brackets with itself).
-        let (ka, kb) = if tt.len() == 1 {
-            (0, 0)
-        } else {
-            let k = tt.partition_point(|&x| x <= t).clamp(1, tt.len() - 1);
-            (k - 1, k)
-        };
-        let w = if kb == ka || tt[kb] == tt[ka] {
+        previous_t = t;
+        // Advance to the first truth row later than t (or the last one).
+        while !truth_ended && b[0] <= t {
+            if truth(&mut next)? {
+                (a, b) = (b, next);
+            } else {
+                truth_ended = true;
+            }
+        }
+        if t < t0 - 1e-9 || (truth_ended && t > b[0] + 1e-9) {
+            let end = if truth_ended {
+                format!("{} s", b[0])
+            } else {
+                "…".into()
+            };
+            return Err(invalid(
+                "compare",
+                format!("estimate time {t} s (row {row}) is outside the truth's {t0}…{end}"),
+            ));
+        }
+        let w = if b[0] == a[0] {
             0.0
         } else {
-            ((t - tt[ka]) / (tt[kb] - tt[ka])).clamp(0.0, 1.0)
+            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
         };
-        let lerp = |c: usize| tv[c][ka] + w * (tv[c][kb] - tv[c][ka]);
-        let dp: [f64; 3] = std::array::from_fn(|j| ev[j][i] - lerp(j));
-        let dv: [f64; 3] = std::array::from_fn(|j| ev[3 + j][i] - lerp(3 + j));
-        let q = |v: &Vec<Vec<f64>>, r: usize| {
-            Rotation::<imu_core::Body, Enu>::from_wxyz([v[6][r], v[7][r], v[8][r], v[9][r]])
-        };
-        let (qa, qb, qe) = match (q(&tv, ka), q(&tv, kb), q(&ev, i)) {
-            (Some(a), Some(b), Some(e)) => (a, b, e),
-            _ => {
-                return Err(invalid(
-                    "compare",
-                    format!("zero quaternion near estimate row {}", i + 2),
-                ));
-            }
+        let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
+        let dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
+        let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
+        let q =
+            |r: &StateRow| Rotation::<imu_core::Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
+        let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
+            return Err(invalid(
+                "compare",
+                format!("zero quaternion near estimate row {row}"),
+            ));
         };
         let qt = qa.quaternion().slerp(qb.quaternion(), w);
         let att = qe.quaternion().angle_to(&qt);
-        let (np, nv) = (
-            dp.iter().map(|x| x * x).sum::<f64>().sqrt(),
-            dv.iter().map(|x| x * x).sum::<f64>().sqrt(),
-        );
-        table.push_row(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], att]);
+        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let (np, nv) = (norm(&dp), norm(&dv));
+        sink(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], att])?;
         (sp, sv, sa) = (sp + np * np, sv + nv * nv, sa + att * att);
-        (fp, fv, fa) = (np, nv, att);
+        (
+            s.position_final_m,
+            s.velocity_final_m_s,
+            s.attitude_final_rad,
+        ) = (np, nv, att);
+        s.rows += 1;
     }
-    let n = te.len() as f64;
-    Ok(Comparison {
-        table,
-        position_rms_m: (sp / n).sqrt(),
-        position_final_m: fp,
-        velocity_rms_m_s: (sv / n).sqrt(),
-        velocity_final_m_s: fv,
-        attitude_rms_rad: (sa / n).sqrt(),
-        attitude_final_rad: fa,
-    })
+    if s.rows == 0 {
+        return Err(invalid("compare", "empty table"));
+    }
+    let n = s.rows as f64;
+    s.position_rms_m = (sp / n).sqrt();
+    s.velocity_rms_m_s = (sv / n).sqrt();
+    s.attitude_rms_rad = (sa / n).sqrt();
+    Ok(s)
 }
 
 /// Rows a streamed integration reads ahead to set the reference interval of the gap check (the
@@ -467,10 +543,9 @@ pub struct NavSummary {
 }
 
 /// Integrates the IMU CSV file `input` into the navigation CSV `out` ([`NAV_COLUMNS`]), the
-/// same numbers as [`integrate`]. The coning/sculling scheme streams (memory does not grow with
-/// the file; gaps are judged against the median interval of the first [`GAP_WINDOW`] rows); the
-/// RK4 scheme, which interpolates over neighbouring samples, reads the file whole. `out`
-/// appears only when complete.
+/// same numbers as [`integrate`], streamed: memory does not grow with the file (the RK4 scheme
+/// holds the six samples around its current interval); gaps are judged against the median
+/// interval of the first [`GAP_WINDOW`] rows. `out` appears only when complete.
 ///
 /// # Errors
 /// As [`integrate`], CSV errors naming file, row and column, and I/O errors.
@@ -480,15 +555,6 @@ pub fn integrate_csv(
     setup: &NavSetup,
     out: &Path,
 ) -> Result<NavSummary> {
-    if setup.scheme != NavScheme::ConingSculling {
-        let nav = integrate(&crate::table::read_table(input)?, initial, setup)?;
-        nav.write_csv(out)?;
-        let last = |c: &str| nav.column(c).and_then(|v| v.last().copied()).unwrap_or(0.0);
-        return Ok(NavSummary {
-            rows: nav.rows(),
-            end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
-        });
-    }
     match setup.nav_frame {
         NavFrameName::ENU => integrate_csv_in::<Enu>(input, initial, setup, out),
         NavFrameName::NED => integrate_csv_in::<Ned>(input, initial, setup, out),
@@ -496,27 +562,109 @@ pub fn integrate_csv(
 }
 
 /// The per-sample integrator of a streamed file.
-enum Stepper<N> {
+enum Stepper<N: NavFrame> {
     Rates(RateStrapdown<N>),
-    Increments { nav: Strapdown<N>, started: bool },
+    Increments {
+        nav: Strapdown<N>,
+        started: bool,
+    },
+    /// RK4 holds the samples its next interval's quintic needs (six, from two before it) and
+    /// emits each state once the three samples after the interval have been read (at the end
+    /// of the file, the last intervals share the final six samples).
+    Rk4 {
+        nav: Rk4Strapdown<N>,
+        initial: NavState<N>,
+        held: VecDeque<[f64; 7]>,
+        first_held: usize,
+        seen: usize,
+        next_interval: usize,
+    },
 }
 
+type Emit<'a, N> = dyn FnMut(NavState<N>) -> Result<()> + 'a;
+
 impl<N: NavFrame> Stepper<N> {
-    /// `force` is the accelerometer column (rates) or Δv, `turn` the gyroscope column or Δθ.
-    fn step(
-        &mut self,
-        t_s: f64,
-        force: [f64; 3],
-        turn: [f64; 3],
-    ) -> core::result::Result<NavState<N>, StrapdownError> {
+    /// Takes the next row `[t, force, turn]` (force: accelerometer or Δv, physical sign; turn:
+    /// gyroscope or Δθ) and emits the states it completes, in order.
+    fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, N>) -> Result<()> {
+        let (t, force, turn) = (row[0], [row[1], row[2], row[3]], [row[4], row[5], row[6]]);
+        let failed = |e: StrapdownError| invalid("IMU data", e.to_string());
         match self {
-            Self::Rates(r) => r.step(t_s, turn, force),
+            Self::Rates(r) => emit(r.step(t, turn, force).map_err(failed)?),
             Self::Increments { nav, started } if !*started => {
                 *started = true;
-                Ok(*nav.state())
+                emit(*nav.state())
             }
-            Self::Increments { nav, .. } => nav.step(t_s, turn, force),
+            Self::Increments { nav, .. } => emit(nav.step(t, turn, force).map_err(failed)?),
+            Self::Rk4 {
+                nav,
+                initial,
+                held,
+                first_held,
+                seen,
+                next_interval,
+            } => {
+                if !row.iter().all(|v| v.is_finite()) {
+                    return Err(failed(StrapdownError::NotFinite { index: *seen }));
+                }
+                held.push_back(row);
+                *seen += 1;
+                if *seen == 1 {
+                    return emit(NavState { t_s: t, ..*initial });
+                }
+                // Interval k's window starts at k − 2 (or 0) unless the file ends within three
+                // samples after it, which is known once sample max(k + 3, 5) is read.
+                while *seen >= (*next_interval + 4).max(NODES) {
+                    let k = *next_interval;
+                    let start = k.saturating_sub(NODES / 2 - 1);
+                    emit(nav.interval(&window(held, start - *first_held), k - start))?;
+                    *next_interval += 1;
+                    while held.len() > NODES && *first_held + NODES / 2 - 1 < *next_interval {
+                        held.pop_front();
+                        *first_held += 1;
+                    }
+                }
+                Ok(())
+            }
         }
+    }
+
+    /// Emits the states still held once the file has ended.
+    fn finish(&mut self, emit: &mut Emit<'_, N>) -> Result<()> {
+        let Self::Rk4 {
+            nav,
+            held,
+            first_held,
+            seen,
+            next_interval,
+            ..
+        } = self
+        else {
+            return Ok(());
+        };
+        let n = *seen;
+        if n < NODES {
+            return Err(invalid(
+                "IMU data",
+                format!("the rk4 scheme needs at least {NODES} samples, got {n}"),
+            ));
+        }
+        for k in *next_interval..n - 1 {
+            let start = window_start(k, n);
+            emit(nav.interval(&window(held, start - *first_held), k - start))?;
+        }
+        *next_interval = n - 1;
+        Ok(())
+    }
+}
+
+/// The six held rows from `offset` as an RK4 window.
+fn window(held: &VecDeque<[f64; 7]>, offset: usize) -> RateWindow {
+    let row = |j: usize| &held[offset + j];
+    RateWindow {
+        t_s: std::array::from_fn(|j| row(j)[0]),
+        gyro_rad_s: std::array::from_fn(|j| [row(j)[4], row(j)[5], row(j)[6]]),
+        accel_m_s2: std::array::from_fn(|j| [row(j)[1], row(j)[2], row(j)[3]]),
     }
 }
 
@@ -572,12 +720,25 @@ fn integrate_csv_in<N: NavFrame>(
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
         position_m: Vec3::from_array(initial.position_m),
     };
-    let mut stepper = if rates {
-        Stepper::Rates(RateStrapdown::new(s0, setup.options))
-    } else {
-        Stepper::Increments {
+    let mut stepper = match (setup.scheme, rates) {
+        (NavScheme::ConingSculling, true) => Stepper::Rates(RateStrapdown::new(s0, setup.options)),
+        (NavScheme::ConingSculling, false) => Stepper::Increments {
             nav: Strapdown::new(s0, setup.options),
             started: false,
+        },
+        (NavScheme::Rk4 { substeps }, true) => Stepper::Rk4 {
+            nav: Rk4Strapdown::new(s0, setup.options.gravity_m_s2, substeps),
+            initial: s0,
+            held: VecDeque::with_capacity(NODES + 1),
+            first_held: 0,
+            seen: 0,
+            next_interval: 0,
+        },
+        (NavScheme::Rk4 { .. }, false) => {
+            return Err(invalid(
+                "IMU data",
+                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+            ));
         }
     };
     let sign = match setup.accel_sign {
@@ -589,7 +750,19 @@ fn integrate_csv_in<N: NavFrame>(
         .write_all(NAV_COLUMNS.join(",").as_bytes())
         .and_then(|()| file.writer().write_all(b"\n"))
         .map_err(|e| file.error(e))?;
-    let (mut last_yaw, mut previous_t, mut end) = (None, None::<f64>, s0);
+    let (mut last_yaw, mut previous_t, mut end, mut written) = (None, None::<f64>, s0, 0usize);
+    let mut write = |state: NavState<N>, file: &mut AtomicFile| -> Result<()> {
+        write_rows(
+            file.writer(),
+            &nav_row(&state, &mut last_yaw),
+            NAV_COLUMNS.len(),
+            b",",
+        )
+        .map_err(|e| file.error(e))?;
+        end = state;
+        written += 1;
+        Ok(())
+    };
     let mut i = 0usize;
     let mut process = |r: &[f64; 7], file: &mut AtomicFile| -> Result<()> {
         let t = r[0];
@@ -609,18 +782,8 @@ fn integrate_csv_in<N: NavFrame>(
             }
         }
         previous_t = Some(t);
-        let f = [sign * r[1], sign * r[2], sign * r[3]];
-        let state = stepper
-            .step(t, f, [r[4], r[5], r[6]])
-            .map_err(|e| invalid("IMU data", e.to_string()))?;
-        write_rows(
-            file.writer(),
-            &nav_row(&state, &mut last_yaw),
-            NAV_COLUMNS.len(),
-            b",",
-        )
-        .map_err(|e| file.error(e))?;
-        end = state;
+        let row = [t, sign * r[1], sign * r[2], sign * r[3], r[4], r[5], r[6]];
+        stepper.push(row, &mut |state| write(state, file))?;
         i += 1;
         Ok(())
     };
@@ -630,9 +793,10 @@ fn integrate_csv_in<N: NavFrame>(
     while rows.next_row(&mut row)?.is_some() {
         process(&row, &mut file)?;
     }
+    stepper.finish(&mut |state| write(state, &mut file))?;
     file.commit()?;
     Ok(NavSummary {
-        rows: i,
+        rows: written,
         end_position_m: end.position_m.to_array(),
     })
 }

@@ -36,7 +36,7 @@ fn rates_and_increments_round_trip_in_both_frames_and_signs() {
         let nav = integrate(&sim.imu, &init, &setup).unwrap();
         let c = compare(&sim.truth, &nav).unwrap();
         assert!(
-            c.position_final_m < 1e-3 && c.attitude_final_rad < 1e-5,
+            c.summary.position_final_m < 1e-3 && c.summary.attitude_final_rad < 1e-5,
             "{frame}: {c:?}"
         );
         // MATLAB's sign, flipped back, gives the same numbers.
@@ -55,7 +55,7 @@ fn rates_and_increments_round_trip_in_both_frames_and_signs() {
         let inc = scenario("output = \"increments\"\n", frame);
         let nav_i = integrate(&inc.imu, &init, &setup).unwrap();
         let d = compare(&nav, &nav_i).unwrap();
-        assert!(d.position_final_m < 1e-9, "{d:?}");
+        assert!(d.summary.position_final_m < 1e-9, "{d:?}");
     }
 }
 
@@ -63,8 +63,11 @@ fn rates_and_increments_round_trip_in_both_frames_and_signs() {
 fn compare_reports_zero_against_itself_and_refuses_times_outside_the_truth() {
     let sim = scenario("", "ENU");
     let c = compare(&sim.truth, &sim.truth).unwrap();
-    assert_eq!((c.position_rms_m, c.velocity_final_m_s), (0.0, 0.0));
-    assert!(c.attitude_rms_rad < 1e-7);
+    assert_eq!(
+        (c.summary.position_rms_m, c.summary.velocity_final_m_s),
+        (0.0, 0.0)
+    );
+    assert!(c.summary.attitude_rms_rad < 1e-7);
     let mut shifted = sim.truth.clone();
     let w = shifted.columns.len();
     for r in 0..shifted.rows() {
@@ -105,7 +108,7 @@ fn rk4_recovers_the_figure8_to_a_micrometre_after_60_s_at_1_khz() {
     .unwrap();
     eprintln!(
         "figure-8, 60 s at 1 kHz: final position error {:e} m (rk4), {:e} m (coning/sculling)",
-        c.position_final_m, coning.position_final_m
+        c.summary.position_final_m, coning.summary.position_final_m
     );
     let max = c
         .table
@@ -114,7 +117,7 @@ fn rk4_recovers_the_figure8_to_a_micrometre_after_60_s_at_1_khz() {
         .into_iter()
         .fold(0.0, f64::max);
     assert!(max <= 1e-6, "{max}");
-    assert!(coning.position_final_m > 1e-2);
+    assert!(coning.summary.position_final_m > 1e-2);
     // rk4 takes rates only.
     let inc = scenario("output = \"increments\"\n", "ENU");
     let e = integrate(
@@ -159,14 +162,32 @@ fn gaps_and_disorder_in_the_times_are_named() {
 
 #[test]
 fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
-    use imu_scenario::navigation::{GAP_WINDOW, integrate_csv};
+    use imu_scenario::navigation::{GAP_WINDOW, NavScheme, integrate_csv};
     let dir = std::env::temp_dir().join(format!("imukit-nav-stream-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // 4001 rows: the gap check's look-ahead window and the rest.
-    for (extra, frame, sign) in [
-        ("", "ENU", AccelSign::SpecificForce),
-        ("output = \"increments\"\n", "NED", AccelSign::SpecificForce),
-        ("accel_sign = \"matlab\"\n", "ENU", AccelSign::Matlab),
+    let rk4 = NavScheme::Rk4 { substeps: 2 };
+    for (extra, frame, sign, scheme) in [
+        (
+            "",
+            "ENU",
+            AccelSign::SpecificForce,
+            NavScheme::ConingSculling,
+        ),
+        (
+            "output = \"increments\"\n",
+            "NED",
+            AccelSign::SpecificForce,
+            NavScheme::ConingSculling,
+        ),
+        (
+            "accel_sign = \"matlab\"\n",
+            "ENU",
+            AccelSign::Matlab,
+            NavScheme::ConingSculling,
+        ),
+        ("", "NED", AccelSign::SpecificForce, rk4),
+        ("accel_sign = \"matlab\"\n", "ENU", AccelSign::Matlab, rk4),
     ] {
         let sim = scenario(extra, frame);
         assert!(sim.imu.rows() > 2 * GAP_WINDOW);
@@ -178,6 +199,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
                 NavFrameName::NED
             },
             accel_sign: sign,
+            scheme,
             ..NavSetup::default()
         };
         let (input, out) = (dir.join("imu.csv"), dir.join("nav.csv"));
@@ -188,8 +210,43 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         assert_eq!(summary.rows, whole.rows());
         assert!(
             streamed == whole,
-            "{extra} {frame}: streamed output differs"
+            "{extra} {frame} {scheme:?}: streamed output differs"
         );
+    }
+    // RK4 on files of 6 to 12 rows (the windows at both ends overlap) and on too few rows.
+    let sim = scenario("", "ENU");
+    let init = InitialState::from_table(&sim.truth).unwrap();
+    let setup = NavSetup {
+        scheme: rk4,
+        ..NavSetup::default()
+    };
+    for rows in (5..=12).chain([GAP_WINDOW + 7]) {
+        let mut short = sim.imu.clone();
+        short.data.truncate(rows * short.columns.len());
+        let (input, out) = (dir.join("short.csv"), dir.join("short_nav.csv"));
+        short.write_csv(&input).unwrap();
+        match (
+            integrate_csv(&input, &init, &setup, &out),
+            integrate(&short, &init, &setup),
+        ) {
+            (Ok(summary), Ok(whole)) => {
+                assert_eq!(summary.rows, rows);
+                assert!(
+                    imu_scenario::table::read_table(&out).unwrap() == whole,
+                    "{rows} rows"
+                );
+            }
+            (Err(e), Err(_)) => {
+                assert_eq!(rows, 5);
+                assert!(e.to_string().contains("at least 6 samples, got 5"), "{e}");
+                assert!(!out.exists());
+            }
+            (a, b) => panic!(
+                "{rows} rows: streamed {:?}, whole {:?}",
+                a.is_ok(),
+                b.is_ok()
+            ),
+        }
     }
     // A gap after the look-ahead window is found, named by its rows, and no output is left.
     let sim = scenario("", "ENU");
@@ -204,5 +261,86 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap_err();
     assert!(e.to_string().contains("between rows 3001 and 3002"), "{e}");
     assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A state table on `times` with position `[t, 2t, 0] + offset`, velocity `[1, 2, 0]` and a yaw
+/// of `0.1 t` (the quaternion interpolates exactly by slerp).
+fn linear_states(times: &[f64], offset: [f64; 3]) -> imu_scenario::Table {
+    let mut t = imu_scenario::Table::new(imu_scenario::navigation::STATE_COLUMNS);
+    for &s in times {
+        let h = 0.05 * s;
+        t.push_row(&[
+            s,
+            s + offset[0],
+            2.0 * s + offset[1],
+            offset[2],
+            1.0,
+            2.0,
+            0.0,
+            h.cos(),
+            0.0,
+            0.0,
+            h.sin(),
+        ]);
+    }
+    t
+}
+
+#[test]
+fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
+    use imu_scenario::navigation::compare_csv;
+    let dir = std::env::temp_dir().join(format!("imukit-compare-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let truth_times: Vec<f64> = (0..200)
+        .map(|k| 0.1 * k as f64 + 0.001 * (k % 3) as f64)
+        .collect();
+    let last = *truth_times.last().unwrap();
+    // Times on, between, repeated and at the very end of the truth's samples.
+    let mut est_times: Vec<f64> = (0..150).map(|k| 0.13 * k as f64).collect();
+    est_times.extend([0.13 * 149.0, last - 1e-3, last, last + 5e-10]);
+    let truth = linear_states(&truth_times, [0.0; 3]);
+    let estimate = linear_states(&est_times, [0.3, -0.4, 0.0]);
+    let c = compare(&truth, &estimate).unwrap();
+    assert_eq!(c.summary.rows, est_times.len());
+    for r in 0..c.table.rows() {
+        let row = &c.table.data[r * 9..(r + 1) * 9];
+        // (The last estimate lies 5e-10 s past the truth, which is held there: 1.2e-9 m.)
+        assert!(
+            (row[4] - 0.5).abs() < 2e-9,
+            "row {r}: position error {}",
+            row[4]
+        );
+        assert!(row[8].abs() < 1e-7, "row {r}: attitude error {}", row[8]);
+    }
+    assert!((c.summary.position_rms_m - 0.5).abs() < 1e-10);
+    // The same through files, streamed.
+    let (tp, ep, out) = (dir.join("t.csv"), dir.join("e.csv"), dir.join("err.csv"));
+    truth.write_csv(&tp).unwrap();
+    estimate.write_csv(&ep).unwrap();
+    let s = compare_csv(&tp, &ep, Some(&out)).unwrap();
+    assert_eq!(s, c.summary);
+    assert!(imu_scenario::table::read_table(&out).unwrap() == c.table);
+    // A single-row truth compares only at its own time.
+    let one = linear_states(&[1.0], [0.0; 3]);
+    assert_eq!(
+        compare(&one, &linear_states(&[1.0], [0.0; 3]))
+            .unwrap()
+            .summary
+            .position_final_m,
+        0.0
+    );
+    // Refusals, and no output file left.
+    std::fs::remove_file(&out).unwrap();
+    for (times, needle) in [
+        (vec![0.5, 0.4], "row 3) goes back"),
+        (vec![-0.1], "(row 2) is outside the truth's 0…"),
+        (vec![1.0, last + 0.01], "(row 3) is outside the truth's 0…19.90"),
+    ] {
+        linear_states(&times, [0.0; 3]).write_csv(&ep).unwrap();
+        let e = compare_csv(&tp, &ep, Some(&out)).unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+        assert!(!out.exists());
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,22 +1,13 @@
 //! `imukit compare TRUTH.csv NAV.csv [--out ERR.csv]`.
 use std::path::Path;
 
-use imu_scenario::Table;
-use imu_scenario::navigation::{STATE_COLUMNS, compare};
-use imu_scenario::table::read_table_columns;
+use imu_scenario::navigation::compare_csv;
 
 use super::CliError;
 
-fn read(path: &Path) -> Result<Table, CliError> {
-    let hint = "; truth and estimate need t_s, pos_*, vel_*, q_*";
-    Ok(read_table_columns(path, STATE_COLUMNS, hint)?)
-}
-
+/// Streams both files (memory does not grow with them).
 pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliError> {
-    let c = compare(&read(truth)?, &read(estimate)?)?;
-    if let Some(o) = out {
-        c.table.write_csv(o)?;
-    }
+    let c = compare_csv(truth, estimate, out)?;
     println!("{:<10} {:>14} {:>14}", "error", "RMS", "final");
     println!(
         "{:<10} {:>12.6e} m {:>12.6e} m",
