@@ -335,7 +335,10 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
     for (times, needle) in [
         (vec![0.5, 0.4], "row 3) goes back"),
         (vec![-0.1], "(row 2) is outside the truth's 0…"),
-        (vec![1.0, last + 0.01], "(row 3) is outside the truth's 0…19.90"),
+        (
+            vec![1.0, last + 0.01],
+            "(row 3) is outside the truth's 0…19.90",
+        ),
     ] {
         linear_states(&times, [0.0; 3]).write_csv(&ep).unwrap();
         let e = compare_csv(&tp, &ep, Some(&out)).unwrap_err().to_string();
