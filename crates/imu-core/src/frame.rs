@@ -2,6 +2,7 @@
 //!
 //! Frames are types, so a body-frame vector cannot be added to a navigation-frame one and generic
 //! code (`fn f<N: NavFrame>`) replaces an `is_enu` flag. The front ends pick `Enu` or `Ned` once.
+use crate::rotation::Rotation;
 use crate::vector::Vec3;
 
 mod sealed {
@@ -32,6 +33,10 @@ pub trait NavFrame: Frame {
     /// (NED `[27.5550, −2.4169, −16.0849]`).
     #[must_use]
     fn default_magnetic_field_ut() -> Vec3<Self>;
+
+    /// The change of axes from NED to this frame (the identity for NED).
+    #[must_use]
+    fn from_ned() -> Rotation<Ned, Self>;
 }
 
 /// East-North-Up navigation frame (the default, as in the German seed). Body frame is FLU.
@@ -61,11 +66,17 @@ impl NavFrame for Enu {
     fn default_magnetic_field_ut() -> Vec3<Self> {
         Vec3::new(-2.4169, 27.5550, 16.0849)
     }
+    fn from_ned() -> Rotation<Ned, Self> {
+        Rotation::ned_to_enu()
+    }
 }
 
 impl NavFrame for Ned {
     const Z_UP: f64 = -1.0;
     fn default_magnetic_field_ut() -> Vec3<Self> {
         Vec3::new(27.5550, -2.4169, -16.0849)
+    }
+    fn from_ned() -> Rotation<Ned, Self> {
+        Rotation::identity()
     }
 }

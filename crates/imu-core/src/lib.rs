@@ -29,6 +29,7 @@ pub mod frame;
 pub mod ideal;
 pub mod kinematics;
 mod math;
+pub mod orientation;
 pub mod rotation;
 pub mod sensor;
 pub mod strapdown;

@@ -1,0 +1,309 @@
+//! Orientation from IMU readings: the e-compass on a grid of attitudes, every filter on ideal
+//! static data, gyroscope-bias estimation by the Kalman filters, refusals.
+use imu_core::orientation::{
+    Complementary, DistanceStats, Estimate, FilterInput, KalmanFilter, KalmanParams, Madgwick,
+    Mahony, OrientError, OrientationFilter, ecompass, quaternion_distance,
+};
+use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+
+const G: f64 = 9.81;
+
+/// Ideal readings of a body at rest with attitude `r` in a field `field_n` (nav frame).
+fn at_rest<N: NavFrame>(r: &Rotation<Body, N>, field_n: Vec3<N>, sign: AccelSign) -> FilterInput {
+    let to_body = r.inverse();
+    let f = to_body.apply(-N::gravity(G)).to_array();
+    FilterInput {
+        accel_m_s2: match sign {
+            AccelSign::SpecificForce => f,
+            AccelSign::Matlab => f.map(|v| -v),
+        },
+        gyro_rad_s: [0.0; 3],
+        mag_ut: to_body.apply(field_n).to_array(),
+    }
+}
+
+/// A field of 50 µT pointing to true north, 60° below the horizon, in `N`.
+fn north_field<N: NavFrame>() -> Vec3<N> {
+    let ned = Vec3::<Ned>::new(25.0, 0.0, 50.0 * 60f64.to_radians().sin());
+    N::from_ned().apply(ned)
+}
+
+fn grid() -> impl Iterator<Item = EulerZyx> {
+    (0..11).flat_map(|i| {
+        (0..9).flat_map(move |j| {
+            (0..10).map(move |k| {
+                EulerZyx::new(
+                    (-170.0 + 34.0 * i as f64).to_radians(),
+                    (-80.0 + 20.0 * j as f64).to_radians(),
+                    (-175.0 + 35.0 * k as f64).to_radians(),
+                )
+            })
+        })
+    })
+}
+
+fn ecompass_grid<N: NavFrame>() {
+    let mut worst = 0.0f64;
+    for sign in [AccelSign::SpecificForce, AccelSign::Matlab] {
+        for e in grid() {
+            let truth = Rotation::<Body, N>::from_euler(e);
+            let s = at_rest(&truth, north_field::<N>(), sign);
+            let got = ecompass::<N>(s.accel_m_s2, s.mag_ut, sign).unwrap();
+            worst = worst.max(quaternion_distance(&got, &truth));
+        }
+    }
+    assert!(worst <= 1e-9, "{}: worst error {worst:e} rad", N::NAME);
+}
+
+#[test]
+fn ecompass_returns_the_true_attitude_over_a_grid_in_ned_and_enu_with_both_signs() {
+    ecompass_grid::<Ned>();
+    ecompass_grid::<Enu>();
+}
+
+#[test]
+fn ecompass_yaw_is_measured_from_magnetic_north() {
+    // MATLAB's default field: declination atan2(−2.4169, 27.5550) = −5.013°.
+    let field = Ned::default_magnetic_field_ut();
+    let declination = (-2.4169f64).atan2(27.5550);
+    let truth = Rotation::<Body, Ned>::from_euler(EulerZyx::new(0.7, 0.1, -0.2));
+    let s = at_rest(&truth, field, AccelSign::Matlab);
+    let got = ecompass::<Ned>(s.accel_m_s2, s.mag_ut, AccelSign::Matlab)
+        .unwrap()
+        .to_euler();
+    assert!((got.yaw_rad - (0.7 - declination)).abs() < 1e-12, "{got:?}");
+    assert!((got.pitch_rad - 0.1).abs() < 1e-12 && (got.roll_rad + 0.2).abs() < 1e-12);
+}
+
+#[test]
+fn ecompass_refuses_degenerate_readings() {
+    let e = |a, m| ecompass::<Ned>(a, m, AccelSign::Matlab).unwrap_err();
+    assert!(
+        matches!(e([0.0; 3], [1.0, 0.0, 0.0]), OrientError::Degenerate { what } if what.contains("accelerometer reading is zero"))
+    );
+    assert!(
+        matches!(e([0.0, 0.0, 9.81], [0.0; 3]), OrientError::Degenerate { what } if what.contains("magnetometer reading is zero"))
+    );
+    assert!(
+        matches!(e([0.0, 0.0, 9.81], [0.0, 0.0, 40.0]), OrientError::Degenerate { what } if what.contains("parallel"))
+    );
+    assert_eq!(
+        e([f64::NAN, 0.0, 9.81], [1.0, 0.0, 0.0]),
+        OrientError::NotFinite {
+            field: "accelerometer"
+        }
+    );
+    let msg = e([0.0, 0.0, 9.81], [0.0, 0.0, -40.0]).to_string();
+    assert!(msg.contains("parallel to gravity"), "{msg}");
+}
+
+/// Every filter, with and without a magnetometer where it has one, in `N` and `sign`.
+fn every_filter<N: NavFrame>(
+    sign: AccelSign,
+) -> Vec<(&'static str, bool, Box<dyn OrientationFilter<N>>)> {
+    let p = KalmanParams {
+        accel_sign: sign,
+        ..KalmanParams::default()
+    };
+    vec![
+        (
+            "imufilter",
+            false,
+            Box::new(KalmanFilter::<N>::imu(p).unwrap()),
+        ),
+        (
+            "ahrsfilter",
+            true,
+            Box::new(KalmanFilter::<N>::ahrs(p).unwrap()),
+        ),
+        (
+            "complementary",
+            true,
+            Box::new(Complementary::new(100.0, 0.01, 0.01, true, sign).unwrap()),
+        ),
+        (
+            "complementary (no mag)",
+            false,
+            Box::new(Complementary::new(100.0, 0.01, 0.01, false, sign).unwrap()),
+        ),
+        (
+            "madgwick",
+            true,
+            Box::new(Madgwick::new(100.0, 0.041, true, sign).unwrap()),
+        ),
+        (
+            "madgwick (no mag)",
+            false,
+            Box::new(Madgwick::new(100.0, 0.033, false, sign).unwrap()),
+        ),
+        (
+            "mahony",
+            true,
+            Box::new(Mahony::new(100.0, 1.0, 0.3, true, sign).unwrap()),
+        ),
+        (
+            "mahony (no mag)",
+            false,
+            Box::new(Mahony::new(100.0, 1.0, 0.3, false, sign).unwrap()),
+        ),
+    ]
+}
+
+fn static_hold<N: NavFrame>(sign: AccelSign) {
+    let truth = Rotation::<Body, N>::from_euler(EulerZyx::new(0.5, 0.2, -0.3));
+    // Without a magnetometer the heading is relative to the start: yaw 0.
+    let level_yaw = Rotation::<Body, N>::from_euler(EulerZyx::new(0.0, 0.2, -0.3));
+    let s = at_rest(&truth, north_field::<N>(), sign);
+    for (name, mag, mut f) in every_filter::<N>(sign) {
+        let expected = if mag { truth } else { level_yaw };
+        let mut stats = DistanceStats::default();
+        for _ in 0..2000 {
+            let est: Estimate<N> = f.update(&s).unwrap().unwrap();
+            stats.push(quaternion_distance(&est.orientation, &expected));
+        }
+        assert!(
+            stats.max() < 1e-9,
+            "{} {name} {sign:?}: max {:e} rad",
+            N::NAME,
+            stats.max()
+        );
+    }
+}
+
+#[test]
+fn every_filter_holds_the_true_orientation_on_ideal_static_data() {
+    for sign in [AccelSign::SpecificForce, AccelSign::Matlab] {
+        static_hold::<Ned>(sign);
+        static_hold::<Enu>(sign);
+    }
+}
+
+/// Runs a level static IMU with gyroscope bias `bias` through a Kalman filter for `seconds`.
+fn estimated_bias(magnetometer: bool, bias: [f64; 3], seconds: f64) -> [f64; 3] {
+    let p = KalmanParams::default();
+    let mut f = if magnetometer {
+        KalmanFilter::<Ned>::ahrs(p).unwrap()
+    } else {
+        KalmanFilter::<Ned>::imu(p).unwrap()
+    };
+    let mut s = at_rest(
+        &Rotation::<Body, Ned>::identity(),
+        north_field::<Ned>(),
+        AccelSign::Matlab,
+    );
+    s.gyro_rad_s = bias;
+    for _ in 0..(seconds * p.sample_rate_hz) as usize {
+        f.update(&s).unwrap();
+    }
+    f.state().gyroscope_offset()
+}
+
+#[test]
+fn kalman_filters_estimate_a_constant_gyroscope_bias() {
+    // Level: the accelerometer sees roll and pitch errors, so the x and y biases are observable
+    // to the IMU filter; the AHRS also sees heading, hence z.
+    let bias = [0.02, -0.015, 0.01];
+    let imu = estimated_bias(false, [bias[0], bias[1], 0.0], 60.0);
+    let ahrs = estimated_bias(true, bias, 60.0);
+    for k in 0..2 {
+        assert!((imu[k] / bias[k] - 1.0).abs() < 0.05, "imufilter {imu:?}");
+    }
+    for k in 0..3 {
+        assert!(
+            (ahrs[k] / bias[k] - 1.0).abs() < 0.05,
+            "ahrsfilter {ahrs:?}"
+        );
+    }
+}
+
+#[test]
+fn decimation_gives_one_estimate_per_block() {
+    let p = KalmanParams {
+        decimation: 4,
+        ..KalmanParams::default()
+    };
+    let mut f = KalmanFilter::<Ned>::imu(p).unwrap();
+    let s = at_rest(
+        &Rotation::<Body, Ned>::identity(),
+        north_field::<Ned>(),
+        AccelSign::Matlab,
+    );
+    let outputs: Vec<bool> = (0..12).map(|_| f.update(&s).unwrap().is_some()).collect();
+    assert_eq!(outputs.iter().filter(|o| **o).count(), 3);
+    assert!(outputs[3] && outputs[7] && outputs[11]);
+}
+
+#[test]
+fn bad_parameters_and_readings_are_named_and_leave_the_state_unchanged() {
+    let bad = |p: KalmanParams| KalmanFilter::<Ned>::imu(p).unwrap_err().to_string();
+    assert!(
+        bad(KalmanParams {
+            sample_rate_hz: 0.0,
+            ..KalmanParams::default()
+        })
+        .contains("SampleRate = 0")
+    );
+    assert!(
+        bad(KalmanParams {
+            decimation: 0,
+            ..KalmanParams::default()
+        })
+        .contains("DecimationFactor")
+    );
+    assert!(
+        bad(KalmanParams {
+            gyroscope_noise: -1.0,
+            ..KalmanParams::default()
+        })
+        .contains("GyroscopeNoise = -1")
+    );
+    assert!(
+        bad(KalmanParams {
+            linear_acceleration_decay: 1.5,
+            ..KalmanParams::default()
+        })
+        .contains("LinearAccelerationDecayFactor = 1.5: must be in [0, 1]")
+    );
+    assert!(Madgwick::new(f64::NAN, 0.1, false, AccelSign::Matlab).is_err());
+    assert!(
+        Complementary::new(100.0, 2.0, 0.01, true, AccelSign::Matlab)
+            .unwrap_err()
+            .to_string()
+            .contains("AccelerometerGain")
+    );
+    let mut f = KalmanFilter::<Ned>::ahrs(KalmanParams::default()).unwrap();
+    let s = at_rest(
+        &Rotation::<Body, Ned>::identity(),
+        north_field::<Ned>(),
+        AccelSign::Matlab,
+    );
+    f.update(&s).unwrap();
+    let before = *f.state();
+    let mut nan = s;
+    nan.mag_ut[1] = f64::NAN;
+    assert_eq!(
+        f.update(&nan).unwrap_err(),
+        OrientError::NotFinite {
+            field: "magnetometer"
+        }
+    );
+    assert_eq!(*f.state(), before);
+}
+
+#[test]
+fn quaternion_distance_is_the_rotation_angle_to_full_precision() {
+    let a = Rotation::<Body, Ned>::from_euler(EulerZyx::new(0.3, -0.2, 0.1));
+    for angle in [1e-12, 1e-6, 0.5, 3.0] {
+        let b = a.then(&Rotation::<Ned, Ned>::from_euler(EulerZyx::new(
+            angle, 0.0, 0.0,
+        )));
+        let d = quaternion_distance(&a, &b);
+        assert!((d - angle).abs() <= 1e-15 + 1e-13 * angle, "{angle}: {d}");
+    }
+    let mut stats = DistanceStats::default();
+    for d in [3.0, 4.0] {
+        stats.push(d);
+    }
+    assert_eq!((stats.count(), stats.max(), stats.last()), (2, 4.0, 4.0));
+    assert!((stats.rms() - 12.5f64.sqrt()).abs() < 1e-15);
+}
