@@ -78,12 +78,38 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Errors of an estimate against truth over time (position, velocity, attitude), with RMS
-    /// and final values printed.
+    /// Orientation from IMU readings by a filter: `imufilter` and `ahrsfilter` (MATLAB's
+    /// Kalman filters), `ecompass`, `madgwick`, `mahony` or `complementary`.
+    Orient {
+        /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
+        /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
+        input: PathBuf,
+        /// The filter.
+        #[arg(long, default_value = "imufilter")]
+        filter: String,
+        /// A filter setting, `KEY=VALUE`, repeatable: MATLAB's property names
+        /// (`GyroscopeNoise=7.6154e-7`, `DecimationFactor=2`, `InitialProcessNoiseScale=10`,
+        /// `SampleRate=100`; `Beta` for madgwick, `Kp`/`Ki` for mahony, `AccelerometerGain`/
+        /// `MagnetometerGain` for complementary). The sample rate defaults to the data's.
+        #[arg(long = "param", value_name = "KEY=VALUE")]
+        params: Vec<String>,
+        /// Navigation frame of the estimate (ENU or NED).
+        #[arg(long, default_value = "ENU")]
+        nav_frame: String,
+        /// Sign of the accelerometer columns (`specific-force` or `matlab`).
+        #[arg(long, default_value = "specific-force")]
+        accel_sign: String,
+        /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,
+        /// roll_rad`).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Errors of an estimate against truth over time: a navigation output (position, velocity,
+    /// attitude) or an orientation output (attitude), with RMS, maximum and final values printed.
     Compare {
         /// Truth CSV (`t_s, pos_*, vel_*, q_*`).
         truth: PathBuf,
-        /// Estimate CSV with the same columns (e.g. from `imukit integrate`).
+        /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
         /// Where to write the errors over time (CSV).
         #[arg(long)]

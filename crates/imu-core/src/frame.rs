@@ -13,7 +13,9 @@ mod sealed {
 }
 
 /// A coordinate frame marker.
-pub trait Frame: sealed::Sealed + Copy + Default + core::fmt::Debug + PartialEq + 'static {
+pub trait Frame:
+    sealed::Sealed + Copy + Default + core::fmt::Debug + PartialEq + Send + Sync + 'static
+{
     /// Short name used in messages and file headers.
     const NAME: &'static str;
 }

@@ -46,19 +46,6 @@ pub const NAV_COLUMNS: [&str; 14] = [
 /// quaternion.
 pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
 
-/// Error columns of [`compare`].
-pub const ERROR_COLUMNS: [&str; 9] = [
-    "t_s",
-    "pos_err_x_m",
-    "pos_err_y_m",
-    "pos_err_z_m",
-    "pos_err_m",
-    "vel_err_x_m_s",
-    "vel_err_y_m_s",
-    "vel_err_z_m_s",
-    "att_err_rad",
-];
-
 /// The initial state of a 3D integration, frame-free (default: at rest at the origin, level).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InitialState {
@@ -210,13 +197,13 @@ pub fn check_gaps(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
 }
 
 /// The median interval of increasing times (at least 2).
-fn median_interval(t_s: &[f64]) -> f64 {
+pub(crate) fn median_interval(t_s: &[f64]) -> f64 {
     let mut dt: Vec<f64> = t_s.windows(2).map(|w| w[1] - w[0]).collect();
     dt.sort_by(f64::total_cmp);
     dt[dt.len() / 2]
 }
 
-fn gap_error(what: &str, row: usize, d: f64, median: f64) -> crate::Error {
+pub(crate) fn gap_error(what: &str, row: usize, d: f64, median: f64) -> crate::Error {
     invalid(
         what,
         format!(
@@ -320,15 +307,24 @@ fn integrate_in<N: NavFrame>(
     Ok(table)
 }
 
-/// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
-fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14] {
-    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
-    let mut e = s.attitude.to_euler();
+/// The z-y-x Euler angles of `r` with the yaw unwrapped against `last_yaw` (then updated).
+pub(crate) fn euler_unwrapped<N: NavFrame>(
+    r: &Rotation<imu_core::Body, N>,
+    last_yaw: &mut Option<f64>,
+) -> imu_core::EulerZyx {
+    let mut e = r.to_euler();
     if let Some(y) = *last_yaw {
         let tau = std::f64::consts::TAU;
         e.yaw_rad += tau * ((y - e.yaw_rad) / tau).round();
     }
     *last_yaw = Some(e.yaw_rad);
+    e
+}
+
+/// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
+fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14] {
+    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
+    let e = euler_unwrapped(&s.attitude, last_yaw);
     let [px, py, pz] = s.position_m.to_array();
     let [vx, vy, vz] = s.velocity_m_s.to_array();
     [
@@ -347,186 +343,6 @@ fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14
         e.pitch_rad,
         e.roll_rad,
     ]
-}
-
-/// Errors of an estimate against truth, both tables with `t_s`, positions, velocities and
-/// quaternions, on the estimate's times (truth linearly interpolated in position and velocity,
-/// its attitude by quaternion slerp).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Comparison {
-    /// Per sample ([`ERROR_COLUMNS`]).
-    pub table: Table,
-    /// RMS and final values.
-    pub summary: ErrorSummary,
-}
-
-/// RMS and final error norms of a comparison.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ErrorSummary {
-    /// Rows compared.
-    pub rows: usize,
-    /// RMS of the position error norm, m.
-    pub position_rms_m: f64,
-    /// Final position error norm, m.
-    pub position_final_m: f64,
-    /// RMS of the velocity error norm, m/s.
-    pub velocity_rms_m_s: f64,
-    /// Final velocity error norm, m/s.
-    pub velocity_final_m_s: f64,
-    /// RMS of the attitude error angle, rad.
-    pub attitude_rms_rad: f64,
-    /// Final attitude error angle, rad.
-    pub attitude_final_rad: f64,
-}
-
-/// One row of a state table in [`STATE_COLUMNS`] order: `t_s`, position, velocity, `q_wxyz`.
-type StateRow = [f64; 11];
-
-/// Compares an estimate with truth (see [`Comparison`]).
-///
-/// # Errors
-/// Missing columns; estimate times outside the truth's time span or going back.
-pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
-    let rows = |t: &Table, what: &str| -> Result<Vec<StateRow>> {
-        let cols: Vec<Vec<f64>> = STATE_COLUMNS
-            .iter()
-            .map(|c| {
-                t.column(c)
-                    .ok_or_else(|| invalid(what, format!("missing column {c}")))
-            })
-            .collect::<Result<_>>()?;
-        Ok((0..t.rows())
-            .map(|r| std::array::from_fn(|c| cols[c][r]))
-            .collect())
-    };
-    let (tr, er) = (rows(truth, "truth")?, rows(estimate, "estimate")?);
-    let (mut ti, mut ei) = (tr.iter(), er.iter());
-    let mut table = Table::new(&ERROR_COLUMNS);
-    let summary = compare_rows(
-        |row| Ok(ti.next().map(|r| *row = *r).is_some()),
-        |row| Ok(ei.next().map(|r| *row = *r).is_some()),
-        |e| {
-            table.push_row(e);
-            Ok(())
-        },
-    )?;
-    Ok(Comparison { table, summary })
-}
-
-/// [`compare`] on two CSV files, streamed (memory does not grow with the files); the errors
-/// over time go to `out` ([`ERROR_COLUMNS`]), which appears only when complete.
-///
-/// # Errors
-/// As [`compare`], CSV errors naming file, row and column, and I/O errors.
-pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
-    let hint = "; truth and estimate need t_s, pos_*, vel_*, q_*";
-    let mut truth_rows = CsvRows::open(truth, STATE_COLUMNS, hint)?;
-    let mut estimate_rows = CsvRows::open(estimate, STATE_COLUMNS, hint)?;
-    let mut file = out.map(AtomicFile::create).transpose()?;
-    if let Some(f) = file.as_mut() {
-        f.writer()
-            .write_all(ERROR_COLUMNS.join(",").as_bytes())
-            .and_then(|()| f.writer().write_all(b"\n"))
-            .map_err(|e| f.error(e))?;
-    }
-    let summary = compare_rows(
-        |row| Ok(truth_rows.next_row(row)?.is_some()),
-        |row| Ok(estimate_rows.next_row(row)?.is_some()),
-        |e| match file.as_mut() {
-            Some(f) => write_rows(f.writer(), e, ERROR_COLUMNS.len(), b",").map_err(|x| f.error(x)),
-            None => Ok(()),
-        },
-    )?;
-    file.map_or(Ok(()), AtomicFile::commit)?;
-    Ok(summary)
-}
-
-/// The comparison of two row streams in time order: for each estimate row the truth rows that
-/// bracket its time (a single-row truth brackets with itself; times beyond the last truth row
-/// use the last two), errors handed to `sink`.
-fn compare_rows(
-    mut truth: impl FnMut(&mut StateRow) -> Result<bool>,
-    mut estimate: impl FnMut(&mut StateRow) -> Result<bool>,
-    mut sink: impl FnMut(&[f64; 9]) -> Result<()>,
-) -> Result<ErrorSummary> {
-    let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
-    if !truth(&mut a)? {
-        return Err(invalid("compare", "empty table"));
-    }
-    let t0 = a[0];
-    let mut truth_ended = !truth(&mut b)?;
-    if truth_ended {
-        b = a;
-    }
-    let mut e = [0.0; 11];
-    let mut s = ErrorSummary::default();
-    let (mut sp, mut sv, mut sa) = (0.0, 0.0, 0.0);
-    let mut previous_t = f64::NEG_INFINITY;
-    while estimate(&mut e)? {
-        let (t, row) = (e[0], s.rows + 2);
-        if t < previous_t {
-            return Err(invalid(
-                "compare",
-                format!("estimate time {t} s (row {row}) goes back from {previous_t} s"),
-            ));
-        }
-        previous_t = t;
-        // Advance to the first truth row later than t (or the last one).
-        while !truth_ended && b[0] <= t {
-            if truth(&mut next)? {
-                (a, b) = (b, next);
-            } else {
-                truth_ended = true;
-            }
-        }
-        if t < t0 - 1e-9 || (truth_ended && t > b[0] + 1e-9) {
-            let end = if truth_ended {
-                format!("{} s", b[0])
-            } else {
-                "…".into()
-            };
-            return Err(invalid(
-                "compare",
-                format!("estimate time {t} s (row {row}) is outside the truth's {t0}…{end}"),
-            ));
-        }
-        let w = if b[0] == a[0] {
-            0.0
-        } else {
-            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
-        };
-        let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
-        let dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
-        let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
-        let q =
-            |r: &StateRow| Rotation::<imu_core::Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
-        let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
-            return Err(invalid(
-                "compare",
-                format!("zero quaternion near estimate row {row}"),
-            ));
-        };
-        let qt = qa.quaternion().slerp(qb.quaternion(), w);
-        let att = qe.quaternion().angle_to(&qt);
-        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let (np, nv) = (norm(&dp), norm(&dv));
-        sink(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], att])?;
-        (sp, sv, sa) = (sp + np * np, sv + nv * nv, sa + att * att);
-        (
-            s.position_final_m,
-            s.velocity_final_m_s,
-            s.attitude_final_rad,
-        ) = (np, nv, att);
-        s.rows += 1;
-    }
-    if s.rows == 0 {
-        return Err(invalid("compare", "empty table"));
-    }
-    let n = s.rows as f64;
-    s.position_rms_m = (sp / n).sqrt();
-    s.velocity_rms_m_s = (sv / n).sqrt();
-    s.attitude_rms_rad = (sa / n).sqrt();
-    Ok(s)
 }
 
 /// Rows a streamed integration reads ahead to set the reference interval of the gap check (the

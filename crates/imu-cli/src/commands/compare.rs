@@ -1,28 +1,35 @@
-//! `imukit compare TRUTH.csv NAV.csv [--out ERR.csv]`.
+//! `imukit compare TRUTH.csv ESTIMATE.csv [--out ERR.csv]`: a navigation output (`imukit
+//! integrate`) or an orientation output (`imukit orient`) against truth.
 use std::path::Path;
 
-use imu_scenario::navigation::compare_csv;
+use imu_core::orientation::DistanceStats;
+use imu_scenario::compare::compare_csv;
 
 use super::CliError;
 
 /// Streams both files (memory does not grow with them).
 pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliError> {
     let c = compare_csv(truth, estimate, out)?;
-    println!("{:<10} {:>14} {:>14}", "error", "RMS", "final");
     println!(
-        "{:<10} {:>12.6e} m {:>12.6e} m",
-        "position", c.position_rms_m, c.position_final_m
+        "{:<10} {:>16} {:>16} {:>16}",
+        "error", "RMS", "max", "final"
     );
-    println!(
-        "{:<10} {:>10.6e} m/s {:>10.6e} m/s",
-        "velocity", c.velocity_rms_m_s, c.velocity_final_m_s
-    );
-    println!(
-        "{:<10} {:>10.6e} deg {:>10.6e} deg",
-        "attitude",
-        c.attitude_rms_rad.to_degrees(),
-        c.attitude_final_rad.to_degrees()
-    );
+    let line = |name: &str, s: &DistanceStats, scale: f64, unit: &str| {
+        println!(
+            "{name:<10} {:>12.6e} {unit:<3} {:>12.6e} {unit:<3} {:>12.6e} {unit:<3}",
+            s.rms() * scale,
+            s.max() * scale,
+            s.last() * scale
+        );
+    };
+    if let Some(p) = &c.position {
+        line("position", p, 1.0, "m");
+    }
+    if let Some(v) = &c.velocity {
+        line("velocity", v, 1.0, "m/s");
+    }
+    line("attitude", &c.attitude, 1f64.to_degrees(), "deg");
+    println!("({} rows compared)", c.rows());
     if let Some(o) = out {
         println!("\nErrors over time written to {}", o.display());
     }

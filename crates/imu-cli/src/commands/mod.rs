@@ -4,6 +4,7 @@ mod compare;
 mod demo;
 mod exercise;
 mod integrate;
+mod orient;
 mod plot;
 mod presets;
 mod scenario;
@@ -97,6 +98,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 integrate::three_d(&common, &opts)
             }
         }
+        Command::Orient {
+            input,
+            filter,
+            params,
+            nav_frame,
+            accel_sign,
+            out,
+        } => orient::run(&input, &filter, &params, &nav_frame, &accel_sign, &out),
         Command::Compare {
             truth,
             estimate,

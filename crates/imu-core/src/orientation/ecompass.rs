@@ -9,7 +9,9 @@
 //! within 1e-9 rad of the vertical (no horizontal component to point north).
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
-use super::{FilterInput, OrientError, check_finite, gravity_reading, to_frame};
+use super::{
+    Estimate, FilterInput, OrientError, OrientationFilter, check_finite, gravity_reading, to_frame,
+};
 use crate::frame::{Body, NavFrame, Ned};
 use crate::ideal::AccelSign;
 use crate::math;
@@ -34,6 +36,26 @@ pub fn ecompass<N: NavFrame>(
     check_finite(&input, false, true)?;
     let q = ecompass_ned(&gravity_reading(accel_m_s2, sign), &Vector3::from(mag_ut))?;
     Ok(to_frame(&q))
+}
+
+/// The e-compass as a filter: each sample's orientation from its own accelerometer and
+/// magnetometer readings alone (no memory; the gyroscope is passed through).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Ecompass {
+    /// Sign of the accelerometer readings fed in.
+    pub accel_sign: AccelSign,
+}
+
+impl<N: NavFrame> OrientationFilter<N> for Ecompass {
+    fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
+        check_finite(input, true, true)?;
+        Ok(Some(Estimate {
+            orientation: ecompass(input.accel_m_s2, input.mag_ut, self.accel_sign)?,
+            angular_velocity_rad_s: input.gyro_rad_s,
+        }))
+    }
+
+    fn reset(&mut self) {}
 }
 
 /// [`ecompass`] on the gravity reading `−f_b`, as the NED-internal quaternion.

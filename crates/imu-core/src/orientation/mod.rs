@@ -17,7 +17,7 @@ pub mod kalman;
 pub mod metrics;
 pub mod simple;
 
-pub use ecompass::ecompass;
+pub use ecompass::{Ecompass, ecompass};
 pub use kalman::{KalmanFilter, KalmanParams};
 pub use metrics::{DistanceStats, quaternion_distance};
 pub use simple::{Complementary, Madgwick, Mahony};
