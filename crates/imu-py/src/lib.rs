@@ -26,6 +26,8 @@ use numpy::{
     PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::create_exception;
+
+mod orientation;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -952,19 +954,22 @@ fn compare<'py>(
         data: estimate.as_array().iter().copied().collect(),
     };
     let c = py
-        .detach(move || navigation::compare(&t, &e))
+        .detach(move || imu_scenario::compare::compare(&t, &e))
         .map_err(refused)?;
     let d = pyo3::types::PyDict::new(py);
-    for (k, v) in [
-        ("position_rms_m", c.summary.position_rms_m),
-        ("position_final_m", c.summary.position_final_m),
-        ("velocity_rms_m_s", c.summary.velocity_rms_m_s),
-        ("velocity_final_m_s", c.summary.velocity_final_m_s),
-        ("attitude_rms_rad", c.summary.attitude_rms_rad),
-        ("attitude_final_rad", c.summary.attitude_final_rad),
-    ] {
-        d.set_item(k, v)?;
+    let s = &c.summary;
+    let put = |name: &str, unit: &str, stats: &imu_core::orientation::DistanceStats| {
+        d.set_item(format!("{name}_rms_{unit}"), stats.rms())?;
+        d.set_item(format!("{name}_max_{unit}"), stats.max())?;
+        d.set_item(format!("{name}_final_{unit}"), stats.last())
+    };
+    if let Some(p) = &s.position {
+        put("position", "m", p)?;
     }
+    if let Some(v) = &s.velocity {
+        put("velocity", "m_s", v)?;
+    }
+    put("attitude", "rad", &s.attitude)?;
     Ok((table_out(py, c.table)?, d))
 }
 
@@ -1182,5 +1187,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frame_plan, m)?)?;
     m.add_function(wrap_pyfunction!(default_body_m, m)?)?;
     m.add_function(wrap_pyfunction!(leaves_plane, m)?)?;
+    orientation::register(m)?;
     Ok(())
 }

@@ -5,8 +5,8 @@ use std::io::Write;
 use std::path::Path;
 
 use imu_core::orientation::{
-    Complementary, Ecompass, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
-    OrientationFilter,
+    Complementary, Ecompass, Estimate, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
+    OrientError, OrientationFilter,
 };
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
@@ -283,41 +283,80 @@ impl FilterSpec {
     ///
     /// # Errors
     /// Unknown settings, invalid values (named), a magnetometer the filter cannot use.
-    pub fn build<N: NavFrame>(
-        &self,
-        sample_rate_hz: f64,
-    ) -> Result<Box<dyn OrientationFilter<N> + Send>> {
+    pub fn build<N: NavFrame>(&self, sample_rate_hz: f64) -> Result<AnyFilter<N>> {
         let rate = self.sample_rate_hz(sample_rate_hz)?;
         let refused = |e: imu_core::orientation::OrientError| invalid("filter", e.to_string());
         let (sign, mag) = (self.accel_sign, self.magnetometer);
         Ok(match self.kind {
             FilterKind::ImuFilter => {
-                Box::new(KalmanFilter::<N>::imu(self.kalman(rate)?).map_err(refused)?)
+                AnyFilter::Kalman(KalmanFilter::<N>::imu(self.kalman(rate)?).map_err(refused)?)
             }
             FilterKind::AhrsFilter => {
-                Box::new(KalmanFilter::<N>::ahrs(self.kalman(rate)?).map_err(refused)?)
+                AnyFilter::Kalman(KalmanFilter::<N>::ahrs(self.kalman(rate)?).map_err(refused)?)
             }
             FilterKind::Ecompass => {
                 self.setting("")?;
-                Box::new(Ecompass { accel_sign: sign })
+                AnyFilter::Ecompass(Ecompass { accel_sign: sign })
             }
             FilterKind::Madgwick => {
                 let beta = self
                     .setting("Beta")?
                     .unwrap_or(if mag { 0.041 } else { 0.033 });
-                Box::new(Madgwick::new(rate, beta, mag, sign).map_err(refused)?)
+                AnyFilter::Madgwick(Madgwick::new(rate, beta, mag, sign).map_err(refused)?)
             }
             FilterKind::Mahony => {
                 let kp = self.setting("Kp")?.unwrap_or(1.0);
                 let ki = self.setting("Ki")?.unwrap_or(0.3);
-                Box::new(Mahony::new(rate, kp, ki, mag, sign).map_err(refused)?)
+                AnyFilter::Mahony(Mahony::new(rate, kp, ki, mag, sign).map_err(refused)?)
             }
             FilterKind::Complementary => {
                 let ka = self.setting("AccelerometerGain")?.unwrap_or(0.01);
                 let km = self.setting("MagnetometerGain")?.unwrap_or(0.01);
-                Box::new(Complementary::new(rate, ka, km, mag, sign).map_err(refused)?)
+                AnyFilter::Complementary(
+                    Complementary::new(rate, ka, km, mag, sign).map_err(refused)?,
+                )
             }
         })
+    }
+}
+
+/// Any of the filters, by value (copyable, so a batch can be undone on error).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AnyFilter<N: NavFrame> {
+    /// `imufilter` or `ahrsfilter`.
+    Kalman(KalmanFilter<N>),
+    /// `ecompass`.
+    Ecompass(Ecompass),
+    /// Madgwick.
+    Madgwick(Madgwick),
+    /// Mahony.
+    Mahony(Mahony),
+    /// `complementaryFilter`.
+    Complementary(Complementary),
+}
+
+impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
+    fn update(
+        &mut self,
+        input: &FilterInput,
+    ) -> std::result::Result<Option<Estimate<N>>, OrientError> {
+        match self {
+            Self::Kalman(f) => f.update(input),
+            Self::Ecompass(f) => f.update(input),
+            Self::Madgwick(f) => f.update(input),
+            Self::Mahony(f) => f.update(input),
+            Self::Complementary(f) => f.update(input),
+        }
+    }
+
+    fn reset(&mut self) {
+        match self {
+            Self::Kalman(f) => f.reset(),
+            Self::Ecompass(f) => OrientationFilter::<N>::reset(f),
+            Self::Madgwick(f) => OrientationFilter::<N>::reset(f),
+            Self::Mahony(f) => OrientationFilter::<N>::reset(f),
+            Self::Complementary(f) => OrientationFilter::<N>::reset(f),
+        }
     }
 }
 
@@ -480,4 +519,58 @@ fn orient_csv_in<N: NavFrame>(
         rows: written,
         sample_rate_hz: rate,
     })
+}
+
+/// Estimates of a batch: `q_nb` (w, x, y, z) and the bias-corrected body rate per estimate.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Estimates {
+    /// Orientations, one per estimate.
+    pub quaternions: Vec<[f64; 4]>,
+    /// Angular velocities, rad/s.
+    pub angular_velocity_rad_s: Vec<[f64; 3]>,
+}
+
+/// Runs `filter` over rows of readings given as flat slices (three values per row):
+/// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use).
+/// The filter carries its state into the next call, so a run in chunks equals a run whole; on
+/// an error the filter is left as it was before the call.
+///
+/// # Errors
+/// Slices of different lengths, and the filter's refusals naming the row index.
+pub fn run_rows<N: NavFrame>(
+    filter: &mut AnyFilter<N>,
+    accel: &[f64],
+    gyro: Option<&[f64]>,
+    mag: Option<&[f64]>,
+) -> Result<Estimates> {
+    let n = accel.len() / 3;
+    for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
+        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
+            return Err(invalid(
+                name,
+                format!("has {} rows, the accelerometer {n}", s.len() / 3),
+            ));
+        }
+    }
+    let mut working = *filter;
+    let mut out = Estimates::default();
+    let three = |s: Option<&[f64]>, i: usize| {
+        s.map_or([0.0; 3], |s| [s[3 * i], s[3 * i + 1], s[3 * i + 2]])
+    };
+    for i in 0..n {
+        let input = FilterInput {
+            accel_m_s2: three(Some(accel), i),
+            gyro_rad_s: three(gyro, i),
+            mag_ut: three(mag, i),
+        };
+        let estimate = working
+            .update(&input)
+            .map_err(|e| invalid("readings", format!("row {i}: {e}")))?;
+        if let Some(e) = estimate {
+            out.quaternions.push(e.orientation.to_wxyz());
+            out.angular_velocity_rad_s.push(e.angular_velocity_rad_s);
+        }
+    }
+    *filter = working;
+    Ok(out)
 }

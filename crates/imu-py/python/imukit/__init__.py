@@ -61,6 +61,13 @@ __all__ = [
     "dcm_to_euler",
     "quaternion_to_dcm",
     "dcm_to_quaternion",
+    "ecompass",
+    "quaternion_distance",
+    "ImuFilter",
+    "AhrsFilter",
+    "ComplementaryFilter",
+    "MadgwickFilter",
+    "MahonyFilter",
 ]
 
 
@@ -632,9 +639,14 @@ def strapdown(
 
 
 def compare(truth: Table, estimate: Table):
-    """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``,
-    a Table (``t_s, pos_err_*_m, pos_err_m, vel_err_*_m_s, att_err_rad``) and a dict of RMS and
-    final values (``position_rms_m``, ``position_final_m``, …, ``attitude_final_rad``)."""
+    """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``.
+
+    A navigation estimate (``t_s, pos_*, vel_*, q_*``) gives the Table ``t_s, pos_err_*_m,
+    pos_err_m, vel_err_*_m_s, att_err_rad``; an orientation estimate (``t_s, q_w, q_x, q_y, q_z``,
+    as ``imukit orient`` writes) gives ``t_s, att_err_rad, yaw_err_rad, pitch_err_rad,
+    roll_err_rad``. The dict holds RMS, maximum and final values (``position_rms_m``,
+    ``position_max_m``, ``position_final_m``, …, ``attitude_final_rad``; attitude only for
+    orientation estimates)."""
     table, summary = _core.compare(list(truth.columns), np.ascontiguousarray(truth.values),
                                    list(estimate.columns), np.ascontiguousarray(estimate.values))
     return _table(table), dict(summary)
@@ -676,3 +688,12 @@ def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_ra
 
 
 from ._monte_carlo import MonteCarlo, monte_carlo  # noqa: E402  (needs Table above)
+from ._orientation import (  # noqa: E402
+    AhrsFilter,
+    ComplementaryFilter,
+    ImuFilter,
+    MadgwickFilter,
+    MahonyFilter,
+    ecompass,
+    quaternion_distance,
+)

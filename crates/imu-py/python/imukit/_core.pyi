@@ -16,6 +16,9 @@ __all__ = [
     "frame_plan",
     "default_body_m",
     "leaves_plane",
+    "OrientationFilter",
+    "ecompass",
+    "quaternion_distance",
     "simulate_text",
     "truth_from_expressions",
     "truth_from_samples",
@@ -205,3 +208,34 @@ def default_body_m(extent_m: float) -> list[float]: ...
 def leaves_plane(points: npt.NDArray[np.float64]) -> bool: ...
 def write_csv(path: str, columns: list[str], values: npt.NDArray[np.float64]) -> None: ...
 def run_path(out: str, run: int, runs: int) -> str: ...
+@final
+class OrientationFilter:
+    def __new__(
+        cls,
+        kind: str,
+        *,
+        sample_rate: float,
+        reference_frame: str = "NED",
+        accel_sign: str = "matlab",
+        magnetometer: bool = False,
+        settings: Sequence[tuple[str, float]] = ...,
+        initial_process_noise: Optional[Sequence[float]] = None,
+    ) -> OrientationFilter: ...
+    def step(
+        self,
+        accel: npt.NDArray[np.float64],
+        gyro: Optional[npt.NDArray[np.float64]] = None,
+        mag: Optional[npt.NDArray[np.float64]] = None,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def reset(self) -> None: ...
+    @property
+    def gyroscope_offset(self) -> Optional[list[float]]: ...
+
+def ecompass(
+    accel: npt.NDArray[np.float64],
+    mag: npt.NDArray[np.float64],
+    *,
+    reference_frame: str = "NED",
+    accel_sign: str = "matlab",
+) -> npt.NDArray[np.float64]: ...
+def quaternion_distance(q1: npt.NDArray[np.float64], q2: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...

@@ -1,0 +1,220 @@
+"""Orientation from IMU readings, shaped like MATLAB's ``ecompass``, ``imufilter``,
+``ahrsfilter`` and ``complementaryFilter`` (plus Madgwick and Mahony).
+
+Orientations are quaternions ``[w, x, y, z]`` = imukit's ``q_nb`` = MATLAB's orientation
+quaternion, or with ``orientation_format="rotmat"`` MATLAB's rotation matrices (nav → body,
+``C_nbᵀ``). Accelerometer readings are taken in MATLAB's sign (gravity minus acceleration) by
+default, as these classes mirror MATLAB; pass ``accel_sign="specific-force"`` for imukit's.
+Filters keep their state between calls (a run in chunks equals the run whole); ``reset()``
+starts over. The equations are in the Rust docs of ``imu_core::orientation``.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from . import _core
+
+_IPN_DIAG = np.repeat([6.092348396e-06, 7.6154354947e-05, 0.00962361, 0.6], 3)
+
+
+def _rows(name: str, x, n: Optional[int] = None) -> np.ndarray:
+    a = np.ascontiguousarray(np.atleast_2d(x), dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3), got {np.shape(x)}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name} has {a.shape[0]} rows, expected {n}")
+    return a
+
+
+def _format(q: np.ndarray, orientation_format: str) -> np.ndarray:
+    if orientation_format == "quaternion":
+        return q
+    if orientation_format == "rotmat":
+        return np.ascontiguousarray(np.swapaxes(_core.quaternion_to_dcm(q), 1, 2))
+    raise ValueError(f'orientation_format must be "quaternion" or "rotmat", got {orientation_format!r}')
+
+
+def ecompass(accel, mag, *, reference_frame: str = "NED", accel_sign: str = "matlab",
+             orientation_format: str = "quaternion") -> np.ndarray:
+    """Orientation from accelerometer and magnetometer readings (N, 3), one per row, yaw from
+    magnetic north (MATLAB ``ecompass``).
+
+    >>> import numpy as np
+    >>> q = ecompass([[0.0, 0.0, 9.81]], [[27.0, 0.0, 16.0]])   # level, facing magnetic north
+    >>> np.round(q, 12).tolist()
+    [[1.0, 0.0, 0.0, 0.0]]
+    """
+    a = _rows("accel", accel)
+    m = _rows("mag", mag, a.shape[0])
+    q = _core.ecompass(a, m, reference_frame=reference_frame, accel_sign=accel_sign)
+    return _format(q, orientation_format)
+
+
+def quaternion_distance(q1, q2) -> np.ndarray:
+    """Angle (rad) of the rotation between orientations row by row (MATLAB ``dist``); (N, 4)
+    arrays or single quaternions."""
+    a = np.ascontiguousarray(np.atleast_2d(q1), dtype=np.float64)
+    b = np.ascontiguousarray(np.atleast_2d(q2), dtype=np.float64)
+    if a.shape[0] == 1 and b.shape[0] > 1:
+        a = np.ascontiguousarray(np.repeat(a, b.shape[0], axis=0))
+    if b.shape[0] == 1 and a.shape[0] > 1:
+        b = np.ascontiguousarray(np.repeat(b, a.shape[0], axis=0))
+    return _core.quaternion_distance(a, b)
+
+
+class _Filter:
+    """Shared machinery: one ``_core.OrientationFilter`` and MATLAB's call shape."""
+
+    _kind = ""
+
+    def __init__(self, sample_rate: float, reference_frame: str, accel_sign: str, magnetometer: bool,
+                 settings: dict, orientation_format: str, initial_process_noise=None) -> None:
+        if orientation_format not in ("quaternion", "rotmat"):
+            raise ValueError(f'orientation_format must be "quaternion" or "rotmat", got {orientation_format!r}')
+        self.orientation_format = orientation_format
+        self.sample_rate = float(sample_rate)
+        self.reference_frame = reference_frame
+        self._magnetometer = magnetometer
+        self._filter = _core.OrientationFilter(
+            self._kind, sample_rate=self.sample_rate, reference_frame=reference_frame, accel_sign=accel_sign,
+            magnetometer=magnetometer, settings=[(k, float(v)) for k, v in settings.items()],
+            initial_process_noise=initial_process_noise)
+
+    def _run(self, accel, gyro, mag, return_angular_velocity: bool):
+        a = _rows("accel", accel)
+        g = _rows("gyro", gyro, a.shape[0])
+        m = None if mag is None else _rows("mag", mag, a.shape[0])
+        q, w = self._filter.step(a, g, m)
+        q = _format(q, self.orientation_format)
+        return (q, w) if return_angular_velocity else q
+
+    def reset(self) -> None:
+        """Back to the state before the first sample."""
+        self._filter.reset()
+
+
+def _diagonal(ipn, states: int):
+    if ipn is None:
+        return None
+    a = np.asarray(ipn, dtype=np.float64)
+    if a.shape == (states, states):
+        if np.any(a - np.diag(np.diag(a))):
+            raise ValueError("initial_process_noise: only a diagonal matrix is supported")
+        a = np.diag(a)
+    if a.shape != (states,):
+        raise ValueError(f"initial_process_noise must be ({states},) or ({states}, {states}), got {a.shape}")
+    return [float(v) for v in a]
+
+
+class ImuFilter(_Filter):
+    """MATLAB's ``imufilter``: an error-state Kalman filter fusing accelerometer and gyroscope
+    (orientation, gyroscope offset and linear acceleration errors). Noise settings are
+    variances, as MATLAB's properties; the defaults are MATLAB's.
+
+    >>> import numpy as np
+    >>> fuse = ImuFilter(sample_rate=100)
+    >>> q = fuse(np.tile([0.0, 0.0, 9.81], (5, 1)), np.zeros((5, 3)))
+    >>> q.shape, np.allclose(q, [1, 0, 0, 0])
+    ((5, 4), True)
+    """
+
+    _kind = "imufilter"
+    _states = 9
+    DEFAULT_INITIAL_PROCESS_NOISE = np.diag(_IPN_DIAG[:9])
+
+    def __init__(self, sample_rate: float = 100.0, *, reference_frame: str = "NED", decimation_factor: int = 1,
+                 accelerometer_noise: float = 0.00019247, gyroscope_noise: float = 9.1385e-5,
+                 gyroscope_drift_noise: float = 3.0462e-13, linear_acceleration_noise: float = 0.0096236,
+                 linear_acceleration_decay_factor: float = 0.5, initial_process_noise=None,
+                 orientation_format: str = "quaternion", accel_sign: str = "matlab", **magnetic) -> None:
+        settings = dict(DecimationFactor=decimation_factor, AccelerometerNoise=accelerometer_noise,
+                        GyroscopeNoise=gyroscope_noise, GyroscopeDriftNoise=gyroscope_drift_noise,
+                        LinearAccelerationNoise=linear_acceleration_noise,
+                        LinearAccelerationDecayFactor=linear_acceleration_decay_factor, **magnetic)
+        super().__init__(sample_rate, reference_frame, accel_sign, self._kind == "ahrsfilter", settings,
+                         orientation_format, _diagonal(initial_process_noise, self._states))
+        self.decimation_factor = int(decimation_factor)
+
+    def __call__(self, accel, gyro, *, return_angular_velocity: bool = False):
+        """Readings (N, 3) → orientations (N / decimation_factor of them), and with
+        ``return_angular_velocity=True`` also the bias-corrected body rates (M, 3)."""
+        return self._run(accel, gyro, None, return_angular_velocity)
+
+    @property
+    def gyroscope_offset(self) -> np.ndarray:
+        """The current gyroscope offset (bias) estimate, rad/s."""
+        return np.array(self._filter.gyroscope_offset)
+
+
+class AhrsFilter(ImuFilter):
+    """MATLAB's ``ahrsfilter``: ``ImuFilter`` plus the magnetometer and magnetic disturbance
+    (12 error states); yaw from magnetic north. ``fuse(accel, gyro, mag)``."""
+
+    _kind = "ahrsfilter"
+    _states = 12
+    DEFAULT_INITIAL_PROCESS_NOISE = np.diag(_IPN_DIAG)
+
+    def __init__(self, sample_rate: float = 100.0, *, magnetometer_noise: float = 0.1,
+                 magnetic_disturbance_noise: float = 0.5, magnetic_disturbance_decay_factor: float = 0.5,
+                 expected_magnetic_field_strength: float = 50.0, **kwargs) -> None:
+        super().__init__(sample_rate, MagnetometerNoise=magnetometer_noise,
+                         MagneticDisturbanceNoise=magnetic_disturbance_noise,
+                         MagneticDisturbanceDecayFactor=magnetic_disturbance_decay_factor,
+                         ExpectedMagneticFieldStrength=expected_magnetic_field_strength, **kwargs)
+
+    def __call__(self, accel, gyro, mag, *, return_angular_velocity: bool = False):  # type: ignore[override]
+        """Readings (N, 3) each → orientations, and optionally body rates."""
+        return self._run(accel, gyro, mag, return_angular_velocity)
+
+
+class _SimpleFilter(_Filter):
+    def __call__(self, accel, gyro, mag=None, *, return_angular_velocity: bool = False):
+        """Readings (N, 3) (``mag`` when built with ``has_magnetometer=True``) → orientations
+        (N, 4), and optionally body rates."""
+        if (mag is None) == self._magnetometer:
+            raise ValueError("give mag readings exactly when the filter has a magnetometer "
+                             f"(has_magnetometer={self._magnetometer})")
+        return self._run(accel, gyro, mag, return_angular_velocity)
+
+
+class ComplementaryFilter(_SimpleFilter):
+    """MATLAB's ``complementaryFilter``: gyroscope integration with a fraction of the tilt error
+    (``accelerometer_gain``) and heading error (``magnetometer_gain``) removed per sample."""
+
+    _kind = "complementary"
+
+    def __init__(self, sample_rate: float = 100.0, *, accelerometer_gain: float = 0.01,
+                 magnetometer_gain: float = 0.01, has_magnetometer: bool = True, reference_frame: str = "NED",
+                 orientation_format: str = "quaternion", accel_sign: str = "matlab") -> None:
+        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer,
+                         dict(AccelerometerGain=accelerometer_gain, MagnetometerGain=magnetometer_gain),
+                         orientation_format)
+
+
+class MadgwickFilter(_SimpleFilter):
+    """Madgwick's gradient-descent filter; ``beta`` defaults to 0.033 (0.041 with a
+    magnetometer)."""
+
+    _kind = "madgwick"
+
+    def __init__(self, sample_rate: float = 100.0, *, beta: Optional[float] = None, has_magnetometer: bool = False,
+                 reference_frame: str = "NED", orientation_format: str = "quaternion",
+                 accel_sign: str = "matlab") -> None:
+        settings = {} if beta is None else dict(Beta=beta)
+        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer, settings, orientation_format)
+
+
+class MahonyFilter(_SimpleFilter):
+    """Mahony's complementary filter with proportional and integral gains."""
+
+    _kind = "mahony"
+
+    def __init__(self, sample_rate: float = 100.0, *, kp: float = 1.0, ki: float = 0.3,
+                 has_magnetometer: bool = False, reference_frame: str = "NED",
+                 orientation_format: str = "quaternion", accel_sign: str = "matlab") -> None:
+        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer, dict(Kp=kp, Ki=ki),
+                         orientation_format)
+
+
