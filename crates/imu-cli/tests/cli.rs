@@ -319,3 +319,67 @@ fn simulate_integrate_compare_closes_the_loop() {
             .contains("gyro_x/y/z_rad_s")
     );
 }
+
+#[test]
+fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
+    let dir = temp_dir("orient");
+    let header =
+        "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s";
+    let good = format!("{header}\n0.00,0,0,9.81,0,0,0\n0.01,0,0,9.81,0,0,0\n0.02,0,0,9.81,0,0,0\n");
+    std::fs::write(dir.join("imu.csv"), &good).unwrap();
+    let bad = good.replace("0.01,0,0,9.81,0,0,0", "0.01,0,0,9.81,0,NaN,0");
+    std::fs::write(dir.join("nan.csv"), bad).unwrap();
+    let out_file = dir.join("o.csv");
+    let orient = |input: &str, args: &[&str]| {
+        let out = imukit()
+            .arg("orient")
+            .arg(dir.join(input))
+            .args(args)
+            .arg("--out")
+            .arg(&out_file)
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8(out.stderr).unwrap())
+    };
+    for (input, args, needle) in [
+        (
+            "imu.csv",
+            vec!["--filter", "kalman"],
+            "unknown filter \"kalman\"; known: imufilter, ahrsfilter",
+        ),
+        (
+            "imu.csv",
+            vec!["--param", "GyroNoise=1"],
+            "GyroNoise: unknown setting for imufilter",
+        ),
+        (
+            "imu.csv",
+            vec!["--param", "GyroscopeNoise"],
+            "is not key=value",
+        ),
+        (
+            "imu.csv",
+            vec!["--param", "GyroscopeNoise=-2"],
+            "GyroscopeNoise = -2: must be finite and > 0",
+        ),
+        ("imu.csv", vec!["--filter", "ahrsfilter"], "missing"),
+        (
+            "nan.csv",
+            vec![],
+            "nan.csv, row 3, column gyro_y_rad_s: not a finite number",
+        ),
+    ] {
+        let (code, err) = orient(input, &args);
+        assert_eq!(code, Some(65), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!out_file.exists(), "{args:?}");
+    }
+    let (code, err) = orient("imu.csv", &["--nav-frame", "NED", "--accel-sign", "matlab"]);
+    assert_eq!(code, Some(0), "{err}");
+    let text = std::fs::read_to_string(&out_file).unwrap();
+    assert_eq!(text.lines().count(), 4);
+    assert!(
+        text.starts_with("t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,1.0,0.0,0.0,0.0,0.0,"),
+        "{text}"
+    );
+}

@@ -115,7 +115,8 @@ impl FilterKind {
                 "ExpectedMagneticFieldStrength",
                 "Gravity",
             ],
-            Self::Ecompass => &[],
+            // The e-compass has no memory; the rate is accepted for uniformity.
+            Self::Ecompass => &["SampleRate"],
             Self::Madgwick => &["SampleRate", "Beta"],
             Self::Mahony => &["SampleRate", "Kp", "Ki"],
             Self::Complementary => &["SampleRate", "AccelerometerGain", "MagnetometerGain"],
@@ -294,10 +295,7 @@ impl FilterSpec {
             FilterKind::AhrsFilter => {
                 AnyFilter::Kalman(KalmanFilter::<N>::ahrs(self.kalman(rate)?).map_err(refused)?)
             }
-            FilterKind::Ecompass => {
-                self.setting("")?;
-                AnyFilter::Ecompass(Ecompass { accel_sign: sign })
-            }
+            FilterKind::Ecompass => AnyFilter::Ecompass(Ecompass { accel_sign: sign }),
             FilterKind::Madgwick => {
                 let beta = self
                     .setting("Beta")?
