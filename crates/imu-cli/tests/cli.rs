@@ -379,7 +379,9 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
     let text = std::fs::read_to_string(&out_file).unwrap();
     assert_eq!(text.lines().count(), 4);
     assert!(
-        text.starts_with("t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,1.0,0.0,0.0,0.0,0.0,"),
+        text.starts_with(
+            "t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,1.0,0.0,0.0,0.0,0.0,"
+        ),
         "{text}"
     );
 }
