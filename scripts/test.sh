@@ -45,7 +45,7 @@ echo "== Python stubs match the built module"
 python -m mypy.stubtest imukit._core
 
 echo "== Python tests"
-IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py
+IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py crates/imu-py/python/imukit/_orientation.py
 
 echo "== Examples"
 out=$(mktemp -d)
@@ -56,9 +56,15 @@ for f in examples/*.toml; do
   target/release/imukit plot "$out/${name}_truth.csv" --out "$out/${name}_truth.png"
   target/release/imukit plot "$out/${name}_imu.csv" --out "$out/${name}_imu.png"
 done
-for f in seed_error_study matlab_imusensor allan_study navigation_round_trip; do
+for f in seed_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
   python "examples/$f.py" --figures "$out/figures"
 done
+for f in imufilter ahrsfilter ecompass madgwick mahony complementary; do
+  target/release/imukit orient "$out/matlab_orientation_imu.csv" --filter "$f" --nav-frame NED --accel-sign matlab \
+    --out "$out/orient_$f.csv"
+  target/release/imukit compare "$out/matlab_orientation_truth.csv" "$out/orient_$f.csv" --out "$out/orient_err_$f.csv"
+done
+target/release/imukit plot "$out/orient_err_ahrsfilter.csv" --out "$out/orient_err.png"
 target/release/imukit exercise --out-dir "$out/exercise"
 
 echo "== NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"

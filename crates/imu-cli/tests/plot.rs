@@ -44,6 +44,9 @@ fn data() -> &'static PathBuf {
         let still = d.join("static_imu.csv");
         ok(&imukit(&["simulate"], &[&scenario, Path::new("--out"), &still]));
         ok(&imukit(&["allan"], &[&still, Path::new("--out"), &d.join("allan.csv")]));
+        let orient = d.join("orient.csv");
+        ok(&imukit(&["orient"], &[&imu, Path::new("--filter"), Path::new("ahrsfilter"), Path::new("--out"), &orient]));
+        ok(&imukit(&["compare"], &[&truth, &orient, Path::new("--out"), &d.join("orient_errors.csv")]));
         d
     })
 }
@@ -128,6 +131,16 @@ fn imu_readings_have_accelerometer_gyroscope_and_magnetometer() {
 #[test]
 fn errors_have_position_velocity_and_attitude_panels() {
     assert_eq!(plot(&["errors.csv"], "errors"), ((560, 960), 4 + 3 + 1));
+}
+
+#[test]
+fn orientation_output_and_its_errors_have_their_panels() {
+    // Euler angles and the quaternion; then the attitude error and the three Euler errors.
+    assert_eq!(plot(&["orient.csv"], "orient"), ((560, 640), 3 + 4));
+    assert_eq!(
+        plot(&["orient_errors.csv"], "orient_errors"),
+        ((560, 640), 1 + 3)
+    );
 }
 
 #[test]

@@ -14,8 +14,10 @@ pub enum TableKind {
     Navigation,
     /// An Allan-deviation table (`tau_s, adev_*`).
     Allan,
-    /// Errors against truth (`t_s, pos_err_*…`).
+    /// Errors against truth (`t_s, pos_err_*…` or `t_s, att_err_rad, yaw_err_rad…`).
     Errors,
+    /// An orientation output (`t_s, q_*, yaw_rad, pitch_rad, roll_rad`, from `imukit orient`).
+    Orientation,
 }
 
 impl TableKind {
@@ -25,12 +27,14 @@ impl TableKind {
         let has = |c: &str| columns.iter().any(|h| h == c);
         if has("tau_s") && columns.iter().any(|c| c.starts_with("adev_")) {
             Some(Self::Allan)
-        } else if has("pos_err_m") {
+        } else if has("pos_err_m") || has("att_err_rad") {
             Some(Self::Errors)
         } else if has("pos_x_m") && has("acc_x_m_s2") && has("omega_x_rad_s") {
             Some(Self::Truth)
         } else if has("pos_x_m") && has("pos_y_m") && has("yaw_rad") {
             Some(Self::Navigation)
+        } else if has("t_s") && has("q_w") && has("yaw_rad") && !has("pos_x_m") {
+            Some(Self::Orientation)
         } else if has("t_s")
             && ["accel_x_m_s2", "dv_x_m_s", "gyro_z_rad_s", "mag_x_ut"]
                 .iter()
@@ -52,7 +56,7 @@ impl TableKind {
                 source,
                 format!(
                     "unknown kind of CSV (columns: {}); imukit plots truth, IMU readings, navigation \
-                     output, Allan deviation and error tables",
+                     output, orientation output, Allan deviation and error tables",
                     columns.join(", ")
                 ),
             )
@@ -68,6 +72,7 @@ impl TableKind {
             Self::Navigation => "navigation output",
             Self::Allan => "Allan deviation",
             Self::Errors => "errors against truth",
+            Self::Orientation => "orientation output",
         }
     }
 
@@ -80,6 +85,7 @@ impl TableKind {
             Self::Navigation => "navigation",
             Self::Allan => "allan",
             Self::Errors => "errors",
+            Self::Orientation => "orientation",
         }
     }
 
@@ -94,13 +100,16 @@ impl TableKind {
             Self::Navigation,
             Self::Allan,
             Self::Errors,
+            Self::Orientation,
         ]
         .into_iter()
         .find(|k| k.key() == key)
         .ok_or_else(|| {
             invalid(
                 "kind",
-                format!("unknown kind {key:?}: truth, imu, navigation, allan or errors"),
+                format!(
+                    "unknown kind {key:?}: truth, imu, navigation, orientation, allan or errors"
+                ),
             )
         })
     }
@@ -192,8 +201,38 @@ impl TableKind {
                         DEG,
                         &[own(("att_err_rad", "angle"))],
                     ),
+                    p(
+                        "Euler angle errors",
+                        "error (deg)",
+                        DEG,
+                        &[
+                            ("yaw_err_rad", "yaw"),
+                            ("pitch_err_rad", "pitch"),
+                            ("roll_err_rad", "roll"),
+                        ]
+                        .map(own),
+                    ),
                 ]
             }
+            Self::Orientation => vec![
+                p(
+                    "Attitude (z-y-x Euler angles)",
+                    "angle (deg)",
+                    DEG,
+                    &[
+                        ("yaw_rad", "yaw"),
+                        ("pitch_rad", "pitch"),
+                        ("roll_rad", "roll"),
+                    ]
+                    .map(own),
+                ),
+                p(
+                    "Orientation quaternion",
+                    "component",
+                    1.0,
+                    &[("q_w", "w"), ("q_x", "x"), ("q_y", "y"), ("q_z", "z")].map(own),
+                ),
+            ],
             Self::Allan => Vec::new(),
         }
     }

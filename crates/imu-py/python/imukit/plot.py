@@ -75,12 +75,12 @@ def _load(items: Sequence[TableLike], labels: Optional[Sequence[str]]) -> list:
 
 def kind(table: Table, source: str = "table") -> str:
     """The kind of an imukit table from its columns: ``truth``, ``imu``, ``navigation``,
-    ``allan`` or ``errors``; :class:`ImuError` for anything else."""
+    ``orientation``, ``allan`` or ``errors``; :class:`ImuError` for anything else."""
     k = _core.table_kind(list(table.columns))
     if k is None:
         raise ImuError(
             f"{source}: unknown kind of table (columns: {', '.join(table.columns)}); imukit plots truth, "
-            "IMU readings, navigation output, Allan deviation and error tables"
+            "IMU readings, navigation output, orientation output, Allan deviation and error tables"
         )
     return k
 
