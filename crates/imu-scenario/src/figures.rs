@@ -142,17 +142,7 @@ impl TableKind {
                     1.0,
                     &xyz("acc", "m_s2"),
                 ),
-                p(
-                    "Attitude (z-y-x Euler angles)",
-                    "angle (deg)",
-                    DEG,
-                    &[
-                        ("yaw_rad", "yaw"),
-                        ("pitch_rad", "pitch"),
-                        ("roll_rad", "roll"),
-                    ]
-                    .map(own),
-                ),
+                attitude_panel(),
                 p("Body rate", "ω (rad/s)", 1.0, &xyz("omega", "rad_s")),
                 p(
                     "Body angular acceleration",
@@ -215,17 +205,7 @@ impl TableKind {
                 ]
             }
             Self::Orientation => vec![
-                p(
-                    "Attitude (z-y-x Euler angles)",
-                    "angle (deg)",
-                    DEG,
-                    &[
-                        ("yaw_rad", "yaw"),
-                        ("pitch_rad", "pitch"),
-                        ("roll_rad", "roll"),
-                    ]
-                    .map(own),
-                ),
+                attitude_panel(),
                 p(
                     "Orientation quaternion",
                     "component",
@@ -266,6 +246,21 @@ impl PanelSpec {
             columns: columns.to_vec(),
         }
     }
+}
+
+/// Yaw, pitch and roll in degrees.
+fn attitude_panel() -> PanelSpec {
+    PanelSpec::new(
+        "Attitude (z-y-x Euler angles)",
+        "angle (deg)",
+        180.0 / core::f64::consts::PI,
+        &[
+            ("yaw_rad", "yaw"),
+            ("pitch_rad", "pitch"),
+            ("roll_rad", "roll"),
+        ]
+        .map(own),
+    )
 }
 
 fn own((c, l): (&str, &str)) -> (String, String) {

@@ -87,42 +87,39 @@ impl FilterKind {
 
     /// The settings the filter takes (MATLAB property names; matched without case or `_`).
     #[must_use]
-    pub fn settings(self) -> &'static [&'static str] {
+    pub fn settings(self) -> Vec<&'static str> {
         match self {
-            Self::ImuFilter => &[
-                "SampleRate",
-                "DecimationFactor",
-                "AccelerometerNoise",
-                "GyroscopeNoise",
-                "GyroscopeDriftNoise",
-                "LinearAccelerationNoise",
-                "LinearAccelerationDecayFactor",
-                "InitialProcessNoiseScale",
-                "Gravity",
-            ],
-            Self::AhrsFilter => &[
-                "SampleRate",
-                "DecimationFactor",
-                "AccelerometerNoise",
-                "GyroscopeNoise",
-                "GyroscopeDriftNoise",
-                "LinearAccelerationNoise",
-                "LinearAccelerationDecayFactor",
-                "InitialProcessNoiseScale",
-                "MagnetometerNoise",
-                "MagneticDisturbanceNoise",
-                "MagneticDisturbanceDecayFactor",
-                "ExpectedMagneticFieldStrength",
-                "Gravity",
-            ],
+            Self::ImuFilter => KALMAN_SETTINGS.to_vec(),
+            Self::AhrsFilter => [KALMAN_SETTINGS.as_slice(), &MAGNETIC_SETTINGS].concat(),
             // The e-compass has no memory; the rate is accepted for uniformity.
-            Self::Ecompass => &["SampleRate"],
-            Self::Madgwick => &["SampleRate", "Beta"],
-            Self::Mahony => &["SampleRate", "Kp", "Ki"],
-            Self::Complementary => &["SampleRate", "AccelerometerGain", "MagnetometerGain"],
+            Self::Ecompass => vec!["SampleRate"],
+            Self::Madgwick => vec!["SampleRate", "Beta"],
+            Self::Mahony => vec!["SampleRate", "Kp", "Ki"],
+            Self::Complementary => vec!["SampleRate", "AccelerometerGain", "MagnetometerGain"],
         }
     }
 }
+
+/// Settings of both Kalman filters.
+const KALMAN_SETTINGS: [&str; 9] = [
+    "SampleRate",
+    "DecimationFactor",
+    "AccelerometerNoise",
+    "GyroscopeNoise",
+    "GyroscopeDriftNoise",
+    "LinearAccelerationNoise",
+    "LinearAccelerationDecayFactor",
+    "InitialProcessNoiseScale",
+    "Gravity",
+];
+
+/// Settings of the AHRS filter's magnetometer.
+const MAGNETIC_SETTINGS: [&str; 4] = [
+    "MagnetometerNoise",
+    "MagneticDisturbanceNoise",
+    "MagneticDisturbanceDecayFactor",
+    "ExpectedMagneticFieldStrength",
+];
 
 /// A filter to build: which, with which sensors and accelerometer sign, and its settings.
 #[derive(Clone, Debug, PartialEq)]
