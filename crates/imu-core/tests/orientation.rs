@@ -179,16 +179,16 @@ fn every_filter_holds_the_true_orientation_on_ideal_static_data() {
 }
 
 /// Runs a level static IMU with gyroscope bias `bias` through a Kalman filter for `seconds`.
-fn estimated_bias(magnetometer: bool, bias: [f64; 3], seconds: f64) -> [f64; 3] {
+fn estimated_bias<N: NavFrame>(magnetometer: bool, bias: [f64; 3], seconds: f64) -> [f64; 3] {
     let p = KalmanParams::default();
     let mut f = if magnetometer {
-        KalmanFilter::<Ned>::ahrs(p).unwrap()
+        KalmanFilter::<N>::ahrs(p).unwrap()
     } else {
-        KalmanFilter::<Ned>::imu(p).unwrap()
+        KalmanFilter::<N>::imu(p).unwrap()
     };
     let mut s = at_rest(
-        &Rotation::<Body, Ned>::identity(),
-        north_field::<Ned>(),
+        &Rotation::<Body, N>::identity(),
+        north_field::<N>(),
         AccelSign::Matlab,
     );
     s.gyro_rad_s = bias;
@@ -203,16 +203,30 @@ fn kalman_filters_estimate_a_constant_gyroscope_bias() {
     // Level: the accelerometer sees roll and pitch errors, so the x and y biases are observable
     // to the IMU filter; the AHRS also sees heading, hence z.
     let bias = [0.02, -0.015, 0.01];
-    let imu = estimated_bias(false, [bias[0], bias[1], 0.0], 60.0);
-    let ahrs = estimated_bias(true, bias, 60.0);
-    for k in 0..2 {
-        assert!((imu[k] / bias[k] - 1.0).abs() < 0.05, "imufilter {imu:?}");
-    }
-    for k in 0..3 {
-        assert!(
-            (ahrs[k] / bias[k] - 1.0).abs() < 0.05,
-            "ahrsfilter {ahrs:?}"
-        );
+    for (frame, imu, ahrs) in [
+        (
+            "NED",
+            estimated_bias::<Ned>(false, [bias[0], bias[1], 0.0], 60.0),
+            estimated_bias::<Ned>(true, bias, 60.0),
+        ),
+        (
+            "ENU",
+            estimated_bias::<Enu>(false, [bias[0], bias[1], 0.0], 60.0),
+            estimated_bias::<Enu>(true, bias, 60.0),
+        ),
+    ] {
+        for k in 0..2 {
+            assert!(
+                (imu[k] / bias[k] - 1.0).abs() < 0.05,
+                "{frame} imufilter {imu:?}"
+            );
+        }
+        for k in 0..3 {
+            assert!(
+                (ahrs[k] / bias[k] - 1.0).abs() < 0.05,
+                "{frame} ahrsfilter {ahrs:?}"
+            );
+        }
     }
 }
 

@@ -161,3 +161,33 @@ def test_quaternion_distance_and_compare_of_an_orientation_output():
     np.testing.assert_allclose(errors["yaw_err_rad"], 0.01, atol=1e-9)
     np.testing.assert_allclose(summary["attitude_rms_rad"], 0.01, atol=1e-9)
     assert "position_rms_m" not in summary and summary["attitude_max_rad"] >= summary["attitude_rms_rad"]
+
+
+def test_decimation_blocks_span_calls():
+    rng = np.random.default_rng(9)
+    accel, mag = readings(np.zeros((24, 3)))
+    accel += rng.normal(scale=0.05, size=accel.shape)
+    gyro = rng.normal(scale=0.01, size=accel.shape)
+    whole = imukit.AhrsFilter(100, decimation_factor=4)(accel, gyro, mag)
+    f = imukit.AhrsFilter(100, decimation_factor=4)
+    parts = [f(accel[i:j], gyro[i:j], mag[i:j]) for i, j in [(0, 3), (3, 13), (13, 24)]]
+    assert [p.shape[0] for p in parts] == [0, 3, 3]
+    np.testing.assert_array_equal(np.vstack(parts), whole)
+
+
+def test_ahrs_ignores_a_jammed_magnetometer_sample():
+    # A 500 µT spike (more than twice ExpectedMagneticFieldStrength) is treated as jamming: the
+    # heading stays where the clean samples put it.
+    n = 300
+    e = np.tile([[0.4, 0.0, 0.0]], (n, 1))
+    accel, mag = readings(e)
+    jammed = mag.copy()
+    jammed[150] = [500.0, 300.0, 0.0]
+    gyro = np.zeros_like(accel)
+    clean = imukit.AhrsFilter(100)(accel, gyro, mag)
+    spiked = imukit.AhrsFilter(100)(accel, gyro, jammed)
+    assert imukit.quaternion_distance(clean, spiked).max() < 1e-9
+    # The same spike just under the jamming bound does move the estimate.
+    jammed[150] = [60.0, 60.0, 0.0]
+    moved = imukit.AhrsFilter(100)(accel, gyro, jammed)
+    assert imukit.quaternion_distance(clean, moved).max() > 1e-3
