@@ -214,10 +214,23 @@ fn truth_from_samples<'py>(
         min_speed_m_s: min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S),
     };
     let nav = nav(nav_frame)?;
-    let table = py
-        .detach(move || arrays::truth_from_arrays(t, pos, att, options, nav))
-        .map_err(refused)?;
-    table_out(py, table)
+    let n = t.len();
+    let out = PyArray2::<f64>::zeros(py, [n, imu_scenario::table::TRUTH_COLUMNS.len()], false);
+    {
+        let mut guard = out.readwrite();
+        let values = guard
+            .as_slice_mut()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        py.detach(move || arrays::truth_from_arrays_into(t, pos, att, options, nav, values))
+            .map_err(refused)?;
+    }
+    Ok((
+        imu_scenario::table::TRUTH_COLUMNS
+            .iter()
+            .map(|c| (*c).to_string())
+            .collect(),
+        out,
+    ))
 }
 
 /// Ideal IMU readings from a truth table (its column names and values).

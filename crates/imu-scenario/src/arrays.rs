@@ -43,17 +43,27 @@ pub fn truth_from_expressions(
     )
 }
 
-/// Truth from sampled arrays by finite differences.
+/// Truth from sampled arrays by finite differences, written row by row into `out` (`n` rows of
+/// [`TRUTH_COLUMNS`](crate::table::TRUTH_COLUMNS), row-major), chunk by chunk: no truth vector
+/// or table of the whole series is built on the way.
 ///
 /// # Errors
-/// As [`SampledPath::truth`], with array indices.
-pub fn truth_from_arrays(
+/// As [`SampledPath::truth`], with array indices; an `out` of the wrong length.
+pub fn truth_from_arrays_into(
     t_s: Vec<f64>,
     position_m: Vec<[f64; 3]>,
     attitude: SampledAttitudeData,
     options: SampledOptions,
     nav: NavFrameName,
-) -> Result<Table> {
+    out: &mut [f64],
+) -> Result<()> {
+    const WIDTH: usize = crate::table::TRUTH_COLUMNS.len();
+    if out.len() != t_s.len() * WIDTH {
+        return Err(invalid(
+            "output",
+            format!("has {} values, expected {} × {WIDTH}", out.len(), t_s.len()),
+        ));
+    }
     let path = SampledPath {
         origin: "samples".into(),
         t_s,
@@ -62,11 +72,23 @@ pub fn truth_from_arrays(
         options,
         first_row: 0,
     };
-    in_frame(
-        nav,
-        || Ok(Table::from_truth(&path.truth::<Enu>()?)),
-        || Ok(Table::from_truth(&path.truth::<Ned>()?)),
-    )
+    let mut rows = out.chunks_exact_mut(WIDTH);
+    const CHUNK: usize = 4096;
+    match nav {
+        NavFrameName::ENU => path.truth_chunks::<Enu>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
+        NavFrameName::NED => path.truth_chunks::<Ned>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
+    }
+}
+
+/// Writes truth samples into the next rows.
+fn fill_rows<N: NavFrame>(
+    chunk: &[Truth<N>],
+    rows: &mut std::slice::ChunksExactMut<'_, f64>,
+) -> Result<()> {
+    for (s, row) in chunk.iter().zip(rows.by_ref()) {
+        row.copy_from_slice(&crate::table::truth_row(s));
+    }
+    Ok(())
 }
 
 /// Truth samples from a table with the truth columns (attitude from the quaternion columns).

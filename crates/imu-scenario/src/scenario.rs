@@ -22,7 +22,9 @@ use std::path::{Path, PathBuf};
 
 use crate::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};
-use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
+use imu_core::kinematics::sampled::{
+    SampledAttitude, SampledOptions, check_samples, truth_from_samples, truth_range,
+};
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 use imu_core::{
     AccelSign, Enu, EulerZyx, ImuMount, KinematicsError, NavFrame, Ned, Rotation, Truth, Vec3,
@@ -533,29 +535,72 @@ impl SampledPath {
     /// The core's refusal, with the file row of the offending sample.
     pub fn truth<N: NavFrame>(&self) -> Result<Vec<Truth<N>>> {
         let mut out = vec![Truth::<N>::default(); self.t_s.len()];
-        let attitude = match &self.attitude {
-            SampledAttitudeData::Euler(e) => SampledAttitude::Euler(e),
-            SampledAttitudeData::Quaternion(q) => SampledAttitude::Quaternion(q),
-            SampledAttitudeData::Tangent => SampledAttitude::Tangent,
-        };
         truth_from_samples(
             &self.t_s,
             &self.position_m,
-            attitude,
+            self.core_attitude(),
             self.options,
             &mut out,
         )
-        .map_err(|source| {
-            let context = match source.index() {
-                Some(i) if self.first_row > 0 => {
-                    format!("{}, row {}", self.origin, i + self.first_row)
-                }
-                Some(i) => format!("{}, index {i}", self.origin),
-                None => self.origin.clone(),
-            };
-            Error::Kinematics { context, source }
-        })?;
+        .map_err(|e| self.located(e))?;
         Ok(out)
+    }
+
+    /// The same truth handed to `emit` in chunks of up to `chunk` samples (a fixed buffer:
+    /// Euler and quaternion attitudes are differentiated chunk by chunk; the tangent attitude,
+    /// which needs the whole series, is computed whole and then handed out).
+    ///
+    /// # Errors
+    /// As [`SampledPath::truth`], or `emit`'s error.
+    pub fn truth_chunks<N: NavFrame>(
+        &self,
+        chunk: usize,
+        emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
+    ) -> Result<()> {
+        let attitude = self.core_attitude();
+        if matches!(attitude, SampledAttitude::Tangent) {
+            return self.truth::<N>()?.chunks(chunk.max(1)).try_for_each(emit);
+        }
+        check_samples(&self.t_s, &self.position_m, attitude, self.options)
+            .map_err(|e| self.located(e))?;
+        let n = self.t_s.len();
+        let mut buffer = vec![Truth::<N>::default(); chunk.max(1).min(n)];
+        let (mut start, mut previous_yaw) = (0, None);
+        while start < n {
+            let out = &mut buffer[..(n - start).min(chunk.max(1))];
+            truth_range(
+                &self.t_s,
+                &self.position_m,
+                attitude,
+                self.options,
+                start,
+                previous_yaw,
+                out,
+            )
+            .map_err(|e| self.located(e))?;
+            previous_yaw = out.last().map(|s| s.euler.yaw_rad);
+            start += out.len();
+            emit(out)?;
+        }
+        Ok(())
+    }
+
+    fn core_attitude(&self) -> SampledAttitude<'_> {
+        match &self.attitude {
+            SampledAttitudeData::Euler(e) => SampledAttitude::Euler(e),
+            SampledAttitudeData::Quaternion(q) => SampledAttitude::Quaternion(q),
+            SampledAttitudeData::Tangent => SampledAttitude::Tangent,
+        }
+    }
+
+    /// The core's refusal with the file row (or array index) of the offending sample.
+    fn located(&self, source: KinematicsError) -> Error {
+        let context = match source.index() {
+            Some(i) if self.first_row > 0 => format!("{}, row {}", self.origin, i + self.first_row),
+            Some(i) => format!("{}, index {i}", self.origin),
+            None => self.origin.clone(),
+        };
+        Error::Kinematics { context, source }
     }
 }
 

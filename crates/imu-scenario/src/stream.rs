@@ -4,8 +4,9 @@
 //! Analytic trajectories (expression, track, waypoints, and the built-ins made of them) are
 //! evaluated sample by sample with the core's [`AnalyticStepper`] at times computed on demand, so
 //! memory does not grow with the duration (only the leading standstill of a tangent attitude is
-//! held until the body first moves). Sampled and body-rate trajectories are read
-//! and differentiated or integrated whole, as they come from files, then streamed.
+//! held until the body first moves). Sampled trajectories are read whole (their samples) and
+//! differentiated chunk by chunk (whole for a tangent attitude); body-rate trajectories are
+//! integrated whole; then everything is streamed.
 use std::path::Path;
 
 use crate::analytic::{AnalyticOptions, AnalyticStepper, Motion};
@@ -143,7 +144,8 @@ impl Scenario {
                 "trajectory (waypoints)",
                 &mut emit,
             ),
-            Trajectory::Samples(_) | Trajectory::BodyRates(_) => {
+            Trajectory::Samples(path) => path.truth_chunks(STREAM_CHUNK, &mut emit),
+            Trajectory::BodyRates(_) => {
                 let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;
                 truth.chunks(STREAM_CHUNK).try_for_each(&mut emit)
             }

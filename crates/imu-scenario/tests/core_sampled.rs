@@ -238,3 +238,77 @@ fn tangent_from_samples_matches_exact_tangent() {
         );
     }
 }
+
+#[test]
+fn truth_in_ranges_equals_the_whole_call_bit_for_bit() {
+    use imu_core::kinematics::sampled::truth_range;
+    // Three turns of the tilted circle at 200 Hz: the yaw wraps several times, across chunk
+    // boundaries too.
+    let t: Vec<f64> = (0..=600).map(|k| k as f64 / 200.0).collect();
+    let ex = exact(&t);
+    let pos: Vec<[f64; 3]> = ex.iter().map(|s| s.position_m.to_array()).collect();
+    let wrap = |a: f64| {
+        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    };
+    let euler: Vec<EulerZyx> = ex
+        .iter()
+        .map(|s| EulerZyx::new(wrap(s.euler.yaw_rad), s.euler.pitch_rad, s.euler.roll_rad))
+        .collect();
+    let quat: Vec<[f64; 4]> = ex.iter().map(|s| s.attitude.to_wxyz()).collect();
+    let options = SampledOptions::default();
+    for attitude in [
+        SampledAttitude::Euler(&euler),
+        SampledAttitude::Quaternion(&quat),
+    ] {
+        let mut whole = vec![Truth::<Enu>::default(); t.len()];
+        truth_from_samples(&t, &pos, attitude, options, &mut whole).unwrap();
+        for chunk in [1, 7, 64, 601] {
+            let mut buffer = vec![Truth::<Enu>::default(); chunk];
+            let (mut start, mut previous) = (0, None);
+            while start < t.len() {
+                let len = chunk.min(t.len() - start);
+                truth_range(
+                    &t,
+                    &pos,
+                    attitude,
+                    options,
+                    start,
+                    previous,
+                    &mut buffer[..len],
+                )
+                .unwrap();
+                assert!(
+                    buffer[..len] == whole[start..start + len],
+                    "chunk {chunk} at {start}"
+                );
+                previous = Some(buffer[len - 1].euler.yaw_rad);
+                start += len;
+            }
+        }
+    }
+    let mut out = vec![Truth::<Enu>::default(); 10];
+    assert_eq!(
+        truth_range(
+            &t,
+            &pos,
+            SampledAttitude::Tangent,
+            options,
+            0,
+            None,
+            &mut out
+        ),
+        Err(KinematicsError::NeedsWholeSeries)
+    );
+    assert!(matches!(
+        truth_range(
+            &t,
+            &pos,
+            SampledAttitude::Euler(&euler),
+            options,
+            595,
+            None,
+            &mut out
+        ),
+        Err(KinematicsError::LengthMismatch { .. })
+    ));
+}

@@ -57,6 +57,8 @@ pub enum KinematicsError {
         /// Sample index.
         index: usize,
     },
+    /// A range of samples asked for with the tangent attitude, which needs the whole series.
+    NeedsWholeSeries,
 }
 
 impl KinematicsError {
@@ -71,7 +73,8 @@ impl KinematicsError {
             | Self::VerticalTangent { index } => Some(index),
             Self::TooFewSamples { .. }
             | Self::LengthMismatch { .. }
-            | Self::UnsupportedOrder { .. } => None,
+            | Self::UnsupportedOrder { .. }
+            | Self::NeedsWholeSeries => None,
         }
     }
 }
@@ -121,6 +124,10 @@ impl fmt::Display for KinematicsError {
                 f,
                 "velocity at sample {index} is vertical: tangent attitude has no yaw there (gimbal \
                  lock); give the attitude explicitly"
+            ),
+            Self::NeedsWholeSeries => write!(
+                f,
+                "the tangent attitude needs the whole series, not a range of samples"
             ),
         }
     }

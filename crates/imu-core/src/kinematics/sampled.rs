@@ -74,6 +74,59 @@ fn unit_wxyz(q: [f64; 4], index: usize) -> Result<[f64; 4], KinematicsError> {
     Ok(q.map(|c| c / n))
 }
 
+/// Checks sampled inputs as [`truth_from_samples`] does, first problem first: lengths, order,
+/// times, positions, then the attitude (finite values, gimbal lock, zero quaternions).
+///
+/// # Errors
+/// As [`truth_from_samples`], except the checks on the results.
+pub fn check_samples(
+    t_s: &[f64],
+    position_m: &[[f64; 3]],
+    attitude: SampledAttitude<'_>,
+    options: SampledOptions,
+) -> Result<(), KinematicsError> {
+    let n = t_s.len();
+    check_len("position_m", n, position_m.len())?;
+    check_times(t_s)?;
+    finite_diff::check_order(options.order, n)?;
+    if let Some(index) = position_m
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(KinematicsError::NotFinite {
+            field: "position_m",
+            index,
+        });
+    }
+    match attitude {
+        SampledAttitude::Euler(e) => {
+            check_len("euler_rad", n, e.len())?;
+            for (index, ei) in e.iter().enumerate() {
+                if !ei.to_array().iter().all(|c| c.is_finite()) {
+                    return Err(KinematicsError::NotFinite {
+                        field: "euler_rad",
+                        index,
+                    });
+                }
+                if ei.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
+                    return Err(KinematicsError::GimbalLock {
+                        index,
+                        pitch_rad: ei.pitch_rad,
+                    });
+                }
+            }
+        }
+        SampledAttitude::Quaternion(q) => {
+            check_len("quaternion", n, q.len())?;
+            for (index, qi) in q.iter().enumerate() {
+                unit_wxyz(*qi, index)?;
+            }
+        }
+        SampledAttitude::Tangent => {}
+    }
+    Ok(())
+}
+
 /// Truth at every sample time `t_s` from positions `position_m` (navigation frame, m) and the
 /// attitude, written into `out` (same length).
 ///
@@ -87,25 +140,72 @@ pub fn truth_from_samples<N: NavFrame>(
     options: SampledOptions,
     out: &mut [Truth<N>],
 ) -> Result<(), KinematicsError> {
-    let n = t_s.len();
-    let order = options.order;
-    check_len("position_m", n, position_m.len())?;
-    check_len("output", n, out.len())?;
-    check_times(t_s)?;
-    finite_diff::check_order(order, n)?;
-    if let Some(index) = position_m
-        .iter()
-        .position(|p| !p.iter().all(|c| c.is_finite()))
-    {
-        return Err(KinematicsError::NotFinite {
-            field: "position_m",
-            index,
+    check_len("position_m", t_s.len(), position_m.len())?;
+    check_len("output", t_s.len(), out.len())?;
+    check_samples(t_s, position_m, attitude, options)?;
+    match attitude {
+        SampledAttitude::Tangent => {
+            translation(t_s, position_m, options.order, 0, out);
+            tangent_path(t_s, options, out)?;
+            check_results(out, 0)
+        }
+        _ => fill_range(t_s, position_m, attitude, options.order, 0, None, out),
+    }
+}
+
+/// [`truth_from_samples`] for the samples `start .. start + out.len()` only, so that a long
+/// series can be turned into truth chunk by chunk with a fixed buffer (Euler or quaternion
+/// attitude; the tangent attitude needs the whole series). The inputs must have passed
+/// [`check_samples`]; `previous_yaw_rad` is the yaw written for sample `start − 1`, which the
+/// yaw is unwrapped against (`None` for the first chunk). The numbers equal those of the whole
+/// call.
+///
+/// # Errors
+/// [`KinematicsError::NeedsWholeSeries`] for the tangent attitude, a range past the end, and
+/// non-finite results.
+pub fn truth_range<N: NavFrame>(
+    t_s: &[f64],
+    position_m: &[[f64; 3]],
+    attitude: SampledAttitude<'_>,
+    options: SampledOptions,
+    start: usize,
+    previous_yaw_rad: Option<f64>,
+    out: &mut [Truth<N>],
+) -> Result<(), KinematicsError> {
+    if matches!(attitude, SampledAttitude::Tangent) {
+        return Err(KinematicsError::NeedsWholeSeries);
+    }
+    let end = start.saturating_add(out.len());
+    if end > t_s.len() || position_m.len() != t_s.len() {
+        return Err(KinematicsError::LengthMismatch {
+            field: "output range",
+            expected: t_s.len(),
+            got: end,
         });
     }
+    fill_range(
+        t_s,
+        position_m,
+        attitude,
+        options.order,
+        start,
+        previous_yaw_rad,
+        out,
+    )
+}
 
-    for i in 0..n {
+/// Position, velocity and acceleration of samples `start ..` into `out`.
+fn translation<N: NavFrame>(
+    t_s: &[f64],
+    position_m: &[[f64; 3]],
+    order: usize,
+    start: usize,
+    out: &mut [Truth<N>],
+) {
+    for (k, s) in out.iter_mut().enumerate() {
+        let i = start + k;
         let (v, a) = derivatives_at(t_s, i, order, |j| position_m[j]);
-        out[i] = Truth {
+        *s = Truth {
             t_s: t_s[i],
             position_m: Vec3::from_array(position_m[i]),
             velocity_m_s: Vec3::from_array(v),
@@ -113,97 +213,98 @@ pub fn truth_from_samples<N: NavFrame>(
             ..Truth::default()
         };
     }
-
-    match attitude {
-        SampledAttitude::Euler(e) => euler_path(t_s, e, order, out)?,
-        SampledAttitude::Quaternion(q) => quaternion_path(t_s, q, order, out)?,
-        SampledAttitude::Tangent => tangent_path(t_s, options, out)?,
-    }
-    if let Some(index) = out.iter().position(|s| !s.is_finite()) {
-        return Err(KinematicsError::NotFinite {
-            field: "truth",
-            index,
-        });
-    }
-    Ok(())
 }
 
-fn euler_path<N: NavFrame>(
+/// Translation and pointwise attitude (Euler or quaternion) of samples `start ..`.
+fn fill_range<N: NavFrame>(
+    t_s: &[f64],
+    position_m: &[[f64; 3]],
+    attitude: SampledAttitude<'_>,
+    order: usize,
+    start: usize,
+    previous_yaw_rad: Option<f64>,
+    out: &mut [Truth<N>],
+) -> Result<(), KinematicsError> {
+    translation(t_s, position_m, order, start, out);
+    let mut previous = previous_yaw_rad;
+    for (k, s) in out.iter_mut().enumerate() {
+        let i = start + k;
+        match attitude {
+            SampledAttitude::Euler(e) => euler_at(t_s, e, order, i, previous, s),
+            SampledAttitude::Quaternion(q) => quaternion_at(t_s, q, order, i, previous, s),
+            SampledAttitude::Tangent => return Err(KinematicsError::NeedsWholeSeries),
+        }
+        previous = Some(s.euler.yaw_rad);
+    }
+    check_results(out, start)
+}
+
+/// Refuses non-finite results, naming the sample.
+fn check_results<N: NavFrame>(out: &[Truth<N>], start: usize) -> Result<(), KinematicsError> {
+    match out.iter().position(|s| !s.is_finite()) {
+        Some(k) => Err(KinematicsError::NotFinite {
+            field: "truth",
+            index: start + k,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Attitude, body rate and angular acceleration of sample `i` of an Euler path (checked).
+fn euler_at<N: NavFrame>(
     t_s: &[f64],
     e: &[EulerZyx],
     order: usize,
-    out: &mut [Truth<N>],
-) -> Result<(), KinematicsError> {
-    check_len("euler_rad", t_s.len(), e.len())?;
-    for (index, ei) in e.iter().enumerate() {
-        if !ei.to_array().iter().all(|c| c.is_finite()) {
-            return Err(KinematicsError::NotFinite {
-                field: "euler_rad",
-                index,
-            });
-        }
-        if ei.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
-            return Err(KinematicsError::GimbalLock {
-                index,
-                pitch_rad: ei.pitch_rad,
-            });
-        }
+    i: usize,
+    previous_yaw: Option<f64>,
+    s: &mut Truth<N>,
+) {
+    let centre = e[i].to_array();
+    let local = |j: usize| {
+        let ej = e[j].to_array();
+        core::array::from_fn(|k| math::unwrap_near(ej[k], centre[k]))
+    };
+    let (d, dd) = derivatives_at(t_s, i, order, local);
+    let mut euler = e[i];
+    if let Some(y) = previous_yaw {
+        euler.yaw_rad = math::unwrap_near(euler.yaw_rad, y);
     }
-    for i in 0..t_s.len() {
-        let centre = e[i].to_array();
-        let local = |j: usize| {
-            let ej = e[j].to_array();
-            core::array::from_fn(|k| math::unwrap_near(ej[k], centre[k]))
-        };
-        let (d, dd) = derivatives_at(t_s, i, order, local);
-        let mut euler = e[i];
-        if i > 0 {
-            euler.yaw_rad = math::unwrap_near(euler.yaw_rad, out[i - 1].euler.yaw_rad);
-        }
-        let (d, dd) = (EulerZyx::from_array(d), EulerZyx::from_array(dd));
-        let s = &mut out[i];
-        s.euler = euler;
-        s.attitude = Rotation::from_euler(euler);
-        s.omega_b_rad_s = body_rate(euler, d);
-        s.alpha_b_rad_s2 = body_angular_acceleration(euler, d, dd);
-    }
-    Ok(())
+    let (d, dd) = (EulerZyx::from_array(d), EulerZyx::from_array(dd));
+    s.euler = euler;
+    s.attitude = Rotation::from_euler(euler);
+    s.omega_b_rad_s = body_rate(euler, d);
+    s.alpha_b_rad_s2 = body_angular_acceleration(euler, d, dd);
 }
 
-fn quaternion_path<N: NavFrame>(
+/// Attitude, body rate and angular acceleration of sample `i` of a quaternion path (checked).
+fn quaternion_at<N: NavFrame>(
     t_s: &[f64],
     q: &[[f64; 4]],
     order: usize,
-    out: &mut [Truth<N>],
-) -> Result<(), KinematicsError> {
-    check_len("quaternion", t_s.len(), q.len())?;
-    for (index, qi) in q.iter().enumerate() {
-        unit_wxyz(*qi, index)?;
-    }
+    i: usize,
+    previous_yaw: Option<f64>,
+    s: &mut Truth<N>,
+) {
     let unit = |j: usize| unit_wxyz(q[j], j).unwrap_or([1.0, 0.0, 0.0, 0.0]);
-    for i in 0..t_s.len() {
-        let qi = unit(i);
-        let aligned = |j: usize| {
-            let qj = unit(j);
-            let dot: f64 = (0..4).map(|k| qj[k] * qi[k]).sum();
-            if dot < 0.0 { qj.map(|c| -c) } else { qj }
-        };
-        let (d, dd) = derivatives_at(t_s, i, order, aligned);
-        let conj = Quaternion::new(qi[0], -qi[1], -qi[2], -qi[3]);
-        let w = conj * Quaternion::new(d[0], d[1], d[2], d[3]);
-        let a = conj * Quaternion::new(dd[0], dd[1], dd[2], dd[3]);
-        let attitude = Rotation::<Body, N>::from_wxyz(qi).unwrap_or_default();
-        let mut euler = attitude.to_euler();
-        if i > 0 {
-            euler.yaw_rad = math::unwrap_near(euler.yaw_rad, out[i - 1].euler.yaw_rad);
-        }
-        let s = &mut out[i];
-        s.attitude = attitude;
-        s.euler = euler;
-        s.omega_b_rad_s = Vec3::new(2.0 * w.i, 2.0 * w.j, 2.0 * w.k);
-        s.alpha_b_rad_s2 = Vec3::new(2.0 * a.i, 2.0 * a.j, 2.0 * a.k);
+    let qi = unit(i);
+    let aligned = |j: usize| {
+        let qj = unit(j);
+        let dot: f64 = (0..4).map(|k| qj[k] * qi[k]).sum();
+        if dot < 0.0 { qj.map(|c| -c) } else { qj }
+    };
+    let (d, dd) = derivatives_at(t_s, i, order, aligned);
+    let conj = Quaternion::new(qi[0], -qi[1], -qi[2], -qi[3]);
+    let w = conj * Quaternion::new(d[0], d[1], d[2], d[3]);
+    let a = conj * Quaternion::new(dd[0], dd[1], dd[2], dd[3]);
+    let attitude = Rotation::<Body, N>::from_wxyz(qi).unwrap_or_default();
+    let mut euler = attitude.to_euler();
+    if let Some(y) = previous_yaw {
+        euler.yaw_rad = math::unwrap_near(euler.yaw_rad, y);
     }
-    Ok(())
+    s.attitude = attitude;
+    s.euler = euler;
+    s.omega_b_rad_s = Vec3::new(2.0 * w.i, 2.0 * w.j, 2.0 * w.k);
+    s.alpha_b_rad_s2 = Vec3::new(2.0 * a.i, 2.0 * a.j, 2.0 * a.k);
 }
 
 fn tangent_path<N: NavFrame>(
