@@ -24,7 +24,7 @@
 //!   `y_m − d̂⁻`; `z_m = m − (y_m − d̂⁻) = −[m×] θ + δd`. A disturbance-corrected reading
 //!   longer than twice ExpectedMagneticFieldStrength is treated as jamming: that update uses the
 //!   accelerometer only (as MATLAB does);
-//! * `K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹`, `x = K z`, `P⁺ = P⁻ − KHP⁻`, with
+//! * `K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹`, `x = K z`, `P⁺ = P⁻ − K(P⁻Hᵀ)ᵀ` (= `P⁻ − KHP⁻`), with
 //!   `R_a = (λ + ξ + κ²(β + η)) I` and `R_m = (μ + δ + κ²(β + η)) I` (λ AccelerometerNoise,
 //!   ξ LinearAccelerationNoise, β GyroscopeDriftNoise, η GyroscopeNoise, μ MagnetometerNoise,
 //!   δ MagneticDisturbanceNoise);
@@ -355,36 +355,45 @@ impl<N: NavFrame> KalmanFilter<N> {
         if use_mag {
             s.mag_nav = horizontal_north(&(s.q * (y_m - s.mag_disturbance)));
         }
-        let block = |r: usize| posterior.fixed_view::<3, 3>(r, r).into_owned();
-        let (bb, beta) = (block(3), p.gyroscope_drift_noise);
+        let [tt, bb, aa, dd] = posterior;
+        let beta = p.gyroscope_drift_noise;
         s.prior = Prior {
-            tt: block(0)
+            tt: tt
                 + (bb + Matrix3::from_diagonal_element(beta + p.gyroscope_noise)) * (kappa * kappa),
             tb: (bb + Matrix3::from_diagonal_element(beta)) * kappa,
             bb: bb + Matrix3::from_diagonal_element(beta),
-            aa: block(6) * (p.linear_acceleration_decay * p.linear_acceleration_decay)
+            aa: aa * (p.linear_acceleration_decay * p.linear_acceleration_decay)
                 + Matrix3::from_diagonal_element(p.linear_acceleration_noise),
-            dd: block(9) * (p.magnetic_disturbance_decay * p.magnetic_disturbance_decay)
+            dd: dd * (p.magnetic_disturbance_decay * p.magnetic_disturbance_decay)
                 + Matrix3::from_diagonal_element(p.magnetic_disturbance_noise),
         };
         Ok(())
     }
 }
 
-/// The Kalman update: `(x, P⁺)` for prior `cov`, observation `h`, innovation `z`, noise `r`.
+/// The Kalman update: the error estimate `x` and the diagonal 3×3 blocks of `P⁺` (all that is
+/// carried) for prior `cov`, observation `h`, innovation `z`, noise `r`. `P⁺ = P⁻ − K (P⁻Hᵀ)ᵀ`
+/// (`P⁻` is symmetric), evaluated only on the diagonal blocks.
 fn update<const M: usize>(
     cov: &SMatrix<f64, STATES, STATES>,
     h: &SMatrix<f64, M, STATES>,
     z: &SVector<f64, M>,
     r: &SVector<f64, M>,
-) -> Result<(SVector<f64, STATES>, SMatrix<f64, STATES, STATES>), OrientError> {
+) -> Result<(SVector<f64, STATES>, [Matrix3<f64>; 4]), OrientError> {
     let pht = cov * h.transpose();
     let innovation = h * pht + SMatrix::<f64, M, M>::from_diagonal(r);
     let inverse = innovation.try_inverse().ok_or(OrientError::Singular)?;
     let gain = pht * inverse;
     let x = gain * z;
-    let posterior = cov - gain * h * cov;
-    Ok((x, posterior))
+    // Each block symmetrised: rounding must not let the carried covariance drift away from a
+    // symmetric matrix over millions of updates.
+    let block = |k: usize| {
+        let r = 3 * k;
+        let b = cov.fixed_view::<3, 3>(r, r)
+            - gain.fixed_view::<3, M>(r, 0) * pht.fixed_view::<3, M>(r, 0).transpose();
+        (b + b.transpose()) * 0.5
+    };
+    Ok((x, [block(0), block(1), block(2), block(3)]))
 }
 
 /// The field `v` (NED) turned about the vertical to have no east component.
