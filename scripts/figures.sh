@@ -32,4 +32,13 @@ TOML
 "$bin" exercise --out-dir "$work/exercise" >/dev/null
 "$bin" plot "$work/exercise/truth.csv" "$work/exercise/inertial_data_errors_trapezoid.csv" \
   "$work/exercise/inertial_data_errors_exercise.csv" --out docs/img/exercise.png
+# 4. Orientation: attitude errors of imufilter, default and tuned, on the rotating platform.
+"$bin" simulate examples/matlab_orientation.toml --out "$work/or_imu.csv" --truth "$work/or_truth.csv" >/dev/null
+"$bin" orient "$work/or_imu.csv" --nav-frame NED --accel-sign matlab --out "$work/default.csv" >/dev/null
+"$bin" orient "$work/or_imu.csv" --nav-frame NED --accel-sign matlab --param GyroscopeNoise=7.6154e-7 \
+  --param AccelerometerNoise=0.0015398 --param GyroscopeDriftNoise=3.0462e-12 \
+  --param LinearAccelerationNoise=0.00096236 --param InitialProcessNoiseScale=10 --out "$work/tuned.csv" >/dev/null
+"$bin" compare "$work/or_truth.csv" "$work/default.csv" --out "$work/imufilter_default.csv" >/dev/null
+"$bin" compare "$work/or_truth.csv" "$work/tuned.csv" --out "$work/imufilter_tuned.csv" >/dev/null
+"$bin" plot "$work/imufilter_default.csv" "$work/imufilter_tuned.csv" --out docs/img/orientation.png
 ls -l docs/img
