@@ -140,3 +140,18 @@ def test_ned_truth_is_drawn_east_north_up(tmp_path):
     anim.save(tmp_path / "ned.gif", writer="pillow", fps=5)
     with pytest.raises(imukit.ImuError, match="nav_frame"):
         ip.animate(sim.truth, nav_frame="XYZ")
+
+
+def test_orientation_outputs_and_their_errors_have_their_panels():
+    t = np.arange(50) / 10.0
+    e = np.column_stack([0.1 * t, np.zeros(50), np.zeros(50)])
+    truth = imukit.truth_from_samples(t, np.zeros((50, 3)), euler_rad=e, nav_frame="NED")
+    estimate = imukit.Table(["t_s", "q_w", "q_x", "q_y", "q_z", "yaw_rad", "pitch_rad", "roll_rad"],
+                            np.column_stack([t, imukit.euler_to_quaternion(e + [0.01, 0, 0]), e + [0.01, 0, 0]]))
+    errors, _ = imukit.compare(truth, estimate)
+    assert imukit.plot.kind(estimate) == "orientation" and imukit.plot.kind(errors) == "errors"
+    fig = imukit.plot.figure(estimate)
+    assert [len(ax.get_lines()) for ax in fig.axes] == [3, 4]   # Euler angles; quaternion
+    fig = imukit.plot.figure(errors)
+    assert [len(ax.get_lines()) for ax in fig.axes] == [1, 3]   # quaternion distance; Euler errors
+    np.testing.assert_allclose(fig.axes[1].get_lines()[0].get_ydata(), np.degrees(0.01), atol=1e-9)

@@ -74,6 +74,15 @@ impl FilterKind {
             })
     }
 
+    /// The filter's name (as [`FilterKind::parse`] takes it).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, k)| *k == self)
+            .map_or("", |(n, _)| *n)
+    }
+
     /// Whether the filter must have a magnetometer (`Some(true)`), must not (`Some(false)`),
     /// or uses one when there is one (`None`).
     #[must_use]
@@ -180,10 +189,7 @@ impl FilterSpec {
         let known = self.kind.settings();
         for (k, _) in &self.settings {
             if !known.iter().any(|n| key(n) == key(k)) {
-                let filter = FilterKind::ALL
-                    .iter()
-                    .find(|(_, f)| *f == self.kind)
-                    .map_or("", |(n, _)| *n);
+                let filter = self.kind.name();
                 return Err(invalid(
                     k.as_str(),
                     format!(
@@ -422,10 +428,7 @@ fn orient_csv_in<N: NavFrame>(
     }
     let hint = format!(
         "; the {} filter needs t_s, accel_*{}{}",
-        FilterKind::ALL
-            .iter()
-            .find(|(_, k)| *k == spec.kind)
-            .map_or("", |(n, _)| *n),
+        spec.kind.name(),
         if gyro { ", gyro_*" } else { "" },
         if spec.magnetometer { ", mag_*" } else { "" }
     );
