@@ -44,7 +44,7 @@ pub fn truth_from_expressions(
 }
 
 /// Truth from sampled arrays by finite differences, written row by row into `out` (`n` rows of
-/// [`TRUTH_COLUMNS`](crate::table::TRUTH_COLUMNS), row-major), chunk by chunk: no truth vector
+/// [`TRUTH_COLUMNS`], row-major), chunk by chunk: no truth vector
 /// or table of the whole series is built on the way.
 ///
 /// # Errors

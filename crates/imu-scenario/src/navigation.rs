@@ -42,7 +42,7 @@ pub const NAV_COLUMNS: [&str; 14] = [
     "roll_rad",
 ];
 
-/// Columns [`compare`] reads from truth and estimate: the navigation columns up to the
+/// Columns [`compare`](crate::compare::compare) reads from truth and estimate: the navigation columns up to the
 /// quaternion.
 pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
 

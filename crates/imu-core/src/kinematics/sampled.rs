@@ -1,5 +1,5 @@
 //! Truth kinematics from sampled positions and attitudes, by finite differences
-//! ([`finite_diff`](super::finite_diff)), writing into a slice the caller owns.
+//! ([`finite_diff`]), writing into a slice the caller owns.
 //!
 //! Attitude derivatives never difference raw wrapped angles: Euler angles are unwrapped locally
 //! around each evaluation point, and quaternions are sign-aligned locally, then

@@ -33,7 +33,7 @@ use crate::rotation::Rotation;
 pub struct FilterInput {
     /// Accelerometer, m/s², in the filter's [`AccelSign`].
     pub accel_m_s2: [f64; 3],
-    /// Gyroscope, rad/s (ignored by [`ecompass`]).
+    /// Gyroscope, rad/s (ignored by [`ecompass()`]).
     pub gyro_rad_s: [f64; 3],
     /// Magnetometer, µT (ignored by filters without a magnetometer).
     pub mag_ut: [f64; 3],
