@@ -52,37 +52,23 @@ impl Core {
         })
     }
 
-    /// The sample's readings (gravity reading, field, rate) and the current quaternion, which
-    /// the first sample sets.
-    #[allow(clippy::type_complexity)]
-    fn begin<N: NavFrame>(
-        &self,
-        input: &FilterInput,
-    ) -> Result<
-        (
-            Vector3<f64>,
-            Vector3<f64>,
-            Vector3<f64>,
-            UnitQuaternion<f64>,
-            bool,
-        ),
-        OrientError,
-    > {
+    /// The sample's readings and the current quaternion, which the first sample sets.
+    fn begin<N: NavFrame>(&self, input: &FilterInput) -> Result<Step, OrientError> {
         check_finite(input, true, self.magnetometer)?;
         let a = gravity_reading(input.accel_m_s2, self.accel_sign);
         let m = Vector3::from(input.mag_ut);
-        let w = Vector3::from(input.gyro_rad_s);
-        match self.q {
-            Some(q) => Ok((a, m, w, q, false)),
-            None => {
-                let q = if self.magnetometer {
-                    ecompass_ned(&a, &m)?
-                } else {
-                    tilt::<N>(&a)?
-                };
-                Ok((a, m, w, q, true))
-            }
-        }
+        let (q, first) = match self.q {
+            Some(q) => (q, false),
+            None if self.magnetometer => (ecompass_ned(&a, &m)?, true),
+            None => (tilt::<N>(&a)?, true),
+        };
+        Ok(Step {
+            a,
+            m,
+            w: Vector3::from(input.gyro_rad_s),
+            q,
+            first,
+        })
     }
 
     fn finish<N: NavFrame>(&mut self, q: UnitQuaternion<f64>, w: Vector3<f64>) -> Estimate<N> {
@@ -92,6 +78,20 @@ impl Core {
             angular_velocity_rad_s: w.into(),
         }
     }
+}
+
+/// One sample as the filters see it.
+struct Step {
+    /// Gravity reading `−f_b`, m/s².
+    a: Vector3<f64>,
+    /// Magnetometer, µT.
+    m: Vector3<f64>,
+    /// Gyroscope, rad/s.
+    w: Vector3<f64>,
+    /// The quaternion before this sample (the start-up attitude on the first).
+    q: UnitQuaternion<f64>,
+    /// Whether this is the first sample.
+    first: bool,
 }
 
 /// `v` normalised, or `None` for a zero vector.
@@ -158,7 +158,13 @@ impl Complementary {
 
 impl<N: NavFrame> OrientationFilter<N> for Complementary {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let (a, m, w, q0, first) = self.core.begin::<N>(input)?;
+        let Step {
+            a,
+            m,
+            w,
+            q: q0,
+            first,
+        } = self.core.begin::<N>(input)?;
         if first {
             return Ok(Some(self.core.finish(q0, w)));
         }
@@ -238,7 +244,13 @@ fn misfit_gradient(q: &Quaternion<f64>, r: &Vector3<f64>, s: &Vector3<f64>) -> V
 
 impl<N: NavFrame> OrientationFilter<N> for Madgwick {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let (a, m, w, q0, first) = self.core.begin::<N>(input)?;
+        let Step {
+            a,
+            m,
+            w,
+            q: q0,
+            first,
+        } = self.core.begin::<N>(input)?;
         if first {
             return Ok(Some(self.core.finish(q0, w)));
         }
@@ -310,7 +322,13 @@ impl Mahony {
 
 impl<N: NavFrame> OrientationFilter<N> for Mahony {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let (a, m, w, q0, first) = self.core.begin::<N>(input)?;
+        let Step {
+            a,
+            m,
+            w,
+            q: q0,
+            first,
+        } = self.core.begin::<N>(input)?;
         if first {
             return Ok(Some(self.core.finish(q0, w)));
         }
