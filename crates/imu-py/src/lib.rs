@@ -93,7 +93,12 @@ fn out3(py: Python<'_>, v: Vec<[f64; 3]>) -> PyResult<Bound<'_, PyArray2<f64>>> 
 }
 
 fn nav(name: &str) -> PyResult<NavFrameName> {
-    parse_name("nav_frame", &name.to_ascii_uppercase()).map_err(refused)
+    frame("nav_frame", name)
+}
+
+/// The navigation frame `name` given for the argument `field`.
+fn frame(field: &str, name: &str) -> PyResult<NavFrameName> {
+    parse_name(field, &name.to_ascii_uppercase()).map_err(refused)
 }
 
 /// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu) tables.
@@ -601,7 +606,7 @@ impl PyImuSensor {
             sensors,
             ..ImuSetup::ideal(kind, [0.0; 3], sign, magnetic_field)
         };
-        let model = match nav(reference_frame)? {
+        let model = match frame("reference_frame", reference_frame)? {
             NavFrameName::ENU => {
                 Model::Enu(setup.model::<Enu>(9.81, sample_rate).map_err(refused)?)
             }

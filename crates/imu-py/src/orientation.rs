@@ -8,7 +8,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use super::{ImuError, array2, flat_rows, nav, refused};
+use super::{ImuError, array2, flat_rows, frame, refused};
 
 fn sign(name: &str) -> PyResult<AccelSign> {
     Ok(parse_name::<AccelSignName>("accel_sign", name)
@@ -51,7 +51,7 @@ impl PyOrientationFilter {
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
         spec.settings = settings;
         spec.initial_process_noise = initial_process_noise;
-        let filter = match nav(reference_frame)? {
+        let filter = match frame("reference_frame", reference_frame)? {
             NavFrameName::ENU => Filter::Enu(spec.build(sample_rate).map_err(refused)?),
             NavFrameName::NED => Filter::Ned(spec.build(sample_rate).map_err(refused)?),
         };
@@ -156,7 +156,7 @@ fn ecompass<'py>(
         )));
     }
     let s = sign(accel_sign)?;
-    let q = match nav(reference_frame)? {
+    let q = match frame("reference_frame", reference_frame)? {
         NavFrameName::ENU => ecompass_in::<Enu>(a, m, s),
         NavFrameName::NED => ecompass_in::<Ned>(a, m, s),
     }
