@@ -37,7 +37,7 @@ use crate::expr::Expr;
 use crate::params::{ImuParams, Profile};
 use crate::perturb::{PerturbationSpec, perturbed};
 use crate::sensors::{SensorKeys, SensorSetup, TemperatureSpec};
-use crate::table::{ImuKind, ImuOutput, Table, read_columns, read_header};
+use crate::table::{CsvRows, ImuKind, ImuOutput, Table, read_columns, read_header};
 use crate::track::{Segment, SpeedProfile, Track};
 use crate::waypoints::Waypoints;
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
@@ -484,41 +484,34 @@ impl SampledPath {
         } else {
             ""
         };
-        let cols = read_columns(path, &required, hint)?;
-        let n = cols.rows();
-        let zip3 = |a: &[f64], b: &[f64], c: &[f64]| -> Vec<[f64; 3]> {
-            (0..n).map(|i| [a[i], b[i], c[i]]).collect()
-        };
-        let position_m = zip3(
-            cols.get("pos_x_m"),
-            cols.get("pos_y_m"),
-            cols.get("pos_z_m"),
-        );
+        // Row by row into the vectors kept (no column copies on the way).
+        let mut rows = CsvRows::open(path, &required, hint)?;
+        let mut row = vec![0.0; required.len()];
+        let (mut t_s, mut position_m) = (Vec::new(), Vec::new());
+        let (mut euler, mut quaternion) = (Vec::new(), Vec::new());
+        while rows.next_row(&mut row)?.is_some() {
+            t_s.push(row[0]);
+            position_m.push([row[1], row[2], row[3]]);
+            match kind {
+                1 => euler.push(EulerZyx::new(row[4], row[5], row[6])),
+                2 => quaternion.push([row[4], row[5], row[6], row[7]]),
+                _ => {}
+            }
+        }
+        if t_s.is_empty() {
+            return Err(Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        }
         let attitude = match kind {
             0 => SampledAttitudeData::Tangent,
-            1 => SampledAttitudeData::Euler(
-                zip3(
-                    cols.get("yaw_rad"),
-                    cols.get("pitch_rad"),
-                    cols.get("roll_rad"),
-                )
-                .into_iter()
-                .map(EulerZyx::from_array)
-                .collect(),
-            ),
-            _ => {
-                let (w, x, y, z) = (
-                    cols.get("q_w"),
-                    cols.get("q_x"),
-                    cols.get("q_y"),
-                    cols.get("q_z"),
-                );
-                SampledAttitudeData::Quaternion((0..n).map(|i| [w[i], x[i], y[i], z[i]]).collect())
-            }
+            1 => SampledAttitudeData::Euler(euler),
+            _ => SampledAttitudeData::Quaternion(quaternion),
         };
         Ok(Self {
             origin: path.display().to_string(),
-            t_s: cols.get("t_s").to_vec(),
+            t_s,
             position_m,
             attitude,
             options: SampledOptions {
