@@ -52,31 +52,28 @@ impl Core {
         })
     }
 
-    /// The sample's readings and the current quaternion, which the first sample sets.
-    fn begin<N: NavFrame>(&self, input: &FilterInput) -> Result<Step, OrientError> {
+    /// One sample through a filter: the readings are checked, the first sample only sets the
+    /// start-up attitude, and later ones go to `advance`, which returns the new quaternion and
+    /// the body rate to report.
+    fn step<N: NavFrame>(
+        &mut self,
+        input: &FilterInput,
+        advance: impl FnOnce(&Step, f64) -> (UnitQuaternion<f64>, Vector3<f64>),
+    ) -> Result<Option<Estimate<N>>, OrientError> {
         check_finite(input, true, self.magnetometer)?;
         let a = gravity_reading(input.accel_m_s2, self.accel_sign);
         let m = Vector3::from(input.mag_ut);
-        let (q, first) = match self.q {
-            Some(q) => (q, false),
-            None if self.magnetometer => (ecompass_ned(&a, &m)?, true),
-            None => (tilt::<N>(&a)?, true),
+        let w = Vector3::from(input.gyro_rad_s);
+        let (q, w) = match self.q {
+            Some(q) => advance(&Step { a, m, w, q }, 1.0 / self.sample_rate_hz),
+            None if self.magnetometer => (ecompass_ned(&a, &m)?, w),
+            None => (tilt::<N>(&a)?, w),
         };
-        Ok(Step {
-            a,
-            m,
-            w: Vector3::from(input.gyro_rad_s),
-            q,
-            first,
-        })
-    }
-
-    fn finish<N: NavFrame>(&mut self, q: UnitQuaternion<f64>, w: Vector3<f64>) -> Estimate<N> {
         self.q = Some(q);
-        Estimate {
+        Ok(Some(Estimate {
             orientation: to_frame(&q),
             angular_velocity_rad_s: w.into(),
-        }
+        }))
     }
 }
 
@@ -88,10 +85,8 @@ struct Step {
     m: Vector3<f64>,
     /// Gyroscope, rad/s.
     w: Vector3<f64>,
-    /// The quaternion before this sample (the start-up attitude on the first).
+    /// The quaternion before this sample.
     q: UnitQuaternion<f64>,
-    /// Whether this is the first sample.
-    first: bool,
 }
 
 /// `v` normalised, or `None` for a zero vector.
@@ -158,38 +153,30 @@ impl Complementary {
 
 impl<N: NavFrame> OrientationFilter<N> for Complementary {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let Step {
-            a,
-            m,
-            w,
-            q: q0,
-            first,
-        } = self.core.begin::<N>(input)?;
-        if first {
-            return Ok(Some(self.core.finish(q0, w)));
-        }
-        let dt = 1.0 / self.core.sample_rate_hz;
-        let mut q = q0 * UnitQuaternion::from_scaled_axis(w * dt);
-        // Tilt: turn the predicted down direction a fraction of the way to the measured one.
-        if let Some(a) = unit(&a) {
-            let v = q.inverse() * Vector3::z();
-            let axis = a.cross(&v);
-            let angle = math::atan2(axis.norm(), a.dot(&v));
-            if let Some(axis) = unit(&axis) {
-                q *= UnitQuaternion::from_scaled_axis(axis * (self.accelerometer_gain * angle));
+        let magnetometer = self.core.magnetometer;
+        self.core.step(input, |&Step { a, m, w, q: q0 }, dt| {
+            let mut q = q0 * UnitQuaternion::from_scaled_axis(w * dt);
+            // Tilt: turn the predicted down direction a fraction of the way to the measured one.
+            if let Some(a) = unit(&a) {
+                let v = q.inverse() * Vector3::z();
+                let axis = a.cross(&v);
+                let angle = math::atan2(axis.norm(), a.dot(&v));
+                if let Some(axis) = unit(&axis) {
+                    q *= UnitQuaternion::from_scaled_axis(axis * (self.accelerometer_gain * angle));
+                }
             }
-        }
-        // Heading: remove a fraction of the measured field's east component (about nav z).
-        if self.core.magnetometer {
-            let h = q * m;
-            if h.x != 0.0 || h.y != 0.0 {
-                let error = math::atan2(h.y, h.x);
-                q = UnitQuaternion::from_scaled_axis(
-                    Vector3::z() * (-self.magnetometer_gain * error),
-                ) * q;
+            // Heading: remove a fraction of the measured field's east component (about nav z).
+            if magnetometer {
+                let h = q * m;
+                if h.x != 0.0 || h.y != 0.0 {
+                    let error = math::atan2(h.y, h.x);
+                    q = UnitQuaternion::from_scaled_axis(
+                        Vector3::z() * (-self.magnetometer_gain * error),
+                    ) * q;
+                }
             }
-        }
-        Ok(Some(self.core.finish(q, w)))
+            (q, w)
+        })
     }
 
     fn reset(&mut self) {
@@ -244,36 +231,26 @@ fn misfit_gradient(q: &Quaternion<f64>, r: &Vector3<f64>, s: &Vector3<f64>) -> V
 
 impl<N: NavFrame> OrientationFilter<N> for Madgwick {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let Step {
-            a,
-            m,
-            w,
-            q: q0,
-            first,
-        } = self.core.begin::<N>(input)?;
-        if first {
-            return Ok(Some(self.core.finish(q0, w)));
-        }
-        let dt = 1.0 / self.core.sample_rate_hz;
-        let mut q_dot = rate_quaternion(&q0, &w);
-        if let Some(a) = unit(&a) {
-            let q = q0.quaternion();
-            let mut grad = misfit_gradient(q, &Vector3::z(), &a);
-            if self.core.magnetometer
-                && let Some(m) = unit(&m)
-            {
-                grad += misfit_gradient(q, &field_reference(&q0, &m), &m);
+        let magnetometer = self.core.magnetometer;
+        self.core.step(input, |&Step { a, m, w, q: q0 }, dt| {
+            let mut q_dot = rate_quaternion(&q0, &w);
+            if let Some(a) = unit(&a) {
+                let q = q0.quaternion();
+                let mut grad = misfit_gradient(q, &Vector3::z(), &a);
+                if magnetometer && let Some(m) = unit(&m) {
+                    grad += misfit_gradient(q, &field_reference(&q0, &m), &m);
+                }
+                // A gradient at rounding level has no direction: normalising it would turn
+                // rounding noise into a full step of β.
+                let n = grad.norm();
+                if n > 1e-12 {
+                    let g = grad * (self.beta / n);
+                    q_dot -= Quaternion::new(g[0], g[1], g[2], g[3]);
+                }
             }
-            // A gradient at rounding level has no direction: normalising it would turn
-            // rounding noise into a full step of β.
-            let n = grad.norm();
-            if n > 1e-12 {
-                let g = grad * (self.beta / n);
-                q_dot -= Quaternion::new(g[0], g[1], g[2], g[3]);
-            }
-        }
-        let q = integrate(&q0, &q_dot, dt);
-        Ok(Some(self.core.finish(q, w)))
+            let q = integrate(&q0, &q_dot, dt);
+            (q, w)
+        })
     }
 
     fn reset(&mut self) {
@@ -322,32 +299,22 @@ impl Mahony {
 
 impl<N: NavFrame> OrientationFilter<N> for Mahony {
     fn update(&mut self, input: &FilterInput) -> Result<Option<Estimate<N>>, OrientError> {
-        let Step {
-            a,
-            m,
-            w,
-            q: q0,
-            first,
-        } = self.core.begin::<N>(input)?;
-        if first {
-            return Ok(Some(self.core.finish(q0, w)));
-        }
-        let dt = 1.0 / self.core.sample_rate_hz;
-        let mut e = Vector3::zeros();
-        if let Some(a) = unit(&a) {
-            let body = q0.inverse();
-            e += a.cross(&(body * Vector3::z()));
-            if self.core.magnetometer
-                && let Some(m) = unit(&m)
-            {
-                e += m.cross(&(body * field_reference(&q0, &m)));
+        let magnetometer = self.core.magnetometer;
+        self.core.step(input, |&Step { a, m, w, q: q0 }, dt| {
+            let mut e = Vector3::zeros();
+            if let Some(a) = unit(&a) {
+                let body = q0.inverse();
+                e += a.cross(&(body * Vector3::z()));
+                if magnetometer && let Some(m) = unit(&m) {
+                    e += m.cross(&(body * field_reference(&q0, &m)));
+                }
             }
-        }
-        let integral = self.integral + e * dt;
-        let corrected = w + e * self.kp + integral * self.ki;
-        let q = integrate(&q0, &rate_quaternion(&q0, &corrected), dt);
-        self.integral = integral;
-        Ok(Some(self.core.finish(q, corrected)))
+            let integral = self.integral + e * dt;
+            let corrected = w + e * self.kp + integral * self.ki;
+            let q = integrate(&q0, &rate_quaternion(&q0, &corrected), dt);
+            self.integral = integral;
+            (q, corrected)
+        })
     }
 
     fn reset(&mut self) {
