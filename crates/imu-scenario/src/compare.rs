@@ -7,7 +7,6 @@
 //! errors in [`ORIENTATION_ERROR_COLUMNS`]: the quaternion distance and the z-y-x Euler angle
 //! differences, wrapped to (−π, π]). Both stream: rows are read in time order, and memory
 //! does not grow with the files.
-use std::io::Write;
 use std::path::Path;
 
 use imu_core::orientation::{DistanceStats, quaternion_distance};
@@ -15,7 +14,7 @@ use imu_core::{Body, Enu, Rotation};
 
 use crate::error::{Result, invalid};
 use crate::navigation::STATE_COLUMNS;
-use crate::table::{AtomicFile, CsvRows, Table, write_rows};
+use crate::table::{AtomicFile, CsvRows, Table};
 
 /// Error columns of a navigation estimate.
 pub const ERROR_COLUMNS: [&str; 9] = [
@@ -217,17 +216,14 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
     let mut file = out.map(AtomicFile::create).transpose()?;
     let columns = kind.error_columns();
     if let Some(f) = file.as_mut() {
-        f.writer()
-            .write_all(columns.join(",").as_bytes())
-            .and_then(|()| f.writer().write_all(b"\n"))
-            .map_err(|e| f.error(e))?;
+        f.write_header(columns)?;
     }
     let summary = compare_rows(
         kind,
         |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
         |row| next_state(&mut estimate_rows, &mut estimate_buffer, kind, row),
         |e| match file.as_mut() {
-            Some(f) => write_rows(f.writer(), e, columns.len(), b",").map_err(|x| f.error(x)),
+            Some(f) => f.write_row(e),
             None => Ok(()),
         },
     )?;

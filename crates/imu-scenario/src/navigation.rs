@@ -9,7 +9,6 @@ use imu_core::strapdown::rk4::{
     NODES, RateWindow, Rk4Strapdown, strapdown_rates_rk4, window_start,
 };
 use std::collections::VecDeque;
-use std::io::Write;
 use std::path::Path;
 
 use imu_core::strapdown::step::{
@@ -21,7 +20,7 @@ use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 use crate::error::{Result, invalid};
 use crate::scenario::NavFrameName;
 use crate::table::{
-    ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table, write_rows,
+    ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table,
 };
 
 /// Navigation output columns.
@@ -349,6 +348,98 @@ fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14
 /// median of their intervals; files this short are checked exactly as [`integrate`] checks).
 pub const GAP_WINDOW: usize = 1001;
 
+/// Rows of an IMU CSV file in time order, for the streamed integration and orientation: each
+/// row's time must increase, and no interval may exceed [`MAX_GAP_FACTOR`] median intervals of
+/// the first [`GAP_WINDOW`] rows (read ahead when the file is opened). Memory does not grow with
+/// the file.
+pub(crate) struct TimedRows {
+    rows: CsvRows,
+    ahead: VecDeque<Vec<f64>>,
+    first_t: f64,
+    median: Option<f64>,
+    previous_t: Option<f64>,
+    taken: usize,
+}
+
+impl TimedRows {
+    /// Opens `path` for `columns` (`t_s` first) and reads the look-ahead.
+    ///
+    /// # Errors
+    /// Missing columns (with `hint`), bad cells, a file without data rows.
+    pub(crate) fn open(path: &Path, columns: &[&str], hint: &str) -> Result<Self> {
+        let mut rows = CsvRows::open(path, columns, hint)?;
+        let mut row = vec![0.0; columns.len()];
+        let mut ahead = VecDeque::with_capacity(GAP_WINDOW + 1);
+        while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {
+            ahead.push_back(row.clone());
+        }
+        let Some(first) = ahead.front() else {
+            return Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        };
+        let first_t = first[0];
+        let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
+        Ok(Self {
+            rows,
+            first_t,
+            median: (times.len() > 1).then(|| median_interval(&times)),
+            ahead,
+            previous_t: None,
+            taken: 0,
+        })
+    }
+
+    /// The first row's time, s.
+    pub(crate) fn first_time(&self) -> f64 {
+        self.first_t
+    }
+
+    /// The median interval of the look-ahead rows, s (`None` for a single row).
+    pub(crate) fn median_interval(&self) -> Option<f64> {
+        self.median
+    }
+
+    /// The file row (header = 1) of the row last read.
+    pub(crate) fn last_row(&self) -> usize {
+        self.taken + 1
+    }
+
+    /// Reads the next row into `row`; `false` at the end of the file.
+    ///
+    /// # Errors
+    /// Bad cells, times that do not increase, gaps (rows named).
+    pub(crate) fn next_row(&mut self, row: &mut [f64]) -> Result<bool> {
+        match self.ahead.pop_front() {
+            Some(r) => row.copy_from_slice(&r),
+            None => {
+                if self.rows.next_row(row)?.is_none() {
+                    return Ok(false);
+                }
+            }
+        }
+        self.taken += 1;
+        let (t, line) = (row[0], self.last_row());
+        if let Some(p) = self.previous_t {
+            if t <= p {
+                return Err(invalid(
+                    "IMU data",
+                    format!(
+                        "time at row {line} does not increase after row {}",
+                        line - 1
+                    ),
+                ));
+            }
+            if let Some(m) = self.median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
+                return Err(gap_error("IMU data", line - 1, t - p, m));
+            }
+        }
+        self.previous_t = Some(t);
+        Ok(true)
+    }
+}
+
 /// What a streamed integration wrote.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavSummary {
@@ -506,24 +597,7 @@ fn integrate_csv_in<N: NavFrame>(
     let mut columns = vec!["t_s"];
     columns.extend(force);
     columns.extend(turn);
-    let mut rows = CsvRows::open(input, &columns, "")?;
-    let mut row = [0.0; 7];
-    let mut ahead: Vec<[f64; 7]> = Vec::with_capacity(GAP_WINDOW + 1);
-    while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {
-        ahead.push(row);
-    }
-    if ahead.is_empty() {
-        return Err(crate::Error::CsvFormat {
-            file: input.into(),
-            message: "no data rows after the header".into(),
-        });
-    }
-    let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
-    let median = if times.len() > 2 {
-        Some(median_interval(&times))
-    } else {
-        None
-    };
+    let mut rows = TimedRows::open(input, &columns, "")?;
     let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
         invalid(
             "initial state",
@@ -531,7 +605,7 @@ fn integrate_csv_in<N: NavFrame>(
         )
     })?;
     let s0 = NavState::<N> {
-        t_s: times[0],
+        t_s: rows.first_time(),
         attitude,
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
         position_m: Vec3::from_array(initial.position_m),
@@ -562,52 +636,26 @@ fn integrate_csv_in<N: NavFrame>(
         AccelSign::Matlab => -1.0,
     };
     let mut file = AtomicFile::create(out)?;
-    file.writer()
-        .write_all(NAV_COLUMNS.join(",").as_bytes())
-        .and_then(|()| file.writer().write_all(b"\n"))
-        .map_err(|e| file.error(e))?;
-    let (mut last_yaw, mut previous_t, mut end, mut written) = (None, None::<f64>, s0, 0usize);
+    file.write_header(&NAV_COLUMNS)?;
+    let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
     let mut write = |state: NavState<N>, file: &mut AtomicFile| -> Result<()> {
-        write_rows(
-            file.writer(),
-            &nav_row(&state, &mut last_yaw),
-            NAV_COLUMNS.len(),
-            b",",
-        )
-        .map_err(|e| file.error(e))?;
+        file.write_row(&nav_row(&state, &mut last_yaw))?;
         end = state;
         written += 1;
         Ok(())
     };
-    let mut i = 0usize;
-    let mut process = |r: &[f64; 7], file: &mut AtomicFile| -> Result<()> {
-        let t = r[0];
-        if let Some(p) = previous_t {
-            if t <= p {
-                return Err(invalid(
-                    "IMU data",
-                    format!(
-                        "time at row {} does not increase after row {}",
-                        i + 2,
-                        i + 1
-                    ),
-                ));
-            }
-            if let Some(m) = median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
-                return Err(gap_error("IMU data", i + 1, t - p, m));
-            }
-        }
-        previous_t = Some(t);
-        let row = [t, sign * r[1], sign * r[2], sign * r[3], r[4], r[5], r[6]];
-        stepper.push(row, &mut |state| write(state, file))?;
-        i += 1;
-        Ok(())
-    };
-    for r in &ahead {
-        process(r, &mut file)?;
-    }
-    while rows.next_row(&mut row)?.is_some() {
-        process(&row, &mut file)?;
+    let mut r = [0.0; 7];
+    while rows.next_row(&mut r)? {
+        let row = [
+            r[0],
+            sign * r[1],
+            sign * r[2],
+            sign * r[3],
+            r[4],
+            r[5],
+            r[6],
+        ];
+        stepper.push(row, &mut |state| write(state, &mut file))?;
     }
     stepper.finish(&mut |state| write(state, &mut file))?;
     file.commit()?;

@@ -1,7 +1,6 @@
 //! Orientation filters by name with `key=value` settings, run over IMU CSV files (streamed) —
 //! the layer under `imukit orient` and the Python filter classes. The filters themselves are
 //! the core's ([`imu_core::orientation`]).
-use std::io::Write;
 use std::path::Path;
 
 use imu_core::orientation::{
@@ -11,9 +10,9 @@ use imu_core::orientation::{
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
 use crate::error::{Result, invalid};
-use crate::navigation::{GAP_WINDOW, MAX_GAP_FACTOR, euler_unwrapped, gap_error, median_interval};
+use crate::navigation::{TimedRows, euler_unwrapped};
 use crate::scenario::NavFrameName;
-use crate::table::{ACCEL_COLUMNS, AtomicFile, CsvRows, GYRO_COLUMNS, MAG_COLUMNS, write_rows};
+use crate::table::{ACCEL_COLUMNS, AtomicFile, GYRO_COLUMNS, MAG_COLUMNS};
 
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
 /// unwrapped).
@@ -389,7 +388,7 @@ pub struct OrientSummary {
 /// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
 /// `mag_*` columns) into `out` ([`ORIENT_COLUMNS`]), streamed; `out` appears only when complete.
 /// The sample rate is `SampleRate` if set, else the median interval of the first
-/// [`GAP_WINDOW`] rows'. Whether the magnetometer is used follows the filter, or for those
+/// [`GAP_WINDOW`](crate::navigation::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
 /// that may use one, whether the file has `mag_*` columns (`spec.magnetometer` is set
 /// accordingly).
 ///
@@ -432,22 +431,8 @@ fn orient_csv_in<N: NavFrame>(
         if gyro { ", gyro_*" } else { "" },
         if spec.magnetometer { ", mag_*" } else { "" }
     );
-    let mut rows = CsvRows::open(input, &columns, &hint)?;
-    let width = columns.len();
-    let mut row = vec![0.0; width];
-    let mut ahead: Vec<Vec<f64>> = Vec::new();
-    while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {
-        ahead.push(row.clone());
-    }
-    if ahead.is_empty() {
-        return Err(crate::Error::CsvFormat {
-            file: input.into(),
-            message: "no data rows after the header".into(),
-        });
-    }
-    let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
-    let median = (times.len() > 1).then(|| median_interval(&times));
-    let data_rate = median.map_or(f64::NAN, |m| 1.0 / m);
+    let mut rows = TimedRows::open(input, &columns, &hint)?;
+    let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
     let rate = spec.sample_rate_hz(data_rate)?;
     if !(rate.is_finite() && rate > 0.0) {
         return Err(invalid(
@@ -457,30 +442,10 @@ fn orient_csv_in<N: NavFrame>(
     }
     let mut filter = spec.build::<N>(rate)?;
     let mut file = AtomicFile::create(out)?;
-    file.writer()
-        .write_all(ORIENT_COLUMNS.join(",").as_bytes())
-        .and_then(|()| file.writer().write_all(b"\n"))
-        .map_err(|e| file.error(e))?;
-    let (mut samples, mut written, mut last_yaw, mut previous_t) = (0usize, 0usize, None, None);
-    let mut process = |r: &[f64], file: &mut AtomicFile| -> Result<()> {
-        let line = samples + 2;
-        let t = r[0];
-        if let Some(p) = previous_t {
-            if t <= p {
-                return Err(invalid(
-                    "IMU data",
-                    format!(
-                        "time at row {line} does not increase after row {}",
-                        line - 1
-                    ),
-                ));
-            }
-            // The filters step at a fixed rate: missing samples would be bridged silently.
-            if let Some(m) = median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
-                return Err(gap_error("IMU data", line - 1, t - p, m));
-            }
-        }
-        previous_t = Some(t);
+    file.write_header(&ORIENT_COLUMNS)?;
+    let (mut samples, mut written, mut last_yaw) = (0usize, 0usize, None);
+    let mut r = vec![0.0; columns.len()];
+    while rows.next_row(&mut r)? {
         let three = |k: usize| [r[k], r[k + 1], r[k + 2]];
         let sample = FilterInput {
             accel_m_s2: three(1),
@@ -493,25 +458,12 @@ fn orient_csv_in<N: NavFrame>(
         };
         let estimate = filter
             .update(&sample)
-            .map_err(|e| invalid("IMU data", format!("row {line}: {e}")))?;
+            .map_err(|e| invalid("IMU data", format!("row {}: {e}", rows.last_row())))?;
         if let Some(est) = estimate {
-            write_rows(
-                file.writer(),
-                &orient_row(t, &est.orientation, &mut last_yaw),
-                ORIENT_COLUMNS.len(),
-                b",",
-            )
-            .map_err(|e| file.error(e))?;
+            file.write_row(&orient_row(r[0], &est.orientation, &mut last_yaw))?;
             written += 1;
         }
         samples += 1;
-        Ok(())
-    };
-    for r in &ahead {
-        process(r, &mut file)?;
-    }
-    while rows.next_row(&mut row)?.is_some() {
-        process(&row, &mut file)?;
     }
     file.commit()?;
     Ok(OrientSummary {

@@ -287,6 +287,27 @@ impl AtomicFile {
         self.writer.as_mut().expect("the writer lives until commit")
     }
 
+    /// Writes the CSV header line of `columns`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
+        let w = self.writer();
+        let written = w
+            .write_all(columns.join(",").as_bytes())
+            .and_then(|()| w.write_all(b"\n"));
+        written.map_err(|e| self.error(e))
+    }
+
+    /// Writes one CSV row of `values` (shortest round-trip form).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
+        let written = write_rows(self.writer(), values, values.len(), b",");
+        written.map_err(|e| self.error(e))
+    }
+
     /// An I/O error of this file.
     #[must_use]
     pub fn error(&self, source: std::io::Error) -> Error {
