@@ -7,9 +7,10 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::{Enu, IdealReading, ImuMount, Truth, Vec3};
-use imu_scenario::analytic::{AnalyticOptions, truth_from_motion};
-use imu_scenario::builtin;
-use imu_scenario::scenario::{ExpressionMotion, TrajectorySpec, sample_times};
+use imukit::motion::ExpressionMotion;
+use imukit::motion::analytic::{AnalyticOptions, truth_from_motion};
+use imukit::scenario::builtin;
+use imukit::scenario::{TrajectorySpec, sample_times};
 
 fn figure8() -> ExpressionMotion {
     match builtin::spec("figure8").expect("built-in").trajectory {

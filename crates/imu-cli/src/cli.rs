@@ -160,7 +160,7 @@ pub enum Command {
         #[arg(long, default_value = "imukit-demo")]
         out_dir: PathBuf,
         /// Built-in scenario to run.
-        #[arg(long, default_value = imu_scenario::builtin::DEMO)]
+        #[arg(long, default_value = imukit::scenario::builtin::DEMO)]
         scenario: String,
     },
     /// Lists the built-in scenarios, or prints one as an editable scenario file.

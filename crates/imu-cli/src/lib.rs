@@ -4,7 +4,7 @@
 //! [`plot::plot_files`] (the default figure of imukit CSV files, SVG or PNG),
 //! [`plot::animate::animate`] (GIF or self-contained HTML of a truth table),
 //! [`plot::allan_figure`] and [`plot::trajectories_figure`]. Which panels each kind of table gets
-//! is decided in `imu_scenario::figures`, shared with the Python package.
+//! is decided in `imukit::figures`, shared with the Python package.
 //!
 //! ```no_run
 //! use std::path::{Path, PathBuf};

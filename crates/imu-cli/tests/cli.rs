@@ -63,14 +63,14 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
             .status()
             .unwrap();
         assert!(status.success(), "{name}");
-        let direct = imu_scenario::builtin::spec(name)
+        let direct = imukit::scenario::builtin::spec(name)
             .unwrap()
             .resolve(&dir)
             .unwrap()
             .simulate()
             .unwrap();
         let reread =
-            imu_scenario::table::read_columns(&out, &["accel_x_m_s2", "gyro_z_rad_s"], "").unwrap();
+            imukit::io::table::read_columns(&out, &["accel_x_m_s2", "gyro_z_rad_s"], "").unwrap();
         assert_eq!(
             reread.get("accel_x_m_s2"),
             direct.imu.column("accel_x_m_s2").unwrap().as_slice(),
@@ -152,7 +152,7 @@ fn exercise_writes_the_datasets_trajectories_and_figure() {
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.matches("<polyline").count() >= 5, "five trajectories");
     // The clean data through the default scheme closes the lap near the start.
-    let nav = imu_scenario::table::read_columns(
+    let nav = imukit::io::table::read_columns(
         &dir.join("inertial_data_trapezoid.csv"),
         &["pos_x_m", "pos_y_m"],
         "",
@@ -264,7 +264,7 @@ fn simulate_integrate_compare_closes_the_loop() {
         "{report}"
     );
     let err =
-        imu_scenario::table::read_columns(&dir.join("err.csv"), &["pos_err_m", "att_err_rad"], "")
+        imukit::io::table::read_columns(&dir.join("err.csv"), &["pos_err_m", "att_err_rad"], "")
             .unwrap();
     let last = |c: &str| *err.get(c).last().unwrap();
     assert!(
@@ -287,8 +287,7 @@ fn simulate_integrate_compare_closes_the_loop() {
         "nav4.csv",
     ]);
     run(&["compare", "truth.csv", "nav4.csv", "--out", "err4.csv"]);
-    let err4 =
-        imu_scenario::table::read_columns(&dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
+    let err4 = imukit::io::table::read_columns(&dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
     assert!(*err4.get("pos_err_m").last().unwrap() < 1e-6);
     // Integrating in the wrong frame is visibly wrong (gravity the other way).
     run(&[
@@ -302,8 +301,7 @@ fn simulate_integrate_compare_closes_the_loop() {
         "wrong.csv",
     ]);
     run(&["compare", "truth.csv", "wrong.csv", "--out", "err2.csv"]);
-    let err2 =
-        imu_scenario::table::read_columns(&dir.join("err2.csv"), &["pos_err_m"], "").unwrap();
+    let err2 = imukit::io::table::read_columns(&dir.join("err2.csv"), &["pos_err_m"], "").unwrap();
     assert!(*err2.get("pos_err_m").last().unwrap() > 100.0);
     // Missing columns are named.
     std::fs::write(dir.join("few.csv"), "t_s,accel_x_m_s2\n0,0\n0.1,0\n").unwrap();

@@ -17,7 +17,7 @@
 //! The crate is `#![no_std]` and never allocates: batch functions write into slices the caller
 //! owns, per-sample steppers keep their state in plain structs; nothing here links `alloc`. Float
 //! math comes from `std` (default feature) or `libm`. Exact analytic trajectories over dual
-//! numbers, which need the standard library, are in `imu_scenario::analytic`.
+//! numbers, which need the standard library, are in `imukit::motion::analytic`.
 #![no_std]
 #![forbid(unsafe_code)]
 

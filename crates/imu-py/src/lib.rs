@@ -10,16 +10,17 @@ use imu_core::sensor::{ImuModel, ImuState, SeededNormals, Temperatures};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{Body, Enu, EulerZyx, NavFrame, Rotation, Vec3};
-use imu_scenario::figures::{self, TableKind};
-use imu_scenario::params::{Profile, read_param_file, to_toml};
-use imu_scenario::scenario::{
-    AccelSignName, BodyRatesData, ExpressionSpec, Formula, ImuSetup, NavFrameName,
-    SampledAttitudeData, parse_name,
+use imukit::figures::{self, TableKind};
+use imukit::io::params::{Profile, read_param_file, to_toml};
+use imukit::io::presets;
+use imukit::io::table::ImuKind;
+use imukit::motion::{BodyRatesData, SampledAttitudeData};
+use imukit::run::{allan as analysis, arrays, navigate as navigation, planar};
+use imukit::scenario::sensors::{SensorKeys, SensorSetup};
+use imukit::scenario::{
+    AccelSignName, ExpressionSpec, Formula, ImuSetup, NavFrameName, parse_name,
 };
-use imu_scenario::sensors::{SensorKeys, SensorSetup};
-use imu_scenario::table::ImuKind;
-use imu_scenario::{ScenarioSpec, Table};
-use imu_scenario::{analysis, arrays, navigation, planar, presets};
+use imukit::{ScenarioSpec, Table};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
@@ -38,7 +39,7 @@ create_exception!(
     "imukit refused the input; the message says what and where."
 );
 
-fn refused(e: imu_scenario::Error) -> PyErr {
+fn refused(e: imukit::Error) -> PyErr {
     ImuError::new_err(e.to_string())
 }
 
@@ -220,7 +221,7 @@ fn truth_from_samples<'py>(
     };
     let nav = nav(nav_frame)?;
     let n = t.len();
-    let out = PyArray2::<f64>::zeros(py, [n, imu_scenario::table::TRUTH_COLUMNS.len()], false);
+    let out = PyArray2::<f64>::zeros(py, [n, imukit::io::table::TRUTH_COLUMNS.len()], false);
     {
         let mut guard = out.readwrite();
         let values = guard
@@ -230,7 +231,7 @@ fn truth_from_samples<'py>(
             .map_err(refused)?;
     }
     Ok((
-        imu_scenario::table::TRUTH_COLUMNS
+        imukit::io::table::TRUTH_COLUMNS
             .iter()
             .map(|c| (*c).to_string())
             .collect(),
@@ -783,7 +784,7 @@ fn identify_noise<'py>(
 /// A datasheet figure in imukit's SI units: `(value, unit, fitting parameters)`.
 #[pyfunction]
 fn convert(value: f64, unit: &str) -> PyResult<(f64, &'static str, &'static str)> {
-    let c = imu_scenario::units::convert(value, unit).map_err(refused)?;
+    let c = imukit::io::units::convert(value, unit).map_err(refused)?;
     Ok((c.value, c.unit, c.fits))
 }
 
@@ -972,7 +973,7 @@ fn compare<'py>(
         data: estimate.as_array().iter().copied().collect(),
     };
     let c = py
-        .detach(move || imu_scenario::compare::compare(&t, &e))
+        .detach(move || imukit::run::compare::compare(&t, &e))
         .map_err(refused)?;
     let d = pyo3::types::PyDict::new(py);
     let s = &c.summary;
@@ -1049,7 +1050,7 @@ fn truth_from_waypoints<'py>(
         .as_ref()
         .map(|e| rows::<3>("euler_rad", e))
         .transpose()?;
-    let w = imu_scenario::waypoints::Waypoints::new(&knots, &p, v.as_deref(), e.as_deref())
+    let w = imukit::motion::waypoints::Waypoints::new(&knots, &p, v.as_deref(), e.as_deref())
         .map_err(refused)?;
     let nav = nav(nav_frame)?;
     let table = py
@@ -1061,19 +1062,19 @@ fn truth_from_waypoints<'py>(
 /// Names of the built-in scenarios.
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
-    imu_scenario::builtin::NAMES.to_vec()
+    imukit::scenario::builtin::NAMES.to_vec()
 }
 
 /// A built-in scenario as TOML text.
 #[pyfunction]
 fn builtin_toml(name: &str) -> PyResult<String> {
-    imu_scenario::builtin::toml(name).map_err(refused)
+    imukit::scenario::builtin::toml(name).map_err(refused)
 }
 
 /// Every column of an imukit CSV file.
 #[pyfunction]
 fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
-    let t = imu_scenario::table::read_table(Path::new(path)).map_err(refused)?;
+    let t = imukit::io::table::read_table(Path::new(path)).map_err(refused)?;
     table_out(py, t)
 }
 
@@ -1105,7 +1106,7 @@ fn write_csv(
 /// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).
 #[pyfunction]
 fn run_path(out: &str, run: u64, runs: u64) -> String {
-    imu_scenario::table::run_path(Path::new(out), run, runs)
+    imukit::io::table::run_path(Path::new(out), run, runs)
         .display()
         .to_string()
 }

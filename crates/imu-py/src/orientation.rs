@@ -2,8 +2,8 @@
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
 use imu_core::orientation::quaternion_distance as distance;
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
-use imu_scenario::orient::{AnyFilter, FilterKind, FilterSpec, run_rows};
-use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
+use imukit::run::orient::{AnyFilter, FilterKind, FilterSpec, run_rows};
+use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

@@ -1,8 +1,8 @@
 //! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
 use std::path::Path;
 
-use imu_scenario::analysis::{allan, mean_rate};
-use imu_scenario::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
+use imukit::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
+use imukit::run::allan::{allan, mean_rate};
 
 use super::CliError;
 

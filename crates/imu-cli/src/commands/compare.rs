@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use imu_core::orientation::DistanceStats;
-use imu_scenario::compare::compare_csv;
+use imukit::run::compare::compare_csv;
 
 use super::CliError;
 

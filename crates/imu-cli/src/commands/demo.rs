@@ -2,12 +2,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use imu_scenario::{Simulation, builtin};
+use imukit::Simulation;
+use imukit::scenario::builtin;
 
 use super::CliError;
 use crate::plot::animate::{AnimateOptions, animate};
 use crate::plot::plot_files;
-use imu_scenario::scenario::NavFrameName;
+use imukit::scenario::NavFrameName;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let io = |source| CliError::Io {

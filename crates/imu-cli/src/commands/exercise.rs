@@ -3,8 +3,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
-use imu_scenario::planar::{integrate, samples_from_table, write_dat};
-use imu_scenario::{Table, builtin};
+use imukit::Table;
+use imukit::run::planar::{integrate, samples_from_table, write_dat};
+use imukit::scenario::builtin;
 
 use super::CliError;
 use crate::plot::{Trace, trajectories_figure};
@@ -29,7 +30,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
     let clean_spec = builtin::spec("cart")?;
     let clean = clean_spec.resolve(out_dir)?.simulate()?;
     let mut noisy_spec = clean_spec.clone();
-    let errors = imu_scenario::ScenarioSpec::from_toml(
+    let errors = imukit::ScenarioSpec::from_toml(
         &format!("{ERRORS}\n[trajectory]\ntype = \"builtin\"\nname = \"cart\"\n"),
         "exercise errors",
     )?;

@@ -4,10 +4,10 @@ use std::path::Path;
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{AccelSign, EulerZyx};
-use imu_scenario::navigation::{InitialState, NavScheme, NavSetup, integrate_csv};
-use imu_scenario::planar::read_planar;
-use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
-use imu_scenario::{Error, Table};
+use imukit::run::navigate::{InitialState, NavScheme, NavSetup, integrate_csv};
+use imukit::run::planar::read_planar;
+use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
+use imukit::{Error, Table};
 
 use super::CliError;
 
@@ -79,7 +79,7 @@ pub fn planar(c: &Common<'_>, scheme_name: &str, heading0: f64) -> Result<(), Cl
         velocity_nav_m_s: v0,
         velocity_body_m_s: [co * v0[0] + s * v0[1], -s * v0[0] + co * v0[1]],
     };
-    let nav = imu_scenario::planar::integrate(&samples, scheme, initial)
+    let nav = imukit::run::planar::integrate(&samples, scheme, initial)
         .map_err(|e| invalid(&c.input.display().to_string(), e.to_string()))?;
     nav.write_csv(c.out)?;
     report(&nav, &format!("{scheme_name} scheme"), c.out);

@@ -17,7 +17,7 @@ use crate::cli::{Cli, Command};
 pub enum CliError {
     /// Input or I/O errors from the scenario layer.
     #[error(transparent)]
-    Scenario(#[from] imu_scenario::Error),
+    Scenario(#[from] imukit::Error),
     /// A figure could not be drawn or written.
     #[error("{path}: {message}")]
     Plot {
@@ -40,9 +40,7 @@ impl CliError {
     /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Scenario(imu_scenario::Error::Io { .. })
-            | Self::Io { .. }
-            | Self::Plot { .. } => 74,
+            Self::Scenario(imukit::Error::Io { .. }) | Self::Io { .. } | Self::Plot { .. } => 74,
             Self::Scenario(_) => 65,
         }
     }
@@ -113,7 +111,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         } => compare::run(&truth, &estimate, out.as_deref()),
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
-            let c = imu_scenario::units::convert(value, &unit)?;
+            let c = imukit::io::units::convert(value, &unit)?;
             println!("{} {}   ({})", c.value, c.unit, c.fits);
             Ok(())
         }

@@ -2,8 +2,8 @@
 use std::path::Path;
 
 use imu_core::AccelSign;
-use imu_scenario::orient::{FilterKind, FilterSpec, orient_csv};
-use imu_scenario::scenario::{AccelSignName, NavFrameName, parse_name};
+use imukit::run::orient::{FilterKind, FilterSpec, orient_csv};
+use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
 
 use super::CliError;
 

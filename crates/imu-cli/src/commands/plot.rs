@@ -3,9 +3,9 @@ use std::path::{Path, PathBuf};
 
 use crate::plot::animate::{self as anim, AnimateOptions};
 use crate::plot::plot_files;
-use imu_scenario::table::read_table;
+use imukit::io::table::read_table;
 
-use imu_scenario::scenario::{NavFrameName, parse_name};
+use imukit::scenario::{NavFrameName, parse_name};
 
 use super::CliError;
 

@@ -1,5 +1,5 @@
 //! `imukit presets [NAME]`: list the sensor presets or print one as a parameter file.
-use imu_scenario::presets;
+use imukit::io::presets;
 
 use super::CliError;
 

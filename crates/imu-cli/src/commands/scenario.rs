@@ -1,5 +1,5 @@
 //! `imukit scenario [NAME]`: list built-ins or print one as TOML.
-use imu_scenario::builtin;
+use imukit::scenario::builtin;
 
 use super::CliError;
 

@@ -2,8 +2,8 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use imu_scenario::Scenario;
-use imu_scenario::table::run_path;
+use imukit::Scenario;
+use imukit::io::table::run_path;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -30,7 +30,7 @@ pub fn run(
         return Ok(());
     };
     if runs == 0 {
-        return Err(imu_scenario::Error::Invalid {
+        return Err(imukit::Error::Invalid {
             field: "--runs".into(),
             message: "must be ≥ 1".into(),
         }

@@ -1,7 +1,7 @@
 //! The Allan-deviation figure: log-log curves with the fitted −½, 0 and +½ lines dashed.
 use std::path::Path;
 
-use imu_scenario::analysis::AllanResult;
+use imukit::run::allan::AllanResult;
 use plotters::prelude::*;
 
 use super::{COLORS, draw_legend, err, key, write_figure};

@@ -8,8 +8,8 @@
 use std::path::Path;
 
 use imu_core::{Body, Enu, Ned, Rotation, Vec3};
-use imu_scenario::figures::{FramePlan, default_body_m, frame_plan};
-use imu_scenario::{Error, Table};
+use imukit::figures::{FramePlan, default_body_m, frame_plan};
+use imukit::{Error, Table};
 use plotters::prelude::*;
 
 use super::{COLORS, err, every, rasterise, stride_for};
@@ -245,7 +245,7 @@ pub fn animate(
         Some("html" | "htm") => html(&scene, opts).into_bytes(),
         _ => return Err(fail("the animation file must end in .gif or .html".into())),
     };
-    imu_scenario::table::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))?;
+    imukit::io::table::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))?;
     Ok(AnimationInfo {
         frames: scene.frames.len(),
         speed: scene.speed,

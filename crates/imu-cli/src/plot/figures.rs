@@ -2,9 +2,9 @@
 use std::path::{Path, PathBuf};
 
 use imu_core::allan::identify_noise;
-use imu_scenario::analysis::AllanResult;
-use imu_scenario::figures::{PanelSpec, TableKind};
-use imu_scenario::{Error, Table};
+use imukit::figures::{PanelSpec, TableKind};
+use imukit::run::allan::AllanResult;
+use imukit::{Error, Table};
 
 use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, is_3d};
 use super::{allan_figure, write_figure};
@@ -66,7 +66,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliErr
     let mut files = Vec::new();
     let mut kind: Option<TableKind> = None;
     for p in paths {
-        let t = imu_scenario::table::read_table(p)?;
+        let t = imukit::io::table::read_table(p)?;
         let k = TableKind::of(&t.columns, &p.display().to_string())?;
         if let Some(first) = kind.filter(|first| !first.overlays(k)) {
             return Err(Error::Invalid {

@@ -102,7 +102,7 @@ pub fn write_figure(
             .map_err(|e| fail(err(e)))?,
         _ => return Err(fail("the figure file must end in .svg or .png".into())),
     };
-    imu_scenario::table::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))?;
+    imukit::io::table::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))?;
     Ok(())
 }
 

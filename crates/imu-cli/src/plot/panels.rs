@@ -116,7 +116,7 @@ impl Trace {
     /// The `pos_x_m`, `pos_y_m` (and `pos_z_m` if present) columns of a table; NED positions
     /// become east, north, up.
     #[must_use]
-    pub fn from_table(name: &str, t: &imu_scenario::Table, ned: bool) -> Self {
+    pub fn from_table(name: &str, t: &imukit::Table, ned: bool) -> Self {
         let (x, y) = (
             t.column("pos_x_m").unwrap_or_default(),
             t.column("pos_y_m").unwrap_or_default(),
@@ -262,7 +262,7 @@ pub fn is_3d(traces: &[Trace]) -> bool {
         .iter()
         .flat_map(|t| t.points.iter().map(|p| [p.0, p.1, p.2]))
         .collect();
-    imu_scenario::figures::leaves_plane(&all)
+    imukit::figures::leaves_plane(&all)
 }
 
 /// A figure of trajectories in the plane, start and end marked (the exercise's figure).

@@ -2,7 +2,7 @@
 //! body rate and body angular acceleration.
 //!
 //! Sources: [`sampled`] (finite differences on caller-owned slices) and [`body_rates`]
-//! (integration of body-frame rates). Exact truth over dual numbers is `imu_scenario::analytic`
+//! (integration of body-frame rates). Exact truth over dual numbers is `imukit::motion::analytic`
 //! (dual numbers need the standard library); it uses [`euler`] (Euler rates → body rate),
 //! [`tangent`] (attitude aligned with the velocity) and [`sampled::backfill_standstill`] from here.
 pub mod body_rates;

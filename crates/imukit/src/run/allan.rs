@@ -1,0 +1,71 @@
+//! Allan deviation of IMU columns and noise identification, shared by the CLI and Python.
+use imu_core::allan::{NoiseIdentification, allan_deviation, identify_noise, octave_cluster_sizes};
+
+use crate::error::{Result, invalid};
+use crate::io::table::Table;
+
+/// Allan deviations of several rate columns at octave-spaced τ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AllanResult {
+    /// `tau_s` then `adev_<column>` per column.
+    pub table: Table,
+    /// Identification per column, in column order.
+    pub noise: Vec<(String, NoiseIdentification)>,
+}
+
+/// Overlapping Allan deviation of each `(name, samples)` at octave cluster sizes, sampled at
+/// `sample_rate_hz`, with N, K and B read off each curve.
+///
+/// # Errors
+/// Fewer than 3 samples, non-finite samples (column and index named), a bad rate.
+pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<AllanResult> {
+    let n = columns.first().map_or(0, |(_, v)| v.len());
+    let mut m = vec![0usize; 64];
+    let count = octave_cluster_sizes(n, &mut m);
+    m.truncate(count);
+    if count == 0 {
+        return Err(invalid(
+            "allan",
+            format!("need at least 3 samples, got {n}"),
+        ));
+    }
+    let tau: Vec<f64> = m.iter().map(|&k| k as f64 / sample_rate_hz).collect();
+    let mut names = vec!["tau_s".to_string()];
+    let mut curves = Vec::new();
+    let mut noise = Vec::new();
+    let mut theta = vec![0.0; n];
+    for (name, x) in columns {
+        let mut adev = vec![0.0; count];
+        allan_deviation(x, sample_rate_hz, &m, &mut theta, &mut adev)
+            .map_err(|e| invalid(name.clone(), e.to_string()))?;
+        noise.push((name.clone(), identify_noise(&tau, &adev)));
+        names.push(format!("adev_{name}"));
+        curves.push(adev);
+    }
+    let mut data = Vec::with_capacity(count * names.len());
+    for (k, t) in tau.iter().enumerate() {
+        data.push(*t);
+        data.extend(curves.iter().map(|c| c[k]));
+    }
+    Ok(AllanResult {
+        table: Table {
+            columns: names,
+            data,
+        },
+        noise,
+    })
+}
+
+/// The mean sample rate of increasing times `t_s`, Hz.
+///
+/// # Errors
+/// Fewer than 2 samples or times that do not increase.
+pub fn mean_rate(t_s: &[f64]) -> Result<f64> {
+    if t_s.len() < 2 || t_s[t_s.len() - 1] <= t_s[0] {
+        return Err(invalid(
+            "t_s",
+            "need at least 2 increasing times to find the sample rate",
+        ));
+    }
+    Ok((t_s.len() - 1) as f64 / (t_s[t_s.len() - 1] - t_s[0]))
+}

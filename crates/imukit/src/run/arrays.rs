@@ -1,0 +1,254 @@
+//! The array-level API behind the Python functions: plain slices in, [`Table`]s out, with errors
+//! that name the argument and index.
+use crate::motion::analytic::AnalyticOptions;
+use imu_core::ideal::at_lever_arm;
+use imu_core::kinematics::sampled::SampledOptions;
+use imu_core::kinematics::tangent::tangent_series;
+use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth, Vec3};
+
+use crate::error::{Error, Result, invalid};
+use crate::io::table::{TRUTH_COLUMNS, Table};
+use crate::motion::{ExpressionMotion, SampledAttitudeData, SampledPath, Trajectory};
+use crate::scenario::{ExpressionSpec, ImuSetup, NavFrameName};
+
+fn in_frame<T>(nav: NavFrameName, enu: impl FnOnce() -> T, ned: impl FnOnce() -> T) -> T {
+    match nav {
+        NavFrameName::ENU => enu(),
+        NavFrameName::NED => ned(),
+    }
+}
+
+/// Exact truth at `t_s` from formulas.
+///
+/// # Errors
+/// Unparsable formulas, non-increasing times, gimbal lock, non-finite results.
+pub fn truth_from_expressions(
+    t_s: &[f64],
+    spec: &ExpressionSpec,
+    nav: NavFrameName,
+) -> Result<Table> {
+    let min_speed_m_s = spec
+        .min_speed_m_s
+        .unwrap_or(imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S);
+    let traj = Trajectory::Expression(
+        ExpressionMotion::from_spec(spec)?,
+        AnalyticOptions { min_speed_m_s },
+    );
+    in_frame(
+        nav,
+        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
+        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+    )
+}
+
+/// Truth from sampled arrays by finite differences, written row by row into `out` (`n` rows of
+/// [`TRUTH_COLUMNS`], row-major), chunk by chunk: no truth vector
+/// or table of the whole series is built on the way.
+///
+/// # Errors
+/// As [`SampledPath::truth`], with array indices; an `out` of the wrong length.
+pub fn truth_from_arrays_into(
+    t_s: Vec<f64>,
+    position_m: Vec<[f64; 3]>,
+    attitude: SampledAttitudeData,
+    options: SampledOptions,
+    nav: NavFrameName,
+    out: &mut [f64],
+) -> Result<()> {
+    const WIDTH: usize = crate::io::table::TRUTH_COLUMNS.len();
+    if out.len() != t_s.len() * WIDTH {
+        return Err(invalid(
+            "output",
+            format!("has {} values, expected {} × {WIDTH}", out.len(), t_s.len()),
+        ));
+    }
+    let path = SampledPath {
+        origin: "samples".into(),
+        t_s,
+        position_m,
+        attitude,
+        options,
+        first_row: 0,
+    };
+    let mut rows = out.chunks_exact_mut(WIDTH);
+    const CHUNK: usize = 4096;
+    match nav {
+        NavFrameName::ENU => path.truth_chunks::<Enu>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
+        NavFrameName::NED => path.truth_chunks::<Ned>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
+    }
+}
+
+/// Writes truth samples into the next rows.
+fn fill_rows<N: NavFrame>(
+    chunk: &[Truth<N>],
+    rows: &mut std::slice::ChunksExactMut<'_, f64>,
+) -> Result<()> {
+    for (s, row) in chunk.iter().zip(rows.by_ref()) {
+        row.copy_from_slice(&crate::io::table::truth_row(s));
+    }
+    Ok(())
+}
+
+/// Truth samples from a table with the truth columns (attitude from the quaternion columns).
+///
+/// # Errors
+/// Missing columns, non-finite values or zero quaternions (with the row index).
+pub fn truth_from_table<N: NavFrame>(table: &Table) -> Result<Vec<Truth<N>>> {
+    let idx: Vec<usize> = TRUTH_COLUMNS
+        .iter()
+        .map(|c| {
+            table
+                .columns
+                .iter()
+                .position(|h| h == c)
+                .ok_or_else(|| invalid("truth", format!("missing column {c}")))
+        })
+        .collect::<Result<_>>()?;
+    let width = table.columns.len();
+    (0..table.rows())
+        .map(|i| {
+            let row = &table.data[i * width..(i + 1) * width];
+            let v = |k: usize| row[idx[k]];
+            if let Some(k) = (0..TRUTH_COLUMNS.len()).find(|&k| !v(k).is_finite()) {
+                return Err(invalid(
+                    "truth",
+                    format!("row {i}, column {}: not a finite number", TRUTH_COLUMNS[k]),
+                ));
+            }
+            let v3 = |k: usize| [v(k), v(k + 1), v(k + 2)];
+            let attitude = Rotation::from_wxyz([v(10), v(11), v(12), v(13)])
+                .ok_or_else(|| invalid("truth", format!("row {i}: quaternion has zero norm")))?;
+            Ok(Truth {
+                t_s: v(0),
+                position_m: Vec3::from_array(v3(1)),
+                velocity_m_s: Vec3::from_array(v3(4)),
+                acceleration_m_s2: Vec3::from_array(v3(7)),
+                attitude,
+                euler: EulerZyx::from_array(v3(14)),
+                omega_b_rad_s: Vec3::from_array(v3(17)),
+                alpha_b_rad_s2: Vec3::from_array(v3(20)),
+            })
+        })
+        .collect()
+}
+
+/// Ideal IMU readings from a truth table.
+///
+/// # Errors
+/// As [`truth_from_table`]; a non-finite gravity.
+pub fn ideal_from_truth(
+    table: &Table,
+    imu: &ImuSetup,
+    gravity_m_s2: f64,
+    nav: NavFrameName,
+) -> Result<Table> {
+    if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
+        return Err(invalid(
+            "gravity_m_s2",
+            format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
+        ));
+    }
+    fn run<N: NavFrame>(table: &Table, imu: &ImuSetup, g: f64) -> Result<Table> {
+        let truth = truth_from_table::<N>(table)?;
+        let mount = imu.mount::<N>(g);
+        let mut readings = vec![IdealReading::default(); truth.len()];
+        mount.read_into(&truth, &mut readings);
+        let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
+        let readings: Vec<_> = readings
+            .iter()
+            .map(crate::scenario::sensors::ideal_as_reading)
+            .collect();
+        Ok(Table::from_readings(&t, &readings, imu.kind))
+    }
+    in_frame(
+        nav,
+        || run::<Enu>(table, imu, gravity_m_s2),
+        || run::<Ned>(table, imu, gravity_m_s2),
+    )
+}
+
+/// Tangent Euler angles of a velocity series (hold at standstill, unwrapped yaw).
+///
+/// # Errors
+/// Vertical velocity or non-finite values, with the index.
+pub fn tangent_euler(velocity_m_s: &[[f64; 3]], min_speed_m_s: f64) -> Result<Vec<EulerZyx>> {
+    let mut out = vec![EulerZyx::default(); velocity_m_s.len()];
+    tangent_series(velocity_m_s, min_speed_m_s, &mut out).map_err(|source| Error::Kinematics {
+        context: "velocity".into(),
+        source,
+    })?;
+    Ok(out)
+}
+
+/// `C_nbᵀ v_n` for each sample: navigation-frame vectors resolved in the body frame.
+#[must_use]
+pub fn nav_to_body(euler: &[EulerZyx], v_n: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    euler
+        .iter()
+        .zip(v_n)
+        .map(|(e, v)| {
+            Rotation::<Body, Enu>::from_euler(*e)
+                .inverse()
+                .apply(Vec3::from_array(*v))
+                .to_array()
+        })
+        .collect()
+}
+
+/// `a + ω × (ω × r) + α × r` for each sample (body frame).
+#[must_use]
+pub fn at_lever_arm_series(
+    a: &[[f64; 3]],
+    omega: &[[f64; 3]],
+    alpha: &[[f64; 3]],
+    r: [f64; 3],
+) -> Vec<[f64; 3]> {
+    let r = Vec3::<Body>::from_array(r);
+    a.iter()
+        .zip(omega)
+        .zip(alpha)
+        .map(|((a, w), al)| {
+            at_lever_arm(
+                Vec3::from_array(*a),
+                Vec3::from_array(*w),
+                Vec3::from_array(*al),
+                r,
+            )
+            .to_array()
+        })
+        .collect()
+}
+
+/// Truth from body-frame acceleration and angular velocity arrays (MATLAB kinematicTrajectory).
+///
+/// # Errors
+/// As [`imu_core::kinematics::body_rates::truth_from_body_rates`], with array indices.
+pub fn truth_from_body_rates(
+    t_s: &[f64],
+    data: crate::motion::BodyRatesData,
+    nav: NavFrameName,
+) -> Result<Table> {
+    let traj = Trajectory::BodyRates(data);
+    in_frame(
+        nav,
+        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
+        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+    )
+}
+
+/// Exact truth at `t_s` of a waypoint trajectory.
+///
+/// # Errors
+/// As [`crate::motion::waypoints::Waypoints::new`]; the core's refusal.
+pub fn truth_from_waypoints(
+    t_s: &[f64],
+    waypoints: crate::motion::waypoints::Waypoints,
+    nav: NavFrameName,
+) -> Result<Table> {
+    let traj = Trajectory::Waypoints(waypoints);
+    in_frame(
+        nav,
+        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
+        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+    )
+}

@@ -1,0 +1,344 @@
+//! Errors of an estimate against truth on the estimate's times: the truth is interpolated
+//! linearly in position and velocity and by quaternion slerp in attitude between the two truth
+//! samples that bracket each estimate time.
+//!
+//! Two kinds of estimate: a navigation output (`t_s`, `pos_*`, `vel_*`, `q_*`; errors in
+//! [`ERROR_COLUMNS`]) and an orientation output (`t_s`, `q_*` only, as `imukit orient` writes;
+//! errors in [`ORIENTATION_ERROR_COLUMNS`]: the quaternion distance and the z-y-x Euler angle
+//! differences, wrapped to (−π, π]). Both stream: rows are read in time order, and memory
+//! does not grow with the files.
+use std::path::Path;
+
+use imu_core::orientation::{DistanceStats, quaternion_distance};
+use imu_core::{Body, Enu, Rotation};
+
+use crate::error::{Result, invalid};
+use crate::io::table::{AtomicFile, CsvRows, Table};
+use crate::run::navigate::STATE_COLUMNS;
+
+/// Error columns of a navigation estimate.
+pub const ERROR_COLUMNS: [&str; 9] = [
+    "t_s",
+    "pos_err_x_m",
+    "pos_err_y_m",
+    "pos_err_z_m",
+    "pos_err_m",
+    "vel_err_x_m_s",
+    "vel_err_y_m_s",
+    "vel_err_z_m_s",
+    "att_err_rad",
+];
+
+/// Error columns of an orientation estimate (estimate − truth for the angles).
+pub const ORIENTATION_ERROR_COLUMNS: [&str; 5] = [
+    "t_s",
+    "att_err_rad",
+    "yaw_err_rad",
+    "pitch_err_rad",
+    "roll_err_rad",
+];
+
+/// The columns an orientation estimate needs.
+pub const ORIENTATION_COLUMNS: [&str; 5] = ["t_s", "q_w", "q_x", "q_y", "q_z"];
+
+/// What kind of estimate a table or file holds, judged by its columns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EstimateKind {
+    /// Position, velocity and attitude.
+    Navigation,
+    /// Attitude only.
+    Orientation,
+}
+
+impl EstimateKind {
+    /// The kind of an estimate with columns `names`: navigation when it has every state
+    /// column, orientation when it has `t_s` and the quaternion.
+    ///
+    /// # Errors
+    /// Neither set of columns.
+    pub fn of(names: &[String]) -> Result<Self> {
+        let has = |cols: &[&str]| cols.iter().all(|c| names.iter().any(|n| n == c));
+        if has(STATE_COLUMNS) {
+            Ok(Self::Navigation)
+        } else if has(&ORIENTATION_COLUMNS) {
+            Ok(Self::Orientation)
+        } else {
+            Err(invalid(
+                "estimate",
+                "needs t_s, pos_*, vel_*, q_* (navigation) or t_s, q_w, q_x, q_y, q_z (orientation)",
+            ))
+        }
+    }
+
+    /// Its error columns.
+    #[must_use]
+    pub fn error_columns(self) -> &'static [&'static str] {
+        match self {
+            Self::Navigation => &ERROR_COLUMNS,
+            Self::Orientation => &ORIENTATION_ERROR_COLUMNS,
+        }
+    }
+}
+
+/// RMS, maximum and final value of each error norm (position and velocity only for
+/// navigation estimates). Values in rad, m and m/s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorSummary {
+    /// The kind of estimate.
+    pub kind: EstimateKind,
+    /// Position error norm, m.
+    pub position: Option<DistanceStats>,
+    /// Velocity error norm, m/s.
+    pub velocity: Option<DistanceStats>,
+    /// Attitude error angle (quaternion distance), rad.
+    pub attitude: DistanceStats,
+}
+
+impl ErrorSummary {
+    /// Rows compared.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.attitude.count()
+    }
+}
+
+/// Errors per estimate row and their summary.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// Per sample ([`EstimateKind::error_columns`]).
+    pub table: Table,
+    /// RMS, maximum and final values.
+    pub summary: ErrorSummary,
+}
+
+/// A state row in [`STATE_COLUMNS`] order: `t_s`, position, velocity, `q_wxyz` (position and
+/// velocity zero for an orientation estimate).
+type StateRow = [f64; 11];
+
+/// Where an estimate row's values sit in its columns (`None`: absent, left zero).
+fn state_index(names: &[String], kind: EstimateKind) -> Vec<Option<usize>> {
+    STATE_COLUMNS
+        .iter()
+        .map(|c| {
+            let wanted = kind == EstimateKind::Navigation || ORIENTATION_COLUMNS.contains(c);
+            wanted.then(|| names.iter().position(|n| n == c)).flatten()
+        })
+        .collect()
+}
+
+/// Compares an estimate table with a truth table (see the module docs).
+///
+/// # Errors
+/// Missing columns; estimate times outside the truth's span or going back; zero quaternions.
+pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
+    let kind = EstimateKind::of(&estimate.columns)?;
+    check_truth(&truth.columns, kind)?;
+    let (mut tr, mut er) = (state_rows(truth, kind), state_rows(estimate, kind));
+    let mut table = Table::new(kind.error_columns());
+    let summary = compare_rows(
+        kind,
+        |row| Ok(tr.next().map(|r| *row = r).is_some()),
+        |row| Ok(er.next().map(|r| *row = r).is_some()),
+        |e| {
+            table.push_row(e);
+            Ok(())
+        },
+    )?;
+    Ok(Comparison { table, summary })
+}
+
+/// A table's rows as state rows (the columns of `kind`).
+fn state_rows(t: &Table, kind: EstimateKind) -> impl Iterator<Item = StateRow> + '_ {
+    let idx = state_index(&t.columns, kind);
+    let w = t.columns.len();
+    (0..t.rows()).map(move |r| std::array::from_fn(|c| idx[c].map_or(0.0, |i| t.data[r * w + i])))
+}
+
+/// Refuses a truth without the columns an estimate of `kind` is compared on.
+fn check_truth(names: &[String], kind: EstimateKind) -> Result<()> {
+    match (EstimateKind::of(names), kind) {
+        (Ok(EstimateKind::Navigation), _)
+        | (Ok(EstimateKind::Orientation), EstimateKind::Orientation) => Ok(()),
+        _ => Err(invalid(
+            "truth",
+            match kind {
+                EstimateKind::Navigation => {
+                    "needs t_s, pos_*, vel_*, q_* to compare a navigation output"
+                }
+                EstimateKind::Orientation => {
+                    "needs t_s, q_w, q_x, q_y, q_z to compare an orientation output"
+                }
+            },
+        )),
+    }
+}
+
+/// The next row of `rows` (its `kind`'s columns) as a state row.
+fn next_state(
+    rows: &mut CsvRows,
+    buffer: &mut [f64],
+    kind: EstimateKind,
+    row: &mut StateRow,
+) -> Result<bool> {
+    if rows.next_row(buffer)?.is_none() {
+        return Ok(false);
+    }
+    match kind {
+        EstimateKind::Navigation => row.copy_from_slice(buffer),
+        EstimateKind::Orientation => {
+            *row = [0.0; 11];
+            row[0] = buffer[0];
+            row[7..].copy_from_slice(&buffer[1..]);
+        }
+    }
+    Ok(true)
+}
+
+/// [`compare`] on two CSV files, streamed; the errors over time go to `out`, which appears only
+/// when complete.
+///
+/// # Errors
+/// As [`compare`], CSV errors naming file, row and column, and I/O errors.
+pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+    let kind = EstimateKind::of(&crate::io::table::read_header(estimate)?)?;
+    let wanted: &[&str] = match kind {
+        EstimateKind::Navigation => STATE_COLUMNS,
+        EstimateKind::Orientation => &ORIENTATION_COLUMNS,
+    };
+    let hint = match kind {
+        EstimateKind::Navigation => "; the truth needs t_s, pos_*, vel_*, q_*",
+        EstimateKind::Orientation => "; the truth needs t_s, q_w, q_x, q_y, q_z",
+    };
+    let mut truth_rows = CsvRows::open(truth, wanted, hint)?;
+    let mut estimate_rows = CsvRows::open(estimate, wanted, "")?;
+    let (mut truth_buffer, mut estimate_buffer) =
+        (vec![0.0; wanted.len()], vec![0.0; wanted.len()]);
+    let mut file = out.map(AtomicFile::create).transpose()?;
+    let columns = kind.error_columns();
+    if let Some(f) = file.as_mut() {
+        f.write_header(columns)?;
+    }
+    let summary = compare_rows(
+        kind,
+        |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
+        |row| next_state(&mut estimate_rows, &mut estimate_buffer, kind, row),
+        |e| match file.as_mut() {
+            Some(f) => f.write_row(e),
+            None => Ok(()),
+        },
+    )?;
+    file.map_or(Ok(()), AtomicFile::commit)?;
+    Ok(summary)
+}
+
+/// The angle `a − b` wrapped to (−π, π].
+fn angle_difference(a: f64, b: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    let d = (a - b).rem_euclid(tau);
+    if d > std::f64::consts::PI { d - tau } else { d }
+}
+
+/// The comparison of two row streams in time order: for each estimate row the truth rows that
+/// bracket its time (a single-row truth brackets with itself; times past the last truth row
+/// but within 1e-9 s use the last two), errors handed to `sink`.
+fn compare_rows(
+    kind: EstimateKind,
+    mut truth: impl FnMut(&mut StateRow) -> Result<bool>,
+    mut estimate: impl FnMut(&mut StateRow) -> Result<bool>,
+    mut sink: impl FnMut(&[f64]) -> Result<()>,
+) -> Result<ErrorSummary> {
+    let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
+    if !truth(&mut a)? {
+        return Err(invalid("compare", "empty table"));
+    }
+    let t0 = a[0];
+    let mut truth_ended = !truth(&mut b)?;
+    if truth_ended {
+        b = a;
+    }
+    let mut e = [0.0; 11];
+    let (mut pos, mut vel, mut att) = (
+        DistanceStats::default(),
+        DistanceStats::default(),
+        DistanceStats::default(),
+    );
+    let mut previous_t = f64::NEG_INFINITY;
+    while estimate(&mut e)? {
+        let (t, row) = (e[0], att.count() + 2);
+        if t < previous_t {
+            return Err(invalid(
+                "compare",
+                format!("estimate time {t} s (row {row}) goes back from {previous_t} s"),
+            ));
+        }
+        previous_t = t;
+        // Advance to the first truth row later than t (or the last one).
+        while !truth_ended && b[0] <= t {
+            if truth(&mut next)? {
+                (a, b) = (b, next);
+            } else {
+                truth_ended = true;
+            }
+        }
+        if t < t0 - 1e-9 || (truth_ended && t > b[0] + 1e-9) {
+            let end = if truth_ended {
+                format!("{} s", b[0])
+            } else {
+                "…".into()
+            };
+            return Err(invalid(
+                "compare",
+                format!("estimate time {t} s (row {row}) is outside the truth's {t0}…{end}"),
+            ));
+        }
+        let w = if b[0] == a[0] {
+            0.0
+        } else {
+            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+        };
+        let q = |r: &StateRow| Rotation::<Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
+        let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
+            return Err(invalid(
+                "compare",
+                format!("zero quaternion near estimate row {row}"),
+            ));
+        };
+        let qt = Rotation::<Body, Enu>::assume_from_quaternion(
+            qa.quaternion().slerp(qb.quaternion(), w),
+        );
+        let angle = quaternion_distance(&qe, &qt);
+        att.push(angle);
+        match kind {
+            EstimateKind::Navigation => {
+                let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
+                let dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
+                let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
+                let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                let (np, nv) = (norm(&dp), norm(&dv));
+                pos.push(np);
+                vel.push(nv);
+                sink(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], angle])?;
+            }
+            EstimateKind::Orientation => {
+                let (ee, et) = (qe.to_euler(), qt.to_euler());
+                sink(&[
+                    t,
+                    angle,
+                    angle_difference(ee.yaw_rad, et.yaw_rad),
+                    angle_difference(ee.pitch_rad, et.pitch_rad),
+                    angle_difference(ee.roll_rad, et.roll_rad),
+                ])?;
+            }
+        }
+    }
+    if att.count() == 0 {
+        return Err(invalid("compare", "empty table"));
+    }
+    let navigation = kind == EstimateKind::Navigation;
+    Ok(ErrorSummary {
+        kind,
+        position: navigation.then_some(pos),
+        velocity: navigation.then_some(vel),
+        attitude: att,
+    })
+}

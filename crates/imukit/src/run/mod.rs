@@ -1,0 +1,9 @@
+//! The jobs a user runs: simulate ([`simulate`], [`arrays`] for in-memory arrays), navigate
+//! ([`navigate`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
+pub mod allan;
+pub mod arrays;
+pub mod compare;
+pub mod navigate;
+pub mod orient;
+pub mod planar;
+pub mod simulate;

@@ -1,0 +1,664 @@
+//! 3D strapdown for the CLI and Python, and errors of an estimate against truth.
+//!
+//! IMU input: rates (`accel_*_m_s2`, `gyro_*_rad_s`, turned into increments by the trapezoid) or
+//! increments (`dv_*_m_s`, `dtheta_*_rad`). The accelerometer columns must hold specific force
+//! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
+//! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
+//! yaw_rad, pitch_rad, roll_rad`.
+use imu_core::strapdown::rk4::{
+    NODES, RateWindow, Rk4Strapdown, strapdown_rates_rk4, window_start,
+};
+use std::collections::VecDeque;
+use std::path::Path;
+
+use imu_core::strapdown::step::{
+    NavState, RateStrapdown, Strapdown, StrapdownError, StrapdownOptions, strapdown_increments,
+    strapdown_rates,
+};
+use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+
+use crate::error::{Result, invalid};
+use crate::io::table::{
+    ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table,
+};
+use crate::scenario::NavFrameName;
+
+/// Navigation output columns.
+pub const NAV_COLUMNS: [&str; 14] = [
+    "t_s",
+    "pos_x_m",
+    "pos_y_m",
+    "pos_z_m",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "vel_z_m_s",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "yaw_rad",
+    "pitch_rad",
+    "roll_rad",
+];
+
+/// Columns [`compare`](crate::run::compare::compare) reads from truth and estimate: the navigation columns up to the
+/// quaternion.
+pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
+
+/// The initial state of a 3D integration, frame-free (default: at rest at the origin, level).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitialState {
+    /// Position, navigation frame, m.
+    pub position_m: [f64; 3],
+    /// Velocity, navigation frame, m/s.
+    pub velocity_m_s: [f64; 3],
+    /// Attitude quaternion `q_nb` `[w, x, y, z]`.
+    pub quaternion: [f64; 4],
+}
+
+impl Default for InitialState {
+    fn default() -> Self {
+        Self {
+            position_m: [0.0; 3],
+            velocity_m_s: [0.0; 3],
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+impl InitialState {
+    /// From position, velocity and z-y-x Euler angles.
+    #[must_use]
+    pub fn from_euler(position_m: [f64; 3], velocity_m_s: [f64; 3], euler: EulerZyx) -> Self {
+        Self {
+            position_m,
+            velocity_m_s,
+            quaternion: Rotation::<imu_core::Body, Enu>::from_euler(euler).to_wxyz(),
+        }
+    }
+
+    /// The first row of a truth (or navigation) table.
+    ///
+    /// # Errors
+    /// Missing columns or an empty table.
+    pub fn from_table(t: &Table) -> Result<Self> {
+        let first = |c: &str| {
+            t.column(c)
+                .and_then(|v| v.first().copied())
+                .ok_or_else(|| invalid("initial state", format!("the truth file has no {c} value")))
+        };
+        Ok(Self {
+            position_m: [first("pos_x_m")?, first("pos_y_m")?, first("pos_z_m")?],
+            velocity_m_s: [
+                first("vel_x_m_s")?,
+                first("vel_y_m_s")?,
+                first("vel_z_m_s")?,
+            ],
+            quaternion: [first("q_w")?, first("q_x")?, first("q_y")?, first("q_z")?],
+        })
+    }
+
+    /// The first row of a truth CSV file (read alone: memory does not grow with the file).
+    ///
+    /// # Errors
+    /// Missing columns, a bad first row (file, row, column), an empty file.
+    pub fn from_csv(path: &Path) -> Result<Self> {
+        const COLS: [&str; 10] = [
+            "pos_x_m",
+            "pos_y_m",
+            "pos_z_m",
+            "vel_x_m_s",
+            "vel_y_m_s",
+            "vel_z_m_s",
+            "q_w",
+            "q_x",
+            "q_y",
+            "q_z",
+        ];
+        let mut rows = CsvRows::open(path, &COLS, "the initial state comes from a truth CSV")?;
+        let mut r = [0.0; 10];
+        if rows.next_row(&mut r)?.is_none() {
+            return Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        }
+        Ok(Self {
+            position_m: [r[0], r[1], r[2]],
+            velocity_m_s: [r[3], r[4], r[5]],
+            quaternion: [r[6], r[7], r[8], r[9]],
+        })
+    }
+}
+
+/// The 3D integration scheme.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NavScheme {
+    /// DESIGN §6: exact rotation-vector step, two-sample coning and sculling, trapezoidal
+    /// position; rates or increments; second order.
+    #[default]
+    ConingSculling,
+    /// RK4 with `substeps` per interval and quintic interpolation of the rate samples; rates only;
+    /// fourth order (see `imu_core::strapdown::rk4`).
+    Rk4 {
+        /// RK4 steps per sample interval.
+        substeps: usize,
+    },
+}
+
+/// What to integrate and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavSetup {
+    /// Navigation frame.
+    pub nav_frame: NavFrameName,
+    /// Algorithm options (gravity, coning, sculling).
+    pub options: StrapdownOptions,
+    /// Sign of the accelerometer columns.
+    pub accel_sign: AccelSign,
+    /// Integration scheme.
+    pub scheme: NavScheme,
+}
+
+impl Default for NavSetup {
+    fn default() -> Self {
+        Self {
+            nav_frame: NavFrameName::ENU,
+            options: StrapdownOptions::default(),
+            accel_sign: AccelSign::SpecificForce,
+            scheme: NavScheme::ConingSculling,
+        }
+    }
+}
+
+/// Intervals longer than this many median intervals count as gaps in the data.
+pub const MAX_GAP_FACTOR: f64 = 2.5;
+
+/// Refuses a gap in sample times: an interval longer than [`MAX_GAP_FACTOR`] median intervals
+/// (missing samples would be bridged silently by the integration). `first_row` is the file row of
+/// sample 0 (2 below a CSV header), for the message.
+///
+/// # Errors
+/// [`crate::Error::Invalid`] naming the rows and the intervals.
+pub fn check_gaps(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
+    if t_s.len() < 3 {
+        return Ok(());
+    }
+    let median = median_interval(t_s);
+    let found = t_s
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .enumerate()
+        .find(|(_, d)| *d > MAX_GAP_FACTOR * median);
+    match found {
+        Some((i, d)) => Err(gap_error(what, i + first_row, d, median)),
+        None => Ok(()),
+    }
+}
+
+/// The median interval of increasing times (at least 2).
+pub(crate) fn median_interval(t_s: &[f64]) -> f64 {
+    let mut dt: Vec<f64> = t_s.windows(2).map(|w| w[1] - w[0]).collect();
+    dt.sort_by(f64::total_cmp);
+    dt[dt.len() / 2]
+}
+
+pub(crate) fn gap_error(what: &str, row: usize, d: f64, median: f64) -> crate::Error {
+    invalid(
+        what,
+        format!(
+            "gap in the sample times between rows {row} and {} ({d} s, the median interval is {median} s)",
+            row + 1
+        ),
+    )
+}
+
+fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
+    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
+    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
+}
+
+/// Integrates an IMU table (rates or increments) from `initial`.
+///
+/// # Errors
+/// Missing columns (both layouts named), invalid initial quaternion, non-finite values or
+/// non-increasing times (sample index named).
+pub fn integrate(imu: &Table, initial: &InitialState, setup: &NavSetup) -> Result<Table> {
+    match setup.nav_frame {
+        NavFrameName::ENU => integrate_in::<Enu>(imu, initial, setup),
+        NavFrameName::NED => integrate_in::<Ned>(imu, initial, setup),
+    }
+}
+
+fn integrate_in<N: NavFrame>(
+    imu: &Table,
+    initial: &InitialState,
+    setup: &NavSetup,
+) -> Result<Table> {
+    let t = imu
+        .column("t_s")
+        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1] || t[i].is_nan()) {
+        return Err(invalid(
+            "IMU data",
+            format!(
+                "time at row {} does not increase after row {}",
+                i + 2,
+                i + 1
+            ),
+        ));
+    }
+    check_gaps(&t, "IMU data", 2)?;
+    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
+        invalid(
+            "initial state",
+            "the quaternion has zero norm or is not finite",
+        )
+    })?;
+    let s0 = NavState::<N> {
+        t_s: t.first().copied().unwrap_or(0.0),
+        attitude,
+        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
+        position_m: Vec3::from_array(initial.position_m),
+    };
+    let flip = |v: Vec<[f64; 3]>| match setup.accel_sign {
+        AccelSign::SpecificForce => v,
+        AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
+    };
+    let mut out = vec![NavState::<N>::default(); t.len()];
+    let result = if let (Some(f), Some(w)) =
+        (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
+    {
+        match setup.scheme {
+            NavScheme::ConingSculling => {
+                strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
+            }
+            NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
+                &t,
+                &w,
+                &flip(f),
+                s0,
+                setup.options.gravity_m_s2,
+                substeps,
+                &mut out,
+            ),
+        }
+    } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
+    {
+        if setup.scheme != NavScheme::ConingSculling {
+            return Err(invalid(
+                "IMU data",
+                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+            ));
+        }
+        strapdown_increments(&t, &dth, &flip(dv), s0, setup.options, &mut out)
+    } else {
+        return Err(invalid(
+            "IMU data",
+            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
+        ));
+    };
+    result.map_err(|e| invalid("IMU data", e.to_string()))?;
+    let mut table = Table::new(&NAV_COLUMNS);
+    let mut last_yaw: Option<f64> = None;
+    for s in &out {
+        table.push_row(&nav_row(s, &mut last_yaw));
+    }
+    Ok(table)
+}
+
+/// The z-y-x Euler angles of `r` with the yaw unwrapped against `last_yaw` (then updated).
+pub(crate) fn euler_unwrapped<N: NavFrame>(
+    r: &Rotation<imu_core::Body, N>,
+    last_yaw: &mut Option<f64>,
+) -> imu_core::EulerZyx {
+    let mut e = r.to_euler();
+    if let Some(y) = *last_yaw {
+        let tau = std::f64::consts::TAU;
+        e.yaw_rad += tau * ((y - e.yaw_rad) / tau).round();
+    }
+    *last_yaw = Some(e.yaw_rad);
+    e
+}
+
+/// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
+fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14] {
+    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
+    let e = euler_unwrapped(&s.attitude, last_yaw);
+    let [px, py, pz] = s.position_m.to_array();
+    let [vx, vy, vz] = s.velocity_m_s.to_array();
+    [
+        s.t_s,
+        px,
+        py,
+        pz,
+        vx,
+        vy,
+        vz,
+        qw,
+        qx,
+        qy,
+        qz,
+        e.yaw_rad,
+        e.pitch_rad,
+        e.roll_rad,
+    ]
+}
+
+/// Rows a streamed integration reads ahead to set the reference interval of the gap check (the
+/// median of their intervals; files this short are checked exactly as [`integrate`] checks).
+pub const GAP_WINDOW: usize = 1001;
+
+/// Rows of an IMU CSV file in time order, for the streamed integration and orientation: each
+/// row's time must increase, and no interval may exceed [`MAX_GAP_FACTOR`] median intervals of
+/// the first [`GAP_WINDOW`] rows (read ahead when the file is opened). Memory does not grow with
+/// the file.
+pub(crate) struct TimedRows {
+    rows: CsvRows,
+    ahead: VecDeque<Vec<f64>>,
+    first_t: f64,
+    median: Option<f64>,
+    previous_t: Option<f64>,
+    taken: usize,
+}
+
+impl TimedRows {
+    /// Opens `path` for `columns` (`t_s` first) and reads the look-ahead.
+    ///
+    /// # Errors
+    /// Missing columns (with `hint`), bad cells, a file without data rows.
+    pub(crate) fn open(path: &Path, columns: &[&str], hint: &str) -> Result<Self> {
+        let mut rows = CsvRows::open(path, columns, hint)?;
+        let mut row = vec![0.0; columns.len()];
+        let mut ahead = VecDeque::with_capacity(GAP_WINDOW + 1);
+        while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {
+            ahead.push_back(row.clone());
+        }
+        let Some(first) = ahead.front() else {
+            return Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        };
+        let first_t = first[0];
+        let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
+        Ok(Self {
+            rows,
+            first_t,
+            median: (times.len() > 1).then(|| median_interval(&times)),
+            ahead,
+            previous_t: None,
+            taken: 0,
+        })
+    }
+
+    /// The first row's time, s.
+    pub(crate) fn first_time(&self) -> f64 {
+        self.first_t
+    }
+
+    /// The median interval of the look-ahead rows, s (`None` for a single row).
+    pub(crate) fn median_interval(&self) -> Option<f64> {
+        self.median
+    }
+
+    /// The file row (header = 1) of the row last read.
+    pub(crate) fn last_row(&self) -> usize {
+        self.taken + 1
+    }
+
+    /// Reads the next row into `row`; `false` at the end of the file.
+    ///
+    /// # Errors
+    /// Bad cells, times that do not increase, gaps (rows named).
+    pub(crate) fn next_row(&mut self, row: &mut [f64]) -> Result<bool> {
+        match self.ahead.pop_front() {
+            Some(r) => row.copy_from_slice(&r),
+            None => {
+                if self.rows.next_row(row)?.is_none() {
+                    return Ok(false);
+                }
+            }
+        }
+        self.taken += 1;
+        let (t, line) = (row[0], self.last_row());
+        if let Some(p) = self.previous_t {
+            if t <= p {
+                return Err(invalid(
+                    "IMU data",
+                    format!(
+                        "time at row {line} does not increase after row {}",
+                        line - 1
+                    ),
+                ));
+            }
+            if let Some(m) = self.median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
+                return Err(gap_error("IMU data", line - 1, t - p, m));
+            }
+        }
+        self.previous_t = Some(t);
+        Ok(true)
+    }
+}
+
+/// What a streamed integration wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavSummary {
+    /// Rows written.
+    pub rows: usize,
+    /// The last position, m.
+    pub end_position_m: [f64; 3],
+}
+
+/// Integrates the IMU CSV file `input` into the navigation CSV `out` ([`NAV_COLUMNS`]), the
+/// same numbers as [`integrate`], streamed: memory does not grow with the file (the RK4 scheme
+/// holds the six samples around its current interval); gaps are judged against the median
+/// interval of the first [`GAP_WINDOW`] rows. `out` appears only when complete.
+///
+/// # Errors
+/// As [`integrate`], CSV errors naming file, row and column, and I/O errors.
+pub fn integrate_csv(
+    input: &Path,
+    initial: &InitialState,
+    setup: &NavSetup,
+    out: &Path,
+) -> Result<NavSummary> {
+    match setup.nav_frame {
+        NavFrameName::ENU => integrate_csv_in::<Enu>(input, initial, setup, out),
+        NavFrameName::NED => integrate_csv_in::<Ned>(input, initial, setup, out),
+    }
+}
+
+/// The per-sample integrator of a streamed file.
+enum Stepper<N: NavFrame> {
+    Rates(RateStrapdown<N>),
+    Increments {
+        nav: Strapdown<N>,
+        started: bool,
+    },
+    /// RK4 holds the samples its next interval's quintic needs (six, from two before it) and
+    /// emits each state once the three samples after the interval have been read (at the end
+    /// of the file, the last intervals share the final six samples).
+    Rk4 {
+        nav: Rk4Strapdown<N>,
+        initial: NavState<N>,
+        held: VecDeque<[f64; 7]>,
+        first_held: usize,
+        seen: usize,
+        next_interval: usize,
+    },
+}
+
+type Emit<'a, N> = dyn FnMut(NavState<N>) -> Result<()> + 'a;
+
+impl<N: NavFrame> Stepper<N> {
+    /// Takes the next row `[t, force, turn]` (force: accelerometer or Δv, physical sign; turn:
+    /// gyroscope or Δθ) and emits the states it completes, in order.
+    fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, N>) -> Result<()> {
+        let (t, force, turn) = (row[0], [row[1], row[2], row[3]], [row[4], row[5], row[6]]);
+        let failed = |e: StrapdownError| invalid("IMU data", e.to_string());
+        match self {
+            Self::Rates(r) => emit(r.step(t, turn, force).map_err(failed)?),
+            Self::Increments { nav, started } if !*started => {
+                *started = true;
+                emit(*nav.state())
+            }
+            Self::Increments { nav, .. } => emit(nav.step(t, turn, force).map_err(failed)?),
+            Self::Rk4 {
+                nav,
+                initial,
+                held,
+                first_held,
+                seen,
+                next_interval,
+            } => {
+                // Rows come from `TimedRows`: finite, times increasing.
+                held.push_back(row);
+                *seen += 1;
+                if *seen == 1 {
+                    return emit(NavState { t_s: t, ..*initial });
+                }
+                // Interval k's window starts at k − 2 (or 0) unless the file ends within three
+                // samples after it, which is known once sample max(k + 3, 5) is read.
+                while *seen >= (*next_interval + 4).max(NODES) {
+                    let k = *next_interval;
+                    let start = k.saturating_sub(NODES / 2 - 1);
+                    emit(nav.interval(&window(held, start - *first_held), k - start))?;
+                    *next_interval += 1;
+                    while held.len() > NODES && *first_held + NODES / 2 - 1 < *next_interval {
+                        held.pop_front();
+                        *first_held += 1;
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Emits the states still held once the file has ended.
+    fn finish(&mut self, emit: &mut Emit<'_, N>) -> Result<()> {
+        let Self::Rk4 {
+            nav,
+            held,
+            first_held,
+            seen,
+            next_interval,
+            ..
+        } = self
+        else {
+            return Ok(());
+        };
+        let n = *seen;
+        if n < NODES {
+            return Err(invalid(
+                "IMU data",
+                format!("the rk4 scheme needs at least {NODES} samples, got {n}"),
+            ));
+        }
+        for k in *next_interval..n - 1 {
+            let start = window_start(k, n);
+            emit(nav.interval(&window(held, start - *first_held), k - start))?;
+        }
+        *next_interval = n - 1;
+        Ok(())
+    }
+}
+
+/// The six held rows from `offset` as an RK4 window.
+fn window(held: &VecDeque<[f64; 7]>, offset: usize) -> RateWindow {
+    let row = |j: usize| &held[offset + j];
+    RateWindow {
+        t_s: std::array::from_fn(|j| row(j)[0]),
+        gyro_rad_s: std::array::from_fn(|j| [row(j)[4], row(j)[5], row(j)[6]]),
+        accel_m_s2: std::array::from_fn(|j| [row(j)[1], row(j)[2], row(j)[3]]),
+    }
+}
+
+fn integrate_csv_in<N: NavFrame>(
+    input: &Path,
+    initial: &InitialState,
+    setup: &NavSetup,
+    out: &Path,
+) -> Result<NavSummary> {
+    let header = crate::io::table::read_header(input)?;
+    let has_all = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+    let rates = has_all(&ACCEL_COLUMNS) && has_all(&GYRO_COLUMNS);
+    let (force, turn) = if rates {
+        (ACCEL_COLUMNS, GYRO_COLUMNS)
+    } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
+        (DV_COLUMNS, DTHETA_COLUMNS)
+    } else {
+        return Err(invalid(
+            "IMU data",
+            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
+        ));
+    };
+    let mut columns = vec!["t_s"];
+    columns.extend(force);
+    columns.extend(turn);
+    let mut rows = TimedRows::open(input, &columns, "")?;
+    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
+        invalid(
+            "initial state",
+            "the quaternion has zero norm or is not finite",
+        )
+    })?;
+    let s0 = NavState::<N> {
+        t_s: rows.first_time(),
+        attitude,
+        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
+        position_m: Vec3::from_array(initial.position_m),
+    };
+    let mut stepper = match (setup.scheme, rates) {
+        (NavScheme::ConingSculling, true) => Stepper::Rates(RateStrapdown::new(s0, setup.options)),
+        (NavScheme::ConingSculling, false) => Stepper::Increments {
+            nav: Strapdown::new(s0, setup.options),
+            started: false,
+        },
+        (NavScheme::Rk4 { substeps }, true) => Stepper::Rk4 {
+            nav: Rk4Strapdown::new(s0, setup.options.gravity_m_s2, substeps),
+            initial: s0,
+            held: VecDeque::with_capacity(NODES + 1),
+            first_held: 0,
+            seen: 0,
+            next_interval: 0,
+        },
+        (NavScheme::Rk4 { .. }, false) => {
+            return Err(invalid(
+                "IMU data",
+                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+            ));
+        }
+    };
+    let sign = match setup.accel_sign {
+        AccelSign::SpecificForce => 1.0,
+        AccelSign::Matlab => -1.0,
+    };
+    let mut file = AtomicFile::create(out)?;
+    file.write_header(&NAV_COLUMNS)?;
+    let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
+    let mut write = |state: NavState<N>, file: &mut AtomicFile| -> Result<()> {
+        file.write_row(&nav_row(&state, &mut last_yaw))?;
+        end = state;
+        written += 1;
+        Ok(())
+    };
+    let mut r = [0.0; 7];
+    while rows.next_row(&mut r)? {
+        let row = [
+            r[0],
+            sign * r[1],
+            sign * r[2],
+            sign * r[3],
+            r[4],
+            r[5],
+            r[6],
+        ];
+        stepper.push(row, &mut |state| write(state, &mut file))?;
+    }
+    stepper.finish(&mut |state| write(state, &mut file))?;
+    file.commit()?;
+    Ok(NavSummary {
+        rows: written,
+        end_position_m: end.position_m.to_array(),
+    })
+}

@@ -1,0 +1,528 @@
+//! Orientation filters by name with `key=value` settings, run over IMU CSV files (streamed) —
+//! the layer under `imukit orient` and the Python filter classes. The filters themselves are
+//! the core's ([`imu_core::orientation`]).
+use std::path::Path;
+
+use imu_core::orientation::{
+    Complementary, Ecompass, Estimate, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
+    OrientError, OrientationFilter,
+};
+use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
+
+use crate::error::{Result, invalid};
+use crate::io::table::{ACCEL_COLUMNS, AtomicFile, GYRO_COLUMNS, MAG_COLUMNS};
+use crate::run::navigate::{TimedRows, euler_unwrapped};
+use crate::scenario::NavFrameName;
+
+/// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
+/// unwrapped).
+pub const ORIENT_COLUMNS: [&str; 8] = [
+    "t_s",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "yaw_rad",
+    "pitch_rad",
+    "roll_rad",
+];
+
+/// The filters, by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FilterKind {
+    /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter.
+    ImuFilter,
+    /// MATLAB `ahrsfilter`: + magnetometer.
+    AhrsFilter,
+    /// MATLAB `ecompass`: accelerometer + magnetometer, sample by sample.
+    Ecompass,
+    /// Madgwick's gradient-descent filter.
+    Madgwick,
+    /// Mahony's complementary filter.
+    Mahony,
+    /// MATLAB `complementaryFilter`.
+    Complementary,
+}
+
+impl FilterKind {
+    /// Every filter with its name.
+    pub const ALL: [(&'static str, Self); 6] = [
+        ("imufilter", Self::ImuFilter),
+        ("ahrsfilter", Self::AhrsFilter),
+        ("ecompass", Self::Ecompass),
+        ("madgwick", Self::Madgwick),
+        ("mahony", Self::Mahony),
+        ("complementary", Self::Complementary),
+    ];
+
+    /// The filter called `name` (case-insensitive).
+    ///
+    /// # Errors
+    /// An unknown name, with the known ones listed.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, k)| *k)
+            .ok_or_else(|| {
+                let known: Vec<&str> = Self::ALL.iter().map(|(n, _)| *n).collect();
+                invalid(
+                    "filter",
+                    format!("unknown filter {name:?}; known: {}", known.join(", ")),
+                )
+            })
+    }
+
+    /// The filter's name (as [`FilterKind::parse`] takes it).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, k)| *k == self)
+            .map_or("", |(n, _)| *n)
+    }
+
+    /// Whether the filter must have a magnetometer (`Some(true)`), must not (`Some(false)`),
+    /// or uses one when there is one (`None`).
+    #[must_use]
+    pub fn magnetometer(self) -> Option<bool> {
+        match self {
+            Self::AhrsFilter | Self::Ecompass => Some(true),
+            Self::ImuFilter => Some(false),
+            Self::Madgwick | Self::Mahony | Self::Complementary => None,
+        }
+    }
+
+    /// The settings the filter takes (MATLAB property names; matched without case or `_`).
+    #[must_use]
+    pub fn settings(self) -> Vec<&'static str> {
+        match self {
+            Self::ImuFilter => KALMAN_SETTINGS.to_vec(),
+            Self::AhrsFilter => [KALMAN_SETTINGS.as_slice(), &MAGNETIC_SETTINGS].concat(),
+            // The e-compass has no memory; the rate is accepted for uniformity.
+            Self::Ecompass => vec!["SampleRate"],
+            Self::Madgwick => vec!["SampleRate", "Beta"],
+            Self::Mahony => vec!["SampleRate", "Kp", "Ki"],
+            Self::Complementary => vec!["SampleRate", "AccelerometerGain", "MagnetometerGain"],
+        }
+    }
+}
+
+/// Settings of both Kalman filters.
+const KALMAN_SETTINGS: [&str; 9] = [
+    "SampleRate",
+    "DecimationFactor",
+    "AccelerometerNoise",
+    "GyroscopeNoise",
+    "GyroscopeDriftNoise",
+    "LinearAccelerationNoise",
+    "LinearAccelerationDecayFactor",
+    "InitialProcessNoiseScale",
+    "Gravity",
+];
+
+/// Settings of the AHRS filter's magnetometer.
+const MAGNETIC_SETTINGS: [&str; 4] = [
+    "MagnetometerNoise",
+    "MagneticDisturbanceNoise",
+    "MagneticDisturbanceDecayFactor",
+    "ExpectedMagneticFieldStrength",
+];
+
+/// A filter to build: which, with which sensors and accelerometer sign, and its settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterSpec {
+    /// Which filter.
+    pub kind: FilterKind,
+    /// Sign of the accelerometer readings.
+    pub accel_sign: AccelSign,
+    /// Whether magnetometer readings are fed (for the filters that may use one).
+    pub magnetometer: bool,
+    /// `(name, value)` settings (see [`FilterKind::settings`]).
+    pub settings: Vec<(String, f64)>,
+    /// The diagonal of InitialProcessNoise (9 or 12 values), replacing the default.
+    pub initial_process_noise: Option<Vec<f64>>,
+}
+
+fn key(name: &str) -> String {
+    name.chars()
+        .filter(|c| *c != '_')
+        .flat_map(char::to_lowercase)
+        .collect()
+}
+
+impl FilterSpec {
+    /// A spec with no settings; the magnetometer as the filter requires (or none).
+    #[must_use]
+    pub fn new(kind: FilterKind, accel_sign: AccelSign) -> Self {
+        Self {
+            kind,
+            accel_sign,
+            magnetometer: kind.magnetometer().unwrap_or(false),
+            settings: Vec::new(),
+            initial_process_noise: None,
+        }
+    }
+
+    /// Parses `key=value` settings (e.g. `GyroscopeNoise=7.6154e-7`).
+    ///
+    /// # Errors
+    /// A setting without `=`, or a value that is not a number.
+    pub fn parse_settings(pairs: &[String]) -> Result<Vec<(String, f64)>> {
+        pairs
+            .iter()
+            .map(|p| {
+                let (k, v) = p
+                    .split_once('=')
+                    .ok_or_else(|| invalid("--param", format!("{p:?} is not key=value")))?;
+                let value: f64 = v.trim().parse().map_err(|_| {
+                    invalid("--param", format!("{}: {v:?} is not a number", k.trim()))
+                })?;
+                Ok((k.trim().to_string(), value))
+            })
+            .collect()
+    }
+
+    /// The value of setting `name` (last one wins), after checking every setting is known.
+    fn setting(&self, name: &str) -> Result<Option<f64>> {
+        let known = self.kind.settings();
+        for (k, _) in &self.settings {
+            if !known.iter().any(|n| key(n) == key(k)) {
+                let filter = self.kind.name();
+                return Err(invalid(
+                    k.as_str(),
+                    format!(
+                        "unknown setting for {filter}; known: {}",
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(self
+            .settings
+            .iter()
+            .rev()
+            .find(|(k, _)| key(k) == key(name))
+            .map(|(_, v)| *v))
+    }
+
+    /// The sample rate: the `SampleRate` setting, else `data_rate_hz`.
+    ///
+    /// # Errors
+    /// An unknown setting.
+    pub fn sample_rate_hz(&self, data_rate_hz: f64) -> Result<f64> {
+        Ok(self.setting("SampleRate")?.unwrap_or(data_rate_hz))
+    }
+
+    /// The Kalman parameters these settings give.
+    fn kalman(&self, sample_rate_hz: f64) -> Result<KalmanParams> {
+        let mut p = KalmanParams {
+            sample_rate_hz,
+            accel_sign: self.accel_sign,
+            ..KalmanParams::default()
+        };
+        let set = |name: &str, field: &mut f64| -> Result<()> {
+            if let Some(v) = self.setting(name)? {
+                *field = v;
+            }
+            Ok(())
+        };
+        set("AccelerometerNoise", &mut p.accelerometer_noise)?;
+        set("GyroscopeNoise", &mut p.gyroscope_noise)?;
+        set("GyroscopeDriftNoise", &mut p.gyroscope_drift_noise)?;
+        set("LinearAccelerationNoise", &mut p.linear_acceleration_noise)?;
+        set(
+            "LinearAccelerationDecayFactor",
+            &mut p.linear_acceleration_decay,
+        )?;
+        set("MagnetometerNoise", &mut p.magnetometer_noise)?;
+        set(
+            "MagneticDisturbanceNoise",
+            &mut p.magnetic_disturbance_noise,
+        )?;
+        set(
+            "MagneticDisturbanceDecayFactor",
+            &mut p.magnetic_disturbance_decay,
+        )?;
+        set(
+            "ExpectedMagneticFieldStrength",
+            &mut p.expected_magnetic_field_ut,
+        )?;
+        set("Gravity", &mut p.gravity_m_s2)?;
+        if let Some(d) = self.setting("DecimationFactor")? {
+            if !(d >= 1.0 && d.fract() == 0.0 && d <= 1e9) {
+                return Err(invalid(
+                    "DecimationFactor",
+                    format!("{d} is not a whole number ≥ 1"),
+                ));
+            }
+            p.decimation = d as usize;
+        }
+        if let Some(diag) = &self.initial_process_noise {
+            let states = if self.kind == FilterKind::AhrsFilter {
+                12
+            } else {
+                9
+            };
+            if diag.len() != states {
+                return Err(invalid(
+                    "InitialProcessNoise",
+                    format!("needs {states} diagonal values, got {}", diag.len()),
+                ));
+            }
+            p.initial_process_noise[..states].copy_from_slice(diag);
+        }
+        if let Some(s) = self.setting("InitialProcessNoiseScale")? {
+            p.initial_process_noise = p.initial_process_noise.map(|v| v * s);
+        }
+        Ok(p)
+    }
+
+    /// The filter, at `sample_rate_hz` unless a `SampleRate` setting says otherwise.
+    ///
+    /// # Errors
+    /// Unknown settings, invalid values (named), a magnetometer the filter cannot use.
+    pub fn build<N: NavFrame>(&self, sample_rate_hz: f64) -> Result<AnyFilter<N>> {
+        let rate = self.sample_rate_hz(sample_rate_hz)?;
+        let refused = |e: imu_core::orientation::OrientError| invalid("filter", e.to_string());
+        let (sign, mag) = (self.accel_sign, self.magnetometer);
+        Ok(match self.kind {
+            FilterKind::ImuFilter => {
+                AnyFilter::Kalman(KalmanFilter::<N>::imu(self.kalman(rate)?).map_err(refused)?)
+            }
+            FilterKind::AhrsFilter => {
+                AnyFilter::Kalman(KalmanFilter::<N>::ahrs(self.kalman(rate)?).map_err(refused)?)
+            }
+            FilterKind::Ecompass => AnyFilter::Ecompass(Ecompass { accel_sign: sign }),
+            FilterKind::Madgwick => {
+                let beta = self
+                    .setting("Beta")?
+                    .unwrap_or(if mag { 0.041 } else { 0.033 });
+                AnyFilter::Madgwick(Madgwick::new(rate, beta, mag, sign).map_err(refused)?)
+            }
+            FilterKind::Mahony => {
+                let kp = self.setting("Kp")?.unwrap_or(1.0);
+                let ki = self.setting("Ki")?.unwrap_or(0.3);
+                AnyFilter::Mahony(Mahony::new(rate, kp, ki, mag, sign).map_err(refused)?)
+            }
+            FilterKind::Complementary => {
+                let ka = self.setting("AccelerometerGain")?.unwrap_or(0.01);
+                let km = self.setting("MagnetometerGain")?.unwrap_or(0.01);
+                AnyFilter::Complementary(
+                    Complementary::new(rate, ka, km, mag, sign).map_err(refused)?,
+                )
+            }
+        })
+    }
+}
+
+/// Any of the filters, by value (copyable, so a batch can be undone on error; the Kalman
+/// variant's 700 bytes are copied once per batch, not per sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+pub enum AnyFilter<N: NavFrame> {
+    /// `imufilter` or `ahrsfilter`.
+    Kalman(KalmanFilter<N>),
+    /// `ecompass`.
+    Ecompass(Ecompass),
+    /// Madgwick.
+    Madgwick(Madgwick),
+    /// Mahony.
+    Mahony(Mahony),
+    /// `complementaryFilter`.
+    Complementary(Complementary),
+}
+
+impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
+    fn update(
+        &mut self,
+        input: &FilterInput,
+    ) -> std::result::Result<Option<Estimate<N>>, OrientError> {
+        match self {
+            Self::Kalman(f) => f.update(input),
+            Self::Ecompass(f) => f.update(input),
+            Self::Madgwick(f) => f.update(input),
+            Self::Mahony(f) => f.update(input),
+            Self::Complementary(f) => f.update(input),
+        }
+    }
+
+    fn reset(&mut self) {
+        match self {
+            Self::Kalman(f) => f.reset(),
+            Self::Ecompass(f) => OrientationFilter::<N>::reset(f),
+            Self::Madgwick(f) => OrientationFilter::<N>::reset(f),
+            Self::Mahony(f) => OrientationFilter::<N>::reset(f),
+            Self::Complementary(f) => OrientationFilter::<N>::reset(f),
+        }
+    }
+}
+
+/// One orientation output row in [`ORIENT_COLUMNS`] order (yaw unwrapped against `last_yaw`).
+#[must_use]
+pub fn orient_row<N: NavFrame>(
+    t_s: f64,
+    q: &Rotation<Body, N>,
+    last_yaw: &mut Option<f64>,
+) -> [f64; 8] {
+    let [w, x, y, z] = q.to_wxyz();
+    let e = euler_unwrapped(q, last_yaw);
+    [t_s, w, x, y, z, e.yaw_rad, e.pitch_rad, e.roll_rad]
+}
+
+/// What [`orient_csv`] wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrientSummary {
+    /// Rows read.
+    pub samples: usize,
+    /// Rows written (fewer with decimation).
+    pub rows: usize,
+    /// The sample rate used, Hz.
+    pub sample_rate_hz: f64,
+}
+
+/// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
+/// `mag_*` columns) into `out` ([`ORIENT_COLUMNS`]), streamed; `out` appears only when complete.
+/// The sample rate is `SampleRate` if set, else the median interval of the first
+/// [`GAP_WINDOW`](crate::run::navigate::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
+/// that may use one, whether the file has `mag_*` columns (`spec.magnetometer` is set
+/// accordingly).
+///
+/// # Errors
+/// Missing columns, bad cells (file, row, column), times that do not increase, the filter's
+/// refusals with the row, I/O errors.
+pub fn orient_csv(
+    input: &Path,
+    spec: &FilterSpec,
+    nav: NavFrameName,
+    out: &Path,
+) -> Result<OrientSummary> {
+    match nav {
+        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, out),
+        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, out),
+    }
+}
+
+fn orient_csv_in<N: NavFrame>(
+    input: &Path,
+    spec: &FilterSpec,
+    out: &Path,
+) -> Result<OrientSummary> {
+    let header = crate::io::table::read_header(input)?;
+    let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+    let mut spec = spec.clone();
+    spec.magnetometer = spec.kind.magnetometer().unwrap_or(has(&MAG_COLUMNS));
+    let gyro = spec.kind != FilterKind::Ecompass;
+    let mut columns = vec!["t_s"];
+    columns.extend(ACCEL_COLUMNS);
+    if gyro {
+        columns.extend(GYRO_COLUMNS);
+    }
+    if spec.magnetometer {
+        columns.extend(MAG_COLUMNS);
+    }
+    let hint = format!(
+        "; the {} filter needs t_s, accel_*{}{}",
+        spec.kind.name(),
+        if gyro { ", gyro_*" } else { "" },
+        if spec.magnetometer { ", mag_*" } else { "" }
+    );
+    let mut rows = TimedRows::open(input, &columns, &hint)?;
+    let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
+    let rate = spec.sample_rate_hz(data_rate)?;
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(invalid(
+            "SampleRate",
+            "cannot be taken from a single row: give SampleRate=…",
+        ));
+    }
+    let mut filter = spec.build::<N>(rate)?;
+    let mut file = AtomicFile::create(out)?;
+    file.write_header(&ORIENT_COLUMNS)?;
+    let (mut samples, mut written, mut last_yaw) = (0usize, 0usize, None);
+    let mut r = vec![0.0; columns.len()];
+    while rows.next_row(&mut r)? {
+        let three = |k: usize| [r[k], r[k + 1], r[k + 2]];
+        let sample = FilterInput {
+            accel_m_s2: three(1),
+            gyro_rad_s: if gyro { three(4) } else { [0.0; 3] },
+            mag_ut: if spec.magnetometer {
+                three(if gyro { 7 } else { 4 })
+            } else {
+                [0.0; 3]
+            },
+        };
+        let estimate = filter
+            .update(&sample)
+            .map_err(|e| invalid("IMU data", format!("row {}: {e}", rows.last_row())))?;
+        if let Some(est) = estimate {
+            file.write_row(&orient_row(r[0], &est.orientation, &mut last_yaw))?;
+            written += 1;
+        }
+        samples += 1;
+    }
+    file.commit()?;
+    Ok(OrientSummary {
+        samples,
+        rows: written,
+        sample_rate_hz: rate,
+    })
+}
+
+/// Estimates of a batch: `q_nb` (w, x, y, z) and the bias-corrected body rate per estimate.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Estimates {
+    /// Orientations, one per estimate.
+    pub quaternions: Vec<[f64; 4]>,
+    /// Angular velocities, rad/s.
+    pub angular_velocity_rad_s: Vec<[f64; 3]>,
+}
+
+/// Runs `filter` over rows of readings given as flat slices (three values per row):
+/// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use).
+/// The filter carries its state into the next call, so a run in chunks equals a run whole; on
+/// an error the filter is left as it was before the call.
+///
+/// # Errors
+/// Slices of different lengths, and the filter's refusals naming the row index.
+pub fn run_rows<N: NavFrame>(
+    filter: &mut AnyFilter<N>,
+    accel: &[f64],
+    gyro: Option<&[f64]>,
+    mag: Option<&[f64]>,
+) -> Result<Estimates> {
+    let n = accel.len() / 3;
+    for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
+        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
+            return Err(invalid(
+                name,
+                format!("has {} rows, the accelerometer {n}", s.len() / 3),
+            ));
+        }
+    }
+    let mut working = *filter;
+    let mut out = Estimates::default();
+    let three = |s: Option<&[f64]>, i: usize| {
+        s.map_or([0.0; 3], |s| [s[3 * i], s[3 * i + 1], s[3 * i + 2]])
+    };
+    for i in 0..n {
+        let input = FilterInput {
+            accel_m_s2: three(Some(accel), i),
+            gyro_rad_s: three(gyro, i),
+            mag_ut: three(mag, i),
+        };
+        let estimate = working
+            .update(&input)
+            .map_err(|e| invalid("readings", format!("row {i}: {e}")))?;
+        if let Some(e) = estimate {
+            out.quaternions.push(e.orientation.to_wxyz());
+            out.angular_velocity_rad_s.push(e.angular_velocity_rad_s);
+        }
+    }
+    *filter = working;
+    Ok(out)
+}

@@ -1,0 +1,180 @@
+//! Planar IMU files and planar dead reckoning for the CLI and Python (seed 001's exercise).
+//!
+//! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
+//! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files
+//! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
+use std::path::Path;
+
+use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
+
+use crate::error::{Error, Result, invalid};
+use crate::io::table::{Table, read_columns, write_atomically, write_rows};
+
+/// Planar IMU columns of a CSV file.
+pub const PLANAR_COLUMNS: [&str; 4] = ["t_s", "accel_x_m_s2", "accel_y_m_s2", "gyro_z_rad_s"];
+
+/// Columns of planar navigation output.
+pub const PLANAR_NAV_COLUMNS: [&str; 8] = [
+    "t_s",
+    "pos_x_m",
+    "pos_y_m",
+    "yaw_rad",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "body_vel_x_m_s",
+    "body_vel_y_m_s",
+];
+
+fn is_dat(path: &Path, first_line: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("dat"))
+        || first_line
+            .split_whitespace()
+            .next()
+            .is_some_and(|w| w.parse::<f64>().is_ok())
+            && !first_line.contains(',')
+}
+
+/// Reads planar IMU samples from a CSV or `.dat` file.
+///
+/// # Errors
+/// Unreadable files, missing columns, a `.dat` line with the wrong number of columns or a value
+/// that is not a finite number (file and line named).
+pub fn read_planar(path: &Path) -> Result<Vec<PlanarSample>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+    if !is_dat(path, first) {
+        let cols = read_columns(path, &PLANAR_COLUMNS, "")?;
+        let (t, ax, ay, wz) = (
+            cols.get("t_s"),
+            cols.get("accel_x_m_s2"),
+            cols.get("accel_y_m_s2"),
+            cols.get("gyro_z_rad_s"),
+        );
+        return Ok((0..t.len())
+            .map(|i| PlanarSample {
+                t_s: t[i],
+                accel_x_m_s2: ax[i],
+                accel_y_m_s2: ay[i],
+                gyro_z_rad_s: wz[i],
+            })
+            .collect());
+    }
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') || l.starts_with('%') {
+            continue;
+        }
+        let at = |msg: String| Error::CsvFormat {
+            file: path.into(),
+            message: format!("line {}: {msg}", n + 1),
+        };
+        let words: Vec<&str> = l.split_whitespace().collect();
+        if words.len() != 4 {
+            return Err(at(format!(
+                "expected 4 columns (t, a_x, a_y, ω_z), found {}",
+                words.len()
+            )));
+        }
+        let mut v = [0.0; 4];
+        for (k, w) in words.iter().enumerate() {
+            let x: f64 = w
+                .parse()
+                .map_err(|_| at(format!("column {}: not a number: \"{w}\"", k + 1)))?;
+            if !x.is_finite() {
+                return Err(at(format!(
+                    "column {}: not a finite number: \"{w}\"",
+                    k + 1
+                )));
+            }
+            v[k] = x;
+        }
+        out.push(PlanarSample {
+            t_s: v[0],
+            accel_x_m_s2: v[1],
+            accel_y_m_s2: v[2],
+            gyro_z_rad_s: v[3],
+        });
+    }
+    if out.is_empty() {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "no data lines".into(),
+        });
+    }
+    Ok(out)
+}
+
+/// Planar samples from an IMU table (its `t_s`, `accel_x/y`, `gyro_z` columns).
+///
+/// # Errors
+/// Missing columns.
+pub fn samples_from_table(t: &Table) -> Result<Vec<PlanarSample>> {
+    let col = |c: &str| {
+        t.column(c)
+            .ok_or_else(|| invalid("imu", format!("missing column {c}")))
+    };
+    let (ts, ax, ay, wz) = (
+        col("t_s")?,
+        col("accel_x_m_s2")?,
+        col("accel_y_m_s2")?,
+        col("gyro_z_rad_s")?,
+    );
+    Ok((0..ts.len())
+        .map(|i| PlanarSample {
+            t_s: ts[i],
+            accel_x_m_s2: ax[i],
+            accel_y_m_s2: ay[i],
+            gyro_z_rad_s: wz[i],
+        })
+        .collect())
+}
+
+/// Writes planar samples as an exercise `.dat` file (t, a_x, a_y, ω_z; shortest round-trip
+/// numbers), atomically.
+///
+/// # Errors
+/// [`Error::Io`].
+pub fn write_dat(path: &Path, samples: &[PlanarSample]) -> Result<()> {
+    let data: Vec<f64> = samples
+        .iter()
+        .flat_map(|s| [s.t_s, s.accel_x_m_s2, s.accel_y_m_s2, s.gyro_z_rad_s])
+        .collect();
+    write_atomically(path, |w| write_rows(w, &data, 4, b" "))
+}
+
+/// Dead reckoning of planar samples into a navigation table ([`PLANAR_NAV_COLUMNS`]).
+///
+/// # Errors
+/// Non-finite values or non-increasing times, with the sample index.
+pub fn integrate(
+    samples: &[PlanarSample],
+    scheme: PlanarScheme,
+    initial: PlanarState,
+) -> Result<Table> {
+    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    if t.windows(2).all(|w| w[1] > w[0]) {
+        crate::run::navigate::check_gaps(&t, "planar IMU", 1)?;
+    }
+    let mut states = vec![PlanarState::default(); samples.len()];
+    dead_reckon(samples, scheme, initial, &mut states)
+        .map_err(|e| invalid("planar IMU", e.to_string()))?;
+    let mut t = Table::new(&PLANAR_NAV_COLUMNS);
+    for s in &states {
+        t.push_row(&[
+            s.t_s,
+            s.position_m[0],
+            s.position_m[1],
+            s.heading_rad,
+            s.velocity_nav_m_s[0],
+            s.velocity_nav_m_s[1],
+            s.velocity_body_m_s[0],
+            s.velocity_body_m_s[1],
+        ]);
+    }
+    Ok(t)
+}

@@ -1,0 +1,190 @@
+//! Streamed simulation: truth and readings in chunks of [`STREAM_CHUNK`] samples, the same
+//! numbers as [`Scenario::simulate`] bit for bit, written as they are made.
+//!
+//! Analytic trajectories (expression, track, waypoints, and the built-ins made of them) are
+//! evaluated sample by sample with the core's [`AnalyticStepper`] at times computed on demand, so
+//! memory does not grow with the duration (only the leading standstill of a tangent attitude is
+//! held until the body first moves). Sampled trajectories are read whole (their samples) and
+//! differentiated chunk by chunk (whole for a tangent attitude); body-rate trajectories are
+//! integrated whole; then everything is streamed.
+use std::path::Path;
+
+use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, Motion};
+use imu_core::kinematics::sampled::backfill_standstill;
+use imu_core::sensor::ImuReading;
+use imu_core::{Enu, NavFrame, Ned, Truth};
+
+use crate::error::Result;
+use crate::io::table::{AtomicFile, ImuOutput, Table};
+use crate::motion::{Trajectory, with_time};
+use crate::scenario::{NavFrameName, SampleTimes, Scenario};
+
+/// Samples per streamed chunk.
+pub const STREAM_CHUNK: usize = 4096;
+
+/// One chunk of a streamed simulation: truth rows and IMU rows, the columns of
+/// [`crate::Simulation`]'s tables.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    /// Truth rows.
+    pub truth: Table,
+    /// IMU rows (rates or increments).
+    pub imu: Table,
+}
+
+impl Scenario {
+    /// Runs the scenario (Monte Carlo run `run`, or the plain seed) and hands each chunk to
+    /// `sink` in order; the chunks together equal [`Scenario::simulate`] /
+    /// [`Scenario::simulate_run`].
+    ///
+    /// # Errors
+    /// The core's refusal (with the time), invalid parameters, or the sink's error.
+    pub fn stream(
+        &self,
+        run: Option<u64>,
+        mut sink: impl FnMut(Chunk) -> Result<()>,
+    ) -> Result<()> {
+        match self.nav_frame {
+            NavFrameName::ENU => self.stream_in::<Enu>(run, &mut sink),
+            NavFrameName::NED => self.stream_in::<Ned>(run, &mut sink),
+        }
+    }
+
+    /// Streams run `run` into `imu_path` (and the truth into `truth_path`) as CSV; each file
+    /// appears only when complete.
+    ///
+    /// # Errors
+    /// As [`Scenario::stream`], and I/O errors naming the file.
+    pub fn stream_to_csv(
+        &self,
+        run: Option<u64>,
+        imu_path: &Path,
+        truth_path: Option<&Path>,
+    ) -> Result<()> {
+        let mut imu_file = AtomicFile::create(imu_path)?;
+        let mut truth_file = truth_path.map(AtomicFile::create).transpose()?;
+        let mut first = true;
+        self.stream(run, |chunk| {
+            let w = imu_file.writer();
+            let written = if first {
+                chunk.imu.write_header(w)
+            } else {
+                Ok(())
+            }
+            .and_then(|()| chunk.imu.write_body(w));
+            written.map_err(|e| imu_file.error(e))?;
+            if let Some(f) = truth_file.as_mut() {
+                let w = f.writer();
+                let written = if first {
+                    chunk.truth.write_header(w)
+                } else {
+                    Ok(())
+                }
+                .and_then(|()| chunk.truth.write_body(w));
+                written.map_err(|e| f.error(e))?;
+            }
+            first = false;
+            Ok(())
+        })?;
+        imu_file.commit()?;
+        truth_file.map_or(Ok(()), AtomicFile::commit)
+    }
+
+    fn stream_in<N: NavFrame>(
+        &self,
+        run: Option<u64>,
+        sink: &mut dyn FnMut(Chunk) -> Result<()>,
+    ) -> Result<()> {
+        let mut sensors =
+            self.imu
+                .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
+        let kind = self.imu.kind;
+        let output = self.imu.output;
+        // The last reading of the previous chunk: increments integrate across the boundary.
+        let mut previous: Option<(f64, ImuReading)> = None;
+        let mut emit = |truth: &[Truth<N>]| -> Result<()> {
+            let readings = sensors.measure(truth);
+            let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
+            let imu = match output {
+                ImuOutput::Rates => Table::from_readings(&t, &readings, kind),
+                ImuOutput::Increments => match previous {
+                    None => Table::from_increments(&t, &readings, kind),
+                    Some((t0, r0)) => {
+                        let (mut t1, mut r1) = (vec![t0], vec![r0]);
+                        t1.extend(&t);
+                        r1.extend(&readings);
+                        let mut table = Table::from_increments(&t1, &r1, kind);
+                        let width = table.columns.len();
+                        table.data.drain(..width);
+                        table
+                    }
+                },
+            };
+            previous = t.last().copied().zip(readings.last().copied());
+            sink(Chunk {
+                truth: Table::from_truth(truth),
+                imu,
+            })
+        };
+        let t_s = &self.t_s;
+        match &self.trajectory {
+            Trajectory::Expression(m, o) => {
+                motion_chunks(m, *o, t_s, "trajectory (expression)", &mut emit)
+            }
+            Trajectory::Track(k) => motion_chunks(
+                k,
+                AnalyticOptions::default(),
+                t_s,
+                "trajectory (track)",
+                &mut emit,
+            ),
+            Trajectory::Waypoints(w) => motion_chunks(
+                w,
+                AnalyticOptions::default(),
+                t_s,
+                "trajectory (waypoints)",
+                &mut emit,
+            ),
+            Trajectory::Samples(path) => path.truth_chunks(STREAM_CHUNK, &mut emit),
+            Trajectory::BodyRates(_) => {
+                let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;
+                truth.chunks(STREAM_CHUNK).try_for_each(&mut emit)
+            }
+        }
+    }
+}
+
+/// Exact truth of `motion` at `t_s` in chunks, as `truth_from_motion` computes it whole: the
+/// leading tangent-attitude standstill is held until the body first moves, then given that
+/// attitude.
+fn motion_chunks<M: Motion, N: NavFrame>(
+    motion: &M,
+    options: AnalyticOptions,
+    t_s: &SampleTimes,
+    what: &str,
+    emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
+) -> Result<()> {
+    let mut stepper = AnalyticStepper::new(motion, options);
+    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(STREAM_CHUNK);
+    let mut moving = false;
+    for k in 0..t_s.len() {
+        let (truth, valid) = stepper
+            .step::<N>(t_s.at(k))
+            .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
+        buffer.push(truth);
+        if valid && !moving {
+            moving = true;
+            let first = buffer.len() - 1;
+            backfill_standstill(&mut buffer, Some(first));
+        }
+        if moving && buffer.len() >= STREAM_CHUNK {
+            emit(&buffer)?;
+            buffer.clear();
+        }
+    }
+    if buffer.is_empty() {
+        Ok(())
+    } else {
+        emit(&buffer)
+    }
+}

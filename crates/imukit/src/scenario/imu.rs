@@ -1,0 +1,156 @@
+//! The IMU of a scenario, resolved: mount, sensors and their seeded error model.
+
+use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
+use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
+
+use crate::error::{Result, invalid};
+use crate::io::params::ImuParams;
+use crate::io::table::{ImuKind, ImuOutput};
+use crate::scenario::perturb::perturbed;
+use crate::scenario::sensors::SensorSetup;
+
+/// The IMU of a scenario, resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImuSetup {
+    /// Sensors simulated.
+    pub kind: ImuKind,
+    /// Rates or increments.
+    pub output: ImuOutput,
+    /// Lever arm, body frame, m.
+    pub lever_arm_m: [f64; 3],
+    /// Accelerometer sign.
+    pub accel_sign: AccelSign,
+    /// Magnetic field in the navigation frame, µT; `None` for the frame's default.
+    pub magnetic_field_ut: Option<[f64; 3]>,
+    /// Sensor errors, profile, seed, temperature (ideal by default).
+    pub sensors: SensorSetup,
+}
+
+impl ImuSetup {
+    /// An IMU without sensor errors.
+    #[must_use]
+    pub fn ideal(
+        kind: ImuKind,
+        lever_arm_m: [f64; 3],
+        accel_sign: AccelSign,
+        magnetic_field_ut: Option<[f64; 3]>,
+    ) -> Self {
+        Self {
+            kind,
+            output: ImuOutput::Rates,
+            lever_arm_m,
+            accel_sign,
+            magnetic_field_ut,
+            sensors: SensorSetup::default(),
+        }
+    }
+
+    /// The validated error model in frame `N` at `sample_rate_hz`.
+    ///
+    /// # Errors
+    /// Invalid parameters, with sensor and field.
+    pub fn model<N: NavFrame>(
+        &self,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+    ) -> Result<ImuModel<N>> {
+        self.model_with::<N>(&self.sensors.params, gravity_m_s2, sample_rate_hz)
+    }
+
+    fn model_with<N: NavFrame>(
+        &self,
+        p: &ImuParams,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+    ) -> Result<ImuModel<N>> {
+        let set = SensorSet {
+            gyroscope: self.kind.has_gyro(),
+            magnetometer: self.kind.has_mag(),
+        };
+        ImuModel::new(
+            self.mount::<N>(gravity_m_s2),
+            set,
+            self.sensors.gyro_acceleration,
+            [&p.accelerometer, &p.gyroscope, &p.magnetometer],
+            sample_rate_hz,
+        )
+        .map_err(|e| invalid("imu", e.to_string()))
+    }
+
+    /// Sensor readings for `truth`: the single run (`run = None`, stream `SeededNormals::new(seed)`)
+    /// or Monte Carlo run `r` (`SeededNormals::for_run(seed, r)`).
+    ///
+    /// # Errors
+    /// Invalid parameters.
+    pub fn readings<N: NavFrame>(
+        &self,
+        truth: &[Truth<N>],
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+        run: Option<u64>,
+    ) -> Result<Vec<ImuReading>> {
+        Ok(self
+            .reading_stream(gravity_m_s2, sample_rate_hz, run)?
+            .measure(truth))
+    }
+
+    /// The sensors as a stream: [`ReadingStream::measure`] over consecutive chunks of truth
+    /// gives the readings of one call over all of it (state and noise carry over).
+    ///
+    /// # Errors
+    /// Invalid (perturbed) parameters.
+    pub fn reading_stream<N: NavFrame>(
+        &self,
+        gravity_m_s2: f64,
+        sample_rate_hz: f64,
+        run: Option<u64>,
+    ) -> Result<ReadingStream<'_, N>> {
+        let seed = self.sensors.seed;
+        let params = perturbed(&self.sensors.params, &self.sensors.perturbations, seed, run)?;
+        Ok(ReadingStream {
+            model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
+            noise: run.map_or_else(
+                || SeededNormals::new(seed),
+                |r| SeededNormals::for_run(seed, r),
+            ),
+            state: ImuState::default(),
+            setup: self,
+        })
+    }
+
+    /// The core's mount description in frame `N`.
+    #[must_use]
+    pub fn mount<N: NavFrame>(&self, gravity_m_s2: f64) -> ImuMount<N> {
+        ImuMount {
+            lever_arm_m: Vec3::from_array(self.lever_arm_m),
+            accel_sign: self.accel_sign,
+            gravity_m_s2,
+            magnetic_field_ut: self
+                .magnetic_field_ut
+                .map_or_else(N::default_magnetic_field_ut, Vec3::from_array),
+        }
+    }
+}
+
+/// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
+#[derive(Debug)]
+pub struct ReadingStream<'a, N: NavFrame> {
+    model: ImuModel<N>,
+    noise: SeededNormals,
+    state: ImuState,
+    setup: &'a ImuSetup,
+}
+
+impl<N: NavFrame> ReadingStream<'_, N> {
+    /// The readings of the next samples of truth.
+    pub fn measure(&mut self, truth: &[Truth<N>]) -> Vec<ImuReading> {
+        truth
+            .iter()
+            .map(|s| {
+                let temperatures = self.setup.sensors.temperature.at(s.t_s);
+                self.model
+                    .measure(s, &temperatures, &mut self.state, &mut self.noise)
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,117 @@
+//! Scenario files (TOML, or JSON / Python dicts with the same keys) and their resolution into a
+//! runnable [`Scenario`].
+//!
+//! ```toml
+//! rate_hz = 200.0
+//! duration_s = 1.0          # samples at k/rate_hz for k = 0..=round(duration_s*rate_hz)
+//! nav_frame = "ENU"         # or "NED"
+//! gravity_m_s2 = 9.81
+//! [trajectory]
+//! type = "expression"       # or "samples", "track", "builtin"
+//! constants = { f = 1.0 }
+//! position_m = ["0.8*cos(2*pi*f*t)", "0.8*sin(2*pi*f*t)", "0.3*cos(2*pi*f*t)"]
+//! attitude = "tangent"      # or "level", or yaw_rad = "...", pitch_rad = "...", roll_rad = "..."
+//! [imu]
+//! kind = "accel-gyro-mag"   # or "accel-gyro", "accel-mag"
+//! lever_arm_m = [-0.075, -0.075, 0.025]
+//! accel_sign = "specific-force"   # or "matlab"
+//! magnetic_field_ut = [-2.4169, 27.5550, 16.0849]   # nav frame
+//! ```
+pub mod builtin;
+pub mod imu;
+pub mod perturb;
+pub mod resolve;
+pub mod sensors;
+pub mod spec;
+pub mod times;
+
+pub use imu::{ImuSetup, ReadingStream};
+pub use spec::{
+    AccelSignName, BodyRatesSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName, SamplesSpec,
+    ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
+};
+pub use times::{SampleTimes, regular_times, sample_times};
+
+use std::path::Path;
+
+use imu_core::{Enu, NavFrame, Ned};
+
+use crate::error::Result;
+use crate::io::table::{ImuOutput, Table};
+use crate::motion::Trajectory;
+
+/// A resolved, runnable scenario.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    /// Sample times.
+    pub t_s: SampleTimes,
+    /// Sample rate of the sensor error model, Hz (`rate_hz`, or the mean rate of a samples file).
+    pub sample_rate_hz: f64,
+    /// Navigation frame.
+    pub nav_frame: NavFrameName,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// The motion.
+    pub trajectory: Trajectory,
+    /// The IMU.
+    pub imu: ImuSetup,
+}
+
+/// Truth and ideal IMU readings of a scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simulation {
+    /// Truth, [`crate::io::table::TRUTH_COLUMNS`].
+    pub truth: Table,
+    /// IMU readings, columns per [`ImuKind::columns`](crate::io::table::ImuKind::columns).
+    pub imu: Table,
+}
+
+impl Scenario {
+    /// Reads and resolves a scenario file.
+    ///
+    /// # Errors
+    /// As [`ScenarioSpec::from_file`] and [`ScenarioSpec::resolve`].
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        ScenarioSpec::from_file(path)?.resolve(base)
+    }
+
+    /// Truth and ideal IMU readings.
+    ///
+    /// # Errors
+    /// The core's refusal, with where and when.
+    pub fn simulate(&self) -> Result<Simulation> {
+        match self.nav_frame {
+            NavFrameName::ENU => self.simulate_in::<Enu>(None),
+            NavFrameName::NED => self.simulate_in::<Ned>(None),
+        }
+    }
+
+    fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
+        let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
+        let readings = self
+            .imu
+            .readings(&truth, self.gravity_m_s2, self.sample_rate_hz, run)?;
+        let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
+        Ok(Simulation {
+            truth: Table::from_truth(&truth),
+            imu: match self.imu.output {
+                ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
+                ImuOutput::Increments => Table::from_increments(&t, &readings, self.imu.kind),
+            },
+        })
+    }
+
+    /// Truth and readings of Monte Carlo run `run`: the noise stream is
+    /// `SeededNormals::for_run(seed, run)`, so a run's numbers do not depend on how many runs
+    /// there are or which thread computes them.
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`].
+    pub fn simulate_run(&self, run: u64) -> Result<Simulation> {
+        match self.nav_frame {
+            NavFrameName::ENU => self.simulate_in::<Enu>(Some(run)),
+            NavFrameName::NED => self.simulate_in::<Ned>(Some(run)),
+        }
+    }
+}

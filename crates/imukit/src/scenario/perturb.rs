@@ -1,0 +1,337 @@
+//! Monte Carlo perturbations of sensor parameters, as MATLAB's `perturbations` offers: each run
+//! replaces a parameter by a draw from a distribution (independently per axis for 3-vector
+//! parameters), from a stream seeded by (seed, run), so a run's parameters do not depend on how
+//! many runs there are or which thread computes them.
+//!
+//! ```toml
+//! [[imu.perturbations]]
+//! parameter = "gyroscope.constant_bias_rad_s"
+//! distribution = "normal"            # "truncated-normal", "uniform", "selection"
+//! mean = 0.0
+//! std = 0.01
+//! # truncated-normal: mean, std, lower, upper; uniform: lower, upper;
+//! # selection: values = [...], probabilities = [...] (equal when left out)
+//! ```
+use imu_core::sensor::SensorParams;
+use rand_core::{Rng, SeedableRng};
+use rand_distr::{Distribution as _, StandardNormal};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, invalid};
+use crate::io::params::{ImuParams, Sensor};
+
+/// A perturbation as written in a scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerturbationSpec {
+    /// `sensor.key`, e.g. `gyroscope.constant_bias_rad_s` (imukit's keys).
+    pub parameter: String,
+    /// `normal`, `truncated-normal`, `uniform` or `selection`.
+    pub distribution: String,
+    /// Mean (normal, truncated normal).
+    pub mean: Option<f64>,
+    /// Standard deviation (normal, truncated normal).
+    pub std: Option<f64>,
+    /// Lower bound (uniform, truncated normal).
+    pub lower: Option<f64>,
+    /// Upper bound (uniform, truncated normal).
+    pub upper: Option<f64>,
+    /// Candidates (selection).
+    pub values: Option<Vec<f64>>,
+    /// Their probabilities (selection; equal when left out).
+    pub probabilities: Option<Vec<f64>>,
+}
+
+/// A distribution to draw a parameter from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Distribution {
+    /// N(mean, std²).
+    Normal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation.
+        std: f64,
+    },
+    /// N(mean, std²) restricted to [lower, upper] (by rejection).
+    TruncatedNormal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation.
+        std: f64,
+        /// Lower bound.
+        lower: f64,
+        /// Upper bound.
+        upper: f64,
+    },
+    /// U(lower, upper).
+    Uniform {
+        /// Lower bound.
+        lower: f64,
+        /// Upper bound.
+        upper: f64,
+    },
+    /// One of `values` with cumulative probabilities `cumulative`.
+    Selection {
+        /// Candidates.
+        values: Vec<f64>,
+        /// Cumulative probabilities, last = 1.
+        cumulative: Vec<f64>,
+    },
+}
+
+/// Which parameter a perturbation replaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Field {
+    MeasurementRange,
+    Resolution,
+    ConstantBias,
+    NoiseDensity,
+    BiasInstability,
+    RandomWalk,
+    TemperatureBias,
+    TemperatureScaleFactor,
+    AccelerationBias,
+}
+
+/// A resolved perturbation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Perturbation {
+    sensor: Sensor,
+    field: Field,
+    name: String,
+    distribution: Distribution,
+}
+
+fn need(v: Option<f64>, field: &str, what: &str) -> Result<f64> {
+    match v {
+        Some(x) if x.is_finite() => Ok(x),
+        Some(x) => Err(invalid(field, format!("{what} must be finite, got {x}"))),
+        None => Err(invalid(field, format!("needs {what}"))),
+    }
+}
+
+impl Perturbation {
+    /// Resolves a written perturbation; `index` numbers it in messages.
+    ///
+    /// # Errors
+    /// Unknown parameters or distributions, missing or invalid distribution parameters.
+    pub fn from_spec(spec: &PerturbationSpec, index: usize) -> Result<Self> {
+        let at = format!("imu.perturbations[{index}]");
+        let (sensor_key, key) = spec.parameter.split_once('.').ok_or_else(|| {
+            invalid(
+                format!("{at}.parameter"),
+                "expected sensor.parameter, e.g. gyroscope.constant_bias_rad_s",
+            )
+        })?;
+        let sensor = Sensor::ALL
+            .into_iter()
+            .find(|s| s.key() == sensor_key)
+            .ok_or_else(|| {
+                invalid(
+                    format!("{at}.parameter"),
+                    format!(
+                        "unknown sensor \"{sensor_key}\" (accelerometer, gyroscope, magnetometer)"
+                    ),
+                )
+            })?;
+        let u = sensor.unit();
+        let fields = [
+            (format!("measurement_range_{u}"), Field::MeasurementRange),
+            (format!("resolution_{u}"), Field::Resolution),
+            (format!("constant_bias_{u}"), Field::ConstantBias),
+            (format!("noise_density_{u}_per_rt_hz"), Field::NoiseDensity),
+            (format!("bias_instability_{u}"), Field::BiasInstability),
+            (format!("random_walk_{u}_rt_hz"), Field::RandomWalk),
+            (
+                format!("temperature_bias_{u}_per_c"),
+                Field::TemperatureBias,
+            ),
+            (
+                "temperature_scale_factor_pct_per_c".to_string(),
+                Field::TemperatureScaleFactor,
+            ),
+            (
+                "acceleration_bias_rad_s_per_m_s2".to_string(),
+                Field::AccelerationBias,
+            ),
+        ];
+        let field = fields
+            .iter()
+            .filter(|(_, f)| *f != Field::AccelerationBias || sensor == Sensor::Gyroscope)
+            .find(|(n, _)| n == key)
+            .map(|(_, f)| *f)
+            .ok_or_else(|| {
+                let known: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
+                invalid(
+                    format!("{at}.parameter"),
+                    format!(
+                        "cannot perturb \"{key}\" (perturbable: {})",
+                        known.join(", ")
+                    ),
+                )
+            })?;
+        let f = |name: &str| format!("{at}.{name}");
+        let distribution = match spec.distribution.as_str() {
+            "normal" => Distribution::Normal {
+                mean: need(spec.mean, &f("mean"), "mean")?,
+                std: need(spec.std, &f("std"), "std")?,
+            },
+            "truncated-normal" => Distribution::TruncatedNormal {
+                mean: need(spec.mean, &f("mean"), "mean")?,
+                std: need(spec.std, &f("std"), "std")?,
+                lower: need(spec.lower, &f("lower"), "lower")?,
+                upper: need(spec.upper, &f("upper"), "upper")?,
+            },
+            "uniform" => Distribution::Uniform {
+                lower: need(spec.lower, &f("lower"), "lower")?,
+                upper: need(spec.upper, &f("upper"), "upper")?,
+            },
+            "selection" => {
+                let values = spec
+                    .values
+                    .clone()
+                    .ok_or_else(|| invalid(f("values"), "needs values"))?;
+                if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+                    return Err(invalid(f("values"), "needs at least one finite value"));
+                }
+                let p = spec
+                    .probabilities
+                    .clone()
+                    .unwrap_or_else(|| vec![1.0 / values.len() as f64; values.len()]);
+                if p.len() != values.len() || p.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                    return Err(invalid(f("probabilities"), "one probability ≥ 0 per value"));
+                }
+                let total: f64 = p.iter().sum();
+                if (total - 1.0).abs() > 1e-9 {
+                    return Err(invalid(
+                        f("probabilities"),
+                        format!("must add up to 1, add up to {total}"),
+                    ));
+                }
+                let mut acc = 0.0;
+                let cumulative = p.iter().map(|x| {
+                    acc += x;
+                    acc / total
+                });
+                Distribution::Selection {
+                    values,
+                    cumulative: cumulative.collect(),
+                }
+            }
+            other => {
+                return Err(invalid(
+                    f("distribution"),
+                    format!(
+                        "unknown distribution \"{other}\" (normal, truncated-normal, uniform, selection)"
+                    ),
+                ));
+            }
+        };
+        match distribution {
+            Distribution::Normal { std, .. } | Distribution::TruncatedNormal { std, .. }
+                if std < 0.0 =>
+            {
+                return Err(invalid(f("std"), "must be ≥ 0"));
+            }
+            Distribution::TruncatedNormal { lower, upper, .. }
+            | Distribution::Uniform { lower, upper }
+                if lower > upper =>
+            {
+                return Err(invalid(f("lower"), "must not exceed upper"));
+            }
+            _ => {}
+        }
+        Ok(Self {
+            sensor,
+            field,
+            name: spec.parameter.clone(),
+            distribution,
+        })
+    }
+
+    fn draw(&self, rng: &mut Xoshiro256PlusPlus) -> f64 {
+        let uniform = |rng: &mut Xoshiro256PlusPlus| {
+            (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+        };
+        match &self.distribution {
+            Distribution::Normal { mean, std } => {
+                let n: f64 = StandardNormal.sample(rng);
+                mean + std * n
+            }
+            Distribution::TruncatedNormal {
+                mean,
+                std,
+                lower,
+                upper,
+            } => {
+                for _ in 0..10_000 {
+                    let n: f64 = StandardNormal.sample(rng);
+                    let x = mean + std * n;
+                    if (*lower..=*upper).contains(&x) {
+                        return x;
+                    }
+                }
+                mean.clamp(*lower, *upper)
+            }
+            Distribution::Uniform { lower, upper } => lower + (upper - lower) * uniform(rng),
+            Distribution::Selection { values, cumulative } => {
+                let u = uniform(rng);
+                let k = cumulative
+                    .iter()
+                    .position(|c| u < *c)
+                    .unwrap_or(values.len() - 1);
+                values[k]
+            }
+        }
+    }
+
+    fn apply(&self, p: &mut SensorParams, rng: &mut Xoshiro256PlusPlus) {
+        let mut three = || [self.draw(rng), self.draw(rng), self.draw(rng)];
+        match self.field {
+            Field::MeasurementRange => p.measurement_range = self.draw(rng),
+            Field::Resolution => p.resolution = self.draw(rng),
+            Field::ConstantBias => p.constant_bias = three(),
+            Field::NoiseDensity => p.noise_density = three(),
+            Field::BiasInstability => p.bias_instability = three(),
+            Field::RandomWalk => p.random_walk = three(),
+            Field::TemperatureBias => p.temperature_bias = three(),
+            Field::TemperatureScaleFactor => p.temperature_scale_factor_pct = three(),
+            Field::AccelerationBias => p.acceleration_bias = three(),
+        }
+    }
+}
+
+/// The parameters of a run: `base` with every perturbation drawn from the stream of
+/// (`seed`, `run`) — `run = None` is the single run of `imukit simulate` without `--runs`.
+///
+/// # Errors
+/// A draw that makes a parameter invalid (e.g. a negative density), with run and parameter.
+pub fn perturbed(
+    base: &ImuParams,
+    perturbations: &[Perturbation],
+    seed: u64,
+    run: Option<u64>,
+) -> Result<ImuParams> {
+    if perturbations.is_empty() {
+        return Ok(*base);
+    }
+    const SALT: u64 = 0x5045_5254_5552_4221;
+    let mut z = (seed ^ SALT) ^ run.map_or(u64::MAX, |r| r.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(z ^ (z >> 31));
+    let mut out = *base;
+    for p in perturbations {
+        let params = out.get_mut(p.sensor);
+        p.apply(params, &mut rng);
+        params.validate().map_err(|e| {
+            let which = run.map_or_else(|| "the run".to_string(), |r| format!("run {r}"));
+            invalid(
+                format!("imu.perturbations ({})", p.name),
+                format!("{which}: the draw is invalid: {e}"),
+            )
+        })?;
+    }
+    Ok(out)
+}

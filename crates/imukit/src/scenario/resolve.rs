@@ -1,0 +1,301 @@
+//! From a scenario as written ([`super::spec`]) to a runnable [`Scenario`]: built-ins merged,
+//! defaults filled, formulas parsed, files read, every value checked once.
+
+use std::path::Path;
+
+use imu_core::AccelSign;
+use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
+
+use crate::error::{Error, Result, invalid};
+use crate::io::table::read_columns;
+use crate::motion::analytic::AnalyticOptions;
+use crate::motion::expr::Expr;
+use crate::motion::track::{SpeedProfile, Track};
+use crate::motion::waypoints::Waypoints;
+use crate::motion::{BodyRatesData, ExpressionMotion, SampledPath, Trajectory};
+use crate::scenario::builtin;
+
+use crate::scenario::sensors::SensorSetup;
+use crate::scenario::spec::*;
+use crate::scenario::times::{SampleTimes, regular_times, sample_times};
+use crate::scenario::{ImuSetup, Scenario};
+
+impl ScenarioSpec {
+    /// Parses TOML text; `origin` names the file in messages.
+    ///
+    /// # Errors
+    /// [`Error::Scenario`] with the parser's message (key and line).
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
+        toml::from_str(text).map_err(|e| Error::Scenario {
+            origin: origin.into(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Parses JSON text with the same keys (what the Python dicts become).
+    ///
+    /// # Errors
+    /// [`Error::Scenario`] with the parser's message.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        serde_json::from_str(text).map_err(|e| Error::Scenario {
+            origin: origin.into(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Reads a scenario file (`.toml`, or `.json`).
+    ///
+    /// # Errors
+    /// Unreadable or unparsable file.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?;
+        let origin = path.display().to_string();
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            Self::from_json(&text, &origin)
+        } else {
+            Self::from_toml(&text, &origin)
+        }
+    }
+
+    /// Resolves defaults, built-ins, formulas and sample files; relative paths are taken from
+    /// `base_dir`.
+    ///
+    /// # Errors
+    /// Any invalid key, formula or file, named.
+    pub fn resolve(&self, base_dir: &Path) -> Result<Scenario> {
+        let merged;
+        let spec = if let TrajectorySpec::Builtin { name } = &self.trajectory {
+            let b = builtin::spec(name)?;
+            merged = ScenarioSpec {
+                rate_hz: self.rate_hz.or(b.rate_hz),
+                duration_s: self.duration_s.or(b.duration_s),
+                nav_frame: self.nav_frame.or(b.nav_frame),
+                gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
+                trajectory: b.trajectory,
+                imu: self.imu.or(&b.imu),
+            };
+            &merged
+        } else {
+            self
+        };
+        let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(9.81);
+        if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
+            return Err(invalid(
+                "gravity_m_s2",
+                format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
+            ));
+        }
+        let sensors = SensorSetup::resolve(&spec.imu.sensor_keys(), base_dir)?;
+        let accel_sign = spec
+            .imu
+            .accel_sign
+            .map_or(sensors.profile.accel_sign(), AccelSign::from);
+        let imu = ImuSetup {
+            kind: spec.imu.kind.unwrap_or_default(),
+            output: spec.imu.output.unwrap_or_default(),
+            lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
+            accel_sign,
+            magnetic_field_ut: spec
+                .imu
+                .magnetic_field_ut
+                .map(|m| finite_vec("imu.magnetic_field_ut", m))
+                .transpose()?,
+            sensors,
+        };
+        let need = |v: Option<f64>, field: &str| {
+            v.ok_or_else(|| invalid(field, "missing (required for this trajectory type)"))
+        };
+        let (trajectory, t_s) = match &spec.trajectory {
+            TrajectorySpec::Expression(e) => {
+                let min_speed_m_s = e.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let t = regular_times(
+                    need(spec.rate_hz, "rate_hz")?,
+                    need(spec.duration_s, "duration_s")?,
+                )?;
+                (
+                    Trajectory::Expression(
+                        ExpressionMotion::from_spec(e)?,
+                        AnalyticOptions { min_speed_m_s },
+                    ),
+                    t,
+                )
+            }
+            TrajectorySpec::Track(k) => {
+                let speed = match k.accel_m_s2 {
+                    Some(accel_m_s2) => SpeedProfile::Trapezoid {
+                        speed_m_s: k.speed_m_s,
+                        accel_m_s2,
+                    },
+                    None => SpeedProfile::Constant(k.speed_m_s),
+                };
+                let track = Track::new(k.start_m, k.heading_rad, k.segments.clone(), speed)?;
+                let duration = spec.duration_s.unwrap_or_else(|| track.travel_time_s());
+                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                (Trajectory::Track(track), t)
+            }
+            TrajectorySpec::Samples(s) => {
+                let tangent = match s.attitude.as_deref() {
+                    None => false,
+                    Some("tangent") => true,
+                    Some(other) => {
+                        return Err(invalid(
+                            "trajectory.attitude",
+                            format!(
+                                "unknown attitude \"{other}\" for samples (use \"tangent\" or leave it out)"
+                            ),
+                        ));
+                    }
+                };
+                let path = base_dir.join(&s.file);
+                let order = s
+                    .order
+                    .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
+                let min_speed = s.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+                let t = SampleTimes::Listed(path.t_s.clone());
+                (Trajectory::Samples(path), t)
+            }
+            TrajectorySpec::Waypoints(w) => {
+                let path = Waypoints::new(
+                    &w.time_s,
+                    &w.position_m,
+                    w.velocity_m_s.as_deref(),
+                    w.euler_rad.as_deref(),
+                )?;
+                let duration = spec.duration_s.unwrap_or(path.end_s);
+                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+                (Trajectory::Waypoints(path), t)
+            }
+            TrajectorySpec::BodyRates(b) => {
+                let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
+                (Trajectory::BodyRates(data), SampleTimes::Listed(t))
+            }
+            TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
+        };
+        let sample_rate_hz = match spec.rate_hz {
+            Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
+            _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s.at(t_s.len() - 1) - t_s.at(0)),
+            _ => spec.rate_hz.unwrap_or(1.0),
+        };
+        Ok(Scenario {
+            t_s,
+            sample_rate_hz,
+            nav_frame: spec.nav_frame.unwrap_or_default(),
+            gravity_m_s2,
+            trajectory,
+            imu,
+        })
+    }
+}
+
+/// Samples of a `body-rates` trajectory: formulas at `k/rate_hz`, or a CSV file.
+fn body_rates(
+    b: &BodyRatesSpec,
+    rate_hz: Option<f64>,
+    duration_s: Option<f64>,
+    base_dir: &Path,
+) -> Result<(Vec<f64>, BodyRatesData)> {
+    let mut data = BodyRatesData {
+        accel_body_m_s2: Vec::new(),
+        omega_body_rad_s: Vec::new(),
+        alpha_body_rad_s2: None,
+        position0_m: finite_vec("trajectory.position0_m", b.position0_m)?,
+        velocity0_m_s: finite_vec("trajectory.velocity0_m_s", b.velocity0_m_s)?,
+        euler0_rad: finite_vec("trajectory.euler0_rad", b.euler0_rad)?,
+    };
+    if let Some(file) = &b.file {
+        if b.acceleration_body_m_s2.is_some() || b.angular_velocity_body_rad_s.is_some() {
+            return Err(invalid(
+                "trajectory.file",
+                "give either a file or formulas, not both",
+            ));
+        }
+        const COLS: [&str; 7] = [
+            "t_s",
+            "acc_body_x_m_s2",
+            "acc_body_y_m_s2",
+            "acc_body_z_m_s2",
+            "omega_x_rad_s",
+            "omega_y_rad_s",
+            "omega_z_rad_s",
+        ];
+        let cols = read_columns(&base_dir.join(file), &COLS, "")?;
+        let n = cols.rows();
+        let g = |c: usize, i: usize| cols.get(COLS[c])[i];
+        data.accel_body_m_s2 = (0..n).map(|i| [g(1, i), g(2, i), g(3, i)]).collect();
+        data.omega_body_rad_s = (0..n).map(|i| [g(4, i), g(5, i), g(6, i)]).collect();
+        return Ok((cols.get("t_s").to_vec(), data));
+    }
+    let rate =
+        rate_hz.ok_or_else(|| invalid("rate_hz", "missing (required for body-rate formulas)"))?;
+    let duration = duration_s
+        .ok_or_else(|| invalid("duration_s", "missing (required for body-rate formulas)"))?;
+    let t = sample_times(rate, duration)?;
+    let zero = || {
+        [
+            Formula::Number(0.0),
+            Formula::Number(0.0),
+            Formula::Number(0.0),
+        ]
+    };
+    let parse = |f: &[Formula; 3], key: &str| -> Result<Vec<Expr>> {
+        (0..3)
+            .map(|k| f[k].parse(&format!("trajectory.{key}[{k}]"), &b.constants))
+            .collect()
+    };
+    let acc = parse(
+        b.acceleration_body_m_s2.as_ref().unwrap_or(&zero()),
+        "acceleration_body_m_s2",
+    )?;
+    let w = parse(
+        b.angular_velocity_body_rad_s.as_ref().unwrap_or(&zero()),
+        "angular_velocity_body_rad_s",
+    )?;
+    let mut alpha = Vec::with_capacity(t.len());
+    for (i, &ti) in t.iter().enumerate() {
+        let a: [f64; 3] = std::array::from_fn(|k| acc[k].eval(ti));
+        let wd: [num_dual::Dual64; 3] =
+            std::array::from_fn(|k| w[k].eval(num_dual::Dual64::new(ti, 1.0)));
+        if !a
+            .iter()
+            .chain(wd.iter().map(|d| &d.re))
+            .chain(wd.iter().map(|d| &d.eps))
+            .all(|v| v.is_finite())
+        {
+            return Err(invalid(
+                "trajectory",
+                format!("body-rate formulas are not finite at t = {ti} s (sample {i})"),
+            ));
+        }
+        data.accel_body_m_s2.push(a);
+        data.omega_body_rad_s.push(wd.map(|d| d.re));
+        alpha.push(wd.map(|d| d.eps));
+    }
+    data.alpha_body_rad_s2 = Some(alpha);
+    Ok((t, data))
+}
+
+pub(crate) fn finite_positive(field: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a finite number > 0, got {v}"),
+        ))
+    }
+}
+
+pub(crate) fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be finite, got {v:?}")))
+    }
+}

@@ -1,0 +1,313 @@
+//! The scenario file's vocabulary: what a user writes in TOML, JSON or a Python dict, before
+//! defaults and files are resolved ([`super::resolve`]).
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use imu_core::AccelSign;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result, invalid};
+use crate::io::params::Profile;
+use crate::io::table::{ImuKind, ImuOutput};
+use crate::motion::expr::Expr;
+use crate::motion::track::Segment;
+use crate::scenario::perturb::PerturbationSpec;
+use crate::scenario::sensors::{SensorKeys, TemperatureSpec};
+
+/// The navigation frame, by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NavFrameName {
+    /// East-North-Up (default).
+    #[default]
+    #[serde(alias = "enu")]
+    ENU,
+    /// North-East-Down.
+    #[serde(alias = "ned")]
+    NED,
+}
+
+/// Accelerometer sign convention, by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelSignName {
+    /// Specific force (default).
+    #[default]
+    SpecificForce,
+    /// MATLAB imuSensor's gravity-minus-acceleration.
+    Matlab,
+}
+
+impl From<AccelSignName> for AccelSign {
+    fn from(s: AccelSignName) -> Self {
+        match s {
+            AccelSignName::SpecificForce => Self::SpecificForce,
+            AccelSignName::Matlab => Self::Matlab,
+        }
+    }
+}
+
+/// A formula, or a plain number where a formula is expected.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Formula {
+    /// A formula string of `t`.
+    Text(String),
+    /// A constant.
+    Number(f64),
+}
+
+impl Formula {
+    pub(crate) fn parse(&self, field: &str, constants: &BTreeMap<String, f64>) -> Result<Expr> {
+        let text = match self {
+            Self::Text(s) => s.clone(),
+            Self::Number(v) => format!("({v:e})"),
+        };
+        Expr::parse(&text, constants).map_err(|source| Error::Expression {
+            field: field.into(),
+            source,
+        })
+    }
+}
+
+impl From<&str> for Formula {
+    fn from(s: &str) -> Self {
+        Self::Text(s.into())
+    }
+}
+
+/// A scenario as written in a file (every key optional where a default or a built-in fills it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Sample rate, Hz.
+    pub rate_hz: Option<f64>,
+    /// Duration, s (samples at `k/rate_hz`, `k = 0..=round(duration_s·rate_hz)`).
+    pub duration_s: Option<f64>,
+    /// Navigation frame (default ENU).
+    pub nav_frame: Option<NavFrameName>,
+    /// Gravity magnitude, m/s² (default 9.81).
+    pub gravity_m_s2: Option<f64>,
+    /// The motion.
+    pub trajectory: TrajectorySpec,
+    /// The IMU.
+    #[serde(default)]
+    pub imu: ImuSpec,
+}
+
+/// The `[trajectory]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case")]
+pub enum TrajectorySpec {
+    /// Formula strings of `t`, exact derivatives.
+    Expression(ExpressionSpec),
+    /// Sampled positions and attitudes from a CSV file, finite differences.
+    Samples(SamplesSpec),
+    /// Straights and arcs with a speed profile, exact.
+    Track(TrackSpec),
+    /// Body-frame acceleration and angular velocity integrated to a trajectory (MATLAB's
+    /// kinematicTrajectory).
+    BodyRates(BodyRatesSpec),
+    /// Positions at times through a cubic spline (MATLAB's waypointTrajectory).
+    Waypoints(WaypointsSpec),
+    /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
+    Builtin {
+        /// Name, see [`NAMES`](crate::scenario::builtin::NAMES).
+        name: String,
+    },
+}
+
+/// `type = "expression"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpressionSpec {
+    /// Named constants usable in the formulas.
+    #[serde(default)]
+    pub constants: BTreeMap<String, f64>,
+    /// Position formulas `[x, y, z]`, navigation frame, m.
+    pub position_m: [Formula; 3],
+    /// `"tangent"` or `"level"`; leave out when giving angles.
+    pub attitude: Option<String>,
+    /// Yaw formula, rad.
+    pub yaw_rad: Option<Formula>,
+    /// Pitch formula, rad.
+    pub pitch_rad: Option<Formula>,
+    /// Roll formula, rad.
+    pub roll_rad: Option<Formula>,
+    /// Standstill threshold of the tangent attitude, m/s.
+    pub min_speed_m_s: Option<f64>,
+}
+
+/// `type = "samples"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplesSpec {
+    /// CSV file with `t_s, pos_x_m, pos_y_m, pos_z_m` and `yaw_rad, pitch_rad, roll_rad` or
+    /// `q_w, q_x, q_y, q_z`; relative paths are relative to the scenario file.
+    pub file: PathBuf,
+    /// Finite-difference order: 2 (MATLAB gradient), 4, 6 (default) or 8.
+    pub order: Option<usize>,
+    /// `"tangent"` to ignore attitude columns and align with the velocity.
+    pub attitude: Option<String>,
+    /// Standstill threshold of the tangent attitude, m/s.
+    pub min_speed_m_s: Option<f64>,
+}
+
+/// `type = "body-rates"`: formulas of `t` or a CSV file of body-frame acceleration (kinematic,
+/// no gravity) and angular velocity.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyRatesSpec {
+    /// Named constants usable in the formulas.
+    #[serde(default)]
+    pub constants: BTreeMap<String, f64>,
+    /// Body acceleration formulas `[x, y, z]`, m/s² (default 0).
+    pub acceleration_body_m_s2: Option<[Formula; 3]>,
+    /// Body angular velocity formulas `[x, y, z]`, rad/s (default 0).
+    pub angular_velocity_body_rad_s: Option<[Formula; 3]>,
+    /// Or a CSV with `t_s, acc_body_x_m_s2, acc_body_y_m_s2, acc_body_z_m_s2, omega_x_rad_s,
+    /// omega_y_rad_s, omega_z_rad_s` (relative to the scenario file).
+    pub file: Option<PathBuf>,
+    /// Initial position, navigation frame, m.
+    #[serde(default)]
+    pub position0_m: [f64; 3],
+    /// Initial velocity, navigation frame, m/s.
+    #[serde(default)]
+    pub velocity0_m_s: [f64; 3],
+    /// Initial attitude `[yaw, pitch, roll]`, rad.
+    #[serde(default)]
+    pub euler0_rad: [f64; 3],
+}
+
+/// `type = "waypoints"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaypointsSpec {
+    /// Waypoint times, s (increasing).
+    pub time_s: Vec<f64>,
+    /// Waypoint positions `[x, y, z]`, navigation frame, m.
+    pub position_m: Vec<[f64; 3]>,
+    /// Velocities: two rows (start, end: clamped spline) or one per waypoint (quintic Hermite, C²).
+    pub velocity_m_s: Option<Vec<[f64; 3]>>,
+    /// Attitude `[yaw, pitch, roll]` per waypoint, rad; without it the attitude is tangent.
+    pub euler_rad: Option<Vec<[f64; 3]>>,
+}
+
+/// `type = "track"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackSpec {
+    /// Start point, navigation frame, m.
+    #[serde(default)]
+    pub start_m: [f64; 3],
+    /// Start heading from the x axis towards y, rad.
+    #[serde(default)]
+    pub heading_rad: f64,
+    /// Cruise speed, m/s.
+    pub speed_m_s: f64,
+    /// With it, start and end at rest, ramping at this acceleration (m/s²); without, constant speed.
+    pub accel_m_s2: Option<f64>,
+    /// Segments: `{ straight_m = L }` or `{ arc_radius_m = R, arc_angle_rad = A }`.
+    pub segments: Vec<Segment>,
+}
+
+/// The `[imu]` table.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuSpec {
+    /// Sensors simulated (default all three).
+    pub kind: Option<ImuKind>,
+    /// `"rates"` (default) or `"increments"` (Δv, Δθ per interval).
+    pub output: Option<ImuOutput>,
+    /// Lever arm from the reference point to the IMU, body frame, m.
+    pub lever_arm_m: Option<[f64; 3]>,
+    /// Accelerometer sign.
+    pub accel_sign: Option<AccelSignName>,
+    /// Magnetic field, navigation frame, µT (default MATLAB's, in the chosen frame).
+    pub magnetic_field_ut: Option<[f64; 3]>,
+    /// `"default"` or `"matlab"` conventions.
+    pub profile: Option<Profile>,
+    /// Seed of the noise stream (default 0).
+    pub seed: Option<u64>,
+    /// Sensor temperature, °C, or a CSV file of a temperature profile.
+    pub temperature_c: Option<TemperatureSpec>,
+    /// A preset of a real part (`imukit presets`).
+    pub preset: Option<String>,
+    /// A parameter file: imukit TOML/JSON or MATLAB `loadparams` JSON.
+    pub params: Option<PathBuf>,
+    /// The part to take from a MATLAB JSON file holding several.
+    pub part: Option<String>,
+    /// Accelerometer parameters (override the preset or file key by key).
+    pub accelerometer: Option<serde_json::Value>,
+    /// Gyroscope parameters.
+    pub gyroscope: Option<serde_json::Value>,
+    /// Magnetometer parameters.
+    pub magnetometer: Option<serde_json::Value>,
+    /// Monte Carlo perturbations of parameters, drawn per run.
+    pub perturbations: Option<Vec<PerturbationSpec>>,
+}
+
+impl ImuSpec {
+    /// Keys of `self`, falling back to `other`'s where `self` has none.
+    #[must_use]
+    pub fn or(&self, other: &Self) -> Self {
+        Self {
+            kind: self.kind.or(other.kind),
+            output: self.output.or(other.output),
+            lever_arm_m: self.lever_arm_m.or(other.lever_arm_m),
+            accel_sign: self.accel_sign.or(other.accel_sign),
+            magnetic_field_ut: self.magnetic_field_ut.or(other.magnetic_field_ut),
+            profile: self.profile.or(other.profile),
+            seed: self.seed.or(other.seed),
+            temperature_c: self
+                .temperature_c
+                .clone()
+                .or_else(|| other.temperature_c.clone()),
+            preset: self.preset.clone().or_else(|| other.preset.clone()),
+            params: self.params.clone().or_else(|| other.params.clone()),
+            part: self.part.clone().or_else(|| other.part.clone()),
+            accelerometer: self
+                .accelerometer
+                .clone()
+                .or_else(|| other.accelerometer.clone()),
+            gyroscope: self.gyroscope.clone().or_else(|| other.gyroscope.clone()),
+            magnetometer: self
+                .magnetometer
+                .clone()
+                .or_else(|| other.magnetometer.clone()),
+            perturbations: self
+                .perturbations
+                .clone()
+                .or_else(|| other.perturbations.clone()),
+        }
+    }
+
+    pub(crate) fn sensor_keys(&self) -> SensorKeys<'_> {
+        SensorKeys {
+            profile: self.profile,
+            seed: self.seed,
+            temperature_c: self.temperature_c.as_ref(),
+            preset: self.preset.as_deref(),
+            params: self.params.as_deref(),
+            part: self.part.as_deref(),
+            tables: [
+                self.accelerometer.as_ref(),
+                self.gyroscope.as_ref(),
+                self.magnetometer.as_ref(),
+            ],
+            perturbations: self.perturbations.as_deref().unwrap_or(&[]),
+        }
+    }
+}
+
+/// Parses a name the way scenario files spell it (`"ENU"`, `"specific-force"`, `"accel-gyro"`…),
+/// for front ends that take names as strings.
+///
+/// # Errors
+/// [`Error::Invalid`] naming `field` and listing the accepted names.
+pub fn parse_name<T: serde::de::DeserializeOwned>(field: &str, name: &str) -> Result<T> {
+    use serde::de::IntoDeserializer;
+    let de: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
+        name.into_deserializer();
+    T::deserialize(de).map_err(|e| invalid(field, e.to_string()))
+}

@@ -1,0 +1,111 @@
+//! A streamed simulation equals the whole one bit for bit: every trajectory type, rates and
+//! increments, a Monte Carlo run, chunk boundaries inside a tangent-attitude standstill.
+use std::path::Path;
+
+use imukit::run::simulate::STREAM_CHUNK;
+use imukit::scenario::builtin;
+use imukit::{Scenario, ScenarioSpec};
+
+fn streamed(sc: &Scenario, run: Option<u64>) -> (Vec<f64>, Vec<f64>, usize) {
+    let (mut truth, mut imu, mut chunks) = (Vec::new(), Vec::new(), 0);
+    sc.stream(run, |c| {
+        assert!(c.truth.columns.len() * STREAM_CHUNK >= c.truth.data.len() || chunks == 0);
+        truth.extend(c.truth.data);
+        imu.extend(c.imu.data);
+        chunks += 1;
+        Ok(())
+    })
+    .unwrap();
+    (truth, imu, chunks)
+}
+
+fn assert_same(sc: &Scenario, run: Option<u64>, min_chunks: usize, what: &str) {
+    let whole = match run {
+        Some(r) => sc.simulate_run(r).unwrap(),
+        None => sc.simulate().unwrap(),
+    };
+    let (truth, imu, chunks) = streamed(sc, run);
+    assert!(chunks >= min_chunks, "{what}: {chunks} chunks");
+    assert!(truth == whole.truth.data, "{what}: truth differs");
+    assert!(imu == whole.imu.data, "{what}: IMU readings differ");
+}
+
+fn builtin_at(name: &str, rate_hz: f64, duration_s: f64, imu: &str) -> Scenario {
+    let mut text = builtin::toml(name).unwrap();
+    text = text
+        .lines()
+        .filter(|l| !l.starts_with("rate_hz") && !l.starts_with("duration_s"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let text = format!("rate_hz = {rate_hz}\nduration_s = {duration_s}\n{text}\n{imu}");
+    ScenarioSpec::from_toml(&text, name)
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+}
+
+#[test]
+fn analytic_trajectories_stream_to_the_same_numbers() {
+    let noisy = "";
+    for name in [
+        "figure8",
+        "tilted-circle",
+        "rounded-rectangle",
+        "platform-turn",
+    ] {
+        let sc = builtin_at(name, 1000.0, 10.0, noisy);
+        assert_same(&sc, None, 3, name);
+    }
+}
+
+fn from_toml(text: &str) -> Scenario {
+    ScenarioSpec::from_toml(text, "test")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+}
+
+#[test]
+fn a_standstill_longer_than_a_chunk_is_backfilled_as_in_one_piece() {
+    // At rest for 3 s (6000 samples at 2 kHz, more than a chunk), then off along a curve: the
+    // tangent attitude of the standstill is the first moving sample's.
+    let sc = from_toml(
+        "rate_hz = 2000.0\nduration_s = 8.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"if(t < 3, 0, (t - 3)^3)\", \"if(t < 3, 0, (t - 3)^4)\", \"0\"]\n\
+         attitude = \"tangent\"\n",
+    );
+    let whole = sc.simulate().unwrap();
+    let yaw = whole.truth.column("yaw_rad").unwrap();
+    assert!(
+        yaw[0] == yaw[5999] && yaw[0] == yaw[6001],
+        "the standstill takes the first moving yaw"
+    );
+    assert_same(&sc, None, 3, "standstill");
+}
+
+#[test]
+fn noisy_increments_and_monte_carlo_runs_continue_across_chunks() {
+    let sc = from_toml(
+        "rate_hz = 500.0\nduration_s = 30.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"cos(t)\", \"sin(t)\", \"0.1*t\"]\nattitude = \"tangent\"\n\
+         [imu]\npreset = \"mpu-6050\"\nseed = 5\noutput = \"increments\"\n",
+    );
+    assert_same(&sc, None, 3, "increments");
+    assert_same(&sc, Some(3), 3, "run 3");
+}
+
+#[test]
+fn example_files_stream_to_the_same_numbers() {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for f in [
+        "samples.toml",
+        "body_rates.toml",
+        "waypoints.toml",
+        "track.toml",
+        "expression.toml",
+        "piecewise.toml",
+    ] {
+        let sc = Scenario::from_file(&examples.join(f)).unwrap();
+        assert_same(&sc, None, 1, f);
+    }
+}
