@@ -16,7 +16,7 @@ python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "num
 echo "== Format and lints"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
-RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imukit -p imu-cli   # doc links resolve
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imukit -p imu-plot -p imu-cli   # doc links resolve
 
 echo "== Heap-free core: builds without std, never names alloc or std, no std-only dependency"
 cargo build --quiet -p imu-core --no-default-features --features libm

@@ -10,7 +10,7 @@ use imu_core::sensor::{ImuModel, ImuState, SeededNormals, Temperatures};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState};
 use imu_core::strapdown::step::StrapdownOptions;
 use imu_core::{Body, Enu, EulerZyx, NavFrame, Rotation, Vec3};
-use imukit::figures::{self, TableKind};
+use imu_plot::spec::{self as figures, TableKind};
 use imukit::io::params::{Profile, read_param_file, to_toml};
 use imukit::io::presets;
 use imukit::io::table::ImuKind;
@@ -39,7 +39,7 @@ create_exception!(
     "imukit refused the input; the message says what and where."
 );
 
-fn refused(e: imukit::Error) -> PyErr {
+fn refused(e: impl ToString) -> PyErr {
     ImuError::new_err(e.to_string())
 }
 

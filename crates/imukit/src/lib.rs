@@ -19,7 +19,6 @@
 //! | [`motion`] | motions: formula strings with exact derivatives, Rust functions over dual numbers, tracks, waypoints, samples, body rates |
 //! | [`io`] | [`Table`] and CSV files (readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
 //! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
-//! | [`figures`] | which panels each kind of table gets (shared with the figures crate and Python) |
 //! | [`error`] | [`Error`]: what went wrong and where |
 //!
 //! ## Simulate a scenario
@@ -89,7 +88,6 @@
 //! # Ok::<(), imukit::Error>(())
 //! ```
 pub mod error;
-pub mod figures;
 pub mod io;
 pub mod motion;
 pub mod run;

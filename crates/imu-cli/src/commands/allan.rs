@@ -39,7 +39,7 @@ pub fn run(
     let result = allan(&series, rate)?;
     result.table.write_csv(out)?;
     if let Some(p) = plot {
-        crate::plot::allan_figure(p, &result)?;
+        imu_plot::allan_figure(p, &result)?;
     }
     println!(
         "{:<16} {:>14} {:>14} {:>14}",

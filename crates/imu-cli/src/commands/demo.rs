@@ -6,8 +6,8 @@ use imukit::Simulation;
 use imukit::scenario::builtin;
 
 use super::CliError;
-use crate::plot::animate::{AnimateOptions, animate};
-use crate::plot::plot_files;
+use imu_plot::animate::{AnimateOptions, animate};
+use imu_plot::plot_files;
 use imukit::scenario::NavFrameName;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {

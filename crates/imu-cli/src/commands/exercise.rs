@@ -8,7 +8,7 @@ use imukit::run::planar::{integrate, samples_from_table, write_dat};
 use imukit::scenario::builtin;
 
 use super::CliError;
-use crate::plot::{Trace, trajectories_figure};
+use imu_plot::{Trace, trajectories_figure};
 
 /// Sensor errors of the exercise's second file: the ICM-42688-P preset's noise plus modest
 /// turn-on biases, so the erroneous trajectory drifts visibly but stays on the page.

@@ -10,41 +10,8 @@ mod presets;
 mod scenario;
 mod simulate;
 
+use crate::CliError;
 use crate::cli::{Cli, Command};
-
-/// What went wrong, for the user; `Display` says what and where.
-#[derive(Debug, thiserror::Error)]
-pub enum CliError {
-    /// Input or I/O errors from the scenario layer.
-    #[error(transparent)]
-    Scenario(#[from] imukit::Error),
-    /// A figure could not be drawn or written.
-    #[error("{path}: {message}")]
-    Plot {
-        /// The figure file.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// Other I/O errors (creating folders, writing text).
-    #[error("{path}: {source}")]
-    Io {
-        /// The path.
-        path: String,
-        /// The OS error.
-        source: std::io::Error,
-    },
-}
-
-impl CliError {
-    /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Self::Scenario(imukit::Error::Io { .. }) | Self::Io { .. } | Self::Plot { .. } => 74,
-            Self::Scenario(_) => 65,
-        }
-    }
-}
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {

@@ -1,8 +1,8 @@
 //! `imukit plot` and `imukit animate`.
 use std::path::{Path, PathBuf};
 
-use crate::plot::animate::{self as anim, AnimateOptions};
-use crate::plot::plot_files;
+use imu_plot::animate::{self as anim, AnimateOptions};
+use imu_plot::plot_files;
 use imukit::io::table::read_table;
 
 use imukit::scenario::{NavFrameName, parse_name};

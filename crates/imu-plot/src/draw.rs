@@ -1,20 +1,12 @@
-//! Figures written by the CLI. plotters draws every figure as SVG; a `.png` path gets the SVG
-//! rasterised by resvg with the embedded DejaVu Sans, so PNGs look the same on every machine. Files are written to a
-//! temporary name and renamed when complete.
-mod allan;
-pub mod animate;
-mod figures;
-mod panels;
-
+//! Drawing shared by every figure: colours, legends, thinning long series, and writing a figure
+//! as SVG or as PNG (the SVG rasterised by resvg with the embedded DejaVu Sans, so PNGs look the
+//! same on every machine), atomically.
 use std::path::Path;
 
-pub use allan::allan_figure;
-pub use figures::plot_files;
-pub use panels::{Trace, trajectories_figure};
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
-use crate::commands::CliError;
+use crate::PlotError;
 
 /// The series colours (matplotlib's tab10 order).
 pub const COLORS: [RGBColor; 8] = [
@@ -78,8 +70,8 @@ pub fn write_figure(
     width: u32,
     height: u32,
     draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<(), CliError> {
-    let fail = |message: String| CliError::Plot {
+) -> Result<(), PlotError> {
+    let fail = |message: String| PlotError::Draw {
         path: path.display().to_string(),
         message,
     };

@@ -4,8 +4,8 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{COLORS, draw_legend, err, every, key, stride_for, write_figure};
-use crate::commands::CliError;
+use crate::PlotError;
+use crate::draw::{COLORS, draw_legend, err, every, key, stride_for, write_figure};
 
 /// One line of a time-series panel.
 pub struct Series {
@@ -262,10 +262,10 @@ pub fn is_3d(traces: &[Trace]) -> bool {
         .iter()
         .flat_map(|t| t.points.iter().map(|p| [p.0, p.1, p.2]))
         .collect();
-    imukit::figures::leaves_plane(&all)
+    crate::spec::leaves_plane(&all)
 }
 
 /// A figure of trajectories in the plane, start and end marked (the exercise's figure).
-pub fn trajectories_figure(path: &Path, title: &str, traces: &[Trace]) -> Result<(), CliError> {
+pub fn trajectories_figure(path: &Path, title: &str, traces: &[Trace]) -> Result<(), PlotError> {
     write_figure(path, 900, 640, |root| draw_plan_view(root, title, traces))
 }

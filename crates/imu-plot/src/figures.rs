@@ -1,14 +1,15 @@
 //! `imukit plot`: default figures for every kind of imukit CSV, several files overlaid.
 use std::path::{Path, PathBuf};
 
+use crate::spec::{PanelSpec, TableKind};
 use imu_core::allan::identify_noise;
-use imukit::figures::{PanelSpec, TableKind};
+use imukit::Table;
 use imukit::run::allan::AllanResult;
-use imukit::{Error, Table};
 
 use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, is_3d};
-use super::{allan_figure, write_figure};
-use crate::commands::CliError;
+use crate::PlotError;
+use crate::allan::allan_figure;
+use crate::draw::write_figure;
 
 fn stem(p: &Path) -> String {
     p.file_stem().map_or_else(
@@ -55,13 +56,12 @@ fn panel(files: &[(String, Table)], spec: &PanelSpec) -> Option<Panel> {
 ///
 /// # Errors
 /// Unreadable or empty files, unknown kinds of CSV, files of different kinds, drawing errors.
-pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliError> {
+pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotError> {
     if paths.is_empty() {
-        return Err(Error::Invalid {
+        return Err(PlotError::Invalid {
             field: "plot".into(),
             message: "give at least one CSV file".into(),
-        }
-        .into());
+        });
     }
     let mut files = Vec::new();
     let mut kind: Option<TableKind> = None;
@@ -69,7 +69,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliErr
         let t = imukit::io::table::read_table(p)?;
         let k = TableKind::of(&t.columns, &p.display().to_string())?;
         if let Some(first) = kind.filter(|first| !first.overlays(k)) {
-            return Err(Error::Invalid {
+            return Err(PlotError::Invalid {
                 field: p.display().to_string(),
                 message: format!(
                     "is {}, but the first file is {}: overlay files of one kind (or truth and \
@@ -77,8 +77,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliErr
                     k.name(),
                     first.name()
                 ),
-            }
-            .into());
+            });
         }
         kind.get_or_insert(k);
         files.push((stem(p), t));
@@ -124,7 +123,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), CliErr
 }
 
 /// Allan tables: the curves with the noise lines identified from each curve.
-fn allan_from_tables(out: &Path, files: &[(String, Table)]) -> Result<(), CliError> {
+fn allan_from_tables(out: &Path, files: &[(String, Table)]) -> Result<(), PlotError> {
     let mut columns = vec!["tau_s".to_string()];
     let mut noise = Vec::new();
     let first = &files[0].1;
@@ -134,11 +133,10 @@ fn allan_from_tables(out: &Path, files: &[(String, Table)]) -> Result<(), CliErr
         for c in t.columns.iter().filter(|c| c.starts_with("adev_")) {
             let adev = t.column(c).unwrap_or_default();
             if adev.len() != tau.len() {
-                return Err(Error::Invalid {
+                return Err(PlotError::Invalid {
                     field: name.clone(),
                     message: "Allan tables to overlay need the same τ values".into(),
-                }
-                .into());
+                });
             }
             let label = if files.len() > 1 {
                 format!("{c} ({name})")

@@ -4,11 +4,11 @@ use std::path::Path;
 use imukit::run::allan::AllanResult;
 use plotters::prelude::*;
 
-use super::{COLORS, draw_legend, err, key, write_figure};
-use crate::commands::CliError;
+use crate::PlotError;
+use crate::draw::{COLORS, draw_legend, err, key, write_figure};
 
 /// Draws `result` (one curve per column) into `path` (SVG or PNG).
-pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), CliError> {
+pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), PlotError> {
     let table = &result.table;
     let tau = table.column("tau_s").unwrap_or_default();
     let curves: Vec<(String, Vec<f64>)> = table
@@ -28,7 +28,7 @@ pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), CliError> {
         .filter(|v| *v > 0.0);
     let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
     if tau.is_empty() || !lo.is_finite() {
-        return Err(CliError::Plot {
+        return Err(PlotError::Draw {
             path: path.display().to_string(),
             message: "nothing to plot: the Allan deviation is empty or zero".into(),
         });

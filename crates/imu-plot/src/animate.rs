@@ -7,13 +7,13 @@
 //! second of animation (by default chosen so the animation lasts at most about 12 s).
 use std::path::Path;
 
-use imu_core::{Body, Enu, Ned, Rotation, Vec3};
-use imukit::figures::{FramePlan, default_body_m, frame_plan};
-use imukit::{Error, Table};
+use crate::spec::{FramePlan, default_body_m, frame_plan};
+use imukit::Table;
 use plotters::prelude::*;
 
-use super::{COLORS, err, every, rasterise, stride_for};
-use crate::commands::CliError;
+use crate::PlotError;
+use crate::draw::{COLORS, err, every, rasterise, stride_for};
+use crate::scene::{BOX_EDGES, BOX_NOSE, body_point_enu, box_corners_m, pose_enu};
 
 /// Animation settings.
 #[derive(Clone, Copy, Debug)]
@@ -63,8 +63,8 @@ struct Pose {
 
 /// Reads the poses, checking positions and quaternions per row (times: [`frame_plan`]); NED
 /// poses are turned into ENU ones (the body axes stay those of the data).
-fn poses(truth: &Table, source: &str, ned: bool) -> Result<Vec<Pose>, Error> {
-    let bad = |at: String, message: String| Error::Invalid { field: at, message };
+fn poses(truth: &Table, source: &str, ned: bool) -> Result<Vec<Pose>, PlotError> {
+    let bad = |at: String, message: String| PlotError::Invalid { field: at, message };
     let col = |c: &str| {
         truth.column(c).ok_or_else(|| {
             let message = format!("no {c} column: animate needs a truth CSV (t_s, pos_*_m, q_*)");
@@ -89,62 +89,14 @@ fn poses(truth: &Table, source: &str, ned: bool) -> Result<Vec<Pose>, Error> {
                 "time, position and quaternion must be finite numbers".into(),
             ));
         }
-        let r = Rotation::<Body, Ned>::from_wxyz(q)
-            .ok_or_else(|| bad(row.clone(), "the quaternion is zero".into()))?;
-        let pose = if ned {
-            let to_enu = Rotation::<Ned, Enu>::ned_to_enu();
-            let p = to_enu.apply(Vec3::from_array(p)).to_array();
-            Pose {
-                t: t[i],
-                p,
-                q: r.then(&to_enu).to_wxyz(),
-            }
-        } else {
-            Pose {
-                t: t[i],
-                p,
-                q: r.to_wxyz(),
-            }
-        };
+        let (p, q) =
+            pose_enu(p, q, ned).ok_or_else(|| bad(row.clone(), "the quaternion is zero".into()))?;
+        let pose = Pose { t: t[i], p, q };
         out.push(pose);
     }
     Ok(out)
 }
 
-/// A body-frame point `c_b` carried by `pose` into the navigation frame.
-fn to_nav(pose: &Pose, c_b: [f64; 3]) -> [f64; 3] {
-    let v = Rotation::<Body, Enu>::from_wxyz(pose.q)
-        .map_or(c_b, |r| r.apply(Vec3::from_array(c_b)).to_array());
-    [pose.p[0] + v[0], pose.p[1] + v[1], pose.p[2] + v[2]]
-}
-
-/// The box's corners in the body frame; bit 0 of the index is +x (nose), bit 1 +y, bit 2 +z.
-fn corners(body: [f64; 3]) -> [[f64; 3]; 8] {
-    let [l, w, h] = body.map(|d| d / 2.0);
-    core::array::from_fn(|i| {
-        [
-            if i & 1 == 0 { -l } else { l },
-            if i & 2 == 0 { -w } else { w },
-            if i & 4 == 0 { -h } else { h },
-        ]
-    })
-}
-
-const EDGES: [(usize, usize); 12] = [
-    (0, 1),
-    (2, 3),
-    (4, 5),
-    (6, 7),
-    (0, 2),
-    (1, 3),
-    (4, 6),
-    (5, 7),
-    (0, 4),
-    (1, 5),
-    (2, 6),
-    (3, 7),
-];
-const NOSE: [usize; 4] = [1, 3, 7, 5];
 /// At most this many points of the path are drawn.
 const PATH_POINTS: usize = 2000;
 
@@ -162,8 +114,8 @@ struct Scene {
 }
 
 impl Scene {
-    fn new(truth: &Table, source: &str, opts: &AnimateOptions) -> Result<Self, Error> {
-        let bad = |field: &str, message: &str| Error::Invalid {
+    fn new(truth: &Table, source: &str, opts: &AnimateOptions) -> Result<Self, PlotError> {
+        let bad = |field: &str, message: &str| PlotError::Invalid {
             field: field.into(),
             message: message.into(),
         };
@@ -229,8 +181,8 @@ pub fn animate(
     source: &str,
     out: &Path,
     opts: &AnimateOptions,
-) -> Result<AnimationInfo, CliError> {
-    let fail = |message: String| CliError::Plot {
+) -> Result<AnimationInfo, PlotError> {
+    let fail = |message: String| PlotError::Draw {
         path: out.display().to_string(),
         message,
     };
@@ -294,22 +246,22 @@ fn gif(scene: &Scene, opts: &AnimateOptions) -> Result<Vec<u8>, String> {
                 chart
                     .draw_series(LineSeries::new(trail, COLORS[0].stroke_width(2)))
                     .map_err(err)?;
-                let c: Vec<(f64, f64, f64)> = corners(scene.body)
+                let c: Vec<(f64, f64, f64)> = box_corners_m(scene.body)
                     .iter()
-                    .map(|c| up(to_nav(pose, *c)))
+                    .map(|c| up(body_point_enu(pose.p, pose.q, *c)))
                     .collect();
                 chart
                     .draw_series([Polygon::new(
-                        NOSE.map(|j| c[j]).to_vec(),
+                        BOX_NOSE.map(|j| c[j]).to_vec(),
                         COLORS[3].mix(0.5).filled(),
                     )])
                     .map_err(err)?;
                 chart
-                    .draw_series(EDGES.iter().map(|&(a, b)| {
+                    .draw_series(BOX_EDGES.iter().map(|&(a, b)| {
                         PathElement::new(vec![c[a], c[b]], COLORS[3].stroke_width(2))
                     }))
                     .map_err(err)?;
-                let imu = to_nav(pose, scene.lever);
+                let imu = body_point_enu(pose.p, pose.q, scene.lever);
                 chart
                     .draw_series([Circle::new(up(pose.p), 5, RGBColor(230, 190, 0).filled())])
                     .map_err(err)?;
@@ -364,6 +316,10 @@ fn html(scene: &Scene, opts: &AnimateOptions) -> String {
         })
         .collect::<Vec<_>>()
         .join(",");
+    let nested = |items: &[String]| {
+        let inner: Vec<String> = items.iter().map(|x| format!("[{x}]")).collect();
+        format!("[{}]", inner.join(","))
+    };
     let (w, h) = opts.size;
     HTML_TEMPLATE
         .replace("@WIDTH@", &w.to_string())
@@ -371,6 +327,18 @@ fn html(scene: &Scene, opts: &AnimateOptions) -> String {
         .replace("@PATH@", &path)
         .replace("@FRAMES@", &frame_data)
         .replace("@BODY@", &list(&scene.body))
+        .replace(
+            "@CORNERS@",
+            &nested(&box_corners_m(scene.body).map(|c| list(&c))),
+        )
+        .replace(
+            "@EDGES@",
+            &nested(&BOX_EDGES.map(|(a, b)| format!("{a},{b}"))),
+        )
+        .replace(
+            "@NOSE@",
+            &format!("[{}]", BOX_NOSE.map(|i| i.to_string()).join(",")),
+        )
         .replace("@LEVER@", &list(&scene.lever))
         .replace("@FPS@", &num(opts.fps))
         .replace("@SPEED@", &num(scene.speed))
@@ -391,6 +359,7 @@ grey: the path; blue: the path travelled. Drag with the mouse to turn the view.<
 const PATH = [@PATH@];
 const FRAMES = [@FRAMES@];
 const BODY = [@BODY@], LEVER = [@LEVER@], FPS = @FPS@, SPEED = @SPEED@;
+const CORNERS = @CORNERS@, EDGES = @EDGES@, NOSE = @NOSE@;
 const canvas = document.getElementById("view"), ctx = canvas.getContext("2d");
 const slider = document.getElementById("slider"), label = document.getElementById("time");
 slider.max = FRAMES.length - 1;
@@ -416,11 +385,10 @@ function draw() {
   for (let i = 1; i < pts.length; i++) line(pts[i-1], pts[i], "#bbb", 1);
   for (let i = 1; i < travelled; i++) line(pts[i-1], pts[i], "#1f77b4", 2);
   if (travelled > 0) line(pts[travelled-1], s, "#1f77b4", 2);
-  const c = []; for (let i = 0; i < 8; i++) { const b = [(i&1?1:-1)*BODY[0]/2, (i&2?1:-1)*BODY[1]/2, (i&4?1:-1)*BODY[2]/2];
-    const r = rotate(q, b); c.push([s[0]+r[0], s[1]+r[1], s[2]+r[2]]); }
-  const nose = [1,3,7,5].map(i => project(c[i])); ctx.fillStyle = "rgba(214,39,40,0.5)"; ctx.beginPath();
+  const c = CORNERS.map(b => { const r = rotate(q, b); return [s[0]+r[0], s[1]+r[1], s[2]+r[2]]; });
+  const nose = NOSE.map(i => project(c[i])); ctx.fillStyle = "rgba(214,39,40,0.5)"; ctx.beginPath();
   ctx.moveTo(...nose[0]); nose.slice(1).forEach(p => ctx.lineTo(...p)); ctx.closePath(); ctx.fill();
-  [[0,1],[2,3],[4,5],[6,7],[0,2],[1,3],[4,6],[5,7],[0,4],[1,5],[2,6],[3,7]].forEach(([a,b]) => line(c[a], c[b], "#d62728", 2));
+  EDGES.forEach(([a,b]) => line(c[a], c[b], "#d62728", 2));
   const l = rotate(q, LEVER); dot(s, "#e6be00", 5); dot([s[0]+l[0], s[1]+l[1], s[2]+l[2]], "#9467bd", 4);
   slider.value = frame; label.textContent = "t = " + t.toFixed(2) + " s (" + SPEED + "× real time)"; }
 function tick() { if (playing) { frame = (frame + 1) % FRAMES.length; draw(); } }

@@ -1,7 +1,9 @@
 //! What imukit draws for each kind of table, shared by the CLI (plotters) and Python
 //! (matplotlib): the kind of a CSV from its columns, the default panels of each kind, and the
 //! frame plan of an animation.
-use crate::error::{Result, invalid};
+use crate::{PlotError, invalid};
+
+type Result<T> = std::result::Result<T, PlotError>;
 
 /// The kinds of table imukit writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,0 +1,34 @@
+//! The command line's error type: every library, figure and I/O error a command can meet, with
+//! the exit code a script can test.
+use imu_plot::PlotError;
+
+/// What went wrong, for the user; `Display` says what and where.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Input or I/O errors from the library.
+    #[error(transparent)]
+    Library(#[from] imukit::Error),
+    /// A figure or animation could not be made.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// Other I/O errors (creating folders, writing text).
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+impl CliError {
+    /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Library(imukit::Error::Io { .. }) | Self::Io { .. } => 74,
+            Self::Plot(p) if p.is_io() => 74,
+            Self::Library(_) | Self::Plot(_) => 65,
+        }
+    }
+}
