@@ -46,7 +46,7 @@ echo "== Python stubs match the built module"
 python -m mypy.stubtest imukit._core
 
 echo "== Python tests"
-IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py crates/imu-py/python/imukit/_orientation.py
+IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py crates/imu-py/python/imukit/_orientation.py crates/imu-py/python/imukit/_sensor.py crates/imu-py/python/imukit/_truth.py
 
 echo "== Examples"
 out=$(mktemp -d)

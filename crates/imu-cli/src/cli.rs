@@ -43,9 +43,9 @@ pub enum Command {
         /// 3D: navigation frame of the data (ENU or NED).
         #[arg(long, default_value = "ENU")]
         nav_frame: String,
-        /// 3D: gravity magnitude, m/s².
-        #[arg(long, default_value_t = 9.81)]
-        gravity: f64,
+        /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling).
+        #[arg(long, alias = "gravity", default_value_t = imu_core::DEFAULT_GRAVITY_M_S2)]
+        gravity_m_s2: f64,
         /// 3D: sign of the accelerometer columns (`specific-force` or `matlab`).
         #[arg(long, default_value = "specific-force")]
         accel_sign: String,
@@ -58,12 +58,12 @@ pub enum Command {
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
         planar: bool,
-        /// Planar: `trapezoid` (default) or `exercise` (seed 001's rules). 3D: `coning` (default;
+        /// Planar: `trapezoid` (default) or `exercise` (the planar cart exercise's rules). 3D: `coning` (default;
         /// coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
         #[arg(long)]
         scheme: Option<String>,
         /// 3D `rk4`: RK4 steps per sample interval.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
         substeps: usize,
         /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
         #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]

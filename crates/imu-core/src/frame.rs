@@ -12,6 +12,11 @@ mod sealed {
     impl Sealed for super::Body {}
 }
 
+/// The gravity magnitude imukit uses unless told otherwise, m/s²: 9.81, MATLAB imuSensor's
+/// value (the standard gravity 9.80665 m/s² is what datasheet units such as mg convert with; see
+/// `imukit::io::units`).
+pub const DEFAULT_GRAVITY_M_S2: f64 = 9.81;
+
 /// A coordinate frame marker.
 pub trait Frame:
     sealed::Sealed + Copy + Default + core::fmt::Debug + PartialEq + Send + Sync + 'static

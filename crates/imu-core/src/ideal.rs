@@ -36,7 +36,7 @@ impl<N: NavFrame> Default for ImuMount<N> {
         Self {
             lever_arm_m: Vec3::zeros(),
             accel_sign: AccelSign::SpecificForce,
-            gravity_m_s2: 9.81,
+            gravity_m_s2: crate::frame::DEFAULT_GRAVITY_M_S2,
             magnetic_field_ut: N::default_magnetic_field_ut(),
         }
     }

@@ -35,7 +35,7 @@ pub mod sensor;
 pub mod strapdown;
 pub mod vector;
 
-pub use frame::{Body, Enu, Frame, NavFrame, Ned};
+pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Enu, Frame, NavFrame, Ned};
 pub use ideal::{AccelSign, IdealReading, ImuMount};
 pub use kinematics::{KinematicsError, Truth};
 pub use rotation::{EulerZyx, Rotation};

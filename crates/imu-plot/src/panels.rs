@@ -124,11 +124,8 @@ impl Trace {
         let z = t.column("pos_z_m").unwrap_or_else(|| vec![0.0; x.len()]);
         let points = (0..x.len())
             .map(|i| {
-                if ned {
-                    (y[i], x[i], -z[i])
-                } else {
-                    (x[i], y[i], z[i])
-                }
+                let [e, n, u] = crate::scene::point_enu([x[i], y[i], z[i]], ned);
+                (e, n, u)
             })
             .collect();
         Self {

@@ -1,7 +1,7 @@
 //! The scene of the animation, defined once: the body drawn as a box centred on the reference
 //! point, its edges and its nose face, and the turn of NED poses into east-north-up for drawing.
 //! The GIF is drawn from these; the HTML page and Python's `imukit.plot.animate` receive them as
-//! data ([`box_corners_m`], [`BOX_EDGES`], [`BOX_NOSE`], [`pose_enu`]).
+//! data ([`box_corners_m`], [`BOX_EDGES`], [`BOX_NOSE`], [`pose_enu`], [`point_enu`]).
 use imu_core::{Body, Enu, Ned, Rotation, Vec3};
 
 /// The box's corners in the body frame, m: half the length, width and height along body x, y, z
@@ -37,6 +37,14 @@ pub const BOX_EDGES: [(usize, usize); 12] = [
 /// The nose face (body +x), corner indices in drawing order.
 pub const BOX_NOSE: [usize; 4] = [1, 3, 7, 5];
 
+/// A navigation-frame point in east-north-up, m: NED `[n, e, d]` becomes `[e, n, −d]` (exactly:
+/// the axes are swapped, not rotated in floating point); ENU stays.
+#[must_use]
+pub fn point_enu(position_m: [f64; 3], ned: bool) -> [f64; 3] {
+    let [x, y, z] = position_m;
+    if ned { [y, x, -z] } else { position_m }
+}
+
 /// A pose to draw: position in east-north-up, m, and the quaternion `[w, x, y, z]` that carries
 /// body-frame points into east-north-up.
 ///
@@ -48,8 +56,7 @@ pub fn pose_enu(position_m: [f64; 3], q_nb: [f64; 4], ned: bool) -> Option<([f64
     let r = Rotation::<Body, Ned>::from_wxyz(q_nb)?;
     if ned {
         let to_enu = Rotation::<Ned, Enu>::ned_to_enu();
-        let p = to_enu.apply(Vec3::from_array(position_m)).to_array();
-        Some((p, r.then(&to_enu).to_wxyz()))
+        Some((point_enu(position_m, true), r.then(&to_enu).to_wxyz()))
     } else {
         Some((position_m, r.to_wxyz()))
     }

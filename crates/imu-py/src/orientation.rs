@@ -1,15 +1,17 @@
 //! Orientation estimation for Python: the e-compass, every filter behind one class, and the
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
-use imu_core::orientation::quaternion_distance as distance;
-use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
+use imu_core::{AccelSign, Enu, Ned};
 use imukit::run::orient::{AnyFilter, FilterKind, FilterSpec, run_rows};
 use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use super::{ImuError, array2, flat_rows, frame, refused};
+use crate::convert::{array2, flat_rows, nav_frame};
+use crate::errors::refused;
+use imukit::run::orient::{ecompass_rows, quaternion_distances};
 
+/// The accelerometer sign by name.
 fn sign(name: &str) -> PyResult<AccelSign> {
     Ok(parse_name::<AccelSignName>("accel_sign", name)
         .map_err(refused)?
@@ -51,7 +53,7 @@ impl PyOrientationFilter {
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
         spec.settings = settings;
         spec.initial_process_noise = initial_process_noise;
-        let filter = match frame("reference_frame", reference_frame)? {
+        let filter = match nav_frame("reference_frame", reference_frame)? {
             NavFrameName::ENU => Filter::Enu(spec.build(sample_rate).map_err(refused)?),
             NavFrameName::NED => Filter::Ned(spec.build(sample_rate).map_err(refused)?),
         };
@@ -126,16 +128,6 @@ impl PyOrientationFilter {
     }
 }
 
-fn ecompass_in<N: NavFrame>(a: &[f64], m: &[f64], s: AccelSign) -> Result<Vec<f64>, String> {
-    let mut out = Vec::with_capacity(a.len() / 3 * 4);
-    for (i, (a, m)) in a.chunks_exact(3).zip(m.chunks_exact(3)).enumerate() {
-        let q = imu_core::orientation::ecompass::<N>([a[0], a[1], a[2]], [m[0], m[1], m[2]], s)
-            .map_err(|e| format!("row {i}: {e}"))?;
-        out.extend(q.to_wxyz());
-    }
-    Ok(out)
-}
-
 /// Orientation `q_nb` (N, 4) from accelerometer and magnetometer rows (N, 3).
 #[pyfunction]
 #[pyo3(signature = (accel, mag, *, reference_frame = "NED", accel_sign = "matlab"))]
@@ -148,19 +140,9 @@ fn ecompass<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a = flat_rows::<3>("accel", &accel)?;
     let m = flat_rows::<3>("mag", &mag)?;
-    if a.len() != m.len() {
-        return Err(PyValueError::new_err(format!(
-            "mag has {} rows, accel {}",
-            m.len() / 3,
-            a.len() / 3
-        )));
-    }
     let s = sign(accel_sign)?;
-    let q = match frame("reference_frame", reference_frame)? {
-        NavFrameName::ENU => ecompass_in::<Enu>(a, m, s),
-        NavFrameName::NED => ecompass_in::<Ned>(a, m, s),
-    }
-    .map_err(ImuError::new_err)?;
+    let nav = nav_frame("reference_frame", reference_frame)?;
+    let q = py.detach(|| ecompass_rows(a, m, s, nav)).map_err(refused)?;
     array2(py, a.len() / 3, 4, q)
 }
 
@@ -172,23 +154,7 @@ fn quaternion_distance<'py>(
     q2: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (a, b) = (flat_rows::<4>("q1", &q1)?, flat_rows::<4>("q2", &q2)?);
-    if a.len() != b.len() {
-        return Err(PyValueError::new_err(format!(
-            "q1 has {} rows, q2 {}",
-            a.len() / 4,
-            b.len() / 4
-        )));
-    }
-    let rot = |c: &[f64], name: &str, i: usize| {
-        Rotation::<Body, Enu>::from_wxyz([c[0], c[1], c[2], c[3]])
-            .ok_or_else(|| ImuError::new_err(format!("{name}[{i}] has zero norm or is not finite")))
-    };
-    let d = a
-        .chunks_exact(4)
-        .zip(b.chunks_exact(4))
-        .enumerate()
-        .map(|(i, (x, y))| Ok(distance(&rot(x, "q1", i)?, &rot(y, "q2", i)?)))
-        .collect::<PyResult<Vec<f64>>>()?;
+    let d = quaternion_distances(a, b).map_err(refused)?;
     Ok(PyArray1::from_vec(py, d))
 }
 

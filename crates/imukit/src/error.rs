@@ -2,6 +2,11 @@
 use std::path::PathBuf;
 
 use imu_core::KinematicsError;
+use imu_core::allan::AllanError;
+use imu_core::orientation::OrientError;
+use imu_core::sensor::{ImuParamError, ParamError};
+use imu_core::strapdown::planar::PlanarError;
+use imu_core::strapdown::step::StrapdownError;
 
 use crate::motion::expr::ExprError;
 
@@ -70,6 +75,60 @@ pub enum Error {
         /// What else would do.
         hint: String,
     },
+    /// A quaternion of zero norm or not finite, where an attitude was expected.
+    #[error("{field} has zero norm or is not finite")]
+    BadQuaternion {
+        /// The argument and index, e.g. `quaternion[3]`.
+        field: String,
+    },
+    /// A sensor parameter the core refused.
+    #[error("{context}: {source}")]
+    Param {
+        /// The parameter table, e.g. `imu.gyroscope`.
+        context: String,
+        /// The core's error, naming the parameter.
+        source: ParamError,
+    },
+    /// A sensor parameter refused at the sample rate of a model.
+    #[error("{context}: {source}")]
+    ImuParam {
+        /// The IMU, e.g. `imu`.
+        context: String,
+        /// The core's error, naming the sensor and the parameter.
+        source: ImuParamError,
+    },
+    /// The 3D strapdown refused the data.
+    #[error("{context}: {source}")]
+    Strapdown {
+        /// The data, e.g. `IMU data`.
+        context: String,
+        /// The core's error, with its sample.
+        source: StrapdownError,
+    },
+    /// Planar dead reckoning refused the data.
+    #[error("{context}: {source}")]
+    Planar {
+        /// The data, e.g. `planar IMU`.
+        context: String,
+        /// The core's error, with its sample.
+        source: PlanarError,
+    },
+    /// An orientation filter refused its settings or data.
+    #[error("{context}: {source}")]
+    Orientation {
+        /// The filter or the data.
+        context: String,
+        /// The core's error.
+        source: OrientError,
+    },
+    /// The Allan deviation refused a column.
+    #[error("{context}: {source}")]
+    Allan {
+        /// The column.
+        context: String,
+        /// The core's error.
+        source: AllanError,
+    },
     /// The kinematics refused the input.
     #[error("{context}: {source}")]
     Kinematics {
@@ -78,6 +137,72 @@ pub enum Error {
         /// The core's error, with its sample index.
         source: KinematicsError,
     },
+}
+
+/// Where an error points, as far as it knows: the scenario key or argument (`field`), the file,
+/// the 1-based row (the header is row 1) and the column. Front ends show it to programs (Python's
+/// `ImuError.field`, `.file`, `.row`, `.column`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Location {
+    /// Dotted key or argument name, e.g. `imu.gyroscope.noise_density`.
+    pub field: Option<String>,
+    /// The file.
+    pub file: Option<PathBuf>,
+    /// The row in the file.
+    pub row: Option<usize>,
+    /// The column name.
+    pub column: Option<String>,
+}
+
+impl Error {
+    /// Where the error points.
+    #[must_use]
+    pub fn location(&self) -> Location {
+        let field = |f: &str| Location {
+            field: Some(f.to_string()),
+            ..Location::default()
+        };
+        let file = |f: &std::path::Path| Location {
+            file: Some(f.to_path_buf()),
+            ..Location::default()
+        };
+        match self {
+            Self::Io { path, .. } => file(path),
+            Self::Scenario { .. } => Location::default(),
+            Self::Invalid { field: f, .. }
+            | Self::Expression { field: f, .. }
+            | Self::BadQuaternion { field: f } => field(f),
+            Self::CsvValue {
+                file: f,
+                row,
+                column,
+                ..
+            } => Location {
+                file: Some(f.clone()),
+                row: Some(*row),
+                column: Some(column.clone()),
+                field: None,
+            },
+            Self::CsvFormat { file: f, .. } => file(f),
+            Self::MissingColumns {
+                file: f, missing, ..
+            } => Location {
+                column: missing.first().cloned(),
+                ..file(f)
+            },
+            Self::Param { context, source } => field(&format!("{context}.{}", source.field())),
+            Self::ImuParam { context, source } => field(&format!(
+                "{context}.{}.{}",
+                source.sensor,
+                source.source.field()
+            )),
+            Self::Kinematics { context, .. }
+            | Self::Strapdown { context, .. }
+            | Self::Planar { context, .. }
+            | Self::Orientation { context, .. }
+            | Self::Allan { context, .. } => field(context),
+        }
+    }
 }
 
 /// Result with [`Error`].

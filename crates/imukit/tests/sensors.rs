@@ -221,7 +221,7 @@ fn parameter_files_round_trip_through_toml() {
         ..SensorParams::default()
     };
     let text = to_toml(&file);
-    let doc: serde_json::Value = toml::from_str(&text).unwrap();
+    let doc: imukit::io::params::ParamValue = toml::from_str(&text).unwrap();
     let back = parse_any_document(&doc, "round trip", None, Profile::Default).unwrap();
     assert_eq!(back, file, "{text}");
 }

@@ -1,15 +1,13 @@
-//! `imukit integrate IMU [--planar] … --out NAV.csv`.
+//! `imukit integrate IMU [--planar] … --out NAV.csv`: flags into the library's request types
+//! ([`NavRequest`], [`PlanarRequest`]), which check them; their errors are renamed to the flags.
 use std::path::Path;
 
-use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
-use imu_core::strapdown::step::StrapdownOptions;
-use imu_core::{AccelSign, EulerZyx};
-use imukit::run::navigate::{InitialState, NavScheme, NavSetup, integrate_csv};
-use imukit::run::planar::read_planar;
-use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
+use imu_core::EulerZyx;
+use imukit::run::navigate::{InitialState, NavRequest, integrate_csv};
+use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
-use super::CliError;
+use crate::CliError;
 
 /// Arguments shared by the planar and the 3D integration.
 pub struct Common<'a> {
@@ -23,7 +21,7 @@ pub struct Common<'a> {
 pub struct Options3d<'a> {
     pub init: Option<&'a Path>,
     pub nav_frame: &'a str,
-    pub gravity: f64,
+    pub gravity_m_s2: f64,
     pub accel_sign: &'a str,
     pub corrections: bool,
     pub euler0: Option<&'a [f64]>,
@@ -31,12 +29,25 @@ pub struct Options3d<'a> {
     pub substeps: usize,
 }
 
-fn invalid(field: &str, message: String) -> CliError {
-    Error::Invalid {
-        field: field.into(),
-        message,
+/// The flag that sets a request field.
+fn flag(field: &str) -> String {
+    match field {
+        "position0_m" => "--position0".into(),
+        "velocity0_m_s" => "--velocity0".into(),
+        "heading0_rad" => "--heading0".into(),
+        other => format!("--{}", other.replace('_', "-")),
     }
-    .into()
+}
+
+/// A request's refusal, named by its flag.
+fn by_flag(e: Error) -> Error {
+    match e {
+        Error::Invalid { field, message } => Error::Invalid {
+            field: flag(&field),
+            message,
+        },
+        other => other,
+    }
 }
 
 fn vector<const K: usize>(
@@ -47,54 +58,46 @@ fn vector<const K: usize>(
     match v {
         None => Ok(default),
         Some(v) if v.len() == K => Ok(std::array::from_fn(|i| v[i])),
-        Some(v) => Err(invalid(
-            flag,
-            format!("expected {K} numbers, got {}", v.len()),
-        )),
+        Some(v) => Err(Error::Invalid {
+            field: flag.into(),
+            message: format!("expected {K} numbers, got {}", v.len()),
+        }
+        .into()),
     }
 }
 
-/// Parses a planar scheme name.
-pub fn scheme(name: &str) -> Result<PlanarScheme, CliError> {
-    match name {
-        "trapezoid" => Ok(PlanarScheme::Trapezoid),
-        "exercise" => Ok(PlanarScheme::Exercise),
-        other => Err(invalid(
-            "--scheme",
-            format!("unknown scheme \"{other}\" (trapezoid, exercise)"),
-        )),
-    }
-}
-
-pub fn planar(c: &Common<'_>, scheme_name: &str, heading0: f64) -> Result<(), CliError> {
-    let scheme = scheme(scheme_name)?;
-    let samples = read_planar(c.input)?;
-    let p0 = vector("--position0", c.position0, [100.0, 100.0])?;
-    let v0 = vector("--velocity0", c.velocity0, [0.0, 0.0])?;
-    let (s, co) = heading0.sin_cos();
-    let initial = PlanarState {
-        t_s: samples.first().map_or(0.0, |s| s.t_s),
-        position_m: p0,
-        heading_rad: heading0,
-        velocity_nav_m_s: v0,
-        velocity_body_m_s: [co * v0[0] + s * v0[1], -s * v0[0] + co * v0[1]],
+pub fn planar(c: &Common<'_>, scheme: &str, heading0_rad: f64) -> Result<(), CliError> {
+    let request = PlanarRequest {
+        scheme,
+        position0_m: vector("--position0", c.position0, EXERCISE_POSITION0_M)?,
+        heading0_rad,
+        velocity0_m_s: vector("--velocity0", c.velocity0, [0.0, 0.0])?,
     };
-    let nav = imukit::run::planar::integrate(&samples, scheme, initial)
-        .map_err(|e| invalid(&c.input.display().to_string(), e.to_string()))?;
+    let scheme_rules = request.scheme().map_err(by_flag)?;
+    let samples = read_planar(c.input)?;
+    let t0 = samples.first().map_or(0.0, |x| x.t_s);
+    let initial = request.initial_state(t0).map_err(by_flag)?;
+    let nav = integrate(&samples, scheme_rules, initial).map_err(|e| Error::Invalid {
+        field: c.input.display().to_string(),
+        message: e.to_string(),
+    })?;
     nav.write_csv(c.out)?;
-    report(&nav, &format!("{scheme_name} scheme"), c.out);
+    report(&nav, &format!("{scheme} scheme"), c.out);
     Ok(())
 }
 
 pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
-    let nav_frame: NavFrameName = parse_name("--nav-frame", &o.nav_frame.to_ascii_uppercase())?;
-    let sign: AccelSign = parse_name::<AccelSignName>("--accel-sign", o.accel_sign)?.into();
-    if !(o.gravity.is_finite() && o.gravity >= 0.0) {
-        return Err(invalid(
-            "--gravity",
-            format!("must be a finite number ≥ 0, got {}", o.gravity),
-        ));
+    let setup = NavRequest {
+        nav_frame: o.nav_frame,
+        accel_sign: o.accel_sign,
+        scheme: o.scheme,
+        substeps: o.substeps,
+        gravity_m_s2: o.gravity_m_s2,
+        coning: o.corrections,
+        sculling: o.corrections,
     }
+    .setup()
+    .map_err(by_flag)?;
     let mut initial = match o.init {
         Some(p) => InitialState::from_csv(p)?,
         None => InitialState::default(),
@@ -113,33 +116,13 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
             EulerZyx::from_array(e),
         );
     }
-    let scheme = match o.scheme {
-        "coning" => NavScheme::ConingSculling,
-        "rk4" if o.substeps >= 1 => NavScheme::Rk4 {
-            substeps: o.substeps,
-        },
-        "rk4" => return Err(invalid("--substeps", "must be ≥ 1".into())),
-        other => {
-            return Err(invalid(
-                "--scheme",
-                format!("unknown 3D scheme \"{other}\" (coning, rk4)"),
-            ));
-        }
-    };
-    let setup = NavSetup {
-        scheme,
-        nav_frame,
-        options: StrapdownOptions {
-            gravity_m_s2: o.gravity,
-            coning: o.corrections,
-            sculling: o.corrections,
-        },
-        accel_sign: sign,
-    };
-    // Streamed for the coning scheme: memory does not grow with the input file.
+    // Streamed: memory does not grow with the input file.
     let summary = integrate_csv(c.input, &initial, &setup, c.out).map_err(|e| match e {
-        Error::Invalid { .. } => invalid(&c.input.display().to_string(), e.to_string()),
-        other => other.into(),
+        Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
+            field: c.input.display().to_string(),
+            message: e.to_string(),
+        },
+        other => other,
     })?;
     let [x, y, z] = summary.end_position_m;
     eprintln!(

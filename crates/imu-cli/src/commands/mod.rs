@@ -29,7 +29,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             input,
             init,
             nav_frame,
-            gravity,
+            gravity_m_s2,
             accel_sign,
             no_corrections,
             euler0,
@@ -53,7 +53,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 let opts = integrate::Options3d {
                     init: init.as_deref(),
                     nav_frame: &nav_frame,
-                    gravity,
+                    gravity_m_s2,
                     accel_sign: &accel_sign,
                     corrections: !no_corrections,
                     euler0: euler0.as_deref(),

@@ -113,7 +113,7 @@ impl Default for KalmanParams {
             magnetic_disturbance_noise: 0.5,
             magnetic_disturbance_decay: 0.5,
             expected_magnetic_field_ut: 50.0,
-            gravity_m_s2: 9.81,
+            gravity_m_s2: crate::frame::DEFAULT_GRAVITY_M_S2,
             accel_sign: AccelSign::Matlab,
         }
     }

@@ -46,6 +46,20 @@ pub enum ParamError {
     },
 }
 
+impl ParamError {
+    /// The parameter's name (`noise_density`, `bias_instability_coefficients`, …).
+    #[must_use]
+    pub fn field(&self) -> &'static str {
+        match *self {
+            Self::NotFinite { field, .. }
+            | Self::Negative { field, .. }
+            | Self::NotPositive { field, .. }
+            | Self::OutOfRange { field, .. } => field,
+            Self::BadFilter { .. } => "bias_instability_coefficients",
+        }
+    }
+}
+
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {

@@ -55,7 +55,7 @@ pub struct StrapdownOptions {
 impl Default for StrapdownOptions {
     fn default() -> Self {
         Self {
-            gravity_m_s2: 9.81,
+            gravity_m_s2: crate::frame::DEFAULT_GRAVITY_M_S2,
             coning: true,
             sculling: true,
         }

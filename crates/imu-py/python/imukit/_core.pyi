@@ -20,6 +20,10 @@ __all__ = [
     "ecompass",
     "quaternion_distance",
     "simulate_text",
+    "simulate_dict",
+    "animation_scene",
+    "points_enu",
+    "poses_enu",
     "truth_from_expressions",
     "truth_from_samples",
     "ideal_imu",
@@ -49,10 +53,17 @@ __all__ = [
     "builtin_toml",
 ]
 
-class ImuError(ValueError): ...
+class ImuError(ValueError):
+    field: Optional[str]
+    file: Optional[str]
+    row: Optional[int]
+    column: Optional[str]
 
 def simulate_text(
     text: str, *, format: str = "toml", origin: str = "scenario", base_dir: str = ".", run: Optional[int] = None
+) -> tuple[_Table, _Table]: ...
+def simulate_dict(
+    scenario: dict[str, Any], *, origin: str = "scenario dict", base_dir: str = ".", run: Optional[int] = None
 ) -> tuple[_Table, _Table]: ...
 def truth_from_expressions(
     t_s: npt.NDArray[np.float64],
@@ -83,7 +94,7 @@ def ideal_imu(
     *,
     lever_arm_m: Sequence[float] = ...,
     accel_sign: str = "specific-force",
-    gravity_m_s2: float = 9.81,
+    gravity_m_s2: float = ...,
     magnetic_field_ut: Optional[Sequence[float]] = None,
     nav_frame: str = "ENU",
     kind: str = "accel-gyro-mag",
@@ -115,9 +126,9 @@ class ImuSensor:
         sample_rate: float = 100.0,
         temperature: float = 25.0,
         magnetic_field: Optional[Sequence[float]] = None,
-        accelerometer: Optional[str] = None,
-        gyroscope: Optional[str] = None,
-        magnetometer: Optional[str] = None,
+        accelerometer: Optional[dict[str, Any]] = None,
+        gyroscope: Optional[dict[str, Any]] = None,
+        magnetometer: Optional[dict[str, Any]] = None,
         preset: Optional[str] = None,
         seed: int = 0,
         profile: str = "matlab",
@@ -164,16 +175,19 @@ def strapdown(
     columns: Sequence[str],
     values: npt.NDArray[np.float64],
     *,
-    position0_m: Sequence[float],
-    velocity0_m_s: Sequence[float],
-    quaternion0: Sequence[float],
+    initial_columns: Optional[Sequence[str]] = None,
+    initial_values: Optional[npt.NDArray[np.float64]] = None,
+    position0_m: Optional[Sequence[float]] = None,
+    velocity0_m_s: Optional[Sequence[float]] = None,
+    quaternion0: Optional[Sequence[float]] = None,
+    euler0_rad: Optional[Sequence[float]] = None,
     nav_frame: str = "ENU",
-    gravity_m_s2: float = 9.81,
+    gravity_m_s2: float = ...,
     coning: bool = True,
     sculling: bool = True,
     accel_sign: str = "specific-force",
     scheme: str = "coning",
-    substeps: int = 4,
+    substeps: int = ...,
 ) -> _Table: ...
 def compare(
     truth_columns: Sequence[str],
@@ -206,6 +220,13 @@ def figure_panels(kind: str) -> list[tuple[str, str, float, list[tuple[str, str]
 def frame_plan(t_s: npt.NDArray[np.float64], fps: float, speed: Optional[float] = None) -> tuple[list[int], float]: ...
 def default_body_m(extent_m: float) -> list[float]: ...
 def leaves_plane(points: npt.NDArray[np.float64]) -> bool: ...
+def animation_scene(
+    body_m: Sequence[float],
+) -> tuple[npt.NDArray[np.float64], list[tuple[int, int]], list[int]]: ...
+def points_enu(points: npt.NDArray[np.float64], nav_frame: str) -> npt.NDArray[np.float64]: ...
+def poses_enu(
+    position_m: npt.NDArray[np.float64], quaternion: npt.NDArray[np.float64], nav_frame: str
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def write_csv(path: str, columns: list[str], values: npt.NDArray[np.float64]) -> None: ...
 def run_path(out: str, run: int, runs: int) -> str: ...
 @final

@@ -7,7 +7,6 @@ bit).
 """
 from __future__ import annotations
 
-import json
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -31,10 +30,11 @@ class MonteCarlo:
     truth: Any  # imukit.Table
 
 
-def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[str, str, str, str]:
-    """(text, format, origin, base_dir): what a worker needs, without reading files itself."""
+def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[Any, str, str, str]:
+    """(text or dict, format, origin, base_dir): what a worker needs, without reading files
+    itself."""
     if isinstance(scenario, Mapping):
-        return json.dumps(scenario), "json", "scenario dict", os.getcwd()
+        return dict(scenario), "dict", "scenario dict", os.getcwd()
     path = Path(scenario)
     try:
         text = path.read_text(encoding="utf-8")
@@ -44,10 +44,13 @@ def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[str, str
     return text, fmt, str(path), str(path.parent.resolve())
 
 
-def _run(spec: Tuple[str, str, str, str], run: int, out: Optional[str], runs: int, with_truth: bool):
+def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: int, with_truth: bool):
     """One run (a Dask task or a thread's job): the IMU table, or the path it was written to."""
     text, fmt, origin, base_dir = spec
-    truth, imu = _core.simulate_text(text, format=fmt, origin=origin, base_dir=base_dir, run=run)
+    if fmt == "dict":
+        truth, imu = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run)
+    else:
+        truth, imu = _core.simulate_text(text, format=fmt, origin=origin, base_dir=base_dir, run=run)
     if out is None:
         return imu, (truth if with_truth else None)
     path = _core.run_path(out, run, runs)

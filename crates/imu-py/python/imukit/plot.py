@@ -98,18 +98,11 @@ def _kinds(tables: list) -> str:
     return first
 
 
-def _ned(nav_frame: str) -> bool:
-    if nav_frame.upper() not in ("ENU", "NED"):
-        raise ImuError(f"nav_frame: unknown frame {nav_frame!r}; ENU or NED")
-    return nav_frame.upper() == "NED"
-
-
-def _points(t: Table, ned: bool = False) -> np.ndarray:
-    """Positions (N, 3); NED ones as east, north, up."""
+def _points(t: Table, nav_frame: str = "ENU") -> np.ndarray:
+    """Positions (N, 3) in east, north, up (NED ones turned as ``imukit plot`` turns them)."""
     z = t["pos_z_m"] if "pos_z_m" in t else np.zeros(len(t))
-    if ned:
-        return np.column_stack([t["pos_y_m"], t["pos_x_m"], -z])
-    return np.column_stack([t["pos_x_m"], t["pos_y_m"], z])
+    p = np.ascontiguousarray(np.column_stack([t["pos_x_m"], t["pos_y_m"], z]))
+    return _core.points_enu(p, nav_frame)
 
 
 def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: Any = None,
@@ -118,8 +111,7 @@ def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: A
     they stay in a plane, in 3D otherwise; start ● and end ✕ marked; ``nav_frame="NED"`` paths
     are drawn east, north, up. Returns the figure."""
     loaded = _load(tables, labels)
-    ned = _ned(nav_frame)
-    paths = [(name, _points(t, ned)) for name, t in loaded]
+    paths = [(name, _points(t, nav_frame)) for name, t in loaded]
     three_d = _core.leaves_plane(np.ascontiguousarray(np.vstack([p for _, p in paths])))
     if ax is None:
         fig = _pyplot().figure(figsize=(6.4, 4.8))
@@ -205,7 +197,7 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None, nav_frame
     fig = plt.figure(figsize=(5.6 * ncols, 3.2 * nrows), layout="constrained")
     index = 1
     if with_path:
-        points = np.vstack([_points(t, _ned(nav_frame)) for _, t in loaded])
+        points = np.vstack([_points(t, nav_frame) for _, t in loaded])
         three_d = _core.leaves_plane(np.ascontiguousarray(points))
         ax = fig.add_subplot(nrows, ncols, index, projection="3d" if three_d else None)
         trajectory(*[t for _, t in loaded], labels=[n for n, _ in loaded], ax=ax, nav_frame=nav_frame)
@@ -248,20 +240,16 @@ def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
     if lever.shape != (3,) or not np.all(np.isfinite(lever)):
         raise ValueError("lever_arm_m must be 3 finite numbers")
     frames, speed_used = _core.frame_plan(np.ascontiguousarray(t["t_s"]), float(fps), speed)
-    ned = _ned(nav_frame)
-    p = _points(t, ned)
+    q_nb = np.ascontiguousarray(np.column_stack([t["q_w"], t["q_x"], t["q_y"], t["q_z"]]))
+    position = np.ascontiguousarray(np.column_stack([t["pos_x_m"], t["pos_y_m"], t["pos_z_m"]]))
+    # Drawn in east, north, up; the body axes stay those of the data (the same turn as imukit animate).
+    p, q = _core.poses_enu(position, q_nb, nav_frame)
     extent = float(np.max(np.ptp(p, axis=0)))
     body = np.asarray(_core.default_body_m(extent) if body_m is None else body_m, dtype=np.float64)
     if body.shape != (3,) or not np.all(body > 0):
         raise ValueError("body_m must be 3 positive numbers (length, width, height)")
-    dcm = quaternion_to_dcm(np.column_stack([t["q_w"], t["q_x"], t["q_y"], t["q_z"]])[frames])
-    if ned:  # the body axes stay those of the data: C_enu,b = C_enu,ned · C_ned,b
-        dcm = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]) @ dcm
-    half = body / 2.0
-    corners = np.array([[(-1) ** (1 + (i & 1)) * half[0], (-1) ** (1 + ((i >> 1) & 1)) * half[1],
-                         (-1) ** (1 + ((i >> 2) & 1)) * half[2]] for i in range(8)])
-    edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)]
-    nose = [1, 3, 7, 5]
+    dcm = quaternion_to_dcm(q[frames])
+    corners, edges, nose = _core.animation_scene([float(b) for b in body])
 
     fig = _pyplot().figure(figsize=(6.4, 4.8))
     ax = fig.add_subplot(projection="3d")

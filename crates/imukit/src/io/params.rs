@@ -33,9 +33,80 @@ use imu_core::AccelSign;
 use imu_core::sensor::{
     BiasInstabilityModel, FilterCoefficients, GyroAccelerationInput, NoiseType, SensorParams,
 };
-use serde_json::Value;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
+
+/// A value as written in a parameter or scenario file or handed over from Python: a boolean, an
+/// integer, a number (infinity allowed where the key allows it; TOML writes `inf`, MATLAB's
+/// JSON `"inf"`), a string, a list (vectors, 3×3 matrices, filter coefficients) or a table of
+/// named values. Typed all the way from the file or the Python object: no value passes through
+/// JSON text (which has no infinity).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    /// `true`/`false`.
+    Bool(bool),
+    /// An integer (a seed, a count); also a number where one is expected.
+    Integer(i64),
+    /// A number.
+    Number(f64),
+    /// A string (`"inf"`, `"single-sided"`).
+    Text(String),
+    /// A list of values.
+    List(Vec<ParamValue>),
+    /// Named values (a sensor's parameters, MATLAB's `BiasInstabilityCoefficients`).
+    Table(BTreeMap<String, ParamValue>),
+    /// JSON's `null`.
+    Null,
+}
+
+/// One sensor's parameters by name (imukit's unit-suffixed keys or MATLAB's property names).
+pub type SensorTable = BTreeMap<String, ParamValue>;
+
+impl ParamValue {
+    /// True for a list.
+    #[must_use]
+    pub fn is_list(&self) -> bool {
+        matches!(self, Self::List(_))
+    }
+
+    /// The string, when this is one.
+    #[must_use]
+    pub fn as_str(&self) -> Option<&str> {
+        match self {
+            Self::Text(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for ParamValue {
+    /// Written as JSON writes it, for messages.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Bool(b) => write!(f, "{b}"),
+            Self::Integer(i) => write!(f, "{i}"),
+            Self::Number(x) => write!(f, "{x:?}"),
+            Self::Text(t) => write!(f, "{t:?}"),
+            Self::Null => write!(f, "null"),
+            Self::List(l) => {
+                write!(f, "[")?;
+                for (k, v) in l.iter().enumerate() {
+                    write!(f, "{}{v}", if k == 0 { "" } else { "," })?;
+                }
+                write!(f, "]")
+            }
+            Self::Table(t) => {
+                write!(f, "{{")?;
+                for (k, (name, v)) in t.iter().enumerate() {
+                    write!(f, "{}{name:?}:{v}", if k == 0 { "" } else { "," })?;
+                }
+                write!(f, "}}")
+            }
+        }
+    }
+}
 
 /// The three sensors of an IMU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -155,21 +226,22 @@ impl Profile {
     }
 }
 
-fn as_number(v: &Value, field: &str) -> Result<f64> {
+fn as_number(v: &ParamValue, field: &str) -> Result<f64> {
     match v {
-        Value::Number(n) => n.as_f64().ok_or_else(|| invalid(field, "not a number")),
-        Value::String(s)
+        ParamValue::Number(x) if x.is_nan() => Err(invalid(field, "not a finite number (NaN)")),
+        ParamValue::Number(x) => Ok(*x),
+        #[allow(clippy::cast_precision_loss)]
+        ParamValue::Integer(i) => Ok(*i as f64),
+        ParamValue::Text(s)
             if matches!(s.to_ascii_lowercase().as_str(), "inf" | "infinity" | "+inf") =>
         {
             Ok(f64::INFINITY)
         }
-        // TOML's nan arrives here as null (JSON has no NaN).
-        Value::Null => Err(invalid(field, "not a finite number (NaN)")),
         other => Err(invalid(field, format!("expected a number, got {other}"))),
     }
 }
 
-fn finite_number(v: &Value, field: &str) -> Result<f64> {
+fn finite_number(v: &ParamValue, field: &str) -> Result<f64> {
     let x = as_number(v, field)?;
     if x.is_finite() {
         Ok(x)
@@ -179,14 +251,14 @@ fn finite_number(v: &Value, field: &str) -> Result<f64> {
 }
 
 /// A number (same on every axis) or a 3-vector.
-fn triple(v: &Value, field: &str) -> Result<[f64; 3]> {
+fn triple(v: &ParamValue, field: &str) -> Result<[f64; 3]> {
     match v {
-        Value::Array(a) if a.len() == 3 => Ok([
+        ParamValue::List(a) if a.len() == 3 => Ok([
             finite_number(&a[0], &format!("{field}[0]"))?,
             finite_number(&a[1], &format!("{field}[1]"))?,
             finite_number(&a[2], &format!("{field}[2]"))?,
         ]),
-        Value::Array(a) => Err(invalid(
+        ParamValue::List(a) => Err(invalid(
             field,
             format!("expected a number or 3 numbers, got {} values", a.len()),
         )),
@@ -195,25 +267,25 @@ fn triple(v: &Value, field: &str) -> Result<[f64; 3]> {
 }
 
 /// MATLAB's AxesMisalignment forms: scalar, 3-vector or 3×3, percent.
-fn misalignment(v: &Value, field: &str) -> Result<[[f64; 3]; 3]> {
+fn misalignment(v: &ParamValue, field: &str) -> Result<[[f64; 3]; 3]> {
     match v {
-        Value::Array(rows) if rows.len() == 3 && rows.iter().all(Value::is_array) => {
+        ParamValue::List(rows) if rows.len() == 3 && rows.iter().all(ParamValue::is_list) => {
             let mut m = [[0.0; 3]; 3];
             for (i, row) in rows.iter().enumerate() {
                 m[i] = triple(row, &format!("{field}[{i}]"))?;
             }
             Ok(m)
         }
-        Value::Array(_) => Ok(SensorParams::misalignment_from_vector(triple(v, field)?)),
+        ParamValue::List(_) => Ok(SensorParams::misalignment_from_vector(triple(v, field)?)),
         other => Ok(SensorParams::misalignment_from_scalar(finite_number(
             other, field,
         )?)),
     }
 }
 
-fn list(v: &Value, field: &str) -> Result<Vec<f64>> {
+fn list(v: &ParamValue, field: &str) -> Result<Vec<f64>> {
     match v {
-        Value::Array(a) => a
+        ParamValue::List(a) => a
             .iter()
             .enumerate()
             .map(|(k, x)| finite_number(x, &format!("{field}[{k}]")))
@@ -222,7 +294,7 @@ fn list(v: &Value, field: &str) -> Result<Vec<f64>> {
     }
 }
 
-fn noise_type(v: &Value, field: &str) -> Result<NoiseType> {
+fn noise_type(v: &ParamValue, field: &str) -> Result<NoiseType> {
     match v.as_str().map(str::to_ascii_lowercase).as_deref() {
         Some("single-sided") => Ok(NoiseType::SingleSided),
         Some("double-sided") => Ok(NoiseType::DoubleSided),
@@ -240,15 +312,12 @@ fn noise_type(v: &Value, field: &str) -> Result<NoiseType> {
 /// # Errors
 /// Unknown keys (the known ones listed), bad values, invalid parameters — each named.
 pub fn parse_sensor(
-    table: &Value,
+    map: &SensorTable,
     sensor: Sensor,
     prefix: &str,
     default_noise: Option<NoiseType>,
     base: SensorParams,
 ) -> Result<SensorParams> {
-    let Value::Object(map) = table else {
-        return Err(invalid(prefix, "expected a table of parameters"));
-    };
     let u = sensor.unit();
     let key = |name: &str| format!("{name}_{u}");
     let mut p = base;
@@ -290,8 +359,11 @@ pub fn parse_sensor(
             (Some(6), _) => numerator = Some(list(v, &field)?),
             (Some(7), _) => denominator = Some(list(v, &field)?),
             (_, "BiasInstabilityCoefficients") => {
+                let ParamValue::Table(t) = v else {
+                    return Err(invalid(field, "needs Numerator and Denominator"));
+                };
                 let get = |name: &str| {
-                    v.get(name)
+                    t.get(name)
                         .map(|x| list(x, &format!("{field}.{name}")))
                         .transpose()
                 };
@@ -319,9 +391,10 @@ pub fn parse_sensor(
                 p.temperature_scale_factor_pct = triple(v, &field)?
             }
             (Some(15), _) => {
-                p.quantization_carry = v.as_bool().ok_or_else(|| {
-                    invalid(field.clone(), format!("expected true or false, got {v}"))
-                })?;
+                let ParamValue::Bool(carry) = v else {
+                    return Err(invalid(field, format!("expected true or false, got {v}")));
+                };
+                p.quantization_carry = *carry;
             }
             (Some(14), _) | (_, "AccelerationBias") if sensor == Sensor::Gyroscope => {
                 p.acceleration_bias = triple(v, &field)?;
@@ -355,11 +428,9 @@ pub fn parse_sensor(
     if numerator.is_some() || denominator.is_some() {
         let num = numerator.unwrap_or_else(|| vec![1.0]);
         let den = denominator.unwrap_or_else(|| vec![1.0, -0.5]);
-        let c = FilterCoefficients::new(&num, &den).map_err(|e| {
-            invalid(
-                format!("{prefix}.bias_instability_coefficients"),
-                e.to_string(),
-            )
+        let c = FilterCoefficients::new(&num, &den).map_err(|source| Error::Param {
+            context: prefix.into(),
+            source,
         })?;
         p.bias_instability_model = BiasInstabilityModel::Filter(c);
     }
@@ -372,7 +443,10 @@ pub fn parse_sensor(
     if let Some(correlation_time_s) = correlation {
         p.bias_instability_model = BiasInstabilityModel::GaussMarkov { correlation_time_s };
     }
-    p.validate().map_err(|e| invalid(prefix, e.to_string()))?;
+    p.validate().map_err(|source| Error::Param {
+        context: prefix.into(),
+        source,
+    })?;
     Ok(p)
 }
 
@@ -394,8 +468,8 @@ const INFO_KEYS: [&str; 4] = ["name", "grade", "source", "notes"];
 ///
 /// # Errors
 /// As [`parse_sensor`]; unknown top-level keys.
-pub fn parse_param_document(doc: &Value, origin: &str, profile: Profile) -> Result<ParamFile> {
-    let Value::Object(map) = doc else {
+pub fn parse_param_document(doc: &ParamValue, origin: &str, profile: Profile) -> Result<ParamFile> {
+    let ParamValue::Table(map) = doc else {
         return Err(invalid(
             origin,
             "expected a table with accelerometer, gyroscope, magnetometer",
@@ -409,8 +483,14 @@ pub fn parse_param_document(doc: &Value, origin: &str, profile: Profile) -> Resu
         {
             let s = Sensor::ALL[i];
             let noise = Some(profile.noise_type());
+            let ParamValue::Table(table) = v else {
+                return Err(invalid(
+                    format!("{origin}: {k}"),
+                    "expected a table of parameters",
+                ));
+            };
             *out.params.get_mut(s) = parse_sensor(
-                v,
+                table,
                 s,
                 &format!("{origin}: {k}"),
                 noise,
@@ -446,7 +526,7 @@ pub fn read_param_file(path: &Path, part: Option<&str>, profile: Profile) -> Res
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let doc: Value = if is_json {
+    let doc: ParamValue = if is_json {
         serde_json::from_str(&text).map_err(|e| Error::Scenario {
             origin: origin.clone(),
             message: e.to_string(),
@@ -465,12 +545,12 @@ pub fn read_param_file(path: &Path, part: Option<&str>, profile: Profile) -> Res
 /// # Errors
 /// As [`read_param_file`].
 pub fn parse_any_document(
-    doc: &Value,
+    doc: &ParamValue,
     origin: &str,
     part: Option<&str>,
     profile: Profile,
 ) -> Result<ParamFile> {
-    let Value::Object(map) = doc else {
+    let ParamValue::Table(map) = doc else {
         return Err(invalid(origin, "expected a table"));
     };
     let is_sensor_key = |k: &str| {

@@ -6,7 +6,6 @@
 //! "bias instability" quoted as an Allan minimum turned into the flicker model's
 //! `B = minimum/0.664` over an assumed τ range of 1–1000 s. Where a datasheet value was not
 //! transcribed, the field keeps its ideal value and the preset's `notes` say so.
-use serde_json::Value;
 
 use crate::error::{Error, Result, invalid};
 use crate::io::params::{ParamFile, Profile, parse_param_document};
@@ -58,9 +57,10 @@ pub fn text(name: &str) -> Result<&'static str> {
 /// # Errors
 /// Unknown preset.
 pub fn load(name: &str) -> Result<ParamFile> {
-    let doc: Value = toml::from_str(text(name)?).map_err(|e| Error::Scenario {
-        origin: format!("preset {name}"),
-        message: e.to_string(),
-    })?;
+    let doc: crate::io::params::ParamValue =
+        toml::from_str(text(name)?).map_err(|e| Error::Scenario {
+            origin: format!("preset {name}"),
+            message: e.to_string(),
+        })?;
     parse_param_document(&doc, &format!("preset {name}"), Profile::Default)
 }

@@ -76,6 +76,15 @@ pub enum ImuKind {
 }
 
 impl ImuKind {
+    /// The name as scenario files and MATLAB write it (`"accel-gyro"`, …).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::AccelGyro => "accel-gyro",
+            Self::AccelMag => "accel-mag",
+            Self::AccelGyroMag => "accel-gyro-mag",
+        }
+    }
     /// True when the kind includes a gyroscope.
     #[must_use]
     pub fn has_gyro(self) -> bool {

@@ -36,8 +36,12 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
     let mut theta = vec![0.0; n];
     for (name, x) in columns {
         let mut adev = vec![0.0; count];
-        allan_deviation(x, sample_rate_hz, &m, &mut theta, &mut adev)
-            .map_err(|e| invalid(name.clone(), e.to_string()))?;
+        allan_deviation(x, sample_rate_hz, &m, &mut theta, &mut adev).map_err(|source| {
+            crate::Error::Allan {
+                context: name.clone(),
+                source,
+            }
+        })?;
         noise.push((name.clone(), identify_noise(&tau, &adev)));
         names.push(format!("adev_{name}"));
         curves.push(adev);

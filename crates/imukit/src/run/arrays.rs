@@ -7,9 +7,11 @@ use imu_core::kinematics::tangent::tangent_series;
 use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth, Vec3};
 
 use crate::error::{Error, Result, invalid};
+use crate::io::table::ImuKind;
 use crate::io::table::{TRUTH_COLUMNS, Table};
 use crate::motion::{ExpressionMotion, SampledAttitudeData, SampledPath, Trajectory};
-use crate::scenario::{ExpressionSpec, ImuSetup, NavFrameName};
+use crate::scenario::resolve::finite_vec;
+use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName, parse_name};
 
 fn in_frame<T>(nav: NavFrameName, enu: impl FnOnce() -> T, ned: impl FnOnce() -> T) -> T {
     match nav {
@@ -142,12 +144,7 @@ pub fn ideal_from_truth(
     gravity_m_s2: f64,
     nav: NavFrameName,
 ) -> Result<Table> {
-    if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
-        return Err(invalid(
-            "gravity_m_s2",
-            format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
-        ));
-    }
+    crate::scenario::resolve::check_gravity("gravity_m_s2", gravity_m_s2)?;
     fn run<N: NavFrame>(table: &Table, imu: &ImuSetup, g: f64) -> Result<Table> {
         let truth = truth_from_table::<N>(table)?;
         let mount = imu.mount::<N>(g);
@@ -165,6 +162,46 @@ pub fn ideal_from_truth(
         || run::<Enu>(table, imu, gravity_m_s2),
         || run::<Ned>(table, imu, gravity_m_s2),
     )
+}
+
+/// Ideal readings of a truth table as a front end states them (names for the kind, the sign and
+/// the frame); checked once, in [`IdealRequest::run`]. Errors name the fields as written here.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IdealRequest<'a> {
+    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
+    pub kind: &'a str,
+    /// Lever arm from the reference point to the IMU, body frame, m.
+    pub lever_arm_m: [f64; 3],
+    /// `"specific-force"` or `"matlab"`.
+    pub accel_sign: &'a str,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// Magnetic field, navigation frame, µT (`None`: MATLAB's default).
+    pub magnetic_field_ut: Option<[f64; 3]>,
+    /// `"ENU"` or `"NED"` (any case).
+    pub nav_frame: &'a str,
+}
+
+impl IdealRequest<'_> {
+    /// Ideal IMU readings of `truth`.
+    ///
+    /// # Errors
+    /// Unknown names, non-finite vectors (named), and as [`ideal_from_truth`].
+    pub fn run(&self, truth: &Table) -> Result<Table> {
+        let lever_arm_m = finite_vec("lever_arm_m", self.lever_arm_m)?;
+        let magnetic_field_ut = self
+            .magnetic_field_ut
+            .map(|m| finite_vec("magnetic_field_ut", m))
+            .transpose()?;
+        let imu = ImuSetup::ideal(
+            parse_name::<ImuKind>("kind", self.kind)?,
+            lever_arm_m,
+            parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into(),
+            magnetic_field_ut,
+        );
+        let nav = parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?;
+        ideal_from_truth(truth, &imu, self.gravity_m_s2, nav)
+    }
 }
 
 /// Tangent Euler angles of a velocity series (hold at standstill, unwrapped yaw).
@@ -251,4 +288,76 @@ pub fn truth_from_waypoints(
         || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
         || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
     )
+}
+
+/// z-y-x Euler angles `[yaw, pitch, roll]` → quaternions `q_nb` `[w, x, y, z]`, row by row.
+#[must_use]
+pub fn euler_to_quaternion(euler_rad: &[[f64; 3]]) -> Vec<[f64; 4]> {
+    euler_rad
+        .iter()
+        .map(|e| Rotation::<Body, Enu>::from_euler(EulerZyx::from_array(*e)).to_wxyz())
+        .collect()
+}
+
+/// Quaternions `[w, x, y, z]` → rotations, row by row.
+///
+/// # Errors
+/// A quaternion of zero norm or not finite, named `quaternion[i]`.
+fn rotations(quaternion: &[[f64; 4]]) -> Result<Vec<Rotation<Body, Enu>>> {
+    quaternion
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            Rotation::from_wxyz(*q).ok_or_else(|| crate::Error::BadQuaternion {
+                field: format!("quaternion[{i}]"),
+            })
+        })
+        .collect()
+}
+
+/// Quaternions `q_nb` → z-y-x Euler angles, row by row.
+///
+/// # Errors
+/// As [`quaternion_to_dcm`].
+pub fn quaternion_to_euler(quaternion: &[[f64; 4]]) -> Result<Vec<[f64; 3]>> {
+    Ok(rotations(quaternion)?
+        .iter()
+        .map(|r| r.to_euler().to_array())
+        .collect())
+}
+
+/// Quaternions `q_nb` → direction cosine matrices `C_nb`, row by row.
+///
+/// # Errors
+/// A quaternion of zero norm or not finite, named `quaternion[i]`.
+pub fn quaternion_to_dcm(quaternion: &[[f64; 4]]) -> Result<Vec<[[f64; 3]; 3]>> {
+    Ok(rotations(quaternion)?
+        .iter()
+        .map(Rotation::to_dcm)
+        .collect())
+}
+
+/// z-y-x Euler angles → direction cosine matrices `C_nb`, row by row.
+#[must_use]
+pub fn euler_to_dcm(euler_rad: &[[f64; 3]]) -> Vec<[[f64; 3]; 3]> {
+    euler_rad
+        .iter()
+        .map(|e| EulerZyx::from_array(*e).to_dcm())
+        .collect()
+}
+
+/// Direction cosine matrices `C_nb` → z-y-x Euler angles, row by row.
+#[must_use]
+pub fn dcm_to_euler(dcm: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
+    dcm.iter()
+        .map(|c| EulerZyx::from_dcm(c).to_array())
+        .collect()
+}
+
+/// Direction cosine matrices `C_nb` → quaternions `q_nb`, row by row.
+#[must_use]
+pub fn dcm_to_quaternion(dcm: &[[[f64; 3]; 3]]) -> Vec<[f64; 4]> {
+    dcm.iter()
+        .map(|c| Rotation::<Body, Enu>::from_dcm(c).to_wxyz())
+        .collect()
 }

@@ -95,6 +95,27 @@ pub struct ErrorSummary {
 }
 
 impl ErrorSummary {
+    /// Every figure by name with its unit: `position_rms_m`, `position_max_m`,
+    /// `position_final_m`, the same for `velocity` (`_m_s`) and `attitude` (`_rad`); position and
+    /// velocity only for navigation estimates.
+    #[must_use]
+    pub fn entries(&self) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        let mut put = |name: &str, unit: &str, s: &DistanceStats| {
+            out.push((format!("{name}_rms_{unit}"), s.rms()));
+            out.push((format!("{name}_max_{unit}"), s.max()));
+            out.push((format!("{name}_final_{unit}"), s.last()));
+        };
+        if let Some(p) = &self.position {
+            put("position", "m", p);
+        }
+        if let Some(v) = &self.velocity {
+            put("velocity", "m_s", v);
+        }
+        put("attitude", "rad", &self.attitude);
+        out
+    }
+
     /// Rows compared.
     #[must_use]
     pub fn rows(&self) -> usize {

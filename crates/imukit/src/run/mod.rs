@@ -3,6 +3,7 @@
 pub mod allan;
 pub mod arrays;
 pub mod compare;
+pub mod imu_sensor;
 pub mod navigate;
 pub mod orient;
 pub mod planar;

@@ -21,7 +21,8 @@ use crate::error::{Result, invalid};
 use crate::io::table::{
     ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table,
 };
-use crate::scenario::NavFrameName;
+use crate::scenario::resolve::check_gravity;
+use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 
 /// Navigation output columns.
 pub const NAV_COLUMNS: [&str; 14] = [
@@ -74,6 +75,57 @@ impl InitialState {
             position_m,
             velocity_m_s,
             quaternion: Rotation::<imu_core::Body, Enu>::from_euler(euler).to_wxyz(),
+        }
+    }
+
+    /// From a front end's parts: position and velocity (default zero), and the attitude as a
+    /// quaternion `q_nb` or as z-y-x Euler angles (default level). Errors name the fields
+    /// (`position0_m`, `velocity0_m_s`, `quaternion0`, `euler0_rad`).
+    ///
+    /// # Errors
+    /// Both attitudes given, non-finite values, a zero quaternion.
+    pub fn from_parts(
+        position_m: Option<[f64; 3]>,
+        velocity_m_s: Option<[f64; 3]>,
+        quaternion: Option<[f64; 4]>,
+        euler_rad: Option<[f64; 3]>,
+    ) -> Result<Self> {
+        let finite = |field: &str, v: &[f64]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(invalid(field, format!("must be finite, got {v:?}")))
+            }
+        };
+        let position_m = position_m.unwrap_or_default();
+        let velocity_m_s = velocity_m_s.unwrap_or_default();
+        finite("position0_m", &position_m)?;
+        finite("velocity0_m_s", &velocity_m_s)?;
+        match (quaternion, euler_rad) {
+            (Some(_), Some(_)) => Err(invalid(
+                "euler0_rad",
+                "give the attitude as a quaternion or as Euler angles, not both",
+            )),
+            (None, Some(e)) => {
+                finite("euler0_rad", &e)?;
+                Ok(Self::from_euler(
+                    position_m,
+                    velocity_m_s,
+                    EulerZyx::from_array(e),
+                ))
+            }
+            (q, None) => {
+                let quaternion = q.unwrap_or([1.0, 0.0, 0.0, 0.0]);
+                finite("quaternion0", &quaternion)?;
+                if quaternion.iter().all(|c| *c == 0.0) {
+                    return Err(invalid("quaternion0", "has zero norm"));
+                }
+                Ok(Self {
+                    position_m,
+                    velocity_m_s,
+                    quaternion,
+                })
+            }
         }
     }
 
@@ -167,6 +219,98 @@ impl Default for NavSetup {
             accel_sign: AccelSign::SpecificForce,
             scheme: NavScheme::ConingSculling,
         }
+    }
+}
+
+/// The sub-steps per interval of the RK4 scheme unless told otherwise.
+pub const DEFAULT_RK4_SUBSTEPS: usize = 4;
+
+impl std::str::FromStr for NavScheme {
+    type Err = String;
+
+    /// `"coning"` or `"rk4"` (with [`DEFAULT_RK4_SUBSTEPS`]; see [`NavScheme::with_substeps`]).
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s {
+            "coning" => Ok(Self::ConingSculling),
+            "rk4" => Ok(Self::Rk4 {
+                substeps: DEFAULT_RK4_SUBSTEPS,
+            }),
+            other => Err(format!("unknown scheme \"{other}\" (coning, rk4)")),
+        }
+    }
+}
+
+impl NavScheme {
+    /// The same scheme with `substeps` RK4 sub-steps per interval (the coning scheme has none).
+    ///
+    /// # Errors
+    /// Zero sub-steps for RK4.
+    pub fn with_substeps(self, substeps: usize) -> std::result::Result<Self, String> {
+        match self {
+            Self::Rk4 { .. } if substeps == 0 => Err("must be ≥ 1".into()),
+            Self::Rk4 { .. } => Ok(Self::Rk4 { substeps }),
+            other => Ok(other),
+        }
+    }
+}
+
+/// A 3D integration as a front end states it (frame, sign and scheme by name); checked once, in
+/// [`NavRequest::setup`]. Errors name the fields as written here (`nav_frame`, `accel_sign`,
+/// `scheme`, `substeps`, `gravity_m_s2`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavRequest<'a> {
+    /// `"ENU"` or `"NED"` (any case).
+    pub nav_frame: &'a str,
+    /// `"specific-force"` or `"matlab"`.
+    pub accel_sign: &'a str,
+    /// `"coning"` or `"rk4"`.
+    pub scheme: &'a str,
+    /// RK4 sub-steps per interval.
+    pub substeps: usize,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// Two-sample coning correction.
+    pub coning: bool,
+    /// Rotation and sculling corrections.
+    pub sculling: bool,
+}
+
+impl Default for NavRequest<'_> {
+    fn default() -> Self {
+        Self {
+            nav_frame: "ENU",
+            accel_sign: "specific-force",
+            scheme: "coning",
+            substeps: DEFAULT_RK4_SUBSTEPS,
+            gravity_m_s2: imu_core::DEFAULT_GRAVITY_M_S2,
+            coning: true,
+            sculling: true,
+        }
+    }
+}
+
+impl NavRequest<'_> {
+    /// The validated setup.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming the field.
+    pub fn setup(&self) -> Result<NavSetup> {
+        let scheme = self
+            .scheme
+            .parse::<NavScheme>()
+            .map_err(|m| invalid("scheme", m))?
+            .with_substeps(self.substeps)
+            .map_err(|m| invalid("substeps", m))?;
+        Ok(NavSetup {
+            nav_frame: parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?,
+            accel_sign: parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into(),
+            scheme,
+            options: StrapdownOptions {
+                gravity_m_s2: check_gravity("gravity_m_s2", self.gravity_m_s2)?,
+                coning: self.coning,
+                sculling: self.sculling,
+            },
+        })
     }
 }
 
@@ -297,7 +441,10 @@ fn integrate_in<N: NavFrame>(
             "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
         ));
     };
-    result.map_err(|e| invalid("IMU data", e.to_string()))?;
+    result.map_err(|source| crate::Error::Strapdown {
+        context: "IMU data".into(),
+        source,
+    })?;
     let mut table = Table::new(&NAV_COLUMNS);
     let mut last_yaw: Option<f64> = None;
     for s in &out {
@@ -495,7 +642,10 @@ impl<N: NavFrame> Stepper<N> {
     /// gyroscope or Δθ) and emits the states it completes, in order.
     fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, N>) -> Result<()> {
         let (t, force, turn) = (row[0], [row[1], row[2], row[3]], [row[4], row[5], row[6]]);
-        let failed = |e: StrapdownError| invalid("IMU data", e.to_string());
+        let failed = |source: StrapdownError| crate::Error::Strapdown {
+            context: "IMU data".into(),
+            source,
+        };
         match self {
             Self::Rates(r) => emit(r.step(t, turn, force).map_err(failed)?),
             Self::Increments { nav, started } if !*started => {

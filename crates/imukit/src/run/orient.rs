@@ -288,7 +288,10 @@ impl FilterSpec {
     /// Unknown settings, invalid values (named), a magnetometer the filter cannot use.
     pub fn build<N: NavFrame>(&self, sample_rate_hz: f64) -> Result<AnyFilter<N>> {
         let rate = self.sample_rate_hz(sample_rate_hz)?;
-        let refused = |e: imu_core::orientation::OrientError| invalid("filter", e.to_string());
+        let refused = |source: imu_core::orientation::OrientError| crate::Error::Orientation {
+            context: "filter".into(),
+            source,
+        };
         let (sign, mag) = (self.accel_sign, self.magnetometer);
         Ok(match self.kind {
             FilterKind::ImuFilter => {
@@ -525,4 +528,71 @@ pub fn run_rows<N: NavFrame>(
     }
     *filter = working;
     Ok(out)
+}
+
+/// The e-compass of each row: accelerometer and magnetometer rows (three values each, flat) in
+/// frame `nav`, with the accelerometer sign `accel_sign`; four values `q_nb` per row.
+///
+/// # Errors
+/// Slices of different lengths; a row the e-compass refuses (parallel or zero vectors), named
+/// by its index.
+pub fn ecompass_rows(
+    accel: &[f64],
+    mag: &[f64],
+    accel_sign: AccelSign,
+    nav: NavFrameName,
+) -> Result<Vec<f64>> {
+    fn rows<N: NavFrame>(a: &[f64], m: &[f64], s: AccelSign) -> Result<Vec<f64>> {
+        let mut out = Vec::with_capacity(a.len() / 3 * 4);
+        for (i, (a, m)) in a.chunks_exact(3).zip(m.chunks_exact(3)).enumerate() {
+            let q = imu_core::orientation::ecompass::<N>([a[0], a[1], a[2]], [m[0], m[1], m[2]], s)
+                .map_err(|source| crate::Error::Orientation {
+                    context: format!("row {i}"),
+                    source,
+                })?;
+            out.extend(q.to_wxyz());
+        }
+        Ok(out)
+    }
+    if accel.len() != mag.len() {
+        return Err(invalid(
+            "mag",
+            format!("has {} rows, accel {}", mag.len() / 3, accel.len() / 3),
+        ));
+    }
+    match nav {
+        NavFrameName::ENU => rows::<Enu>(accel, mag, accel_sign),
+        NavFrameName::NED => rows::<Ned>(accel, mag, accel_sign),
+    }
+}
+
+/// The quaternion distance (rad) between the rows of two flat lists of quaternions
+/// `[w, x, y, z]` (four values per row).
+///
+/// # Errors
+/// Lists of different lengths; a quaternion of zero norm or not finite, named `q1[i]`/`q2[i]`.
+pub fn quaternion_distances(q1: &[f64], q2: &[f64]) -> Result<Vec<f64>> {
+    if q1.len() != q2.len() {
+        return Err(invalid(
+            "q2",
+            format!("has {} rows, q1 {}", q2.len() / 4, q1.len() / 4),
+        ));
+    }
+    let rotation = |c: &[f64], name: &str, i: usize| {
+        Rotation::<Body, Enu>::from_wxyz([c[0], c[1], c[2], c[3]]).ok_or_else(|| {
+            crate::Error::BadQuaternion {
+                field: format!("{name}[{i}]"),
+            }
+        })
+    };
+    q1.chunks_exact(4)
+        .zip(q2.chunks_exact(4))
+        .enumerate()
+        .map(|(i, (a, b))| {
+            Ok(imu_core::orientation::quaternion_distance(
+                &rotation(a, "q1", i)?,
+                &rotation(b, "q2", i)?,
+            ))
+        })
+        .collect()
 }

@@ -5,7 +5,9 @@
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
 use std::path::Path;
 
-use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
+use imu_core::strapdown::planar::{
+    PlanarSample, PlanarScheme, PlanarState, UnknownPlanarScheme, dead_reckon,
+};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{Table, read_columns, write_atomically, write_rows};
@@ -147,6 +149,102 @@ pub fn write_dat(path: &Path, samples: &[PlanarSample]) -> Result<()> {
     write_atomically(path, |w| write_rows(w, &data, 4, b" "))
 }
 
+/// Planar samples as a table of [`PLANAR_COLUMNS`].
+#[must_use]
+pub fn samples_table(samples: &[PlanarSample]) -> Table {
+    let mut t = Table::new(&PLANAR_COLUMNS);
+    for s in samples {
+        t.push_row(&[s.t_s, s.accel_x_m_s2, s.accel_y_m_s2, s.gyro_z_rad_s]);
+    }
+    t
+}
+
+/// The exercise's start position X₀, m (the default of `imukit integrate --planar` and Python's
+/// `planar_dead_reckon`).
+pub const EXERCISE_POSITION0_M: [f64; 2] = [100.0, 100.0];
+
+/// A planar dead reckoning as a front end states it (the scheme by name); checked once, in
+/// [`PlanarRequest::run`]. Errors name the fields as written here (`scheme`, `position0_m`,
+/// `heading0_rad`, `velocity0_m_s`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanarRequest<'a> {
+    /// `"trapezoid"` or `"exercise"` ([`PlanarScheme::NAMES`]).
+    pub scheme: &'a str,
+    /// Start position, navigation X, Y, m.
+    pub position0_m: [f64; 2],
+    /// Start heading from nav X counter-clockwise, rad.
+    pub heading0_rad: f64,
+    /// Start velocity in the navigation frame, m/s.
+    pub velocity0_m_s: [f64; 2],
+}
+
+impl Default for PlanarRequest<'_> {
+    fn default() -> Self {
+        Self {
+            scheme: "trapezoid",
+            position0_m: EXERCISE_POSITION0_M,
+            heading0_rad: 0.0,
+            velocity0_m_s: [0.0; 2],
+        }
+    }
+}
+
+impl PlanarRequest<'_> {
+    /// The scheme named in the request.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for `scheme`, listing the known names.
+    pub fn scheme(&self) -> Result<PlanarScheme> {
+        self.scheme.parse().map_err(|_: UnknownPlanarScheme| {
+            invalid(
+                "scheme",
+                format!(
+                    "unknown scheme \"{}\" ({})",
+                    self.scheme,
+                    PlanarScheme::NAMES
+                ),
+            )
+        })
+    }
+
+    /// The state at the first sample's time `t0_s`: the body-frame velocity is the navigation
+    /// velocity turned by −heading (`v_b = R(α)ᵀ v_n`).
+    ///
+    /// # Errors
+    /// Non-finite start values, named.
+    pub fn initial_state(&self, t0_s: f64) -> Result<PlanarState> {
+        let finite = |field: &str, v: &[f64]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(invalid(field, format!("must be finite, got {v:?}")))
+            }
+        };
+        finite("position0_m", &self.position0_m)?;
+        finite("heading0_rad", &[self.heading0_rad])?;
+        finite("velocity0_m_s", &self.velocity0_m_s)?;
+        let (s, c) = self.heading0_rad.sin_cos();
+        let v = self.velocity0_m_s;
+        Ok(PlanarState {
+            t_s: t0_s,
+            position_m: self.position0_m,
+            heading_rad: self.heading0_rad,
+            velocity_nav_m_s: v,
+            velocity_body_m_s: [c * v[0] + s * v[1], -s * v[0] + c * v[1]],
+        })
+    }
+
+    /// Dead reckoning of `samples` from this request's start with its scheme.
+    ///
+    /// # Errors
+    /// As [`PlanarRequest::scheme`], [`PlanarRequest::initial_state`] and [`integrate`].
+    pub fn run(&self, samples: &[PlanarSample]) -> Result<Table> {
+        let scheme = self.scheme()?;
+        let initial = self.initial_state(samples.first().map_or(0.0, |x| x.t_s))?;
+        integrate(samples, scheme, initial)
+    }
+}
+
 /// Dead reckoning of planar samples into a navigation table ([`PLANAR_NAV_COLUMNS`]).
 ///
 /// # Errors
@@ -161,8 +259,10 @@ pub fn integrate(
         crate::run::navigate::check_gaps(&t, "planar IMU", 1)?;
     }
     let mut states = vec![PlanarState::default(); samples.len()];
-    dead_reckon(samples, scheme, initial, &mut states)
-        .map_err(|e| invalid("planar IMU", e.to_string()))?;
+    dead_reckon(samples, scheme, initial, &mut states).map_err(|source| Error::Planar {
+        context: "planar IMU".into(),
+        source,
+    })?;
     let mut t = Table::new(&PLANAR_NAV_COLUMNS);
     for s in &states {
         t.push_row(&[

@@ -57,7 +57,7 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         rate_hz: Some(rate_hz),
         duration_s,
         nav_frame: Some(NavFrameName::ENU),
-        gravity_m_s2: Some(9.81),
+        gravity_m_s2: Some(imu_core::DEFAULT_GRAVITY_M_S2),
         trajectory,
         imu: ImuSpec::default(),
     };

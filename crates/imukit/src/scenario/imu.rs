@@ -3,7 +3,7 @@
 use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
 use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 
-use crate::error::{Result, invalid};
+use crate::error::{Error, Result};
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::scenario::perturb::perturbed;
@@ -74,7 +74,10 @@ impl ImuSetup {
             [&p.accelerometer, &p.gyroscope, &p.magnetometer],
             sample_rate_hz,
         )
-        .map_err(|e| invalid("imu", e.to_string()))
+        .map_err(|source| Error::ImuParam {
+            context: "imu".into(),
+            source,
+        })
     }
 
     /// Sensor readings for `truth`: the single run (`run = None`, stream `SeededNormals::new(seed)`)

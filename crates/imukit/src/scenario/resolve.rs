@@ -7,6 +7,7 @@ use imu_core::AccelSign;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 
 use crate::error::{Error, Result, invalid};
+use crate::io::params::ParamValue;
 use crate::io::table::read_columns;
 use crate::motion::analytic::AnalyticOptions;
 use crate::motion::expr::Expr;
@@ -41,6 +42,22 @@ impl ScenarioSpec {
             origin: origin.into(),
             message: e.to_string(),
         })
+    }
+
+    /// From a tree of values (what a Python dict becomes), keys as in a file; `origin` names it
+    /// in messages. Integers stay integers and infinities stay infinite.
+    ///
+    /// # Errors
+    /// [`Error::Scenario`] with the key that does not fit.
+    pub fn from_tree(tree: &ParamValue, origin: &str) -> Result<Self> {
+        let fail = |message: String| Error::Scenario {
+            origin: origin.into(),
+            message,
+        };
+        let value = toml::Value::try_from(tree).map_err(|e| fail(e.to_string()))?;
+        value
+            .try_into()
+            .map_err(|e: toml::de::Error| fail(e.to_string()))
     }
 
     /// Reads a scenario file (`.toml`, or `.json`).
@@ -84,14 +101,9 @@ impl ScenarioSpec {
         } else {
             self
         };
-        let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(9.81);
-        if !(gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0) {
-            return Err(invalid(
-                "gravity_m_s2",
-                format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
-            ));
-        }
-        let sensors = SensorSetup::resolve(&spec.imu.sensor_keys(), base_dir)?;
+        let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(imu_core::DEFAULT_GRAVITY_M_S2);
+        check_gravity("gravity_m_s2", gravity_m_s2)?;
+        let sensors = SensorSetup::resolve(&spec.imu, base_dir)?;
         let accel_sign = spec
             .imu
             .accel_sign
@@ -281,6 +293,21 @@ fn body_rates(
     Ok((t, data))
 }
 
+/// The one rule for a gravity magnitude, m/s²: finite and ≥ 0 (0 simulates free fall).
+///
+/// # Errors
+/// [`Error::Invalid`] naming `field`.
+pub fn check_gravity(field: &str, gravity_m_s2: f64) -> Result<f64> {
+    if gravity_m_s2.is_finite() && gravity_m_s2 >= 0.0 {
+        Ok(gravity_m_s2)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a finite number ≥ 0, got {gravity_m_s2}"),
+        ))
+    }
+}
+
 pub(crate) fn finite_positive(field: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -292,7 +319,11 @@ pub(crate) fn finite_positive(field: &str, v: f64) -> Result<f64> {
     }
 }
 
-pub(crate) fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
+/// A 3-vector whose components are all finite.
+///
+/// # Errors
+/// [`Error::Invalid`] naming `field`.
+pub fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {

@@ -20,13 +20,13 @@ use std::path::{Path, PathBuf};
 
 use imu_core::sensor::{GyroAccelerationInput, ImuReading, Temperatures};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
 use crate::error::{Result, invalid};
 use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor, read_param_file};
 use crate::io::presets;
 use crate::io::table::read_columns;
-use crate::scenario::perturb::{Perturbation, PerturbationSpec};
+use crate::scenario::perturb::Perturbation;
+use crate::scenario::spec::ImuSpec;
 
 /// `temperature_c`: a constant, or a CSV file of a temperature profile.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -162,36 +162,15 @@ impl Default for SensorSetup {
     }
 }
 
-/// The sensor keys of `[imu]` as written.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SensorKeys<'a> {
-    /// `profile`.
-    pub profile: Option<Profile>,
-    /// `seed`.
-    pub seed: Option<u64>,
-    /// `temperature_c`.
-    pub temperature_c: Option<&'a TemperatureSpec>,
-    /// `preset`.
-    pub preset: Option<&'a str>,
-    /// `params`.
-    pub params: Option<&'a Path>,
-    /// `part`.
-    pub part: Option<&'a str>,
-    /// Inline tables, accelerometer, gyroscope, magnetometer.
-    pub tables: [Option<&'a Value>; 3],
-    /// `perturbations`.
-    pub perturbations: &'a [PerturbationSpec],
-}
-
 impl SensorSetup {
     /// Resolves the sensor keys; relative files are taken from `base_dir`.
     ///
     /// # Errors
     /// Unknown presets, unreadable or invalid parameter files, invalid inline parameters,
     /// temperature files — each named.
-    pub fn resolve(keys: &SensorKeys<'_>, base_dir: &Path) -> Result<Self> {
+    pub fn resolve(keys: &ImuSpec, base_dir: &Path) -> Result<Self> {
         let profile = keys.profile.unwrap_or_default();
-        let file = match (keys.preset, keys.params) {
+        let file = match (keys.preset.as_deref(), keys.params.as_deref()) {
             (Some(_), Some(_)) => {
                 return Err(invalid(
                     "imu.preset",
@@ -199,7 +178,11 @@ impl SensorSetup {
                 ));
             }
             (Some(name), None) => Some(presets::load(name)?),
-            (None, Some(path)) => Some(read_param_file(&base_dir.join(path), keys.part, profile)?),
+            (None, Some(path)) => Some(read_param_file(
+                &base_dir.join(path),
+                keys.part.as_deref(),
+                profile,
+            )?),
             (None, None) => {
                 if keys.part.is_some() {
                     return Err(invalid("imu.part", "part needs params = \"file.json\""));
@@ -213,7 +196,8 @@ impl SensorSetup {
             if !from_file {
                 params.get_mut(*sensor).noise_type = profile.noise_type();
             }
-            if let Some(table) = keys.tables[i] {
+            let table = [&keys.accelerometer, &keys.gyroscope, &keys.magnetometer][i];
+            if let Some(table) = table {
                 let default_noise = if from_file {
                     None
                 } else {
@@ -229,7 +213,7 @@ impl SensorSetup {
                 )?;
             }
         }
-        let temperature = match keys.temperature_c {
+        let temperature = match &keys.temperature_c {
             None => Temperature::default(),
             Some(TemperatureSpec::Constant(c)) if c.is_finite() => Temperature::Constant(*c),
             Some(TemperatureSpec::Constant(c)) => {
@@ -249,6 +233,7 @@ impl SensorSetup {
             perturbations: keys
                 .perturbations
                 .iter()
+                .flatten()
                 .enumerate()
                 .map(|(i, p)| Perturbation::from_spec(p, i))
                 .collect::<Result<_>>()?,

@@ -9,11 +9,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::params::Profile;
+use crate::io::params::SensorTable;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::motion::expr::Expr;
 use crate::motion::track::Segment;
 use crate::scenario::perturb::PerturbationSpec;
-use crate::scenario::sensors::{SensorKeys, TemperatureSpec};
+use crate::scenario::sensors::TemperatureSpec;
 
 /// The navigation frame, by name.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -238,11 +239,11 @@ pub struct ImuSpec {
     /// The part to take from a MATLAB JSON file holding several.
     pub part: Option<String>,
     /// Accelerometer parameters (override the preset or file key by key).
-    pub accelerometer: Option<serde_json::Value>,
+    pub accelerometer: Option<SensorTable>,
     /// Gyroscope parameters.
-    pub gyroscope: Option<serde_json::Value>,
+    pub gyroscope: Option<SensorTable>,
     /// Magnetometer parameters.
-    pub magnetometer: Option<serde_json::Value>,
+    pub magnetometer: Option<SensorTable>,
     /// Monte Carlo perturbations of parameters, drawn per run.
     pub perturbations: Option<Vec<PerturbationSpec>>,
 }
@@ -279,23 +280,6 @@ impl ImuSpec {
                 .perturbations
                 .clone()
                 .or_else(|| other.perturbations.clone()),
-        }
-    }
-
-    pub(crate) fn sensor_keys(&self) -> SensorKeys<'_> {
-        SensorKeys {
-            profile: self.profile,
-            seed: self.seed,
-            temperature_c: self.temperature_c.as_ref(),
-            preset: self.preset.as_deref(),
-            params: self.params.as_deref(),
-            part: self.part.as_deref(),
-            tables: [
-                self.accelerometer.as_ref(),
-                self.gyroscope.as_ref(),
-                self.magnetometer.as_ref(),
-            ],
-            perturbations: self.perturbations.as_deref().unwrap_or(&[]),
         }
     }
 }

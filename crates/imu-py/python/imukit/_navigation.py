@@ -1,0 +1,93 @@
+"""Navigation: planar dead reckoning, 3D strapdown, and errors against truth."""
+from __future__ import annotations
+
+import os
+from typing import Mapping, Optional, Sequence, Union
+
+from . import _core
+from ._convert import _f64, _table_args, _times
+from ._table import Table, _table
+from ._truth import DEFAULT_GRAVITY_M_S2
+
+
+def planar_dead_reckon(
+    t_s,
+    accel_x_m_s2,
+    accel_y_m_s2,
+    gyro_z_rad_s,
+    *,
+    scheme: str = "trapezoid",
+    position0_m: Sequence[float] = (100.0, 100.0),
+    heading0_rad: float = 0.0,
+    velocity0_m_s: Sequence[float] = (0.0, 0.0),
+) -> Table:
+    """Planar dead reckoning of a cart (the planar cart exercise): body x forward, y left, ω_z counter-clockwise.
+
+    ``scheme="trapezoid"`` (second order, default) or ``"exercise"`` (the exercise's rules
+    verbatim; its rotation turns increments by −α, which mirrors left turns into right turns).
+    The defaults are the exercise's initial conditions (X₀ = [100, 100], α₀ = 0, v₀ = 0). Returns
+    ``t_s, pos_x_m, pos_y_m, yaw_rad, vel_x_m_s, vel_y_m_s, body_vel_x_m_s, body_vel_y_m_s``.
+    """
+    return _table(_core.planar_dead_reckon(
+        _times(t_s), _f64("accel_x_m_s2", accel_x_m_s2, 1), _f64("accel_y_m_s2", accel_y_m_s2, 1),
+        _f64("gyro_z_rad_s", gyro_z_rad_s, 1), scheme=scheme,
+        position0_m=[float(v) for v in position0_m], heading0_rad=float(heading0_rad),
+        velocity0_m_s=[float(v) for v in velocity0_m_s]))
+
+def read_planar(path: Union[str, os.PathLike]) -> Table:
+    """Planar IMU data from a CSV (``t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s``) or the
+    exercise's whitespace ``.dat`` file (t, a_x, a_y, ω_z)."""
+    return _table(_core.read_planar(str(path)))
+
+def strapdown(
+    imu: Table,
+    *,
+    initial: Optional[Union[Table, Mapping]] = None,
+    nav_frame: str = "ENU",
+    gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
+    coning: bool = True,
+    sculling: bool = True,
+    accel_sign: str = "specific-force",
+    scheme: str = "coning",
+    substeps: int = 4,
+) -> Table:
+    """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
+    increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
+    rotation-vector attitude step, two-sample coning and sculling corrections and gravity.
+
+    ``initial`` is a truth ``Table`` (its first row is used) or a dict with ``position_m``,
+    ``velocity_m_s`` and ``quaternion`` (``[w, x, y, z]``) or ``euler_rad`` (``[yaw, pitch, roll]``);
+    by default at rest, level, at the origin. Returns ``t_s, pos_*, vel_*, q_*, yaw_rad, pitch_rad,
+    roll_rad``.
+
+    ``scheme="coning"`` (default, docs/design.md §6, second order; rates or increments) or ``"rk4"``
+    (fourth order: RK4 with ``substeps`` per interval on quintic-interpolated rates; rates only).
+    """
+    start: dict = {}
+    if isinstance(initial, Table):
+        start["initial_columns"], start["initial_values"] = _table_args("initial", initial)
+    elif isinstance(initial, Mapping):
+        keys = {"position_m": "position0_m", "velocity_m_s": "velocity0_m_s", "quaternion": "quaternion0",
+                "euler_rad": "euler0_rad"}
+        unknown = set(initial) - set(keys)
+        if unknown:
+            raise ValueError(f"initial: unknown keys {sorted(unknown)}; known: {sorted(keys)}")
+        start = {keys[k]: [float(v) for v in value] for k, value in initial.items()}
+    elif initial is not None:
+        raise TypeError("initial must be a truth Table or a dict")
+    return _table(_core.strapdown(
+        *_table_args("imu", imu), **start,
+        nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
+        accel_sign=accel_sign, scheme=scheme, substeps=int(substeps)))
+
+def compare(truth: Table, estimate: Table):
+    """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``.
+
+    A navigation estimate (``t_s, pos_*, vel_*, q_*``) gives the Table ``t_s, pos_err_*_m,
+    pos_err_m, vel_err_*_m_s, att_err_rad``; an orientation estimate (``t_s, q_w, q_x, q_y, q_z``,
+    as ``imukit orient`` writes) gives ``t_s, att_err_rad, yaw_err_rad, pitch_err_rad,
+    roll_err_rad``. The dict holds RMS, maximum and final values (``position_rms_m``,
+    ``position_max_m``, ``position_final_m``, …, ``attitude_final_rad``; attitude only for
+    orientation estimates)."""
+    table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate))
+    return _table(table), dict(summary)

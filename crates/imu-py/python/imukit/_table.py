@@ -1,0 +1,61 @@
+"""The :class:`Table` every result comes back as, and :class:`Simulation`."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterator, Sequence
+
+import numpy as np
+
+
+class Table:
+    """Named columns over a 2-D float64 array (one row per sample).
+
+    ``table["t_s"]`` is a column (a read-only view), ``table.values`` the whole array,
+    ``table.columns`` the names in order, ``len(table)`` the number of rows.
+    """
+
+    def __init__(self, columns: Sequence[str], values: np.ndarray) -> None:
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 2 or values.shape[1] != len(columns):
+            raise ValueError(f"values must have shape (N, {len(columns)}), got {values.shape}")
+        values.setflags(write=False)
+        self.columns: tuple = tuple(columns)
+        self.values: np.ndarray = values
+        self._index = {c: k for k, c in enumerate(self.columns)}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.values[:, self._index[name]]
+        except KeyError:
+            raise KeyError(f"no column {name!r}; columns: {', '.join(self.columns)}") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._index
+
+    def __len__(self) -> int:
+        return self.values.shape[0]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.columns)
+
+    def keys(self) -> tuple:
+        """Column names."""
+        return self.columns
+
+    def to_dict(self) -> dict:
+        """``{name: column}``."""
+        return {c: self[c] for c in self.columns}
+
+    def __repr__(self) -> str:
+        return f"Table({len(self)} rows: {', '.join(self.columns)})"
+
+@dataclass(frozen=True)
+class Simulation:
+    """Truth kinematics and IMU readings of a scenario."""
+
+    truth: Table
+    imu: Table
+
+def _table(out) -> Table:
+    columns, values = out
+    return Table(columns, values)

@@ -1,0 +1,184 @@
+"""Scenarios and truth: :func:`simulate`, truth from formulas, samples, body rates and waypoints,
+ideal readings, CSV files and the built-in scenarios."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Optional, Sequence, Union
+
+from . import _core
+from ._convert import _f64, _table_args, _times
+from ._core import ImuError
+from ._table import Simulation, Table, _table
+
+DEFAULT_GRAVITY_M_S2 = 9.81  # imu_core::DEFAULT_GRAVITY_M_S2, MATLAB imuSensor's value
+
+
+def simulate(scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] = None) -> Simulation:
+    """Runs a scenario: a path to a TOML/JSON scenario file, or a dict with the same keys.
+
+    Relative file paths are taken from the scenario file's folder (for a dict, from the current
+    directory). The numbers equal those of ``imukit simulate`` bit for bit. ``run=r`` gives
+    Monte Carlo run ``r`` (noise drawn from (seed, r)), the same as file ``r`` of
+    ``imukit simulate --runs``.
+
+    >>> sim = simulate({"trajectory": {"type": "builtin", "name": "static"}})
+    >>> float(sim.imu["accel_z_m_s2"][0])
+    9.81
+    """
+    if isinstance(scenario, Mapping):
+        out = _core.simulate_dict(dict(scenario), base_dir=os.getcwd(), run=run)
+    else:
+        path = Path(scenario)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise ImuError(f"{path}: {e.strerror or e}") from None
+        fmt = "json" if path.suffix.lower() == ".json" else "toml"
+        out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run)
+    truth, imu = out
+    return Simulation(truth=_table(truth), imu=_table(imu))
+
+def read_csv(path: Union[str, os.PathLike]) -> Table:
+    """Every column of an imukit CSV file (truth, IMU readings, navigation output, errors, Allan
+    table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
+    return _table(_core.read_csv(str(path)))
+
+def builtin_scenarios() -> list:
+    """Names of the built-in scenarios."""
+    return list(_core.builtin_names())
+
+def builtin_scenario_toml(name: str) -> str:
+    """A built-in scenario as an editable TOML text."""
+    return _core.builtin_toml(name)
+
+def _formula(name: str, f) -> Optional[str]:
+    if f is None:
+        return None
+    if isinstance(f, str):
+        return f
+    if isinstance(f, (int, float)):
+        return repr(float(f))
+    from .compat import sympy_to_formula  # sympy is optional
+
+    return sympy_to_formula(f, name)
+
+def truth_from_expressions(
+    t_s,
+    position_m: Sequence,
+    *,
+    attitude: Optional[str] = None,
+    yaw_rad=None,
+    pitch_rad=None,
+    roll_rad=None,
+    constants: Optional[Mapping[str, float]] = None,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> Table:
+    """Exact truth from formulas of ``t`` (strings, numbers or sympy expressions).
+
+    ``attitude`` is ``"tangent"`` (body x along the velocity) or ``"level"``; or give
+    ``yaw_rad``/``pitch_rad``/``roll_rad`` formulas (missing ones are 0). Derivatives are exact
+    (dual numbers), so results are at machine precision.
+    """
+    if len(position_m) != 3:
+        raise ValueError(f"position_m must have 3 formulas, got {len(position_m)}")
+    pos = [_formula(f"position_m[{k}]", f) for k, f in enumerate(position_m)]
+    return _table(
+        _core.truth_from_expressions(
+            _times(t_s),
+            pos,
+            attitude=attitude,
+            yaw_rad=_formula("yaw_rad", yaw_rad),
+            pitch_rad=_formula("pitch_rad", pitch_rad),
+            roll_rad=_formula("roll_rad", roll_rad),
+            constants=None if constants is None else {k: float(v) for k, v in constants.items()},
+            nav_frame=nav_frame,
+            min_speed_m_s=min_speed_m_s,
+        )
+    )
+
+def truth_from_samples(
+    t_s,
+    position_m,
+    *,
+    euler_rad=None,
+    quaternion=None,
+    attitude: Optional[str] = None,
+    order: int = 6,
+    nav_frame: str = "ENU",
+    min_speed_m_s: Optional[float] = None,
+) -> Table:
+    """Truth from sampled positions (N, 3) and attitude by finite differences.
+
+    Attitude: ``euler_rad`` (N, 3) as ``[yaw, pitch, roll]``, or ``quaternion`` (N, 4) as
+    ``[w, x, y, z]``, or ``attitude="tangent"`` / ``"level"`` (default level). ``order`` 2 is
+    MATLAB's ``gradient`` (for comparison with MATLAB scripts); 4, 6 (default) and 8 use
+    Fornberg stencils of that order with one-sided stencils at the ends.
+    """
+    t = _times(t_s)
+    return _table(
+        _core.truth_from_samples(
+            t,
+            _f64("position_m", position_m, 2),
+            euler_rad=None if euler_rad is None else _f64("euler_rad", euler_rad, 2),
+            quaternion=None if quaternion is None else _f64("quaternion", quaternion, 2),
+            attitude=attitude,
+            order=int(order),
+            nav_frame=nav_frame,
+            min_speed_m_s=min_speed_m_s,
+        )
+    )
+
+def ideal_imu(
+    truth: Table,
+    *,
+    lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
+    accel_sign: str = "specific-force",
+    gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
+    magnetic_field_ut: Optional[Sequence[float]] = None,
+    nav_frame: str = "ENU",
+    kind: str = "accel-gyro-mag",
+) -> Table:
+    """Ideal IMU readings from truth: specific force at the lever arm (body frame, m), body
+    rate, magnetic field (navigation frame, µT; MATLAB's default when ``None``)."""
+    return _table(
+        _core.ideal_imu(
+            *_table_args("truth", truth),
+            lever_arm_m=[float(v) for v in lever_arm_m],
+            accel_sign=accel_sign,
+            gravity_m_s2=float(gravity_m_s2),
+            magnetic_field_ut=None if magnetic_field_ut is None else [float(v) for v in magnetic_field_ut],
+            nav_frame=nav_frame,
+            kind=kind,
+        )
+    )
+
+def truth_from_body_rates(
+    t_s,
+    accel_body_m_s2,
+    omega_body_rad_s,
+    *,
+    position0_m: Sequence[float] = (0.0, 0.0, 0.0),
+    velocity0_m_s: Sequence[float] = (0.0, 0.0, 0.0),
+    euler0_rad: Sequence[float] = (0.0, 0.0, 0.0),
+    nav_frame: str = "ENU",
+) -> Table:
+    """Truth from body-frame acceleration (kinematic, no gravity) and angular velocity, as MATLAB's
+    ``kinematicTrajectory`` builds it: exact rotation-vector attitude step,
+    ``p ← p + vΔt + ½aΔt²``, the state before each update at each sample (first order)."""
+    return _table(_core.truth_from_body_rates(
+        _times(t_s), _f64("accel_body_m_s2", accel_body_m_s2, 2), _f64("omega_body_rad_s", omega_body_rad_s, 2),
+        position0_m=[float(v) for v in position0_m], velocity0_m_s=[float(v) for v in velocity0_m_s],
+        euler0_rad=[float(v) for v in euler0_rad], nav_frame=nav_frame))
+
+def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_rad=None, nav_frame: str = "ENU") -> Table:
+    """Exact truth at ``t_s`` of a waypoint trajectory (like MATLAB's waypointTrajectory): a natural
+    cubic spline through ``position_m`` (N, 3) at ``time_s`` (N,), clamped to ``velocity_m_s`` when it
+    has 2 rows (start, end) or through all of them when it has one row per waypoint; the attitude is
+    tangent, or a spline through ``euler_rad`` (N, 3) ``[yaw, pitch, roll]``. With one velocity row per
+    waypoint each interval is a quintic Hermite polynomial, so the path stays C²."""
+    return _table(_core.truth_from_waypoints(
+        _times(t_s), _f64("time_s", time_s, 1), _f64("position_m", position_m, 2),
+        velocity_m_s=None if velocity_m_s is None else _f64("velocity_m_s", velocity_m_s, 2),
+        euler_rad=None if euler_rad is None else _f64("euler_rad", euler_rad, 2), nav_frame=nav_frame))

@@ -1,0 +1,230 @@
+//! NumPy and Python objects in, library types out, and back: shapes are checked here, once, with
+//! the argument named. Nothing here computes.
+use imukit::Table;
+use imukit::io::params::{ParamValue, SensorTable};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+
+use crate::errors::shape_error;
+
+/// A table for Python: column names and a (rows, columns) array.
+pub(crate) type TableOut<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>);
+
+/// A shape as Python writes it: `(5, 2)`.
+fn shape(s: &[usize]) -> String {
+    match s {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            s.iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// The rows of an (N, K) array.
+pub(crate) fn rows<const K: usize>(
+    name: &str,
+    a: &PyReadonlyArray2<'_, f64>,
+) -> PyResult<Vec<[f64; K]>> {
+    let v = a.as_array();
+    if v.ncols() != K {
+        return Err(shape_error(format!(
+            "{name} must have shape (N, {K}), got {}",
+            shape(v.shape())
+        )));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|k| r[k]))
+        .collect())
+}
+
+/// A contiguous (N, K) array as one flat slice, row after row.
+pub(crate) fn flat_rows<'a, const K: usize>(
+    name: &str,
+    a: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<&'a [f64]> {
+    let s = a.shape();
+    if s[1] != K {
+        return Err(shape_error(format!(
+            "{name} must have shape (N, {K}), got {}",
+            shape(s)
+        )));
+    }
+    a.as_slice()
+        .map_err(|_| shape_error(format!("{name} must be C-contiguous")))
+}
+
+/// A one-dimensional array as a vector.
+pub(crate) fn vector(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    a.as_array().to_vec()
+}
+
+/// `got` rows where `expected` are needed (one per time).
+pub(crate) fn check_len(name: &str, got: usize, expected: usize) -> PyResult<()> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(shape_error(format!(
+            "{name} has {got} rows, expected {expected} (one per time)"
+        )))
+    }
+}
+
+/// Column names and a (rows, columns) array as a library table.
+pub(crate) fn table_in(
+    name: &str,
+    columns: Vec<String>,
+    values: &PyReadonlyArray2<'_, f64>,
+) -> PyResult<Table> {
+    let v = values.as_array();
+    if v.ncols() != columns.len() {
+        return Err(shape_error(format!(
+            "{name} has {} columns but {} column names",
+            v.ncols(),
+            columns.len()
+        )));
+    }
+    Ok(Table {
+        columns,
+        data: v.iter().copied().collect(),
+    })
+}
+
+/// A library table for Python.
+pub(crate) fn table_out(py: Python<'_>, t: Table) -> PyResult<TableOut<'_>> {
+    let shape = (t.rows(), t.columns.len());
+    let arr = Array2::from_shape_vec(shape, t.data).map_err(|e| shape_error(e.to_string()))?;
+    Ok((t.columns, arr.into_pyarray(py)))
+}
+
+/// A row-major (rows, cols) array from flat data.
+pub(crate) fn array2(
+    py: Python<'_>,
+    rows: usize,
+    cols: usize,
+    data: Vec<f64>,
+) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    Array2::from_shape_vec((rows, cols), data)
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| shape_error(e.to_string()))
+}
+
+/// Rows of K values as an (N, K) array.
+pub(crate) fn rows_out<const K: usize>(
+    py: Python<'_>,
+    v: Vec<[f64; K]>,
+) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    let n = v.len();
+    array2(py, n, K, v.into_iter().flatten().collect())
+}
+
+/// 3×3 matrices from an (N, 3, 3) array.
+pub(crate) fn matrices_in(
+    name: &str,
+    a: &PyReadonlyArray3<'_, f64>,
+) -> PyResult<Vec<[[f64; 3]; 3]>> {
+    let v = a.as_array();
+    if v.shape()[1..] != [3, 3] {
+        return Err(shape_error(format!(
+            "{name} must have shape (N, 3, 3), got {}",
+            shape(v.shape())
+        )));
+    }
+    Ok(v.outer_iter()
+        .map(|m| std::array::from_fn(|i| std::array::from_fn(|k| m[[i, k]])))
+        .collect())
+}
+
+/// 3×3 matrices as an (N, 3, 3) array.
+pub(crate) fn matrices_out(
+    py: Python<'_>,
+    m: Vec<[[f64; 3]; 3]>,
+) -> PyResult<Bound<'_, PyArray3<f64>>> {
+    let n = m.len();
+    Array3::from_shape_vec((n, 3, 3), m.into_iter().flatten().flatten().collect())
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| shape_error(e.to_string()))
+}
+
+/// A Python value (dict, list, tuple, NumPy array or scalar, number, string, bool) as the
+/// library's typed value tree: integers stay integers, `inf` stays infinite. Dict entries whose
+/// value is `None` are left out (not given); `path` names the value in messages.
+pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamValue> {
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(ParamValue::Bool(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        if let Ok(i) = obj.extract::<i64>() {
+            return Ok(ParamValue::Integer(i));
+        }
+        return Ok(ParamValue::Number(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        return Ok(ParamValue::Number(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyString>() {
+        return Ok(ParamValue::Text(obj.extract()?));
+    }
+    if obj.is_none() {
+        return Ok(ParamValue::Null);
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut table = SensorTable::new();
+        for (k, v) in d.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("{path}: keys must be strings")))?;
+            if v.is_none() {
+                continue;
+            }
+            let inner = value_tree(&v, &format!("{path}.{key}"))?;
+            table.insert(key, inner);
+        }
+        return Ok(ParamValue::Table(table));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let items = obj
+            .try_iter()?
+            .enumerate()
+            .map(|(k, v)| value_tree(&v?, &format!("{path}[{k}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(ParamValue::List(items));
+    }
+    // NumPy arrays and scalars: their Python equivalents.
+    if obj.hasattr("tolist")? {
+        return value_tree(&obj.call_method0("tolist")?, path);
+    }
+    Err(PyTypeError::new_err(format!(
+        "{path}: expected a number, string, bool, list or dict, got {}",
+        obj.get_type().name()?
+    )))
+}
+
+/// A sensor's parameters given as a dict (imukit's or MATLAB's names).
+pub(crate) fn sensor_table(
+    name: &str,
+    obj: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<SensorTable>> {
+    match obj.map(|o| value_tree(o, name)).transpose()? {
+        None | Some(ParamValue::Null) => Ok(None),
+        Some(ParamValue::Table(t)) => Ok(Some(t)),
+        Some(_) => Err(PyTypeError::new_err(format!(
+            "{name} must be AccelParams/GyroParams/MagParams or a dict of parameters (imukit or MATLAB names)"
+        ))),
+    }
+}
+
+/// A navigation frame given by name (any case) for the argument `field`.
+pub(crate) fn nav_frame(field: &str, name: &str) -> PyResult<imukit::scenario::NavFrameName> {
+    imukit::scenario::parse_name(field, &name.to_ascii_uppercase()).map_err(crate::errors::refused)
+}

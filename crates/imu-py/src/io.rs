@@ -1,0 +1,43 @@
+//! Files: imukit CSV tables in and out, and the file names of Monte Carlo runs.
+use std::path::Path;
+
+use imukit::Table;
+use imukit::io::table::{read_table, run_path as run_file};
+use numpy::PyReadonlyArray2;
+use pyo3::prelude::*;
+
+use crate::convert::{TableOut, table_in, table_out};
+use crate::errors::refused;
+
+/// Every column of an imukit CSV file.
+#[pyfunction]
+fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
+    table_out(py, read_table(Path::new(path)).map_err(refused)?)
+}
+
+/// Writes a table as an imukit CSV (shortest round-trip numbers, atomically).
+#[pyfunction]
+fn write_csv(
+    py: Python<'_>,
+    path: &str,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'_, f64>,
+) -> PyResult<()> {
+    let t: Table = table_in("values", columns, &values)?;
+    py.detach(move || t.write_csv(Path::new(path)))
+        .map_err(refused)
+}
+
+/// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).
+#[pyfunction]
+fn run_path(out: &str, run: u64, runs: u64) -> String {
+    run_file(Path::new(out), run, runs).display().to_string()
+}
+
+/// Adds this module's functions.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(run_path, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,150 @@
+//! Navigation: planar dead reckoning, 3D strapdown, and errors against truth.
+use std::path::Path;
+
+use imu_core::strapdown::planar::PlanarSample;
+use imukit::Table;
+use imukit::run::compare as comparison;
+use imukit::run::navigate::{InitialState, NavRequest, integrate};
+use imukit::run::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
+use numpy::PyReadonlyArray1;
+use numpy::PyReadonlyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{TableOut, check_len, table_in, table_out};
+use crate::errors::refused;
+
+/// Planar dead reckoning of (t, a_x, a_y, ω_z) into a navigation table.
+#[pyfunction]
+#[pyo3(signature = (t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s, *, scheme = "trapezoid",
+                    position0_m = EXERCISE_POSITION0_M, heading0_rad = 0.0, velocity0_m_s = [0.0, 0.0]))]
+#[allow(clippy::too_many_arguments)]
+fn planar_dead_reckon<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    accel_x_m_s2: PyReadonlyArray1<'py, f64>,
+    accel_y_m_s2: PyReadonlyArray1<'py, f64>,
+    gyro_z_rad_s: PyReadonlyArray1<'py, f64>,
+    scheme: &str,
+    position0_m: [f64; 2],
+    heading0_rad: f64,
+    velocity0_m_s: [f64; 2],
+) -> PyResult<TableOut<'py>> {
+    let t = t_s.as_array();
+    let (ax, ay, wz) = (
+        accel_x_m_s2.as_array(),
+        accel_y_m_s2.as_array(),
+        gyro_z_rad_s.as_array(),
+    );
+    for (name, len) in [
+        ("accel_x_m_s2", ax.len()),
+        ("accel_y_m_s2", ay.len()),
+        ("gyro_z_rad_s", wz.len()),
+    ] {
+        check_len(name, len, t.len())?;
+    }
+    let samples: Vec<PlanarSample> = (0..t.len())
+        .map(|i| PlanarSample {
+            t_s: t[i],
+            accel_x_m_s2: ax[i],
+            accel_y_m_s2: ay[i],
+            gyro_z_rad_s: wz[i],
+        })
+        .collect();
+    let request = PlanarRequest {
+        scheme,
+        position0_m,
+        heading0_rad,
+        velocity0_m_s,
+    };
+    let table = py.detach(|| request.run(&samples)).map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Planar IMU samples from a CSV or `.dat` file, as a table with `t_s, accel_x_m_s2,
+/// accel_y_m_s2, gyro_z_rad_s`.
+#[pyfunction]
+fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
+    let samples = planar::read_planar(Path::new(path)).map_err(refused)?;
+    table_out(py, planar::samples_table(&samples))
+}
+
+/// 3D strapdown of an IMU table (rates or increments) from an initial state: the first row of
+/// a truth table (`initial_columns`, `initial_values`) or its parts.
+#[pyfunction]
+#[pyo3(signature = (columns, values, *, initial_columns = None, initial_values = None, position0_m = None,
+                    velocity0_m_s = None, quaternion0 = None, euler0_rad = None, nav_frame = "ENU",
+                    gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
+                    accel_sign = "specific-force", scheme = "coning",
+                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS))]
+#[allow(clippy::too_many_arguments)]
+fn strapdown<'py>(
+    py: Python<'py>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+    initial_columns: Option<Vec<String>>,
+    initial_values: Option<PyReadonlyArray2<'py, f64>>,
+    position0_m: Option<[f64; 3]>,
+    velocity0_m_s: Option<[f64; 3]>,
+    quaternion0: Option<[f64; 4]>,
+    euler0_rad: Option<[f64; 3]>,
+    nav_frame: &str,
+    gravity_m_s2: f64,
+    coning: bool,
+    sculling: bool,
+    accel_sign: &str,
+    scheme: &str,
+    substeps: usize,
+) -> PyResult<TableOut<'py>> {
+    let setup = NavRequest {
+        nav_frame,
+        accel_sign,
+        scheme,
+        substeps,
+        gravity_m_s2,
+        coning,
+        sculling,
+    }
+    .setup()
+    .map_err(refused)?;
+    let imu = table_in("imu", columns, &values)?;
+    let initial = match (initial_columns, &initial_values) {
+        (Some(c), Some(v)) => InitialState::from_table(&table_in("initial", c, v)?),
+        _ => InitialState::from_parts(position0_m, velocity0_m_s, quaternion0, euler0_rad),
+    }
+    .map_err(refused)?;
+    let out = py
+        .detach(|| integrate(&imu, &initial, &setup))
+        .map_err(refused)?;
+    table_out(py, out)
+}
+
+/// Errors of an estimate against truth: (error table, summary dict).
+#[pyfunction]
+fn compare<'py>(
+    py: Python<'py>,
+    truth_columns: Vec<String>,
+    truth: PyReadonlyArray2<'py, f64>,
+    estimate_columns: Vec<String>,
+    estimate: PyReadonlyArray2<'py, f64>,
+) -> PyResult<(TableOut<'py>, Bound<'py, PyDict>)> {
+    let t: Table = table_in("truth", truth_columns, &truth)?;
+    let e: Table = table_in("estimate", estimate_columns, &estimate)?;
+    let c = py
+        .detach(move || comparison::compare(&t, &e))
+        .map_err(refused)?;
+    let d = PyDict::new(py);
+    for (name, value) in c.summary.entries() {
+        d.set_item(name, value)?;
+    }
+    Ok((table_out(py, c.table)?, d))
+}
+
+/// Adds this module's functions.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(planar_dead_reckon, m)?)?;
+    m.add_function(wrap_pyfunction!(read_planar, m)?)?;
+    m.add_function(wrap_pyfunction!(strapdown, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    Ok(())
+}

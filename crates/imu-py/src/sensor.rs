@@ -1,0 +1,242 @@
+//! Realistic sensors: MATLAB's `imuSensor` (`imukit.ImuSensor`), presets, parameter files,
+//! datasheet units, and Allan deviation with noise identification.
+use std::path::Path;
+
+use imukit::io::params::{Profile, read_param_file, to_toml};
+use imukit::io::{presets, units};
+use imukit::run::allan;
+use imukit::run::imu_sensor::{ImuSensor, ImuSensorRequest, Orientation};
+use imukit::scenario::ImuSpec;
+use numpy::ndarray::Array2;
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{check_len, flat_rows, matrices_in, sensor_table, vector};
+use crate::errors::{refused, shape_error};
+
+/// MATLAB-shaped IMU simulator (see the Python class `imukit.ImuSensor`).
+#[pyclass(module = "imukit._core", name = "ImuSensor")]
+struct PyImuSensor(ImuSensor);
+
+#[pymethods]
+impl PyImuSensor {
+    #[new]
+    #[pyo3(signature = (imu_type = "accel-gyro", *, reference_frame = "NED", sample_rate = 100.0, temperature = 25.0,
+                        magnetic_field = None, accelerometer = None, gyroscope = None, magnetometer = None,
+                        preset = None, seed = 0, profile = "matlab", accel_sign = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        imu_type: &str,
+        reference_frame: &str,
+        sample_rate: f64,
+        temperature: f64,
+        magnetic_field: Option<[f64; 3]>,
+        accelerometer: Option<&Bound<'_, PyAny>>,
+        gyroscope: Option<&Bound<'_, PyAny>>,
+        magnetometer: Option<&Bound<'_, PyAny>>,
+        preset: Option<String>,
+        seed: u64,
+        profile: &str,
+        accel_sign: Option<&str>,
+    ) -> PyResult<Self> {
+        let request = ImuSensorRequest {
+            imu_type,
+            reference_frame,
+            sample_rate_hz: sample_rate,
+            temperature_c: temperature,
+            magnetic_field_ut: magnetic_field,
+            profile,
+            accel_sign,
+            params: ImuSpec {
+                preset,
+                seed: Some(seed),
+                accelerometer: sensor_table("accelerometer", accelerometer)?,
+                gyroscope: sensor_table("gyroscope", gyroscope)?,
+                magnetometer: sensor_table("magnetometer", magnetometer)?,
+                ..ImuSpec::default()
+            },
+        };
+        ImuSensor::new(&request).map(Self).map_err(refused)
+    }
+
+    /// Readings for nav-frame acceleration (N, 3), angular velocity (N, 3) and attitude
+    /// quaternions `q_nb` (N, 4) or MATLAB's rotation matrices `C_nbᵀ` (N, 3, 3); returns
+    /// (N, 9) rows of accel, gyro, mag (absent sensors zero). State and noise stream carry over
+    /// between calls. `out`, a C-contiguous writeable (N, 9) float64 array, receives the rows
+    /// instead of a new array (a buffer reused across chunks is not page-faulted again).
+    #[pyo3(signature = (acceleration, angular_velocity, *, quaternion = None, dcm = None, out = None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        acceleration: PyReadonlyArray2<'py, f64>,
+        angular_velocity: PyReadonlyArray2<'py, f64>,
+        quaternion: Option<PyReadonlyArray2<'py, f64>>,
+        dcm: Option<PyReadonlyArray3<'py, f64>>,
+        out: Option<Bound<'py, PyArray2<f64>>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let a = flat_rows::<3>("acceleration", &acceleration)?;
+        let w = flat_rows::<3>("angular_velocity", &angular_velocity)?;
+        let n = a.len() / 3;
+        check_len("angular_velocity", w.len() / 3, n)?;
+        // The orientation stays in the caller's array; each sample's rotation is made in the loop.
+        let matrices;
+        let orientation = match (&quaternion, &dcm) {
+            (Some(q), None) => Orientation::Quaternions(flat_rows::<4>("orientation", q)?),
+            (None, Some(m)) => {
+                matrices = matrices_in("orientation", m)?;
+                Orientation::NavToBody(&matrices)
+            }
+            _ => {
+                return Err(PyValueError::new_err(
+                    "give the orientation as quaternions or as matrices",
+                ));
+            }
+        };
+        check_len("orientation", orientation.len(), n)?;
+        let out = match out {
+            Some(o) if o.shape() == [n, 9] => o,
+            Some(o) => {
+                return Err(shape_error(format!(
+                    "out must have shape ({n}, 9), got ({}, {})",
+                    o.shape()[0],
+                    o.shape()[1]
+                )));
+            }
+            None => PyArray2::<f64>::zeros(py, [n, 9], false),
+        };
+        {
+            let mut guard = out
+                .try_readwrite()
+                .map_err(|e| shape_error(format!("out: {e}")))?;
+            let o = guard
+                .as_slice_mut()
+                .map_err(|e| shape_error(format!("out must be C-contiguous: {e}")))?;
+            let sensor = &mut self.0;
+            py.detach(|| sensor.measure(a, w, orientation, o))
+                .map_err(refused)?;
+        }
+        Ok(out)
+    }
+
+    /// Back to the initial state and the start of the seeded noise stream.
+    fn reset(&mut self) {
+        self.0.reset();
+    }
+
+    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
+    #[getter]
+    fn imu_type(&self) -> &'static str {
+        self.0.kind().name()
+    }
+
+    /// Temperature of all sensors, °C.
+    #[getter]
+    fn get_temperature(&self) -> f64 {
+        self.0.temperature_c()
+    }
+
+    #[setter]
+    fn set_temperature(&mut self, t: f64) -> PyResult<()> {
+        self.0.set_temperature_c(t).map_err(refused)
+    }
+}
+
+/// `(tau_s, adev)`.
+type AllanOut<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// Overlapping Allan deviation of each column of `x` (N, k) at octave τ: returns
+/// `(tau_s, adev)` with `adev` of shape (T, k).
+#[pyfunction]
+fn allan_deviation<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    sample_rate_hz: f64,
+) -> PyResult<AllanOut<'py>> {
+    let v = x.as_array();
+    let series: Vec<(String, Vec<f64>)> = (0..v.ncols())
+        .map(|k| (format!("column {k}"), v.column(k).to_vec()))
+        .collect();
+    let result = py
+        .detach(move || allan::allan(&series, sample_rate_hz))
+        .map_err(refused)?;
+    let t = result.table;
+    let tau = t.column("tau_s").unwrap_or_default();
+    let cols = t.columns.len() - 1;
+    let adev: Vec<f64> = t
+        .data
+        .chunks(t.columns.len())
+        .flat_map(|r| r[1..].to_vec())
+        .collect();
+    let adev =
+        Array2::from_shape_vec((tau.len(), cols), adev).map_err(|e| shape_error(e.to_string()))?;
+    Ok((PyArray1::from_vec(py, tau), adev.into_pyarray(py)))
+}
+
+/// N, K, B and the fitted lines of an Allan curve, as a dict.
+#[pyfunction]
+fn identify_noise<'py>(
+    py: Python<'py>,
+    tau_s: PyReadonlyArray1<'py, f64>,
+    adev: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (tau, a) = (vector(&tau_s), vector(&adev));
+    check_len("adev", a.len(), tau.len())?;
+    let id = imu_core::allan::identify_noise(&tau, &a);
+    let d = PyDict::new(py);
+    d.set_item("noise_density", id.noise_density)?;
+    d.set_item("bias_instability", id.bias_instability)?;
+    d.set_item("random_walk", id.random_walk)?;
+    for (name, line) in [
+        ("white_line", id.white_line),
+        ("random_walk_line", id.random_walk_line),
+        ("bias_line", id.bias_line),
+    ] {
+        d.set_item(name, line.map(|l| (l.slope, l.intercept)))?;
+    }
+    Ok(d)
+}
+
+/// A datasheet figure in imukit's SI units: `(value, unit, fitting parameters)`.
+#[pyfunction]
+fn convert(value: f64, unit: &str) -> PyResult<(f64, &'static str, &'static str)> {
+    let c = units::convert(value, unit).map_err(refused)?;
+    Ok((c.value, c.unit, c.fits))
+}
+
+/// Names of the sensor presets.
+#[pyfunction]
+fn preset_names() -> Vec<&'static str> {
+    presets::names()
+}
+
+/// A preset as an imukit parameter file (TOML text).
+#[pyfunction]
+fn preset_toml(name: &str) -> PyResult<&'static str> {
+    presets::text(name).map_err(refused)
+}
+
+/// A parameter file (imukit TOML/JSON or MATLAB loadparams JSON) as imukit TOML text.
+#[pyfunction]
+#[pyo3(signature = (path, *, part = None))]
+fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<String> {
+    read_param_file(Path::new(path), part, Profile::Default)
+        .map(|f| to_toml(&f))
+        .map_err(refused)
+}
+
+/// Adds this module's classes and functions.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyImuSensor>()?;
+    m.add_function(wrap_pyfunction!(allan_deviation, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(convert, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,371 @@
+//! Scenarios and truth: `simulate` (TOML/JSON text or a dict), truth from formulas, samples,
+//! body rates and waypoints, ideal readings of a truth table, the built-in scenarios, and the
+//! array helpers of the compatibility module.
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use imu_core::EulerZyx;
+use imu_core::kinematics::sampled::SampledOptions;
+use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
+use imukit::ScenarioSpec;
+use imukit::io::table::TRUTH_COLUMNS;
+use imukit::motion::waypoints::Waypoints;
+use imukit::motion::{BodyRatesData, SampledAttitudeData};
+use imukit::run::arrays::{self, IdealRequest};
+use imukit::scenario::{ExpressionSpec, Formula, builtin};
+use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::convert::{
+    TableOut, check_len, nav_frame, rows, rows_out, table_in, table_out, value_tree, vector,
+};
+use crate::errors::{refused, shape_error};
+
+/// Truth and IMU tables of one run.
+type SimulationOut<'py> = (TableOut<'py>, TableOut<'py>);
+
+/// Runs a resolved scenario spec with the GIL released.
+fn run_spec<'py>(
+    py: Python<'py>,
+    spec: ScenarioSpec,
+    base_dir: &str,
+    run: Option<u64>,
+) -> PyResult<SimulationOut<'py>> {
+    let base = base_dir.to_string();
+    let sim = py
+        .detach(move || {
+            let sc = spec.resolve(Path::new(&base))?;
+            match run {
+                Some(r) => sc.simulate_run(r),
+                None => sc.simulate(),
+            }
+        })
+        .map_err(refused)?;
+    Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?))
+}
+
+/// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu) tables.
+#[pyfunction]
+#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None))]
+fn simulate_text<'py>(
+    py: Python<'py>,
+    text: &str,
+    format: &str,
+    origin: &str,
+    base_dir: &str,
+    run: Option<u64>,
+) -> PyResult<SimulationOut<'py>> {
+    let spec = match format {
+        "toml" => ScenarioSpec::from_toml(text, origin),
+        "json" => ScenarioSpec::from_json(text, origin),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "format must be \"toml\" or \"json\", got {other:?}"
+            )));
+        }
+    }
+    .map_err(refused)?;
+    run_spec(py, spec, base_dir, run)
+}
+
+/// Resolves and runs a scenario given as a dict (keys as in a file, values typed: `inf` and
+/// integers kept); returns (truth, imu) tables.
+#[pyfunction]
+#[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None))]
+fn simulate_dict<'py>(
+    py: Python<'py>,
+    scenario: &Bound<'py, PyAny>,
+    origin: &str,
+    base_dir: &str,
+    run: Option<u64>,
+) -> PyResult<SimulationOut<'py>> {
+    let tree = value_tree(scenario, "scenario")?;
+    let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
+    run_spec(py, spec, base_dir, run)
+}
+
+/// Exact truth from formula strings at the times `t_s`.
+#[pyfunction]
+#[pyo3(signature = (t_s, position_m, *, attitude = None, yaw_rad = None, pitch_rad = None, roll_rad = None,
+                    constants = None, nav_frame = "ENU", min_speed_m_s = None))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_expressions<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    position_m: [String; 3],
+    attitude: Option<String>,
+    yaw_rad: Option<String>,
+    pitch_rad: Option<String>,
+    roll_rad: Option<String>,
+    constants: Option<BTreeMap<String, f64>>,
+    nav_frame: &str,
+    min_speed_m_s: Option<f64>,
+) -> PyResult<TableOut<'py>> {
+    let t = vector(&t_s);
+    let spec = ExpressionSpec {
+        constants: constants.unwrap_or_default(),
+        position_m: position_m.map(Formula::Text),
+        attitude,
+        yaw_rad: yaw_rad.map(Formula::Text),
+        pitch_rad: pitch_rad.map(Formula::Text),
+        roll_rad: roll_rad.map(Formula::Text),
+        min_speed_m_s,
+    };
+    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_expressions(&t, &spec, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// The attitude arguments of `truth_from_samples` as the library's attitude.
+fn sampled_attitude(
+    n: usize,
+    euler_rad: Option<PyReadonlyArray2<'_, f64>>,
+    quaternion: Option<PyReadonlyArray2<'_, f64>>,
+    attitude: Option<&str>,
+) -> PyResult<SampledAttitudeData> {
+    Ok(match (euler_rad, quaternion, attitude) {
+        (Some(e), None, None) => {
+            let e = rows::<3>("euler_rad", &e)?;
+            check_len("euler_rad", e.len(), n)?;
+            SampledAttitudeData::Euler(e.into_iter().map(EulerZyx::from_array).collect())
+        }
+        (None, Some(q), None) => {
+            let q = rows::<4>("quaternion", &q)?;
+            check_len("quaternion", q.len(), n)?;
+            SampledAttitudeData::Quaternion(q)
+        }
+        (None, None, Some("tangent")) => SampledAttitudeData::Tangent,
+        (None, None, Some("level") | None) => {
+            SampledAttitudeData::Euler(vec![EulerZyx::default(); n])
+        }
+        (None, None, Some(other)) => {
+            return Err(PyValueError::new_err(format!(
+                "attitude must be \"tangent\" or \"level\", got {other:?}"
+            )));
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "give at most one of euler_rad, quaternion and attitude",
+            ));
+        }
+    })
+}
+
+/// Truth from sampled positions and attitude by finite differences.
+#[pyfunction]
+#[pyo3(signature = (t_s, position_m, *, euler_rad = None, quaternion = None, attitude = None, order = 6,
+                    nav_frame = "ENU", min_speed_m_s = None))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_samples<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    position_m: PyReadonlyArray2<'py, f64>,
+    euler_rad: Option<PyReadonlyArray2<'py, f64>>,
+    quaternion: Option<PyReadonlyArray2<'py, f64>>,
+    attitude: Option<&str>,
+    order: usize,
+    nav_frame: &str,
+    min_speed_m_s: Option<f64>,
+) -> PyResult<TableOut<'py>> {
+    let t = vector(&t_s);
+    let pos = rows::<3>("position_m", &position_m)?;
+    check_len("position_m", pos.len(), t.len())?;
+    let att = sampled_attitude(t.len(), euler_rad, quaternion, attitude)?;
+    let options = SampledOptions {
+        order,
+        min_speed_m_s: min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S),
+    };
+    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let out = PyArray2::<f64>::zeros(py, [t.len(), TRUTH_COLUMNS.len()], false);
+    {
+        let mut guard = out.readwrite();
+        let values = guard
+            .as_slice_mut()
+            .map_err(|e| shape_error(e.to_string()))?;
+        py.detach(move || arrays::truth_from_arrays_into(t, pos, att, options, nav, values))
+            .map_err(refused)?;
+    }
+    let columns = TRUTH_COLUMNS.iter().map(|c| (*c).to_string()).collect();
+    Ok((columns, out))
+}
+
+/// Ideal IMU readings from a truth table (its column names and values).
+#[pyfunction]
+#[pyo3(signature = (columns, values, *, lever_arm_m = [0.0, 0.0, 0.0], accel_sign = "specific-force",
+                    gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, magnetic_field_ut = None,
+                    nav_frame = "ENU", kind = "accel-gyro-mag"))]
+#[allow(clippy::too_many_arguments)]
+fn ideal_imu<'py>(
+    py: Python<'py>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+    lever_arm_m: [f64; 3],
+    accel_sign: &str,
+    gravity_m_s2: f64,
+    magnetic_field_ut: Option<[f64; 3]>,
+    nav_frame: &str,
+    kind: &str,
+) -> PyResult<TableOut<'py>> {
+    let truth = table_in("truth", columns, &values)?;
+    let request = IdealRequest {
+        kind,
+        lever_arm_m,
+        accel_sign,
+        gravity_m_s2,
+        magnetic_field_ut,
+        nav_frame,
+    };
+    let out = py.detach(|| request.run(&truth)).map_err(refused)?;
+    table_out(py, out)
+}
+
+/// Tangent z-y-x Euler angles `[yaw, pitch, roll]` of a velocity series.
+#[pyfunction]
+#[pyo3(signature = (velocity_m_s, *, min_speed_m_s = DEFAULT_MIN_SPEED_M_S))]
+fn tangent_euler<'py>(
+    py: Python<'py>,
+    velocity_m_s: PyReadonlyArray2<'py, f64>,
+    min_speed_m_s: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let v = rows::<3>("velocity_m_s", &velocity_m_s)?;
+    let e = py
+        .detach(move || arrays::tangent_euler(&v, min_speed_m_s))
+        .map_err(refused)?;
+    rows_out(py, e.into_iter().map(EulerZyx::to_array).collect())
+}
+
+/// `C_nbᵀ v_n`: navigation-frame vectors resolved in the body frame, per sample.
+#[pyfunction]
+fn nav_to_body<'py>(
+    py: Python<'py>,
+    euler_rad: PyReadonlyArray2<'py, f64>,
+    v_n: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e: Vec<EulerZyx> = rows::<3>("euler_rad", &euler_rad)?
+        .into_iter()
+        .map(EulerZyx::from_array)
+        .collect();
+    let v = rows::<3>("v_n", &v_n)?;
+    check_len("v_n", v.len(), e.len())?;
+    rows_out(py, py.detach(move || arrays::nav_to_body(&e, &v)))
+}
+
+/// `a + ω × (ω × r) + α × r` per sample (body frame).
+#[pyfunction]
+fn at_lever_arm<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray2<'py, f64>,
+    omega: PyReadonlyArray2<'py, f64>,
+    alpha: PyReadonlyArray2<'py, f64>,
+    r: [f64; 3],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, w, al) = (
+        rows::<3>("a", &a)?,
+        rows::<3>("omega", &omega)?,
+        rows::<3>("alpha", &alpha)?,
+    );
+    check_len("omega", w.len(), a.len())?;
+    check_len("alpha", al.len(), a.len())?;
+    rows_out(
+        py,
+        py.detach(move || arrays::at_lever_arm_series(&a, &w, &al, r)),
+    )
+}
+
+/// Truth from body-frame acceleration and angular velocity (MATLAB kinematicTrajectory).
+#[pyfunction]
+#[pyo3(signature = (t_s, accel_body_m_s2, omega_body_rad_s, *, position0_m = [0.0; 3],
+                    velocity0_m_s = [0.0; 3], euler0_rad = [0.0; 3], nav_frame = "ENU"))]
+#[allow(clippy::too_many_arguments)]
+fn truth_from_body_rates<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    accel_body_m_s2: PyReadonlyArray2<'py, f64>,
+    omega_body_rad_s: PyReadonlyArray2<'py, f64>,
+    position0_m: [f64; 3],
+    velocity0_m_s: [f64; 3],
+    euler0_rad: [f64; 3],
+    nav_frame: &str,
+) -> PyResult<TableOut<'py>> {
+    let t = vector(&t_s);
+    let a = rows::<3>("accel_body_m_s2", &accel_body_m_s2)?;
+    let w = rows::<3>("omega_body_rad_s", &omega_body_rad_s)?;
+    check_len("accel_body_m_s2", a.len(), t.len())?;
+    check_len("omega_body_rad_s", w.len(), t.len())?;
+    let data = BodyRatesData {
+        accel_body_m_s2: a,
+        omega_body_rad_s: w,
+        alpha_body_rad_s2: None,
+        position0_m,
+        velocity0_m_s,
+        euler0_rad,
+    };
+    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_body_rates(&t, data, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Exact truth at `t_s` of a waypoint trajectory (cubic spline through the waypoints).
+#[pyfunction]
+#[pyo3(signature = (t_s, time_s, position_m, *, velocity_m_s = None, euler_rad = None, nav_frame = "ENU"))]
+fn truth_from_waypoints<'py>(
+    py: Python<'py>,
+    t_s: PyReadonlyArray1<'py, f64>,
+    time_s: PyReadonlyArray1<'py, f64>,
+    position_m: PyReadonlyArray2<'py, f64>,
+    velocity_m_s: Option<PyReadonlyArray2<'py, f64>>,
+    euler_rad: Option<PyReadonlyArray2<'py, f64>>,
+    nav_frame: &str,
+) -> PyResult<TableOut<'py>> {
+    let t = vector(&t_s);
+    let knots = vector(&time_s);
+    let p = rows::<3>("position_m", &position_m)?;
+    let v = velocity_m_s
+        .as_ref()
+        .map(|v| rows::<3>("velocity_m_s", v))
+        .transpose()?;
+    let e = euler_rad
+        .as_ref()
+        .map(|e| rows::<3>("euler_rad", e))
+        .transpose()?;
+    let w = Waypoints::new(&knots, &p, v.as_deref(), e.as_deref()).map_err(refused)?;
+    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let table = py
+        .detach(move || arrays::truth_from_waypoints(&t, w, nav))
+        .map_err(refused)?;
+    table_out(py, table)
+}
+
+/// Names of the built-in scenarios.
+#[pyfunction]
+fn builtin_names() -> Vec<&'static str> {
+    builtin::NAMES.to_vec()
+}
+
+/// A built-in scenario as TOML text.
+#[pyfunction]
+fn builtin_toml(name: &str) -> PyResult<String> {
+    builtin::toml(name).map_err(refused)
+}
+
+/// Adds this module's functions.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate_text, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_expressions, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(ideal_imu, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent_euler, m)?)?;
+    m.add_function(wrap_pyfunction!(nav_to_body, m)?)?;
+    m.add_function(wrap_pyfunction!(at_lever_arm, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_body_rates, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_from_waypoints, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_toml, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,264 @@
+//! MATLAB's imuSensor call shape, with its state: navigation-frame acceleration (no gravity),
+//! navigation-frame angular velocity and orientation in, accelerometer, gyroscope and
+//! magnetometer readings out, one call after another on one drift state and one seeded noise
+//! stream (so a run in chunks equals the run whole). Python's `imukit.ImuSensor` is this object.
+use std::path::Path;
+
+use imu_core::sensor::{ImuModel, ImuState, SeededNormals, Temperatures};
+use imu_core::{AccelSign, Body, DEFAULT_GRAVITY_M_S2, Enu, NavFrame, Ned, Rotation, Vec3};
+
+use crate::error::{Result, invalid};
+use crate::io::params::Profile;
+use crate::io::table::ImuKind;
+use crate::scenario::sensors::SensorSetup;
+use crate::scenario::{AccelSignName, ImuSetup, ImuSpec, NavFrameName, parse_name};
+
+/// An imuSensor as MATLAB's constructor states it; checked once, in [`ImuSensor::new`]. Errors
+/// name MATLAB's (Python's) argument names: `imu_type`, `reference_frame`, `profile`,
+/// `accel_sign`, `temperature`, `magnetic_field`, and `accelerometer.…` for parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImuSensorRequest<'a> {
+    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
+    pub imu_type: &'a str,
+    /// `"NED"` or `"ENU"` (any case).
+    pub reference_frame: &'a str,
+    /// Sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Sensor temperature, °C.
+    pub temperature_c: f64,
+    /// Magnetic field in the navigation frame, µT (`None`: MATLAB's default).
+    pub magnetic_field_ut: Option<[f64; 3]>,
+    /// `"matlab"` (the class default: MATLAB's conventions) or `"default"`.
+    pub profile: &'a str,
+    /// The accelerometer sign; `None` follows the profile.
+    pub accel_sign: Option<&'a str>,
+    /// Parameters: `preset`, `seed` and the three sensor tables (MATLAB's or imukit's names);
+    /// its `profile` is set from [`ImuSensorRequest::profile`].
+    pub params: ImuSpec,
+}
+
+/// The orientation of each sample as a caller hands it over.
+#[derive(Clone, Copy, Debug)]
+pub enum Orientation<'a> {
+    /// Quaternions `q_nb` `[w, x, y, z]`, four numbers per sample, flat.
+    Quaternions(&'a [f64]),
+    /// Direction cosine matrices `C_nb` (body → navigation), one per sample.
+    Matrices(&'a [[[f64; 3]; 3]]),
+    /// MATLAB's rotation matrices `C_nbᵀ` (navigation → body), one per sample.
+    NavToBody(&'a [[[f64; 3]; 3]]),
+}
+
+impl Orientation<'_> {
+    /// Number of samples.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Quaternions(q) => q.len() / 4,
+            Self::Matrices(m) | Self::NavToBody(m) => m.len(),
+        }
+    }
+
+    /// True when there is none.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sample `i`'s attitude; `None` for a quaternion of zero norm or not finite.
+    fn at<N: NavFrame>(&self, i: usize) -> Option<Rotation<Body, N>> {
+        match self {
+            Self::Quaternions(q) => {
+                let c = &q[4 * i..4 * i + 4];
+                Rotation::from_wxyz([c[0], c[1], c[2], c[3]])
+            }
+            Self::Matrices(m) => Some(Rotation::from_dcm(&m[i])),
+            Self::NavToBody(m) => {
+                let c_nb: [[f64; 3]; 3] =
+                    std::array::from_fn(|r| std::array::from_fn(|k| m[i][k][r]));
+                Some(Rotation::from_dcm(&c_nb))
+            }
+        }
+    }
+}
+
+/// The model in the chosen navigation frame.
+#[derive(Clone, Debug)]
+enum FrameModel {
+    Enu(ImuModel<Enu>),
+    Ned(ImuModel<Ned>),
+}
+
+/// A MATLAB-shaped IMU simulator with its drift state and noise stream.
+#[derive(Clone, Debug)]
+pub struct ImuSensor {
+    model: FrameModel,
+    kind: ImuKind,
+    state: ImuState,
+    noise: SeededNormals,
+    seed: u64,
+    temperature: Temperatures,
+}
+
+/// The finite temperature, or a refusal naming `temperature`.
+fn temperature(c: f64) -> Result<Temperatures> {
+    if c.is_finite() {
+        Ok(Temperatures::uniform(c))
+    } else {
+        Err(invalid("temperature", "must be finite"))
+    }
+}
+
+impl ImuSensor {
+    /// Builds the validated model.
+    ///
+    /// # Errors
+    /// Unknown names, non-finite numbers, invalid parameters — each named.
+    pub fn new(r: &ImuSensorRequest<'_>) -> Result<Self> {
+        let kind = parse_name::<ImuKind>("imu_type", r.imu_type)?;
+        let profile = parse_name::<Profile>("profile", r.profile)?;
+        let spec = ImuSpec {
+            profile: Some(profile),
+            ..r.params.clone()
+        };
+        let sensors = SensorSetup::resolve(&spec, Path::new("."))?;
+        let temperature = temperature(r.temperature_c)?;
+        if let Some(m) = r.magnetic_field_ut
+            && !m.iter().all(|c| c.is_finite())
+        {
+            return Err(invalid("magnetic_field", "must be finite"));
+        }
+        let sign: AccelSign = match r.accel_sign {
+            Some(s) => parse_name::<AccelSignName>("accel_sign", s)?.into(),
+            None => profile.accel_sign(),
+        };
+        let setup = ImuSetup {
+            sensors,
+            ..ImuSetup::ideal(kind, [0.0; 3], sign, r.magnetic_field_ut)
+        };
+        let g = DEFAULT_GRAVITY_M_S2;
+        let frame: NavFrameName =
+            parse_name("reference_frame", &r.reference_frame.to_ascii_uppercase())?;
+        let model = match frame {
+            NavFrameName::ENU => FrameModel::Enu(setup.model::<Enu>(g, r.sample_rate_hz)?),
+            NavFrameName::NED => FrameModel::Ned(setup.model::<Ned>(g, r.sample_rate_hz)?),
+        };
+        let seed = setup.sensors.seed;
+        Ok(Self {
+            model,
+            kind,
+            state: ImuState::default(),
+            noise: SeededNormals::new(seed),
+            seed,
+            temperature,
+        })
+    }
+
+    /// Readings for `n` samples: `acceleration_n` and `angular_velocity_n` hold three numbers
+    /// per sample (navigation frame, m/s² and rad/s), `orientation` one attitude per sample;
+    /// `out` receives nine numbers per sample (accelerometer, gyroscope, magnetometer; absent
+    /// sensors zero) through the core's per-sample path ([`ImuModel::measure_nav`]).
+    ///
+    /// # Errors
+    /// Slices of unequal lengths, or a quaternion of zero norm or not finite (named by index);
+    /// then the drift state and the noise stream are as they were before the call.
+    pub fn measure(
+        &mut self,
+        acceleration_n: &[f64],
+        angular_velocity_n: &[f64],
+        orientation: Orientation<'_>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let n = acceleration_n.len() / 3;
+        let lengths = [
+            ("acceleration", acceleration_n.len(), 3 * n),
+            ("angular_velocity", angular_velocity_n.len(), 3 * n),
+            ("orientation", orientation.len(), n),
+            ("out", out.len(), 9 * n),
+        ];
+        if let Some((name, got, want)) = lengths.iter().find(|(_, got, want)| got != want) {
+            return Err(invalid(
+                *name,
+                format!("has {got} numbers, expected {want}"),
+            ));
+        }
+        let (start_state, start_noise) = (self.state, self.noise.clone());
+        let result = match &self.model {
+            FrameModel::Enu(m) => measure_rows(
+                m,
+                acceleration_n,
+                angular_velocity_n,
+                orientation,
+                &self.temperature,
+                &mut self.state,
+                &mut self.noise,
+                out,
+            ),
+            FrameModel::Ned(m) => measure_rows(
+                m,
+                acceleration_n,
+                angular_velocity_n,
+                orientation,
+                &self.temperature,
+                &mut self.state,
+                &mut self.noise,
+                out,
+            ),
+        };
+        result.map_err(|i| {
+            (self.state, self.noise) = (start_state, start_noise);
+            crate::Error::BadQuaternion {
+                field: format!("quaternion[{i}]"),
+            }
+        })
+    }
+
+    /// Back to the initial drift state and the start of the seeded noise stream.
+    pub fn reset(&mut self) {
+        self.state = ImuState::default();
+        self.noise = SeededNormals::new(self.seed);
+    }
+
+    /// The sensors simulated.
+    #[must_use]
+    pub fn kind(&self) -> ImuKind {
+        self.kind
+    }
+
+    /// The temperature of all sensors, °C.
+    #[must_use]
+    pub fn temperature_c(&self) -> f64 {
+        self.temperature.accel_c
+    }
+
+    /// Changes the temperature of all sensors between calls, °C.
+    ///
+    /// # Errors
+    /// A non-finite temperature.
+    pub fn set_temperature_c(&mut self, c: f64) -> Result<()> {
+        self.temperature = temperature(c)?;
+        Ok(())
+    }
+}
+
+/// The rows of one call; `Err(i)` at the first sample whose attitude is refused.
+#[allow(clippy::too_many_arguments)]
+fn measure_rows<N: NavFrame>(
+    model: &ImuModel<N>,
+    a: &[f64],
+    w: &[f64],
+    orientation: Orientation<'_>,
+    temperatures: &Temperatures,
+    state: &mut ImuState,
+    noise: &mut SeededNormals,
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    for (i, o) in out.chunks_exact_mut(9).enumerate() {
+        let attitude = orientation.at::<N>(i).ok_or(i)?;
+        let v = |x: &[f64]| Vec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        let r = model.measure_nav(v(a), v(w), &attitude, temperatures, state, noise);
+        o[..3].copy_from_slice(&r.accel_m_s2);
+        o[3..6].copy_from_slice(&r.gyro_rad_s);
+        o[6..].copy_from_slice(&r.mag_ut);
+    }
+    Ok(())
+}
