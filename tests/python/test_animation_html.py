@@ -76,3 +76,20 @@ def test_script_runs_and_draws_every_frame(page):
     assert r["interval"] == 100  # 10 frames/s
     assert r["slider_max"] == n_frames - 1
     assert r["label"].startswith("t = ")
+
+
+def test_page_draws_the_box_the_library_defines(page):
+    # The box is defined once (imu_plot::scene) and handed to the page and to Python as data.
+    html = page.read_text()
+    body = json.loads("[" + html.split("const BODY = [")[1].split("]")[0] + "]")
+    corners = json.loads(html.split("const CORNERS = ")[1].split(", EDGES")[0])
+    edges = json.loads(html.split("EDGES = ")[1].split(", NOSE")[0])
+    nose = json.loads(html.split("NOSE = ")[1].split(";")[0])
+    import imukit
+
+    py_corners, py_edges, py_nose = imukit._core.animation_scene(body)
+    assert corners == py_corners.tolist()
+    assert [tuple(e) for e in edges] == py_edges and nose == py_nose
+    # The nose face is the box's +x face and the corners span the body.
+    assert all(corners[i][0] == body[0] / 2 for i in nose)
+    assert [max(c[k] for c in corners) - min(c[k] for c in corners) for k in range(3)] == body

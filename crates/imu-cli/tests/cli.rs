@@ -383,3 +383,67 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         "{text}"
     );
 }
+
+#[test]
+fn gravity_flag_carries_its_unit_and_keeps_the_old_spelling() {
+    let dir = temp_dir("gravity");
+    let scenario = dir.join("static.toml");
+    std::fs::write(
+        &scenario,
+        "rate_hz = 10.0\nduration_s = 2.0\ngravity_m_s2 = 9.8\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+    )
+    .unwrap();
+    let imu = dir.join("imu.csv");
+    let ok = imukit()
+        .arg("simulate")
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&imu)
+        .output()
+        .unwrap();
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    // Integrating with the gravity the readings were made with keeps the IMU at rest; both
+    // spellings of the flag mean the same.
+    for flag in ["--gravity-m-s2", "--gravity"] {
+        let nav = dir.join(format!("nav{flag}.csv"));
+        let out = imukit()
+            .arg("integrate")
+            .arg(&imu)
+            .args([flag, "9.8", "--out"])
+            .arg(&nav)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(&nav).unwrap();
+        let last: Vec<f64> = text
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(&last[1..4], &[0.0, 0.0, 0.0], "{flag}: {text}");
+    }
+    let bad = imukit()
+        .arg("integrate")
+        .arg(&imu)
+        .args(["--gravity-m-s2", "inf", "--out"])
+        .arg(dir.join("bad.csv"))
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(65));
+    let err = String::from_utf8(bad.stderr).unwrap();
+    assert!(
+        err.contains("--gravity-m-s2: must be a finite number"),
+        "{err}"
+    );
+    assert!(!dir.join("bad.csv").exists());
+}

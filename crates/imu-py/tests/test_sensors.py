@@ -202,3 +202,43 @@ def test_parameter_classes_mirror_matlabs_accelparams():
         np.testing.assert_array_equal(x, y)
     with pytest.raises(TypeError, match="AccelParams"):
         imukit.ImuSensor(accelerometer=[1, 2, 3])
+
+
+def test_an_infinite_measurement_range_reaches_rust_as_infinity():
+    # Parameter objects are handed over typed (no JSON text, which has no infinity): an
+    # infinite range means no saturation, so a reading far beyond any finite range passes.
+    imu = imukit.ImuSensor(accelerometer=imukit.AccelParams(measurement_range=float("inf")))
+    accel, _ = imu(np.array([[1e6, 0.0, 0.0]]), np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0, 0.0]]))
+    assert accel[0].tolist() == [-1e6, 0.0, 9.81]  # MATLAB's sign: gravity minus acceleration
+    limited = imukit.ImuSensor(accelerometer=imukit.AccelParams(measurement_range=19.6))
+    accel, _ = limited(np.array([[1e6, 0.0, 0.0]]), np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0, 0.0]]))
+    assert accel[0, 0] == -19.6
+    # The same through a scenario dict.
+    sim = imukit.simulate({"rate_hz": 10.0, "duration_s": 0.1,
+                           "trajectory": {"type": "builtin", "name": "static"},
+                           "imu": {"accelerometer": {"MeasurementRange": float("inf")}}})
+    assert sim.imu["accel_z_m_s2"][0] == 9.81
+
+
+def test_imu_errors_carry_the_field_for_programs():
+    with pytest.raises(ImuError) as e:
+        imukit.ImuSensor(gyroscope=imukit.GyroParams(noise_density=-1.0))
+    assert e.value.field == "imu.gyroscope.noise_density"
+    assert e.value.file is None and e.value.row is None and e.value.column is None
+    with pytest.raises(ImuError) as e:
+        imukit.ImuSensor(gyroscope={"NoSuchParameter": 1.0})
+    assert e.value.field == "imu.gyroscope.NoSuchParameter"
+    with pytest.raises(ImuError) as e:
+        imukit.ImuSensor("accel-gyro", reference_frame="XYZ")
+    assert e.value.field == "reference_frame"
+    with pytest.raises(TypeError, match="gyroscope"):
+        imukit.ImuSensor(gyroscope=[1.0, 2.0])
+
+
+def test_imu_errors_name_file_row_and_column(tmp_path):
+    bad = tmp_path / "imu.csv"
+    bad.write_text("t_s,gyro_x_rad_s\n0,0.1\n0.01,nan\n")
+    with pytest.raises(ImuError) as e:
+        imukit.read_csv(bad)
+    assert (e.value.file, e.value.row, e.value.column) == (str(bad), 3, "gyro_x_rad_s")
+    assert e.value.field is None

@@ -1,0 +1,171 @@
+//! The request types front ends fill in: one place that checks names and numbers, errors that
+//! name the field (and, for files, the row and column), and scheme names that parse.
+use std::path::Path;
+
+use imu_core::strapdown::planar::PlanarScheme;
+use imukit::io::table::ImuKind;
+use imukit::run::navigate::{DEFAULT_RK4_SUBSTEPS, NavRequest, NavScheme};
+use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest};
+use imukit::scenario::parse_name;
+use imukit::{Error, ScenarioSpec};
+
+#[test]
+fn scheme_names_parse_and_unknown_ones_are_listed() {
+    assert_eq!("coning".parse(), Ok(NavScheme::ConingSculling));
+    assert_eq!(
+        "rk4".parse(),
+        Ok(NavScheme::Rk4 {
+            substeps: DEFAULT_RK4_SUBSTEPS
+        })
+    );
+    let e = "euler".parse::<NavScheme>().unwrap_err();
+    assert!(e.contains("\"euler\"") && e.contains("coning, rk4"), "{e}");
+    assert_eq!("exercise".parse(), Ok(PlanarScheme::Exercise));
+    assert_eq!("trapezoid".parse(), Ok(PlanarScheme::Trapezoid));
+    assert!("rk4".parse::<PlanarScheme>().is_err());
+}
+
+#[test]
+fn imu_kind_names_round_trip_through_the_scenario_parser() {
+    for kind in [ImuKind::AccelGyro, ImuKind::AccelMag, ImuKind::AccelGyroMag] {
+        assert_eq!(parse_name::<ImuKind>("kind", kind.name()).unwrap(), kind);
+    }
+}
+
+#[test]
+fn a_nav_request_is_checked_field_by_field() {
+    let ok = NavRequest::default().setup().unwrap();
+    assert_eq!(ok.options.gravity_m_s2, imu_core::DEFAULT_GRAVITY_M_S2);
+    let field = |r: NavRequest<'_>| r.setup().unwrap_err().location().field;
+    let d = NavRequest::default();
+    assert_eq!(
+        field(NavRequest {
+            nav_frame: "XYZ",
+            ..d
+        })
+        .as_deref(),
+        Some("nav_frame")
+    );
+    assert_eq!(
+        field(NavRequest {
+            accel_sign: "up",
+            ..d
+        })
+        .as_deref(),
+        Some("accel_sign")
+    );
+    assert_eq!(
+        field(NavRequest {
+            scheme: "euler",
+            ..d
+        })
+        .as_deref(),
+        Some("scheme")
+    );
+    let zero_substeps = NavRequest {
+        scheme: "rk4",
+        substeps: 0,
+        ..d
+    };
+    assert_eq!(field(zero_substeps).as_deref(), Some("substeps"));
+    for g in [f64::NAN, f64::INFINITY, -1.0, 1e308 * 10.0] {
+        let r = NavRequest {
+            gravity_m_s2: g,
+            ..d
+        };
+        assert_eq!(field(r).as_deref(), Some("gravity_m_s2"), "{g}");
+    }
+    // The coning scheme ignores sub-steps; RK4 takes them.
+    let rk4 = NavRequest {
+        scheme: "rk4",
+        substeps: 7,
+        ..d
+    };
+    assert_eq!(rk4.setup().unwrap().scheme, NavScheme::Rk4 { substeps: 7 });
+}
+
+#[test]
+fn a_planar_request_turns_the_start_velocity_into_the_body_frame() {
+    let r = PlanarRequest {
+        heading0_rad: std::f64::consts::FRAC_PI_2,
+        velocity0_m_s: [0.0, 2.0],
+        ..PlanarRequest::default()
+    };
+    let s = r.initial_state(5.0).unwrap();
+    assert_eq!(s.position_m, EXERCISE_POSITION0_M);
+    assert_eq!(s.t_s, 5.0);
+    // Heading north (+90°) and moving north: straight ahead in the body frame.
+    assert!((s.velocity_body_m_s[0] - 2.0).abs() < 1e-15);
+    assert!(s.velocity_body_m_s[1].abs() < 1e-15);
+    let bad = PlanarRequest {
+        heading0_rad: f64::INFINITY,
+        ..PlanarRequest::default()
+    };
+    let e = bad.initial_state(0.0).unwrap_err();
+    assert_eq!(e.location().field.as_deref(), Some("heading0_rad"));
+    let unknown = PlanarRequest {
+        scheme: "euler",
+        ..PlanarRequest::default()
+    };
+    assert_eq!(
+        unknown.scheme().unwrap_err().to_string(),
+        "scheme: unknown scheme \"euler\" (trapezoid, exercise)"
+    );
+}
+
+#[test]
+fn an_infinite_measurement_range_in_a_scenario_file_means_no_saturation() {
+    // TOML writes infinity as `inf`; it used to reach the parameter parser as NaN.
+    let spec = ScenarioSpec::from_toml(
+        "rate_hz = 10.0\nduration_s = 0.1\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+         [imu.accelerometer]\nMeasurementRange = inf\n",
+        "inf.toml",
+    )
+    .unwrap();
+    let sim = spec.resolve(Path::new(".")).unwrap().simulate().unwrap();
+    assert_eq!(sim.imu.column("accel_z_m_s2").unwrap()[0], 9.81);
+    let nan = ScenarioSpec::from_toml(
+        "[trajectory]\ntype = \"builtin\"\nname = \"static\"\n[imu.accelerometer]\nMeasurementRange = nan\n",
+        "nan.toml",
+    )
+    .unwrap();
+    let e = nan.resolve(Path::new(".")).unwrap_err();
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("imu.accelerometer.MeasurementRange")
+    );
+}
+
+#[test]
+fn a_refused_parameter_carries_the_cores_error_as_its_source() {
+    let spec = ScenarioSpec::from_toml(
+        "[trajectory]\ntype = \"builtin\"\nname = \"static\"\n[imu.gyroscope]\nNoiseDensity = -1\n",
+        "neg.toml",
+    )
+    .unwrap();
+    let e = spec.resolve(Path::new(".")).unwrap_err();
+    let Error::Param { context, source } = &e else {
+        panic!("expected a parameter error, got {e:?}");
+    };
+    assert_eq!(context, "imu.gyroscope");
+    assert_eq!(source.field(), "noise_density");
+    assert!(std::error::Error::source(&e).is_some());
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("imu.gyroscope.noise_density")
+    );
+}
+
+#[test]
+fn a_bad_csv_cell_is_located_by_file_row_and_column() {
+    let dir = std::env::temp_dir().join(format!("imukit-requests-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.csv");
+    std::fs::write(&path, "t_s,gyro_z_rad_s\n0,0.1\n0.01,oops\n").unwrap();
+    let e = imukit::io::table::read_table(&path).unwrap_err();
+    let at = e.location();
+    assert_eq!(at.file.as_deref(), Some(path.as_path()));
+    assert_eq!(at.row, Some(3));
+    assert_eq!(at.column.as_deref(), Some("gyro_z_rad_s"));
+    std::fs::remove_dir_all(&dir).ok();
+}
