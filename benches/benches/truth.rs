@@ -14,7 +14,7 @@ use imukit::scenario::{TrajectorySpec, sample_times};
 
 fn figure8() -> ExpressionMotion {
     match builtin::spec("figure8").expect("built-in").trajectory {
-        TrajectorySpec::Expression(e) => ExpressionMotion::from_spec(&e).expect("parses"),
+        TrajectorySpec::Expression(e) => e.motion().expect("parses"),
         _ => unreachable!("figure8 is an expression trajectory"),
     }
 }

@@ -167,7 +167,8 @@ fn gaps_and_disorder_in_the_times_are_named() {
 
 #[test]
 fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
-    use imukit::run::navigate::{GAP_WINDOW, NavScheme, integrate_csv};
+    use imukit::io::rows::GAP_WINDOW;
+    use imukit::run::navigate::{NavScheme, integrate_csv};
     let dir = std::env::temp_dir().join(format!("imukit-nav-stream-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // 4001 rows: the gap check's look-ahead window and the rest.

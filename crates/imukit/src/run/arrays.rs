@@ -9,7 +9,7 @@ use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth
 use crate::error::{Error, Result, invalid};
 use crate::io::table::ImuKind;
 use crate::io::table::{TRUTH_COLUMNS, Table};
-use crate::motion::{ExpressionMotion, SampledAttitudeData, SampledPath, Trajectory};
+use crate::motion::{SampledAttitudeData, SampledPath, Trajectory};
 use crate::scenario::resolve::finite_vec;
 use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName, parse_name};
 
@@ -32,10 +32,7 @@ pub fn truth_from_expressions(
     let min_speed_m_s = spec
         .min_speed_m_s
         .unwrap_or(imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S);
-    let traj = Trajectory::Expression(
-        ExpressionMotion::from_spec(spec)?,
-        AnalyticOptions { min_speed_m_s },
-    );
+    let traj = Trajectory::Expression(spec.motion()?, AnalyticOptions { min_speed_m_s });
     in_frame(
         nav,
         || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),

@@ -10,8 +10,9 @@ use imu_core::orientation::{
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
 use crate::error::{Result, invalid};
+use crate::io::rows::TimedRows;
 use crate::io::table::{ACCEL_COLUMNS, AtomicFile, GYRO_COLUMNS, MAG_COLUMNS};
-use crate::run::navigate::{TimedRows, euler_unwrapped};
+use crate::run::navigate::euler_unwrapped;
 use crate::scenario::NavFrameName;
 
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
@@ -391,7 +392,7 @@ pub struct OrientSummary {
 /// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
 /// `mag_*` columns) into `out` ([`ORIENT_COLUMNS`]), streamed; `out` appears only when complete.
 /// The sample rate is `SampleRate` if set, else the median interval of the first
-/// [`GAP_WINDOW`](crate::run::navigate::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
+/// [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
 /// that may use one, whether the file has `mag_*` columns (`spec.magnetometer` is set
 /// accordingly).
 ///

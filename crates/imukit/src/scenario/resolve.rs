@@ -13,7 +13,7 @@ use crate::motion::analytic::AnalyticOptions;
 use crate::motion::expr::Expr;
 use crate::motion::track::{SpeedProfile, Track};
 use crate::motion::waypoints::Waypoints;
-use crate::motion::{BodyRatesData, ExpressionMotion, SampledPath, Trajectory};
+use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
 
 use crate::scenario::sensors::SensorSetup;
@@ -131,10 +131,7 @@ impl ScenarioSpec {
                     need(spec.duration_s, "duration_s")?,
                 )?;
                 (
-                    Trajectory::Expression(
-                        ExpressionMotion::from_spec(e)?,
-                        AnalyticOptions { min_speed_m_s },
-                    ),
+                    Trajectory::Expression(e.motion()?, AnalyticOptions { min_speed_m_s }),
                     t,
                 )
             }

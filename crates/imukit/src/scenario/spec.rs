@@ -13,6 +13,7 @@ use crate::io::params::SensorTable;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::motion::expr::Expr;
 use crate::motion::track::Segment;
+use crate::motion::{ExpressionAttitude, ExpressionMotion};
 use crate::scenario::perturb::PerturbationSpec;
 use crate::scenario::sensors::TemperatureSpec;
 
@@ -294,4 +295,51 @@ pub fn parse_name<T: serde::de::DeserializeOwned>(field: &str, name: &str) -> Re
     let de: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
         name.into_deserializer();
     T::deserialize(de).map_err(|e| invalid(field, e.to_string()))
+}
+
+impl ExpressionSpec {
+    /// The motion these formulas describe, parsed.
+    ///
+    /// # Errors
+    /// Unparsable formulas (field and column named), conflicting attitude keys.
+    pub fn motion(&self) -> Result<ExpressionMotion> {
+        let spec = self;
+        let c = &spec.constants;
+        let position = [
+            spec.position_m[0].parse("trajectory.position_m[0]", c)?,
+            spec.position_m[1].parse("trajectory.position_m[1]", c)?,
+            spec.position_m[2].parse("trajectory.position_m[2]", c)?,
+        ];
+        let angles = [&spec.yaw_rad, &spec.pitch_rad, &spec.roll_rad];
+        let has_angles = angles.iter().any(|a| a.is_some());
+        let attitude = match (spec.attitude.as_deref(), has_angles) {
+            (Some(_), true) => {
+                return Err(invalid(
+                    "trajectory.attitude",
+                    "give either attitude = \"tangent\"/\"level\" or yaw_rad/pitch_rad/roll_rad, not both",
+                ));
+            }
+            (Some("tangent"), false) => ExpressionAttitude::Tangent,
+            (Some("level") | None, false) => ExpressionAttitude::Level,
+            (Some(other), false) => {
+                return Err(invalid(
+                    "trajectory.attitude",
+                    format!(
+                        "unknown attitude \"{other}\" (use \"tangent\" or \"level\", or give angles)"
+                    ),
+                ));
+            }
+            (None, true) => {
+                let zero = Formula::Number(0.0);
+                let names = [
+                    "trajectory.yaw_rad",
+                    "trajectory.pitch_rad",
+                    "trajectory.roll_rad",
+                ];
+                let e = |k: usize| angles[k].as_ref().unwrap_or(&zero).parse(names[k], c);
+                ExpressionAttitude::Euler(Box::new([e(0)?, e(1)?, e(2)?]))
+            }
+        };
+        Ok(ExpressionMotion { position, attitude })
+    }
 }
