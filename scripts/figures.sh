@@ -9,7 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p docs/img
 
-# 1. The demo's truth: the seed's figure-8, exact kinematics.
+# 1. The demo's truth: the figure-8, exact kinematics.
 "$bin" demo --out-dir "$work/demo" >/dev/null
 "$bin" plot "$work/demo/truth.csv" --out docs/img/truth.png
 
@@ -28,7 +28,7 @@ TOML
 "$bin" allan "$work/stim300.csv" --column gyro_x_rad_s --column gyro_y_rad_s --column gyro_z_rad_s \
   --out "$work/allan.csv" --plot docs/img/allan.png >/dev/null
 
-# 3. Seed 001's exercise: the cart's rail against dead reckoning of the erroneous data.
+# 3. The planar cart exercise: the cart's rail against dead reckoning of the erroneous data.
 "$bin" exercise --out-dir "$work/exercise" >/dev/null
 "$bin" plot "$work/exercise/truth.csv" "$work/exercise/inertial_data_errors_trapezoid.csv" \
   "$work/exercise/inertial_data_errors_exercise.csv" --out docs/img/exercise.png

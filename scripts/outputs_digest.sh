@@ -82,7 +82,7 @@ run bad_orient "$bin" orient ex_matlab_orientation_imu.csv --filter nosuch --out
 
 # The Python examples and their figures.
 if command -v python >/dev/null && python -c 'import imukit' 2>/dev/null; then
-  for f in seed_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
+  for f in differentiation_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
     [ -f "$OLDPWD/examples/$f.py" ] || continue
     run "py_$f" python "$OLDPWD/examples/$f.py" --figures "py_$f"
   done

@@ -57,7 +57,7 @@ for f in examples/*.toml; do
   target/release/imukit plot "$out/${name}_truth.csv" --out "$out/${name}_truth.png"
   target/release/imukit plot "$out/${name}_imu.csv" --out "$out/${name}_imu.png"
 done
-for f in seed_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
+for f in differentiation_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
   python "examples/$f.py" --figures "$out/figures"
 done
 for f in imufilter ahrsfilter ecompass madgwick mahony complementary; do

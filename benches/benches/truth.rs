@@ -1,4 +1,4 @@
-//! Truth + ideal IMU throughput (samples/s) on the seed's figure-8: exact (formula strings over
+//! Truth + ideal IMU throughput (samples/s) on the figure-8: exact (formula strings over
 //! dual numbers) and sampled (finite differences, order 6, tangent attitude).
 //!
 //! Run: `cargo bench -p imu-benches --bench truth`.

@@ -115,7 +115,7 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Seed 001's exercise end to end: the built-in cart's clean and erroneous `.dat` files,
+    /// The planar cart exercise end to end: the built-in cart's clean and erroneous `.dat` files,
     /// dead-reckoned with both schemes, and a plot of the trajectories (start and end marked).
     Exercise {
         /// Output folder.
@@ -152,7 +152,7 @@ pub enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
-    /// Runs a built-in scenario (default: the seed's figure-8 with its lever arm) and writes the
+    /// Runs a built-in scenario (default: the figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
     /// and a summary into a folder.
     Demo {

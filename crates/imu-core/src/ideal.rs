@@ -1,6 +1,6 @@
 //! Ideal IMU readings from truth: specific force at a lever arm, body rate, magnetic field.
 //!
-//! `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r` (rigid-body kinematics, seed 000 eq. 9,
+//! `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r` (rigid-body kinematics, eq. 9 of the MATLAB trajectory tool,
 //! with gravity taken out as a real accelerometer senses it), `ω_b` unchanged (the same at every
 //! point of a rigid body), `m_b = C_nbᵀ m_n`.
 use crate::frame::{Body, NavFrame};
@@ -55,7 +55,7 @@ pub struct IdealReading {
 
 /// Acceleration-like quantity carried from the reference point S to a point at lever arm `r`
 /// (body frame, m) of a rigid body turning at `ω_b` with `α_b`:
-/// `a_I = a_S + ω_b × (ω_b × r) + α_b × r` (seed 000 eq. 9; centripetal and Euler terms).
+/// `a_I = a_S + ω_b × (ω_b × r) + α_b × r` (the MATLAB trajectory tool's eq. 9; centripetal and Euler terms).
 #[must_use]
 #[inline]
 pub fn at_lever_arm(

@@ -1,6 +1,6 @@
 //! # imu-core — heap-free IMU kinematics and ideal sensors
 //!
-//! Conventions (the contract every module keeps; see `DESIGN.md` §2):
+//! Conventions (the contract every module keeps; see `docs/design.md` §2):
 //!
 //! * **Units**: SI throughout (s, m, m/s, m/s², rad, rad/s, rad/s²); magnetic field in µT.
 //! * **Navigation frame** `n`: [`Enu`] (x east, y north, z up) or [`Ned`] (x north, y east, z down),

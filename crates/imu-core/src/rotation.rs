@@ -1,7 +1,7 @@
 //! Rotations between frames, z-y-x Euler angles, quaternions and direction cosine matrices.
 //!
 //! `Rotation<Body, N>` is `C_nb` (body → navigation). Euler angles are intrinsic z-y-x:
-//! `C_nb = Rz(yaw)·Ry(pitch)·Rx(roll)` with the elementary matrices of seed 000 eq. (2).
+//! `C_nb = Rz(yaw)·Ry(pitch)·Rx(roll)` with the elementary matrices of the MATLAB trajectory tool's eq. (2).
 //! Quaternions are Hamilton, scalar first (`[w, x, y, z]`), `v_n = q ⊗ v_b ⊗ q*`; this `q_nb` equals
 //! MATLAB's "frame rotation from navigation to body" orientation.
 use core::marker::PhantomData;

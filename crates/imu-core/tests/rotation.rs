@@ -1,4 +1,4 @@
-//! Euler ↔ DCM ↔ quaternion round trips and the sign anchors of DESIGN §2.
+//! Euler ↔ DCM ↔ quaternion round trips and the sign anchors of docs/design.md §2.
 use imu_core::{Body, Enu, EulerZyx, Ned, Rotation, Vec3};
 use proptest::prelude::*;
 

@@ -1,4 +1,4 @@
-//! `imukit animate`: the rigid body moving along its path (seed 000's `my_traAnim`).
+//! `imukit animate`: the rigid body moving along its path (the MATLAB trajectory tool's `my_traAnim`).
 //!
 //! The body is a box of the given size centred on the reference point S, turned by the truth's
 //! attitude; its nose face (body +x) is filled. The reference point (yellow) and the IMU point at

@@ -1,4 +1,4 @@
-"""imukit.compat: the seed-000 functions, their arguments and outputs, 'num' and 'sym'."""
+"""imukit.compat: the MATLAB trajectory tool's functions, their arguments and outputs, 'num' and 'sym'."""
 import math
 
 import numpy as np
@@ -55,7 +55,7 @@ def test_my_tang_gives_tangent_angles_and_unit_tangent():
     assert np.all(np.isfinite(tz)) and np.all(tz[10:20] == tz[9])
 
 
-def test_my_ang_body_rate_and_the_seeds_nav_frame_rate():
+def test_my_ang_body_rate_and_the_tools_nav_frame_rate():
     pitch = "asin(3*sqrt(2)*sin(2*pi*t)/sqrt(137 - 9*cos(4*pi*t)))"
     phi, omega_b, alpha_b = my_ang(["0", pitch, "2*pi*t + pi/2"], "sym", T)
     exact = imukit.truth_from_expressions(T, [0, 0, 0], yaw_rad="2*pi*t + pi/2", pitch_rad=pitch)
@@ -71,11 +71,11 @@ def test_my_ang_body_rate_and_the_seeds_nav_frame_rate():
     assert np.max(np.abs(omega_num - omega_b)) < 1e-8 * np.max(np.abs(omega_b))
 
 
-def test_my_rotate_goes_nav_to_body_and_can_reproduce_the_seed():
+def test_my_rotate_goes_nav_to_body_and_can_reproduce_the_tool():
     phi = np.array([[0.0, 0.0, math.pi / 2]])  # [roll, pitch, yaw]
     north = np.array([[0.0, 1.0, 0.0]])
     np.testing.assert_allclose(my_rotate(phi, north), [[1.0, 0.0, 0.0]], atol=1e-15)
-    np.testing.assert_allclose(my_rotate(phi, north, seed_convention=True), [[-1.0, 0.0, 0.0]], atol=1e-15)
+    np.testing.assert_allclose(my_rotate(phi, north, tool_convention=True), [[-1.0, 0.0, 0.0]], atol=1e-15)
 
 
 def test_my_imu_adds_centripetal_and_euler_terms():

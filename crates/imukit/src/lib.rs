@@ -97,3 +97,8 @@ pub use error::{Error, Result};
 pub use imu_core as core;
 pub use io::table::Table;
 pub use scenario::{Scenario, ScenarioSpec, Simulation};
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+mod readme {}

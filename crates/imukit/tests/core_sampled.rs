@@ -1,10 +1,10 @@
-//! Sampled input (finite differences) against the exact truth of the seed's tilted circle.
+//! Sampled input (finite differences) against the exact truth of the MATLAB trajectory tool's tilted circle.
 use imu_core::kinematics::KinematicsError;
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
 use imu_core::{Enu, EulerZyx, Truth};
 use imukit::motion::analytic::{AnalyticOptions, Motion, Scalar, truth_from_motion};
 
-/// Seed 000's tilted circle (f = 1 Hz) with its explicit Euler angles (its Figure 3 example).
+/// The MATLAB trajectory tool's tilted circle (f = 1 Hz) with its explicit Euler angles (the example of its error study).
 struct TiltedCircle;
 impl Motion for TiltedCircle {
     fn position<D: Scalar>(&self, t: D) -> [D; 3] {
@@ -228,7 +228,7 @@ fn tangent_from_samples_matches_exact_tangent() {
     // Angles are differenced after being computed from differenced velocities: one order of
     // differentiation more, so a looser but still tight bound.
     assert!(errs.iter().all(|&e| e < 1e-6), "{errs:?}");
-    // The exact tangent attitude reproduces the seed's explicit angles on this circle.
+    // The exact tangent attitude reproduces the tool's explicit angles on this circle.
     let seed = exact(&t);
     for (a, b) in ex.iter().zip(&seed) {
         assert!((a.euler.pitch_rad - b.euler.pitch_rad).abs() < 1e-12);

@@ -1,4 +1,4 @@
-//! `imukit exercise`: seed 001's inertial-navigation exercise, end to end.
+//! `imukit exercise`: the planar cart exercise (inertial navigation in a plane), end to end.
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -47,7 +47,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
     let mut summary = String::new();
     let _ = writeln!(
         summary,
-        "seed 001 exercise: cart on a closed rail, start and end at (100, 100) m"
+        "planar cart exercise: cart on a closed rail, start and end at (100, 100) m"
     );
     let _ = writeln!(
         summary,
@@ -85,7 +85,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
     );
     trajectories_figure(
         &out_dir.join("trajectories.svg"),
-        "Seed 001 exercise: dead reckoning of the cart",
+        "Planar cart exercise: dead reckoning of the cart",
         &traces,
     )?;
     std::fs::write(out_dir.join("summary.txt"), &summary).map_err(io)?;

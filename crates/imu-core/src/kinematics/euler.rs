@@ -3,7 +3,7 @@
 //! `ω_b = [ṙ − ẏ sin p, ṗ cos r + ẏ cos p sin r, −ṗ sin r + ẏ cos p cos r]` (y = yaw, p = pitch,
 //! r = roll), from `[ω_b×] = C_nbᵀ dC_nb/dt` with `C_nb = Rz(y)·Ry(p)·Rx(r)`
 //! (Titterton & Weston, *Strapdown Inertial Navigation Technology*, 2nd ed., eq. 3.52).
-//! `α_b` is its exact time derivative. Seed 000 eq. (7) forms `dR/dt·R⁻¹`, the rate in the
+//! `α_b` is its exact time derivative. The MATLAB trajectory tool's eq. (7) forms `dR/dt·R⁻¹`, the rate in the
 //! navigation frame `ω_n = C_nb ω_b`, which equals `ω_b` only for rotation about one fixed axis.
 use crate::frame::Body;
 use crate::math;

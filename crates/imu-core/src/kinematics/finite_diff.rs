@@ -2,7 +2,7 @@
 //!
 //! * Order 2 reproduces MATLAB `gradient`: central `(x[i+1] − x[i−1]) / (t[i+1] − t[i−1])` inside,
 //!   one-sided first-order differences at the ends; the second derivative is the gradient of the
-//!   gradient, as seed 000 computes acceleration.
+//!   gradient, as the MATLAB trajectory tool computes acceleration.
 //! * Orders 4, 6 (default) and 8 use Fornberg weights (B. Fornberg, "Generation of finite
 //!   difference formulas on arbitrarily spaced grids", Math. Comp. 51, 1988) on the actual sample
 //!   times: centred `order + 1`-point stencils inside, and `order + 4`-point one-sided stencils

@@ -1,4 +1,4 @@
-//! Tangent attitude: the body x axis along the velocity (seed 000 eqs. 10–13).
+//! Tangent attitude: the body x axis along the velocity (the MATLAB trajectory tool's eqs. 10–13).
 //!
 //! `yaw = atan2(v_y, v_x)`, `pitch = −asin(v_z / |v|)` (written as `−atan2(v_z, |v_h|)`),
 //! `roll = 0`; the same formula in ENU and NED (in NED a climb is nose-up). Where the speed falls

@@ -3,7 +3,7 @@
 //! all behind one per-sample trait ([`OrientationFilter`]); and the quaternion distance that
 //! judges them against truth ([`metrics`]).
 //!
-//! Conventions (DESIGN §2): the estimate is `q_nb`, the rotation from the body to the
+//! Conventions (docs/design.md §2): the estimate is `q_nb`, the rotation from the body to the
 //! navigation frame `N` (ENU or NED) — MATLAB's "orientation" quaternion (its nav→body frame
 //! rotation) has the same four numbers. Readings are body-frame: accelerometer in m/s² in the
 //! [`AccelSign`] the filter is told (specific force, or MATLAB's gravity minus acceleration;

@@ -1,6 +1,6 @@
 //! Dead reckoning and strapdown navigation from IMU data.
 //!
-//! [`planar`]: a cart in a plane with two accelerometers and a yaw gyro (seed 001), with the
+//! [`planar`]: a cart in a plane with two accelerometers and a yaw gyro (the planar cart exercise), with the
 //! exercise's own update rules kept verbatim and a consistent second-order default.
 //! [`step`]: 3D strapdown with coning and sculling in a flat-Earth local-level frame (second order);
 //! [`rk4`]: a fourth-order alternative for rate samples.

@@ -1,4 +1,4 @@
-//! Planar dead reckoning (seed 001, DESIGN §2): nav axes X, Y; body x forward, y left; ω_z positive
+//! Planar dead reckoning (the planar cart exercise; docs/design.md §2): nav axes X, Y; body x forward, y left; ω_z positive
 //! counter-clockwise; heading α from nav X counter-clockwise; body → nav is
 //! `R(α) = [[cos α, −sin α], [sin α, cos α]]`. Accelerometers measure the body-frame components of
 //! the cart's acceleration `a_b = R(α)ᵀ a_n` (no gravity in the plane).

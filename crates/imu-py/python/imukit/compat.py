@@ -1,4 +1,4 @@
-"""Seed 000 compatibility: the five MATLAB functions ``my_lin``, ``my_tang``, ``my_ang``,
+"""Compatibility with the MATLAB trajectory tool: its five functions ``my_lin``, ``my_tang``, ``my_ang``,
 ``my_rotate`` and ``my_imu`` with their arguments and outputs, on NumPy arrays.
 
 ``option='num'`` differentiates sampled arrays (MATLAB ``gradient`` by default, ``order=2``;
@@ -10,29 +10,29 @@ Migration from the MATLAB tool
 ------------------------------
 
 ====================  =======================================  ==========================================
-MATLAB (seed 000)     imukit.compat                            notes
+MATLAB tool           imukit.compat                            notes
 ====================  =======================================  ==========================================
 ``my_lin(s,'num',t)`` ``my_lin(s, 'num', t)``                   same outputs; ``order=6`` for 1e-8 accuracy
 ``my_lin(s,'sym',t)`` ``my_lin(["0.8*cos(2*pi*f*t)", ...],      strings or sympy; ``constants={'f': 1}``
                       'sym', t, constants={'f': 1})``
 ``my_tang(v,t)``      ``my_tang(v, t)``                         returns ``phi_tz, phi_ty, phi_tx, ta``;
                                                                 holds the last attitude at standstill
-                                                                (the seed returns NaN there)
+                                                                (the tool returns NaN there)
 ``my_ang(phi,o,t)``   ``my_ang(phi, o, t)``                     ``phi`` columns ``[phi_x, phi_y, phi_z]`` =
-                                                                ``[roll, pitch, yaw]`` as in the seed. omega
+                                                                ``[roll, pitch, yaw]`` as in the tool. omega
                                                                 is the **body** rate (what a gyro measures);
-                                                                the seed's eq. (7) ``dR/dt·R⁻¹`` is the
+                                                                the tool's eq. (7) ``dR/dt·R⁻¹`` is the
                                                                 nav-frame rate: ``frame='nav'`` gives it
-``my_rotate(phi,aN,t)`` ``my_rotate(phi, aN, t)``               returns ``C_nbᵀ·aN`` (nav → body). The seed
+``my_rotate(phi,aN,t)`` ``my_rotate(phi, aN, t)``               returns ``C_nbᵀ·aN`` (nav → body). The tool
                                                                 multiplies by ``R = C_nb`` (body → nav), the
-                                                                opposite rotation; ``seed_convention=True``
+                                                                opposite rotation; ``tool_convention=True``
                                                                 reproduces its numbers
-``my_imu(aB,w,al,r,t)`` ``my_imu(aB, w, al, r, t)``             ``aB + ω×(ω×r) + α×r`` (seed eq. 9)
+``my_imu(aB,w,al,r,t)`` ``my_imu(aB, w, al, r, t)``             ``aB + ω×(ω×r) + α×r`` (the tool's eq. 9)
 gravity               ``imukit.ideal_imu`` / ``simulate``       imukit reports the specific force ``a − g_n``
                                                                 (at rest ENU ``[0, 0, +9.81]``);
                                                                 ``accel_sign='matlab'`` gives MATLAB
                                                                 imuSensor's ``g_n − a`` (``[0, 0, −9.81]``).
-                                                                The seed's scripts add ``[0, 0, −g]``, i.e.
+                                                                The tool's scripts add ``[0, 0, −g]``, i.e.
                                                                 ``a + g_n``: MATLAB's sign at rest but the
                                                                 motion term of the specific force — neither
 ====================  =======================================  ==========================================
@@ -138,8 +138,8 @@ def my_ang(phi, option: str, t_, *, order: int = 2, frame: str = "body",
     """Euler angles, angular rate and angular acceleration: ``[phi, omega, alpha] = my_ang(...)``.
 
     ``phi`` columns (or the three formulas) are ``[phi_x, phi_y, phi_z]`` = ``[roll, pitch, yaw]``
-    as in the seed. ``frame='body'`` (default) gives the gyro's body rate; ``frame='nav'`` the
-    navigation-frame rate of the seed's eq. (7).
+    as in the tool. ``frame='body'`` (default) gives the gyro's body rate; ``frame='nav'`` the
+    navigation-frame rate of the tool's eq. (7).
     """
     t = np.ascontiguousarray(t_, dtype=np.float64).ravel()
     if frame not in ("body", "nav"):
@@ -165,23 +165,23 @@ def my_ang(phi, option: str, t_, *, order: int = 2, frame: str = "body",
     return angles, omega, alpha
 
 
-def my_rotate(phi, aN, t=None, *, seed_convention: bool = False):
+def my_rotate(phi, aN, t=None, *, tool_convention: bool = False):
     """Navigation-frame vectors in the body frame: ``aB = my_rotate(phi, aN, t)``.
 
     ``phi`` columns ``[phi_x, phi_y, phi_z]`` = ``[roll, pitch, yaw]``. Returns ``C_nbᵀ·aN``;
-    with ``seed_convention=True`` returns the seed's ``R(phi)·aN`` (which is ``C_nb·aN``).
+    with ``tool_convention=True`` returns the tool's ``R(phi)·aN`` (which is ``C_nb·aN``).
     """
     p = np.ascontiguousarray(phi, dtype=np.float64)
     a = np.ascontiguousarray(aN, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"phi must have shape (N, 3), got {p.shape}")
     euler = np.ascontiguousarray(p[:, ::-1])
-    if seed_convention:
+    if tool_convention:
         return np.einsum("nij,nj->ni", _core.euler_to_dcm(euler), a)
     return _core.nav_to_body(euler, a)
 
 
 def my_imu(aB, omega, alpha, r: Sequence[float], t=None):
-    """Acceleration at the IMU point: ``a_IMU = aB + ω×(ω×r) + α×r`` (seed eq. 9), body frame."""
+    """Acceleration at the IMU point: ``a_IMU = aB + ω×(ω×r) + α×r`` (the tool's eq. 9), body frame."""
     f = lambda x: np.ascontiguousarray(x, dtype=np.float64)  # noqa: E731
     return _core.at_lever_arm(f(aB), f(omega), f(alpha), [float(c) for c in r])

@@ -9,7 +9,7 @@
 //! functions of time, generic over the scalar (any [`num_dual::DualNum`] with `f64` primitive, and
 //! `f64` itself). Position is evaluated once over a third-order dual number (p, v, a and the jerk
 //! that the tangent attitude's angular acceleration needs) and the angles over a second-order dual
-//! number, so every derivative is exact to rounding: the counterpart of seed 000's `'sym'` option.
+//! number, so every derivative is exact to rounding: the counterpart of the MATLAB trajectory tool's `'sym'` option.
 //!
 //! ```
 //! use imukit::motion::analytic::{truth_from_motion, AnalyticOptions, Motion, Scalar};

@@ -187,7 +187,7 @@ impl InitialState {
 /// The 3D integration scheme.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NavScheme {
-    /// DESIGN §6: exact rotation-vector step, two-sample coning and sculling, trapezoidal
+    /// docs/design.md §6: exact rotation-vector step, two-sample coning and sculling, trapezoidal
     /// position; rates or increments; second order.
     #[default]
     ConingSculling,

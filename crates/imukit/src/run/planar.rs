@@ -1,4 +1,4 @@
-//! Planar IMU files and planar dead reckoning for the CLI and Python (seed 001's exercise).
+//! Planar IMU files and planar dead reckoning for the CLI and Python (the planar cart exercise).
 //!
 //! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
 //! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files

@@ -1,13 +1,13 @@
-//! Built-in scenarios: the seeds' examples and MATLAB's documentation examples.
+//! Built-in scenarios: the MATLAB trajectory tool's examples, the planar cart exercise and MATLAB's documentation examples.
 //!
 //! | name | what | source |
 //! |---|---|---|
-//! | `figure8` | figure-8 with tangent attitude, lever arm [−75, −75, 25] mm, 2 kHz, 1 s | seed 000, "8-Trajektorie" |
-//! | `tilted-circle` | tilted circle with explicit Euler angles, 200 Hz, 1 s | seed 000, Figure 3 |
-//! | `rounded-rectangle` | 1 m × 1 m square with 0.1 m corner radius at 0.8 m/s, 2 kHz, one lap | seed 000, "Abgerundetes Viereck" |
+//! | `figure8` | figure-8 with tangent attitude, lever arm [−75, −75, 25] mm, 2 kHz, 1 s | the MATLAB trajectory tool, "8-Trajektorie" |
+//! | `tilted-circle` | tilted circle with explicit Euler angles, 200 Hz, 1 s | the MATLAB trajectory tool, Figure 3 |
+//! | `rounded-rectangle` | 1 m × 1 m square with 0.1 m corner radius at 0.8 m/s, 2 kHz, one lap | the MATLAB trajectory tool, "Abgerundetes Viereck" |
 //! | `static` | level IMU at rest, 100 Hz, 10 s | — |
-//! | `platform-turn` | NED platform turning 360° in 4 s, then 360° in 2 s, 100 Hz, 600 samples | MATLAB imuSensor page (seed 003) |
-//! | `cart` | planar cart on a closed rail (20 m straights, 5 m half turns to the left) from [100, 100], starting and stopping at rest (2 m/s, 0.5 m/s²), 50 Hz | seed 001's exercise |
+//! | `platform-turn` | NED platform turning 360° in 4 s, then 360° in 2 s, 100 Hz, 600 samples | MATLAB's imuSensor page |
+//! | `cart` | planar cart on a closed rail (20 m straights, 5 m half turns to the left) from [100, 100], starting and stopping at rest (2 m/s, 0.5 m/s²), 50 Hz | the planar cart exercise's exercise |
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_PI_2;
 
