@@ -22,7 +22,7 @@ use crate::io::rows::{TimedRows, check_gaps};
 use crate::io::table::{
     ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table,
 };
-use crate::scenario::resolve::check_gravity;
+use crate::scenario::resolve::{check_gravity, finite_vec};
 use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 
 /// Navigation output columns.
@@ -91,24 +91,15 @@ impl InitialState {
         quaternion: Option<[f64; 4]>,
         euler_rad: Option<[f64; 3]>,
     ) -> Result<Self> {
-        let finite = |field: &str, v: &[f64]| {
-            if v.iter().all(|x| x.is_finite()) {
-                Ok(())
-            } else {
-                Err(invalid(field, format!("must be finite, got {v:?}")))
-            }
-        };
-        let position_m = position_m.unwrap_or_default();
-        let velocity_m_s = velocity_m_s.unwrap_or_default();
-        finite("position0_m", &position_m)?;
-        finite("velocity0_m_s", &velocity_m_s)?;
+        let position_m = finite_vec("position0_m", position_m.unwrap_or_default())?;
+        let velocity_m_s = finite_vec("velocity0_m_s", velocity_m_s.unwrap_or_default())?;
         match (quaternion, euler_rad) {
             (Some(_), Some(_)) => Err(invalid(
                 "euler0_rad",
                 "give the attitude as a quaternion or as Euler angles, not both",
             )),
             (None, Some(e)) => {
-                finite("euler0_rad", &e)?;
+                let e = finite_vec("euler0_rad", e)?;
                 Ok(Self::from_euler(
                     position_m,
                     velocity_m_s,
@@ -116,8 +107,7 @@ impl InitialState {
                 ))
             }
             (q, None) => {
-                let quaternion = q.unwrap_or([1.0, 0.0, 0.0, 0.0]);
-                finite("quaternion0", &quaternion)?;
+                let quaternion = finite_vec("quaternion0", q.unwrap_or([1.0, 0.0, 0.0, 0.0]))?;
                 if quaternion.iter().all(|c| *c == 0.0) {
                     return Err(invalid("quaternion0", "has zero norm"));
                 }

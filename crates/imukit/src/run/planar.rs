@@ -11,6 +11,7 @@ use imu_core::strapdown::planar::{
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{Table, read_columns, write_atomically, write_rows};
+use crate::scenario::resolve::finite_vec;
 
 /// Planar IMU columns of a CSV file.
 pub const PLANAR_COLUMNS: [&str; 4] = ["t_s", "accel_x_m_s2", "accel_y_m_s2", "gyro_z_rad_s"];
@@ -213,16 +214,9 @@ impl PlanarRequest<'_> {
     /// # Errors
     /// Non-finite start values, named.
     pub fn initial_state(&self, t0_s: f64) -> Result<PlanarState> {
-        let finite = |field: &str, v: &[f64]| {
-            if v.iter().all(|x| x.is_finite()) {
-                Ok(())
-            } else {
-                Err(invalid(field, format!("must be finite, got {v:?}")))
-            }
-        };
-        finite("position0_m", &self.position0_m)?;
-        finite("heading0_rad", &[self.heading0_rad])?;
-        finite("velocity0_m_s", &self.velocity0_m_s)?;
+        finite_vec("position0_m", self.position0_m)?;
+        finite_vec("heading0_rad", [self.heading0_rad])?;
+        finite_vec("velocity0_m_s", self.velocity0_m_s)?;
         let (s, c) = self.heading0_rad.sin_cos();
         let v = self.velocity0_m_s;
         Ok(PlanarState {

@@ -316,11 +316,11 @@ pub(crate) fn finite_positive(field: &str, v: f64) -> Result<f64> {
     }
 }
 
-/// A 3-vector whose components are all finite.
+/// A vector whose components are all finite.
 ///
 /// # Errors
 /// [`Error::Invalid`] naming `field`.
-pub fn finite_vec(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
+pub fn finite_vec<const K: usize>(field: &str, v: [f64; K]) -> Result<[f64; K]> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {
