@@ -355,6 +355,7 @@ fn builtin_toml(name: &str) -> PyResult<String> {
 
 /// Adds this module's functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("DEFAULT_GRAVITY_M_S2", imu_core::DEFAULT_GRAVITY_M_S2)?;
     m.add_function(wrap_pyfunction!(simulate_text, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_dict, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_expressions, m)?)?;

@@ -8,6 +8,7 @@ _Table = tuple[list[str], npt.NDArray[np.float64]]
 
 __all__ = [
     "ImuError",
+    "DEFAULT_GRAVITY_M_S2",
     "read_csv",
     "write_csv",
     "run_path",
@@ -52,6 +53,8 @@ __all__ = [
     "builtin_names",
     "builtin_toml",
 ]
+
+DEFAULT_GRAVITY_M_S2: float
 
 class ImuError(ValueError):
     field: Optional[str]

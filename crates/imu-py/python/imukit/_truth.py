@@ -11,7 +11,7 @@ from ._convert import _f64, _table_args, _times
 from ._core import ImuError
 from ._table import Simulation, Table, _table
 
-DEFAULT_GRAVITY_M_S2 = 9.81  # imu_core::DEFAULT_GRAVITY_M_S2, MATLAB imuSensor's value
+DEFAULT_GRAVITY_M_S2: float = _core.DEFAULT_GRAVITY_M_S2  # m/s², MATLAB imuSensor's value
 
 
 def simulate(scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] = None) -> Simulation:
