@@ -37,7 +37,7 @@ pub enum Command {
         /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
         input: PathBuf,
         /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
-        /// origin unless --position0/--velocity0/--euler0 say otherwise).
+        /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
         init: Option<PathBuf>,
         /// 3D: navigation frame of the data (ENU or NED).
@@ -53,7 +53,7 @@ pub enum Command {
         #[arg(long)]
         no_corrections: bool,
         /// 3D: initial attitude yaw, pitch, roll, rad.
-        #[arg(long, num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_negative_numbers = true)]
+        #[arg(long = "euler0-rad", alias = "euler0", num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_negative_numbers = true)]
         euler0: Option<Vec<f64>>,
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
@@ -66,13 +66,18 @@ pub enum Command {
         #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
         substeps: usize,
         /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
-        #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]
+        #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_negative_numbers = true)]
         position0: Option<Vec<f64>>,
         /// Planar: initial heading, rad from nav X, counter-clockwise.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(
+            long = "heading0-rad",
+            alias = "heading0",
+            default_value_t = 0.0,
+            allow_negative_numbers = true
+        )]
         heading0: f64,
         /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
-        #[arg(long, num_args = 2..=3, allow_negative_numbers = true)]
+        #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_negative_numbers = true)]
         velocity0: Option<Vec<f64>>,
         /// Where to write the trajectory (CSV).
         #[arg(long)]
@@ -192,10 +197,10 @@ pub enum Command {
         out: PathBuf,
         /// Box length, width and height along body x, y, z, m (default: a tenth of the path's
         /// extent long).
-        #[arg(long, num_args = 3, value_names = ["L", "W", "H"])]
+        #[arg(long = "body-m", alias = "body", num_args = 3, value_names = ["L", "W", "H"])]
         body: Option<Vec<f64>>,
         /// Lever arm of the IMU point from the reference point, body frame, m.
-        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true)]
+        #[arg(long = "lever-arm-m", alias = "lever-arm", num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true)]
         lever_arm: Option<Vec<f64>>,
         /// Frames per second.
         #[arg(long, default_value_t = 20.0)]

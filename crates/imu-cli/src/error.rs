@@ -32,3 +32,33 @@ impl CliError {
         }
     }
 }
+
+/// The flag that sets a library field: `gravity_m_s2` → `--gravity-m-s2`.
+#[must_use]
+pub fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// A library refusal of a request field, named by its flag.
+#[must_use]
+pub fn by_flag(e: imukit::Error) -> imukit::Error {
+    match e {
+        imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
+            field: flag(&field),
+            message,
+        },
+        other => other,
+    }
+}
+
+/// A figure's refusal of an option, named by its flag.
+#[must_use]
+pub fn plot_by_flag(e: PlotError) -> PlotError {
+    match e {
+        PlotError::Invalid { field, message } => PlotError::Invalid {
+            field: flag(&field),
+            message,
+        },
+        other => other,
+    }
+}

@@ -9,4 +9,4 @@ pub mod cli;
 pub mod commands;
 mod error;
 
-pub use error::CliError;
+pub use error::{CliError, by_flag, flag, plot_by_flag};

@@ -124,10 +124,10 @@ impl Scene {
             .body_m
             .is_some_and(|b| !(finite3(b) && b.iter().all(|v| *v > 0.0)))
         {
-            return Err(bad("--body", "length, width and height must be positive"));
+            return Err(bad("body_m", "length, width and height must be positive"));
         }
         if !finite3(opts.lever_arm_m) {
-            return Err(bad("--lever-arm", "must be finite"));
+            return Err(bad("lever_arm_m", "must be finite"));
         }
         let poses = poses(truth, source, opts.ned)?;
         let times: Vec<f64> = poses.iter().map(|p| p.t).collect();

@@ -42,7 +42,7 @@ pub enum PlotError {
     /// An option or a table value that cannot be drawn.
     #[error("{field}: {message}")]
     Invalid {
-        /// The option (`fps`, `--body`) or the file and row.
+        /// The option (`fps`, `body_m`, as named in [`animate::AnimateOptions`]) or the file and row.
         field: String,
         /// What is wrong.
         message: String,

@@ -7,7 +7,7 @@ use imukit::run::navigate::{InitialState, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
-use crate::CliError;
+use crate::{CliError, by_flag};
 
 /// Arguments shared by the planar and the 3D integration.
 pub struct Common<'a> {
@@ -29,27 +29,6 @@ pub struct Options3d<'a> {
     pub substeps: usize,
 }
 
-/// The flag that sets a request field.
-fn flag(field: &str) -> String {
-    match field {
-        "position0_m" => "--position0".into(),
-        "velocity0_m_s" => "--velocity0".into(),
-        "heading0_rad" => "--heading0".into(),
-        other => format!("--{}", other.replace('_', "-")),
-    }
-}
-
-/// A request's refusal, named by its flag.
-fn by_flag(e: Error) -> Error {
-    match e {
-        Error::Invalid { field, message } => Error::Invalid {
-            field: flag(&field),
-            message,
-        },
-        other => other,
-    }
-}
-
 fn vector<const K: usize>(
     flag: &str,
     v: Option<&[f64]>,
@@ -69,9 +48,9 @@ fn vector<const K: usize>(
 pub fn planar(c: &Common<'_>, scheme: &str, heading0_rad: f64) -> Result<(), CliError> {
     let request = PlanarRequest {
         scheme,
-        position0_m: vector("--position0", c.position0, EXERCISE_POSITION0_M)?,
+        position0_m: vector("--position0-m", c.position0, EXERCISE_POSITION0_M)?,
         heading0_rad,
-        velocity0_m_s: vector("--velocity0", c.velocity0, [0.0, 0.0])?,
+        velocity0_m_s: vector("--velocity0-m-s", c.velocity0, [0.0, 0.0])?,
     };
     let scheme_rules = request.scheme().map_err(by_flag)?;
     let samples = read_planar(c.input)?;
@@ -103,13 +82,13 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         None => InitialState::default(),
     };
     if let Some(p) = c.position0 {
-        initial.position_m = vector("--position0", Some(p), [0.0; 3])?;
+        initial.position_m = vector("--position0-m", Some(p), [0.0; 3])?;
     }
     if let Some(v) = c.velocity0 {
-        initial.velocity_m_s = vector("--velocity0", Some(v), [0.0; 3])?;
+        initial.velocity_m_s = vector("--velocity0-m-s", Some(v), [0.0; 3])?;
     }
     if let Some(e) = o.euler0 {
-        let e = vector("--euler0", Some(e), [0.0; 3])?;
+        let e = vector("--euler0-rad", Some(e), [0.0; 3])?;
         initial = InitialState::from_euler(
             initial.position_m,
             initial.velocity_m_s,

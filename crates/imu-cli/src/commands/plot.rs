@@ -42,7 +42,8 @@ pub fn options(
 
 pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), CliError> {
     let table = read_table(truth)?;
-    let info = anim::animate(&table, &truth.display().to_string(), out, opts)?;
+    let info = anim::animate(&table, &truth.display().to_string(), out, opts)
+        .map_err(crate::plot_by_flag)?;
     println!(
         "Wrote {} ({} frames at {} frames/s, {}× real time)",
         out.display(),
