@@ -1,7 +1,7 @@
 //! Orientation estimation for Python: the e-compass, every filter behind one class, and the
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
 use imu_core::{AccelSign, Enu, Ned};
-use imukit::run::orient::{AnyFilter, FilterKind, FilterSpec, run_rows};
+use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows};
 use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -48,12 +48,26 @@ impl PyOrientationFilter {
         settings: Vec<(String, f64)>,
         initial_process_noise: Option<Vec<f64>>,
     ) -> PyResult<Self> {
-        let kind = FilterKind::parse(kind).map_err(refused)?;
-        let mut spec = FilterSpec::new(kind, sign(accel_sign)?);
+        let request = OrientRequest {
+            filter: kind,
+            nav_frame: reference_frame,
+            accel_sign,
+            settings,
+        };
+        let (mut spec, nav) = request.resolve().map_err(|e| match e {
+            // The MATLAB-shaped classes call the navigation frame reference_frame.
+            imukit::Error::Invalid { field, message } if field == "nav_frame" => {
+                refused(imukit::Error::Invalid {
+                    field: "reference_frame".into(),
+                    message,
+                })
+            }
+            other => refused(other),
+        })?;
+        let kind = spec.kind;
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
-        spec.settings = settings;
         spec.initial_process_noise = initial_process_noise;
-        let filter = match nav_frame("reference_frame", reference_frame)? {
+        let filter = match nav {
             NavFrameName::ENU => Filter::Enu(spec.build(sample_rate).map_err(refused)?),
             NavFrameName::NED => Filter::Ned(spec.build(sample_rate).map_err(refused)?),
         };

@@ -1,11 +1,9 @@
 //! `imukit orient IMU.csv --filter NAME [--param KEY=VALUE …] --out ORIENT.csv`.
 use std::path::Path;
 
-use imu_core::AccelSign;
-use imukit::run::orient::{FilterKind, FilterSpec, orient_csv};
-use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
+use imukit::run::orient::{FilterSpec, OrientRequest, orient_csv};
 
-use super::CliError;
+use crate::{CliError, by_flag};
 
 pub fn run(
     input: &Path,
@@ -15,10 +13,14 @@ pub fn run(
     accel_sign: &str,
     out: &Path,
 ) -> Result<(), CliError> {
-    let nav: NavFrameName = parse_name("--nav-frame", &nav_frame.to_ascii_uppercase())?;
-    let sign: AccelSign = parse_name::<AccelSignName>("--accel-sign", accel_sign)?.into();
-    let mut spec = FilterSpec::new(FilterKind::parse(filter)?, sign);
-    spec.settings = FilterSpec::parse_settings(params)?;
+    let (spec, nav) = OrientRequest {
+        filter,
+        nav_frame,
+        accel_sign,
+        settings: FilterSpec::parse_settings(params)?,
+    }
+    .resolve()
+    .map_err(by_flag)?;
     let s = orient_csv(input, &spec, nav, out)?;
     println!(
         "imukit: {} samples at {} Hz through {filter}: {} orientations in {}",

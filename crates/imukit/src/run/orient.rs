@@ -13,7 +13,7 @@ use crate::error::{Result, invalid};
 use crate::io::rows::TimedRows;
 use crate::io::table::{ACCEL_COLUMNS, AtomicFile, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
-use crate::scenario::NavFrameName;
+use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
 /// unwrapped).
@@ -129,6 +129,35 @@ const MAGNETIC_SETTINGS: [&str; 4] = [
     "MagneticDisturbanceDecayFactor",
     "ExpectedMagneticFieldStrength",
 ];
+
+/// An orientation run as a front end states it (filter, frame and sign by name, settings by
+/// MATLAB's property names); checked once, in [`OrientRequest::resolve`]. Errors name the fields
+/// as written here (`filter`, `nav_frame`, `accel_sign`) or the setting.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrientRequest<'a> {
+    /// The filter's name ([`FilterKind::ALL`]).
+    pub filter: &'a str,
+    /// `"ENU"` or `"NED"` (any case).
+    pub nav_frame: &'a str,
+    /// `"specific-force"` or `"matlab"`.
+    pub accel_sign: &'a str,
+    /// `(name, value)` settings.
+    pub settings: Vec<(String, f64)>,
+}
+
+impl OrientRequest<'_> {
+    /// The filter spec and the navigation frame.
+    ///
+    /// # Errors
+    /// Unknown names, named by field.
+    pub fn resolve(&self) -> Result<(FilterSpec, NavFrameName)> {
+        let nav = parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?;
+        let sign: AccelSign = parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into();
+        let mut spec = FilterSpec::new(FilterKind::parse(self.filter)?, sign);
+        spec.settings.clone_from(&self.settings);
+        Ok((spec, nav))
+    }
+}
 
 /// A filter to build: which, with which sensors and accelerometer sign, and its settings.
 #[derive(Clone, Debug, PartialEq)]
