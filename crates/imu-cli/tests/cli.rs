@@ -447,3 +447,57 @@ fn gravity_flag_carries_its_unit_and_keeps_the_old_spelling() {
     );
     assert!(!dir.join("bad.csv").exists());
 }
+
+#[test]
+fn a_duplicated_column_or_a_missing_position_is_refused_not_a_panic() {
+    let dir = temp_dir("columns");
+    let dup = dir.join("dup.csv");
+    std::fs::write(
+        &dup,
+        "t_s,gyro_x_rad_s,gyro_x_rad_s\n0,0.1,0.2\n0.01,0.1,0.2\n",
+    )
+    .unwrap();
+    let out = imukit()
+        .arg("allan")
+        .arg(&dup)
+        .arg("--out")
+        .arg(dir.join("a.csv"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(65));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("column gyro_x_rad_s appears twice in the header (fields 2 and 3)"),
+        "{err}"
+    );
+    assert!(!dir.join("a.csv").exists());
+    // A truth table without pos_y_m: the trajectory panel cannot be drawn.
+    let truth = dir.join("truth.csv");
+    let columns: Vec<&str> = imukit::io::table::TRUTH_COLUMNS
+        .iter()
+        .copied()
+        .filter(|c| *c != "pos_y_m")
+        .collect();
+    let row = |t: &str| {
+        let mut r = vec!["0"; columns.len()];
+        r[0] = t;
+        r[columns.iter().position(|c| *c == "q_w").unwrap()] = "1";
+        r.join(",")
+    };
+    std::fs::write(
+        &truth,
+        format!("{}\n{}\n{}\n", columns.join(","), row("0"), row("0.1")),
+    )
+    .unwrap();
+    let out = imukit()
+        .arg("plot")
+        .arg(&truth)
+        .arg("--out")
+        .arg(dir.join("t.png"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(65), "{err}");
+    assert!(err.contains("no pos_y_m column"), "{err}");
+    assert!(!dir.join("t.png").exists());
+}

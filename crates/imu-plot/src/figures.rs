@@ -64,6 +64,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
         });
     }
     let mut files = Vec::new();
+    let mut traces: Vec<Trace> = Vec::new();
     let mut kind: Option<TableKind> = None;
     for p in paths {
         let t = imukit::io::table::read_table(p)?;
@@ -80,6 +81,16 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
             });
         }
         kind.get_or_insert(k);
+        if k.has_trajectory() {
+            let trace = Trace::from_table(&stem(p), &t, ned).map_err(|e| match e {
+                PlotError::Invalid { message, .. } => PlotError::Invalid {
+                    field: p.display().to_string(),
+                    message,
+                },
+                other => other,
+            })?;
+            traces.push(trace);
+        }
         files.push((stem(p), t));
     }
     let kind = kind.unwrap_or(TableKind::Imu);
@@ -91,14 +102,9 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
         .iter()
         .filter_map(|spec| panel(&files, spec))
         .collect();
-    let traces: Vec<Trace> = if kind.has_trajectory() {
-        files
-            .iter()
-            .map(|(name, t)| Trace::from_table(name, t, ned))
-            .collect()
-    } else {
-        Vec::new()
-    };
+    if !kind.has_trajectory() {
+        traces.clear();
+    }
     let three_d = is_3d(&traces);
     let cells = panels.len() + usize::from(!traces.is_empty());
     let cols = if cells > 3 { 2 } else { 1 };

@@ -115,12 +115,19 @@ pub struct Trace {
 impl Trace {
     /// The `pos_x_m`, `pos_y_m` (and `pos_z_m` if present) columns of a table; NED positions
     /// become east, north, up.
-    #[must_use]
-    pub fn from_table(name: &str, t: &imukit::Table, ned: bool) -> Self {
-        let (x, y) = (
-            t.column("pos_x_m").unwrap_or_default(),
-            t.column("pos_y_m").unwrap_or_default(),
-        );
+    ///
+    /// # Errors
+    /// [`PlotError::Invalid`] naming the table when `pos_x_m` or `pos_y_m` is missing.
+    pub fn from_table(name: &str, t: &imukit::Table, ned: bool) -> Result<Self, PlotError> {
+        let column = |c: &str| {
+            t.column(c).ok_or_else(|| PlotError::Invalid {
+                field: name.to_string(),
+                message: format!(
+                    "no {c} column: a trajectory needs pos_x_m and pos_y_m (pos_z_m optional)"
+                ),
+            })
+        };
+        let (x, y) = (column("pos_x_m")?, column("pos_y_m")?);
         let z = t.column("pos_z_m").unwrap_or_else(|| vec![0.0; x.len()]);
         let points = (0..x.len())
             .map(|i| {
@@ -128,10 +135,10 @@ impl Trace {
                 (e, n, u)
             })
             .collect();
-        Self {
+        Ok(Self {
             name: name.to_string(),
             points,
-        }
+        })
     }
 }
 

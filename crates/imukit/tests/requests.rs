@@ -169,3 +169,31 @@ fn a_bad_csv_cell_is_located_by_file_row_and_column() {
     assert_eq!(at.column.as_deref(), Some("gyro_z_rad_s"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_column_named_twice_is_refused_with_both_places() {
+    let dir = std::env::temp_dir().join(format!("imukit-dup-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("dup.csv");
+    std::fs::write(
+        &path,
+        "t_s,gyro_x_rad_s,gyro_x_rad_s\n0,0.1,0.2\n0.01,0.1,0.2\n",
+    )
+    .unwrap();
+    for e in [
+        imukit::io::table::read_table(&path).unwrap_err(),
+        imukit::io::table::read_columns(&path, &["t_s", "gyro_x_rad_s"], "")
+            .map(|_| ())
+            .unwrap_err(),
+    ] {
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: column gyro_x_rad_s appears twice in the header (fields 2 and 3)",
+                path.display()
+            )
+        );
+        assert_eq!(e.location().file.as_deref(), Some(path.as_path()));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -43,7 +43,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
         ("inertial_data.dat", &clean),
         ("inertial_data_errors.dat", &noisy),
     ];
-    let mut traces = vec![Trace::from_table("truth (rail)", &clean.truth, false)];
+    let mut traces = vec![Trace::from_table("truth (rail)", &clean.truth, false)?];
     let mut summary = String::new();
     let _ = writeln!(
         summary,
@@ -75,7 +75,7 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
                 "{file:<26} {name:<10} {:>24} {err:>14.3}",
                 format!("({x:.3}, {y:.3})")
             );
-            traces.push(Trace::from_table(&format!("{stem} ({name})"), &nav, false));
+            traces.push(Trace::from_table(&format!("{stem} ({name})"), &nav, false)?);
         }
     }
     let _ = writeln!(

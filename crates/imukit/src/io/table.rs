@@ -467,7 +467,7 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
 /// The header of a CSV file (trimmed names).
 ///
 /// # Errors
-/// Unreadable or empty file.
+/// Unreadable or empty file, a column name that appears twice.
 pub fn read_header(path: &Path) -> Result<Vec<String>> {
     let mut r = reader(path)?;
     let h = r.headers().map_err(|e| csv_error(path, &e))?;
@@ -477,6 +477,21 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
             file: path.into(),
             message: "empty file (no header row)".into(),
         });
+    }
+    // A column name read twice would make every reader pick one of them silently (or worse).
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(names.len());
+    for (j, name) in names.iter().enumerate() {
+        if let Some(&i) = seen.get(name.as_str()) {
+            return Err(Error::CsvFormat {
+                file: path.into(),
+                message: format!(
+                    "column {name} appears twice in the header (fields {} and {})",
+                    i + 1,
+                    j + 1
+                ),
+            });
+        }
+        seen.insert(name, j);
     }
     Ok(names)
 }
