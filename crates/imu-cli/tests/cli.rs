@@ -501,3 +501,51 @@ fn a_duplicated_column_or_a_missing_position_is_refused_not_a_panic() {
     assert!(err.contains("no pos_y_m column"), "{err}");
     assert!(!dir.join("t.png").exists());
 }
+
+#[test]
+fn a_deeply_nested_or_very_long_formula_is_refused_without_a_crash() {
+    let dir = temp_dir("nesting");
+    let nested = format!("{}t{}", "(".repeat(5000), ")".repeat(5000));
+    let sum = vec!["t"; 40_000].join("+");
+    for (formula, message) in [
+        (
+            nested.as_str(),
+            "trajectory.position_m[0]: nested deeper than 64 levels (parentheses, signs, powers, calls) at column 65",
+        ),
+        (
+            sum.as_str(),
+            "trajectory.position_m[0]: more than 1000 operations deep",
+        ),
+    ] {
+        let scenario = dir.join("deep.toml");
+        std::fs::write(
+            &scenario,
+            format!(
+                "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\n\
+                 position_m = [\"{formula}\", \"0\", \"0\"]\n"
+            ),
+        )
+        .unwrap();
+        let out = imukit()
+            .arg("simulate")
+            .arg(&scenario)
+            .arg("--out")
+            .arg(dir.join("imu.csv"))
+            .arg("--truth")
+            .arg(dir.join("truth.csv"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(65), "{err}");
+        assert!(err.contains(message), "{err}");
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(
+            left,
+            [std::ffi::OsString::from("deep.toml")],
+            "no output left behind"
+        );
+    }
+}

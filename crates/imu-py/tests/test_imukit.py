@@ -145,3 +145,12 @@ def test_simulate_dict_and_builtins():
     assert "mag_x_ut" in sim.imu and "omega_z_rad_s" in sim.truth
     with pytest.raises(KeyError, match="no column 'nope'"):
         sim.truth["nope"]
+
+
+def test_a_deeply_nested_formula_raises_instead_of_crashing_the_interpreter():
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ImuError, match="nested deeper than 64 levels") as e:
+        imukit.truth_from_expressions(t, ["(" * 5000 + "t" + ")" * 5000, "0", "0"])
+    assert e.value.field == "trajectory.position_m[0]"
+    with pytest.raises(ImuError, match="more than 1000 operations deep"):
+        imukit.truth_from_expressions(t, ["+".join(["t"] * 40_000), "0", "0"])

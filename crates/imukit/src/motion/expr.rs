@@ -16,6 +16,18 @@ use std::fmt;
 
 use crate::motion::analytic::Scalar;
 
+/// The deepest nesting of parentheses, signs, powers and calls a formula may have. The parser
+/// and the evaluator recurse once per level, so the limit keeps them far from the end of any
+/// thread's stack (Python's, rayon's); no hand-written motion comes near it.
+pub const MAX_NESTING: usize = 64;
+
+/// The deepest tree a formula may become: a sum of `n` terms is `n` deep (it is evaluated left
+/// to right, term by term). Longer formulas: split them into named parts, or use samples.
+pub const MAX_DEPTH: usize = 1000;
+
+/// The longest formula, in characters.
+pub const MAX_LENGTH: usize = 100_000;
+
 /// A parse error, with the 1-based character column where it was found.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ExprError {
@@ -265,6 +277,12 @@ struct Parser<'a> {
     pos: usize,
     source: &'a str,
     constants: &'a BTreeMap<String, f64>,
+    /// Nesting levels entered now (parentheses, signs, powers, calls, conditions).
+    nesting: usize,
+    /// Depth of the node (or condition) most recently returned.
+    depth: usize,
+    /// Depth of the deepest argument of the call most recently parsed.
+    args_depth: usize,
 }
 
 impl Parser<'_> {
@@ -285,6 +303,36 @@ impl Parser<'_> {
             source: self.source.into(),
         }
     }
+    /// Enters one nesting level at the token in `column`.
+    fn enter(&mut self, column: usize) -> Result<(), ExprError> {
+        self.nesting += 1;
+        if self.nesting > MAX_NESTING {
+            return Err(self.error(
+                format!(
+                    "nested deeper than {MAX_NESTING} levels (parentheses, signs, powers, calls)"
+                ),
+                column,
+            ));
+        }
+        Ok(())
+    }
+    fn leave(&mut self) {
+        self.nesting -= 1;
+    }
+    /// Records the depth of a node built on children of depth `child` and checks the limit.
+    fn built(&mut self, child: usize, column: usize) -> Result<(), ExprError> {
+        self.depth = child + 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.error(
+                format!(
+                    "more than {MAX_DEPTH} operations deep (a sum or product of that many terms): \
+                     split the formula into named parts"
+                ),
+                column,
+            ));
+        }
+        Ok(())
+    }
     fn is_op(&self, op: &str) -> bool {
         matches!(self.peek().tok, Tok::Op(o) if o == op)
     }
@@ -299,30 +347,51 @@ impl Parser<'_> {
 
     fn cond(&mut self) -> Result<Cond, ExprError> {
         let mut lhs = self.cond_and()?;
+        let mut depth = self.depth;
         while self.is_op("||") {
+            let column = self.peek().column;
             self.next();
-            lhs = Cond::Or(Box::new(lhs), Box::new(self.cond_and()?));
+            let rhs = self.cond_and()?;
+            self.built(depth.max(self.depth), column)?;
+            depth = self.depth;
+            lhs = Cond::Or(Box::new(lhs), Box::new(rhs));
         }
+        self.depth = depth;
         Ok(lhs)
     }
     fn cond_and(&mut self) -> Result<Cond, ExprError> {
         let mut lhs = self.cond_atom()?;
+        let mut depth = self.depth;
         while self.is_op("&&") {
+            let column = self.peek().column;
             self.next();
-            lhs = Cond::And(Box::new(lhs), Box::new(self.cond_atom()?));
+            let rhs = self.cond_atom()?;
+            self.built(depth.max(self.depth), column)?;
+            depth = self.depth;
+            lhs = Cond::And(Box::new(lhs), Box::new(rhs));
         }
+        self.depth = depth;
         Ok(lhs)
     }
     fn cond_atom(&mut self) -> Result<Cond, ExprError> {
         if self.is_op("!") {
+            let column = self.peek().column;
             self.next();
-            return Ok(Cond::Not(Box::new(self.cond_atom()?)));
+            self.enter(column)?;
+            let inner = self.cond_atom()?;
+            self.leave();
+            self.built(self.depth, self.peek().column)?;
+            return Ok(Cond::Not(Box::new(inner)));
         }
         if self.peek().tok == Tok::LParen {
             // A parenthesised condition, or a parenthesised value that a comparison follows.
             let start = self.pos;
+            let column = self.peek().column;
             self.next();
-            if let Ok(c) = self.cond()
+            self.enter(column)?;
+            let inner = self.cond();
+            self.leave();
+            if let Ok(c) = inner
                 && self.peek().tok == Tok::RParen
             {
                 self.next();
@@ -331,6 +400,7 @@ impl Parser<'_> {
             self.pos = start;
         }
         let lhs = self.sum()?;
+        let lhs_depth = self.depth;
         let t = self.next();
         let op = match t.tok {
             Tok::Op("<") => CmpOp::Lt,
@@ -349,53 +419,84 @@ impl Parser<'_> {
                 ));
             }
         };
-        Ok(Cond::Cmp(op, lhs, self.sum()?))
+        let rhs = self.sum()?;
+        self.built(lhs_depth.max(self.depth), t.column)?;
+        Ok(Cond::Cmp(op, lhs, rhs))
     }
 
     fn sum(&mut self) -> Result<Node, ExprError> {
         let mut lhs = self.product()?;
+        let mut depth = self.depth;
         loop {
+            let column = self.peek().column;
             if self.is_op("+") {
                 self.next();
-                lhs = Node::Add(Box::new(lhs), Box::new(self.product()?));
+                let rhs = self.product()?;
+                self.built(depth.max(self.depth), column)?;
+                lhs = Node::Add(Box::new(lhs), Box::new(rhs));
             } else if self.is_op("-") {
                 self.next();
-                lhs = Node::Sub(Box::new(lhs), Box::new(self.product()?));
+                let rhs = self.product()?;
+                self.built(depth.max(self.depth), column)?;
+                lhs = Node::Sub(Box::new(lhs), Box::new(rhs));
             } else {
+                self.depth = depth;
                 return Ok(lhs);
             }
+            depth = self.depth;
         }
     }
     fn product(&mut self) -> Result<Node, ExprError> {
         let mut lhs = self.unary()?;
+        let mut depth = self.depth;
         loop {
+            let column = self.peek().column;
             if self.is_op("*") {
                 self.next();
-                lhs = Node::Mul(Box::new(lhs), Box::new(self.unary()?));
+                let rhs = self.unary()?;
+                self.built(depth.max(self.depth), column)?;
+                lhs = Node::Mul(Box::new(lhs), Box::new(rhs));
             } else if self.is_op("/") {
                 self.next();
-                lhs = Node::Div(Box::new(lhs), Box::new(self.unary()?));
+                let rhs = self.unary()?;
+                self.built(depth.max(self.depth), column)?;
+                lhs = Node::Div(Box::new(lhs), Box::new(rhs));
             } else {
+                self.depth = depth;
                 return Ok(lhs);
             }
+            depth = self.depth;
         }
     }
     fn unary(&mut self) -> Result<Node, ExprError> {
+        let column = self.peek().column;
         if self.is_op("-") {
             self.next();
-            return Ok(Node::Neg(Box::new(self.unary()?)));
+            self.enter(column)?;
+            let inner = self.unary()?;
+            self.leave();
+            self.built(self.depth, column)?;
+            return Ok(Node::Neg(Box::new(inner)));
         }
         if self.is_op("+") {
             self.next();
-            return self.unary();
+            self.enter(column)?;
+            let inner = self.unary();
+            self.leave();
+            return inner;
         }
         self.power()
     }
     fn power(&mut self) -> Result<Node, ExprError> {
         let base = self.atom()?;
+        let base_depth = self.depth;
         if self.is_op("^") || self.is_op("**") {
+            let column = self.peek().column;
             self.next();
+            self.enter(column)?;
             let exponent = self.unary()?;
+            self.leave();
+            self.built(base_depth.max(self.depth), column)?;
             return Ok(match exponent {
                 Node::Num(k) if k.fract() == 0.0 && k.abs() < 1e6 => {
                     Node::PowI(Box::new(base), k as i32)
@@ -411,14 +512,18 @@ impl Parser<'_> {
                 other => Node::Pow(Box::new(base), Box::new(other)),
             });
         }
+        self.depth = base_depth;
         Ok(base)
     }
     fn atom(&mut self) -> Result<Node, ExprError> {
         let t = self.next();
+        self.depth = 1;
         match t.tok {
             Tok::Num(v) => Ok(Node::Num(v)),
             Tok::LParen => {
+                self.enter(t.column)?;
                 let inner = self.sum()?;
+                self.leave();
                 self.expect(Tok::RParen, "')'")?;
                 Ok(inner)
             }
@@ -454,10 +559,12 @@ impl Parser<'_> {
     fn args(&mut self) -> Result<Vec<(Token, ArgKind)>, ExprError> {
         self.expect(Tok::LParen, "'('")?;
         let mut out = Vec::new();
+        self.args_depth = 0;
         if self.peek().tok == Tok::RParen {
             self.next();
             return Ok(out);
         }
+        let mut deepest = 0;
         loop {
             let start = self.pos;
             let column = self.peek().column;
@@ -469,6 +576,7 @@ impl Parser<'_> {
                     ArgKind::Cond(self.cond()?)
                 }
             };
+            deepest = deepest.max(self.depth);
             out.push((
                 Token {
                     tok: Tok::End,
@@ -480,7 +588,10 @@ impl Parser<'_> {
             let t = self.next();
             match t.tok {
                 Tok::Comma => continue,
-                Tok::RParen => return Ok(out),
+                Tok::RParen => {
+                    self.args_depth = deepest;
+                    return Ok(out);
+                }
                 _ => {
                     return Err(self.error(
                         format!("expected ',' or ')', found {}", describe(&t)),
@@ -497,7 +608,12 @@ impl Parser<'_> {
     }
     fn call(&mut self, f: &Token) -> Result<Node, ExprError> {
         let name = f.text.as_str();
-        let args = self.args()?;
+        self.enter(f.column)?;
+        let args = self.args();
+        self.leave();
+        let args = args?;
+        let deepest = self.args_depth;
+        self.built(deepest, f.column)?;
         let value = |p: &Self, (tok, kind): (Token, ArgKind)| match kind {
             ArgKind::Value(n) => Ok(n),
             ArgKind::Cond(_) => Err(p.error("a condition is not a value here".into(), tok.column)),
@@ -589,12 +705,22 @@ impl Expr {
     /// # Errors
     /// [`ExprError`] naming the problem (unknown function or variable, syntax) and its column.
     pub fn parse(source: &str, constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
+        if source.chars().count() > MAX_LENGTH {
+            return Err(ExprError {
+                message: format!("longer than {MAX_LENGTH} characters"),
+                column: MAX_LENGTH + 1,
+                source: source.chars().take(80).collect::<String>() + "…",
+            });
+        }
         let tokens = tokenize(source)?;
         let mut p = Parser {
             tokens,
             pos: 0,
             source,
             constants,
+            nesting: 0,
+            depth: 0,
+            args_depth: 0,
         };
         if p.peek().tok == Tok::End {
             return Err(p.error("empty expression".into(), 1));
@@ -794,5 +920,51 @@ mod tests {
         assert!(parse("").is_err());
         let e = parse("if(t, 1, 2)").unwrap_err();
         assert!(e.message.contains("condition"), "{e}");
+    }
+
+    #[test]
+    fn nesting_depth_and_length_are_limited_before_the_stack_is() {
+        let nested = |n: usize| format!("{}t{}", "(".repeat(n), ")".repeat(n));
+        assert!(parse(&nested(MAX_NESTING)).is_ok());
+        let e = parse(&nested(5000)).unwrap_err();
+        assert!(e.message.contains("nested deeper than 64 levels"), "{e}");
+        assert_eq!(e.column, MAX_NESTING + 1);
+        let signs = format!("{}t", "-".repeat(5000));
+        assert!(parse(&signs).unwrap_err().message.contains("nested deeper"));
+        let calls = format!("{}t{}", "sin(".repeat(5000), ")".repeat(5000));
+        assert!(parse(&calls).unwrap_err().message.contains("nested deeper"));
+        let powers = format!("t{}", "^t".repeat(5000));
+        assert!(
+            parse(&powers)
+                .unwrap_err()
+                .message
+                .contains("nested deeper")
+        );
+        // A long sum is deep although not nested: refused at the term that passes the limit.
+        let sum = |n: usize| vec!["t"; n].join("+");
+        let ok = parse(&sum(MAX_DEPTH)).unwrap();
+        assert_eq!(ok.eval(2.0), 2.0 * MAX_DEPTH as f64);
+        let e = parse(&sum(40_000)).unwrap_err();
+        assert!(e.message.contains("more than 1000 operations deep"), "{e}");
+        assert_eq!(e.column, 2 * MAX_DEPTH); // the '+' before term 1001
+        let conds = format!("if({}, 1, 0)", vec!["t < 1"; 5000].join(" && "));
+        assert!(
+            parse(&conds)
+                .unwrap_err()
+                .message
+                .contains("operations deep")
+        );
+        let e = parse(&"t".repeat(MAX_LENGTH + 1)).unwrap_err();
+        assert!(e.message.contains("longer than 100000 characters"), "{e}");
+    }
+
+    #[test]
+    fn nested_conditions_parse_in_bounded_time() {
+        // Parenthesised conditions are tried as conditions first, then as values: the work grows
+        // with the square of the nesting, not exponentially (this would not finish otherwise).
+        let n = MAX_NESTING - 2;
+        let f = format!("if({}t{} < 1, 1, 0)", "(".repeat(n), ")".repeat(n));
+        assert_eq!(parse(&f).unwrap().eval(0.5), 1.0);
+        assert_eq!(parse(&f).unwrap().eval(1.5), 0.0);
     }
 }
