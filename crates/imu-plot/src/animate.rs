@@ -170,6 +170,35 @@ impl Scene {
     }
 }
 
+/// The kinds of animation file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnimationFormat {
+    /// `.gif`.
+    Gif,
+    /// `.html` or `.htm`: a self-contained page.
+    Html,
+}
+
+/// The format an animation path asks for, by extension; checked before any work.
+///
+/// # Errors
+/// [`PlotError::Draw`] for another extension.
+pub fn check_animation_path(out: &Path) -> Result<AnimationFormat, PlotError> {
+    match out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("gif") => Ok(AnimationFormat::Gif),
+        Some("html" | "htm") => Ok(AnimationFormat::Html),
+        _ => Err(PlotError::Draw {
+            path: out.display().to_string(),
+            message: "the animation file must end in .gif or .html".into(),
+        }),
+    }
+}
+
 /// Writes a GIF (`.gif`) or a self-contained HTML page (`.html`) animating `truth` (read from
 /// `source`, named in errors).
 ///
@@ -186,18 +215,13 @@ pub fn animate(
         path: out.display().to_string(),
         message,
     };
+    let format = check_animation_path(out)?;
     let scene = Scene::new(truth, source, opts)?;
-    let bytes = match out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("gif") => gif(&scene, opts).map_err(fail)?,
-        Some("html" | "htm") => html(&scene, opts).into_bytes(),
-        _ => return Err(fail("the animation file must end in .gif or .html".into())),
+    let bytes = match format {
+        AnimationFormat::Gif => gif(&scene, opts).map_err(fail)?,
+        AnimationFormat::Html => html(&scene, opts).into_bytes(),
     };
-    imukit::io::table::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))?;
+    imukit::io::output::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))?;
     Ok(AnimationInfo {
         frames: scene.frames.len(),
         speed: scene.speed,

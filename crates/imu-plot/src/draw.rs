@@ -63,6 +63,34 @@ pub fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
+/// The kinds of figure file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FigureFormat {
+    /// `.svg`.
+    Svg,
+    /// `.png`.
+    Png,
+}
+
+/// The format a figure path asks for, by extension; checked before any work.
+///
+/// # Errors
+/// [`PlotError::Draw`] for another extension.
+pub fn check_figure_path(path: &Path) -> Result<FigureFormat, PlotError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("svg") => Ok(FigureFormat::Svg),
+        Some("png") => Ok(FigureFormat::Png),
+        _ => Err(PlotError::Draw {
+            path: path.display().to_string(),
+            message: "the figure file must end in .svg or .png".into(),
+        }),
+    }
+}
+
 /// Draws a `width × height` figure with `draw` and writes it to `path` as SVG or PNG (by
 /// extension).
 pub fn write_figure(
@@ -82,19 +110,14 @@ pub fn write_figure(
         draw(&root).map_err(fail)?;
         root.present().map_err(|e| fail(err(e)))?;
     }
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let bytes = match ext.as_deref() {
-        Some("svg") => svg.into_bytes(),
-        Some("png") => rasterise(&svg, width, height)
+    let bytes = match check_figure_path(path)? {
+        FigureFormat::Svg => svg.into_bytes(),
+        FigureFormat::Png => rasterise(&svg, width, height)
             .map_err(fail)?
             .encode_png()
             .map_err(|e| fail(err(e)))?,
-        _ => return Err(fail("the figure file must end in .svg or .png".into())),
     };
-    imukit::io::table::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))?;
+    imukit::io::output::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))?;
     Ok(())
 }
 

@@ -28,7 +28,7 @@ pub mod scene;
 pub mod spec;
 
 pub use allan::allan_figure;
-pub use draw::{COLORS, rasterise, write_figure};
+pub use draw::{COLORS, FigureFormat, check_figure_path, rasterise, write_figure};
 pub use figures::plot_files;
 pub use panels::{Trace, trajectories_figure};
 pub use spec::{FramePlan, PanelSpec, TableKind};

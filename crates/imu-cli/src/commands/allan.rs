@@ -1,6 +1,7 @@
 //! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
 use std::path::Path;
 
+use imukit::io::output::check_outputs;
 use imukit::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
 use imukit::run::allan::{allan, mean_rate};
 
@@ -12,6 +13,12 @@ pub fn run(
     out: &Path,
     plot: Option<&Path>,
 ) -> Result<(), CliError> {
+    if let Some(p) = plot {
+        imu_plot::check_figure_path(p)?;
+    }
+    let mut outputs = vec![("--out", out)];
+    outputs.extend(plot.map(|p| ("--plot", p)));
+    check_outputs(&[("input", input)], &outputs)?;
     let header = read_header(input)?;
     let chosen: Vec<String> = if columns.is_empty() {
         GYRO_COLUMNS

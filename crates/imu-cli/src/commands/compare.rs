@@ -3,12 +3,18 @@
 use std::path::Path;
 
 use imu_core::orientation::DistanceStats;
+use imukit::io::output::check_outputs;
 use imukit::run::compare::compare_csv;
 
 use super::CliError;
 
 /// Streams both files (memory does not grow with them).
 pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliError> {
+    let inputs = [("truth file", truth), ("estimate file", estimate)];
+    check_outputs(
+        &inputs,
+        &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
+    )?;
     let c = compare_csv(truth, estimate, out)?;
     println!(
         "{:<10} {:>16} {:>16} {:>16}",

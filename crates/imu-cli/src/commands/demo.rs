@@ -15,8 +15,9 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
         path: out_dir.display().to_string(),
         source,
     };
-    std::fs::create_dir_all(out_dir).map_err(io)?;
+    // The scenario is checked before the folder is made.
     let spec = builtin::spec(name)?;
+    std::fs::create_dir_all(out_dir).map_err(io)?;
     let sim = spec.resolve(out_dir)?.simulate()?;
     let files = [(
         "scenario.toml",

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use imu_core::EulerZyx;
+use imukit::io::output::check_outputs;
 use imukit::run::navigate::{InitialState, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
@@ -53,6 +54,7 @@ pub fn planar(c: &Common<'_>, scheme: &str, heading0_rad: f64) -> Result<(), Cli
         velocity0_m_s: vector("--velocity0-m-s", c.velocity0, [0.0, 0.0])?,
     };
     let scheme_rules = request.scheme().map_err(by_flag)?;
+    check_outputs(&[("input", c.input)], &[("--out", c.out)])?;
     let samples = read_planar(c.input)?;
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
     let initial = request.initial_state(t0).map_err(by_flag)?;
@@ -77,6 +79,9 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     }
     .setup()
     .map_err(by_flag)?;
+    let mut inputs = vec![("input", c.input)];
+    inputs.extend(o.init.map(|p| ("--init file", p)));
+    check_outputs(&inputs, &[("--out", c.out)])?;
     let mut initial = match o.init {
         Some(p) => InitialState::from_csv(p)?,
         None => InitialState::default(),

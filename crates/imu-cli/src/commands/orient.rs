@@ -1,6 +1,7 @@
 //! `imukit orient IMU.csv --filter NAME [--param KEY=VALUE …] --out ORIENT.csv`.
 use std::path::Path;
 
+use imukit::io::output::check_outputs;
 use imukit::run::orient::{FilterSpec, OrientRequest, orient_csv};
 
 use crate::{CliError, by_flag};
@@ -21,6 +22,7 @@ pub fn run(
     }
     .resolve()
     .map_err(by_flag)?;
+    check_outputs(&[("input", input)], &[("--out", out)])?;
     let s = orient_csv(input, &spec, nav, out)?;
     println!(
         "imukit: {} samples at {} Hz through {filter}: {} orientations in {}",

@@ -3,6 +3,7 @@ use std::path::{Path, PathBuf};
 
 use imu_plot::animate::{self as anim, AnimateOptions};
 use imu_plot::plot_files;
+use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
 
 use imukit::scenario::{NavFrameName, parse_name};
@@ -10,6 +11,9 @@ use imukit::scenario::{NavFrameName, parse_name};
 use super::CliError;
 
 pub fn plot(files: &[PathBuf], out: &Path, nav_frame: &str) -> Result<(), CliError> {
+    imu_plot::check_figure_path(out)?;
+    let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
+    check_outputs(&inputs, &[("--out", out)])?;
     plot_files(files, out, is_ned(nav_frame)?)?;
     println!("Wrote {}", out.display());
     Ok(())
@@ -41,6 +45,8 @@ pub fn options(
 }
 
 pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), CliError> {
+    anim::check_animation_path(out)?;
+    check_outputs(&[("truth file", truth)], &[("--out", out)])?;
     let table = read_table(truth)?;
     let info = anim::animate(&table, &truth.display().to_string(), out, opts)
         .map_err(crate::plot_by_flag)?;

@@ -2,7 +2,8 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use imukit::Scenario;
+use imukit::ScenarioSpec;
+use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -15,7 +16,20 @@ pub fn run(
     truth: Option<&Path>,
     runs: Option<u64>,
 ) -> Result<(), CliError> {
-    let sc = Scenario::from_file(scenario)?;
+    let spec = ScenarioSpec::from_file(scenario)?;
+    let base = scenario.parent().unwrap_or_else(|| Path::new("."));
+    let files = spec.input_files(base);
+    let mut inputs = vec![("scenario file", scenario)];
+    inputs.extend(files.iter().map(|(what, p)| (*what, p.as_path())));
+    let run_files: Vec<_> = match runs {
+        Some(n) => (0..n).map(|r| run_path(out, r, n)).collect(),
+        None => vec![out.to_path_buf()],
+    };
+    let mut outputs: Vec<(&str, &Path)> =
+        run_files.iter().map(|p| ("--out", p.as_path())).collect();
+    outputs.extend(truth.map(|t| ("--truth", t)));
+    check_outputs(&inputs, &outputs)?;
+    let sc = spec.resolve(base)?;
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
         sc.stream_to_csv(None, out, truth)?;

@@ -5,13 +5,14 @@
 //! that is renamed into place only when complete.
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use imu_core::sensor::ImuReading;
 use imu_core::{NavFrame, Truth};
 
 use crate::error::{Error, Result};
+use crate::io::output::write_atomically;
 
 /// Truth columns, in order.
 pub const TRUTH_COLUMNS: [&str; 23] = [
@@ -246,110 +247,6 @@ impl Table {
     }
 }
 
-/// Writes a file through `fill` into a temporary name beside it, renamed into place only when
-/// complete (no half-written file left looking complete); the temporary file is removed on error.
-///
-/// # Errors
-/// [`Error::Io`] naming the file.
-pub fn write_atomically(
-    path: &Path,
-    fill: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> Result<()> {
-    let mut file = AtomicFile::create(path)?;
-    fill(file.writer()).map_err(|source| file.error(source))?;
-    file.commit()
-}
-
-/// A file written under a temporary name beside its path and renamed into place by
-/// [`AtomicFile::commit`]; dropped uncommitted (an error on the way), the temporary file is
-/// removed, so no half-written file is ever left looking complete.
-#[derive(Debug)]
-pub struct AtomicFile {
-    path: PathBuf,
-    tmp: PathBuf,
-    writer: Option<BufWriter<File>>,
-}
-
-impl AtomicFile {
-    /// Creates the temporary file.
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file.
-    pub fn create(path: &Path) -> Result<Self> {
-        let tmp = temporary_path(path);
-        let file = File::create(&tmp).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Ok(Self {
-            path: path.to_path_buf(),
-            tmp,
-            writer: Some(BufWriter::new(file)),
-        })
-    }
-
-    /// The buffered writer.
-    ///
-    /// # Panics
-    /// Never: the writer exists until `commit` consumes the file.
-    pub fn writer(&mut self) -> &mut BufWriter<File> {
-        self.writer.as_mut().expect("the writer lives until commit")
-    }
-
-    /// Writes the CSV header line of `columns`.
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file.
-    pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
-        let w = self.writer();
-        let written = w
-            .write_all(columns.join(",").as_bytes())
-            .and_then(|()| w.write_all(b"\n"));
-        written.map_err(|e| self.error(e))
-    }
-
-    /// Writes one CSV row of `values` (shortest round-trip form).
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file.
-    pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
-        let written = write_rows(self.writer(), values, values.len(), b",");
-        written.map_err(|e| self.error(e))
-    }
-
-    /// An I/O error of this file.
-    #[must_use]
-    pub fn error(&self, source: std::io::Error) -> Error {
-        Error::Io {
-            path: self.path.clone(),
-            source,
-        }
-    }
-
-    /// Flushes, syncs and renames the file into place.
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file (the temporary file is then removed).
-    pub fn commit(mut self) -> Result<()> {
-        let result = (|| -> std::io::Result<()> {
-            if let Some(w) = self.writer.take() {
-                w.into_inner()
-                    .map_err(std::io::IntoInnerError::into_error)?
-                    .sync_all()?;
-            }
-            std::fs::rename(&self.tmp, &self.path)
-        })();
-        result.map_err(|source| self.error(source))
-    }
-}
-
-impl Drop for AtomicFile {
-    fn drop(&mut self) {
-        // Committed files were renamed away; anything left is incomplete.
-        let _ = std::fs::remove_file(&self.tmp);
-    }
-}
-
 /// Writes row-major `data` in rows of `width`, values in shortest round-trip form separated by
 /// `separator`.
 ///
@@ -409,15 +306,6 @@ pub fn truth_row<N: NavFrame>(s: &Truth<N>) -> [f64; 23] {
         by,
         bz,
     ]
-}
-
-fn temporary_path(path: &Path) -> PathBuf {
-    let mut name = path
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
-    name.push(".imukit-partial");
-    path.with_file_name(name)
 }
 
 /// Columns read from a CSV file, by name.

@@ -13,7 +13,8 @@ use imu_core::orientation::{DistanceStats, quaternion_distance};
 use imu_core::{Body, Enu, Rotation};
 
 use crate::error::{Result, invalid};
-use crate::io::table::{AtomicFile, CsvRows, Table};
+use crate::io::output::AtomicFile;
+use crate::io::table::{CsvRows, Table};
 use crate::run::navigate::STATE_COLUMNS;
 
 /// Error columns of a navigation estimate.

@@ -18,10 +18,9 @@ use imu_core::strapdown::step::{
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
+use crate::io::output::AtomicFile;
 use crate::io::rows::{TimedRows, check_gaps};
-use crate::io::table::{
-    ACCEL_COLUMNS, AtomicFile, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table,
-};
+use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::scenario::resolve::{check_gravity, finite_vec};
 use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 

@@ -10,8 +10,9 @@ use imu_core::orientation::{
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
 use crate::error::{Result, invalid};
+use crate::io::output::AtomicFile;
 use crate::io::rows::TimedRows;
-use crate::io::table::{ACCEL_COLUMNS, AtomicFile, GYRO_COLUMNS, MAG_COLUMNS};
+use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
 use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 

@@ -10,7 +10,8 @@ use imu_core::strapdown::planar::{
 };
 
 use crate::error::{Error, Result, invalid};
-use crate::io::table::{Table, read_columns, write_atomically, write_rows};
+use crate::io::output::write_atomically;
+use crate::io::table::{Table, read_columns, write_rows};
 use crate::scenario::resolve::finite_vec;
 
 /// Planar IMU columns of a CSV file.

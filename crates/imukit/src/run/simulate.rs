@@ -15,7 +15,8 @@ use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
-use crate::io::table::{AtomicFile, ImuOutput, Table};
+use crate::io::output::AtomicFile;
+use crate::io::table::{ImuOutput, Table};
 use crate::motion::{Trajectory, with_time};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 

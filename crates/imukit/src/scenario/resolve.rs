@@ -1,7 +1,7 @@
 //! From a scenario as written ([`super::spec`]) to a runnable [`Scenario`]: built-ins merged,
 //! defaults filled, formulas parsed, files read, every value checked once.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use imu_core::AccelSign;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
@@ -16,7 +16,7 @@ use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
 
-use crate::scenario::sensors::SensorSetup;
+use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
 use crate::scenario::times::{SampleTimes, regular_times, sample_times};
 use crate::scenario::{ImuSetup, Scenario};
@@ -58,6 +58,27 @@ impl ScenarioSpec {
         value
             .try_into()
             .map_err(|e: toml::de::Error| fail(e.to_string()))
+    }
+
+    /// The files this scenario reads, with what each is, relative paths taken from `base_dir`
+    /// (for [`crate::io::output::check_outputs`]).
+    #[must_use]
+    pub fn input_files(&self, base_dir: &Path) -> Vec<(&'static str, PathBuf)> {
+        let mut files = Vec::new();
+        match &self.trajectory {
+            TrajectorySpec::Samples(s) => files.push(("samples file", base_dir.join(&s.file))),
+            TrajectorySpec::BodyRates(BodyRatesSpec { file: Some(f), .. }) => {
+                files.push(("body-rate file", base_dir.join(f)));
+            }
+            _ => {}
+        }
+        if let Some(p) = &self.imu.params {
+            files.push(("parameter file", base_dir.join(p)));
+        }
+        if let Some(TemperatureSpec::File(p)) = &self.imu.temperature_c {
+            files.push(("temperature file", base_dir.join(p)));
+        }
+        files
     }
 
     /// Reads a scenario file (`.toml`, or `.json`).

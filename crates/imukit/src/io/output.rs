@@ -1,0 +1,234 @@
+//! Output files: written under a temporary name and renamed into place when complete, so a
+//! failed command leaves no partial file; special files (`/dev/null`, `/dev/stdout`, FIFOs) are
+//! written directly, never replaced; and a job's outputs are checked against its inputs and
+//! against each other before work starts ([`check_outputs`]), so no input is overwritten.
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result, invalid};
+use crate::io::table::write_rows;
+
+/// The longest file name most file systems take, bytes.
+const NAME_MAX: usize = 255;
+
+/// The suffix of a file being written.
+const PARTIAL: &str = ".imukit-partial";
+
+/// Writes a file through `fill` into a temporary name beside it, renamed into place only when
+/// complete (no half-written file left looking complete); the temporary file is removed on error.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn write_atomically(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let mut file = AtomicFile::create(path)?;
+    fill(file.writer()).map_err(|source| file.error(source))?;
+    file.commit()
+}
+
+/// A file written under a temporary name beside its path and renamed into place by
+/// [`AtomicFile::commit`]; dropped uncommitted (an error on the way), the temporary file is
+/// removed, so no half-written file is ever left looking complete.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    /// The temporary name; `None` for a special file written directly.
+    tmp: Option<PathBuf>,
+    writer: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn create(path: &Path) -> Result<Self> {
+        let io = |source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        if path.is_dir() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a folder, not a file",
+            )));
+        }
+        if is_special(path) {
+            // A device or FIFO: written as it is, never renamed over.
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(io)?;
+            return Ok(Self {
+                path: path.to_path_buf(),
+                tmp: None,
+                writer: Some(BufWriter::new(file)),
+            });
+        }
+        let tmp = temporary_path(path);
+        let file = File::create(&tmp).map_err(io)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp: Some(tmp),
+            writer: Some(BufWriter::new(file)),
+        })
+    }
+
+    /// The buffered writer.
+    ///
+    /// # Panics
+    /// Never: the writer exists until `commit` consumes the file.
+    pub fn writer(&mut self) -> &mut BufWriter<File> {
+        self.writer.as_mut().expect("the writer lives until commit")
+    }
+
+    /// Writes the CSV header line of `columns`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
+        let w = self.writer();
+        let written = w
+            .write_all(columns.join(",").as_bytes())
+            .and_then(|()| w.write_all(b"\n"));
+        written.map_err(|e| self.error(e))
+    }
+
+    /// Writes one CSV row of `values` (shortest round-trip form).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
+        let written = write_rows(self.writer(), values, values.len(), b",");
+        written.map_err(|e| self.error(e))
+    }
+
+    /// An I/O error of this file.
+    #[must_use]
+    pub fn error(&self, source: std::io::Error) -> Error {
+        Error::Io {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    /// Flushes, syncs and renames the file into place.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file (the temporary file is then removed).
+    pub fn commit(mut self) -> Result<()> {
+        let result = (|| -> std::io::Result<()> {
+            let file = match self.writer.take() {
+                Some(w) => Some(
+                    w.into_inner()
+                        .map_err(std::io::IntoInnerError::into_error)?,
+                ),
+                None => None,
+            };
+            match &self.tmp {
+                Some(tmp) => {
+                    if let Some(f) = file {
+                        f.sync_all()?;
+                    }
+                    std::fs::rename(tmp, &self.path)
+                }
+                None => Ok(()),
+            }
+        })();
+        result.map_err(|source| self.error(source))
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Committed files were renamed away; anything left is incomplete.
+        if let Some(tmp) = &self.tmp {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// The temporary name beside `path`: its file name with [`PARTIAL`] appended, the name cut (at a
+/// character boundary) so that the whole stays within the file-name limit.
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut keep = name.len().min(NAME_MAX - PARTIAL.len());
+    while !name.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    path.with_file_name(format!("{}{PARTIAL}", &name[..keep]))
+}
+
+/// True for an existing path that is neither a regular file nor a folder: a device such as
+/// `/dev/null`, a FIFO or a socket. Such outputs are written directly.
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// The identity of a path for comparison: the canonical path of the file, or of its folder
+/// joined with its name when the file does not exist yet.
+fn identity(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Some(parent.canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// Refuses a job whose outputs would overwrite one of its inputs or each other, before any work:
+/// paths are compared after resolving `.`, `..` and links. Special files (`/dev/null`) may be
+/// given as several outputs. `-` (standard output) is refused with a hint.
+///
+/// # Errors
+/// [`Error::Invalid`] naming the output (by `name`) and the input it would overwrite.
+pub fn check_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<()> {
+    let mut seen: Vec<(&str, PathBuf)> = Vec::new();
+    for (name, out) in outputs {
+        if out.as_os_str() == "-" {
+            return Err(invalid(
+                *name,
+                "\"-\" is not a file: give /dev/stdout to write to standard output",
+            ));
+        }
+        if out.is_dir() {
+            return Err(invalid(
+                *name,
+                format!("{} is a folder; give a file name", out.display()),
+            ));
+        }
+        let Some(id) = identity(out) else { continue };
+        for (input_name, input) in inputs {
+            if identity(input).is_some_and(|i| i == id) && !is_special(out) {
+                return Err(invalid(
+                    *name,
+                    format!(
+                        "{} is also the {input_name}: writing it would destroy the input",
+                        out.display()
+                    ),
+                ));
+            }
+        }
+        if let Some((other, _)) = seen.iter().find(|(_, p)| *p == id)
+            && !is_special(out)
+        {
+            return Err(invalid(
+                *name,
+                format!(
+                    "{} is also the {other}: give two different files",
+                    out.display()
+                ),
+            ));
+        }
+        seen.push((name, id));
+    }
+    Ok(())
+}
