@@ -303,6 +303,9 @@ pub struct FramePlan {
     pub speed: f64,
 }
 
+/// The most frames an animation may have (at 20 frames/s, over eight minutes).
+pub const MAX_FRAMES: usize = 10_000;
+
 /// Plans an animation of samples at times `t_s` (finite, increasing): frames every
 /// `speed / fps` seconds of motion from the first to the last sample. Without a `speed` the
 /// animation lasts between 4 and 12 s: real time for motions of that length, slow motion for
@@ -332,7 +335,18 @@ pub fn frame_plan(t_s: &[f64], fps: f64, speed: Option<f64>, source: &str) -> Re
     let (t0, t1) = (t_s[0], t_s[t_s.len() - 1]);
     let duration = t1 - t0;
     let speed = speed.unwrap_or_else(|| duration / duration.clamp(4.0, 12.0));
-    let n = ((duration / speed * fps).floor() as usize + 1).max(2);
+    // Counted in floating point first: a huge rate must not reach an allocation.
+    let frames = (duration / speed * fps).floor() + 1.0;
+    if frames > MAX_FRAMES as f64 {
+        return Err(invalid(
+            "fps",
+            format!(
+                "{fps} frames/s at {speed}× real time over {duration} s would be {frames:e} frames, \
+                 more than {MAX_FRAMES}: lower the frames per second or raise the speed"
+            ),
+        ));
+    }
+    let n = (frames as usize).max(2);
     let indices = (0..n)
         .map(|k| {
             let t = (t0 + k as f64 * speed / fps).min(t1);
@@ -419,5 +433,15 @@ mod tests {
         assert!(frame_plan(&t, 0.0, None, "truth").is_err());
         assert!(frame_plan(&t, 20.0, Some(-1.0), "truth").is_err());
         assert!(frame_plan(&t[..1], 20.0, None, "truth").is_err());
+    }
+
+    #[test]
+    fn a_frame_rate_too_high_is_refused_before_the_frames_are_listed() {
+        let t: Vec<f64> = (0..=100).map(|k| f64::from(k) * 0.1).collect();
+        let e = frame_plan(&t, 1e9, None, "truth").unwrap_err();
+        assert!(e.to_string().starts_with("fps: 1000000000 frames/s"), "{e}");
+        assert!(e.to_string().contains("more than 10000"), "{e}");
+        assert!(frame_plan(&t, 999.0, Some(1.0), "truth").is_ok()); // 9 991 frames
+        assert!(frame_plan(&t, 1000.0, Some(1.0), "truth").is_err()); // 10 001 frames
     }
 }

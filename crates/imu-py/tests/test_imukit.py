@@ -154,3 +154,9 @@ def test_a_deeply_nested_formula_raises_instead_of_crashing_the_interpreter():
     assert e.value.field == "trajectory.position_m[0]"
     with pytest.raises(ImuError, match="more than 1000 operations deep"):
         imukit.truth_from_expressions(t, ["+".join(["t"] * 40_000), "0", "0"])
+
+
+def test_a_run_too_long_for_memory_raises_before_allocating():
+    with pytest.raises(ImuError, match="IMUKIT_MAX_MEMORY_GB") as e:
+        imukit.simulate({"rate_hz": 1e8, "duration_s": 9.99, "trajectory": {"type": "builtin", "name": "static"}})
+    assert e.value.field == "duration_s"

@@ -197,3 +197,43 @@ fn a_column_named_twice_is_refused_with_both_places() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn runs_too_long_for_memory_are_refused_before_anything_is_allocated() {
+    // 10⁹ body-rate samples would be evaluated into memory whole.
+    let body_rates = ScenarioSpec::from_toml(
+        "rate_hz = 1e9\nduration_s = 1.0\n[trajectory]\ntype = \"body-rates\"\n\
+         angular_velocity_body_rad_s = [\"0\", \"0\", \"0.1\"]\n",
+        "fast.toml",
+    )
+    .unwrap();
+    let e = body_rates.resolve(Path::new(".")).unwrap_err();
+    assert_eq!(e.location().field.as_deref(), Some("duration_s"));
+    assert!(e.to_string().contains("IMUKIT_MAX_MEMORY_GB"), "{e}");
+    // Formulas resolve without holding samples; the in-memory simulation is what is refused
+    // (the command line streams the same scenario).
+    let long = ScenarioSpec::from_toml(
+        "rate_hz = 1e8\nduration_s = 9.99\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+        "long.toml",
+    )
+    .unwrap()
+    .resolve(Path::new("."))
+    .unwrap();
+    let e = long.simulate().unwrap_err();
+    assert!(
+        e.to_string().contains("999000001 samples would take about"),
+        "{e}"
+    );
+}
+
+#[test]
+fn rk4_substeps_are_bounded() {
+    let r = NavRequest {
+        scheme: "rk4",
+        substeps: 1_000_000_000,
+        ..NavRequest::default()
+    };
+    let e = r.setup().unwrap_err();
+    assert_eq!(e.location().field.as_deref(), Some("substeps"));
+    assert!(e.to_string().contains("at most 1000"), "{e}");
+}

@@ -215,6 +215,10 @@ impl Default for NavSetup {
 /// The sub-steps per interval of the RK4 scheme unless told otherwise.
 pub const DEFAULT_RK4_SUBSTEPS: usize = 4;
 
+/// The most RK4 sub-steps per interval (more only costs time: the interpolated rates limit the
+/// accuracy long before).
+pub const MAX_RK4_SUBSTEPS: usize = 1000;
+
 impl std::str::FromStr for NavScheme {
     type Err = String;
 
@@ -234,10 +238,13 @@ impl NavScheme {
     /// The same scheme with `substeps` RK4 sub-steps per interval (the coning scheme has none).
     ///
     /// # Errors
-    /// Zero sub-steps for RK4.
+    /// Zero sub-steps, or more than [`MAX_RK4_SUBSTEPS`], for RK4.
     pub fn with_substeps(self, substeps: usize) -> std::result::Result<Self, String> {
         match self {
             Self::Rk4 { .. } if substeps == 0 => Err("must be ≥ 1".into()),
+            Self::Rk4 { .. } if substeps > MAX_RK4_SUBSTEPS => Err(format!(
+                "must be at most {MAX_RK4_SUBSTEPS}, got {substeps} (the error stops falling long before)"
+            )),
             Self::Rk4 { .. } => Ok(Self::Rk4 { substeps }),
             other => Ok(other),
         }

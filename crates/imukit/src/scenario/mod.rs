@@ -30,7 +30,7 @@ pub use spec::{
     AccelSignName, BodyRatesSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName, SamplesSpec,
     ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
 };
-pub use times::{SampleTimes, regular_times, sample_times};
+pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
 
 use std::path::Path;
 
@@ -39,6 +39,10 @@ use imu_core::{Enu, NavFrame, Ned};
 use crate::error::Result;
 use crate::io::table::{ImuOutput, Table};
 use crate::motion::Trajectory;
+
+/// Bytes an in-memory simulation holds per sample: the truth (23 numbers) and the readings
+/// (9), and both as tables (23 and up to 10 columns), with the times.
+const IN_MEMORY_BYTES_PER_SAMPLE: usize = 8 * (23 + 9 + 23 + 10 + 1);
 
 /// A resolved, runnable scenario.
 #[derive(Clone, Debug)]
@@ -88,6 +92,7 @@ impl Scenario {
     }
 
     fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
+        check_in_memory(self.t_s.len(), IN_MEMORY_BYTES_PER_SAMPLE, "duration_s")?;
         let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
         let readings = self
             .imu

@@ -18,7 +18,7 @@ use crate::scenario::builtin;
 
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
-use crate::scenario::times::{SampleTimes, regular_times, sample_times};
+use crate::scenario::times::{SampleTimes, check_in_memory, regular_times};
 use crate::scenario::{ImuSetup, Scenario};
 
 impl ScenarioSpec {
@@ -266,7 +266,10 @@ fn body_rates(
         rate_hz.ok_or_else(|| invalid("rate_hz", "missing (required for body-rate formulas)"))?;
     let duration = duration_s
         .ok_or_else(|| invalid("duration_s", "missing (required for body-rate formulas)"))?;
-    let t = sample_times(rate, duration)?;
+    let grid = regular_times(rate, duration)?;
+    // Three vectors of three numbers and a time per sample, held whole.
+    check_in_memory(grid.len(), 80, "duration_s")?;
+    let t = grid.to_vec();
     let zero = || {
         [
             Formula::Number(0.0),
