@@ -661,3 +661,24 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
     assert_eq!(code, Some(65));
     assert!(!dir.join("newdir").exists());
 }
+
+#[test]
+fn an_allan_deviation_that_overflows_is_refused_and_nothing_is_written() {
+    let dir = temp_dir("allan-overflow");
+    let mut text = String::from("t_s,gyro_x_rad_s\n");
+    for k in 0..200 {
+        let v = if k == 5 { "1e200" } else { "0.001" };
+        text += &format!("{},{v}\n", f64::from(k) * 0.01);
+    }
+    std::fs::write(dir.join("imu.csv"), text).unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &["allan", "imu.csv", "--out", "a.csv", "--plot", "a.png"],
+    );
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("imu.csv, column gyro_x_rad_s: the Allan deviation at τ = 0.01 s overflows (values up to 1e200)"),
+        "{err}"
+    );
+    assert!(!dir.join("a.csv").exists() && !dir.join("a.png").exists());
+}

@@ -43,7 +43,19 @@ pub fn run(
         .iter()
         .map(|c| (c.clone(), data.get(c).to_vec()))
         .collect();
-    let result = allan(&series, rate)?;
+    // The library names the column; the file is named here.
+    let in_file = |column: String| format!("{}, column {column}", input.display());
+    let result = allan(&series, rate).map_err(|e| match e {
+        imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
+            field: in_file(field),
+            message,
+        },
+        imukit::Error::Allan { context, source } => imukit::Error::Allan {
+            context: in_file(context),
+            source,
+        },
+        other => other,
+    })?;
     result.table.write_csv(out)?;
     if let Some(p) = plot {
         imu_plot::allan_figure(p, &result)?;

@@ -17,7 +17,8 @@ pub struct AllanResult {
 /// `sample_rate_hz`, with N, K and B read off each curve.
 ///
 /// # Errors
-/// Fewer than 3 samples, non-finite samples (column and index named), a bad rate.
+/// Fewer than 3 samples, non-finite samples (column and index named), a bad rate, a deviation
+/// that overflows (values too large to square).
 pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<AllanResult> {
     let n = columns.first().map_or(0, |(_, v)| v.len());
     let mut m = vec![0usize; 64];
@@ -42,6 +43,17 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
                 source,
             }
         })?;
+        if let Some(k) = adev.iter().position(|a| !a.is_finite()) {
+            let peak = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            return Err(invalid(
+                name.clone(),
+                format!(
+                    "the Allan deviation at τ = {} s overflows (values up to {peak:e}): the column \
+                     is not a rate of this magnitude; nothing was written",
+                    tau[k]
+                ),
+            ));
+        }
         noise.push((name.clone(), identify_noise(&tau, &adev)));
         names.push(format!("adev_{name}"));
         curves.push(adev);
