@@ -682,3 +682,33 @@ fn an_allan_deviation_that_overflows_is_refused_and_nothing_is_written() {
     );
     assert!(!dir.join("a.csv").exists() && !dir.join("a.png").exists());
 }
+
+#[test]
+fn compare_refuses_truth_times_that_repeat_or_go_back_anywhere_in_the_file() {
+    let dir = temp_dir("compare-times");
+    let header = "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,q_w,q_x,q_y,q_z\n";
+    let rows = |times: &[&str]| {
+        let mut s = header.to_string();
+        for t in times {
+            s += &format!("{t},0,0,0,0,0,0,1,0,0,0\n");
+        }
+        s
+    };
+    std::fs::write(dir.join("zero.csv"), rows(&["0", "0", "0"])).unwrap();
+    std::fs::write(dir.join("back.csv"), rows(&["0", "2", "1"])).unwrap();
+    std::fs::write(dir.join("est.csv"), rows(&["0", "0.5", "1"])).unwrap();
+    let (code, err) = run_in(&dir, &["compare", "zero.csv", "zero.csv"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("zero.csv, row 3: truth time 0 s does not increase (previous 0 s)"),
+        "{err}"
+    );
+    // The bad row lies past every estimate time: it is found all the same.
+    let (code, err) = run_in(&dir, &["compare", "back.csv", "est.csv", "--out", "e.csv"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("back.csv, row 4: truth time 1 s does not increase (previous 2 s)"),
+        "{err}"
+    );
+    assert!(!dir.join("e.csv").exists());
+}

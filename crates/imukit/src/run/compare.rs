@@ -151,7 +151,8 @@ fn state_index(names: &[String], kind: EstimateKind) -> Vec<Option<usize>> {
 /// Compares an estimate table with a truth table (see the module docs).
 ///
 /// # Errors
-/// Missing columns; estimate times outside the truth's span or going back; zero quaternions.
+/// Missing columns; truth or estimate times that do not increase (or are not finite); estimate
+/// times outside the truth's span; zero quaternions.
 pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
     let kind = EstimateKind::of(&estimate.columns)?;
     check_truth(&truth.columns, kind)?;
@@ -159,6 +160,7 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
     let mut table = Table::new(kind.error_columns());
     let summary = compare_rows(
         kind,
+        ["truth", "estimate"],
         |row| Ok(tr.next().map(|r| *row = r).is_some()),
         |row| Ok(er.next().map(|r| *row = r).is_some()),
         |e| {
@@ -240,8 +242,10 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
     if let Some(f) = file.as_mut() {
         f.write_header(columns)?;
     }
+    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
     let summary = compare_rows(
         kind,
+        [&truth_name, &estimate_name],
         |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
         |row| next_state(&mut estimate_rows, &mut estimate_buffer, kind, row),
         |e| match file.as_mut() {
@@ -265,10 +269,31 @@ fn angle_difference(a: f64, b: f64) -> f64 {
 /// but within 1e-9 s use the last two), errors handed to `sink`.
 fn compare_rows(
     kind: EstimateKind,
-    mut truth: impl FnMut(&mut StateRow) -> Result<bool>,
+    names: [&str; 2],
+    mut read_truth: impl FnMut(&mut StateRow) -> Result<bool>,
     mut estimate: impl FnMut(&mut StateRow) -> Result<bool>,
     mut sink: impl FnMut(&[f64]) -> Result<()>,
 ) -> Result<ErrorSummary> {
+    let [truth_name, estimate_name] = names;
+    // Truth times must increase strictly: bracketing an estimate time needs them ordered.
+    let (mut truth_rows, mut last_truth) = (0usize, f64::NEG_INFINITY);
+    let mut truth = |row: &mut StateRow| -> Result<bool> {
+        if !read_truth(row)? {
+            return Ok(false);
+        }
+        truth_rows += 1;
+        if row[0].partial_cmp(&last_truth) != Some(std::cmp::Ordering::Greater) {
+            return Err(invalid(
+                format!("{truth_name}, row {}", truth_rows + 1),
+                format!(
+                    "truth time {} s does not increase (previous {last_truth} s)",
+                    row[0]
+                ),
+            ));
+        }
+        last_truth = row[0];
+        Ok(true)
+    };
     let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
     if !truth(&mut a)? {
         return Err(invalid("compare", "empty table"));
@@ -287,9 +312,15 @@ fn compare_rows(
     let mut previous_t = f64::NEG_INFINITY;
     while estimate(&mut e)? {
         let (t, row) = (e[0], att.count() + 2);
+        if !t.is_finite() {
+            return Err(invalid(
+                estimate_name,
+                format!("estimate time {t} s (row {row}) is not a finite number"),
+            ));
+        }
         if t < previous_t {
             return Err(invalid(
-                "compare",
+                estimate_name,
                 format!("estimate time {t} s (row {row}) goes back from {previous_t} s"),
             ));
         }
@@ -309,7 +340,7 @@ fn compare_rows(
                 "…".into()
             };
             return Err(invalid(
-                "compare",
+                estimate_name,
                 format!("estimate time {t} s (row {row}) is outside the truth's {t0}…{end}"),
             ));
         }
@@ -356,6 +387,9 @@ fn compare_rows(
     if att.count() == 0 {
         return Err(invalid("compare", "empty table"));
     }
+    // The truth rows past the last estimate are read too: a truth file is refused whole or not
+    // at all.
+    while !truth_ended && truth(&mut next)? {}
     let navigation = kind == EstimateKind::Navigation;
     Ok(ErrorSummary {
         kind,
