@@ -712,3 +712,30 @@ fn compare_refuses_truth_times_that_repeat_or_go_back_anywhere_in_the_file() {
     );
     assert!(!dir.join("e.csv").exists());
 }
+
+#[test]
+fn samples_whose_times_go_back_are_named_by_row_not_by_a_sample_rate() {
+    let dir = temp_dir("samples-back");
+    let mut csv = String::from("t_s,pos_x_m,pos_y_m,pos_z_m\n");
+    for (k, t) in [0.0, 0.2, 0.1, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8]
+        .iter()
+        .enumerate()
+    {
+        csv += &format!("{t},{k},0,0\n");
+    }
+    std::fs::write(dir.join("dec.csv"), csv).unwrap();
+    std::fs::write(
+        dir.join("dec.toml"),
+        "[trajectory]\ntype = \"samples\"\nfile = \"dec.csv\"\nattitude = \"tangent\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(&dir, &["simulate", "dec.toml", "--out", "o.csv"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains(
+            "dec.csv, row 4: time at sample 2 (0.1 s) does not increase after sample 1 (0.2 s)"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("sample_rate_hz"), "{err}");
+}

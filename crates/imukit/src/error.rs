@@ -75,6 +75,20 @@ pub enum Error {
         /// What else would do.
         hint: String,
     },
+    /// A result that is not a finite number: refused at the boundary, never written.
+    #[error(
+        "{what}, row {row}, column {column}: the result is {value}, not a finite number (an input or parameter is too large for it); nothing was written"
+    )]
+    NotFinite {
+        /// The output (file or table).
+        what: String,
+        /// 1-based row (the header is row 1).
+        row: usize,
+        /// The column.
+        column: String,
+        /// The value (inf or NaN).
+        value: f64,
+    },
     /// A quaternion of zero norm or not finite, where an attitude was expected.
     #[error("{field} has zero norm or is not finite")]
     BadQuaternion {
@@ -184,6 +198,14 @@ impl Error {
                 field: None,
             },
             Self::CsvFormat { file: f, .. } => file(f),
+            Self::NotFinite {
+                what, row, column, ..
+            } => Location {
+                field: Some(what.clone()),
+                row: Some(*row),
+                column: Some(column.clone()),
+                file: None,
+            },
             Self::MissingColumns {
                 file: f, missing, ..
             } => Location {

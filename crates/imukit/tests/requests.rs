@@ -237,3 +237,67 @@ fn rk4_substeps_are_bounded() {
     assert_eq!(e.location().field.as_deref(), Some("substeps"));
     assert!(e.to_string().contains("at most 1000"), "{e}");
 }
+
+#[test]
+fn parameters_that_overflow_at_the_sample_rate_are_named() {
+    let resolve = |imu: &str| {
+        ScenarioSpec::from_toml(
+            &format!(
+                "rate_hz = 100.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n{imu}"
+            ),
+            "overflow.toml",
+        )
+        .unwrap()
+        .resolve(Path::new("."))
+    };
+    let e = resolve("[imu.gyroscope]\nNoiseDensity = 1e308\n").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "imu: gyroscope.noise_density[0] is too large: at this sample rate the model is not finite"
+    );
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("imu.gyroscope.noise_density")
+    );
+    let e = resolve(
+        "[imu.gyroscope]\nbias_instability_rad_s = 0.01\nbias_instability_flicker_tau_s = [1, 1e300]\n",
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("bias_instability_flicker_tau_s[0] is too large"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_result_that_is_not_finite_is_never_written() {
+    // Each parameter is valid, but 1.7e308 scaled by 11 (100 %/°C at 35 °C) overflows.
+    let scenario = ScenarioSpec::from_toml(
+        "rate_hz = 100.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+         [imu]\ntemperature_c = 35.0\n[imu.accelerometer]\nConstantBias = 1.7e308\n\
+         TemperatureScaleFactor = 100\n",
+        "inf.toml",
+    )
+    .unwrap()
+    .resolve(Path::new("."))
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("imukit-notfinite-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("imu.csv");
+    let e = scenario.stream_to_csv(None, &out, None).unwrap_err();
+    assert!(matches!(e, Error::NotFinite { row: 2, .. }), "{e}");
+    assert_eq!(e.location().column.as_deref(), Some("accel_x_m_s2"));
+    assert!(!out.exists());
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "no partial file"
+    );
+    let e = scenario.simulate().unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("IMU readings, row 2, column accel_x_m_s2: the result is inf"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -39,6 +39,14 @@ pub enum ParamError {
         /// Upper bound.
         max: f64,
     },
+    /// Valid alone, but not a finite number once scaled to the sample rate (or, for a bias
+    /// instability model, its filter is not).
+    Overflow {
+        /// Parameter name.
+        field: &'static str,
+        /// Axis index.
+        index: usize,
+    },
     /// Filter coefficients: empty, too many, or a zero leading denominator coefficient.
     BadFilter {
         /// What is wrong.
@@ -52,6 +60,7 @@ impl ParamError {
     pub fn field(&self) -> &'static str {
         match *self {
             Self::NotFinite { field, .. }
+            | Self::Overflow { field, .. }
             | Self::Negative { field, .. }
             | Self::NotPositive { field, .. }
             | Self::OutOfRange { field, .. } => field,
@@ -81,6 +90,10 @@ impl fmt::Display for ParamError {
             } => {
                 write!(f, "{field}[{index}] must be in [{min}, {max}], got {value}")
             }
+            Self::Overflow { field, index } => write!(
+                f,
+                "{field}[{index}] is too large: at this sample rate the model is not finite"
+            ),
             Self::BadFilter { reason } => write!(f, "bias_instability_coefficients: {reason}"),
         }
     }

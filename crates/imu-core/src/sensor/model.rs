@@ -27,6 +27,16 @@ enum BiasFilter {
 }
 
 impl BiasFilter {
+    /// True when every coefficient is a finite number.
+    fn is_finite(&self) -> bool {
+        match self {
+            Self::Iir { b, a, .. } => b.iter().chain(a).all(|v| v.is_finite()),
+            Self::Cascade {
+                zero, pole, gain, ..
+            } => zero.iter().chain(pole).all(|v| v.is_finite()) && gain.is_finite(),
+        }
+    }
+
     fn new(model: &BiasInstabilityModel, sample_rate_hz: f64) -> Self {
         match model {
             BiasInstabilityModel::Filter(c) => {
@@ -234,7 +244,7 @@ impl SensorModel {
             NoiseType::DoubleSided => sample_rate_hz / 2.0,
         };
         let root = math::sqrt(bandwidth);
-        Ok(Self {
+        let model = Self {
             misalignment: params
                 .axes_misalignment_pct
                 .map(|row| row.map(|m| m / 100.0)),
@@ -249,7 +259,32 @@ impl SensorModel {
             range: params.measurement_range,
             resolution: params.resolution,
             quantization_carry: params.quantization_carry,
-        })
+        };
+        // Parameters valid on their own can still overflow once scaled to the sample rate.
+        let overflow = |field, values: &[f64; 3]| {
+            values
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|index| ParamError::Overflow { field, index })
+        };
+        if let Some(e) = overflow("noise_density", &model.white_sigma)
+            .or_else(|| overflow("random_walk", &model.random_walk_sigma))
+        {
+            return Err(e);
+        }
+        if !model.bias_filter.is_finite() {
+            return Err(ParamError::Overflow {
+                field: match params.bias_instability_model {
+                    BiasInstabilityModel::Filter(_) => "bias_instability_coefficients",
+                    BiasInstabilityModel::Flicker { .. } => "bias_instability_flicker_tau_s",
+                    BiasInstabilityModel::GaussMarkov { .. } => {
+                        "bias_instability_correlation_time_s"
+                    }
+                },
+                index: 0,
+            });
+        }
+        Ok(model)
     }
 
     /// One reading from the ideal input `u` (sensor frame); advances `state`; draws exactly nine

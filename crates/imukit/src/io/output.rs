@@ -7,7 +7,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result, invalid};
-use crate::io::table::write_rows;
+use crate::io::table::{check_finite, write_rows};
 
 /// The longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
@@ -35,6 +35,9 @@ pub fn write_atomically(
 #[derive(Debug)]
 pub struct AtomicFile {
     path: PathBuf,
+    /// The header's columns and the rows written, to name a refused value.
+    columns: Vec<String>,
+    rows: usize,
     /// The temporary name; `None` for a special file written directly.
     tmp: Option<PathBuf>,
     writer: Option<BufWriter<File>>,
@@ -64,6 +67,8 @@ impl AtomicFile {
                 .map_err(io)?;
             return Ok(Self {
                 path: path.to_path_buf(),
+                columns: Vec::new(),
+                rows: 0,
                 tmp: None,
                 writer: Some(BufWriter::new(file)),
             });
@@ -72,6 +77,8 @@ impl AtomicFile {
         let file = File::create(&tmp).map_err(io)?;
         Ok(Self {
             path: path.to_path_buf(),
+            columns: Vec::new(),
+            rows: 0,
             tmp: Some(tmp),
             writer: Some(BufWriter::new(file)),
         })
@@ -90,6 +97,7 @@ impl AtomicFile {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
+        self.columns = columns.iter().map(|c| (*c).to_string()).collect();
         let w = self.writer();
         let written = w
             .write_all(columns.join(",").as_bytes())
@@ -100,8 +108,27 @@ impl AtomicFile {
     /// Writes one CSV row of `values` (shortest round-trip form).
     ///
     /// # Errors
+    /// [`Error::NotFinite`] for a value that is not finite (the file is then not written);
     /// [`Error::Io`] naming the file.
     pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
+        self.rows += 1;
+        if let Err(e) = check_finite(&self.columns, values, &self.path.display().to_string()) {
+            // Rows are checked one at a time: say which row of the file it is.
+            return Err(match e {
+                Error::NotFinite {
+                    what,
+                    column,
+                    value,
+                    ..
+                } => Error::NotFinite {
+                    what,
+                    row: self.rows + 1,
+                    column,
+                    value,
+                },
+                other => other,
+            });
+        }
         let written = write_rows(self.writer(), values, values.len(), b",");
         written.map_err(|e| self.error(e))
     }

@@ -120,7 +120,47 @@ pub struct Table {
     pub data: Vec<f64>,
 }
 
+/// Refuses rows (row-major, `columns.len()` wide) holding a value that is not finite, naming the
+/// first one (rows counted from 2, below a header).
+///
+/// # Errors
+/// [`Error::NotFinite`] for `what`.
+pub fn check_finite<S: AsRef<str>>(columns: &[S], data: &[f64], what: &str) -> Result<()> {
+    check_finite_from(columns, data, what, 2)
+}
+
+/// [`check_finite`] for rows that start at file row `first_row`.
+///
+/// # Errors
+/// [`Error::NotFinite`] for `what`.
+pub fn check_finite_from<S: AsRef<str>>(
+    columns: &[S],
+    data: &[f64],
+    what: &str,
+    first_row: usize,
+) -> Result<()> {
+    match data.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NotFinite {
+            what: what.into(),
+            row: i / columns.len().max(1) + first_row,
+            column: columns
+                .get(i % columns.len().max(1))
+                .map_or_else(String::new, |c| c.as_ref().to_string()),
+            value: data[i],
+        }),
+    }
+}
+
 impl Table {
+    /// Refuses a table holding a value that is not finite (see [`check_finite`]).
+    ///
+    /// # Errors
+    /// [`Error::NotFinite`] naming `what`, the row and the column.
+    pub fn check_finite(&self, what: &str) -> Result<()> {
+        check_finite(&self.columns, &self.data, what)
+    }
+
     /// An empty table with these columns.
     #[must_use]
     pub fn new(columns: &[&str]) -> Self {
@@ -224,6 +264,7 @@ impl Table {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
+        self.check_finite(&path.display().to_string())?;
         write_atomically(path, |w| {
             self.write_header(w)?;
             self.write_body(w)

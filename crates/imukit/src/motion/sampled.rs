@@ -162,6 +162,21 @@ impl SampledPath {
         Ok(())
     }
 
+    /// Checks the samples (increasing finite times, finite values, enough samples for the
+    /// stencil) without differentiating them.
+    ///
+    /// # Errors
+    /// The core's refusal, with the file row of the offending sample.
+    pub fn check(&self) -> Result<()> {
+        check_samples(
+            &self.t_s,
+            &self.position_m,
+            self.core_attitude(),
+            self.options,
+        )
+        .map_err(|e| self.located(e))
+    }
+
     fn core_attitude(&self) -> SampledAttitude<'_> {
         match &self.attitude {
             SampledAttitudeData::Euler(e) => SampledAttitude::Euler(e),

@@ -20,6 +20,13 @@ fn in_frame<T>(nav: NavFrameName, enu: impl FnOnce() -> T, ned: impl FnOnce() ->
     }
 }
 
+/// The truth as a table, refused if a value is not finite.
+fn finite_truth<N: NavFrame>(truth: &[Truth<N>]) -> Result<Table> {
+    let table = Table::from_truth(truth);
+    table.check_finite("truth")?;
+    Ok(table)
+}
+
 /// Exact truth at `t_s` from formulas.
 ///
 /// # Errors
@@ -35,8 +42,8 @@ pub fn truth_from_expressions(
     let traj = Trajectory::Expression(spec.motion()?, AnalyticOptions { min_speed_m_s });
     in_frame(
         nav,
-        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
-        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+        || finite_truth(&traj.truth::<Enu>(t_s)?),
+        || finite_truth(&traj.truth::<Ned>(t_s)?),
     )
 }
 
@@ -74,7 +81,8 @@ pub fn truth_from_arrays_into(
     match nav {
         NavFrameName::ENU => path.truth_chunks::<Enu>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
         NavFrameName::NED => path.truth_chunks::<Ned>(CHUNK, &mut |c| fill_rows(c, &mut rows)),
-    }
+    }?;
+    crate::io::table::check_finite(&TRUTH_COLUMNS, out, "truth")
 }
 
 /// Writes truth samples into the next rows.
@@ -152,7 +160,9 @@ pub fn ideal_from_truth(
             .iter()
             .map(crate::scenario::sensors::ideal_as_reading)
             .collect();
-        Ok(Table::from_readings(&t, &readings, imu.kind))
+        let table = Table::from_readings(&t, &readings, imu.kind);
+        table.check_finite("IMU readings")?;
+        Ok(table)
     }
     in_frame(
         nav,
@@ -265,8 +275,8 @@ pub fn truth_from_body_rates(
     let traj = Trajectory::BodyRates(data);
     in_frame(
         nav,
-        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
-        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+        || finite_truth(&traj.truth::<Enu>(t_s)?),
+        || finite_truth(&traj.truth::<Ned>(t_s)?),
     )
 }
 
@@ -282,8 +292,8 @@ pub fn truth_from_waypoints(
     let traj = Trajectory::Waypoints(waypoints);
     in_frame(
         nav,
-        || Ok(Table::from_truth(&traj.truth::<Enu>(t_s)?)),
-        || Ok(Table::from_truth(&traj.truth::<Ned>(t_s)?)),
+        || finite_truth(&traj.truth::<Enu>(t_s)?),
+        || finite_truth(&traj.truth::<Ned>(t_s)?),
     )
 }
 

@@ -9,7 +9,7 @@ use imu_core::{AccelSign, Body, DEFAULT_GRAVITY_M_S2, Enu, NavFrame, Ned, Rotati
 
 use crate::error::{Result, invalid};
 use crate::io::params::Profile;
-use crate::io::table::ImuKind;
+use crate::io::table::{ImuKind, check_finite};
 use crate::scenario::sensors::SensorSetup;
 use crate::scenario::{AccelSignName, ImuSetup, ImuSpec, NavFrameName, parse_name};
 
@@ -80,6 +80,11 @@ impl Orientation<'_> {
         }
     }
 }
+
+/// The nine numbers of a reading row, named for messages.
+const READING_COLUMNS: [&str; 9] = [
+    "accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z", "mag_x", "mag_y", "mag_z",
+];
 
 /// The model in the chosen navigation frame.
 #[derive(Clone, Debug)]
@@ -159,7 +164,8 @@ impl ImuSensor {
     /// sensors zero) through the core's per-sample path ([`ImuModel::measure_nav`]).
     ///
     /// # Errors
-    /// Slices of unequal lengths, or a quaternion of zero norm or not finite (named by index);
+    /// Slices of unequal lengths, a quaternion of zero norm or not finite (named by index), a
+    /// reading that is not finite (from non-finite or overflowing input, as MATLAB refuses it);
     /// then the drift state and the noise stream are as they were before the call.
     pub fn measure(
         &mut self,
@@ -204,12 +210,19 @@ impl ImuSensor {
                 out,
             ),
         };
-        result.map_err(|i| {
-            (self.state, self.noise) = (start_state, start_noise);
-            crate::Error::BadQuaternion {
+        let refused = match result {
+            Err(i) => Some(crate::Error::BadQuaternion {
                 field: format!("quaternion[{i}]"),
+            }),
+            Ok(()) => check_finite(&READING_COLUMNS, out, "readings").err(),
+        };
+        match refused {
+            Some(e) => {
+                (self.state, self.noise) = (start_state, start_noise);
+                Err(e)
             }
-        })
+            None => Ok(()),
+        }
     }
 
     /// Back to the initial drift state and the start of the seeded noise stream.

@@ -322,10 +322,12 @@ fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
 /// Missing columns (both layouts named), invalid initial quaternion, non-finite values or
 /// non-increasing times (sample index named).
 pub fn integrate(imu: &Table, initial: &InitialState, setup: &NavSetup) -> Result<Table> {
-    match setup.nav_frame {
+    let nav = match setup.nav_frame {
         NavFrameName::ENU => integrate_in::<Enu>(imu, initial, setup),
         NavFrameName::NED => integrate_in::<Ned>(imu, initial, setup),
-    }
+    }?;
+    nav.check_finite("navigation")?;
+    Ok(nav)
 }
 
 fn integrate_in<N: NavFrame>(

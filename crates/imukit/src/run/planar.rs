@@ -271,5 +271,6 @@ pub fn integrate(
             s.velocity_body_m_s[1],
         ]);
     }
+    t.check_finite("planar navigation")?;
     Ok(t)
 }

@@ -16,7 +16,7 @@ use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
 use crate::io::output::AtomicFile;
-use crate::io::table::{ImuOutput, Table};
+use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 
@@ -65,7 +65,18 @@ impl Scenario {
         let mut imu_file = AtomicFile::create(imu_path)?;
         let mut truth_file = truth_path.map(AtomicFile::create).transpose()?;
         let mut first = true;
+        let mut next_row = 2;
+        let (imu_name, truth_name) = (
+            imu_path.display().to_string(),
+            truth_path.map(|p| p.display().to_string()),
+        );
         self.stream(run, |chunk| {
+            // Nothing that is not a finite number reaches a file.
+            check_finite_from(&chunk.imu.columns, &chunk.imu.data, &imu_name, next_row)?;
+            if let Some(name) = &truth_name {
+                check_finite_from(&chunk.truth.columns, &chunk.truth.data, name, next_row)?;
+            }
+            next_row += chunk.imu.rows();
             let w = imu_file.writer();
             let written = if first {
                 chunk.imu.write_header(w)

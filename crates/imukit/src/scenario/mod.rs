@@ -98,13 +98,16 @@ impl Scenario {
             .imu
             .readings(&truth, self.gravity_m_s2, self.sample_rate_hz, run)?;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
-        Ok(Simulation {
+        let simulation = Simulation {
             truth: Table::from_truth(&truth),
             imu: match self.imu.output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
                 ImuOutput::Increments => Table::from_increments(&t, &readings, self.imu.kind),
             },
-        })
+        };
+        simulation.truth.check_finite("truth")?;
+        simulation.imu.check_finite("IMU readings")?;
+        Ok(simulation)
     }
 
     /// Truth and readings of Monte Carlo run `run`: the noise stream is

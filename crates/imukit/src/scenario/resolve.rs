@@ -188,6 +188,7 @@ impl ScenarioSpec {
                     .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
                 let min_speed = s.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
                 let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+                path.check()?;
                 let t = SampleTimes::Listed(path.t_s.clone());
                 (Trajectory::Samples(path), t)
             }
@@ -213,6 +214,8 @@ impl ScenarioSpec {
             _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s.at(t_s.len() - 1) - t_s.at(0)),
             _ => spec.rate_hz.unwrap_or(1.0),
         };
+        // The sensor model is checked now, at this sample rate, before any work.
+        imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;
         Ok(Scenario {
             t_s,
             sample_rate_hz,
