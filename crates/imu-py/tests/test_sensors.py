@@ -242,3 +242,40 @@ def test_imu_errors_name_file_row_and_column(tmp_path):
         imukit.read_csv(bad)
     assert (e.value.file, e.value.row, e.value.column) == (str(bad), 3, "gyro_x_rad_s")
     assert e.value.field is None
+
+
+def test_matlab_parity_gaps_closed():
+    # Non-finite input is refused (MATLAB refuses it), naming the argument and row.
+    acc = np.zeros((3, 3))
+    acc[1, 2] = np.nan
+    imu = imukit.ImuSensor()
+    with pytest.raises(ImuError, match=r"acceleration\[1\]: is not a finite number") as e:
+        imu(acc, np.zeros((3, 3)), np.tile([1.0, 0, 0, 0], (3, 1)))
+    assert e.value.field == "acceleration[1]"
+    # A matrix that is not a rotation is refused, not silently replaced.
+    m = np.tile(np.eye(3), (2, 1, 1))
+    m[1, 0, 0] = 1.01
+    with pytest.raises(ImuError, match=r"orientation\[1\]: is not a rotation matrix"):
+        imukit.ImuSensor()(np.zeros((2, 3)), np.zeros((2, 3)), m)
+    m[1] = np.diag([1.0, 1.0, -1.0])
+    with pytest.raises(ImuError, match=r"reflection"):
+        imukit.ImuSensor()(np.zeros((2, 3)), np.zeros((2, 3)), m)
+    # Without an orientation the body is level (MATLAB's identity).
+    a, g = imukit.ImuSensor()(np.zeros((2, 3)), np.zeros((2, 3)))
+    assert a.tolist() == [[0.0, 0.0, 9.81]] * 2
+    # AxesMisalignment as a 3×1 column means the 3-vector form.
+    col = imukit.ImuSensor(accelerometer={"AxesMisalignment": [[1.0], [2.0], [3.0]]})
+    vec = imukit.ImuSensor(accelerometer={"AxesMisalignment": [1.0, 2.0, 3.0]})
+    u = np.array([[0.3, -0.2, 0.1]])
+    q = np.array([[1.0, 0, 0, 0]])
+    assert col(u, np.zeros((1, 3)), q)[0].tolist() == vec(u, np.zeros((1, 3)), q)[0].tolist()
+
+
+def test_a_matlab_parameter_file_means_what_it_means_in_matlab(tmp_path):
+    path = tmp_path / "parts.json"
+    path.write_text(json.dumps({"MPU_6050": {"Gyroscope": {"NoiseDensity": 0.001}},
+                                "Other": {"Gyroscope": {"NoiseDensity": 0.002}}}))
+    # MATLAB's loadparams leaves NoiseType double-sided, whatever imukit's profile.
+    p = imukit.loadparams(path, part="mpu-6050")  # part names match as MATLAB identifiers
+    assert p["gyroscope"]["noise_type"] == "double-sided"
+    assert p["gyroscope"]["noise_density_rad_s_per_rt_hz"] == 0.001

@@ -90,7 +90,9 @@ class ImuSensor:
     (N, 3), nav-frame angular velocity (N, 3), and the orientation as quaternions
     ``[w, x, y, z]`` (N, 4) — MATLAB's navigation-to-body frame rotation, imukit's ``q_nb`` — or as
     MATLAB rotation matrices (N, 3, 3), which rotate navigation-frame vectors into the body frame
-    (``C_nbᵀ``). It returns ``(accel, gyro)``, ``(accel, mag)`` or ``(accel, gyro, mag)`` per
+    (``C_nbᵀ``; a matrix that is not a rotation to 1e-6 is refused); without an orientation the
+    body is level, as in MATLAB. Non-finite inputs are refused, naming the argument and row, as
+    MATLAB refuses them. It returns ``(accel, gyro)``, ``(accel, mag)`` or ``(accel, gyro, mag)`` per
     ``imu_type``. The drift state and the seeded noise stream carry over between calls (so one
     call of 2N samples equals two calls of N); ``reset()`` starts over.
 
@@ -144,9 +146,11 @@ class ImuSensor:
     def temperature(self, value: float) -> None:
         self._imu.temperature = float(value)
 
-    def __call__(self, acc, ang_vel, orientation, *, out: Optional[np.ndarray] = None):
+    def __call__(self, acc, ang_vel, orientation=None, *, out: Optional[np.ndarray] = None):
         a = _rows("acc", acc)
         w = _rows("ang_vel", ang_vel)
+        if orientation is None:  # MATLAB: without an orientation the body is level (identity)
+            orientation = np.tile([1.0, 0.0, 0.0, 0.0], (a.shape[0], 1))
         o = np.ascontiguousarray(orientation, dtype=np.float64)
         if o.ndim == 1 and o.shape == (4,) or o.ndim == 2 and o.shape == (3, 3):
             o = o[None]

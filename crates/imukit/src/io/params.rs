@@ -269,6 +269,25 @@ fn triple(v: &ParamValue, field: &str) -> Result<[f64; 3]> {
 /// MATLAB's AxesMisalignment forms: scalar, 3-vector or 3×3, percent.
 fn misalignment(v: &ParamValue, field: &str) -> Result<[[f64; 3]; 3]> {
     match v {
+        // MATLAB also takes a 3×1 column for the 3-vector form.
+        ParamValue::List(rows)
+            if rows.len() == 3
+                && rows
+                    .iter()
+                    .all(|r| matches!(r, ParamValue::List(c) if c.len() == 1)) =>
+        {
+            let column: Vec<ParamValue> = rows
+                .iter()
+                .filter_map(|r| match r {
+                    ParamValue::List(c) => c.first().cloned(),
+                    _ => None,
+                })
+                .collect();
+            Ok(SensorParams::misalignment_from_vector(triple(
+                &ParamValue::List(column),
+                field,
+            )?))
+        }
         ParamValue::List(rows) if rows.len() == 3 && rows.iter().all(ParamValue::is_list) => {
             let mut m = [[0.0; 3]; 3];
             for (i, row) in rows.iter().enumerate() {
@@ -564,20 +583,36 @@ pub fn parse_any_document(
     }
     // MATLAB loadparams: { "PartName": { "Accelerometer": {...}, ... }, ... }
     let parts: Vec<&String> = map.keys().collect();
+    // MATLAB matches part names as identifiers: case aside, `MPU-6050` is `MPU_6050`.
+    let identifier = |s: &str| -> String {
+        s.chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect()
+    };
     let name = match part {
-        Some(p) => map.get_key_value(p).map(|(k, _)| k).ok_or_else(|| {
-            invalid(
-                origin,
-                format!(
-                    "no part \"{p}\" (parts: {})",
-                    parts
-                        .iter()
-                        .map(|s| s.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            )
-        })?,
+        Some(p) => map
+            .get_key_value(p)
+            .map(|(k, _)| k)
+            .or_else(|| map.keys().find(|k| identifier(k) == identifier(p)))
+            .ok_or_else(|| {
+                invalid(
+                    origin,
+                    format!(
+                        "no part \"{p}\" (parts: {})",
+                        parts
+                            .iter()
+                            .map(|s| s.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })?,
         None if parts.len() == 1 => parts[0],
         None => {
             return Err(invalid(
@@ -593,7 +628,9 @@ pub fn parse_any_document(
             ));
         }
     };
-    let mut file = parse_param_document(&map[name], &format!("{origin}: {name}"), profile)?;
+    // MATLAB's loadparams leaves NoiseType double-sided (its JSON cannot set it): a MATLAB
+    // file means what it means in MATLAB, whatever the profile.
+    let mut file = parse_param_document(&map[name], &format!("{origin}: {name}"), Profile::Matlab)?;
     file.info
         .entry("name".into())
         .or_insert_with(|| name.clone());

@@ -64,20 +64,59 @@ impl Orientation<'_> {
         self.len() == 0
     }
 
-    /// Sample `i`'s attitude; `None` for a quaternion of zero norm or not finite.
-    fn at<N: NavFrame>(&self, i: usize) -> Option<Rotation<Body, N>> {
+    /// Sample `i`'s attitude, or why it is refused.
+    fn at<N: NavFrame>(&self, i: usize) -> std::result::Result<Rotation<Body, N>, Refusal> {
         match self {
             Self::Quaternions(q) => {
                 let c = &q[4 * i..4 * i + 4];
-                Rotation::from_wxyz([c[0], c[1], c[2], c[3]])
+                Rotation::from_wxyz([c[0], c[1], c[2], c[3]]).ok_or(Refusal::Quaternion)
             }
-            Self::Matrices(m) => Some(Rotation::from_dcm(&m[i])),
+            Self::Matrices(m) => rotation_matrix(&m[i]),
             Self::NavToBody(m) => {
                 let c_nb: [[f64; 3]; 3] =
                     std::array::from_fn(|r| std::array::from_fn(|k| m[i][k][r]));
-                Some(Rotation::from_dcm(&c_nb))
+                rotation_matrix(&c_nb)
             }
         }
+    }
+}
+
+/// How far a matrix may be from a rotation (largest element of `CᵀC − I`) and still be taken as
+/// one: MATLAB applies any matrix as given, which a quaternion cannot; a matrix that is not a
+/// rotation to this tolerance is refused rather than silently replaced.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Why a sample is refused.
+#[derive(Clone, Copy, Debug)]
+enum Refusal {
+    /// A quaternion of zero norm or not finite.
+    Quaternion,
+    /// A matrix that is not a rotation: its distance from orthonormality (or NaN), or a
+    /// reflection (determinant −1).
+    Matrix(f64),
+    /// A non-finite input value, by argument.
+    NotFinite(&'static str),
+}
+
+/// A rotation matrix as an attitude, refused beyond [`ROTATION_TOLERANCE`].
+fn rotation_matrix<N: NavFrame>(
+    c: &[[f64; 3]; 3],
+) -> std::result::Result<Rotation<Body, N>, Refusal> {
+    let mut worst = 0.0_f64;
+    for i in 0..3 {
+        for j in 0..3 {
+            let dot: f64 = (0..3).map(|k| c[k][i] * c[k][j]).sum();
+            let e = (dot - if i == j { 1.0 } else { 0.0 }).abs();
+            worst = if e.is_nan() { f64::NAN } else { worst.max(e) };
+        }
+    }
+    let det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
+        - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
+        + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+    if worst <= ROTATION_TOLERANCE && det > 0.0 {
+        Ok(Rotation::from_dcm(c))
+    } else {
+        Err(Refusal::Matrix(if det > 0.0 { worst } else { -1.0 }))
     }
 }
 
@@ -211,9 +250,24 @@ impl ImuSensor {
             ),
         };
         let refused = match result {
-            Err(i) => Some(crate::Error::BadQuaternion {
+            Err((i, Refusal::Quaternion)) => Some(crate::Error::BadQuaternion {
                 field: format!("quaternion[{i}]"),
             }),
+            Err((i, Refusal::Matrix(distance))) => Some(invalid(
+                format!("orientation[{i}]"),
+                if distance < 0.0 {
+                    "is a reflection (determinant −1), not a rotation matrix".to_string()
+                } else {
+                    format!(
+                        "is not a rotation matrix (largest element of CᵀC − I: {distance:e}, \
+                         tolerance {ROTATION_TOLERANCE:e})"
+                    )
+                },
+            )),
+            Err((i, Refusal::NotFinite(what))) => Some(invalid(
+                format!("{what}[{i}]"),
+                "is not a finite number (MATLAB refuses it too)",
+            )),
             Ok(()) => check_finite(&READING_COLUMNS, out, "readings").err(),
         };
         match refused {
@@ -253,7 +307,7 @@ impl ImuSensor {
     }
 }
 
-/// The rows of one call; `Err(i)` at the first sample whose attitude is refused.
+/// The rows of one call; `Err((i, why))` at the first sample refused.
 #[allow(clippy::too_many_arguments)]
 fn measure_rows<N: NavFrame>(
     model: &ImuModel<N>,
@@ -264,9 +318,14 @@ fn measure_rows<N: NavFrame>(
     state: &mut ImuState,
     noise: &mut SeededNormals,
     out: &mut [f64],
-) -> std::result::Result<(), usize> {
+) -> std::result::Result<(), (usize, Refusal)> {
     for (i, o) in out.chunks_exact_mut(9).enumerate() {
-        let attitude = orientation.at::<N>(i).ok_or(i)?;
+        let attitude = orientation.at::<N>(i).map_err(|r| (i, r))?;
+        for (what, x) in [("acceleration", a), ("angular_velocity", w)] {
+            if !x[3 * i..3 * i + 3].iter().all(|v| v.is_finite()) {
+                return Err((i, Refusal::NotFinite(what)));
+            }
+        }
         let v = |x: &[f64]| Vec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
         let r = model.measure_nav(v(a), v(w), &attitude, temperatures, state, noise);
         o[..3].copy_from_slice(&r.accel_m_s2);
