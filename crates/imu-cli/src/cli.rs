@@ -58,8 +58,9 @@ pub enum Command {
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
         planar: bool,
-        /// Planar: `trapezoid` (default) or `exercise` (the planar cart exercise's rules). 3D: `coning` (default;
-        /// coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
+        /// Planar: `trapezoid` (default) or `exercise` (the planar cart exercise's rules). 3D: `auto`
+        /// (default: `rk4` for rates, `coning` for increments or with --no-corrections), `coning`
+        /// (coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
         #[arg(long)]
         scheme: Option<String>,
         /// 3D `rk4`: RK4 steps per sample interval.

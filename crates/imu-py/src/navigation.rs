@@ -75,7 +75,7 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 #[pyo3(signature = (columns, values, *, initial_columns = None, initial_values = None, position0_m = None,
                     velocity0_m_s = None, quaternion0 = None, euler0_rad = None, nav_frame = "ENU",
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
-                    accel_sign = "specific-force", scheme = "coning",
+                    accel_sign = "specific-force", scheme = "auto",
                     substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(

@@ -355,3 +355,64 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_default_scheme_is_the_best_for_rate_samples_on_a_coning_motion() {
+    use imu_core::{Body, Enu, Rotation, Vec3};
+    use imukit::run::navigate::{NavRequest, NavScheme};
+    // Classic coning (docs/design.md §6): a 5° cone at 2 Hz, 200 Hz rate samples, 30 s, at rest.
+    let (a, w) = (5f64.to_radians(), 2.0 * std::f64::consts::TAU);
+    let attitude = |t: f64| {
+        let (s, c) = (a / 2.0).sin_cos();
+        Rotation::<Body, Enu>::from_wxyz([c, 0.0, s * (w * t).cos(), s * (w * t).sin()]).unwrap()
+    };
+    let mut imu = imukit::Table::new(&[
+        "t_s",
+        "accel_x_m_s2",
+        "accel_y_m_s2",
+        "accel_z_m_s2",
+        "gyro_x_rad_s",
+        "gyro_y_rad_s",
+        "gyro_z_rad_s",
+    ]);
+    for k in 0..=6000 {
+        let t = f64::from(k) / 200.0;
+        let f = attitude(t)
+            .inverse()
+            .apply(Vec3::new(0.0, 0.0, 9.81))
+            .to_array();
+        let omega = [
+            -2.0 * w * (a / 2.0).sin().powi(2),
+            -w * a.sin() * (w * t).sin(),
+            w * a.sin() * (w * t).cos(),
+        ];
+        imu.push_row(&[t, f[0], f[1], f[2], omega[0], omega[1], omega[2]]);
+    }
+    let initial = InitialState {
+        quaternion: attitude(0.0).to_wxyz(),
+        ..InitialState::default()
+    };
+    let end = |scheme: &str| {
+        let setup = NavRequest {
+            scheme,
+            gravity_m_s2: 9.81,
+            ..NavRequest::default()
+        }
+        .setup()
+        .unwrap();
+        let nav = integrate(&imu, &initial, &setup).unwrap();
+        let last = |c: &str| *nav.column(c).unwrap().last().unwrap();
+        (
+            last("pos_x_m")
+                .hypot(last("pos_y_m"))
+                .hypot(last("pos_z_m")),
+            setup.scheme,
+        )
+    };
+    let (auto, scheme) = end("auto");
+    let (coning, _) = end("coning");
+    eprintln!("coning motion, 30 s: {auto:e} m (auto), {coning:e} m (coning)");
+    assert_eq!(scheme.for_input(true, true), NavScheme::Rk4 { substeps: 4 });
+    assert!(auto < 1e-5, "{auto}");
+    assert!(coning > 0.1, "{coning}");
+}

@@ -110,8 +110,9 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     })?;
     let [x, y, z] = summary.end_position_m;
     eprintln!(
-        "imukit: {} samples, strapdown; end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
+        "imukit: {} samples, strapdown ({}); end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
         summary.rows,
+        summary.scheme.describe(),
         c.out.display()
     );
     Ok(())

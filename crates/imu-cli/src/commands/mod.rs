@@ -57,7 +57,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     accel_sign: &accel_sign,
                     corrections: !no_corrections,
                     euler0: euler0.as_deref(),
-                    scheme: scheme.as_deref().unwrap_or("coning"),
+                    scheme: scheme.as_deref().unwrap_or("auto"),
                     substeps,
                 };
                 integrate::three_d(&common, &opts)

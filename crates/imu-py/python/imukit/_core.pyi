@@ -189,7 +189,7 @@ def strapdown(
     coning: bool = True,
     sculling: bool = True,
     accel_sign: str = "specific-force",
-    scheme: str = "coning",
+    scheme: str = "auto",
     substeps: int = ...,
 ) -> _Table: ...
 def compare(

@@ -48,7 +48,7 @@ def strapdown(
     coning: bool = True,
     sculling: bool = True,
     accel_sign: str = "specific-force",
-    scheme: str = "coning",
+    scheme: str = "auto",
     substeps: int = 4,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
@@ -60,7 +60,9 @@ def strapdown(
     by default at rest, level, at the origin. Returns ``t_s, pos_*, vel_*, q_*, yaw_rad, pitch_rad,
     roll_rad``.
 
-    ``scheme="coning"`` (default, docs/design.md §6, second order; rates or increments) or ``"rk4"``
+    ``scheme="auto"`` (default) takes the best scheme for the input: ``"rk4"`` for rates, ``"coning"``
+    for increments or when ``coning``/``sculling`` are switched off. ``"coning"`` (docs/design.md
+    §6, second order; rates or increments) or ``"rk4"``
     (fourth order: RK4 with ``substeps`` per interval on quintic-interpolated rates; rates only).
     """
     start: dict = {}

@@ -186,6 +186,37 @@ pub enum NavScheme {
         /// RK4 steps per sample interval.
         substeps: usize,
     },
+    /// The best scheme for the input: [`NavScheme::Rk4`] for rate samples (the trapezoid
+    /// increments of rates lose what the coning correction needs), [`NavScheme::ConingSculling`]
+    /// for increments, or when the coning and sculling corrections are switched off (which only
+    /// means something for that scheme).
+    Auto {
+        /// RK4 steps per sample interval, when RK4 is chosen.
+        substeps: usize,
+    },
+}
+
+impl NavScheme {
+    /// The concrete scheme for rate samples (`rates`) or increments, with the corrections on or
+    /// off (`corrections`).
+    #[must_use]
+    pub fn for_input(self, rates: bool, corrections: bool) -> Self {
+        match self {
+            Self::Auto { substeps } if rates && corrections => Self::Rk4 { substeps },
+            Self::Auto { .. } => Self::ConingSculling,
+            other => other,
+        }
+    }
+
+    /// The scheme's name as `--scheme` takes it, with its sub-steps.
+    #[must_use]
+    pub fn describe(self) -> String {
+        match self {
+            Self::ConingSculling => "coning".into(),
+            Self::Rk4 { substeps } => format!("rk4, {substeps} sub-steps"),
+            Self::Auto { substeps } => format!("auto ({substeps} RK4 sub-steps for rates)"),
+        }
+    }
 }
 
 /// What to integrate and how.
@@ -229,7 +260,10 @@ impl std::str::FromStr for NavScheme {
             "rk4" => Ok(Self::Rk4 {
                 substeps: DEFAULT_RK4_SUBSTEPS,
             }),
-            other => Err(format!("unknown scheme \"{other}\" (coning, rk4)")),
+            "auto" => Ok(Self::Auto {
+                substeps: DEFAULT_RK4_SUBSTEPS,
+            }),
+            other => Err(format!("unknown scheme \"{other}\" (auto, coning, rk4)")),
         }
     }
 }
@@ -241,11 +275,12 @@ impl NavScheme {
     /// Zero sub-steps, or more than [`MAX_RK4_SUBSTEPS`], for RK4.
     pub fn with_substeps(self, substeps: usize) -> std::result::Result<Self, String> {
         match self {
-            Self::Rk4 { .. } if substeps == 0 => Err("must be ≥ 1".into()),
-            Self::Rk4 { .. } if substeps > MAX_RK4_SUBSTEPS => Err(format!(
+            Self::Rk4 { .. } | Self::Auto { .. } if substeps == 0 => Err("must be ≥ 1".into()),
+            Self::Rk4 { .. } | Self::Auto { .. } if substeps > MAX_RK4_SUBSTEPS => Err(format!(
                 "must be at most {MAX_RK4_SUBSTEPS}, got {substeps} (the error stops falling long before)"
             )),
             Self::Rk4 { .. } => Ok(Self::Rk4 { substeps }),
+            Self::Auto { .. } => Ok(Self::Auto { substeps }),
             other => Ok(other),
         }
     }
@@ -260,7 +295,7 @@ pub struct NavRequest<'a> {
     pub nav_frame: &'a str,
     /// `"specific-force"` or `"matlab"`.
     pub accel_sign: &'a str,
-    /// `"coning"` or `"rk4"`.
+    /// `"auto"` (the best for the input, see [`NavScheme::Auto`]), `"coning"` or `"rk4"`.
     pub scheme: &'a str,
     /// RK4 sub-steps per interval.
     pub substeps: usize,
@@ -277,7 +312,7 @@ impl Default for NavRequest<'_> {
         Self {
             nav_frame: "ENU",
             accel_sign: "specific-force",
-            scheme: "coning",
+            scheme: "auto",
             substeps: DEFAULT_RK4_SUBSTEPS,
             gravity_m_s2: imu_core::DEFAULT_GRAVITY_M_S2,
             coning: true,
@@ -366,10 +401,11 @@ fn integrate_in<N: NavFrame>(
         AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
     };
     let mut out = vec![NavState::<N>::default(); t.len()];
+    let corrections = setup.options.coning || setup.options.sculling;
     let result = if let (Some(f), Some(w)) =
         (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
     {
-        match setup.scheme {
+        match setup.scheme.for_input(true, corrections) {
             NavScheme::ConingSculling => {
                 strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
             }
@@ -382,10 +418,11 @@ fn integrate_in<N: NavFrame>(
                 substeps,
                 &mut out,
             ),
+            NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
         }
     } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
     {
-        if setup.scheme != NavScheme::ConingSculling {
+        if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
             return Err(invalid(
                 "IMU data",
                 "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
@@ -453,6 +490,8 @@ fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14
 pub struct NavSummary {
     /// Rows written.
     pub rows: usize,
+    /// The scheme used (what [`NavScheme::Auto`] chose).
+    pub scheme: NavScheme,
     /// The last position, m.
     pub end_position_m: [f64; 3],
 }
@@ -619,7 +658,10 @@ fn integrate_csv_in<N: NavFrame>(
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
         position_m: Vec3::from_array(initial.position_m),
     };
-    let mut stepper = match (setup.scheme, rates) {
+    let scheme = setup
+        .scheme
+        .for_input(rates, setup.options.coning || setup.options.sculling);
+    let mut stepper = match (scheme, rates) {
         (NavScheme::ConingSculling, true) => Stepper::Rates(RateStrapdown::new(s0, setup.options)),
         (NavScheme::ConingSculling, false) => Stepper::Increments {
             nav: Strapdown::new(s0, setup.options),
@@ -639,6 +681,7 @@ fn integrate_csv_in<N: NavFrame>(
                 "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
             ));
         }
+        (NavScheme::Auto { .. }, _) => unreachable!("for_input chooses a concrete scheme"),
     };
     let sign = match setup.accel_sign {
         AccelSign::SpecificForce => 1.0,
@@ -670,6 +713,7 @@ fn integrate_csv_in<N: NavFrame>(
     file.commit()?;
     Ok(NavSummary {
         rows: written,
+        scheme,
         end_position_m: end.position_m.to_array(),
     })
 }
