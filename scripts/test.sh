@@ -48,6 +48,9 @@ python -m mypy.stubtest imukit._core
 echo "== Python tests"
 IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py crates/imu-py/python/imukit/_orientation.py crates/imu-py/python/imukit/_sensor.py crates/imu-py/python/imukit/_truth.py
 
+echo "== Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"
+IMUKIT_BIN="$PWD/target/release/imukit" python tests/fuzz/hostile.py --cases 400 --seed 1
+
 echo "== Examples"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT

@@ -14,7 +14,7 @@ fn euler_to_quaternion<'py>(
     euler_rad: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let e = rows::<3>("euler_rad", &euler_rad)?;
-    rows_out(py, arrays::euler_to_quaternion(&e))
+    rows_out(py, arrays::euler_to_quaternion(&e).map_err(refused)?)
 }
 
 /// Quaternions (N, 4) → z-y-x Euler angles (N, 3).
@@ -34,7 +34,7 @@ fn euler_to_dcm<'py>(
     euler_rad: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let e = rows::<3>("euler_rad", &euler_rad)?;
-    matrices_out(py, arrays::euler_to_dcm(&e))
+    matrices_out(py, arrays::euler_to_dcm(&e).map_err(refused)?)
 }
 
 /// Direction cosine matrices (N, 3, 3) → z-y-x Euler angles (N, 3).
@@ -44,7 +44,7 @@ fn dcm_to_euler<'py>(
     dcm: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let m = matrices_in("dcm", &dcm)?;
-    rows_out(py, arrays::dcm_to_euler(&m))
+    rows_out(py, arrays::dcm_to_euler(&m).map_err(refused)?)
 }
 
 /// Quaternions (N, 4) → direction cosine matrices (N, 3, 3).
@@ -64,7 +64,7 @@ fn dcm_to_quaternion<'py>(
     dcm: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let m = matrices_in("dcm", &dcm)?;
-    rows_out(py, arrays::dcm_to_quaternion(&m))
+    rows_out(py, arrays::dcm_to_quaternion(&m).map_err(refused)?)
 }
 
 /// Adds this module's functions.

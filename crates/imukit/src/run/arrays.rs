@@ -297,13 +297,35 @@ pub fn truth_from_waypoints(
     )
 }
 
+/// Refuses rows holding a value that is not finite, naming `name[i]`.
+fn finite_rows<const K: usize>(name: &str, rows: &[[f64; K]]) -> Result<()> {
+    match rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
+        None => Ok(()),
+        Some(i) => Err(invalid(format!("{name}[{i}]"), "is not finite")),
+    }
+}
+
+/// Refuses matrices holding a value that is not finite, naming `dcm[i]`.
+fn finite_matrices(dcm: &[[[f64; 3]; 3]]) -> Result<()> {
+    match dcm
+        .iter()
+        .position(|m| !m.iter().flatten().all(|v| v.is_finite()))
+    {
+        None => Ok(()),
+        Some(i) => Err(invalid(format!("dcm[{i}]"), "is not finite")),
+    }
+}
+
 /// z-y-x Euler angles `[yaw, pitch, roll]` → quaternions `q_nb` `[w, x, y, z]`, row by row.
-#[must_use]
-pub fn euler_to_quaternion(euler_rad: &[[f64; 3]]) -> Vec<[f64; 4]> {
-    euler_rad
+///
+/// # Errors
+/// A row that is not finite.
+pub fn euler_to_quaternion(euler_rad: &[[f64; 3]]) -> Result<Vec<[f64; 4]>> {
+    finite_rows("euler_rad", euler_rad)?;
+    Ok(euler_rad
         .iter()
         .map(|e| Rotation::<Body, Enu>::from_euler(EulerZyx::from_array(*e)).to_wxyz())
-        .collect()
+        .collect())
 }
 
 /// Quaternions `[w, x, y, z]` → rotations, row by row.
@@ -345,26 +367,37 @@ pub fn quaternion_to_dcm(quaternion: &[[f64; 4]]) -> Result<Vec<[[f64; 3]; 3]>> 
 }
 
 /// z-y-x Euler angles → direction cosine matrices `C_nb`, row by row.
-#[must_use]
-pub fn euler_to_dcm(euler_rad: &[[f64; 3]]) -> Vec<[[f64; 3]; 3]> {
-    euler_rad
+///
+/// # Errors
+/// A row that is not finite.
+pub fn euler_to_dcm(euler_rad: &[[f64; 3]]) -> Result<Vec<[[f64; 3]; 3]>> {
+    finite_rows("euler_rad", euler_rad)?;
+    Ok(euler_rad
         .iter()
         .map(|e| EulerZyx::from_array(*e).to_dcm())
-        .collect()
+        .collect())
 }
 
 /// Direction cosine matrices `C_nb` → z-y-x Euler angles, row by row.
-#[must_use]
-pub fn dcm_to_euler(dcm: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
-    dcm.iter()
+///
+/// # Errors
+/// A matrix that is not finite.
+pub fn dcm_to_euler(dcm: &[[[f64; 3]; 3]]) -> Result<Vec<[f64; 3]>> {
+    finite_matrices(dcm)?;
+    Ok(dcm
+        .iter()
         .map(|c| EulerZyx::from_dcm(c).to_array())
-        .collect()
+        .collect())
 }
 
 /// Direction cosine matrices `C_nb` → quaternions `q_nb`, row by row.
-#[must_use]
-pub fn dcm_to_quaternion(dcm: &[[[f64; 3]; 3]]) -> Vec<[f64; 4]> {
-    dcm.iter()
+///
+/// # Errors
+/// A matrix that is not finite.
+pub fn dcm_to_quaternion(dcm: &[[[f64; 3]; 3]]) -> Result<Vec<[f64; 4]>> {
+    finite_matrices(dcm)?;
+    Ok(dcm
+        .iter()
         .map(|c| Rotation::<Body, Enu>::from_dcm(c).to_wxyz())
-        .collect()
+        .collect())
 }

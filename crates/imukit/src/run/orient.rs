@@ -522,7 +522,8 @@ pub struct Estimates {
 /// an error the filter is left as it was before the call.
 ///
 /// # Errors
-/// Slices of different lengths, and the filter's refusals naming the row index.
+/// Slices of different lengths, values that are not finite (named by sensor and row), and the
+/// filter's refusals naming the row index.
 pub fn run_rows<N: NavFrame>(
     filter: &mut AnyFilter<N>,
     accel: &[f64],
@@ -535,6 +536,14 @@ pub fn run_rows<N: NavFrame>(
             return Err(invalid(
                 name,
                 format!("has {} rows, the accelerometer {n}", s.len() / 3),
+            ));
+        }
+    }
+    for (name, s) in [("accel", Some(accel)), ("gyro", gyro), ("mag", mag)] {
+        if let Some(i) = s.and_then(|s| s.iter().position(|v| !v.is_finite())) {
+            return Err(invalid(
+                format!("{name}[{}]", i / 3),
+                "is not a finite number",
             ));
         }
     }
@@ -553,8 +562,18 @@ pub fn run_rows<N: NavFrame>(
             .update(&input)
             .map_err(|e| invalid("readings", format!("row {i}: {e}")))?;
         if let Some(e) = estimate {
-            out.quaternions.push(e.orientation.to_wxyz());
-            out.angular_velocity_rad_s.push(e.angular_velocity_rad_s);
+            let (q, w) = (e.orientation.to_wxyz(), e.angular_velocity_rad_s);
+            if !q.iter().chain(&w).all(|v| v.is_finite()) {
+                return Err(invalid(
+                    "readings",
+                    format!(
+                        "row {i}: the estimate is not finite (readings too large for the filter, \
+                         or a sample rate too small)"
+                    ),
+                ));
+            }
+            out.quaternions.push(q);
+            out.angular_velocity_rad_s.push(w);
         }
     }
     *filter = working;

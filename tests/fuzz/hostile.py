@@ -1,0 +1,333 @@
+"""Hostile input against the command line and the Python API: seeded random and adversarial
+cases per class, each checked for what must never happen.
+
+Never: a panic (exit 101), a signal or abort (negative exit, 134), a hang (a case over its time
+bound), a leftover ``*.imukit-partial`` file, an input changed, a non-finite number in an output
+written with exit 0, or — from Python — an exception other than ``ImuError``, ``ValueError`` or
+``TypeError``. A refusal (exit 65/74/2, ``ImuError``) is a pass: the point is that the program
+says no cleanly.
+
+    python tests/fuzz/hostile.py                     # the short seeded run CI does (~400 cases)
+    python tests/fuzz/hostile.py --cases 5000 --seed 7   # a long run; any seed reproduces itself
+
+Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
+long, extreme numbers); extreme numeric options; output paths that collide with inputs, special
+files and folders; Python calls with NaN, inf, huge and misshapen arguments. Prints one line per
+class and a closing ``N passed, M failed`` line; exits 1 on any failure.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+TIME_LIMIT_S = 30.0
+ALLOWED_EXITS = {0, 2, 65, 74}
+
+SCENARIO = """rate_hz = 100.0
+duration_s = 0.5
+nav_frame = "ENU"
+[trajectory]
+type = "expression"
+constants = { f = 1.0 }
+position_m = ["0.8*cos(2*pi*f*t)", "0.8*sin(2*pi*f*t)", "0.3*cos(2*pi*f*t)"]
+attitude = "tangent"
+[imu]
+kind = "accel-gyro-mag"
+lever_arm_m = [-0.075, -0.075, 0.025]
+seed = 3
+[imu.gyroscope]
+NoiseDensity = 1e-4
+"""
+
+PARAMS = json.dumps({"Part": {"Gyroscope": {"NoiseDensity": 0.001, "MeasurementRange": "inf"},
+                              "Accelerometer": {"ConstantBias": [0.1, 0.2, 0.3]}}})
+
+EXTREMES = ["nan", "inf", "-inf", "1e308", "-1e308", "1e-320", "0", "-1", "1e9", "-0", "3", "0.5"]
+
+
+def imukit_bin() -> str:
+    explicit = os.environ.get("IMUKIT_BIN")
+    if explicit:
+        return explicit
+    for profile in ("release", "debug"):
+        p = ROOT / "target" / profile / "imukit"
+        if p.exists():
+            return str(p)
+    sys.exit("the imukit binary was not found: build it (cargo build --release -p imu-cli) or set IMUKIT_BIN")
+
+
+def digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else "absent"
+
+
+class Run:
+    """The checks of one case and the tally of a class."""
+
+    def __init__(self, name: str) -> None:
+        self.name, self.passed, self.failures = name, 0, []
+
+    def fail(self, case: str, why: str) -> None:
+        self.failures.append(f"{self.name}: {case}: {why}")
+
+
+def run_cli(run: Run, work: Path, args: list, inputs: list, case: str) -> None:
+    """Runs one command in `work` and checks it against every rule."""
+    before = {p: digest(work / p) for p in inputs}
+    try:
+        out = subprocess.run([imukit_bin(), *args], cwd=work, capture_output=True, timeout=TIME_LIMIT_S)
+    except subprocess.TimeoutExpired:
+        run.fail(case, f"no answer within {TIME_LIMIT_S} s: {args}")
+        return
+    code = out.returncode
+    problems = []
+    if code not in ALLOWED_EXITS:
+        problems.append(f"exit {code}: {out.stderr.decode(errors='replace')[-300:]}")
+    if b"panicked" in out.stderr:
+        problems.append("a panic message")
+    left = [p.name for p in work.iterdir() if p.name.endswith(".imukit-partial")]
+    if left:
+        problems.append(f"partial files left: {left}")
+    for p, d in before.items():
+        if digest(work / p) != d:
+            problems.append(f"input {p} changed")
+    if code == 0:
+        for p in work.iterdir():
+            if p.suffix == ".csv" and p.name not in inputs and p.is_file():
+                text = p.read_text(errors="replace").lower()
+                if "nan" in text.replace("nan_", "") or "inf" in text:
+                    problems.append(f"non-finite value written to {p.name}")
+                p.unlink()
+    if problems:
+        run.fail(case, "; ".join(problems) + f" [{' '.join(args)}]")
+    else:
+        run.passed += 1
+
+
+def mutate(rng: random.Random, data: bytes) -> bytes:
+    """One of: flip bytes, cut, duplicate a slice, insert extreme text, swap lines."""
+    b = bytearray(data)
+    kind = rng.randrange(5)
+    if kind == 0 and b:
+        for _ in range(rng.randint(1, 8)):
+            b[rng.randrange(len(b))] = rng.randrange(256)
+    elif kind == 1 and b:
+        b = b[: rng.randrange(len(b))]
+    elif kind == 2 and b:
+        i, j = sorted(rng.randrange(len(b)) for _ in range(2))
+        b[i:i] = b[i:j] * rng.randint(1, 50)
+    elif kind == 3:
+        i = rng.randrange(len(b) + 1)
+        b[i:i] = rng.choice(EXTREMES + ["(" * 500, ",,,", '"', "\n\n", "t_s", "\x00"]).encode()
+    else:
+        lines = bytes(b).split(b"\n")
+        rng.shuffle(lines)
+        b = bytearray(b"\n".join(lines))
+    return bytes(b)
+
+
+def formula(rng: random.Random, depth: int = 0, limit: int = 0) -> str:
+    """A random formula: mostly legal, sometimes deep (nested to `limit`), long or extreme."""
+    limit = limit or rng.choice([3, 8, 30, 63, 64, 65, 120])
+    if depth == 0 and rng.random() < 0.15:  # a long flat sum or product
+        return rng.choice(["+", "*", "-"]).join([rng.choice(["t", "1e308", "pi"])] * rng.choice([10, 999, 1000, 1001, 40000]))
+    if depth >= limit or (depth > 2 and rng.random() < 0.3):
+        return rng.choice(["t", "pi", "e", "f", "1", "2.5", "1e308", "1e-308", "0"])
+    inner = formula(rng, depth + 1, limit)
+    op = rng.randrange(5)
+    if op == 0:
+        return f"({inner})"
+    if op == 1:
+        return f"-{inner}"
+    if op == 2:
+        return f"{rng.choice(['sin', 'cos', 'exp', 'sqrt', 'ln', 'abs', 'tan', 'asin'])}({inner})"
+    if op == 3:
+        return f"{inner}{rng.choice(['+', '-', '*', '/', '^'])}{rng.choice(['t', '2', '1e308', '0'])}"
+    return f"if(t < {rng.choice(EXTREMES[3:])}, {inner}, {rng.choice(['t', '0', '1e308'])})"
+
+
+def cli_cases(rng: random.Random, cases: int) -> list:
+    runs = []
+    work = Path(tempfile.mkdtemp(prefix="imukit-hostile-"))
+    try:
+        (work / "s.toml").write_text(SCENARIO)
+        subprocess.run([imukit_bin(), "simulate", "s.toml", "--out", "imu.csv", "--truth", "truth.csv"],
+                       cwd=work, check=True, capture_output=True)
+        (work / "p.json").write_text(PARAMS)
+        valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json")}
+        per = max(1, cases // 5)
+
+        r = Run("byte mutations of valid files")
+        for k in range(per):
+            name = rng.choice(list(valid))
+            bad = work / f"m{k}{Path(name).suffix}"
+            bad.write_bytes(mutate(rng, valid[name]))
+            args = {
+                "s.toml": ["simulate", bad.name, "--out", "o.csv"],
+                "imu.csv": rng.choice([["integrate", bad.name, "--out", "o.csv"],
+                                       ["orient", bad.name, "--out", "o.csv"],
+                                       ["allan", bad.name, "--out", "o.csv"],
+                                       ["plot", bad.name, "--out", "o.svg"]]),
+                "truth.csv": rng.choice([["compare", bad.name, "truth.csv"], ["plot", bad.name, "--out", "o.svg"],
+                                         ["animate", bad.name, "--out", "o.html"]]),
+                "p.json": ["simulate", "ps.toml", "--out", "o.csv"],
+            }[name]
+            if name == "p.json":
+                (work / "ps.toml").write_text(f'[trajectory]\ntype = "builtin"\nname = "static"\n[imu]\nparams = "{bad.name}"\n')
+            run_cli(r, work, args, [bad.name, "imu.csv", "truth.csv", "s.toml"], f"case {k}")
+            bad.unlink()
+            for leftover in ("o.svg", "o.html"):
+                (work / leftover).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("generated formulas")
+        for k in range(per):
+            f = formula(rng).replace('"', "")
+            (work / "f.toml").write_text(
+                f'rate_hz = 20.0\nduration_s = 0.5\n[trajectory]\ntype = "expression"\n'
+                f'constants = {{ f = 1.0 }}\nposition_m = ["{f}", "0", "t"]\n')
+            run_cli(r, work, ["simulate", "f.toml", "--out", "o.csv", "--truth", "ot.csv"], ["f.toml"], f"case {k}")
+        runs.append(r)
+
+        r = Run("extreme numeric options")
+        for k in range(per):
+            x = lambda: rng.choice(EXTREMES)  # noqa: E731
+            args = rng.choice([
+                ["integrate", "imu.csv", "--gravity-m-s2", x(), "--out", "o.csv"],
+                ["integrate", "imu.csv", "--scheme", "rk4", "--substeps", rng.choice(["0", "1", "1000", "1001", "999999999"]), "--out", "o.csv"],
+                ["integrate", "imu.csv", "--position0-m", x(), x(), x(), "--euler0-rad", x(), x(), x(), "--out", "o.csv"],
+                ["animate", "truth.csv", "--fps", x(), "--out", "o.html"],
+                ["animate", "truth.csv", "--speed", x(), "--body-m", x(), x(), x(), "--out", "o.gif"],
+                ["convert", x(), rng.choice(["°/h", "°/√h", "mg", "µg/√Hz", "furlong"])],
+                ["orient", "imu.csv", "--param", f"GyroscopeNoise={x()}", "--out", "o.csv"],
+                ["orient", "imu.csv", "--filter", "madgwick", "--param", f"Beta={x()}", "--out", "o.csv"],
+            ])
+            run_cli(r, work, args, ["imu.csv", "truth.csv"], f"case {k}")
+            for leftover in ("o.html", "o.gif"):
+                (work / leftover).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("colliding and special output paths")
+        (work / "folder").mkdir(exist_ok=True)
+        long = "x" * 250 + ".csv"
+        for k in range(per):
+            out = rng.choice(["s.toml", "imu.csv", "truth.csv", "./imu.csv", "../" + work.name + "/truth.csv",
+                              "/dev/null", "folder", "-", long, "o.csv"])
+            args, inputs = rng.choice([
+                (["simulate", "s.toml", "--out", out, "--truth", rng.choice(["truth2.csv", out, "/dev/null"])],
+                 ["s.toml"]),
+                (["integrate", "imu.csv", "--init", "truth.csv", "--out", out], ["imu.csv", "truth.csv"]),
+                (["compare", "truth.csv", "truth.csv", "--out", out], ["truth.csv"]),
+                (["allan", "imu.csv", "--out", out, "--plot", rng.choice(["a.svg", "a.txt", out])], ["imu.csv"]),
+            ])
+            run_cli(r, work, args, inputs, f"case {k}")
+            for leftover in ("truth2.csv", long, "a.svg"):
+                (work / leftover).unlink(missing_ok=True)
+            for name, data in valid.items():  # an output may legitimately replace a file of another case
+                (work / name).write_bytes(data)
+        runs.append(r)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return runs
+
+
+PY_CASES = r"""
+import random, sys, numpy as np, imukit
+rng = random.Random(int(sys.argv[1]))
+cases = int(sys.argv[2])
+X = [np.nan, np.inf, -np.inf, 1e308, -1e308, 0.0, -1.0, 1e9, 1e-320]
+def arr(shape):
+    a = np.array([[rng.choice(X + [rng.uniform(-5, 5)] * 6) for _ in range(shape[1])] for _ in range(shape[0])])
+    return a
+passed = failed = 0
+for k in range(cases):
+    n = rng.choice([0, 1, 2, 5, 50])
+    calls = [
+        lambda: imukit.ImuSensor("accel-gyro-mag", sample_rate=rng.choice(X + [100.0]))(arr((n, 3)), arr((n, 3)), arr((n, 4))),
+        lambda: imukit.ImuSensor(accelerometer={"MeasurementRange": rng.choice(X), "NoiseDensity": rng.choice(X)})(arr((n, 3)), arr((n, 3))),
+        lambda: imukit.truth_from_samples(np.sort(arr((n, 1))[:, 0]) if n else np.zeros(0), arr((n, 3)), attitude="tangent"),
+        lambda: imukit.truth_from_expressions(np.linspace(0, 1, max(n, 2)), [rng.choice(["t", "1e308*t*t", "(" * 70 + "t" + ")" * 70, "ln(t-2)"]), "0", "0"]),
+        lambda: imukit.allan_deviation(arr((n, rng.choice([1, 3]))), rng.choice(X + [100.0])),
+        lambda: imukit.euler_to_quaternion(arr((n, rng.choice([2, 3, 4])))),
+        lambda: imukit.quaternion_to_dcm(arr((n, 4))),
+        lambda: imukit.simulate({"rate_hz": rng.choice(X + [100.0]), "duration_s": rng.choice(X + [1.0]),
+                                 "trajectory": {"type": "builtin", "name": "static"}}),
+        lambda: imukit.planar_dead_reckon(np.arange(n, dtype=float), arr((n, 1))[:, 0] if n else np.zeros(0),
+                                          np.zeros(n), np.zeros(n), heading0_rad=rng.choice(X)),
+        lambda: imukit.ImuFilter(sample_rate=rng.choice(X + [100.0]))(arr((n, 3)), arr((n, 3))),
+    ]
+    call = rng.choice(calls)
+    try:
+        out = call()
+        values = [v for v in (out if isinstance(out, tuple) else (out,))]
+        for v in values:
+            data = getattr(v, "values", v)
+            if isinstance(data, np.ndarray) and data.dtype.kind == "f" and not np.all(np.isfinite(data)):
+                failed += 1
+                print(f"case {k}: a non-finite result was returned")
+                break
+        else:
+            passed += 1
+    except (imukit.ImuError, ValueError, TypeError):
+        passed += 1
+    except Exception as e:  # anything else is a failure of the binding
+        failed += 1
+        print(f"case {k}: {type(e).__name__}: {e}")
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)
+"""
+
+
+def python_cases(seed: int, cases: int) -> Run:
+    r = Run("Python API with NaN, inf, huge and misshapen arguments")
+    try:
+        out = subprocess.run([sys.executable, "-c", PY_CASES, str(seed), str(cases)], capture_output=True,
+                             timeout=TIME_LIMIT_S * 10, text=True)
+    except subprocess.TimeoutExpired:
+        r.fail("all", "no answer in time")
+        return r
+    if out.returncode not in (0, 1):
+        r.fail("all", f"the interpreter died (exit {out.returncode}): {out.stderr[-400:]}")
+        return r
+    last = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else ""
+    try:
+        passed, failed = (int(last.split()[0]), int(last.split()[2]))
+    except (IndexError, ValueError):
+        r.fail("all", f"unreadable result: {out.stdout[-300:]} {out.stderr[-300:]}")
+        return r
+    r.passed = passed
+    for line in out.stdout.strip().splitlines()[:-1]:
+        r.fail("case", line)
+    if failed and not r.failures:
+        r.fail("all", f"{failed} failures")
+    return r
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", type=int, default=400, help="cases in all (CLI classes share 4/5)")
+    ap.add_argument("--seed", type=int, default=1)
+    a = ap.parse_args()
+    rng = random.Random(a.seed)
+    runs = cli_cases(rng, a.cases * 4 // 5)
+    runs.append(python_cases(a.seed, max(1, a.cases // 5)))
+    total_pass = sum(r.passed for r in runs)
+    total_fail = sum(len(r.failures) for r in runs)
+    for r in runs:
+        print(f"{r.name}: {r.passed} passed, {len(r.failures)} failed")
+        for f in r.failures[:20]:
+            print("   ", f)
+    print(f"{total_pass} passed, {total_fail} failed")
+    return 1 if total_fail else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
