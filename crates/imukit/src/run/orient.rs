@@ -522,8 +522,8 @@ pub struct Estimates {
 /// an error the filter is left as it was before the call.
 ///
 /// # Errors
-/// Slices of different lengths, values that are not finite (named by sensor and row), and the
-/// filter's refusals naming the row index.
+/// Slices of different lengths, the filter's refusals naming the row index (non-finite
+/// readings among them), and estimates that are not finite.
 pub fn run_rows<N: NavFrame>(
     filter: &mut AnyFilter<N>,
     accel: &[f64],
@@ -536,14 +536,6 @@ pub fn run_rows<N: NavFrame>(
             return Err(invalid(
                 name,
                 format!("has {} rows, the accelerometer {n}", s.len() / 3),
-            ));
-        }
-    }
-    for (name, s) in [("accel", Some(accel)), ("gyro", gyro), ("mag", mag)] {
-        if let Some(i) = s.and_then(|s| s.iter().position(|v| !v.is_finite())) {
-            return Err(invalid(
-                format!("{name}[{}]", i / 3),
-                "is not a finite number",
             ));
         }
     }
