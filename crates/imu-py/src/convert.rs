@@ -228,3 +228,14 @@ pub(crate) fn sensor_table(
 pub(crate) fn nav_frame(field: &str, name: &str) -> PyResult<imukit::scenario::NavFrameName> {
     imukit::scenario::parse_name(field, &name.to_ascii_uppercase()).map_err(crate::errors::refused)
 }
+
+/// A count or seed given as a Python int: refused by name when negative (instead of Python's
+/// bare `OverflowError` from the conversion).
+pub(crate) fn non_negative(name: &str, v: i64) -> PyResult<u64> {
+    u64::try_from(v).map_err(|_| {
+        crate::errors::refused(imukit::Error::Invalid {
+            field: name.into(),
+            message: format!("must be ≥ 0, got {v}"),
+        })
+    })
+}

@@ -11,7 +11,7 @@ use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{TableOut, check_len, table_in, table_out};
+use crate::convert::{TableOut, check_len, non_negative, table_in, table_out};
 use crate::errors::refused;
 
 /// Planar dead reckoning of (t, a_x, a_y, ω_z) into a navigation table.
@@ -76,7 +76,7 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
                     velocity0_m_s = None, quaternion0 = None, euler0_rad = None, nav_frame = "ENU",
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
                     accel_sign = "specific-force", scheme = "auto",
-                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS))]
+                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
     py: Python<'py>,
@@ -94,8 +94,9 @@ fn strapdown<'py>(
     sculling: bool,
     accel_sign: &str,
     scheme: &str,
-    substeps: usize,
+    substeps: i64,
 ) -> PyResult<TableOut<'py>> {
+    let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
     let setup = NavRequest {
         nav_frame,
         accel_sign,

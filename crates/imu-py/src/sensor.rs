@@ -16,7 +16,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{check_len, flat_rows, matrices_in, sensor_table, vector};
+use crate::convert::{check_len, flat_rows, matrices_in, non_negative, sensor_table, vector};
 use crate::errors::{refused, shape_error};
 
 /// MATLAB-shaped IMU simulator (see the Python class `imukit.ImuSensor`).
@@ -40,7 +40,7 @@ impl PyImuSensor {
         gyroscope: Option<&Bound<'_, PyAny>>,
         magnetometer: Option<&Bound<'_, PyAny>>,
         preset: Option<String>,
-        seed: u64,
+        seed: i64,
         profile: &str,
         accel_sign: Option<&str>,
     ) -> PyResult<Self> {
@@ -54,7 +54,7 @@ impl PyImuSensor {
             accel_sign,
             params: ImuSpec {
                 preset,
-                seed: Some(seed),
+                seed: Some(non_negative("seed", seed)?),
                 accelerometer: sensor_table("accelerometer", accelerometer)?,
                 gyroscope: sensor_table("gyroscope", gyroscope)?,
                 magnetometer: sensor_table("magnetometer", magnetometer)?,

@@ -18,7 +18,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::convert::{
-    TableOut, check_len, nav_frame, rows, rows_out, table_in, table_out, value_tree, vector,
+    TableOut, check_len, nav_frame, non_negative, rows, rows_out, table_in, table_out, value_tree,
+    vector,
 };
 use crate::errors::{refused, shape_error};
 
@@ -30,8 +31,9 @@ fn run_spec<'py>(
     py: Python<'py>,
     spec: ScenarioSpec,
     base_dir: &str,
-    run: Option<u64>,
+    run: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
+    let run = run.map(|r| non_negative("run", r)).transpose()?;
     let base = base_dir.to_string();
     let sim = py
         .detach(move || {
@@ -54,7 +56,7 @@ fn simulate_text<'py>(
     format: &str,
     origin: &str,
     base_dir: &str,
-    run: Option<u64>,
+    run: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
     let spec = match format {
         "toml" => ScenarioSpec::from_toml(text, origin),
@@ -78,7 +80,7 @@ fn simulate_dict<'py>(
     scenario: &Bound<'py, PyAny>,
     origin: &str,
     base_dir: &str,
-    run: Option<u64>,
+    run: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
     let tree = value_tree(scenario, "scenario")?;
     let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
@@ -166,10 +168,11 @@ fn truth_from_samples<'py>(
     euler_rad: Option<PyReadonlyArray2<'py, f64>>,
     quaternion: Option<PyReadonlyArray2<'py, f64>>,
     attitude: Option<&str>,
-    order: usize,
+    order: i64,
     nav_frame: &str,
     min_speed_m_s: Option<f64>,
 ) -> PyResult<TableOut<'py>> {
+    let order = usize::try_from(non_negative("order", order)?).unwrap_or(usize::MAX);
     let t = vector(&t_s);
     let pos = rows::<3>("position_m", &position_m)?;
     check_len("position_m", pos.len(), t.len())?;

@@ -160,3 +160,15 @@ def test_a_run_too_long_for_memory_raises_before_allocating():
     with pytest.raises(ImuError, match="IMUKIT_MAX_MEMORY_GB") as e:
         imukit.simulate({"rate_hz": 1e8, "duration_s": 9.99, "trajectory": {"type": "builtin", "name": "static"}})
     assert e.value.field == "duration_s"
+
+
+def test_negative_counts_and_seeds_are_refused_by_name():
+    for call, field in [
+        (lambda: imukit.simulate({"trajectory": {"type": "builtin", "name": "static"}}, run=-1), "run"),
+        (lambda: imukit.ImuSensor(seed=-1), "seed"),
+        (lambda: imukit.truth_from_samples(np.arange(10.0), np.zeros((10, 3)), order=-1), "order"),
+        (lambda: imukit.ImuSensor(temperature=-300.0), "temperature"),
+    ]:
+        with pytest.raises(ImuError) as e:
+            call()
+        assert e.value.field == field

@@ -301,3 +301,34 @@ fn a_result_that_is_not_finite_is_never_written() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn typos_and_impossible_values_in_a_scenario_are_refused() {
+    let resolve = |text: &str| {
+        ScenarioSpec::from_toml(text, "s.toml").and_then(|s| s.resolve(Path::new(".")))
+    };
+    // A misspelt key beside a built-in's name is refused, as in every other table.
+    let e =
+        resolve("[trajectory]\ntype = \"builtin\"\nname = \"static\"\nnmae = \"x\"\n").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("unknown field `nmae`, expected `name`"),
+        "{e}"
+    );
+    let tangent = "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\n\
+                   position_m = [\"t\", \"0\", \"0\"]\nattitude = \"tangent\"\n";
+    for speed in ["-1", "nan"] {
+        let e = resolve(&format!("{tangent}min_speed_m_s = {speed}\n")).unwrap_err();
+        assert_eq!(
+            e.location().field.as_deref(),
+            Some("trajectory.min_speed_m_s"),
+            "{e}"
+        );
+    }
+    let e = resolve(&format!("{tangent}[imu]\ntemperature_c = -300\n")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "imu.temperature_c: must be a finite temperature ≥ -273.15 °C, got -300"
+    );
+    assert!(resolve(&format!("{tangent}[imu]\ntemperature_c = -273.15\n")).is_ok());
+}

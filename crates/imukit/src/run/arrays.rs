@@ -36,9 +36,8 @@ pub fn truth_from_expressions(
     spec: &ExpressionSpec,
     nav: NavFrameName,
 ) -> Result<Table> {
-    let min_speed_m_s = spec
-        .min_speed_m_s
-        .unwrap_or(imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S);
+    let min_speed_m_s =
+        crate::scenario::resolve::check_min_speed("min_speed_m_s", spec.min_speed_m_s)?;
     let traj = Trajectory::Expression(spec.motion()?, AnalyticOptions { min_speed_m_s });
     in_frame(
         nav,

@@ -143,13 +143,11 @@ pub struct ImuSensor {
     temperature: Temperatures,
 }
 
-/// The finite temperature, or a refusal naming `temperature`.
+/// The temperature of all sensors, or a refusal naming `temperature`.
 fn temperature(c: f64) -> Result<Temperatures> {
-    if c.is_finite() {
-        Ok(Temperatures::uniform(c))
-    } else {
-        Err(invalid("temperature", "must be finite"))
-    }
+    Ok(Temperatures::uniform(
+        crate::scenario::resolve::check_temperature("temperature", c)?,
+    ))
 }
 
 impl ImuSensor {

@@ -27,8 +27,8 @@ pub mod times;
 
 pub use imu::{ImuSetup, ReadingStream};
 pub use spec::{
-    AccelSignName, BodyRatesSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName, SamplesSpec,
-    ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
+    AccelSignName, BodyRatesSpec, BuiltinSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName,
+    SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
 };
 pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
 

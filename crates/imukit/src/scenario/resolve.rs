@@ -108,7 +108,7 @@ impl ScenarioSpec {
     /// Any invalid key, formula or file, named.
     pub fn resolve(&self, base_dir: &Path) -> Result<Scenario> {
         let merged;
-        let spec = if let TrajectorySpec::Builtin { name } = &self.trajectory {
+        let spec = if let TrajectorySpec::Builtin(BuiltinSpec { name }) = &self.trajectory {
             let b = builtin::spec(name)?;
             merged = ScenarioSpec {
                 rate_hz: self.rate_hz.or(b.rate_hz),
@@ -146,7 +146,7 @@ impl ScenarioSpec {
         };
         let (trajectory, t_s) = match &spec.trajectory {
             TrajectorySpec::Expression(e) => {
-                let min_speed_m_s = e.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let min_speed_m_s = check_min_speed("trajectory.min_speed_m_s", e.min_speed_m_s)?;
                 let t = regular_times(
                     need(spec.rate_hz, "rate_hz")?,
                     need(spec.duration_s, "duration_s")?,
@@ -186,7 +186,7 @@ impl ScenarioSpec {
                 let order = s
                     .order
                     .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
-                let min_speed = s.min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+                let min_speed = check_min_speed("trajectory.min_speed_m_s", s.min_speed_m_s)?;
                 let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
                 path.check()?;
                 let t = SampleTimes::Listed(path.t_s.clone());
@@ -207,7 +207,7 @@ impl ScenarioSpec {
                 let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
                 (Trajectory::BodyRates(data), SampleTimes::Listed(t))
             }
-            TrajectorySpec::Builtin { .. } => unreachable!("built-ins resolve to another type"),
+            TrajectorySpec::Builtin(_) => unreachable!("built-ins resolve to another type"),
         };
         let sample_rate_hz = match spec.rate_hz {
             Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
@@ -315,6 +315,41 @@ fn body_rates(
     }
     data.alpha_body_rad_s2 = Some(alpha);
     Ok((t, data))
+}
+
+/// The coldest temperature there is, °C.
+pub const ABSOLUTE_ZERO_C: f64 = -273.15;
+
+/// The one rule for a sensor temperature, °C: finite and not below absolute zero.
+///
+/// # Errors
+/// [`Error::Invalid`] naming `field`.
+pub fn check_temperature(field: &str, c: f64) -> Result<f64> {
+    if c.is_finite() && c >= ABSOLUTE_ZERO_C {
+        Ok(c)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a finite temperature ≥ {ABSOLUTE_ZERO_C} °C, got {c}"),
+        ))
+    }
+}
+
+/// The one rule for the standstill speed of the tangent attitude, m/s: finite and ≥ 0
+/// (`None`: the default).
+///
+/// # Errors
+/// [`Error::Invalid`] naming `field`.
+pub fn check_min_speed(field: &str, v: Option<f64>) -> Result<f64> {
+    let v = v.unwrap_or(DEFAULT_MIN_SPEED_M_S);
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a finite speed ≥ 0, got {v}"),
+        ))
+    }
 }
 
 /// The one rule for a gravity magnitude, m/s²: finite and ≥ 0 (0 simulates free fall).

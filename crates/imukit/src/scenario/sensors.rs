@@ -26,6 +26,7 @@ use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor, read_param_fil
 use crate::io::presets;
 use crate::io::table::read_columns;
 use crate::scenario::perturb::Perturbation;
+use crate::scenario::resolve::check_temperature;
 use crate::scenario::spec::ImuSpec;
 
 /// `temperature_c`: a constant, or a CSV file of a temperature profile.
@@ -215,12 +216,8 @@ impl SensorSetup {
         }
         let temperature = match &keys.temperature_c {
             None => Temperature::default(),
-            Some(TemperatureSpec::Constant(c)) if c.is_finite() => Temperature::Constant(*c),
             Some(TemperatureSpec::Constant(c)) => {
-                return Err(invalid(
-                    "imu.temperature_c",
-                    format!("must be finite, got {c}"),
-                ));
+                Temperature::Constant(check_temperature("imu.temperature_c", *c)?)
             }
             Some(TemperatureSpec::File(p)) => Temperature::from_csv(&base_dir.join(p))?,
         };

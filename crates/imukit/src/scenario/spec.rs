@@ -113,10 +113,15 @@ pub enum TrajectorySpec {
     /// Positions at times through a cubic spline (MATLAB's waypointTrajectory).
     Waypoints(WaypointsSpec),
     /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
-    Builtin {
-        /// Name, see [`NAMES`](crate::scenario::builtin::NAMES).
-        name: String,
-    },
+    Builtin(BuiltinSpec),
+}
+
+/// `type = "builtin"`: only the name (a misspelt key beside it is refused like everywhere else).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuiltinSpec {
+    /// Name, see [`NAMES`](crate::scenario::builtin::NAMES).
+    pub name: String,
 }
 
 /// `type = "expression"`.
