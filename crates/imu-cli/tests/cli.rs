@@ -740,3 +740,28 @@ fn samples_whose_times_go_back_are_named_by_row_not_by_a_sample_rate() {
     );
     assert!(!err.contains("sample_rate_hz"), "{err}");
 }
+
+#[test]
+fn a_filter_that_may_use_a_magnetometer_names_a_missing_mag_column() {
+    let dir = temp_dir("orient-mag");
+    let header = "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,mag_x_ut,mag_y_ut";
+    let mut text = format!("{header}\n");
+    for k in 0..10 {
+        text += &format!("{},0,0,9.81,0,0,0,27,0\n", f64::from(k) * 0.01);
+    }
+    std::fs::write(dir.join("imu.csv"), text).unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "orient",
+            "imu.csv",
+            "--filter",
+            "complementary",
+            "--out",
+            "o.csv",
+        ],
+    );
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("missing column(s) mag_z_ut"), "{err}");
+    assert!(!dir.join("o.csv").exists());
+}

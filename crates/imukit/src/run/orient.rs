@@ -449,7 +449,25 @@ fn orient_csv_in<N: NavFrame>(
     let header = crate::io::table::read_header(input)?;
     let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
     let mut spec = spec.clone();
-    spec.magnetometer = spec.kind.magnetometer().unwrap_or(has(&MAG_COLUMNS));
+    // A filter that may use a magnetometer uses one when the file has it; a file with only some
+    // of the mag_* columns is a mistake to name, not a reason to drop the magnetometer silently.
+    let some_mag = MAG_COLUMNS.iter().any(|c| header.iter().any(|h| h == c));
+    spec.magnetometer = spec.kind.magnetometer().unwrap_or(some_mag);
+    if spec.magnetometer && !has(&MAG_COLUMNS) {
+        let missing = MAG_COLUMNS
+            .iter()
+            .filter(|c| !header.iter().any(|h| h == *c))
+            .map(|c| (*c).to_string())
+            .collect();
+        return Err(crate::Error::MissingColumns {
+            file: input.into(),
+            missing,
+            hint: format!(
+                "; the {} filter uses all three magnetometer columns when the file has any",
+                spec.kind.name()
+            ),
+        });
+    }
     let gyro = spec.kind != FilterKind::Ecompass;
     let mut columns = vec!["t_s"];
     columns.extend(ACCEL_COLUMNS);
