@@ -201,11 +201,12 @@ impl Motion for Track {
     fn position<D: Scalar>(&self, t: D) -> [D; 3] {
         let s = self.distance(t);
         let sr = s.re();
+        // The last segment starting at or before s (starts increase): a binary search, so a
+        // track of many segments costs log(segments) per sample, not segments.
         let k = self
             .starts
-            .iter()
-            .rposition(|(s0, _, _)| *s0 <= sr)
-            .unwrap_or(0);
+            .partition_point(|(s0, _, _)| *s0 <= sr)
+            .saturating_sub(1);
         let (s0, p0, h0) = self.starts[k];
         let u = s - s0;
         let z = D::from(self.start[2]);
