@@ -22,6 +22,20 @@ pub enum TableKind {
     Orientation,
 }
 
+/// Column names for a message: all of them, or the first 20 and how many there are.
+fn shown(columns: &[String]) -> String {
+    const SHOWN: usize = 20;
+    if columns.len() <= SHOWN {
+        columns.join(", ")
+    } else {
+        format!(
+            "{}, … {} in all",
+            columns[..SHOWN].join(", "),
+            columns.len()
+        )
+    }
+}
+
 impl TableKind {
     /// Recognises a table by its columns; `None` when it is none of imukit's kinds.
     #[must_use]
@@ -59,7 +73,7 @@ impl TableKind {
                 format!(
                     "unknown kind of CSV (columns: {}); imukit plots truth, IMU readings, navigation \
                      output, orientation output, Allan deviation and error tables",
-                    columns.join(", ")
+                    shown(columns)
                 ),
             )
         })

@@ -543,9 +543,15 @@ impl CsvRows {
     /// Missing columns (all named at once, with `hint`), unreadable or empty files.
     pub fn open(path: &Path, required: &[&str], hint: &str) -> Result<Self> {
         let names = read_header(path)?;
+        // Looked up by name, so a file of many columns costs linear time, not quadratic.
+        let index: HashMap<&str, usize> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.as_str(), i))
+            .collect();
         let missing: Vec<String> = required
             .iter()
-            .filter(|c| !names.iter().any(|n| n == **c))
+            .filter(|c| !index.contains_key(**c))
             .map(|c| (*c).to_string())
             .collect();
         if !missing.is_empty() {
@@ -557,12 +563,7 @@ impl CsvRows {
         }
         let wanted = required
             .iter()
-            .map(|c| {
-                (
-                    names.iter().position(|n| n == *c).unwrap_or(0),
-                    (*c).to_string(),
-                )
-            })
+            .map(|c| (index.get(*c).copied().unwrap_or(0), (*c).to_string()))
             .collect();
         Ok(Self {
             path: path.into(),
