@@ -239,3 +239,17 @@ pub(crate) fn non_negative(name: &str, v: i64) -> PyResult<u64> {
         })
     })
 }
+
+/// `N` numbers given as a Python sequence, named in the error when there are not `N`.
+pub(crate) fn fixed<const N: usize>(name: &str, v: &[f64]) -> PyResult<[f64; N]> {
+    <[f64; N]>::try_from(v)
+        .map_err(|_| shape_error(format!("{name} must have {N} numbers, got {}", v.len())))
+}
+
+/// [`fixed`] for an optional argument.
+pub(crate) fn fixed_opt<const N: usize>(
+    name: &str,
+    v: Option<Vec<f64>>,
+) -> PyResult<Option<[f64; N]>> {
+    v.map(|v| fixed::<N>(name, &v)).transpose()
+}

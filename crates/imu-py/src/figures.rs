@@ -6,7 +6,7 @@ use imu_plot::spec::{self, TableKind};
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::convert::{check_len, nav_frame, rows, rows_out};
+use crate::convert::{check_len, fixed, nav_frame, rows, rows_out};
 use crate::errors::{refused, refused_figure, shape_error};
 use imukit::scenario::NavFrameName;
 
@@ -74,7 +74,8 @@ type PosesOut<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 /// The animated body box of size `body_m`: corners (8, 3) in the body frame, edges as corner
 /// index pairs, the nose face's corners in drawing order.
 #[pyfunction]
-fn animation_scene<'py>(py: Python<'py>, body_m: [f64; 3]) -> PyResult<SceneOut<'py>> {
+fn animation_scene<'py>(py: Python<'py>, body_m: Vec<f64>) -> PyResult<SceneOut<'py>> {
+    let body_m = fixed::<3>("body_m", &body_m)?;
     Ok((
         rows_out(py, box_corners_m(body_m).to_vec())?,
         BOX_EDGES.to_vec(),

@@ -11,13 +11,13 @@ use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{TableOut, check_len, non_negative, table_in, table_out};
+use crate::convert::{TableOut, check_len, fixed, fixed_opt, non_negative, table_in, table_out};
 use crate::errors::refused;
 
 /// Planar dead reckoning of (t, a_x, a_y, ω_z) into a navigation table.
 #[pyfunction]
 #[pyo3(signature = (t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s, *, scheme = "trapezoid",
-                    position0_m = EXERCISE_POSITION0_M, heading0_rad = 0.0, velocity0_m_s = [0.0, 0.0]))]
+                    position0_m = EXERCISE_POSITION0_M.to_vec(), heading0_rad = 0.0, velocity0_m_s = vec![0.0, 0.0]))]
 #[allow(clippy::too_many_arguments)]
 fn planar_dead_reckon<'py>(
     py: Python<'py>,
@@ -26,10 +26,12 @@ fn planar_dead_reckon<'py>(
     accel_y_m_s2: PyReadonlyArray1<'py, f64>,
     gyro_z_rad_s: PyReadonlyArray1<'py, f64>,
     scheme: &str,
-    position0_m: [f64; 2],
+    position0_m: Vec<f64>,
     heading0_rad: f64,
-    velocity0_m_s: [f64; 2],
+    velocity0_m_s: Vec<f64>,
 ) -> PyResult<TableOut<'py>> {
+    let position0_m = fixed::<2>("position0_m", &position0_m)?;
+    let velocity0_m_s = fixed::<2>("velocity0_m_s", &velocity0_m_s)?;
     let t = t_s.as_array();
     let (ax, ay, wz) = (
         accel_x_m_s2.as_array(),
@@ -84,10 +86,10 @@ fn strapdown<'py>(
     values: PyReadonlyArray2<'py, f64>,
     initial_columns: Option<Vec<String>>,
     initial_values: Option<PyReadonlyArray2<'py, f64>>,
-    position0_m: Option<[f64; 3]>,
-    velocity0_m_s: Option<[f64; 3]>,
-    quaternion0: Option<[f64; 4]>,
-    euler0_rad: Option<[f64; 3]>,
+    position0_m: Option<Vec<f64>>,
+    velocity0_m_s: Option<Vec<f64>>,
+    quaternion0: Option<Vec<f64>>,
+    euler0_rad: Option<Vec<f64>>,
     nav_frame: &str,
     gravity_m_s2: f64,
     coning: bool,
@@ -111,7 +113,12 @@ fn strapdown<'py>(
     let imu = table_in("imu", columns, &values)?;
     let initial = match (initial_columns, &initial_values) {
         (Some(c), Some(v)) => InitialState::from_table(&table_in("initial", c, v)?),
-        _ => InitialState::from_parts(position0_m, velocity0_m_s, quaternion0, euler0_rad),
+        _ => InitialState::from_parts(
+            fixed_opt::<3>("position0_m", position0_m)?,
+            fixed_opt::<3>("velocity0_m_s", velocity0_m_s)?,
+            fixed_opt::<4>("quaternion0", quaternion0)?,
+            fixed_opt::<3>("euler0_rad", euler0_rad)?,
+        ),
     }
     .map_err(refused)?;
     let out = py

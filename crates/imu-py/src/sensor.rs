@@ -16,7 +16,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{check_len, flat_rows, matrices_in, non_negative, sensor_table, vector};
+use crate::convert::{
+    check_len, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table, vector,
+};
 use crate::errors::{refused, shape_error};
 
 /// MATLAB-shaped IMU simulator (see the Python class `imukit.ImuSensor`).
@@ -35,7 +37,7 @@ impl PyImuSensor {
         reference_frame: &str,
         sample_rate: f64,
         temperature: f64,
-        magnetic_field: Option<[f64; 3]>,
+        magnetic_field: Option<Vec<f64>>,
         accelerometer: Option<&Bound<'_, PyAny>>,
         gyroscope: Option<&Bound<'_, PyAny>>,
         magnetometer: Option<&Bound<'_, PyAny>>,
@@ -49,7 +51,7 @@ impl PyImuSensor {
             reference_frame,
             sample_rate_hz: sample_rate,
             temperature_c: temperature,
-            magnetic_field_ut: magnetic_field,
+            magnetic_field_ut: fixed_opt::<3>("magnetic_field", magnetic_field)?,
             profile,
             accel_sign,
             params: ImuSpec {

@@ -18,8 +18,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::convert::{
-    TableOut, check_len, nav_frame, non_negative, rows, rows_out, table_in, table_out, value_tree,
-    vector,
+    TableOut, check_len, fixed, fixed_opt, nav_frame, non_negative, rows, rows_out, table_in,
+    table_out, value_tree, vector,
 };
 use crate::errors::{refused, shape_error};
 
@@ -197,7 +197,7 @@ fn truth_from_samples<'py>(
 
 /// Ideal IMU readings from a truth table (its column names and values).
 #[pyfunction]
-#[pyo3(signature = (columns, values, *, lever_arm_m = [0.0, 0.0, 0.0], accel_sign = "specific-force",
+#[pyo3(signature = (columns, values, *, lever_arm_m = vec![0.0, 0.0, 0.0], accel_sign = "specific-force",
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, magnetic_field_ut = None,
                     nav_frame = "ENU", kind = "accel-gyro-mag"))]
 #[allow(clippy::too_many_arguments)]
@@ -205,20 +205,20 @@ fn ideal_imu<'py>(
     py: Python<'py>,
     columns: Vec<String>,
     values: PyReadonlyArray2<'py, f64>,
-    lever_arm_m: [f64; 3],
+    lever_arm_m: Vec<f64>,
     accel_sign: &str,
     gravity_m_s2: f64,
-    magnetic_field_ut: Option<[f64; 3]>,
+    magnetic_field_ut: Option<Vec<f64>>,
     nav_frame: &str,
     kind: &str,
 ) -> PyResult<TableOut<'py>> {
     let truth = table_in("truth", columns, &values)?;
     let request = IdealRequest {
         kind,
-        lever_arm_m,
+        lever_arm_m: fixed::<3>("lever_arm_m", &lever_arm_m)?,
         accel_sign,
         gravity_m_s2,
-        magnetic_field_ut,
+        magnetic_field_ut: fixed_opt::<3>("magnetic_field_ut", magnetic_field_ut)?,
         nav_frame,
     };
     let out = py.detach(|| request.run(&truth)).map_err(refused)?;
@@ -263,8 +263,9 @@ fn at_lever_arm<'py>(
     a: PyReadonlyArray2<'py, f64>,
     omega: PyReadonlyArray2<'py, f64>,
     alpha: PyReadonlyArray2<'py, f64>,
-    r: [f64; 3],
+    r: Vec<f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = fixed::<3>("r", &r)?;
     let (a, w, al) = (
         rows::<3>("a", &a)?,
         rows::<3>("omega", &omega)?,
@@ -280,19 +281,22 @@ fn at_lever_arm<'py>(
 
 /// Truth from body-frame acceleration and angular velocity (MATLAB kinematicTrajectory).
 #[pyfunction]
-#[pyo3(signature = (t_s, accel_body_m_s2, omega_body_rad_s, *, position0_m = [0.0; 3],
-                    velocity0_m_s = [0.0; 3], euler0_rad = [0.0; 3], nav_frame = "ENU"))]
+#[pyo3(signature = (t_s, accel_body_m_s2, omega_body_rad_s, *, position0_m = vec![0.0; 3],
+                    velocity0_m_s = vec![0.0; 3], euler0_rad = vec![0.0; 3], nav_frame = "ENU"))]
 #[allow(clippy::too_many_arguments)]
 fn truth_from_body_rates<'py>(
     py: Python<'py>,
     t_s: PyReadonlyArray1<'py, f64>,
     accel_body_m_s2: PyReadonlyArray2<'py, f64>,
     omega_body_rad_s: PyReadonlyArray2<'py, f64>,
-    position0_m: [f64; 3],
-    velocity0_m_s: [f64; 3],
-    euler0_rad: [f64; 3],
+    position0_m: Vec<f64>,
+    velocity0_m_s: Vec<f64>,
+    euler0_rad: Vec<f64>,
     nav_frame: &str,
 ) -> PyResult<TableOut<'py>> {
+    let position0_m = fixed::<3>("position0_m", &position0_m)?;
+    let velocity0_m_s = fixed::<3>("velocity0_m_s", &velocity0_m_s)?;
+    let euler0_rad = fixed::<3>("euler0_rad", &euler0_rad)?;
     let t = vector(&t_s);
     let a = rows::<3>("accel_body_m_s2", &accel_body_m_s2)?;
     let w = rows::<3>("omega_body_rad_s", &omega_body_rad_s)?;

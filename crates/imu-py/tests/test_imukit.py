@@ -172,3 +172,13 @@ def test_negative_counts_and_seeds_are_refused_by_name():
         with pytest.raises(ImuError) as e:
             call()
         assert e.value.field == field
+
+
+def test_wrong_lengths_and_empty_inputs_name_the_argument():
+    sim = imukit.simulate({"rate_hz": 10.0, "duration_s": 1.0, "trajectory": {"type": "builtin", "name": "static"}})
+    with pytest.raises(ValueError, match="lever_arm_m must have 3 numbers, got 2"):
+        imukit.ideal_imu(sim.truth, lever_arm_m=[1.0, 2.0])
+    with pytest.raises(ValueError, match="position0_m must have 2 numbers, got 3"):
+        imukit.planar_dead_reckon(np.arange(3.0), np.zeros(3), np.zeros(3), np.zeros(3), position0_m=[0, 0, 0])
+    with pytest.raises(ImuError, match="need at least 3 samples, got 0"):
+        imukit.allan_deviation(np.zeros(0), 100.0)

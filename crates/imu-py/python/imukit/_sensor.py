@@ -176,7 +176,7 @@ def allan_deviation(x, sample_rate_hz: float):
     a = np.ascontiguousarray(x, dtype=np.float64)
     if a.ndim not in (1, 2):
         raise ValueError(f"x must be (N,) or (N, k), got shape {a.shape}")
-    tau, adev = _core.allan_deviation(a.reshape(a.shape[0], -1), float(sample_rate_hz))
+    tau, adev = _core.allan_deviation(a[:, None] if a.ndim == 1 else a, float(sample_rate_hz))
     return tau, (adev[:, 0] if a.ndim == 1 else adev)
 
 def identify_noise(tau_s, adev) -> dict:
