@@ -332,3 +332,25 @@ fn typos_and_impossible_values_in_a_scenario_are_refused() {
     );
     assert!(resolve(&format!("{tangent}[imu]\ntemperature_c = -273.15\n")).is_ok());
 }
+
+#[test]
+fn an_error_inside_the_trajectory_table_names_the_key() {
+    let e = ScenarioSpec::from_toml(
+        "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\nposition_m = [\"t\", \"0\"]\n",
+        "two.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("invalid length 2, expected an array of length 3")
+            && e.contains("in `position_m`"),
+        "{e}"
+    );
+    let e = ScenarioSpec::from_toml("[trajectory]\ntype = \"expresion\"\n", "typo.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unknown variant `expresion`, expected one of `expression`"),
+        "{e}"
+    );
+}

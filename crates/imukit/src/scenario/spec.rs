@@ -98,7 +98,7 @@ pub struct ScenarioSpec {
 }
 
 /// The `[trajectory]` table.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "kebab-case")]
 pub enum TrajectorySpec {
     /// Formula strings of `t`, exact derivatives.
@@ -114,6 +114,53 @@ pub enum TrajectorySpec {
     Waypoints(WaypointsSpec),
     /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
     Builtin(BuiltinSpec),
+}
+
+/// The trajectory types by their `type` name.
+const TRAJECTORY_TYPES: [&str; 6] = [
+    "expression",
+    "samples",
+    "track",
+    "body-rates",
+    "waypoints",
+    "builtin",
+];
+
+impl<'de> Deserialize<'de> for TrajectorySpec {
+    /// Reads `type` first, then the keys of that type, so that an error names the key inside the
+    /// table (`position_m: invalid length 2, expected an array of length 3`) rather than only the
+    /// table (what serde's internally tagged enums do: they buffer the table and lose the path).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let value = toml::Value::deserialize(d)?;
+        let toml::Value::Table(mut table) = value else {
+            return Err(D::Error::custom("expected a table with a type key"));
+        };
+        let kind = match table.remove("type") {
+            Some(toml::Value::String(s)) => s,
+            Some(other) => {
+                return Err(D::Error::custom(format!(
+                    "type: expected a string, got {other}"
+                )));
+            }
+            None => return Err(D::Error::missing_field("type")),
+        };
+        fn keys<T: serde::de::DeserializeOwned, E: serde::de::Error>(
+            table: toml::Table,
+        ) -> std::result::Result<T, E> {
+            // Deserialized from the table itself, toml names the key of an error.
+            T::deserialize(toml::Value::Table(table)).map_err(E::custom)
+        }
+        Ok(match kind.as_str() {
+            "expression" => Self::Expression(keys(table)?),
+            "samples" => Self::Samples(keys(table)?),
+            "track" => Self::Track(keys(table)?),
+            "body-rates" => Self::BodyRates(keys(table)?),
+            "waypoints" => Self::Waypoints(keys(table)?),
+            "builtin" => Self::Builtin(keys(table)?),
+            other => return Err(D::Error::unknown_variant(other, &TRAJECTORY_TYPES)),
+        })
+    }
 }
 
 /// `type = "builtin"`: only the name (a misspelt key beside it is refused like everywhere else).
