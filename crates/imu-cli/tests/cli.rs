@@ -765,3 +765,29 @@ fn a_filter_that_may_use_a_magnetometer_names_a_missing_mag_column() {
     assert!(err.contains("missing column(s) mag_z_ut"), "{err}");
     assert!(!dir.join("o.csv").exists());
 }
+
+#[test]
+fn a_matlab_parameter_file_with_unknown_keys_is_read_with_warnings() {
+    let dir = temp_dir("matlab-vendor");
+    std::fs::write(
+        dir.join("p.json"),
+        r#"{"Part": {"Vendor": "ACME", "Gyroscope": {"NoiseDensity": 0.001, "Colour": "blue"}}}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n[imu]\nparams = \"p.json\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(&dir, &["simulate", "s.toml", "--out", "o.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("warning: ") && err.contains("Part: Vendor: not a sensor, skipped"),
+        "{err}"
+    );
+    assert!(
+        err.contains("Gyroscope.Colour: unknown property, skipped"),
+        "{err}"
+    );
+    assert!(dir.join("o.csv").exists());
+}

@@ -222,13 +222,13 @@ fn preset_toml(name: &str) -> PyResult<&'static str> {
     presets::text(name).map_err(refused)
 }
 
-/// A parameter file (imukit TOML/JSON or MATLAB loadparams JSON) as imukit TOML text.
+/// A parameter file (imukit TOML/JSON or MATLAB loadparams JSON) as imukit TOML text, with what
+/// a MATLAB file had that was skipped (as MATLAB skips it).
 #[pyfunction]
 #[pyo3(signature = (path, *, part = None))]
-fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<String> {
-    read_param_file(Path::new(path), part, Profile::Default)
-        .map(|f| to_toml(&f))
-        .map_err(refused)
+fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<(String, Vec<String>)> {
+    let file = read_param_file(Path::new(path), part, Profile::Default).map_err(refused)?;
+    Ok((to_toml(&file), file.warnings))
 }
 
 /// Adds this module's classes and functions.

@@ -279,3 +279,20 @@ def test_a_matlab_parameter_file_means_what_it_means_in_matlab(tmp_path):
     p = imukit.loadparams(path, part="mpu-6050")  # part names match as MATLAB identifiers
     assert p["gyroscope"]["noise_type"] == "double-sided"
     assert p["gyroscope"]["noise_density_rad_s_per_rt_hz"] == 0.001
+
+
+def test_a_matlab_file_with_keys_matlab_skips_is_read_with_warnings(tmp_path):
+    path = tmp_path / "vendor.json"
+    path.write_text(json.dumps({"Part": {"Vendor": "ACME",
+                                         "Gyroscope": {"NoiseDensity": 0.001, "Colour": "blue"}}}))
+    with pytest.warns(UserWarning) as caught:
+        p = imukit.loadparams(path)
+    messages = sorted(str(w.message) for w in caught)
+    assert messages[0].endswith("Part: Gyroscope.Colour: unknown property, skipped (as MATLAB does)")
+    assert messages[1].endswith("Part: Vendor: not a sensor, skipped (as MATLAB does)")
+    assert p["gyroscope"]["noise_density_rad_s_per_rt_hz"] == 0.001
+    # imukit's own files stay strict.
+    own = tmp_path / "own.toml"
+    own.write_text("[gyroscope]\ncolour = 1\n")
+    with pytest.raises(ImuError, match="unknown parameter"):
+        imukit.loadparams(own)

@@ -30,6 +30,9 @@ pub fn run(
     outputs.extend(truth.map(|t| ("--truth", t)));
     check_outputs(&inputs, &outputs)?;
     let sc = spec.resolve(base)?;
+    for w in &sc.imu.sensors.warnings {
+        eprintln!("imukit: warning: {w}");
+    }
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
         sc.stream_to_csv(None, out, truth)?;

@@ -3,6 +3,7 @@ parameter files, datasheet units, Allan deviation."""
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Mapping, Optional, Sequence, Union
 
@@ -211,4 +212,7 @@ def preset_params(name: str) -> dict:
 def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dict:
     """Reads a parameter file — imukit TOML/JSON, or MATLAB ``loadparams`` JSON (``part`` picks one
     of several parts) — into a dict like :func:`preset_params`."""
-    return _toml_to_dict(_core.load_params_toml(str(path), part=part))
+    text, skipped = _core.load_params_toml(str(path), part=part)
+    for what in skipped:  # MATLAB's loadparams skips these too
+        warnings.warn(what, stacklevel=2)
+    return _toml_to_dict(text)

@@ -337,6 +337,19 @@ pub fn parse_sensor(
     default_noise: Option<NoiseType>,
     base: SensorParams,
 ) -> Result<SensorParams> {
+    parse_sensor_keys(map, sensor, prefix, default_noise, base, None)
+}
+
+/// [`parse_sensor`], skipping unknown keys into `skipped` when it is given (MATLAB's
+/// `loadparams` ignores properties it does not know) instead of refusing them.
+fn parse_sensor_keys(
+    map: &SensorTable,
+    sensor: Sensor,
+    prefix: &str,
+    default_noise: Option<NoiseType>,
+    base: SensorParams,
+    mut skipped: Option<&mut Vec<String>>,
+) -> Result<SensorParams> {
     let u = sensor.unit();
     let key = |name: &str| format!("{name}_{u}");
     let mut p = base;
@@ -419,6 +432,12 @@ pub fn parse_sensor(
                 p.acceleration_bias = triple(v, &field)?;
             }
             _ => {
+                if let Some(list) = skipped.as_deref_mut() {
+                    list.push(format!(
+                        "{field}: unknown property, skipped (as MATLAB does)"
+                    ));
+                    continue;
+                }
                 return Err(invalid(
                     field,
                     format!(
@@ -478,6 +497,9 @@ pub struct ParamFile {
     pub present: [bool; 3],
     /// `name`, `grade`, `source` and other descriptive strings from the file.
     pub info: BTreeMap<String, String>,
+    /// What was skipped in a MATLAB file (keys MATLAB's `loadparams` ignores), for the front end
+    /// to show as warnings.
+    pub warnings: Vec<String>,
 }
 
 const INFO_KEYS: [&str; 4] = ["name", "grade", "source", "notes"];
@@ -488,6 +510,17 @@ const INFO_KEYS: [&str; 4] = ["name", "grade", "source", "notes"];
 /// # Errors
 /// As [`parse_sensor`]; unknown top-level keys.
 pub fn parse_param_document(doc: &ParamValue, origin: &str, profile: Profile) -> Result<ParamFile> {
+    parse_document(doc, origin, profile, false)
+}
+
+/// [`parse_param_document`]; `matlab` skips (with a warning) what MATLAB's `loadparams` skips:
+/// keys of a part that are not sensors, and properties it does not know.
+fn parse_document(
+    doc: &ParamValue,
+    origin: &str,
+    profile: Profile,
+    matlab: bool,
+) -> Result<ParamFile> {
     let ParamValue::Table(map) = doc else {
         return Err(invalid(
             origin,
@@ -508,12 +541,14 @@ pub fn parse_param_document(doc: &ParamValue, origin: &str, profile: Profile) ->
                     "expected a table of parameters",
                 ));
             };
-            *out.params.get_mut(s) = parse_sensor(
+            let skipped = matlab.then_some(&mut out.warnings);
+            *out.params.get_mut(s) = parse_sensor_keys(
                 table,
                 s,
                 &format!("{origin}: {k}"),
                 noise,
                 SensorParams::default(),
+                skipped,
             )?;
             out.present[i] = true;
         } else if INFO_KEYS.contains(&k.as_str()) {
@@ -521,6 +556,10 @@ pub fn parse_param_document(doc: &ParamValue, origin: &str, profile: Profile) ->
                 k.clone(),
                 v.as_str().map_or_else(|| v.to_string(), str::to_string),
             );
+        } else if matlab {
+            out.warnings.push(format!(
+                "{origin}: {k}: not a sensor, skipped (as MATLAB does)"
+            ));
         } else {
             return Err(invalid(
                 format!("{origin}: {k}"),
@@ -630,7 +669,12 @@ pub fn parse_any_document(
     };
     // MATLAB's loadparams leaves NoiseType double-sided (its JSON cannot set it): a MATLAB
     // file means what it means in MATLAB, whatever the profile.
-    let mut file = parse_param_document(&map[name], &format!("{origin}: {name}"), Profile::Matlab)?;
+    let mut file = parse_document(
+        &map[name],
+        &format!("{origin}: {name}"),
+        Profile::Matlab,
+        true,
+    )?;
     file.info
         .entry("name".into())
         .or_insert_with(|| name.clone());

@@ -148,6 +148,8 @@ pub struct SensorSetup {
     pub temperature: Temperature,
     /// Monte Carlo perturbations of the parameters.
     pub perturbations: Vec<Perturbation>,
+    /// What a MATLAB parameter file had that was skipped, for the front end to show.
+    pub warnings: Vec<String>,
 }
 
 impl Default for SensorSetup {
@@ -159,6 +161,7 @@ impl Default for SensorSetup {
             seed: 0,
             temperature: Temperature::default(),
             perturbations: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 }
@@ -234,6 +237,7 @@ impl SensorSetup {
                 .enumerate()
                 .map(|(i, p)| Perturbation::from_spec(p, i))
                 .collect::<Result<_>>()?,
+            warnings: file.map(|f| f.warnings).unwrap_or_default(),
         })
     }
 }
