@@ -791,3 +791,72 @@ fn a_matlab_parameter_file_with_unknown_keys_is_read_with_warnings() {
     );
     assert!(dir.join("o.csv").exists());
 }
+
+#[test]
+fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
+    let dir = temp_dir("bad-start");
+    let scenario =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/expression.toml");
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            scenario.to_str().unwrap(),
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "integrate",
+            "imu.csv",
+            "--euler0-rad",
+            "nan",
+            "0",
+            "0",
+            "--out",
+            "n.csv",
+        ],
+    );
+    assert_eq!(code, Some(65));
+    assert!(
+        err.contains("--euler0-rad: must be finite, got [NaN, 0.0, 0.0]"),
+        "{err}"
+    );
+    // A zero quaternion in the --init file's first row.
+    let truth = std::fs::read_to_string(dir.join("truth.csv")).unwrap();
+    let mut lines: Vec<String> = truth.lines().map(str::to_string).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let q: Vec<usize> = ["q_w", "q_x", "q_y", "q_z"]
+        .iter()
+        .map(|c| header.iter().position(|h| h == c).unwrap())
+        .collect();
+    let mut first: Vec<String> = lines[1].split(',').map(str::to_string).collect();
+    for i in q {
+        first[i] = "0".into();
+    }
+    lines[1] = first.join(",");
+    std::fs::write(dir.join("zero_q.csv"), lines.join("\n") + "\n").unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "integrate",
+            "imu.csv",
+            "--init",
+            "zero_q.csv",
+            "--out",
+            "n.csv",
+        ],
+    );
+    assert_eq!(code, Some(65));
+    assert!(
+        err.contains("zero_q.csv, row 2: the initial quaternion has zero norm"),
+        "{err}"
+    );
+    assert!(!err.contains("imu.csv"), "{err}");
+    assert!(!dir.join("n.csv").exists());
+}

@@ -37,7 +37,10 @@ fn vector<const K: usize>(
 ) -> Result<[f64; K], CliError> {
     match v {
         None => Ok(default),
-        Some(v) if v.len() == K => Ok(std::array::from_fn(|i| v[i])),
+        Some(v) if v.len() == K => Ok(imukit::scenario::resolve::finite_vec(
+            flag,
+            std::array::from_fn(|i| v[i]),
+        )?),
         Some(v) => Err(Error::Invalid {
             field: flag.into(),
             message: format!("expected {K} numbers, got {}", v.len()),
@@ -99,6 +102,11 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
             initial.velocity_m_s,
             EulerZyx::from_array(e),
         );
+    }
+    // Checked here, so that a bad start is blamed on where it came from, not on the IMU file.
+    // The start options are checked as they are read; what remains is the --init file's row.
+    if let Some(p) = o.init {
+        initial.check(&format!("{}, row 2", p.display()))?;
     }
     // Streamed: memory does not grow with the input file.
     let summary = integrate_csv(c.input, &initial, &setup, c.out).map_err(|e| match e {

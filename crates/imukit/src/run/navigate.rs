@@ -119,6 +119,30 @@ impl InitialState {
         }
     }
 
+    /// Refuses a state that cannot start an integration: values that are not finite, or a
+    /// quaternion of zero norm; `source` names where the state came from (a file and its row,
+    /// or the options) in the message.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming `source`.
+    pub fn check(&self, source: &str) -> Result<()> {
+        let values = self
+            .position_m
+            .iter()
+            .chain(&self.velocity_m_s)
+            .chain(&self.quaternion);
+        if !values.clone().all(|v| v.is_finite()) {
+            return Err(invalid(
+                source,
+                "the initial position, velocity and attitude must be finite numbers",
+            ));
+        }
+        if self.quaternion.iter().all(|q| *q == 0.0) {
+            return Err(invalid(source, "the initial quaternion has zero norm"));
+        }
+        Ok(())
+    }
+
     /// The first row of a truth (or navigation) table.
     ///
     /// # Errors
