@@ -126,12 +126,12 @@ impl InitialState {
     /// # Errors
     /// [`crate::Error::Invalid`] naming `source`.
     pub fn check(&self, source: &str) -> Result<()> {
-        let values = self
+        let mut values = self
             .position_m
             .iter()
             .chain(&self.velocity_m_s)
             .chain(&self.quaternion);
-        if !values.clone().all(|v| v.is_finite()) {
+        if !values.all(|v| v.is_finite()) {
             return Err(invalid(
                 source,
                 "the initial position, velocity and attitude must be finite numbers",
@@ -169,19 +169,9 @@ impl InitialState {
     /// # Errors
     /// Missing columns, a bad first row (file, row, column), an empty file.
     pub fn from_csv(path: &Path) -> Result<Self> {
-        const COLS: [&str; 10] = [
-            "pos_x_m",
-            "pos_y_m",
-            "pos_z_m",
-            "vel_x_m_s",
-            "vel_y_m_s",
-            "vel_z_m_s",
-            "q_w",
-            "q_x",
-            "q_y",
-            "q_z",
-        ];
-        let mut rows = CsvRows::open(path, &COLS, "the initial state comes from a truth CSV")?;
+        // The state columns after t_s: position, velocity, quaternion.
+        let columns = &STATE_COLUMNS[1..];
+        let mut rows = CsvRows::open(path, columns, "the initial state comes from a truth CSV")?;
         let mut r = [0.0; 10];
         if rows.next_row(&mut r)?.is_none() {
             return Err(crate::Error::CsvFormat {
