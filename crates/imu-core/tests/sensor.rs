@@ -783,3 +783,74 @@ fn the_model_gives_the_bits_of_the_seven_steps_written_plainly() {
         }
     }
 }
+
+/// A noise source that is 1 on the very first draw and 0 afterwards: the model's output on one
+/// axis is then the bias-instability filter's impulse response times `BiasInstability`.
+struct Impulse(bool);
+
+impl NoiseSource for Impulse {
+    fn standard_normal(&mut self) -> f64 {
+        let first = self.0;
+        self.0 = false;
+        if first { 1.0 } else { 0.0 }
+    }
+}
+
+/// MATLAB's `fractalcoef(poles)` (Kasdin 1995, eq. 116): `Num = 1`, `Den = [1, a₁, …, a_p]`
+/// with `a_k = (k − 1 − α/2)·a_{k−1}/k`, a 1/f^α generator.
+fn fractal_denominator(poles: usize, alpha: f64) -> Vec<f64> {
+    let mut den = vec![1.0];
+    for k in 1..=poles {
+        den.push((k as f64 - 1.0 - alpha / 2.0) * den[k - 1] / k as f64);
+    }
+    den
+}
+
+#[test]
+fn a_long_fractal_filter_like_matlabs_allan_example_has_the_closed_form_impulse_response() {
+    // fractalcoef(500): 501 denominator coefficients. Its impulse response equals the
+    // moving-average expansion of (1 − z⁻¹)^{−α/2}, h_k = h_{k−1}·(k − 1 + α/2)/k, exactly
+    // for k ≤ 500 (the truncated AR terms only act beyond the filter's length); later samples
+    // follow the recursion with the 501 coefficients.
+    let den = fractal_denominator(500, 1.0);
+    let coeffs = FilterCoefficients::new(&[1.0], &den).unwrap();
+    let p = SensorParams {
+        bias_instability: [2.0; 3],
+        bias_instability_model: imu_core::sensor::BiasInstabilityModel::Filter(coeffs),
+        ..SensorParams::default()
+    };
+    let model = SensorModel::new(&p, 100.0).unwrap();
+    let mut state = SensorState::default();
+    let mut noise = Impulse(true);
+    let mut h = vec![1.0_f64];
+    for k in 0..1500 {
+        let y = model.measure([0.0; 3], &Environment::default(), &mut state, &mut noise)[0];
+        if k > 0 {
+            let next = if k <= 500 {
+                h[k - 1] * (k as f64 - 0.5) / k as f64
+            } else {
+                -(1..=500).map(|j| den[j] * h[k - j]).sum::<f64>()
+            };
+            h.push(next);
+        }
+        let want = 2.0 * h[k];
+        assert!(
+            (y - want).abs() <= 1e-13 * want.abs().max(1e-3),
+            "sample {k}: {y} vs {want}"
+        );
+    }
+    // 1/f^α: within the filter's length the response decays like k^{α/2 − 1} = k^{−1/2}.
+    let ratio = h[500] / h[125];
+    assert!((ratio - 0.5).abs() < 1e-3, "{ratio}");
+}
+
+#[test]
+fn filters_longer_than_the_bound_are_refused_with_the_bound_named() {
+    let den = fractal_denominator(1024, 1.0);
+    let err = FilterCoefficients::new(&[1.0], &den).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "bias_instability_coefficients: 1 to 1024 numerator and denominator coefficients needed"
+    );
+    assert!(FilterCoefficients::new(&[1.0], &den[..1024]).is_ok());
+}

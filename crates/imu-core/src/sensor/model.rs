@@ -6,9 +6,17 @@ use crate::sensor::{
 
 /// Largest number of first-order sections of the flicker bias-instability model.
 pub const MAX_FLICKER_SECTIONS: usize = 16;
-const FILTER_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
+const FILTER_STATE: usize = if MAX_FILTER_COEFFICIENTS > 2 * MAX_FLICKER_SECTIONS {
+    MAX_FILTER_COEFFICIENTS
+} else {
+    2 * MAX_FLICKER_SECTIONS
+};
 
 /// The bias-instability generator, ready to step.
+#[allow(
+    clippy::large_enum_variant,
+    reason = "the core has no heap: a long filter is stored inline, not boxed"
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum BiasFilter {
     /// MATLAB `filter(b, a, ·)`, coefficients normalised by a₀, transposed direct form II.

@@ -2,8 +2,13 @@
 use crate::sensor::ParamError;
 
 /// Largest number of numerator or denominator coefficients of the bias-instability filter
-/// (filter order up to 7).
-pub const MAX_FILTER_COEFFICIENTS: usize = 8;
+/// (filter order up to 1023). MATLAB takes any length; its own Allan-variance example uses
+/// `fractalcoef(500)` (501 denominator coefficients), well inside this bound. The coefficients
+/// and the filter state live in fixed arrays (the core has no heap), so the bound is a size, not
+/// a cost: each step runs over the filter's own length only.
+pub const MAX_FILTER_COEFFICIENTS: usize = 1024;
+// `FilterCoefficients::new`'s message states the bound.
+const _: () = assert!(MAX_FILTER_COEFFICIENTS == 1024);
 
 /// Power spectral density convention of `noise_density` and `random_walk`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -57,7 +62,7 @@ impl FilterCoefficients {
             || denominator.len() > MAX_FILTER_COEFFICIENTS;
         if numerator.is_empty() || denominator.is_empty() || too_long {
             return Err(ParamError::BadFilter {
-                reason: "1 to 8 numerator and denominator coefficients needed",
+                reason: "1 to 1024 numerator and denominator coefficients needed",
             });
         }
         if let Some(index) = numerator
@@ -100,6 +105,10 @@ impl FilterCoefficients {
 }
 
 /// How the bias-instability drift is generated from `BiasInstability·n`.
+#[allow(
+    clippy::large_enum_variant,
+    reason = "the core has no heap: a long filter is stored inline, not boxed"
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BiasInstabilityModel {
     /// MATLAB's `filter(Num, Den, ·)` (default `Num = [1]`, `Den = [1, −0.5]`). Note that this
