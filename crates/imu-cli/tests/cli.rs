@@ -860,3 +860,33 @@ fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
     assert!(!err.contains("imu.csv"), "{err}");
     assert!(!dir.join("n.csv").exists());
 }
+
+#[test]
+fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
+    let dir = temp_dir("orient-decimation");
+    let header =
+        "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s";
+    let mut text = format!("{header}\n");
+    for k in 0..50 {
+        text += &format!("{},0,0,9.81,0,0,0\n", f64::from(k) * 0.01);
+    }
+    std::fs::write(dir.join("imu.csv"), text).unwrap();
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["orient", "imu.csv", "--param", "DecimationFactor=3"])
+        .args(["--out", "o.csv"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains(": 16 orientations in o.csv"), "{stdout}");
+    assert!(
+        stdout.contains("the last 2 samples do not fill a block"),
+        "{stdout}"
+    );
+    let rows = std::fs::read_to_string(dir.join("o.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(rows, 17);
+}

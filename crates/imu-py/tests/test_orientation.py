@@ -163,16 +163,23 @@ def test_quaternion_distance_and_compare_of_an_orientation_output():
     assert "position_rms_m" not in summary and summary["attitude_max_rad"] >= summary["attitude_rms_rad"]
 
 
-def test_decimation_blocks_span_calls():
+def test_decimation_takes_whole_blocks_per_call_as_matlab_does():
     rng = np.random.default_rng(9)
     accel, mag = readings(np.zeros((24, 3)))
     accel += rng.normal(scale=0.05, size=accel.shape)
     gyro = rng.normal(scale=0.01, size=accel.shape)
     whole = imukit.AhrsFilter(100, decimation_factor=4)(accel, gyro, mag)
     f = imukit.AhrsFilter(100, decimation_factor=4)
-    parts = [f(accel[i:j], gyro[i:j], mag[i:j]) for i, j in [(0, 3), (3, 13), (13, 24)]]
-    assert [p.shape[0] for p in parts] == [0, 3, 3]
+    parts = [f(accel[i:j], gyro[i:j], mag[i:j]) for i, j in [(0, 4), (4, 16), (16, 24)]]
+    assert [p.shape[0] for p in parts] == [1, 3, 2]
     np.testing.assert_array_equal(np.vstack(parts), whole)
+    # MATLAB refuses a call whose row count is not a multiple of DecimationFactor; so does imukit,
+    # and the refused call leaves the filter as it was.
+    g = imukit.ImuFilter(100, decimation_factor=3)
+    a50, g50 = readings(np.zeros((50, 3)))[0], np.zeros((50, 3))
+    with pytest.raises(ImuError, match="50 rows is not a multiple of DecimationFactor = 3"):
+        g(a50, g50)
+    np.testing.assert_array_equal(g(a50[:48], g50[:48]), imukit.ImuFilter(100, decimation_factor=3)(a50[:48], g50[:48]))
 
 
 def test_ahrs_ignores_a_jammed_magnetometer_sample():

@@ -31,5 +31,12 @@ pub fn run(
         s.rows,
         out.display()
     );
+    if s.unfinished > 0 {
+        println!(
+            "imukit: the last {} samples do not fill a block of DecimationFactor samples and \
+             give no orientation",
+            s.unfinished
+        );
+    }
     Ok(())
 }

@@ -371,6 +371,17 @@ pub enum AnyFilter<N: NavFrame> {
     Complementary(Complementary),
 }
 
+impl<N: NavFrame> AnyFilter<N> {
+    /// Samples per estimate: MATLAB's `DecimationFactor` for `imufilter`/`ahrsfilter`, else 1.
+    #[must_use]
+    pub fn decimation(&self) -> usize {
+        match self {
+            Self::Kalman(f) => f.params().decimation,
+            _ => 1,
+        }
+    }
+}
+
 impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
     fn update(
         &mut self,
@@ -415,6 +426,9 @@ pub struct OrientSummary {
     pub samples: usize,
     /// Rows written (fewer with decimation).
     pub rows: usize,
+    /// Samples at the end that do not fill a decimation block, so give no estimate (0 without
+    /// decimation; MATLAB's filters refuse such a call, a file is read whole instead).
+    pub unfinished: usize,
     /// The sample rate used, Hz.
     pub sample_rate_hz: f64,
 }
@@ -521,6 +535,7 @@ fn orient_csv_in<N: NavFrame>(
     Ok(OrientSummary {
         samples,
         rows: written,
+        unfinished: samples - written * filter.decimation(),
         sample_rate_hz: rate,
     })
 }
@@ -537,11 +552,14 @@ pub struct Estimates {
 /// Runs `filter` over rows of readings given as flat slices (three values per row):
 /// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use).
 /// The filter carries its state into the next call, so a run in chunks equals a run whole; on
-/// an error the filter is left as it was before the call.
+/// an error the filter is left as it was before the call. As in MATLAB's `imufilter` and
+/// `ahrsfilter`, each call takes whole decimation blocks: the row count must be a multiple of
+/// the `DecimationFactor`.
 ///
 /// # Errors
-/// Slices of different lengths, the filter's refusals naming the row index (non-finite
-/// readings among them), and estimates that are not finite.
+/// Slices of different lengths, a row count that is not a multiple of the decimation factor,
+/// the filter's refusals naming the row index (non-finite readings among them), and estimates
+/// that are not finite.
 pub fn run_rows<N: NavFrame>(
     filter: &mut AnyFilter<N>,
     accel: &[f64],
@@ -556,6 +574,16 @@ pub fn run_rows<N: NavFrame>(
                 format!("has {} rows, the accelerometer {n}", s.len() / 3),
             ));
         }
+    }
+    let decimation = filter.decimation();
+    if n % decimation != 0 {
+        return Err(invalid(
+            "readings",
+            format!(
+                "{n} rows is not a multiple of DecimationFactor = {decimation} (each call takes \
+                 whole blocks of {decimation} samples, as MATLAB's imufilter and ahrsfilter do)"
+            ),
+        ));
     }
     let mut working = *filter;
     let mut out = Estimates::default();
