@@ -576,7 +576,7 @@ pub fn run_rows<N: NavFrame>(
         }
     }
     let decimation = filter.decimation();
-    if n % decimation != 0 {
+    if !n.is_multiple_of(decimation) {
         return Err(invalid(
             "readings",
             format!(
