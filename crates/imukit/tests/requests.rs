@@ -341,9 +341,22 @@ fn an_error_inside_the_trajectory_table_names_the_key() {
     )
     .unwrap_err()
     .to_string();
+    // The key's own line is shown (line 5), not the table's header (line 3), and its full path.
     assert!(
         e.contains("invalid length 2, expected an array of length 3")
-            && e.contains("in `position_m`"),
+            && e.contains("in `trajectory.position_m`")
+            && e.contains("TOML parse error at line 5, column 14")
+            && e.contains("position_m = [\"t\", \"0\"]"),
+        "{e}"
+    );
+    let e = ScenarioSpec::from_toml(
+        "[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\nspeed = 3\n",
+        "builtin.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("line 4, column 1") && e.contains("in `trajectory.speed`"),
         "{e}"
     );
     let e = ScenarioSpec::from_toml("[trajectory]\ntype = \"expresion\"\n", "typo.toml")

@@ -27,9 +27,20 @@ impl ScenarioSpec {
     /// # Errors
     /// [`Error::Scenario`] with the parser's message (key and line).
     pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
-        toml::from_str(text).map_err(|e| Error::Scenario {
-            origin: origin.into(),
-            message: e.to_string(),
+        toml::from_str(text).map_err(|e: toml::de::Error| {
+            // An error inside `[trajectory]` is shown at its key's line, not the table's header.
+            let message = e.to_string();
+            let inner = TrajectorySpec::error_in_toml(text).filter(|inner| {
+                // The same error, found again with its key's line.
+                e.message()
+                    .lines()
+                    .next()
+                    .is_some_and(|m| inner.contains(m))
+            });
+            Error::Scenario {
+                origin: origin.into(),
+                message: inner.unwrap_or(message),
+            }
         })
     }
 

@@ -145,21 +145,61 @@ impl<'de> Deserialize<'de> for TrajectorySpec {
             }
             None => return Err(D::Error::missing_field("type")),
         };
-        fn keys<T: serde::de::DeserializeOwned, E: serde::de::Error>(
-            table: toml::Table,
-        ) -> std::result::Result<T, E> {
-            // Deserialized from the table itself, toml names the key of an error.
-            T::deserialize(toml::Value::Table(table)).map_err(E::custom)
-        }
-        Ok(match kind.as_str() {
-            "expression" => Self::Expression(keys(table)?),
-            "samples" => Self::Samples(keys(table)?),
-            "track" => Self::Track(keys(table)?),
-            "body-rates" => Self::BodyRates(keys(table)?),
-            "waypoints" => Self::Waypoints(keys(table)?),
-            "builtin" => Self::Builtin(keys(table)?),
+        // Deserialized from the table itself, toml names the key of an error.
+        TrajectorySpec::of_type(&kind, toml::Value::Table(table)).map_err(D::Error::custom)
+    }
+}
+
+impl TrajectorySpec {
+    /// The keys of a `[trajectory]` table of type `kind` (the `type` key taken out), read from
+    /// `keys` so that an error names the key inside the table.
+    fn of_type<'de, D: serde::Deserializer<'de>>(
+        kind: &str,
+        keys: D,
+    ) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        Ok(match kind {
+            "expression" => Self::Expression(ExpressionSpec::deserialize(keys)?),
+            "samples" => Self::Samples(SamplesSpec::deserialize(keys)?),
+            "track" => Self::Track(TrackSpec::deserialize(keys)?),
+            "body-rates" => Self::BodyRates(BodyRatesSpec::deserialize(keys)?),
+            "waypoints" => Self::Waypoints(WaypointsSpec::deserialize(keys)?),
+            "builtin" => Self::Builtin(BuiltinSpec::deserialize(keys)?),
             other => return Err(D::Error::unknown_variant(other, &TRAJECTORY_TYPES)),
         })
+    }
+
+    /// The error of the `[trajectory]` table of the TOML document `text`, pointed at the key's
+    /// own line (the whole-document pass can only point at the table's header: the table is read
+    /// as a value first, to find its `type`). `None` when the table reads without error.
+    pub(crate) fn error_in_toml(text: &str) -> Option<String> {
+        use toml::de::{DeTable, DeValue, ValueDeserializer};
+        let mut root = DeTable::parse(text).ok()?.into_inner();
+        let table = root.remove("trajectory")?;
+        let span = table.span();
+        let DeValue::Table(mut keys) = table.into_inner() else {
+            return None;
+        };
+        let DeValue::String(kind) = keys.remove("type")?.into_inner() else {
+            return None;
+        };
+        let spans: Vec<(String, std::ops::Range<usize>)> = keys
+            .iter()
+            .map(|(k, v)| (k.get_ref().to_string(), k.span().start..v.span().end))
+            .collect();
+        let keys = ValueDeserializer::from(toml::Spanned::new(span, DeValue::Table(keys)));
+        let mut error = Self::of_type(&kind, keys).err()?;
+        error.set_input(Some(text));
+        let at = error.span().unwrap_or_default();
+        Some(
+            match spans
+                .iter()
+                .find(|(_, s)| s.start <= at.start && at.end <= s.end)
+            {
+                Some((key, _)) => format!("{error}in `trajectory.{key}`\n"),
+                None => error.to_string(),
+            },
+        )
     }
 }
 
