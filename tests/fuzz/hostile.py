@@ -161,8 +161,9 @@ def cli_cases(rng: random.Random, cases: int) -> list:
         (work / "s.toml").write_text(SCENARIO)
         subprocess.run([imukit_bin(), "simulate", "s.toml", "--out", "imu.csv", "--truth", "truth.csv"],
                        cwd=work, check=True, capture_output=True)
+        subprocess.run([imukit_bin(), "allan", "imu.csv", "--out", "allan.csv"], cwd=work, check=True, capture_output=True)
         (work / "p.json").write_text(PARAMS)
-        valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json")}
+        valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv")}
         per = max(1, cases // 5)
 
         r = Run("byte mutations of valid files")
@@ -179,12 +180,13 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                 "truth.csv": rng.choice([["compare", bad.name, "truth.csv"], ["plot", bad.name, "--out", "o.svg"],
                                          ["animate", bad.name, "--out", "o.html"]]),
                 "p.json": ["simulate", "ps.toml", "--out", "o.csv"],
+                "allan.csv": ["plot", bad.name, "--out", rng.choice(["o.svg", "o.png"])],
             }[name]
             if name == "p.json":
                 (work / "ps.toml").write_text(f'[trajectory]\ntype = "builtin"\nname = "static"\n[imu]\nparams = "{bad.name}"\n')
             run_cli(r, work, args, [bad.name, "imu.csv", "truth.csv", "s.toml"], f"case {k}")
             bad.unlink()
-            for leftover in ("o.svg", "o.html"):
+            for leftover in ("o.svg", "o.png", "o.html"):
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 

@@ -339,3 +339,63 @@ fn ned_truth_is_animated_east_north_up() {
         "{q:?}"
     );
 }
+
+/// Runs `imukit args…` and kills it if it is still running after a minute: a hang fails the
+/// test instead of stalling the suite (a guard, not a speed measurement).
+fn within_a_minute(args: &[&str], paths: &[&Path]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_imukit"));
+    c.args(args).args(paths);
+    let mut child = c
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    for _ in 0..600 {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    child.kill().unwrap();
+    panic!("imukit {args:?} {paths:?} did not finish");
+}
+
+#[test]
+fn allan_tables_spanning_the_whole_float_range_and_extreme_truth_values_are_drawn() {
+    let d = data();
+    // Deviations from 1e-308 to 1e308: plotters' log axis would count infinitely many decades
+    // (1e308 / 1e-308 overflows); the axis keeps 300 decades below the largest value.
+    let allan = d.join("extreme_allan.csv");
+    std::fs::write(
+        &allan,
+        "tau_s,adev_gyro_x_rad_s\n1e-308,0.1\n1,1e308\n2,1e-308\n1e308,1e-320\n",
+    )
+    .unwrap();
+    let png = d.join("extreme_allan.png");
+    ok(&within_a_minute(
+        &["plot"],
+        &[&allan, Path::new("--out"), &png],
+    ));
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    // Equal times in an Allan table and a 1e308 position in a truth file.
+    let equal = d.join("equal_allan.csv");
+    std::fs::write(&equal, "tau_s,adev_gyro_x_rad_s\n1,0.1\n1,0.1\n1,0.1\n").unwrap();
+    let svg = d.join("equal_allan.svg");
+    ok(&within_a_minute(
+        &["plot"],
+        &[&equal, Path::new("--out"), &svg],
+    ));
+    let mut truth = std::fs::read_to_string(d.join("truth.csv")).unwrap();
+    let row = truth.lines().nth(50).unwrap().to_string();
+    let (first, rest) = row.split_once(',').unwrap();
+    let (_, rest) = rest.split_once(',').unwrap();
+    truth = truth.replace(&row, &format!("{first},1e308,{rest}"));
+    let big = d.join("big_truth.csv");
+    std::fs::write(&big, truth).unwrap();
+    let png = d.join("big_truth.png");
+    ok(&within_a_minute(
+        &["plot"],
+        &[&big, Path::new("--out"), &png],
+    ));
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+}

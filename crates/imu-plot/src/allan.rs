@@ -7,6 +7,20 @@ use plotters::prelude::*;
 use crate::PlotError;
 use crate::draw::{COLORS, draw_legend, err, key, write_figure};
 
+/// Most decades a log axis spans: plotters counts an axis's decades through `hi / lo`, which
+/// must stay finite (beyond about 308 decades it is infinite and the tick loop never ends).
+pub const MAX_LOG_AXIS_DECADES: i32 = 300;
+
+/// A log axis from `lo` to `hi` kept within the positive normal numbers and within
+/// [`MAX_LOG_AXIS_DECADES`] below `hi` (values further down are cut off at the axis).
+fn log_range(lo: f64, hi: f64) -> std::ops::Range<f64> {
+    let hi = hi.clamp(f64::MIN_POSITIVE, f64::MAX);
+    let lo = lo
+        .clamp(f64::MIN_POSITIVE, f64::MAX)
+        .max(hi / 10f64.powi(MAX_LOG_AXIS_DECADES));
+    if hi > lo { lo..hi } else { lo..lo * 10.0 }
+}
+
 /// Draws `result` (one curve per column) into `path` (SVG or PNG).
 pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), PlotError> {
     let table = &result.table;
@@ -40,8 +54,8 @@ pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), PlotError> 
             .x_label_area_size(45)
             .y_label_area_size(80)
             .build_cartesian_2d(
-                (tau[0] * 0.8..tau[tau.len() - 1] * 1.25).log_scale(),
-                (lo * 0.5..hi * 2.0).log_scale(),
+                log_range(tau[0] * 0.8, tau[tau.len() - 1] * 1.25).log_scale(),
+                log_range(lo * 0.5, hi * 2.0).log_scale(),
             )
             .map_err(err)?;
         chart
