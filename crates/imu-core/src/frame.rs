@@ -10,6 +10,7 @@ mod sealed {
     impl Sealed for super::Enu {}
     impl Sealed for super::Ned {}
     impl Sealed for super::Body {}
+    impl Sealed for super::Ecef {}
 }
 
 /// The gravity magnitude imukit uses unless told otherwise, m/s²: 9.81, MATLAB imuSensor's
@@ -66,6 +67,15 @@ impl Frame for Ned {
 }
 impl Frame for Body {
     const NAME: &'static str = "body";
+}
+
+/// The Earth-centred, Earth-fixed frame of WGS-84: x through the equator at the prime meridian,
+/// z through the north pole, y completing the right-handed set (see [`crate::earth`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Ecef;
+
+impl Frame for Ecef {
+    const NAME: &'static str = "ECEF";
 }
 
 impl NavFrame for Enu {

@@ -25,6 +25,7 @@
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");
 
 pub mod allan;
+pub mod earth;
 pub mod frame;
 pub mod ideal;
 pub mod kinematics;
@@ -35,7 +36,7 @@ pub mod sensor;
 pub mod strapdown;
 pub mod vector;
 
-pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Enu, Frame, NavFrame, Ned};
+pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, NavFrame, Ned};
 pub use ideal::{AccelSign, IdealReading, ImuMount};
 pub use kinematics::{KinematicsError, Truth};
 pub use rotation::{EulerZyx, Rotation};

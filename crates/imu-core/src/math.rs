@@ -63,6 +63,14 @@ pub(crate) fn powf(x: f64, y: f64) -> f64 {
 pub(crate) fn ceil(x: f64) -> f64 {
     Float::ceil(x)
 }
+#[inline]
+pub(crate) fn cbrt(x: f64) -> f64 {
+    Float::cbrt(x)
+}
+#[inline]
+pub(crate) fn tan(x: f64) -> f64 {
+    Float::tan(x)
+}
 
 #[cfg(test)]
 mod tests {
