@@ -139,7 +139,7 @@ fn parameters_are_validated_with_the_field_named() {
     assert_eq!(
         bad(SensorParams {
             noise_density: [0.1, -1.0, 0.0],
-            ..d
+            ..d.clone()
         }),
         ParamError::Negative {
             field: "noise_density",
@@ -150,7 +150,7 @@ fn parameters_are_validated_with_the_field_named() {
     assert_eq!(
         bad(SensorParams {
             measurement_range: 0.0,
-            ..d
+            ..d.clone()
         }),
         ParamError::NotPositive {
             field: "measurement_range",
@@ -160,14 +160,14 @@ fn parameters_are_validated_with_the_field_named() {
     assert!(matches!(
         bad(SensorParams {
             measurement_range: f64::NAN,
-            ..d
+            ..d.clone()
         }),
         ParamError::NotPositive { .. }
     ));
     assert_eq!(
         bad(SensorParams {
             constant_bias: [0.0, 0.0, f64::NAN],
-            ..d
+            ..d.clone()
         }),
         ParamError::NotFinite {
             field: "constant_bias",
@@ -177,14 +177,14 @@ fn parameters_are_validated_with_the_field_named() {
     assert!(matches!(
         bad(SensorParams {
             temperature_scale_factor_pct: [0.0, 101.0, 0.0],
-            ..d
+            ..d.clone()
         }),
         ParamError::OutOfRange { index: 1, .. }
     ));
     assert!(matches!(
         bad(SensorParams {
             resolution: -1.0,
-            ..d
+            ..d.clone()
         }),
         ParamError::Negative {
             field: "resolution",
@@ -196,7 +196,7 @@ fn parameters_are_validated_with_the_field_named() {
     assert!(SensorModel::new(&d, 0.0).is_err());
     let msg = bad(SensorParams {
         random_walk: [-2.0, 0.0, 0.0],
-        ..d
+        ..d.clone()
     })
     .to_string();
     assert_eq!(msg, "random_walk[0] must be ≥ 0, got -2");
@@ -205,7 +205,7 @@ fn parameters_are_validated_with_the_field_named() {
         SensorModel::new(
             &SensorParams {
                 measurement_range: f64::INFINITY,
-                ..d
+                ..d.clone()
             },
             100.0
         )
@@ -681,7 +681,7 @@ fn transcribed(
     env: &Environment,
     seed: u64,
 ) -> Vec<[f64; 3]> {
-    let imu_core::sensor::BiasInstabilityModel::Filter(c) = p.bias_instability_model else {
+    let imu_core::sensor::BiasInstabilityModel::Filter(c) = &p.bias_instability_model else {
         unreachable!("filter models only")
     };
     let (num, den) = (c.numerator(), c.denominator());
@@ -762,7 +762,7 @@ fn the_model_gives_the_bits_of_the_seven_steps_written_plainly() {
         for carry in [false, true] {
             for noise_type in [NoiseType::SingleSided, NoiseType::DoubleSided] {
                 let p = SensorParams {
-                    bias_instability_model: filter,
+                    bias_instability_model: filter.clone(),
                     quantization_carry: carry,
                     noise_type,
                     ..full_params()
@@ -846,11 +846,13 @@ fn a_long_fractal_filter_like_matlabs_allan_example_has_the_closed_form_impulse_
 
 #[test]
 fn filters_longer_than_the_bound_are_refused_with_the_bound_named() {
-    let den = fractal_denominator(1024, 1.0);
+    // With `alloc` (the default) up to 4096 coefficients, on the heap.
+    let den = fractal_denominator(4096, 1.0);
     let err = FilterCoefficients::new(&[1.0], &den).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "bias_instability_coefficients: 1 to 1024 numerator and denominator coefficients needed"
+        "bias_instability_coefficients: 1 to 4096 numerator and denominator coefficients needed"
     );
-    assert!(FilterCoefficients::new(&[1.0], &den[..1024]).is_ok());
+    assert!(FilterCoefficients::new(&[1.0], &den[..4096]).is_ok());
+    assert_eq!(imu_core::sensor::MAX_FILTER_COEFFICIENTS, 4096);
 }

@@ -318,7 +318,7 @@ def test_a_500_pole_fractal_filter_as_in_matlabs_allan_example_gives_a_flat_alla
     # Kasdin's generator has the two-sided PSD B²/(2πf) at low f: the floor is √(2 ln 2/π)·B.
     floor = at(0.1) / (0.664 * 0.01)
     assert np.all(np.abs(floor - 1) < 0.08), floor
-    with pytest.raises(ImuError, match="1 to 1024") as e:
+    with pytest.raises(ImuError, match="1 to 4096") as e:
         imukit.ImuSensor("accel-gyro", gyroscope=imukit.GyroParams(
-            bias_instability=0.01, bias_instability_coefficients=fractalcoef(1024)))
+            bias_instability=0.01, bias_instability_coefficients=fractalcoef(4096)))
     assert e.value.field.endswith("bias_instability_coefficients")

@@ -1,30 +1,27 @@
 //! One validated sensor triad and its drifting state.
 use crate::math;
-use crate::sensor::{
-    BiasInstabilityModel, MAX_FILTER_COEFFICIENTS, NoiseSource, NoiseType, ParamError, SensorParams,
-};
+use crate::sensor::params::{Coefficients, coefficients};
+use crate::sensor::{BiasInstabilityModel, NoiseSource, NoiseType, ParamError, SensorParams};
 
 /// Largest number of first-order sections of the flicker bias-instability model.
 pub const MAX_FLICKER_SECTIONS: usize = 16;
-const FILTER_STATE: usize = if MAX_FILTER_COEFFICIENTS > 2 * MAX_FLICKER_SECTIONS {
-    MAX_FILTER_COEFFICIENTS
-} else {
-    2 * MAX_FLICKER_SECTIONS
-};
+/// Filter memory held inline per axis: the flicker cascade's, or a filter's up to this order.
+const INLINE_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
 
 /// The bias-instability generator, ready to step.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 #[allow(
     clippy::large_enum_variant,
-    reason = "the core has no heap: a long filter is stored inline, not boxed"
+    reason = "built once per model and stepped in place; boxing would need a heap"
 )]
-#[derive(Clone, Copy, Debug, PartialEq)]
 enum BiasFilter {
-    /// MATLAB `filter(b, a, ·)`, coefficients normalised by a₀, transposed direct form II.
-    Iir {
-        b: [f64; MAX_FILTER_COEFFICIENTS],
-        a: [f64; MAX_FILTER_COEFFICIENTS],
-        len: usize,
-    },
+    /// A first-order `filter([b₀, b₁], [1, a₁], ·)` (MATLAB's default and Gauss–Markov),
+    /// unrolled: the hot path.
+    FirstOrder { b0: f64, b1: f64, a1: f64 },
+    /// MATLAB `filter(b, a, ·)`, coefficients normalised by a₀ and padded with zeros to the
+    /// same length, transposed direct form II.
+    Iir { b: Coefficients, a: Coefficients },
     /// Cascade of `(1 − ζ z⁻¹)/(1 − φ z⁻¹)` sections times a gain (flicker noise).
     Cascade {
         zero: [f64; MAX_FLICKER_SECTIONS],
@@ -34,14 +31,47 @@ enum BiasFilter {
     },
 }
 
+/// `values / scale`, padded with zeros to `len` (≤
+/// [`MAX_FILTER_COEFFICIENTS`](crate::sensor::MAX_FILTER_COEFFICIENTS)).
+fn normalised(values: &[f64], scale: f64, len: usize) -> Coefficients {
+    let mut padded = [0.0; 8];
+    #[cfg(feature = "alloc")]
+    let mut long = alloc::vec::Vec::new();
+    let out: &mut [f64] = if len <= padded.len() {
+        &mut padded[..len]
+    } else {
+        #[cfg(feature = "alloc")]
+        {
+            long.resize(len, 0.0);
+            &mut long[..]
+        }
+        #[cfg(not(feature = "alloc"))]
+        unreachable!("FilterCoefficients::new keeps heap-free filters within 8 coefficients")
+    };
+    for (o, v) in out.iter_mut().zip(values) {
+        *o = v / scale;
+    }
+    coefficients(out)
+}
+
 impl BiasFilter {
     /// True when every coefficient is a finite number.
     fn is_finite(&self) -> bool {
         match self {
-            Self::Iir { b, a, .. } => b.iter().chain(a).all(|v| v.is_finite()),
+            Self::FirstOrder { b0, b1, a1 } => [b0, b1, a1].iter().all(|v| v.is_finite()),
+            Self::Iir { b, a } => b.iter().chain(a.iter()).all(|v| v.is_finite()),
             Self::Cascade {
                 zero, pole, gain, ..
             } => zero.iter().chain(pole).all(|v| v.is_finite()) && gain.is_finite(),
+        }
+    }
+
+    /// Memory one axis needs, values.
+    fn memory(&self) -> usize {
+        match self {
+            Self::FirstOrder { .. } => 1,
+            Self::Iir { b, .. } => b.len().saturating_sub(1),
+            Self::Cascade { .. } => INLINE_STATE,
         }
     }
 
@@ -49,18 +79,19 @@ impl BiasFilter {
         match model {
             BiasInstabilityModel::Filter(c) => {
                 let (num, den) = (c.numerator(), c.denominator());
-                let mut b = [0.0; MAX_FILTER_COEFFICIENTS];
-                let mut a = [0.0; MAX_FILTER_COEFFICIENTS];
-                for (k, v) in num.iter().enumerate() {
-                    b[k] = v / den[0];
-                }
-                for (k, v) in den.iter().enumerate() {
-                    a[k] = v / den[0];
-                }
-                Self::Iir {
-                    b,
-                    a,
-                    len: num.len().max(den.len()),
+                let len = num.len().max(den.len());
+                if len == 2 {
+                    let at = |v: &[f64], k: usize| v.get(k).map_or(0.0, |x| x / den[0]);
+                    Self::FirstOrder {
+                        b0: at(num, 0),
+                        b1: at(num, 1),
+                        a1: at(den, 1),
+                    }
+                } else {
+                    Self::Iir {
+                        b: normalised(num, den[0], len),
+                        a: normalised(den, den[0], len),
+                    }
                 }
             }
             BiasInstabilityModel::Flicker {
@@ -69,61 +100,105 @@ impl BiasFilter {
             } => flicker(*tau_min_s, *tau_max_s, sample_rate_hz),
             BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
                 let phi = math::exp(-1.0 / (sample_rate_hz * correlation_time_s));
-                let mut b = [0.0; MAX_FILTER_COEFFICIENTS];
-                let mut a = [0.0; MAX_FILTER_COEFFICIENTS];
-                b[0] = math::sqrt(1.0 - phi * phi);
-                a[0] = 1.0;
-                a[1] = -phi;
-                Self::Iir { b, a, len: 2 }
+                Self::FirstOrder {
+                    b0: math::sqrt(1.0 - phi * phi),
+                    b1: 0.0,
+                    a1: -phi,
+                }
             }
         }
     }
 
-    /// [`Self::step`] on the three axes, each with its own state.
-    #[inline]
-    fn step3(&self, x: [f64; 3], z: &mut [[f64; FILTER_STATE]; 3]) -> [f64; 3] {
-        match self {
-            // First order (MATLAB's default and Gauss–Markov): the general recursion unrolled,
-            // the same operations in the same order.
-            Self::Iir { b, a, len: 2 } => {
+    /// One step of the filter on the three axes, each with its own memory.
+    #[inline(always)]
+    fn step3(&self, x: [f64; 3], z: &mut [FilterMemory; 3]) -> [f64; 3] {
+        match *self {
+            // The general recursion unrolled for order 1, the same operations in the same order.
+            Self::FirstOrder { b0, b1, a1 } => {
                 let mut y = [0.0; 3];
                 for i in 0..3 {
-                    y[i] = b[0] * x[i] + z[i][0];
-                    z[i][0] = b[1] * x[i] + 0.0 - a[1] * y[i];
-                }
-                y
-            }
-            _ => [0, 1, 2].map(|i| self.step(x[i], &mut z[i])),
-        }
-    }
-
-    fn step(&self, x: f64, z: &mut [f64; FILTER_STATE]) -> f64 {
-        match self {
-            Self::Iir { b, a, len } => {
-                let n = *len;
-                let y = b[0] * x + if n > 1 { z[0] } else { 0.0 };
-                for k in 1..n {
-                    let next = if k + 1 < n { z[k] } else { 0.0 };
-                    z[k - 1] = b[k] * x + next - a[k] * y;
+                    let z0 = &mut z[i].inline[0];
+                    y[i] = b0 * x[i] + *z0;
+                    *z0 = b1 * x[i] + 0.0 - a1 * y[i];
                 }
                 y
             }
             Self::Cascade {
-                zero,
-                pole,
+                ref zero,
+                ref pole,
                 sections,
                 gain,
             } => {
-                let mut v = x;
-                for i in 0..*sections {
-                    let y = v - zero[i] * z[i] + pole[i] * z[MAX_FLICKER_SECTIONS + i];
-                    z[i] = v;
-                    z[MAX_FLICKER_SECTIONS + i] = y;
-                    v = y;
-                }
-                gain * v
+                [0, 1, 2].map(|i| cascade_step(zero, pole, sections, x[i], &mut z[i].inline) * gain)
+            }
+            Self::Iir { ref b, ref a } => {
+                let n = self.memory();
+                [0, 1, 2].map(|i| iir_step(b, a, x[i], z[i].slots(n)))
             }
         }
+    }
+}
+
+/// One step of `filter(b, a, ·)` in transposed direct form II (`b`, `a` of equal length,
+/// `a₀ = 1`) with memory `z` (at least `len − 1` values). Kept out of line: the first-order
+/// and flicker paths are the hot ones, and inlining this loop there slowed them by 10 %.
+#[inline(never)]
+fn iir_step(b: &[f64], a: &[f64], x: f64, z: &mut [f64]) -> f64 {
+    let n = b.len();
+    let y = b[0] * x + if n > 1 { z[0] } else { 0.0 };
+    for k in 1..n {
+        let next = if k + 1 < n { z[k] } else { 0.0 };
+        z[k - 1] = b[k] * x + next - a[k] * y;
+    }
+    y
+}
+
+/// One step of the flicker cascade (without its gain) on the inline memory: inputs in
+/// `z[..16]`, outputs in `z[16..]`.
+#[inline]
+fn cascade_step(
+    zero: &[f64; MAX_FLICKER_SECTIONS],
+    pole: &[f64; MAX_FLICKER_SECTIONS],
+    sections: usize,
+    x: f64,
+    z: &mut [f64; INLINE_STATE],
+) -> f64 {
+    let mut v = x;
+    for i in 0..sections.min(MAX_FLICKER_SECTIONS) {
+        let y = v - zero[i] * z[i] + pole[i] * z[MAX_FLICKER_SECTIONS + i];
+        z[i] = v;
+        z[MAX_FLICKER_SECTIONS + i] = y;
+        v = y;
+    }
+    v
+}
+
+/// One axis's bias-instability filter memory: inline for the flicker cascade and filters up to
+/// order 32; with `alloc`, longer filters keep theirs on the heap (grown on first use).
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
+struct FilterMemory {
+    inline: [f64; INLINE_STATE],
+    #[cfg(feature = "alloc")]
+    long: alloc::vec::Vec<f64>,
+}
+
+impl FilterMemory {
+    /// At least `n` values of memory.
+    #[inline]
+    fn slots(&mut self, n: usize) -> &mut [f64] {
+        if n <= INLINE_STATE {
+            return &mut self.inline;
+        }
+        #[cfg(feature = "alloc")]
+        {
+            if self.long.len() < n {
+                self.long.resize(n, 0.0);
+            }
+            &mut self.long
+        }
+        #[cfg(not(feature = "alloc"))]
+        unreachable!("FilterCoefficients::new keeps heap-free filters within 8 coefficients")
     }
 }
 
@@ -192,9 +267,11 @@ impl Default for Environment {
 }
 
 /// What drifts over time: the bias-instability filter state and the random-walk value, per axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// (`Copy` in a heap-free build; with `alloc` a long filter's memory is on the heap.)
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorState {
-    filter: [[f64; FILTER_STATE]; 3],
+    filter: [FilterMemory; 3],
     random_walk: [f64; 3],
     quantization_residual: [f64; 3],
 }
@@ -202,7 +279,7 @@ pub struct SensorState {
 impl Default for SensorState {
     fn default() -> Self {
         Self {
-            filter: [[0.0; FILTER_STATE]; 3],
+            filter: Default::default(),
             random_walk: [0.0; 3],
             quantization_residual: [0.0; 3],
         }
@@ -218,7 +295,8 @@ impl SensorState {
 }
 
 /// A validated error model of one triad at a fixed sample rate.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorModel {
     misalignment: [[f64; 3]; 3],
     bias: [f64; 3],

@@ -1,14 +1,62 @@
 //! Error parameters of one sensor triad, as a user writes them (SI units, per axis).
 use crate::sensor::ParamError;
 
+/// Largest number of numerator or denominator coefficients of the bias-instability filter.
+///
+/// With the `alloc` feature (on by default, through `std`) the coefficients and the filter's
+/// state live on the heap and a filter may have up to 4096 coefficients: MATLAB takes any length,
+/// and its own Allan-variance example uses `fractalcoef(500)` (501 denominator coefficients).
+/// Without it (a heap-free embedded build) they live inline and the bound is 8 (order 7).
+#[cfg(feature = "alloc")]
+pub const MAX_FILTER_COEFFICIENTS: usize = 4096;
 /// Largest number of numerator or denominator coefficients of the bias-instability filter
-/// (filter order up to 1023). MATLAB takes any length; its own Allan-variance example uses
-/// `fractalcoef(500)` (501 denominator coefficients), well inside this bound. The coefficients
-/// and the filter state live in fixed arrays (the core has no heap), so the bound is a size, not
-/// a cost: each step runs over the filter's own length only.
-pub const MAX_FILTER_COEFFICIENTS: usize = 1024;
-// `FilterCoefficients::new`'s message states the bound.
-const _: () = assert!(MAX_FILTER_COEFFICIENTS == 1024);
+/// (heap-free build: inline, order up to 7; the `alloc` feature raises it to 4096).
+#[cfg(not(feature = "alloc"))]
+pub const MAX_FILTER_COEFFICIENTS: usize = 8;
+
+#[cfg(feature = "alloc")]
+const TOO_LONG: &str = "1 to 4096 numerator and denominator coefficients needed";
+#[cfg(not(feature = "alloc"))]
+const TOO_LONG: &str =
+    "1 to 8 numerator and denominator coefficients needed (a build without `alloc`)";
+const _: () = assert!(MAX_FILTER_COEFFICIENTS == 4096 || MAX_FILTER_COEFFICIENTS == 8);
+
+/// A list of filter coefficients: shared on the heap with `alloc`, inline without.
+#[cfg(feature = "alloc")]
+pub(crate) type Coefficients = alloc::sync::Arc<[f64]>;
+
+/// A list of filter coefficients: shared on the heap with `alloc`, inline without.
+#[cfg(not(feature = "alloc"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Coefficients {
+    values: [f64; MAX_FILTER_COEFFICIENTS],
+    len: usize,
+}
+
+#[cfg(not(feature = "alloc"))]
+impl core::ops::Deref for Coefficients {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        &self.values[..self.len]
+    }
+}
+
+/// `values` stored (the caller has checked the length against [`MAX_FILTER_COEFFICIENTS`]).
+pub(crate) fn coefficients(values: &[f64]) -> Coefficients {
+    #[cfg(feature = "alloc")]
+    {
+        Coefficients::from(values)
+    }
+    #[cfg(not(feature = "alloc"))]
+    {
+        let mut c = Coefficients {
+            values: [0.0; MAX_FILTER_COEFFICIENTS],
+            len: values.len(),
+        };
+        c.values[..values.len()].copy_from_slice(values);
+        c
+    }
+}
 
 /// Power spectral density convention of `noise_density` and `random_walk`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -21,12 +69,11 @@ pub enum NoiseType {
 }
 
 /// Numerator and denominator of the bias-instability filter (MATLAB `filter(Num, Den, x)`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct FilterCoefficients {
-    numerator: [f64; MAX_FILTER_COEFFICIENTS],
-    denominator: [f64; MAX_FILTER_COEFFICIENTS],
-    num_len: usize,
-    den_len: usize,
+    numerator: Coefficients,
+    denominator: Coefficients,
 }
 
 impl Default for FilterCoefficients {
@@ -39,31 +86,22 @@ impl Default for FilterCoefficients {
 impl FilterCoefficients {
     /// MATLAB's default: `Num = [1]`, `Den = [1, −0.5]`.
     #[must_use]
-    pub const fn matlab_default() -> Self {
-        let mut numerator = [0.0; MAX_FILTER_COEFFICIENTS];
-        let mut denominator = [0.0; MAX_FILTER_COEFFICIENTS];
-        numerator[0] = 1.0;
-        denominator[0] = 1.0;
-        denominator[1] = -0.5;
+    pub fn matlab_default() -> Self {
         Self {
-            numerator,
-            denominator,
-            num_len: 1,
-            den_len: 2,
+            numerator: coefficients(&[1.0]),
+            denominator: coefficients(&[1.0, -0.5]),
         }
     }
 
     /// Coefficients `numerator` (b₀ … b_m) and `denominator` (a₀ … a_n), a₀ ≠ 0.
     ///
     /// # Errors
-    /// Empty or too long lists, non-finite values, a₀ = 0.
+    /// Empty or too long lists ([`MAX_FILTER_COEFFICIENTS`]), non-finite values, a₀ = 0.
     pub fn new(numerator: &[f64], denominator: &[f64]) -> Result<Self, ParamError> {
         let too_long = numerator.len() > MAX_FILTER_COEFFICIENTS
             || denominator.len() > MAX_FILTER_COEFFICIENTS;
         if numerator.is_empty() || denominator.is_empty() || too_long {
-            return Err(ParamError::BadFilter {
-                reason: "1 to 1024 numerator and denominator coefficients needed",
-            });
+            return Err(ParamError::BadFilter { reason: TOO_LONG });
         }
         if let Some(index) = numerator
             .iter()
@@ -80,36 +118,28 @@ impl FilterCoefficients {
                 reason: "the leading denominator coefficient must not be 0",
             });
         }
-        let mut c = Self {
-            numerator: [0.0; MAX_FILTER_COEFFICIENTS],
-            denominator: [0.0; MAX_FILTER_COEFFICIENTS],
-            num_len: numerator.len(),
-            den_len: denominator.len(),
-        };
-        c.numerator[..numerator.len()].copy_from_slice(numerator);
-        c.denominator[..denominator.len()].copy_from_slice(denominator);
-        Ok(c)
+        Ok(Self {
+            numerator: coefficients(numerator),
+            denominator: coefficients(denominator),
+        })
     }
 
     /// The numerator coefficients.
     #[must_use]
     pub fn numerator(&self) -> &[f64] {
-        &self.numerator[..self.num_len]
+        &self.numerator
     }
 
     /// The denominator coefficients.
     #[must_use]
     pub fn denominator(&self) -> &[f64] {
-        &self.denominator[..self.den_len]
+        &self.denominator
     }
 }
 
 /// How the bias-instability drift is generated from `BiasInstability·n`.
-#[allow(
-    clippy::large_enum_variant,
-    reason = "the core has no heap: a long filter is stored inline, not boxed"
-)]
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub enum BiasInstabilityModel {
     /// MATLAB's `filter(Num, Den, ·)` (default `Num = [1]`, `Den = [1, −0.5]`). Note that this
     /// default is an AR(1) process with a 2-sample correlation: under Allan analysis it looks like
@@ -141,7 +171,8 @@ impl Default for BiasInstabilityModel {
 /// Error parameters of one triad (accelerometer, gyroscope or magnetometer), MATLAB's
 /// `accelparams`/`gyroparams`/`magparams` fields in SI units of the measurand `[u]`
 /// (m/s², rad/s or µT). The default is an ideal sensor.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorParams {
     /// Saturation level, `[u]`, > 0 (may be infinite).
     pub measurement_range: f64,

@@ -155,7 +155,7 @@ impl Sensor {
 }
 
 /// Parameters of the three sensors.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ImuParams {
     /// Accelerometer.
     pub accelerometer: SensorParams,
@@ -725,7 +725,7 @@ pub fn to_toml(file: &ParamFile) -> String {
         );
         s += &format!("noise_density_{u}_per_rt_hz = {}\n", fmt3(p.noise_density));
         s += &format!("bias_instability_{u} = {}\n", fmt3(p.bias_instability));
-        match p.bias_instability_model {
+        match &p.bias_instability_model {
             BiasInstabilityModel::Filter(c) => {
                 let l = |v: &[f64]| v.iter().map(|x| fmt1(*x)).collect::<Vec<_>>().join(", ");
                 s += &format!("bias_instability_numerator = [{}]\n", l(c.numerator()));
@@ -737,14 +737,14 @@ pub fn to_toml(file: &ParamFile) -> String {
             } => {
                 s += &format!(
                     "bias_instability_flicker_tau_s = [{}, {}]\n",
-                    fmt1(tau_min_s),
-                    fmt1(tau_max_s)
+                    fmt1(*tau_min_s),
+                    fmt1(*tau_max_s)
                 );
             }
             BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
                 s += &format!(
                     "bias_instability_correlation_time_s = {}\n",
-                    fmt1(correlation_time_s)
+                    fmt1(*correlation_time_s)
                 );
             }
         }

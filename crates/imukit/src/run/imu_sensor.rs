@@ -224,7 +224,7 @@ impl ImuSensor {
                 format!("has {got} numbers, expected {want}"),
             ));
         }
-        let (start_state, start_noise) = (self.state, self.noise.clone());
+        let (start_state, start_noise) = (self.state.clone(), self.noise.clone());
         let result = match &self.model {
             FrameModel::Enu(m) => measure_rows(
                 m,

@@ -314,14 +314,14 @@ pub fn perturbed(
     run: Option<u64>,
 ) -> Result<ImuParams> {
     if perturbations.is_empty() {
-        return Ok(*base);
+        return Ok(base.clone());
     }
     const SALT: u64 = 0x5045_5254_5552_4221;
     let mut z = (seed ^ SALT) ^ run.map_or(u64::MAX, |r| r.wrapping_mul(0x9E37_79B9_7F4A_7C15));
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(z ^ (z >> 31));
-    let mut out = *base;
+    let mut out = base.clone();
     for p in perturbations {
         let params = out.get_mut(p.sensor);
         p.apply(params, &mut rng);

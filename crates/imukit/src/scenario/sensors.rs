@@ -194,7 +194,7 @@ impl SensorSetup {
                 None
             }
         };
-        let mut params = file.as_ref().map(|f| f.params).unwrap_or_default();
+        let mut params = file.as_ref().map(|f| f.params.clone()).unwrap_or_default();
         for (i, sensor) in Sensor::ALL.iter().enumerate() {
             let from_file = file.as_ref().is_some_and(|f| f.present[i]);
             if !from_file {
@@ -207,7 +207,7 @@ impl SensorSetup {
                 } else {
                     Some(profile.noise_type())
                 };
-                let base = *params.get(*sensor);
+                let base = params.get(*sensor).clone();
                 *params.get_mut(*sensor) = parse_sensor(
                     table,
                     *sensor,
