@@ -31,7 +31,7 @@ fn derivative(
 pub const NODES: usize = 6;
 
 /// Lagrange weights at `x` for the nodes `xs`.
-fn lagrange(xs: &[f64; NODES], x: f64) -> [f64; NODES] {
+pub(crate) fn lagrange(xs: &[f64; NODES], x: f64) -> [f64; NODES] {
     core::array::from_fn(|i| {
         (0..NODES)
             .filter(|&j| j != i)

@@ -75,6 +75,16 @@ pub enum StrapdownError {
         /// Sample index.
         index: usize,
     },
+    /// The latitude left ±89.9°, where the local NED frame is not used (Earth mechanization).
+    NearPole {
+        /// Sample index.
+        index: usize,
+    },
+    /// An option out of its range.
+    BadOption {
+        /// Which option and its range.
+        field: &'static str,
+    },
     /// Input slices of different lengths, or an output slice too short.
     LengthMismatch {
         /// Which slice.
@@ -99,6 +109,12 @@ impl core::fmt::Display for StrapdownError {
                     index.saturating_sub(1)
                 )
             }
+            Self::NearPole { index } => write!(
+                f,
+                "at sample {index} the latitude is beyond ±89.9°, where the local NED frame is \
+                 not used (the transport rate grows without bound near the poles)"
+            ),
+            Self::BadOption { field } => write!(f, "{field}"),
             Self::LengthMismatch {
                 field,
                 expected,
