@@ -157,11 +157,35 @@ impl<N: NavFrame> ImuModel<N> {
             f_b,
             truth.acceleration_m_s2,
             truth.omega_b_rad_s,
-            &truth.attitude,
+            || self.field_in_body(&truth.attitude),
             temperatures,
             state,
             noise,
         )
+    }
+
+    /// Readings from ideal body-frame inputs worked out elsewhere (the WGS-84 Earth model of
+    /// [`crate::earth`]): the specific force at the IMU `f_b` (m/s², physical sign; the mount's
+    /// sign convention is applied here), the angular rate `w_b` (rad/s), the magnetic field in
+    /// body axes `m_b` (µT), and the navigation-frame acceleration (m/s², used only as MATLAB's
+    /// gyroscope acceleration input). The mount's lever arm, gravity and field are not used.
+    #[allow(clippy::too_many_arguments)]
+    pub fn measure_ideal(
+        &self,
+        f_b: Vec3<Body>,
+        w_b: Vec3<Body>,
+        m_b: Vec3<Body>,
+        acceleration_n: Vec3<N>,
+        temperatures: &Temperatures,
+        state: &mut ImuState,
+        noise: &mut impl NoiseSource,
+    ) -> ImuReading {
+        self.finish(f_b, acceleration_n, w_b, || m_b, temperatures, state, noise)
+    }
+
+    /// The mount's magnetic field in body axes at attitude `C_nb`.
+    fn field_in_body(&self, attitude: &Rotation<Body, N>) -> Vec3<Body> {
+        attitude.inverse().apply(self.mount.magnetic_field_ut)
     }
 
     /// Readings from MATLAB's call shape: navigation-frame acceleration without gravity (m/s²),
@@ -183,7 +207,7 @@ impl<N: NavFrame> ImuModel<N> {
             f_b,
             acceleration_n,
             w_b,
-            attitude,
+            || self.field_in_body(attitude),
             temperatures,
             state,
             noise,
@@ -222,7 +246,7 @@ impl<N: NavFrame> ImuModel<N> {
         f_b: Vec3<Body>,
         acceleration_n: Vec3<N>,
         w_b: Vec3<Body>,
-        attitude: &Rotation<Body, N>,
+        m_b: impl FnOnce() -> Vec3<Body>,
         temperatures: &Temperatures,
         state: &mut ImuState,
         noise: &mut impl NoiseSource,
@@ -268,9 +292,8 @@ impl<N: NavFrame> ImuModel<N> {
             );
         }
         if self.sensors.magnetometer {
-            let m_b = attitude.inverse().apply(self.mount.magnetic_field_ut);
             reading.mag_ut = self.mag.measure_drawn(
-                m_b.to_array(),
+                m_b().to_array(),
                 &env(temperatures.mag_c, [0.0; 3]),
                 &mut state.mag,
                 &normals[2],

@@ -115,7 +115,7 @@ impl Scenario {
         // The last reading of the previous chunk: increments integrate across the boundary.
         let mut previous: Option<(f64, ImuReading)> = None;
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            let readings = sensors.measure(truth);
+            let (truth_table, readings) = self.on_earth(truth, &mut sensors)?;
             let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
             let imu = match output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, kind),
@@ -134,7 +134,7 @@ impl Scenario {
             };
             previous = t.last().copied().zip(readings.last().copied());
             sink(Chunk {
-                truth: Table::from_truth(truth),
+                truth: truth_table,
                 imu,
             })
         };

@@ -58,6 +58,8 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         duration_s,
         nav_frame: Some(NavFrameName::ENU),
         gravity_m_s2: Some(imu_core::DEFAULT_GRAVITY_M_S2),
+        earth: None,
+        origin: None,
         trajectory,
         imu: ImuSpec::default(),
     };

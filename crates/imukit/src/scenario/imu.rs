@@ -6,8 +6,10 @@ use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 use crate::error::{Error, Result};
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
+use crate::scenario::earth::TangentPlane;
 use crate::scenario::perturb::perturbed;
 use crate::scenario::sensors::SensorSetup;
+use imu_core::earth::EarthTruth;
 
 /// The IMU of a scenario, resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -145,6 +147,35 @@ pub struct ReadingStream<'a, N: NavFrame> {
 }
 
 impl<N: NavFrame> ReadingStream<'_, N> {
+    /// The readings of the next samples on the WGS-84 Earth: `earth` the samples, `local` the
+    /// same in frame `N` (for the time and MATLAB's gyroscope acceleration input).
+    pub fn measure_earth(
+        &mut self,
+        plane: &TangentPlane,
+        earth: &[EarthTruth],
+        local: &[Truth<N>],
+    ) -> Vec<ImuReading> {
+        let lever = Vec3::from_array(self.setup.lever_arm_m);
+        let field = self.model.mount.magnetic_field_ut;
+        earth
+            .iter()
+            .zip(local)
+            .map(|(e, s)| {
+                let ideal = plane.ideal::<N>(e, lever, field);
+                let temperatures = self.setup.sensors.temperature.at(s.t_s);
+                self.model.measure_ideal(
+                    ideal.accel_m_s2,
+                    ideal.gyro_rad_s,
+                    ideal.mag_ut,
+                    s.acceleration_m_s2,
+                    &temperatures,
+                    &mut self.state,
+                    &mut self.noise,
+                )
+            })
+            .collect()
+    }
+
     /// The readings of the next samples of truth.
     pub fn measure(&mut self, truth: &[Truth<N>]) -> Vec<ImuReading> {
         truth

@@ -18,6 +18,7 @@
 //! magnetic_field_ut = [-2.4169, 27.5550, 16.0849]   # nav frame
 //! ```
 pub mod builtin;
+pub mod earth;
 pub mod imu;
 pub mod perturb;
 pub mod resolve;
@@ -25,6 +26,7 @@ pub mod sensors;
 pub mod spec;
 pub mod times;
 
+pub use earth::{EarthSetup, TangentPlane};
 pub use imu::{ImuSetup, ReadingStream};
 pub use spec::{
     AccelSignName, BodyRatesSpec, BuiltinSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName,
@@ -34,7 +36,8 @@ pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
 
 use std::path::Path;
 
-use imu_core::{Enu, NavFrame, Ned};
+use imu_core::sensor::ImuReading;
+use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
 use crate::io::table::{ImuOutput, Table};
@@ -53,8 +56,10 @@ pub struct Scenario {
     pub sample_rate_hz: f64,
     /// Navigation frame.
     pub nav_frame: NavFrameName,
-    /// Gravity magnitude, m/s².
+    /// Gravity magnitude, m/s² (the flat Earth's).
     pub gravity_m_s2: f64,
+    /// The Earth the scenario runs on.
+    pub earth: EarthSetup,
     /// The motion.
     pub trajectory: Trajectory,
     /// The IMU.
@@ -94,12 +99,13 @@ impl Scenario {
     fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
         check_in_memory(self.t_s.len(), IN_MEMORY_BYTES_PER_SAMPLE, "duration_s")?;
         let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
-        let readings = self
-            .imu
-            .readings(&truth, self.gravity_m_s2, self.sample_rate_hz, run)?;
+        let mut sensors =
+            self.imu
+                .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
+        let (truth_table, readings) = self.on_earth(&truth, &mut sensors)?;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         let simulation = Simulation {
-            truth: Table::from_truth(&truth),
+            truth: truth_table,
             imu: match self.imu.output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
                 ImuOutput::Increments => Table::from_increments(&t, &readings, self.imu.kind),
@@ -108,6 +114,34 @@ impl Scenario {
         simulation.truth.check_finite("truth")?;
         simulation.imu.check_finite("IMU readings")?;
         Ok(simulation)
+    }
+
+    /// Tangent-plane (or flat) truth samples on the scenario's Earth: the truth table and the
+    /// readings, the sensors' state carried on.
+    ///
+    /// # Errors
+    /// A sample off the Earth or beyond ±89.9° of latitude (WGS-84), with its time.
+    pub(crate) fn on_earth<N: NavFrame>(
+        &self,
+        truth: &[Truth<N>],
+        sensors: &mut ReadingStream<'_, N>,
+    ) -> Result<(Table, Vec<ImuReading>)> {
+        match &self.earth {
+            EarthSetup::Flat => Ok((Table::from_truth(truth), sensors.measure(truth))),
+            EarthSetup::Wgs84(plane) => {
+                let earth = truth
+                    .iter()
+                    .map(|s| plane.to_earth(s))
+                    .collect::<Result<Vec<_>>>()?;
+                let local: Vec<Truth<N>> = truth
+                    .iter()
+                    .zip(&earth)
+                    .map(|(s, e)| TangentPlane::local(s, e))
+                    .collect();
+                let readings = sensors.measure_earth(plane, &earth, &local);
+                Ok((earth::earth_truth_table(&local, &earth), readings))
+            }
+        }
     }
 
     /// Truth and readings of Monte Carlo run `run`: the noise stream is

@@ -16,10 +16,12 @@ use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
 
+use crate::scenario::earth::{EarthSetup, TangentPlane};
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
 use crate::scenario::times::{SampleTimes, check_in_memory, regular_times};
 use crate::scenario::{ImuSetup, Scenario};
+use imu_core::earth::{Geodetic, GravityModel};
 
 impl ScenarioSpec {
     /// Parses TOML text; `origin` names the file in messages.
@@ -126,6 +128,8 @@ impl ScenarioSpec {
                 duration_s: self.duration_s.or(b.duration_s),
                 nav_frame: self.nav_frame.or(b.nav_frame),
                 gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
+                earth: self.earth.or(b.earth),
+                origin: self.origin.or(b.origin),
                 trajectory: b.trajectory,
                 imu: self.imu.or(&b.imu),
             };
@@ -135,6 +139,9 @@ impl ScenarioSpec {
         };
         let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(imu_core::DEFAULT_GRAVITY_M_S2);
         check_gravity("gravity_m_s2", gravity_m_s2)?;
+        // On the WGS-84 Earth, normal gravity unless this file sets a constant (a built-in's
+        // flat-Earth 9.81 does not count).
+        let earth = earth_setup(spec.earth, spec.origin, self.gravity_m_s2)?;
         let sensors = SensorSetup::resolve(&spec.imu, base_dir)?;
         let accel_sign = spec
             .imu
@@ -232,9 +239,37 @@ impl ScenarioSpec {
             sample_rate_hz,
             nav_frame: spec.nav_frame.unwrap_or_default(),
             gravity_m_s2,
+            earth,
             trajectory,
             imu,
         })
+    }
+}
+
+/// The Earth of a scenario: flat unless `earth = "wgs84"`, which needs an `origin`.
+fn earth_setup(
+    earth: Option<EarthName>,
+    origin: Option<OriginSpec>,
+    gravity_m_s2: Option<f64>,
+) -> Result<EarthSetup> {
+    match (earth.unwrap_or_default(), origin) {
+        (EarthName::Flat, None) => Ok(EarthSetup::Flat),
+        (EarthName::Flat, Some(_)) => Err(invalid(
+            "origin",
+            "is used only with earth = \"wgs84\" (the flat Earth has no place on the globe)",
+        )),
+        (EarthName::Wgs84, None) => Err(invalid(
+            "origin",
+            "missing: earth = \"wgs84\" needs origin = { latitude_deg, longitude_deg, height_m }",
+        )),
+        (EarthName::Wgs84, Some(o)) => {
+            let gravity = match gravity_m_s2 {
+                Some(g) => GravityModel::Constant(check_gravity("gravity_m_s2", g)?),
+                None => GravityModel::Normal,
+            };
+            let origin = Geodetic::from_degrees(o.latitude_deg, o.longitude_deg, o.height_m);
+            Ok(EarthSetup::Wgs84(TangentPlane::new(origin, gravity)?))
+        }
     }
 }
 

@@ -88,13 +88,42 @@ pub struct ScenarioSpec {
     pub duration_s: Option<f64>,
     /// Navigation frame (default ENU).
     pub nav_frame: Option<NavFrameName>,
-    /// Gravity magnitude, m/s² (default 9.81).
+    /// Gravity magnitude, m/s² (default 9.81 on the flat Earth; on the WGS-84 Earth normal
+    /// gravity unless this is set).
     pub gravity_m_s2: Option<f64>,
+    /// The Earth model: `"flat"` (default) or `"wgs84"`.
+    pub earth: Option<EarthName>,
+    /// Where the trajectory's tangent plane touches the WGS-84 ellipsoid (`earth = "wgs84"`).
+    pub origin: Option<OriginSpec>,
     /// The motion.
     pub trajectory: TrajectorySpec,
     /// The IMU.
     #[serde(default)]
     pub imu: ImuSpec,
+}
+
+/// The Earth model of a scenario.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EarthName {
+    /// Flat, non-rotating, constant gravity (the default).
+    #[default]
+    Flat,
+    /// The rotating WGS-84 ellipsoid with normal gravity.
+    Wgs84,
+}
+
+/// `origin = { latitude_deg, longitude_deg, height_m }`: geodetic coordinates on WGS-84.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OriginSpec {
+    /// Geodetic latitude, degrees north.
+    pub latitude_deg: f64,
+    /// Longitude, degrees east.
+    pub longitude_deg: f64,
+    /// Height above the ellipsoid, m (default 0).
+    #[serde(default)]
+    pub height_m: f64,
 }
 
 /// The `[trajectory]` table.

@@ -1,0 +1,210 @@
+//! A scenario on the WGS-84 Earth (`earth = "wgs84"`): the trajectory is given in the local
+//! tangent plane at `origin` (metres along the scenario's frame axes, ENU or NED, attitude
+//! relative to those axes) and carried exactly through ECEF onto the ellipsoid; truth is then
+//! reported in the local-level frame at each position and the IMU senses the Earth rate,
+//! transport rate, Coriolis force and normal gravity ([`imu_core::earth`]).
+//!
+//! The tangent plane is not the ellipsoid: a path level in the plane climbs away from the
+//! ellipsoid (8 m after 10 km), and its local-level attitude turns with the transport rate.
+//! Columns keep their meaning: `pos_*` are the tangent-plane coordinates, `vel_*`/`acc_*` the
+//! ground velocity in the local-level frame at the position and the derivative of its
+//! components, the attitude is relative to that frame, `omega_*` is the attitude rate
+//! `ω_nb^b`; `lat_rad, lon_rad, height_m` and `ecef_*_m` are added.
+use imu_core::earth::ideal::EcefKinematics;
+use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel};
+use imu_core::ideal::IdealReading;
+use imu_core::{Body, Ecef, EulerZyx, NavFrame, Ned, Rotation, Truth, Vec3};
+
+use crate::error::{Result, invalid};
+use crate::io::table::{TRUTH_COLUMNS, Table, truth_row};
+
+/// The truth columns added on the WGS-84 Earth, after [`crate::io::table::TRUTH_COLUMNS`].
+pub const EARTH_TRUTH_COLUMNS: [&str; 6] = [
+    "lat_rad", "lon_rad", "height_m", "ecef_x_m", "ecef_y_m", "ecef_z_m",
+];
+
+/// The Earth a scenario runs on.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum EarthSetup {
+    /// A flat, non-rotating Earth with constant gravity along the frame's vertical (MATLAB
+    /// imuSensor's world; the default).
+    #[default]
+    Flat,
+    /// The rotating WGS-84 ellipsoid, the trajectory in the tangent plane at the origin.
+    Wgs84(TangentPlane),
+}
+
+/// The tangent plane at a point of the WGS-84 ellipsoid and the gravity model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TangentPlane {
+    /// Where the plane touches: its axes are the local NED (or ENU) axes there.
+    pub origin: Geodetic,
+    /// Normal gravity, or a constant when the scenario sets `gravity_m_s2`.
+    pub gravity: GravityModel,
+}
+
+/// Body axes of the frame convention of `N` from FRD: the identity under NED (FRD), a half
+/// turn about x under ENU (FLU: `(x, −y, −z)`).
+fn frd_to_body<N: NavFrame>() -> Rotation<Body, Body> {
+    if N::Z_UP > 0.0 {
+        Rotation::from_wxyz([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()
+    } else {
+        Rotation::identity()
+    }
+}
+
+impl TangentPlane {
+    /// Checks the origin: latitude within ±89.9° (the local NED frame is not used nearer the
+    /// poles), every value finite, the height within 1000 km of the ellipsoid.
+    ///
+    /// # Errors
+    /// The field out of range, named (`origin.latitude_deg`, …).
+    pub fn new(origin: Geodetic, gravity: GravityModel) -> Result<Self> {
+        let lat = origin.latitude_rad.to_degrees();
+        if !(lat.is_finite() && lat.abs() <= imu_core::earth::MAX_LATITUDE_RAD.to_degrees()) {
+            return Err(invalid(
+                "origin.latitude_deg",
+                format!(
+                    "must be within ±89.9° (the local NED frame is not used at the poles), got {lat}"
+                ),
+            ));
+        }
+        if !origin.longitude_rad.is_finite() {
+            return Err(invalid("origin.longitude_deg", "must be a finite number"));
+        }
+        if !(origin.height_m.is_finite() && origin.height_m.abs() <= 1e6) {
+            return Err(invalid(
+                "origin.height_m",
+                format!(
+                    "must be within ±1000 km of the ellipsoid, got {}",
+                    origin.height_m
+                ),
+            ));
+        }
+        Ok(Self { origin, gravity })
+    }
+
+    /// The tangent-plane axes of `N` resolved in ECEF.
+    fn plane_to_ecef<N: NavFrame>(&self) -> Rotation<N, Ecef> {
+        N::from_ned().inverse().then(&self.origin.ned_to_ecef())
+    }
+
+    /// A tangent-plane truth sample (frame `N`, body axes of `N`'s convention) on the Earth.
+    ///
+    /// # Errors
+    /// A position within 43 km of the Earth's centre, or beyond ±89.9° of latitude, named with
+    /// its time.
+    pub fn to_earth<N: NavFrame>(&self, s: &Truth<N>) -> Result<EarthTruth> {
+        let c_et = self.plane_to_ecef::<N>();
+        let to_frd = frd_to_body::<N>().inverse();
+        let k = EcefKinematics {
+            position_m: self.origin.to_ecef() + c_et.apply(s.position_m),
+            velocity_m_s: c_et.apply(s.velocity_m_s),
+            acceleration_m_s2: c_et.apply(s.acceleration_m_s2),
+            attitude: frd_to_body::<N>().then(&s.attitude).then(&c_et),
+            omega_eb_b_rad_s: to_frd.apply(s.omega_b_rad_s),
+            alpha_eb_b_rad_s2: to_frd.apply(s.alpha_b_rad_s2),
+        };
+        let earth = EarthTruth::from_ecef(s.t_s, &k).ok_or_else(|| {
+            invalid(
+                "trajectory",
+                format!("at t = {} s the position is not on the Earth (too near its centre or not finite)", s.t_s),
+            )
+        })?;
+        if earth.position.latitude_rad.abs() > imu_core::earth::MAX_LATITUDE_RAD {
+            return Err(invalid(
+                "trajectory",
+                format!(
+                    "at t = {} s the latitude is {:.4}°, beyond ±89.9° where the local NED frame is not used",
+                    s.t_s,
+                    earth.position.latitude_rad.to_degrees()
+                ),
+            ));
+        }
+        Ok(earth)
+    }
+
+    /// The truth sample as reported in frame `N`: the tangent-plane position of `plane`, the
+    /// rest in the local-level frame at the position (`N`'s axes and body convention).
+    #[must_use]
+    pub fn local<N: NavFrame>(plane: &Truth<N>, earth: &EarthTruth) -> Truth<N> {
+        let from_ned = N::from_ned();
+        let to_body = frd_to_body::<N>();
+        let attitude = to_body.inverse().then(&earth.attitude).then(&from_ned);
+        Truth {
+            t_s: earth.t_s,
+            position_m: plane.position_m,
+            velocity_m_s: from_ned.apply(earth.velocity_m_s),
+            acceleration_m_s2: from_ned.apply(earth.acceleration_m_s2),
+            attitude,
+            euler: unwrap_yaw(attitude.to_euler(), plane.euler),
+            omega_b_rad_s: to_body.apply(earth.omega_nb_b_rad_s),
+            alpha_b_rad_s2: to_body.apply(earth.alpha_nb_b_rad_s2),
+        }
+    }
+
+    /// The columns [`EARTH_TRUTH_COLUMNS`] of a sample.
+    #[must_use]
+    pub fn earth_row(earth: &EarthTruth) -> [f64; 6] {
+        let p = &earth.position;
+        let r = p.to_ecef();
+        [
+            p.latitude_rad,
+            p.longitude_rad,
+            p.height_m,
+            r.x(),
+            r.y(),
+            r.z(),
+        ]
+    }
+
+    /// The ideal reading on the Earth in `N`'s body convention, for the lever arm (body axes
+    /// of `N`'s convention, m) and the magnetic field given in frame `N` (µT): the specific
+    /// force (physical sign), the inertial rate `ω_ib^b` and the field in body axes.
+    #[must_use]
+    pub fn ideal<N: NavFrame>(
+        &self,
+        earth: &EarthTruth,
+        lever_arm_m: Vec3<Body>,
+        magnetic_field_ut: Vec3<N>,
+    ) -> IdealReading {
+        let to_body = frd_to_body::<N>();
+        let mount = EarthMount {
+            lever_arm_m: to_body.inverse().apply(lever_arm_m),
+            accel_sign: imu_core::AccelSign::SpecificForce,
+            gravity: self.gravity,
+        };
+        let field_ned: Vec3<Ned> = N::from_ned().inverse().apply(magnetic_field_ut);
+        let r = mount.read(earth, field_ned);
+        IdealReading {
+            accel_m_s2: to_body.apply(r.accel_m_s2),
+            gyro_rad_s: to_body.apply(r.gyro_rad_s),
+            mag_ut: to_body.apply(r.mag_ut),
+        }
+    }
+}
+
+/// A chunk of truth on the Earth as a table: [`crate::io::table::TRUTH_COLUMNS`] of the local
+/// samples, then [`EARTH_TRUTH_COLUMNS`].
+#[must_use]
+pub fn earth_truth_table<N: NavFrame>(local: &[Truth<N>], earth: &[EarthTruth]) -> Table {
+    let names: Vec<&str> = TRUTH_COLUMNS
+        .iter()
+        .chain(&EARTH_TRUTH_COLUMNS)
+        .copied()
+        .collect();
+    let mut t = Table::new(&names);
+    t.data.reserve(local.len() * names.len());
+    for (s, e) in local.iter().zip(earth) {
+        t.data.extend_from_slice(&truth_row(s));
+        t.data.extend_from_slice(&TangentPlane::earth_row(e));
+    }
+    t
+}
+
+/// Keeps yaw continuous with the tangent-plane yaw (which the trajectory unwrapped).
+fn unwrap_yaw(e: EulerZyx, reference: EulerZyx) -> EulerZyx {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let yaw = e.yaw_rad + two_pi * ((reference.yaw_rad - e.yaw_rad) / two_pi).round();
+    EulerZyx::new(yaw, e.pitch_rad, e.roll_rad)
+}
