@@ -80,6 +80,35 @@ pub enum Command {
         /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
         #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_negative_numbers = true)]
         velocity0: Option<Vec<f64>>,
+        /// 3D: the Earth: `flat` (default; non-rotating, constant gravity) or `wgs84` (the
+        /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
+        /// needs a geodetic position, from an --init truth file of a `wgs84` scenario or
+        /// --lat0-deg/--lon0-deg/--height0-m). Writes lat_rad, lon_rad, height_m beside the
+        /// local columns.
+        #[arg(long, default_value = "flat")]
+        earth: String,
+        /// 3D, `--earth wgs84`: the vertical channel: `free` (unstable, as physics says),
+        /// `hold` (height and vertical velocity held) or `baro` (a third-order loop on the IMU
+        /// file's `baro_height_m` column).
+        #[arg(long, default_value = "free")]
+        vertical: String,
+        /// 3D, `--vertical baro`: the loop's time constant, s.
+        #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
+        baro_time_constant_s: f64,
+        /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
+        /// (--gravity-m-s2).
+        #[arg(long, default_value = "normal")]
+        earth_gravity: String,
+        /// 3D, `--earth wgs84`: the starting latitude, degrees (with --lon0-deg and
+        /// --height0-m; instead of, or over, the --init file's).
+        #[arg(long, allow_negative_numbers = true)]
+        lat0_deg: Option<f64>,
+        /// 3D, `--earth wgs84`: the starting longitude, degrees.
+        #[arg(long, allow_negative_numbers = true)]
+        lon0_deg: Option<f64>,
+        /// 3D, `--earth wgs84`: the starting height above the WGS-84 ellipsoid, m.
+        #[arg(long, allow_negative_numbers = true)]
+        height0_m: Option<f64>,
         /// Where to write the trajectory (CSV).
         #[arg(long)]
         out: PathBuf,

@@ -78,7 +78,10 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
                     velocity0_m_s = None, quaternion0 = None, euler0_rad = None, nav_frame = "ENU",
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
                     accel_sign = "specific-force", scheme = "auto",
-                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64))]
+                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64, earth = "flat",
+                    vertical = "free",
+                    baro_time_constant_s = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
+                    earth_gravity = "normal", lat0_deg = None, lon0_deg = None, height0_m = None))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
     py: Python<'py>,
@@ -97,6 +100,13 @@ fn strapdown<'py>(
     accel_sign: &str,
     scheme: &str,
     substeps: i64,
+    earth: &str,
+    vertical: &str,
+    baro_time_constant_s: f64,
+    earth_gravity: &str,
+    lat0_deg: Option<f64>,
+    lon0_deg: Option<f64>,
+    height0_m: Option<f64>,
 ) -> PyResult<TableOut<'py>> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
     let setup = NavRequest {
@@ -107,6 +117,10 @@ fn strapdown<'py>(
         gravity_m_s2,
         coning,
         sculling,
+        earth,
+        vertical,
+        baro_time_constant_s,
+        earth_gravity,
     }
     .setup()
     .map_err(refused)?;
@@ -120,6 +134,7 @@ fn strapdown<'py>(
             fixed_opt::<3>("euler0_rad", euler0_rad)?,
         ),
     }
+    .and_then(|s| s.with_geodetic0(lat0_deg, lon0_deg, height0_m))
     .map_err(refused)?;
     let out = py
         .detach(|| integrate(&imu, &initial, &setup))

@@ -61,3 +61,47 @@ def test_waypoints_pass_through_their_positions():
     np.testing.assert_allclose(np.column_stack([truth[f"pos_{a}_m"] for a in "xyz"]), p, atol=1e-12)
     with pytest.raises(ImuError, match="at least 2 waypoints"):
         imukit.truth_from_waypoints([0.0], [0.0], [[0, 0, 0]])
+
+
+EARTH_FLIGHT = {
+    "rate_hz": 50.0, "duration_s": 300.0, "nav_frame": "NED", "earth": "wgs84",
+    "origin": {"latitude_deg": 47.0, "longitude_deg": 8.0, "height_m": 500.0},
+    "trajectory": {"type": "expression",
+                   "position_m": ["3000*sin(0.03*t) + 20*t", "3000*(1 - cos(0.03*t))", "-100*sin(0.01*t)"],
+                   "attitude": "tangent"},
+    "imu": {"kind": "accel-gyro"},
+}
+
+
+def test_on_the_wgs84_earth_the_imu_senses_the_earth_and_the_earth_strapdown_undoes_it():
+    rest = imukit.simulate({"nav_frame": "NED", "earth": "wgs84", "duration_s": 1.0,
+                            "origin": {"latitude_deg": 45.0, "longitude_deg": 0.0},
+                            "trajectory": {"type": "builtin", "name": "static"}})
+    omega = 7.292115e-5
+    np.testing.assert_allclose(rest.imu["gyro_x_rad_s"], omega * np.cos(np.pi / 4), rtol=1e-14)
+    np.testing.assert_allclose(rest.imu["gyro_z_rad_s"], -omega * np.sin(np.pi / 4), rtol=1e-14)
+    assert list(rest.truth.columns[-6:]) == ["lat_rad", "lon_rad", "height_m", "ecef_x_m", "ecef_y_m", "ecef_z_m"]
+
+    sim = imukit.simulate(EARTH_FLIGHT)
+    nav = imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED", earth="wgs84")
+    _, on_earth = imukit.compare(sim.truth, nav)
+    assert on_earth["position_max_m"] < 1e-6
+    np.testing.assert_allclose(nav["lat_rad"], sim.truth["lat_rad"], atol=1e-12)
+    flat = imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED")
+    _, on_flat = imukit.compare(sim.truth, flat)
+    assert on_flat["position_final_m"] > 1000.0  # the flat mechanization ignores the Earth
+
+    # A start given by its parts: at rest, level, at 45° N, for an hour with the height held.
+    imu = imukit.simulate({"nav_frame": "NED", "earth": "wgs84", "duration_s": 600.0, "rate_hz": 10.0,
+                           "origin": {"latitude_deg": 45.0, "longitude_deg": 0.0},
+                           "trajectory": {"type": "builtin", "name": "static"}}).imu
+    still = imukit.strapdown(imu, nav_frame="NED", earth="wgs84", vertical="hold",
+                             initial={"latitude_deg": 45.0, "longitude_deg": 0.0, "height_m": 0.0})
+    assert np.max(np.abs(still["pos_x_m"])) < 1e-6 and np.max(np.abs(still["pos_y_m"])) < 1e-6
+    with pytest.raises(ImuError, match="lat_rad, lon_rad, height_m") as e:
+        imukit.strapdown(imu, nav_frame="NED", earth="wgs84")
+    with pytest.raises(ImuError, match="unknown vertical channel") as e:
+        imukit.strapdown(imu, earth="wgs84", vertical="float", initial={"latitude_deg": 0, "longitude_deg": 0, "height_m": 0})
+    assert e.value.field == "vertical"
+    with pytest.raises(ImuError, match="lon0_deg: missing"):
+        imukit.strapdown(imu, earth="wgs84", initial={"latitude_deg": 0})

@@ -28,6 +28,12 @@ pub struct Options3d<'a> {
     pub euler0: Option<&'a [f64]>,
     pub scheme: &'a str,
     pub substeps: usize,
+    pub earth: &'a str,
+    pub vertical: &'a str,
+    pub baro_time_constant_s: f64,
+    pub earth_gravity: &'a str,
+    /// `--lat0-deg`, `--lon0-deg`, `--height0-m`.
+    pub geodetic0: (Option<f64>, Option<f64>, Option<f64>),
 }
 
 fn vector<const K: usize>(
@@ -79,6 +85,10 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         gravity_m_s2: o.gravity_m_s2,
         coning: o.corrections,
         sculling: o.corrections,
+        earth: o.earth,
+        vertical: o.vertical,
+        baro_time_constant_s: o.baro_time_constant_s,
+        earth_gravity: o.earth_gravity,
     }
     .setup()
     .map_err(by_flag)?;
@@ -97,12 +107,17 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     }
     if let Some(e) = o.euler0 {
         let e = vector("--euler0-rad", Some(e), [0.0; 3])?;
-        initial = InitialState::from_euler(
-            initial.position_m,
-            initial.velocity_m_s,
-            EulerZyx::from_array(e),
-        );
+        initial = InitialState {
+            geodetic: initial.geodetic,
+            ..InitialState::from_euler(
+                initial.position_m,
+                initial.velocity_m_s,
+                EulerZyx::from_array(e),
+            )
+        };
     }
+    let (lat, lon, h) = o.geodetic0;
+    initial = initial.with_geodetic0(lat, lon, h).map_err(by_flag)?;
     // Checked here, so that a bad start is blamed on where it came from, not on the IMU file.
     // The start options are checked as they are read; what remains is the --init file's row.
     if let Some(p) = o.init {

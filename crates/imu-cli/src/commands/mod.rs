@@ -39,6 +39,13 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             position0,
             heading0,
             velocity0,
+            earth,
+            vertical,
+            baro_time_constant_s,
+            earth_gravity,
+            lat0_deg,
+            lon0_deg,
+            height0_m,
             out,
         } => {
             let common = integrate::Common {
@@ -59,6 +66,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     euler0: euler0.as_deref(),
                     scheme: scheme.as_deref().unwrap_or("auto"),
                     substeps,
+                    earth: &earth,
+                    vertical: &vertical,
+                    baro_time_constant_s,
+                    earth_gravity: &earth_gravity,
+                    geodetic0: (lat0_deg, lon0_deg, height0_m),
                 };
                 integrate::three_d(&common, &opts)
             }

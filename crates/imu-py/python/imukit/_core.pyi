@@ -191,6 +191,13 @@ def strapdown(
     accel_sign: str = "specific-force",
     scheme: str = "auto",
     substeps: int = ...,
+    earth: str = "flat",
+    vertical: str = "free",
+    baro_time_constant_s: float = ...,
+    earth_gravity: str = "normal",
+    lat0_deg: Optional[float] = None,
+    lon0_deg: Optional[float] = None,
+    height0_m: Optional[float] = None,
 ) -> _Table: ...
 def compare(
     truth_columns: Sequence[str],

@@ -50,6 +50,10 @@ def strapdown(
     accel_sign: str = "specific-force",
     scheme: str = "auto",
     substeps: int = 4,
+    earth: str = "flat",
+    vertical: str = "free",
+    baro_time_constant_s: float = 100.0,
+    earth_gravity: str = "normal",
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
     increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
@@ -64,6 +68,14 @@ def strapdown(
     for increments or when ``coning``/``sculling`` are switched off. ``"coning"`` (docs/design.md
     §6, second order; rates or increments) or ``"rk4"``
     (fourth order: RK4 with ``substeps`` per interval on quintic-interpolated rates; rates only).
+
+    ``earth="wgs84"`` navigates on the rotating WGS-84 Earth (Earth rate, transport rate, Coriolis,
+    normal gravity — or ``earth_gravity="constant"`` for ``gravity_m_s2``): the start needs a
+    geodetic position, from a truth Table of a ``wgs84`` scenario (``lat_rad, lon_rad, height_m``)
+    or the dict keys ``latitude_deg``, ``longitude_deg``, ``height_m``. ``vertical`` is ``"free"``
+    (unstable, as physics says), ``"hold"`` or ``"baro"`` (a third-order loop with time constant
+    ``baro_time_constant_s`` on the IMU table's ``baro_height_m`` column). The output adds
+    ``lat_rad, lon_rad, height_m``; ``pos_*`` stay in the tangent plane of the truth's origin.
     """
     start: dict = {}
     if isinstance(initial, Table):
@@ -71,16 +83,19 @@ def strapdown(
     elif isinstance(initial, Mapping):
         keys = {"position_m": "position0_m", "velocity_m_s": "velocity0_m_s", "quaternion": "quaternion0",
                 "euler_rad": "euler0_rad"}
-        unknown = set(initial) - set(keys)
+        scalars = {"latitude_deg": "lat0_deg", "longitude_deg": "lon0_deg", "height_m": "height0_m"}
+        unknown = set(initial) - set(keys) - set(scalars)
         if unknown:
-            raise ValueError(f"initial: unknown keys {sorted(unknown)}; known: {sorted(keys)}")
-        start = {keys[k]: [float(v) for v in value] for k, value in initial.items()}
+            raise ValueError(f"initial: unknown keys {sorted(unknown)}; known: {sorted(keys) + sorted(scalars)}")
+        start = {keys[k]: [float(v) for v in value] for k, value in initial.items() if k in keys}
+        start.update({scalars[k]: float(v) for k, v in initial.items() if k in scalars})
     elif initial is not None:
         raise TypeError("initial must be a truth Table or a dict")
     return _table(_core.strapdown(
         *_table_args("imu", imu), **start,
         nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
-        accel_sign=accel_sign, scheme=scheme, substeps=int(substeps)))
+        accel_sign=accel_sign, scheme=scheme, substeps=int(substeps), earth=earth, vertical=vertical,
+        baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity))
 
 def compare(truth: Table, estimate: Table):
     """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``.

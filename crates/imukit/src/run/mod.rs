@@ -1,8 +1,9 @@
 //! The jobs a user runs: simulate ([`simulate`], [`arrays`] for in-memory arrays), navigate
-//! ([`navigate`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
+//! ([`navigate`], on the WGS-84 Earth [`earth_nav`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
 pub mod allan;
 pub mod arrays;
 pub mod compare;
+pub mod earth_nav;
 pub mod imu_sensor;
 pub mod navigate;
 pub mod orient;

@@ -11,11 +11,15 @@ use imu_core::strapdown::rk4::{
 use std::collections::VecDeque;
 use std::path::Path;
 
+use imu_core::earth::{Geodetic, GravityModel};
+use imu_core::strapdown::earth::VerticalChannel;
 use imu_core::strapdown::step::{
     NavState, RateStrapdown, Strapdown, StrapdownError, StrapdownOptions, strapdown_increments,
     strapdown_rates,
 };
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+
+use crate::run::earth_nav::{EarthNav, integrate_earth_in};
 
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
@@ -42,6 +46,9 @@ pub const NAV_COLUMNS: [&str; 14] = [
     "roll_rad",
 ];
 
+/// The geodetic columns of truth and navigation on the WGS-84 Earth.
+pub const GEODETIC_COLUMNS: [&str; 3] = ["lat_rad", "lon_rad", "height_m"];
+
 /// Columns [`compare`](crate::run::compare::compare) reads from truth and estimate: the navigation columns up to the
 /// quaternion.
 pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
@@ -55,6 +62,10 @@ pub struct InitialState {
     pub velocity_m_s: [f64; 3],
     /// Attitude quaternion `q_nb` `[w, x, y, z]`.
     pub quaternion: [f64; 4],
+    /// Geodetic position on WGS-84 (navigation on the Earth needs it; `None` on the flat
+    /// Earth). On the Earth, `position_m` is the position in the tangent plane of the truth's
+    /// origin, velocity and attitude are relative to the local-level frame at this position.
+    pub geodetic: Option<Geodetic>,
 }
 
 impl Default for InitialState {
@@ -63,6 +74,7 @@ impl Default for InitialState {
             position_m: [0.0; 3],
             velocity_m_s: [0.0; 3],
             quaternion: [1.0, 0.0, 0.0, 0.0],
+            geodetic: None,
         }
     }
 }
@@ -75,6 +87,7 @@ impl InitialState {
             position_m,
             velocity_m_s,
             quaternion: Rotation::<imu_core::Body, Enu>::from_euler(euler).to_wxyz(),
+            geodetic: None,
         }
     }
 
@@ -114,9 +127,52 @@ impl InitialState {
                     position_m,
                     velocity_m_s,
                     quaternion,
+                    geodetic: None,
                 })
             }
         }
+    }
+
+    /// The same state at the geodetic position `lat0_deg`, `lon0_deg`, `height0_m` (all three
+    /// or none; kept as it is when none).
+    ///
+    /// # Errors
+    /// One or two of the three, non-finite values or a latitude beyond ±90°, naming the field.
+    pub fn with_geodetic0(
+        mut self,
+        lat0_deg: Option<f64>,
+        lon0_deg: Option<f64>,
+        height0_m: Option<f64>,
+    ) -> Result<Self> {
+        let parts = [
+            ("lat0_deg", lat0_deg),
+            ("lon0_deg", lon0_deg),
+            ("height0_m", height0_m),
+        ];
+        if parts.iter().all(|(_, v)| v.is_none()) {
+            return Ok(self);
+        }
+        let mut values = [0.0_f64; 3];
+        for (k, &(name, v)) in parts.iter().enumerate() {
+            values[k] = match v {
+                Some(x) if x.is_finite() => x,
+                Some(x) => return Err(invalid(name, format!("must be a finite number, got {x}"))),
+                None => {
+                    return Err(invalid(
+                        name,
+                        "missing: the starting latitude, longitude and height go together",
+                    ));
+                }
+            };
+        }
+        if values[0].abs() > 90.0 {
+            return Err(invalid(
+                "lat0_deg",
+                format!("must be within ±90°, got {}", values[0]),
+            ));
+        }
+        self.geodetic = Some(Geodetic::from_degrees(values[0], values[1], values[2]));
+        Ok(self)
     }
 
     /// Refuses a state that cannot start an integration: values that are not finite, or a
@@ -161,6 +217,18 @@ impl InitialState {
                 first("vel_z_m_s")?,
             ],
             quaternion: [first("q_w")?, first("q_x")?, first("q_y")?, first("q_z")?],
+            geodetic: match (
+                first("lat_rad").ok(),
+                first("lon_rad").ok(),
+                first("height_m").ok(),
+            ) {
+                (Some(latitude_rad), Some(longitude_rad), Some(height_m)) => Some(Geodetic {
+                    latitude_rad,
+                    longitude_rad,
+                    height_m,
+                }),
+                _ => None,
+            },
         })
     }
 
@@ -179,10 +247,27 @@ impl InitialState {
                 message: "no data rows after the header".into(),
             });
         }
+        let header = crate::io::table::read_header(path)?;
+        let geodetic = if GEODETIC_COLUMNS
+            .iter()
+            .all(|c| header.iter().any(|h| h == c))
+        {
+            let mut rows = CsvRows::open(path, &GEODETIC_COLUMNS, "")?;
+            let mut g = [0.0; 3];
+            rows.next_row(&mut g)?;
+            Some(Geodetic {
+                latitude_rad: g[0],
+                longitude_rad: g[1],
+                height_m: g[2],
+            })
+        } else {
+            None
+        };
         Ok(Self {
             position_m: [r[0], r[1], r[2]],
             velocity_m_s: [r[3], r[4], r[5]],
             quaternion: [r[6], r[7], r[8], r[9]],
+            geodetic,
         })
     }
 }
@@ -244,6 +329,8 @@ pub struct NavSetup {
     pub accel_sign: AccelSign,
     /// Integration scheme.
     pub scheme: NavScheme,
+    /// The WGS-84 Earth mechanization (`None`: the flat Earth).
+    pub earth: Option<EarthNav>,
 }
 
 impl Default for NavSetup {
@@ -253,6 +340,7 @@ impl Default for NavSetup {
             options: StrapdownOptions::default(),
             accel_sign: AccelSign::SpecificForce,
             scheme: NavScheme::ConingSculling,
+            earth: None,
         }
     }
 }
@@ -319,7 +407,19 @@ pub struct NavRequest<'a> {
     pub coning: bool,
     /// Rotation and sculling corrections.
     pub sculling: bool,
+    /// `"flat"` (a flat, non-rotating Earth) or `"wgs84"` (the rotating WGS-84 Earth).
+    pub earth: &'a str,
+    /// On the WGS-84 Earth: `"free"`, `"hold"` or `"baro"` (see [`VerticalChannel`]).
+    pub vertical: &'a str,
+    /// Time constant of the baro loop, s.
+    pub baro_time_constant_s: f64,
+    /// On the WGS-84 Earth: `"normal"` (WGS-84 normal gravity) or `"constant"`
+    /// (`gravity_m_s2`).
+    pub earth_gravity: &'a str,
 }
+
+/// The baro loop's time constant unless told otherwise, s.
+pub const DEFAULT_BARO_TIME_CONSTANT_S: f64 = 100.0;
 
 impl Default for NavRequest<'_> {
     fn default() -> Self {
@@ -331,6 +431,10 @@ impl Default for NavRequest<'_> {
             gravity_m_s2: imu_core::DEFAULT_GRAVITY_M_S2,
             coning: true,
             sculling: true,
+            earth: "flat",
+            vertical: "free",
+            baro_time_constant_s: DEFAULT_BARO_TIME_CONSTANT_S,
+            earth_gravity: "normal",
         }
     }
 }
@@ -356,7 +460,62 @@ impl NavRequest<'_> {
                 coning: self.coning,
                 sculling: self.sculling,
             },
+            earth: self.earth_nav()?,
         })
+    }
+
+    /// The Earth mechanization, checked: `None` on the flat Earth (where `vertical` and
+    /// `earth_gravity` must keep their defaults: they mean nothing there).
+    fn earth_nav(&self) -> Result<Option<EarthNav>> {
+        let vertical = match self.vertical {
+            "free" => VerticalChannel::Free,
+            "hold" => VerticalChannel::Hold,
+            "baro" => {
+                let tau = self.baro_time_constant_s;
+                if !(tau.is_finite() && tau > 0.0) {
+                    return Err(invalid(
+                        "baro_time_constant_s",
+                        format!("must be a finite number > 0 s, got {tau}"),
+                    ));
+                }
+                VerticalChannel::Baro {
+                    time_constant_s: tau,
+                }
+            }
+            other => {
+                return Err(invalid(
+                    "vertical",
+                    format!("unknown vertical channel \"{other}\" (free, hold, baro)"),
+                ));
+            }
+        };
+        let gravity = match self.earth_gravity {
+            "normal" => GravityModel::Normal,
+            "constant" => GravityModel::Constant(check_gravity("gravity_m_s2", self.gravity_m_s2)?),
+            other => {
+                return Err(invalid(
+                    "earth_gravity",
+                    format!("unknown gravity model \"{other}\" (normal, constant)"),
+                ));
+            }
+        };
+        match self.earth {
+            "wgs84" => Ok(Some(EarthNav { vertical, gravity })),
+            "flat" if self.vertical != "free" => Err(invalid(
+                "vertical",
+                "chooses the vertical channel of the WGS-84 Earth (earth = \"wgs84\"); the flat \
+                 Earth has none to choose",
+            )),
+            "flat" if self.earth_gravity != "normal" => Err(invalid(
+                "earth_gravity",
+                "is for the WGS-84 Earth (earth = \"wgs84\"); the flat Earth takes gravity_m_s2",
+            )),
+            "flat" => Ok(None),
+            other => Err(invalid(
+                "earth",
+                format!("unknown Earth model \"{other}\" (flat, wgs84)"),
+            )),
+        }
     }
 }
 
@@ -398,6 +557,9 @@ fn integrate_in<N: NavFrame>(
         ));
     }
     check_gaps(&t, "IMU data", 2)?;
+    if let Some(earth) = &setup.earth {
+        return integrate_earth_in::<N>(imu, &t, initial, setup, earth);
+    }
     let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
         invalid(
             "initial state",
@@ -523,6 +685,9 @@ pub fn integrate_csv(
     setup: &NavSetup,
     out: &Path,
 ) -> Result<NavSummary> {
+    if setup.earth.is_some() {
+        return crate::run::earth_nav::integrate_earth_csv(input, initial, setup, out);
+    }
     match setup.nav_frame {
         NavFrameName::ENU => integrate_csv_in::<Enu>(input, initial, setup, out),
         NavFrameName::NED => integrate_csv_in::<Ned>(input, initial, setup, out),

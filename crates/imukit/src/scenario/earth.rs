@@ -45,7 +45,7 @@ pub struct TangentPlane {
 
 /// Body axes of the frame convention of `N` from FRD: the identity under NED (FRD), a half
 /// turn about x under ENU (FLU: `(x, −y, −z)`).
-fn frd_to_body<N: NavFrame>() -> Rotation<Body, Body> {
+pub(crate) fn frd_to_body<N: NavFrame>() -> Rotation<Body, Body> {
     if N::Z_UP > 0.0 {
         Rotation::from_wxyz([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()
     } else {
