@@ -14,6 +14,10 @@ pub struct Cli {
 
 /// Subcommands.
 #[derive(Debug, Subcommand)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "parsed once per process; boxing the options would only obscure them"
+)]
 pub enum Command {
     /// Truth kinematics and ideal IMU readings of a scenario file (TOML or JSON).
     Simulate {
