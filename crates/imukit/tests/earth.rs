@@ -265,3 +265,89 @@ fn a_bad_origin_or_a_trip_over_the_pole_is_refused_by_name() {
     let e = run(polar).unwrap_err().to_string();
     assert!(e.contains("beyond ±89.9°") && e.contains("at t = 3"), "{e}");
 }
+
+#[test]
+fn the_world_magnetic_model_gives_the_field_at_each_position_and_date() {
+    // At rest and level at 80° N, 0° E on the ellipsoid, 2025-01-01 (decimal year 2025.0): the
+    // magnetometer (NED, FRD) reads NOAA's test value X = 6521.6, Y = 145.9, Z = 54791.5 nT.
+    let text = "rate_hz = 1.0\nduration_s = 2.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+        origin = { latitude_deg = 80.0, longitude_deg = 0.0, height_m = 0.0 }\n\
+        magnetic_model = \"wmm2025\"\ndate = \"2025-01-01\"\n\
+        [trajectory]\ntype = \"builtin\"\nname = \"static\"\n";
+    let sim = run(text).unwrap();
+    for (c, want_nt) in [
+        ("mag_x_ut", 6521.6),
+        ("mag_y_ut", 145.9),
+        ("mag_z_ut", 54791.5),
+    ] {
+        let got = col(&sim, "imu", c)[0] * 1000.0;
+        assert!(
+            (got - want_nt).abs() <= 0.05 + 1e-6,
+            "{c}: {got} nT vs {want_nt}"
+        );
+    }
+    // ENU, level at zero yaw (body FLU along east, north, up): the same field on those axes.
+    let enu = run(&text.replace("\"NED\"", "\"ENU\"")).unwrap();
+    for (c, want_nt) in [
+        ("mag_x_ut", 145.9),
+        ("mag_y_ut", 6521.6),
+        ("mag_z_ut", -54791.5),
+    ] {
+        let got = col(&enu, "imu", c)[0] * 1000.0;
+        assert!(
+            (got - want_nt).abs() <= 0.05 + 1e-6,
+            "ENU {c}: {got} nT vs {want_nt}"
+        );
+    }
+    // Moving 100 km east changes the field: the model is evaluated at each position.
+    let moving = text
+        .replace("duration_s = 2.0", "duration_s = 100.0")
+        .replace(
+            "[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+            "[trajectory]\ntype = \"expression\"\nposition_m = [\"0\", \"1000*t\", \"0\"]\n",
+        );
+    let m = run(&moving).unwrap();
+    let y = col(&m, "imu", "mag_y_ut");
+    assert!((y[100] - y[0]).abs() > 0.05, "{} → {}", y[0], y[100]);
+}
+
+#[test]
+fn a_magnetic_model_needs_the_earth_a_date_in_its_validity_and_no_constant_field() {
+    let base = "rate_hz = 1.0\nduration_s = 2.0\nearth = \"wgs84\"\n\
+        origin = { latitude_deg = 45.0, longitude_deg = 7.0 }\n\
+        magnetic_model = \"wmm2025\"\ndate = \"2026-06-01\"\n\
+        [trajectory]\ntype = \"builtin\"\nname = \"static\"\n";
+    assert!(run(base).is_ok());
+    let cases = [
+        (
+            base.replace("earth = \"wgs84\"\n", "").replace(
+                "origin = { latitude_deg = 45.0, longitude_deg = 7.0 }\n",
+                "",
+            ),
+            "magnetic_model: needs positions on the Earth",
+        ),
+        (base.replace("date = \"2026-06-01\"\n", ""), "date: missing"),
+        (
+            base.replace("2026-06-01", "2026-02-30"),
+            "date: \"2026-02-30\"",
+        ),
+        (base.replace("2026-06-01", "June 1st"), "date: \"June 1st\""),
+        (
+            base.replace("2026-06-01", "2031-01-01"),
+            "valid from 2025.0 to 2030.0",
+        ),
+        (
+            base.replace("magnetic_model = \"wmm2025\"\n", ""),
+            "date: is used by the magnetic model",
+        ),
+        (base.replace("wmm2025", "igrf"), "unknown variant `igrf`"),
+        (
+            format!("{base}[imu]\nmagnetic_field_ut = [20, 0, 40]\n"),
+            "not both",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = run(&text).unwrap_err().to_string();
+        assert!(e.contains(want), "{e}\n-- wanted: {want}");
+    }
+}

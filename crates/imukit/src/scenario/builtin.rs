@@ -60,6 +60,8 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         gravity_m_s2: Some(imu_core::DEFAULT_GRAVITY_M_S2),
         earth: None,
         origin: None,
+        magnetic_model: None,
+        date: None,
         trajectory,
         imu: ImuSpec::default(),
     };

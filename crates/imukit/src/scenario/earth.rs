@@ -11,7 +11,7 @@
 //! components, the attitude is relative to that frame, `omega_*` is the attitude rate
 //! `ω_nb^b`; `lat_rad, lon_rad, height_m` and `ecef_*_m` are added.
 use imu_core::earth::ideal::EcefKinematics;
-use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel};
+use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel, MagneticModel};
 use imu_core::ideal::IdealReading;
 use imu_core::{Body, Ecef, EulerZyx, NavFrame, Ned, Rotation, Truth, Vec3};
 
@@ -24,23 +24,54 @@ pub const EARTH_TRUTH_COLUMNS: [&str; 6] = [
 ];
 
 /// The Earth a scenario runs on.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub enum EarthSetup {
     /// A flat, non-rotating Earth with constant gravity along the frame's vertical (MATLAB
     /// imuSensor's world; the default).
     #[default]
     Flat,
-    /// The rotating WGS-84 ellipsoid, the trajectory in the tangent plane at the origin.
-    Wgs84(TangentPlane),
+    /// The rotating WGS-84 ellipsoid, the trajectory in the tangent plane at the origin (boxed:
+    /// it carries the magnetic model's coefficients).
+    Wgs84(Box<TangentPlane>),
 }
 
-/// The tangent plane at a point of the WGS-84 ellipsoid and the gravity model.
+/// The tangent plane at a point of the WGS-84 ellipsoid, the gravity model and the magnetic
+/// field.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentPlane {
     /// Where the plane touches: its axes are the local NED (or ENU) axes there.
     pub origin: Geodetic,
     /// Normal gravity, or a constant when the scenario sets `gravity_m_s2`.
     pub gravity: GravityModel,
+    /// The World Magnetic Model and the date, or `None` for the constant field of the IMU.
+    pub magnetic: Option<MagneticEnvironment>,
+}
+
+/// A magnetic model and the decimal year at `t = 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticEnvironment {
+    /// The model.
+    pub model: MagneticModel,
+    /// Decimal year at `t = 0`.
+    pub year_at_start: f64,
+}
+
+/// Seconds in a decimal year of the magnetic model's clock (the mean Gregorian year).
+const SECONDS_PER_YEAR: f64 = 365.2425 * 86_400.0;
+
+impl MagneticEnvironment {
+    /// The field at `earth`'s position and time, local NED, µT.
+    ///
+    /// # Errors
+    /// The model's refusal (a height outside −1 km … 850 km, a time past its validity), with
+    /// the time.
+    pub fn field_ned_ut(&self, earth: &EarthTruth) -> Result<Vec3<Ned>> {
+        let year = self.year_at_start + earth.t_s / SECONDS_PER_YEAR;
+        self.model
+            .field_ned_nt(&earth.position, year)
+            .map(|f| f * 1e-3)
+            .map_err(|e| invalid("magnetic_model", format!("at t = {} s: {e}", earth.t_s)))
+    }
 }
 
 /// Body axes of the frame convention of `N` from FRD: the identity under NED (FRD), a half
@@ -81,7 +112,11 @@ impl TangentPlane {
                 ),
             ));
         }
-        Ok(Self { origin, gravity })
+        Ok(Self {
+            origin,
+            gravity,
+            magnetic: None,
+        })
     }
 
     /// The tangent-plane axes of `N` resolved in ECEF.
@@ -159,14 +194,14 @@ impl TangentPlane {
     }
 
     /// The ideal reading on the Earth in `N`'s body convention, for the lever arm (body axes
-    /// of `N`'s convention, m) and the magnetic field given in frame `N` (µT): the specific
-    /// force (physical sign), the inertial rate `ω_ib^b` and the field in body axes.
+    /// of `N`'s convention, m) and the magnetic field in local NED (µT): the specific force
+    /// (physical sign), the inertial rate `ω_ib^b` and the field in body axes.
     #[must_use]
     pub fn ideal<N: NavFrame>(
         &self,
         earth: &EarthTruth,
         lever_arm_m: Vec3<Body>,
-        magnetic_field_ut: Vec3<N>,
+        field_ned: Vec3<Ned>,
     ) -> IdealReading {
         let to_body = frd_to_body::<N>();
         let mount = EarthMount {
@@ -174,7 +209,6 @@ impl TangentPlane {
             accel_sign: imu_core::AccelSign::SpecificForce,
             gravity: self.gravity,
         };
-        let field_ned: Vec3<Ned> = N::from_ned().inverse().apply(magnetic_field_ut);
         let r = mount.read(earth, field_ned);
         IdealReading {
             accel_m_s2: to_body.apply(r.accel_m_s2),

@@ -148,22 +148,33 @@ pub struct ReadingStream<'a, N: NavFrame> {
 
 impl<N: NavFrame> ReadingStream<'_, N> {
     /// The readings of the next samples on the WGS-84 Earth: `earth` the samples, `local` the
-    /// same in frame `N` (for the time and MATLAB's gyroscope acceleration input).
+    /// same in frame `N` (for the time and MATLAB's gyroscope acceleration input). The field is
+    /// the magnetic model's at each position and time, or the IMU's constant field.
+    ///
+    /// # Errors
+    /// The magnetic model's refusal, with the time.
     pub fn measure_earth(
         &mut self,
         plane: &TangentPlane,
         earth: &[EarthTruth],
         local: &[Truth<N>],
-    ) -> Vec<ImuReading> {
+    ) -> Result<Vec<ImuReading>> {
         let lever = Vec3::from_array(self.setup.lever_arm_m);
-        let field = self.model.mount.magnetic_field_ut;
+        let constant = N::from_ned()
+            .inverse()
+            .apply(self.model.mount.magnetic_field_ut);
+        let measure_field = self.setup.kind.has_mag();
         earth
             .iter()
             .zip(local)
             .map(|(e, s)| {
+                let field = match &plane.magnetic {
+                    Some(m) if measure_field => m.field_ned_ut(e)?,
+                    _ => constant,
+                };
                 let ideal = plane.ideal::<N>(e, lever, field);
                 let temperatures = self.setup.sensors.temperature.at(s.t_s);
-                self.model.measure_ideal(
+                Ok(self.model.measure_ideal(
                     ideal.accel_m_s2,
                     ideal.gyro_rad_s,
                     ideal.mag_ut,
@@ -171,7 +182,7 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                     &temperatures,
                     &mut self.state,
                     &mut self.noise,
-                )
+                ))
             })
             .collect()
     }

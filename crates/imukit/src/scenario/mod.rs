@@ -138,7 +138,7 @@ impl Scenario {
                     .zip(&earth)
                     .map(|(s, e)| TangentPlane::local(s, e))
                     .collect();
-                let readings = sensors.measure_earth(plane, &earth, &local);
+                let readings = sensors.measure_earth(plane, &earth, &local)?;
                 Ok((earth::earth_truth_table(&local, &earth), readings))
             }
         }

@@ -16,12 +16,13 @@ use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
 
+use crate::scenario::earth::MagneticEnvironment;
 use crate::scenario::earth::{EarthSetup, TangentPlane};
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
 use crate::scenario::times::{SampleTimes, check_in_memory, regular_times};
 use crate::scenario::{ImuSetup, Scenario};
-use imu_core::earth::{Geodetic, GravityModel};
+use imu_core::earth::{Geodetic, GravityModel, MagneticModel};
 
 impl ScenarioSpec {
     /// Parses TOML text; `origin` names the file in messages.
@@ -130,6 +131,8 @@ impl ScenarioSpec {
                 gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
                 earth: self.earth.or(b.earth),
                 origin: self.origin.or(b.origin),
+                magnetic_model: self.magnetic_model.or(b.magnetic_model),
+                date: self.date.clone().or(b.date),
                 trajectory: b.trajectory,
                 imu: self.imu.or(&b.imu),
             };
@@ -141,7 +144,17 @@ impl ScenarioSpec {
         check_gravity("gravity_m_s2", gravity_m_s2)?;
         // On the WGS-84 Earth, normal gravity unless this file sets a constant (a built-in's
         // flat-Earth 9.81 does not count).
-        let earth = earth_setup(spec.earth, spec.origin, self.gravity_m_s2)?;
+        let mut earth = earth_setup(spec.earth, spec.origin, self.gravity_m_s2)?;
+        let magnetic = magnetic_setup(spec.magnetic_model, spec.date.as_deref(), &earth)?;
+        if magnetic.is_some() && spec.imu.magnetic_field_ut.is_some() {
+            return Err(invalid(
+                "imu.magnetic_field_ut",
+                "give the field as a constant or by magnetic_model, not both",
+            ));
+        }
+        if let EarthSetup::Wgs84(plane) = &mut earth {
+            plane.magnetic = magnetic;
+        }
         let sensors = SensorSetup::resolve(&spec.imu, base_dir)?;
         let accel_sign = spec
             .imu
@@ -246,6 +259,80 @@ impl ScenarioSpec {
     }
 }
 
+/// The magnetic model and the decimal year at `t = 0`: both or neither, on the WGS-84 Earth,
+/// the date within the model's validity.
+fn magnetic_setup(
+    name: Option<MagneticModelName>,
+    date: Option<&str>,
+    earth: &EarthSetup,
+) -> Result<Option<MagneticEnvironment>> {
+    let Some(MagneticModelName::Wmm2025) = name else {
+        return match date {
+            Some(_) => Err(invalid(
+                "date",
+                "is used by the magnetic model: set magnetic_model = \"wmm2025\" too",
+            )),
+            None => Ok(None),
+        };
+    };
+    let EarthSetup::Wgs84(plane) = earth else {
+        return Err(invalid(
+            "magnetic_model",
+            "needs positions on the Earth: set earth = \"wgs84\" and an origin",
+        ));
+    };
+    let date = date.ok_or_else(|| {
+        invalid(
+            "date",
+            "missing: the magnetic model needs the date at t = 0, \"YYYY-MM-DD\"",
+        )
+    })?;
+    let year = decimal_year(date)?;
+    let model = MagneticModel::wmm2025();
+    model
+        .field_ned_nt(&plane.origin, year)
+        .map_err(|e| invalid("date", e.to_string()))?;
+    Ok(Some(MagneticEnvironment {
+        model,
+        year_at_start: year,
+    }))
+}
+
+/// The decimal year of the start of the day `"YYYY-MM-DD"`.
+fn decimal_year(date: &str) -> Result<f64> {
+    let bad = |why: String| invalid("date", format!("\"{date}\": {why}"));
+    let parsed: toml::value::Datetime = date
+        .parse()
+        .map_err(|e: toml::value::DatetimeParseError| bad(e.to_string()))?;
+    let d = match parsed {
+        toml::value::Datetime {
+            date: Some(d),
+            time: None,
+            offset: None,
+        } => d,
+        _ => return Err(bad("expected a date as YYYY-MM-DD".into())),
+    };
+    let year = i32::from(d.year);
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    let days = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
+    let before: u32 = days[..usize::from(d.month) - 1].iter().sum();
+    let day_of_year = before + u32::from(d.day) - 1;
+    Ok(f64::from(year) + f64::from(day_of_year) / if leap { 366.0 } else { 365.0 })
+}
+
 /// The Earth of a scenario: flat unless `earth = "wgs84"`, which needs an `origin`.
 fn earth_setup(
     earth: Option<EarthName>,
@@ -268,7 +355,7 @@ fn earth_setup(
                 None => GravityModel::Normal,
             };
             let origin = Geodetic::from_degrees(o.latitude_deg, o.longitude_deg, o.height_m);
-            Ok(EarthSetup::Wgs84(TangentPlane::new(origin, gravity)?))
+            Ok(EarthSetup::Wgs84(Box::new(TangentPlane::new(origin, gravity)?)))
         }
     }
 }

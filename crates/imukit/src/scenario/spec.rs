@@ -95,6 +95,11 @@ pub struct ScenarioSpec {
     pub earth: Option<EarthName>,
     /// Where the trajectory's tangent plane touches the WGS-84 ellipsoid (`earth = "wgs84"`).
     pub origin: Option<OriginSpec>,
+    /// The magnetic field: `"wmm2025"` (the World Magnetic Model at each position and time;
+    /// `earth = "wgs84"`), else the constant `imu.magnetic_field_ut`.
+    pub magnetic_model: Option<MagneticModelName>,
+    /// The date at `t = 0`, `"YYYY-MM-DD"` (for the magnetic model).
+    pub date: Option<String>,
     /// The motion.
     pub trajectory: TrajectorySpec,
     /// The IMU.
@@ -111,6 +116,14 @@ pub enum EarthName {
     Flat,
     /// The rotating WGS-84 ellipsoid with normal gravity.
     Wgs84,
+}
+
+/// A magnetic field model by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MagneticModelName {
+    /// The World Magnetic Model 2025 (valid 2025.0 to 2030.0).
+    Wmm2025,
 }
 
 /// `origin = { latitude_deg, longitude_deg, height_m }`: geodetic coordinates on WGS-84.
