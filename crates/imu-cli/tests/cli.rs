@@ -890,3 +890,110 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
         .count();
     assert_eq!(rows, 17);
 }
+
+#[test]
+fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missing() {
+    let dir = temp_dir("earth-integrate");
+    std::fs::write(
+        dir.join("flight.toml"),
+        "rate_hz = 50.0\nduration_s = 120.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = { latitude_deg = 47.0, longitude_deg = 8.0, height_m = 500.0 }\n\
+         [trajectory]\ntype = \"expression\"\n\
+         position_m = [\"3000*sin(0.03*t) + 20*t\", \"3000*(1 - cos(0.03*t))\", \"-100*sin(0.01*t)\"]\n\
+         attitude = \"tangent\"\n[imu]\nkind = \"accel-gyro\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            "flight.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let truth_header = std::fs::read_to_string(dir.join("truth.csv")).unwrap();
+    assert!(
+        truth_header
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",lat_rad,lon_rad,height_m,ecef_x_m,ecef_y_m,ecef_z_m")
+    );
+    let integrate = |extra: &[&str], out: &str| {
+        let mut args = vec!["integrate", "imu.csv", "--nav-frame", "NED", "--out", out];
+        args.extend(extra);
+        run_in(&dir, &args)
+    };
+    let (code, err) = integrate(&["--init", "truth.csv", "--earth", "wgs84"], "nav.csv");
+    assert_eq!(code, Some(0), "{err}");
+    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    assert!(
+        nav.lines()
+            .next()
+            .unwrap()
+            .ends_with(",lat_rad,lon_rad,height_m")
+    );
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["compare", "truth.csv", "nav.csv"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8(out.stdout).unwrap();
+    let max_position: f64 = report
+        .lines()
+        .find(|l| l.starts_with("position"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    assert!(max_position < 1e-6, "{report}");
+    // Without a geodetic start, with a flat-only flag, an unknown channel: named.
+    for (extra, needle) in [
+        (
+            vec!["--earth", "wgs84"],
+            "needs the starting latitude, longitude and height",
+        ),
+        (
+            vec!["--vertical", "hold"],
+            "--vertical: chooses the vertical channel of the WGS-84",
+        ),
+        (
+            vec![
+                "--earth",
+                "wgs84",
+                "--vertical",
+                "sideways",
+                "--init",
+                "truth.csv",
+            ],
+            "--vertical: unknown vertical channel \"sideways\"",
+        ),
+        (
+            vec!["--earth", "wgs84", "--lat0-deg", "45"],
+            "--lon0-deg: missing",
+        ),
+        (
+            vec!["--earth", "globe"],
+            "--earth: unknown Earth model \"globe\"",
+        ),
+        (
+            vec![
+                "--earth",
+                "wgs84",
+                "--vertical",
+                "baro",
+                "--init",
+                "truth.csv",
+            ],
+            "needs a baro_height_m column",
+        ),
+    ] {
+        let (code, err) = integrate(&extra, "bad.csv");
+        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        assert!(err.contains(needle), "{extra:?}: {err}");
+        assert!(!dir.join("bad.csv").exists());
+    }
+}

@@ -74,7 +74,8 @@ fn start<N: NavFrame>(initial: &InitialState, t0: f64) -> Result<(EarthNavState,
         invalid(
             "initial state",
             "--earth wgs84 needs the starting latitude, longitude and height: a truth file with \
-             lat_rad, lon_rad, height_m (from a scenario with earth = \"wgs84\"), or geodetic0",
+             lat_rad, lon_rad, height_m (from a scenario with earth = \"wgs84\"), or lat0_deg, \
+             lon0_deg, height0_m",
         )
     })?;
     let attitude = Rotation::<Body, N>::from_wxyz(initial.quaternion).ok_or_else(|| {

@@ -355,7 +355,9 @@ fn earth_setup(
                 None => GravityModel::Normal,
             };
             let origin = Geodetic::from_degrees(o.latitude_deg, o.longitude_deg, o.height_m);
-            Ok(EarthSetup::Wgs84(Box::new(TangentPlane::new(origin, gravity)?)))
+            Ok(EarthSetup::Wgs84(Box::new(TangentPlane::new(
+                origin, gravity,
+            )?)))
         }
     }
 }
