@@ -72,6 +72,11 @@ done
 for f in differentiation_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
   python "examples/$f.py" --figures "$out/figures"
 done
+python examples/gyrocompass.py
+target/release/imukit integrate "$out/schuler_imu.csv" --init "$out/schuler_truth.csv" --nav-frame NED \
+  --earth wgs84 --vertical hold --out "$out/schuler_nav.csv"
+target/release/imukit compare "$out/schuler_truth.csv" "$out/schuler_nav.csv" --out "$out/schuler_err.csv"
+target/release/imukit plot "$out/schuler_err.csv" --out "$out/schuler.png"
 for f in imufilter ahrsfilter ecompass madgwick mahony complementary; do
   target/release/imukit orient "$out/matlab_orientation_imu.csv" --filter "$f" --nav-frame NED --accel-sign matlab \
     --out "$out/orient_$f.csv"

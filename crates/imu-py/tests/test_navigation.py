@@ -105,3 +105,19 @@ def test_on_the_wgs84_earth_the_imu_senses_the_earth_and_the_earth_strapdown_und
     assert e.value.field == "vertical"
     with pytest.raises(ImuError, match="lon0_deg: missing"):
         imukit.strapdown(imu, earth="wgs84", initial={"latitude_deg": 0})
+
+
+def test_gyrocompassing_finds_north_with_a_navigation_grade_imu_only():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[3] / "examples" / "gyrocompass.py"
+    spec = importlib.util.spec_from_file_location("gyrocompass", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    # HG9900: bias 0.003 °/h and angle random walk against the 10.6 °/h horizontal Earth rate at
+    # 45°: a few hundredths of a degree after ten minutes (well within 0.1° for any seed).
+    for seed in (1, 2, 3):
+        assert abs(module.run("hg9900", seed=seed)) < 0.1
+    # HG1700 (1 °/h bias): degrees off, as bias / (Ω cos φ) = 5.4° predicts.
+    assert 2.0 < abs(module.run("hg1700")) < 15.0
