@@ -1,13 +1,22 @@
 //! Throughput (samples/s) of the 3D strapdown step (coning, sculling, gravity, trapezoidal
-//! position) on rate input, and of planar dead reckoning.
+//! position) on rate input, flat and on the WGS-84 Earth (the same increments scheme with Earth
+//! rate, transport rate, Coriolis and normal gravity; and RK4 on both), and of planar dead
+//! reckoning.
 //!
 //! Run: `cargo bench -p imu-benches --bench strapdown`.
 #![allow(missing_docs)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_core::Enu;
+use imu_core::earth::Geodetic;
+use imu_core::strapdown::earth::{
+    EarthNavState, EarthOptions, strapdown_increments_earth, strapdown_rates_earth,
+};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
-use imu_core::strapdown::step::{NavState, StrapdownOptions, strapdown_rates};
+use imu_core::strapdown::rk4::strapdown_rates_rk4;
+use imu_core::strapdown::step::{
+    NavState, StrapdownOptions, strapdown_increments, strapdown_rates,
+};
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("strapdown");
@@ -33,6 +42,64 @@ fn bench(c: &mut Criterion) {
                 .expect("valid")
             });
         });
+        // Increments, flat and on the Earth: the same scheme, the Earth terms added.
+        let dth: Vec<[f64; 3]> = gyro.iter().map(|w| w.map(|x| x * 1e-3)).collect();
+        let dv: Vec<[f64; 3]> = accel.iter().map(|f| f.map(|x| x * 1e-3)).collect();
+        group.bench_function(BenchmarkId::new("3d_increments_flat", n), |b| {
+            b.iter(|| {
+                strapdown_increments(
+                    &t,
+                    &dth,
+                    &dv,
+                    NavState::default(),
+                    StrapdownOptions::default(),
+                    &mut out,
+                )
+                .expect("valid")
+            });
+        });
+        let start = EarthNavState {
+            position: Geodetic::from_degrees(45.0, 7.0, 300.0),
+            ..EarthNavState::default()
+        };
+        let mut eout = vec![EarthNavState::default(); n];
+        group.bench_function(BenchmarkId::new("3d_increments_earth", n), |b| {
+            b.iter(|| {
+                strapdown_increments_earth(
+                    &t,
+                    &dth,
+                    &dv,
+                    None,
+                    &start,
+                    EarthOptions::default(),
+                    &mut eout,
+                )
+                .expect("valid")
+            });
+        });
+        if n >= 6 {
+            group.bench_function(BenchmarkId::new("3d_rk4_flat", n), |b| {
+                b.iter(|| {
+                    strapdown_rates_rk4(&t, &gyro, &accel, NavState::default(), 9.81, 4, &mut out)
+                        .expect("valid")
+                });
+            });
+            group.bench_function(BenchmarkId::new("3d_rk4_earth", n), |b| {
+                b.iter(|| {
+                    strapdown_rates_earth(
+                        &t,
+                        &gyro,
+                        &accel,
+                        None,
+                        &start,
+                        EarthOptions::default(),
+                        4,
+                        &mut eout,
+                    )
+                    .expect("valid")
+                });
+            });
+        }
         let planar: Vec<PlanarSample> = t
             .iter()
             .map(|&s| PlanarSample {
