@@ -107,7 +107,10 @@ fn truth_from_expressions<'py>(
     let t = vector(&t_s);
     let spec = ExpressionSpec {
         constants: constants.unwrap_or_default(),
-        position_m: position_m.map(Formula::Text),
+        position_m: Some(position_m.map(Formula::Text)),
+        latitude_rad: None,
+        longitude_rad: None,
+        height_m: None,
         attitude,
         yaw_rad: yaw_rad.map(Formula::Text),
         pitch_rad: pitch_rad.map(Formula::Text),

@@ -351,3 +351,105 @@ fn a_magnetic_model_needs_the_earth_a_date_in_its_validity_and_no_constant_field
         assert!(e.contains(want), "{e}\n-- wanted: {want}");
     }
 }
+
+#[test]
+fn flying_east_along_a_parallel_given_by_latitude_longitude_height_formulas() {
+    // 250 m/s due east at 30° N, 10 km up, level and heading east relative to the local level:
+    // the specific force is (2Ωv + v²/ρ)·[sin φ, 0, cos φ] − [0, 0, γ] in NED (ρ = (R_E + h)
+    // cos φ, the distance to the polar axis) and the body turns at (Ω + v/ρ) about the axis.
+    let (phi, h, v) = (30f64.to_radians(), 10_000.0, 250.0);
+    let p = Geodetic {
+        latitude_rad: phi,
+        longitude_rad: 0.1,
+        height_m: h,
+    };
+    let (_, r_e) = p.radii_m();
+    let rho = (r_e + h) * phi.cos();
+    let text = format!(
+        "rate_hz = 10.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = {{ latitude_deg = 30.0, longitude_deg = 5.7295779513082321, height_m = 10000.0 }}\n\
+         [trajectory]\ntype = \"expression\"\nconstants = {{ rho = {rho:.17e} }}\n\
+         latitude_rad = \"{phi:.17e}\"\nlongitude_rad = \"0.1 + {v}*t/rho\"\nheight_m = \"{h}\"\n\
+         yaw_rad = \"pi/2\"\npitch_rad = \"0\"\nroll_rad = \"0\"\n[imu]\nkind = \"accel-gyro\"\n"
+    );
+    let sim = run(&text).unwrap();
+    let gamma = normal_gravity_m_s2(&p);
+    let k = 2.0 * OMEGA_IE_RAD_S * v + v * v / rho;
+    let (f_n, f_d) = (k * phi.sin(), k * phi.cos() - gamma);
+    let w = OMEGA_IE_RAD_S + v / rho;
+    // Body x east, y south, z down.
+    let want = [
+        ("accel_x_m_s2", 0.0, 1e-9),
+        ("accel_y_m_s2", -f_n, 1e-9),
+        ("accel_z_m_s2", f_d, 1e-9),
+        ("gyro_x_rad_s", 0.0, 1e-16),
+        ("gyro_y_rad_s", -w * phi.cos(), 1e-16),
+        ("gyro_z_rad_s", -w * phi.sin(), 1e-16),
+    ];
+    for (name, value, tol) in want {
+        for (i, got) in col(&sim, "imu", name).iter().enumerate() {
+            assert!(
+                (got - value).abs() <= tol + 1e-9 * value.abs(),
+                "{name} at sample {i}: {got} vs {value}"
+            );
+        }
+    }
+    let ve = col(&sim, "truth", "vel_y_m_s");
+    assert!(ve.iter().all(|x| (x - v).abs() < 1e-9), "{:?}", &ve[..3]);
+    let lat = col(&sim, "truth", "lat_rad");
+    assert!(lat.iter().all(|l| (l - phi).abs() < 1e-14));
+    // The formulas need the Earth, and come as a set.
+    let flat = text.replace("earth = \"wgs84\"\n", "").replace(
+        "origin = { latitude_deg = 30.0, longitude_deg = 5.7295779513082321, height_m = 10000.0 }\n",
+        "",
+    );
+    let e = run(&flat).unwrap_err().to_string();
+    assert!(e.contains("trajectory.latitude_rad: latitude, longitude and height formulas need earth = \"wgs84\""), "{e}");
+    let partial = text.replace("height_m = \"10000\"\n", "");
+    let e = run(&partial).unwrap_err().to_string();
+    assert!(e.contains("trajectory.height_m: missing"), "{e}");
+    let tangent = text.replace(
+        "yaw_rad = \"pi/2\"\npitch_rad = \"0\"\nroll_rad = \"0\"\n",
+        "attitude = \"tangent\"\n",
+    );
+    let e = run(&tangent).unwrap_err().to_string();
+    assert!(
+        e.contains("not available with latitude/longitude/height formulas"),
+        "{e}"
+    );
+}
+
+#[test]
+fn angles_given_relative_to_the_local_level_come_back_in_the_truth() {
+    // A climbing, turning path by latitude, longitude and height; the attitude written relative
+    // to the local level at each position is what the truth reports (the motion goes through
+    // the tangent plane and back, exactly), in NED and in ENU.
+    for frame in ["NED", "ENU"] {
+        let text = format!(
+            "rate_hz = 10.0\nduration_s = 300.0\nnav_frame = \"{frame}\"\nearth = \"wgs84\"\n\
+             origin = {{ latitude_deg = 52.0, longitude_deg = 4.0, height_m = 0.0 }}\n\
+             [trajectory]\ntype = \"expression\"\n\
+             latitude_rad = \"0.9075712110370514 + 1e-5*t + 2e-8*t^2\"\n\
+             longitude_rad = \"0.06981317007977318 + 2e-5*sin(0.01*t)\"\nheight_m = \"500 + 3*t\"\n\
+             yaw_rad = \"0.3 + 0.01*t\"\npitch_rad = \"0.05\"\nroll_rad = \"0.1*sin(t)\"\n"
+        );
+        let sim = run(&text).unwrap();
+        let t = col(&sim, "truth", "t_s");
+        let (yaw, pitch, roll) = (
+            col(&sim, "truth", "yaw_rad"),
+            col(&sim, "truth", "pitch_rad"),
+            col(&sim, "truth", "roll_rad"),
+        );
+        let lat = col(&sim, "truth", "lat_rad");
+        let h = col(&sim, "truth", "height_m");
+        for i in (0..t.len()).step_by(97) {
+            let s = t[i];
+            let want = [0.3 + 0.01 * s, 0.05, 0.1 * s.sin()];
+            for (got, w) in [yaw[i], pitch[i], roll[i]].iter().zip(want) {
+                assert!((got - w).abs() < 1e-10, "{frame} t = {s}: {got} vs {w}");
+            }
+            assert!((lat[i] - (0.907_571_211_037_051_4 + 1e-5 * s + 2e-8 * s * s)).abs() < 1e-13);
+            assert!((h[i] - (500.0 + 3.0 * s)).abs() < 1e-6);
+        }
+    }
+}

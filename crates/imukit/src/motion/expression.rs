@@ -1,7 +1,15 @@
-//! A motion given by formula strings of time (`type = "expression"`).
+//! A motion given by formula strings of time (`type = "expression"`): positions in metres, or on
+//! the WGS-84 Earth latitude, longitude and height with the attitude relative to the local
+//! level, carried into the tangent plane of the scenario's origin exactly (the ellipsoid's
+//! formulas evaluated over dual numbers).
+
+use imu_core::earth::Geodetic;
+use imu_core::earth::wgs84::{A_M, E2};
+use imu_core::{Ecef, NavFrame, Rotation};
 
 use crate::motion::analytic::{Motion, Scalar};
 use crate::motion::expr::Expr;
+use crate::scenario::NavFrameName;
 
 /// Attitude of an expression motion.
 #[derive(Clone, Debug)]
@@ -14,28 +22,159 @@ pub enum ExpressionAttitude {
     Euler(Box<[Expr; 3]>),
 }
 
+/// Where latitude/longitude/height formulas are carried: the tangent plane at the scenario's
+/// origin, in its frame's axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GeodeticPlane {
+    /// Geodetic formulas whose plane is not known yet (set when the scenario is resolved).
+    Unplaced,
+    /// The plane: the origin's ECEF position, ECEF → plane axes, and whether the axes (and the
+    /// body convention) are ENU/FLU rather than NED/FRD.
+    Placed {
+        /// The origin's ECEF position, m.
+        origin_m: [f64; 3],
+        /// `C_te`: ECEF → plane axes, row-major.
+        ecef_to_plane: [[f64; 3]; 3],
+        /// Axes ENU (body FLU) rather than NED (body FRD).
+        enu: bool,
+    },
+}
+
+impl GeodeticPlane {
+    /// The plane at `origin` with the axes of `frame`.
+    #[must_use]
+    pub fn placed(origin: &Geodetic, frame: NavFrameName) -> Self {
+        fn c_te<N: NavFrame>(origin: &Geodetic) -> [[f64; 3]; 3] {
+            let r: Rotation<Ecef, N> = origin.ned_to_ecef().inverse().then(&N::from_ned());
+            r.to_dcm()
+        }
+        let (ecef_to_plane, enu) = match frame {
+            NavFrameName::ENU => (c_te::<imu_core::Enu>(origin), true),
+            NavFrameName::NED => (c_te::<imu_core::Ned>(origin), false),
+        };
+        Self::Placed {
+            origin_m: origin.to_ecef().to_array(),
+            ecef_to_plane,
+            enu,
+        }
+    }
+}
+
 /// A motion given by formulas of time.
 #[derive(Clone, Debug)]
 pub struct ExpressionMotion {
-    /// `[x, y, z]` formulas, m.
+    /// `[x, y, z]` formulas, m; or `[latitude (rad), longitude (rad), height (m)]` when
+    /// `geodetic` is set.
     pub position: [Expr; 3],
-    /// The attitude.
+    /// The attitude (relative to the local level for geodetic formulas).
     pub attitude: ExpressionAttitude,
+    /// Geodetic formulas and their tangent plane.
+    pub geodetic: Option<GeodeticPlane>,
 }
 
-impl Motion for ExpressionMotion {
-    fn position<D: Scalar>(&self, t: D) -> [D; 3] {
+/// `M · v` for a constant matrix and a dual vector.
+fn mat_vec<D: Scalar>(m: &[[f64; 3]; 3], v: [D; 3]) -> [D; 3] {
+    std::array::from_fn(|i| v[0] * m[i][0] + v[1] * m[i][1] + v[2] * m[i][2])
+}
+
+/// `A · B` for dual matrices.
+fn mat_mul<D: Scalar>(a: &[[D; 3]; 3], b: &[[D; 3]; 3]) -> [[D; 3]; 3] {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
+    })
+}
+
+/// `C = Rz(yaw) Ry(pitch) Rx(roll)` over duals.
+fn zyx<D: Scalar>(yaw: D, pitch: D, roll: D) -> [[D; 3]; 3] {
+    let (sy, cy, sp, cp, sr, cr) = (
+        yaw.sin(),
+        yaw.cos(),
+        pitch.sin(),
+        pitch.cos(),
+        roll.sin(),
+        roll.cos(),
+    );
+    [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+}
+
+/// The local NED axes in ECEF at `(φ, λ)` over duals (`C_en`, columns north, east, down).
+fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
+    let (sp, cp, sl, cl) = (lat.sin(), lat.cos(), lon.sin(), lon.cos());
+    let zero = D::from(0.0);
+    [
+        [-sp * cl, -sl, -cp * cl],
+        [-sp * sl, cl, -cp * sl],
+        [cp, zero, -sp],
+    ]
+}
+
+impl ExpressionMotion {
+    /// The formulas at `t`: `[x, y, z]`, or `[φ, λ, h]` for geodetic ones.
+    fn formulas<D: Scalar>(&self, t: D) -> [D; 3] {
         [
             self.position[0].eval(t),
             self.position[1].eval(t),
             self.position[2].eval(t),
         ]
     }
-    fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
-        match &self.attitude {
-            ExpressionAttitude::Tangent => None,
-            ExpressionAttitude::Level => Some([D::from(0.0); 3]),
-            ExpressionAttitude::Euler(e) => Some([e[0].eval(t), e[1].eval(t), e[2].eval(t)]),
+}
+
+impl Motion for ExpressionMotion {
+    fn position<D: Scalar>(&self, t: D) -> [D; 3] {
+        let p = self.formulas(t);
+        match self.geodetic {
+            Some(GeodeticPlane::Placed {
+                origin_m,
+                ecef_to_plane,
+                ..
+            }) => {
+                // ECEF of (φ, λ, h), then into the plane: exact derivatives through the duals.
+                let [lat, lon, h] = p;
+                let s = lat.sin();
+                let r_e = (-(s * s) * E2 + 1.0).sqrt().recip() * A_M;
+                let horizontal = (r_e + h) * lat.cos();
+                let ecef = [
+                    horizontal * lon.cos() - origin_m[0],
+                    horizontal * lon.sin() - origin_m[1],
+                    (r_e * (1.0 - E2) + h) * s - origin_m[2],
+                ];
+                mat_vec(&ecef_to_plane, ecef)
+            }
+            _ => p,
         }
+    }
+    fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
+        let local = match &self.attitude {
+            ExpressionAttitude::Tangent => return None,
+            ExpressionAttitude::Level => [D::from(0.0); 3],
+            ExpressionAttitude::Euler(e) => [e[0].eval(t), e[1].eval(t), e[2].eval(t)],
+        };
+        let Some(GeodeticPlane::Placed {
+            ecef_to_plane, enu, ..
+        }) = self.geodetic
+        else {
+            return Some(local);
+        };
+        // C_tb = C_te · C_e,local(φ, λ) · C_local,b, each in the frame's convention; then the
+        // z-y-x angles of C_tb over duals.
+        let [lat, lon, _] = self.formulas(t);
+        let c_en = ned_to_ecef(lat, lon);
+        let c_el = if enu {
+            // Local ENU axes: (e, n, u) = (y, x, −z) of NED, so C_e,enu = C_en · P.
+            std::array::from_fn(|i| [c_en[i][1], c_en[i][0], -c_en[i][2]])
+        } else {
+            c_en
+        };
+        let c_te: [[D; 3]; 3] = ecef_to_plane.map(|row| row.map(D::from));
+        let c_tb = mat_mul(&mat_mul(&c_te, &c_el), &zyx(local[0], local[1], local[2]));
+        Some([
+            c_tb[1][0].atan2(c_tb[0][0]),
+            (-c_tb[2][0]).asin(),
+            c_tb[2][1].atan2(c_tb[2][2]),
+        ])
     }
 }

@@ -39,7 +39,10 @@ fn expression(
     constants.insert("f".to_string(), 1.0);
     TrajectorySpec::Expression(ExpressionSpec {
         constants,
-        position_m: position.map(Formula::from),
+        position_m: Some(position.map(Formula::from)),
+        latitude_rad: None,
+        longitude_rad: None,
+        height_m: None,
         attitude: attitude.map(str::to_string),
         yaw_rad: angles.map(|a| a[0].into()),
         pitch_rad: angles.map(|a| a[1].into()),

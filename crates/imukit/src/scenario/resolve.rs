@@ -11,6 +11,7 @@ use crate::io::params::ParamValue;
 use crate::io::table::read_columns;
 use crate::motion::analytic::AnalyticOptions;
 use crate::motion::expr::Expr;
+use crate::motion::expression::GeodeticPlane;
 use crate::motion::track::{SpeedProfile, Track};
 use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
@@ -182,8 +183,21 @@ impl ScenarioSpec {
                     need(spec.rate_hz, "rate_hz")?,
                     need(spec.duration_s, "duration_s")?,
                 )?;
+                let mut motion = e.motion()?;
+                if motion.geodetic.is_some() {
+                    let EarthSetup::Wgs84(plane) = &earth else {
+                        return Err(invalid(
+                            "trajectory.latitude_rad",
+                            "latitude, longitude and height formulas need earth = \"wgs84\" and an origin",
+                        ));
+                    };
+                    motion.geodetic = Some(GeodeticPlane::placed(
+                        &plane.origin,
+                        spec.nav_frame.unwrap_or_default(),
+                    ));
+                }
                 (
-                    Trajectory::Expression(e.motion()?, AnalyticOptions { min_speed_m_s }),
+                    Trajectory::Expression(motion, AnalyticOptions { min_speed_m_s }),
                     t,
                 )
             }

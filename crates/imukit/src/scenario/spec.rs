@@ -12,6 +12,7 @@ use crate::io::params::Profile;
 use crate::io::params::SensorTable;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::motion::expr::Expr;
+use crate::motion::expression::GeodeticPlane;
 use crate::motion::track::Segment;
 use crate::motion::{ExpressionAttitude, ExpressionMotion};
 use crate::scenario::perturb::PerturbationSpec;
@@ -260,8 +261,20 @@ pub struct ExpressionSpec {
     /// Named constants usable in the formulas.
     #[serde(default)]
     pub constants: BTreeMap<String, f64>,
-    /// Position formulas `[x, y, z]`, navigation frame, m.
-    pub position_m: [Formula; 3],
+    /// Position formulas `[x, y, z]`, navigation frame, m (or, on the WGS-84 Earth,
+    /// `latitude_rad`, `longitude_rad`, `height_m`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<[Formula; 3]>,
+    /// Geodetic latitude formula, rad (`earth = "wgs84"`, with `longitude_rad` and `height_m`
+    /// instead of `position_m`; angles are then relative to the local level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub latitude_rad: Option<Formula>,
+    /// Longitude formula, rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub longitude_rad: Option<Formula>,
+    /// Height above the WGS-84 ellipsoid formula, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_m: Option<Formula>,
     /// `"tangent"` or `"level"`; leave out when giving angles.
     pub attitude: Option<String>,
     /// Yaw formula, rad.
@@ -439,11 +452,46 @@ impl ExpressionSpec {
     pub fn motion(&self) -> Result<ExpressionMotion> {
         let spec = self;
         let c = &spec.constants;
-        let position = [
-            spec.position_m[0].parse("trajectory.position_m[0]", c)?,
-            spec.position_m[1].parse("trajectory.position_m[1]", c)?,
-            spec.position_m[2].parse("trajectory.position_m[2]", c)?,
-        ];
+        let geodetic = [&spec.latitude_rad, &spec.longitude_rad, &spec.height_m];
+        let (position, geodetic_formulas) = match (&spec.position_m, geodetic) {
+            (Some(p), [None, None, None]) => (
+                [
+                    p[0].parse("trajectory.position_m[0]", c)?,
+                    p[1].parse("trajectory.position_m[1]", c)?,
+                    p[2].parse("trajectory.position_m[2]", c)?,
+                ],
+                false,
+            ),
+            (None, [Some(lat), Some(lon), Some(h)]) => (
+                [
+                    lat.parse("trajectory.latitude_rad", c)?,
+                    lon.parse("trajectory.longitude_rad", c)?,
+                    h.parse("trajectory.height_m", c)?,
+                ],
+                true,
+            ),
+            (Some(_), _) => {
+                return Err(invalid(
+                    "trajectory.position_m",
+                    "give position_m or latitude_rad, longitude_rad and height_m, not both",
+                ));
+            }
+            (None, [None, None, None]) => {
+                return Err(invalid(
+                    "trajectory.position_m",
+                    "missing: give position_m = [x, y, z] (or, with earth = \"wgs84\", \
+                     latitude_rad, longitude_rad and height_m)",
+                ));
+            }
+            (None, parts) => {
+                let names = ["latitude_rad", "longitude_rad", "height_m"];
+                let missing = names[parts.iter().position(|p| p.is_none()).unwrap_or(0)];
+                return Err(invalid(
+                    &format!("trajectory.{missing}"),
+                    "missing: geodetic formulas come as latitude_rad, longitude_rad and height_m together",
+                ));
+            }
+        };
         let angles = [&spec.yaw_rad, &spec.pitch_rad, &spec.roll_rad];
         let has_angles = angles.iter().any(|a| a.is_some());
         let attitude = match (spec.attitude.as_deref(), has_angles) {
@@ -474,6 +522,18 @@ impl ExpressionSpec {
                 ExpressionAttitude::Euler(Box::new([e(0)?, e(1)?, e(2)?]))
             }
         };
-        Ok(ExpressionMotion { position, attitude })
+        if geodetic_formulas && matches!(attitude, ExpressionAttitude::Tangent) {
+            return Err(invalid(
+                "trajectory.attitude",
+                "\"tangent\" is not available with latitude/longitude/height formulas yet: give \
+                 yaw_rad, pitch_rad, roll_rad relative to the local level (or position_m in the \
+                 tangent plane)",
+            ));
+        }
+        Ok(ExpressionMotion {
+            position,
+            attitude,
+            geodetic: geodetic_formulas.then_some(GeodeticPlane::Unplaced),
+        })
     }
 }
