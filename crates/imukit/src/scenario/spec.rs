@@ -487,7 +487,7 @@ impl ExpressionSpec {
                 let names = ["latitude_rad", "longitude_rad", "height_m"];
                 let missing = names[parts.iter().position(|p| p.is_none()).unwrap_or(0)];
                 return Err(invalid(
-                    &format!("trajectory.{missing}"),
+                    format!("trajectory.{missing}"),
                     "missing: geodetic formulas come as latitude_rad, longitude_rad and height_m together",
                 ));
             }
