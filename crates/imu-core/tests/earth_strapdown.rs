@@ -406,3 +406,40 @@ fn the_poles_are_refused_by_sample() {
     .unwrap_err();
     assert!(matches!(err, StrapdownError::BadOption { .. }), "{err:?}");
 }
+
+#[test]
+fn an_east_gyro_bias_gives_the_textbook_growing_schuler_response() {
+    // ε = 0.01 °/h on the east gyro, level at 45° N, height held: the tilt it builds is fed back
+    // through the Schuler loop and the north position error follows
+    // −R ε (t − sin(ω_s t)/ω_s) (a tilt about east carries the platform south; Titterton &
+    // Weston §12.3): a linear drift with the 84-minute ripple, 1.6 km after 90 minutes. The
+    // Earth rate's coupling into heading bends it by 2.5 % at most over that time.
+    let truth = rest_45();
+    let r = EarthMount::default().read(&truth, Vec3::zeros());
+    let eps = (0.01f64 / 3600.0).to_radians();
+    let gyro = r.gyro_rad_s + Vec3::new(0.0, eps, 0.0);
+    let out = run_constant(
+        &nav_state(&truth),
+        gyro,
+        r.accel_m_s2,
+        1.0,
+        5401,
+        VerticalChannel::Hold,
+        None,
+    );
+    let (r_n, _) = truth.position.radii_m();
+    let radius = r_n + truth.position.height_m;
+    let w_s = (normal_gravity_m_s2(&truth.position) / radius).sqrt();
+    let north = |t: usize| north_east_m(&truth.position, &out[t].position).0;
+    let end = radius * eps * (5400.0 - (w_s * 5400.0).sin() / w_s);
+    assert!((1500.0..2000.0).contains(&end.abs()), "{end}");
+    for t in (600..=5400).step_by(600) {
+        let want = radius * eps * (t as f64 - (w_s * t as f64).sin() / w_s);
+        assert!(
+            (north(t) + want).abs() < 0.03 * end.abs(),
+            "{t} s: {} m vs {} m",
+            north(t),
+            -want
+        );
+    }
+}
