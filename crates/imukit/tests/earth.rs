@@ -453,3 +453,57 @@ fn angles_given_relative_to_the_local_level_come_back_in_the_truth() {
         }
     }
 }
+
+#[test]
+fn geodetic_waypoints_are_passed_exactly_on_the_earth() {
+    let text = "rate_hz = 10.0\nduration_s = 300.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+        origin = { latitude_deg = 47.0, longitude_deg = 8.0, height_m = 400.0 }\n\
+        [trajectory]\ntype = \"waypoints\"\ntime_s = [0, 100, 200, 300]\n\
+        geodetic = [\n  { latitude_deg = 47.0, longitude_deg = 8.0, height_m = 400.0 },\n\
+          { latitude_deg = 47.05, longitude_deg = 8.05, height_m = 900.0 },\n\
+          { latitude_deg = 47.12, longitude_deg = 8.06, height_m = 1500.0 },\n\
+          { latitude_deg = 47.15, longitude_deg = 8.2, height_m = 1200.0 },\n]\n";
+    let sim = run(text).unwrap();
+    let (lat, lon, h) = (
+        col(&sim, "truth", "lat_rad"),
+        col(&sim, "truth", "lon_rad"),
+        col(&sim, "truth", "height_m"),
+    );
+    for (k, (la, lo, he)) in [
+        (47.0, 8.0, 400.0),
+        (47.05, 8.05, 900.0),
+        (47.12, 8.06, 1500.0),
+        (47.15, 8.2, 1200.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let i = k * 1000;
+        assert!(
+            (lat[i] - f64::to_radians(la)).abs() < 1e-12,
+            "{k}: {}",
+            lat[i]
+        );
+        assert!(
+            (lon[i] - f64::to_radians(lo)).abs() < 1e-12,
+            "{k}: {}",
+            lon[i]
+        );
+        assert!((h[i] - he).abs() < 1e-6, "{k}: {}", h[i]);
+    }
+    let flat = text.replace("earth = \"wgs84\"\n", "").replace(
+        "origin = { latitude_deg = 47.0, longitude_deg = 8.0, height_m = 400.0 }\n",
+        "",
+    );
+    let e = run(&flat).unwrap_err().to_string();
+    assert!(
+        e.contains("trajectory.geodetic: geodetic waypoints need earth"),
+        "{e}"
+    );
+    let polar = text.replace("latitude_deg = 47.15", "latitude_deg = 95");
+    let e = run(&polar).unwrap_err().to_string();
+    assert!(
+        e.contains("trajectory.geodetic[3]: needs a latitude within ±89.9°"),
+        "{e}"
+    );
+}

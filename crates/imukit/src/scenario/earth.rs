@@ -119,6 +119,28 @@ impl TangentPlane {
         })
     }
 
+    /// The coordinates of `p` in the plane, axes of `frame`, m.
+    #[must_use]
+    pub fn plane_coordinates(
+        &self,
+        p: &Geodetic,
+        frame: crate::scenario::NavFrameName,
+    ) -> [f64; 3] {
+        let d = p.to_ecef() - self.origin.to_ecef();
+        match frame {
+            crate::scenario::NavFrameName::ENU => self
+                .plane_to_ecef::<imu_core::Enu>()
+                .inverse()
+                .apply(d)
+                .to_array(),
+            crate::scenario::NavFrameName::NED => self
+                .plane_to_ecef::<imu_core::Ned>()
+                .inverse()
+                .apply(d)
+                .to_array(),
+        }
+    }
+
     /// The tangent-plane axes of `N` resolved in ECEF.
     fn plane_to_ecef<N: NavFrame>(&self) -> Rotation<N, Ecef> {
         N::from_ned().inverse().then(&self.origin.ned_to_ecef())

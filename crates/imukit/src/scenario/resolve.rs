@@ -238,9 +238,10 @@ impl ScenarioSpec {
                 (Trajectory::Samples(path), t)
             }
             TrajectorySpec::Waypoints(w) => {
+                let positions = waypoint_positions(w, &earth, spec.nav_frame.unwrap_or_default())?;
                 let path = Waypoints::new(
                     &w.time_s,
-                    &w.position_m,
+                    &positions,
                     w.velocity_m_s.as_deref(),
                     w.euler_rad.as_deref(),
                 )?;
@@ -345,6 +346,51 @@ fn decimal_year(date: &str) -> Result<f64> {
     let before: u32 = days[..usize::from(d.month) - 1].iter().sum();
     let day_of_year = before + u32::from(d.day) - 1;
     Ok(f64::from(year) + f64::from(day_of_year) / if leap { 366.0 } else { 365.0 })
+}
+
+/// Waypoint positions in the navigation frame: as given, or geodetic ones placed in the tangent
+/// plane at the origin (axes of `frame`).
+fn waypoint_positions(
+    w: &WaypointsSpec,
+    earth: &EarthSetup,
+    frame: NavFrameName,
+) -> Result<Vec<[f64; 3]>> {
+    match (&w.position_m, &w.geodetic) {
+        (Some(p), None) => Ok(p.clone()),
+        (None, Some(g)) => {
+            let EarthSetup::Wgs84(plane) = earth else {
+                return Err(invalid(
+                    "trajectory.geodetic",
+                    "geodetic waypoints need earth = \"wgs84\" and an origin",
+                ));
+            };
+            g.iter()
+                .enumerate()
+                .map(|(k, o)| {
+                    let lat = o.latitude_deg;
+                    if !(lat.abs() <= 89.9 && o.longitude_deg.is_finite() && o.height_m.is_finite()) {
+                        return Err(invalid(
+                            format!("trajectory.geodetic[{k}]"),
+                            format!(
+                                "needs a latitude within ±89.9° and a finite longitude and height, got {lat}°, {}°, {} m",
+                                o.longitude_deg, o.height_m
+                            ),
+                        ));
+                    }
+                    let p = Geodetic::from_degrees(lat, o.longitude_deg, o.height_m);
+                    Ok(plane.plane_coordinates(&p, frame))
+                })
+                .collect()
+        }
+        (Some(_), Some(_)) => Err(invalid(
+            "trajectory.geodetic",
+            "give position_m or geodetic waypoints, not both",
+        )),
+        (None, None) => Err(invalid(
+            "trajectory.position_m",
+            "missing: give position_m (or, with earth = \"wgs84\", geodetic) waypoints",
+        )),
+    }
 }
 
 /// The Earth of a scenario: flat unless `earth = "wgs84"`, which needs an `origin`.

@@ -335,7 +335,13 @@ pub struct WaypointsSpec {
     /// Waypoint times, s (increasing).
     pub time_s: Vec<f64>,
     /// Waypoint positions `[x, y, z]`, navigation frame, m.
-    pub position_m: Vec<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<Vec<[f64; 3]>>,
+    /// Instead of `position_m`, on the WGS-84 Earth: `{ latitude_deg, longitude_deg, height_m }`
+    /// per waypoint, placed exactly in the tangent plane at the origin (the path between them is
+    /// the spline in that plane; velocities and angles are along its axes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geodetic: Option<Vec<OriginSpec>>,
     /// Velocities: two rows (start, end: clamped spline) or one per waypoint (quintic Hermite, C²).
     pub velocity_m_s: Option<Vec<[f64; 3]>>,
     /// Attitude `[yaw, pitch, roll]` per waypoint, rad; without it the attitude is tangent.
