@@ -11,8 +11,9 @@ says no cleanly.
     python tests/fuzz/hostile.py --cases 5000 --seed 7   # a long run; any seed reproduces itself
 
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
-long, extreme numbers); extreme numeric options; output paths that collide with inputs, special
-files and folders; Python calls with NaN, inf, huge and misshapen arguments. Prints one line per
+long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
+(extreme origins, geodetic formulas, dates, vertical channels); output paths that collide with
+inputs, special files and folders; Python calls with NaN, inf, huge and misshapen arguments. Prints one line per
 class and a closing ``N passed, M failed`` line; exits 1 on any failure.
 """
 from __future__ import annotations
@@ -164,7 +165,7 @@ def cli_cases(rng: random.Random, cases: int) -> list:
         subprocess.run([imukit_bin(), "allan", "imu.csv", "--out", "allan.csv"], cwd=work, check=True, capture_output=True)
         (work / "p.json").write_text(PARAMS)
         valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv")}
-        per = max(1, cases // 5)
+        per = max(1, cases // 6)
 
         r = Run("byte mutations of valid files")
         for k in range(per):
@@ -214,6 +215,32 @@ def cli_cases(rng: random.Random, cases: int) -> list:
             ])
             run_cli(r, work, args, ["imu.csv", "truth.csv"], f"case {k}")
             for leftover in ("o.html", "o.gif"):
+                (work / leftover).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("scenarios and navigation on the WGS-84 Earth")
+        for k in range(per):
+            x = lambda: rng.choice(EXTREMES + ["45", "-89.9", "89.95", "90", "180", "1e6", "-2000"])  # noqa: E731
+            motion = rng.choice([
+                f'position_m = ["{rng.choice(["300*t", "1e7*t", "t", "0"])}", "0", "{x()}"]\nattitude = "tangent"',
+                f'latitude_rad = "{x()}"\nlongitude_rad = "{rng.choice(["0.1", "t", "1e9*t"])}"\nheight_m = "{x()}"\nyaw_rad = "1"',
+                'latitude_rad = "0.5"\nlongitude_rad = "0.1"',
+            ])
+            extra = rng.choice(["", f'magnetic_model = "wmm2025"\ndate = "{rng.choice(["2026-06-01", "2031-01-01", "2026-02-30", "x"])}"\n'])
+            (work / "e.toml").write_text(
+                f'rate_hz = 10.0\nduration_s = {rng.choice(["1", "5", "0"])}\nnav_frame = "{rng.choice(["NED", "ENU"])}"\n'
+                f'earth = "{rng.choice(["wgs84", "wgs84", "flat"])}"\n'
+                f'origin = {{ latitude_deg = {x()}, longitude_deg = {x()}, height_m = {x()} }}\n{extra}'
+                f'[trajectory]\ntype = "expression"\n{motion}\n')
+            run_cli(r, work, ["simulate", "e.toml", "--out", "eo.csv", "--truth", "et.csv"], ["e.toml"], f"case {k}")
+            if (work / "eo.csv").exists() and (work / "et.csv").exists():
+                run_cli(r, work, rng.choice([
+                    ["integrate", "eo.csv", "--init", "et.csv", "--earth", "wgs84", "--vertical",
+                     rng.choice(["free", "hold", "baro", "up"]), "--out", "en.csv"],
+                    ["integrate", "eo.csv", "--earth", "wgs84", "--lat0-deg", x(), "--lon0-deg", x(),
+                     "--height0-m", x(), "--out", "en.csv"],
+                ]), ["eo.csv", "et.csv"], f"case {k} (navigation)")
+            for leftover in ("eo.csv", "et.csv", "en.csv"):
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 

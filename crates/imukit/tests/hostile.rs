@@ -176,6 +176,8 @@ const SCENARIOS: &[&str] = &[
     "samples.toml",
     "matlab_stationary.toml",
     "matlab_platform_realistic.toml",
+    "earth_flight.toml",
+    "schuler.toml",
 ];
 
 proptest! {
