@@ -507,3 +507,73 @@ fn geodetic_waypoints_are_passed_exactly_on_the_earth() {
         "{e}"
     );
 }
+
+#[test]
+fn samples_of_latitude_longitude_and_height_give_the_formulas_readings() {
+    // The climbing, turning path by formulas, then the same path as samples of latitude,
+    // longitude, height and local angles (no pos_* columns): the finite differences (sixth
+    // order at 20 Hz) give the exact readings to their error, which here is the rounding of
+    // positions carried from radians on a 6.4e6 m Earth (1e-9 m, amplified by 1/h²).
+    let dir = std::env::temp_dir().join(format!("imukit-earth-samples-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let head = "rate_hz = 20.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+        origin = { latitude_deg = 52.0, longitude_deg = 4.0, height_m = 0.0 }\n";
+    let formulas = format!(
+        "{head}[trajectory]\ntype = \"expression\"\n\
+         latitude_rad = \"0.9075712110370514 + 1e-5*t + 2e-8*t^2\"\n\
+         longitude_rad = \"0.06981317007977318 + 2e-5*sin(0.01*t)\"\nheight_m = \"500 + 3*t\"\n\
+         yaw_rad = \"0.3 + 0.01*t\"\npitch_rad = \"0.05\"\nroll_rad = \"0.1*sin(t)\"\n\
+         [imu]\nkind = \"accel-gyro\"\n"
+    );
+    let exact = run(&formulas).unwrap();
+    let names = [
+        "t_s",
+        "lat_rad",
+        "lon_rad",
+        "height_m",
+        "yaw_rad",
+        "pitch_rad",
+        "roll_rad",
+    ];
+    let cols: Vec<Vec<f64>> = names.iter().map(|c| col(&exact, "truth", c)).collect();
+    let mut csv = names.join(",") + "\n";
+    for i in 0..cols[0].len() {
+        let row: Vec<String> = cols.iter().map(|c| format!("{:?}", c[i])).collect();
+        csv += &(row.join(",") + "\n");
+    }
+    std::fs::write(dir.join("geodetic.csv"), csv).unwrap();
+    let samples = format!(
+        "{head}[trajectory]\ntype = \"samples\"\nfile = \"geodetic.csv\"\n[imu]\nkind = \"accel-gyro\"\n"
+    );
+    let sampled = ScenarioSpec::from_toml(&samples, "samples.toml")
+        .unwrap()
+        .resolve(&dir)
+        .unwrap()
+        .simulate()
+        .unwrap();
+    // Away from the ends (one-sided differences there).
+    for (name, tol) in [
+        ("accel_x_m_s2", 1e-5),
+        ("accel_y_m_s2", 1e-5),
+        ("accel_z_m_s2", 1e-5),
+        ("gyro_x_rad_s", 1e-10),
+        ("gyro_y_rad_s", 1e-10),
+        ("gyro_z_rad_s", 1e-10),
+    ] {
+        let (a, b) = (col(&exact, "imu", name), col(&sampled, "imu", name));
+        let worst = (20..a.len() - 20)
+            .map(|i| (a[i] - b[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < tol, "{name}: {worst:e}");
+    }
+    let flat = samples.replace("earth = \"wgs84\"\n", "").replace(
+        "origin = { latitude_deg = 52.0, longitude_deg = 4.0, height_m = 0.0 }\n",
+        "",
+    );
+    let e = ScenarioSpec::from_toml(&flat, "samples.toml")
+        .unwrap()
+        .resolve(&dir)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("geodetic samples need earth = \"wgs84\""), "{e}");
+}

@@ -37,6 +37,10 @@ pub struct SampledPath {
     pub options: SampledOptions,
     /// First data row in the file (2 for a CSV file with a header), 0 for arrays.
     pub first_row: usize,
+    /// The positions are `[latitude (rad), longitude (rad), height (m)]` and the attitude is
+    /// relative to the local level (a file with `lat_rad, lon_rad, height_m` and no `pos_*`),
+    /// until the scenario places them in its tangent plane.
+    pub geodetic: bool,
 }
 
 impl SampledPath {
@@ -46,11 +50,14 @@ impl SampledPath {
     /// Missing columns, bad values (row and column named), unreadable files.
     pub fn from_csv(path: &Path, order: usize, tangent: bool, min_speed_m_s: f64) -> Result<Self> {
         const POS: [&str; 4] = ["t_s", "pos_x_m", "pos_y_m", "pos_z_m"];
+        const GEODETIC: [&str; 4] = ["t_s", "lat_rad", "lon_rad", "height_m"];
         const EULER: [&str; 3] = ["yaw_rad", "pitch_rad", "roll_rad"];
         const QUAT: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
         let header = read_header(path)?;
         let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
-        let mut required: Vec<&str> = POS.to_vec();
+        // Metres when the file has them; else latitude, longitude and height.
+        let geodetic = !has(&POS) && has(&GEODETIC);
+        let mut required: Vec<&str> = if geodetic { GEODETIC } else { POS }.to_vec();
         let kind = if tangent {
             0
         } else if has(&EULER) {
@@ -103,6 +110,7 @@ impl SampledPath {
                 min_speed_m_s,
             },
             first_row: 2,
+            geodetic,
         })
     }
 

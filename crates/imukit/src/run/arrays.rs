@@ -74,6 +74,7 @@ pub fn truth_from_arrays_into(
         attitude,
         options,
         first_row: 0,
+        geodetic: false,
     };
     let mut rows = out.chunks_exact_mut(WIDTH);
     const CHUNK: usize = 4096;

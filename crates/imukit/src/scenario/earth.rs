@@ -141,6 +141,75 @@ impl TangentPlane {
         }
     }
 
+    /// Geodetic samples (`[φ, λ, h]`, attitude relative to the local level) placed in the plane:
+    /// positions in plane coordinates, attitudes as quaternions relative to the plane's axes
+    /// (`C_tb = C_t,local(φ, λ) C_local,b`), axes of `frame`. The finite differences then run
+    /// in the plane, where the motion is smooth.
+    ///
+    /// # Errors
+    /// A latitude beyond ±89.9° or a value that is not finite, with its row.
+    pub fn place_samples(
+        &self,
+        path: &mut crate::motion::SampledPath,
+        frame: crate::scenario::NavFrameName,
+    ) -> Result<()> {
+        match frame {
+            crate::scenario::NavFrameName::ENU => self.place_in::<imu_core::Enu>(path),
+            crate::scenario::NavFrameName::NED => self.place_in::<imu_core::Ned>(path),
+        }
+    }
+
+    fn place_in<N: NavFrame>(&self, path: &mut crate::motion::SampledPath) -> Result<()> {
+        use crate::motion::sampled::SampledAttitudeData;
+        let c_te = self.plane_to_ecef::<N>().inverse();
+        let r0 = self.origin.to_ecef();
+        let mut quaternions = Vec::with_capacity(path.position_m.len());
+        for (k, p) in path.position_m.iter_mut().enumerate() {
+            let [lat, lon, h] = *p;
+            if !(lat.abs() <= imu_core::earth::MAX_LATITUDE_RAD && lon.is_finite() && h.is_finite())
+            {
+                return Err(invalid(
+                    &path.origin,
+                    format!(
+                        "row {}: latitude {lat} rad, longitude {lon} rad, height {h} m: the latitude must be within ±89.9° and every value finite",
+                        k + path.first_row
+                    ),
+                ));
+            }
+            let g = Geodetic {
+                latitude_rad: lat,
+                longitude_rad: lon,
+                height_m: h,
+            };
+            *p = c_te.apply(g.to_ecef() - r0).to_array();
+            // Local level of N's convention at the sample, in the plane's axes.
+            let local: Rotation<N, N> = N::from_ned().inverse().then(&g.ned_to_ecef()).then(&c_te);
+            let body: Option<Rotation<Body, N>> = match &path.attitude {
+                SampledAttitudeData::Euler(e) => Some(Rotation::from_euler(e[k])),
+                SampledAttitudeData::Quaternion(q) => {
+                    Some(Rotation::from_wxyz(q[k]).ok_or_else(|| {
+                        invalid(
+                            &path.origin,
+                            format!(
+                                "row {}: the quaternion has zero norm or is not finite",
+                                k + path.first_row
+                            ),
+                        )
+                    })?)
+                }
+                SampledAttitudeData::Tangent => None,
+            };
+            if let Some(b) = body {
+                quaternions.push(b.then(&local).to_wxyz());
+            }
+        }
+        if !matches!(path.attitude, SampledAttitudeData::Tangent) {
+            path.attitude = SampledAttitudeData::Quaternion(quaternions);
+        }
+        path.geodetic = false;
+        Ok(())
+    }
+
     /// The tangent-plane axes of `N` resolved in ECEF.
     fn plane_to_ecef<N: NavFrame>(&self) -> Rotation<N, Ecef> {
         N::from_ned().inverse().then(&self.origin.ned_to_ecef())

@@ -232,7 +232,19 @@ impl ScenarioSpec {
                     .order
                     .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
                 let min_speed = check_min_speed("trajectory.min_speed_m_s", s.min_speed_m_s)?;
-                let path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+                let mut path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+                if path.geodetic {
+                    let EarthSetup::Wgs84(plane) = &earth else {
+                        return Err(invalid(
+                            "trajectory.file",
+                            format!(
+                                "{} has lat_rad, lon_rad, height_m and no pos_*: geodetic samples need earth = \"wgs84\" and an origin",
+                                path.origin
+                            ),
+                        ));
+                    };
+                    plane.place_samples(&mut path, spec.nav_frame.unwrap_or_default())?;
+                }
                 path.check()?;
                 let t = SampleTimes::Listed(path.t_s.clone());
                 (Trajectory::Samples(path), t)
