@@ -412,11 +412,64 @@ fn flying_east_along_a_parallel_given_by_latitude_longitude_height_formulas() {
         "yaw_rad = \"pi/2\"\npitch_rad = \"0\"\nroll_rad = \"0\"\n",
         "attitude = \"tangent\"\n",
     );
-    let e = run(&tangent).unwrap_err().to_string();
-    assert!(
-        e.contains("not available with latitude/longitude/height formulas"),
-        "{e}"
-    );
+    // The tangent attitude (nose along the ground velocity, wings level in the local frame)
+    // is the same heading east, level: the same readings.
+    let along = run(&tangent).unwrap();
+    for (name, _, _) in want {
+        let (a, b) = (col(&sim, "imu", name), col(&along, "imu", name));
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-12, "{name}: {worst:e}");
+    }
+}
+
+#[test]
+fn a_tangent_attitude_over_geodetic_formulas_follows_the_local_ground_velocity() {
+    // Climbing at 3 m/s while drifting north-east: the nose along the ground velocity in the
+    // local frame, in NED (yaw from north, climb nose-up) and ENU (yaw from east, the flat
+    // tangent attitude's convention), from the truth's own velocity columns.
+    for frame in ["NED", "ENU"] {
+        let text = format!(
+            "rate_hz = 10.0\nduration_s = 300.0\nnav_frame = \"{frame}\"\nearth = \"wgs84\"\n\
+             origin = {{ latitude_deg = 52.0, longitude_deg = 4.0, height_m = 0.0 }}\n\
+             [trajectory]\ntype = \"expression\"\n\
+             latitude_rad = \"0.9075712110370514 + 1e-5*t + 2e-8*t^2\"\n\
+             longitude_rad = \"0.06981317007977318 + 2e-5*sin(0.01*t)\"\nheight_m = \"500 + 3*t\"\n\
+             attitude = \"tangent\"\n"
+        );
+        let sim = run(&text).unwrap();
+        let v: Vec<Vec<f64>> = ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]
+            .iter()
+            .map(|c| col(&sim, "truth", c))
+            .collect();
+        let (yaw, pitch, roll) = (
+            col(&sim, "truth", "yaw_rad"),
+            col(&sim, "truth", "pitch_rad"),
+            col(&sim, "truth", "roll_rad"),
+        );
+        for i in (0..yaw.len()).step_by(53) {
+            let (vx, vy, vz) = (v[0][i], v[1][i], v[2][i]);
+            let want_yaw = vy.atan2(vx);
+            let want_pitch = -vz.atan2(vx.hypot(vy));
+            assert!(
+                (yaw[i] - want_yaw).abs() < 1e-10,
+                "{frame} {i}: {} vs {want_yaw}",
+                yaw[i]
+            );
+            assert!(
+                (pitch[i] - want_pitch).abs() < 1e-10,
+                "{frame} {i}: {}",
+                pitch[i]
+            );
+            assert!(roll[i].abs() < 1e-10, "{frame} {i}: roll {}", roll[i]);
+        }
+        if frame == "NED" {
+            assert!(pitch[100] > 0.0, "a climb is nose-up in NED");
+        }
+    }
 }
 
 #[test]

@@ -43,6 +43,23 @@ use imu_core::{EulerZyx, NavFrame, Rotation, Vec3};
 pub trait Scalar: DualNum<Primitive = f64> + Copy {}
 impl<D: DualNum<Primitive = f64> + Copy> Scalar for D {}
 
+/// `atan2(y, x)` over duals with derivatives that stay finite wherever the angle is defined:
+/// num-dual's differentiates `atan(y/x)`, which is infinite at `x = 0` (a heading of exactly
+/// 90°); this takes `atan(y/x)` or `−atan(x/y)`, whichever divides by the larger, and sets the
+/// value from `f64::atan2`.
+#[must_use]
+pub fn atan2<D: Scalar>(y: D, x: D) -> D {
+    let (yr, xr) = (y.re(), x.re());
+    let branch = if xr.abs() >= yr.abs() {
+        (y / x).atan()
+    } else {
+        -(x / y).atan()
+    };
+    // The value exactly `f64::atan2` (the branch's own value cancels exactly), the derivatives
+    // the branch's.
+    D::from(yr.atan2(xr)) + (branch - D::from(branch.re()))
+}
+
 /// An analytic motion: position of S (navigation frame, m) and optional Euler angles (rad).
 pub trait Motion {
     /// Position `[x, y, z]` of the reference point S at time `t` (s), navigation frame, m.

@@ -794,7 +794,7 @@ fn eval<D: Scalar>(n: &Node, t: D) -> D {
         Node::F2(f, a, b) => {
             let (x, y) = (eval(a, t), eval(b, t));
             match f {
-                Func2::Atan2 => x.atan2(y),
+                Func2::Atan2 => crate::motion::analytic::atan2(x, y),
                 Func2::Hypot => (x * x + y * y).sqrt(),
                 Func2::Pow => x.powd(y),
                 Func2::Min => {
@@ -887,6 +887,22 @@ mod tests {
             .eval(Dual3::<f64>::new(4.0, 1.0, 0.0, 0.0));
         assert!((p.v1 - (3.0 * 16.0 - 16.0 + 0.25)).abs() < 1e-14);
         assert!((p.v2 - (6.0 * 4.0 - 4.0 - 0.25 / 8.0)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn atan2_differentiates_where_its_second_argument_is_zero() {
+        // atan2(t, 1 − t) at t = 1: the angle π/2, d/dt = ((1 − t)·1 − t·(−1))/((1−t)² + t²) = 1,
+        // second derivative −2(2t − 1)… = −2 at t = 1 ((x² + y²)' = 2(2t − 1)).
+        let e = parse("atan2(t, 1 - t)").unwrap();
+        let d = e.eval(Dual3::new(1.0, 1.0, 0.0, 0.0));
+        assert_eq!(d.re, std::f64::consts::FRAC_PI_2);
+        assert!((d.v1 - 1.0).abs() < 1e-15, "{}", d.v1);
+        assert!((d.v2 + 2.0).abs() < 1e-14, "{}", d.v2);
+        // The value is f64::atan2's, bit for bit, on either branch.
+        for (y, x) in [(1.0, 3.0), (3.0, 1.0), (-2.0, -0.5), (0.1, -4.0)] {
+            let v: f64 = parse(&format!("atan2({y}, {x})")).unwrap().eval(0.0);
+            assert_eq!(v.to_bits(), f64::atan2(y, x).to_bits());
+        }
     }
 
     #[test]

@@ -7,7 +7,9 @@ use imu_core::earth::Geodetic;
 use imu_core::earth::wgs84::{A_M, E2};
 use imu_core::{Ecef, NavFrame, Rotation};
 
-use crate::motion::analytic::{Motion, Scalar};
+use num_dual::DualNum;
+
+use crate::motion::analytic::{Motion, Scalar, atan2};
 use crate::motion::expr::Expr;
 use crate::scenario::NavFrameName;
 
@@ -113,6 +115,43 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
+    /// The tangent attitude relative to the local level for geodetic formulas: yaw and pitch of
+    /// the ground velocity `v^n = C_ne dr^e/dt` (NED; the frame's convention for ENU), no roll.
+    /// The velocity's own derivatives come from evaluating the formulas once more over a dual
+    /// number nested inside `D`. A standstill has no direction: its angles are not finite, and
+    /// the sample is refused.
+    fn local_tangent<D: Scalar>(&self, t: D) -> [D; 3] {
+        let inner = num_dual::Dual::<D>::new(t, D::from(1.0));
+        let [lat, lon, h] = self.formulas(inner);
+        let s = lat.sin();
+        let r_e = (-(s * s) * E2 + 1.0).sqrt().recip() * A_M;
+        let horizontal = (r_e + h) * lat.cos();
+        let ecef = [
+            horizontal * lon.cos(),
+            horizontal * lon.sin(),
+            (r_e * (1.0 - E2) + h) * s,
+        ];
+        let v_e = ecef.map(|c| c.eps);
+        let c_en = ned_to_ecef(lat.re, lon.re);
+        // v^n = C_enᵀ v^e.
+        let v: [D; 3] = std::array::from_fn(|i| {
+            c_en[0][i] * v_e[0] + c_en[1][i] * v_e[1] + c_en[2][i] * v_e[2]
+        });
+        let enu = matches!(self.geodetic, Some(GeodeticPlane::Placed { enu: true, .. }));
+        let (along, across, down) = if enu {
+            (v[1], v[0], v[2]) // ENU: x east, y north; yaw from east towards north
+        } else {
+            (v[0], v[1], v[2])
+        };
+        let ground = (along * along + across * across).sqrt();
+        let pitch = if enu {
+            atan2(down, ground) // FLU: nose up is negative pitch about y (left)
+        } else {
+            atan2(-down, ground)
+        };
+        [atan2(across, along), pitch, D::from(0.0)]
+    }
+
     /// The formulas at `t`: `[x, y, z]`, or `[φ, λ, h]` for geodetic ones.
     fn formulas<D: Scalar>(&self, t: D) -> [D; 3] {
         [
@@ -148,7 +187,9 @@ impl Motion for ExpressionMotion {
         }
     }
     fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]> {
+        let placed = matches!(self.geodetic, Some(GeodeticPlane::Placed { .. }));
         let local = match &self.attitude {
+            ExpressionAttitude::Tangent if placed => self.local_tangent(t),
             ExpressionAttitude::Tangent => return None,
             ExpressionAttitude::Level => [D::from(0.0); 3],
             ExpressionAttitude::Euler(e) => [e[0].eval(t), e[1].eval(t), e[2].eval(t)],
@@ -172,9 +213,9 @@ impl Motion for ExpressionMotion {
         let c_te: [[D; 3]; 3] = ecef_to_plane.map(|row| row.map(D::from));
         let c_tb = mat_mul(&mat_mul(&c_te, &c_el), &zyx(local[0], local[1], local[2]));
         Some([
-            c_tb[1][0].atan2(c_tb[0][0]),
+            atan2(c_tb[1][0], c_tb[0][0]),
             (-c_tb[2][0]).asin(),
-            c_tb[2][1].atan2(c_tb[2][2]),
+            atan2(c_tb[2][1], c_tb[2][2]),
         ])
     }
 }

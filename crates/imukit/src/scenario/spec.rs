@@ -528,14 +528,6 @@ impl ExpressionSpec {
                 ExpressionAttitude::Euler(Box::new([e(0)?, e(1)?, e(2)?]))
             }
         };
-        if geodetic_formulas && matches!(attitude, ExpressionAttitude::Tangent) {
-            return Err(invalid(
-                "trajectory.attitude",
-                "\"tangent\" is not available with latitude/longitude/height formulas yet: give \
-                 yaw_rad, pitch_rad, roll_rad relative to the local level (or position_m in the \
-                 tangent plane)",
-            ));
-        }
         Ok(ExpressionMotion {
             position,
             attitude,
