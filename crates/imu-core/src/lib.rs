@@ -29,6 +29,7 @@ extern crate alloc;
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");
 
+pub mod aiding;
 pub mod allan;
 pub mod earth;
 pub mod frame;

@@ -32,11 +32,25 @@ impl SeededNormals {
     /// do not depend on how many runs there are or which thread runs them.
     #[must_use]
     pub fn for_run(seed: u64, run: u64) -> Self {
-        let mut z = seed ^ run.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        Self::new(z ^ (z >> 31))
+        Self::new(mix(seed, run))
     }
+
+    /// The stream of another sensor of the same scenario (`stream` ≥ 1; the IMU's own streams
+    /// are [`Self::new`] and [`Self::for_run`]), for the single run (`run = None`) or Monte Carlo
+    /// run `r`: independent of the IMU's and of each other, and as reproducible.
+    #[must_use]
+    pub fn for_sensor(seed: u64, run: Option<u64>, stream: u64) -> Self {
+        let key = mix(seed, u64::MAX - stream);
+        Self::new(mix(key, run.unwrap_or(u64::MAX)))
+    }
+}
+
+/// SplitMix64's finaliser of `seed` mixed with `index`.
+fn mix(seed: u64, index: u64) -> u64 {
+    let mut z = seed ^ index.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 impl NoiseSource for SeededNormals {

@@ -1,0 +1,5 @@
+//! Aiding sensors: what a navigator fuses with the IMU. [`gnss`]: a GNSS receiver's position and
+//! velocity errors (MATLAB gpsSensor's model, and a Gauss–Markov alternative).
+pub mod gnss;
+
+pub use gnss::{GnssError, GnssModel, GnssParams, GnssState, PositionNoise};
