@@ -29,6 +29,10 @@ pub enum Command {
         /// Where to write the truth (CSV).
         #[arg(long)]
         truth: Option<PathBuf>,
+        /// Where to write the GNSS fixes of the scenario's `[gnss]` receiver (CSV; with --runs,
+        /// one per run like the IMU readings).
+        #[arg(long)]
+        gnss: Option<PathBuf>,
         /// Monte Carlo: this many runs, in parallel on all cores, one output per run
         /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
         #[arg(long)]

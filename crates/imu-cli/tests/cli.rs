@@ -997,3 +997,35 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
         assert!(!dir.join("bad.csv").exists());
     }
 }
+
+#[test]
+fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
+    let dir = temp_dir("gnss-simulate");
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 50.0\nduration_s = 10.0\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n\
+         [gnss]\nrate_hz = 5.0\n[[gnss.outages]]\nstart_s = 2.0\nduration_s = 1.0\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate", "s.toml", "--out", "imu.csv", "--gnss", "gnss.csv", "--runs", "2",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    for r in 0..2 {
+        let text = std::fs::read_to_string(dir.join(format!("gnss_run{r:04}.csv"))).unwrap();
+        // 51 epochs at 5 Hz, 5 in the outage [2, 3).
+        assert_eq!(text.lines().count(), 1 + 51 - 5, "run {r}");
+        assert!(text.starts_with("t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n"));
+    }
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate", "s.toml", "--out", "imu.csv", "--gnss", "imu.csv",
+        ],
+    );
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("--gnss") && err.contains("--out"), "{err}");
+}

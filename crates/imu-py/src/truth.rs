@@ -23,8 +23,8 @@ use crate::convert::{
 };
 use crate::errors::{refused, shape_error};
 
-/// Truth and IMU tables of one run.
-type SimulationOut<'py> = (TableOut<'py>, TableOut<'py>);
+/// Truth, IMU and (when the scenario has a receiver) GNSS tables of one run.
+type SimulationOut<'py> = (TableOut<'py>, TableOut<'py>, Option<TableOut<'py>>);
 
 /// Runs a resolved scenario spec with the GIL released.
 fn run_spec<'py>(
@@ -44,10 +44,12 @@ fn run_spec<'py>(
             }
         })
         .map_err(refused)?;
-    Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?))
+    let gnss = sim.gnss.map(|g| table_out(py, g)).transpose()?;
+    Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?, gnss))
 }
 
-/// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu) tables.
+/// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu, gnss or None)
+/// tables.
 #[pyfunction]
 #[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None))]
 fn simulate_text<'py>(

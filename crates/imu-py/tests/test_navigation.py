@@ -121,3 +121,21 @@ def test_gyrocompassing_finds_north_with_a_navigation_grade_imu_only():
         assert abs(module.run("hg9900", seed=seed)) < 0.1
     # HG1700 (1 °/h bias): degrees off, as bias / (Ω cos φ) = 5.4° predicts.
     assert 2.0 < abs(module.run("hg1700")) < 15.0
+
+
+def test_a_scenario_with_a_gnss_receiver_returns_its_fixes():
+    scenario = {"rate_hz": 100.0, "duration_s": 20.0, "trajectory": {"type": "builtin", "name": "figure8"},
+                "gnss": {"rate_hz": 10.0, "horizontal_accuracy_m": 0.0, "vertical_accuracy_m": 0.0,
+                         "velocity_accuracy_m_s": 0.0, "latency_s": 0.1}}
+    sim = imukit.simulate(scenario)
+    assert list(sim.gnss.columns) == ["t_s", "pos_x_m", "pos_y_m", "pos_z_m", "vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]
+    # Exact fixes of every 10th sample, stamped 0.1 s late (the last one falls after the run).
+    np.testing.assert_allclose(sim.gnss["t_s"], sim.truth["t_s"][:-10:10] + 0.1, atol=1e-12)
+    np.testing.assert_allclose(sim.gnss["pos_x_m"], sim.truth["pos_x_m"][:-10:10], atol=1e-12)
+    noisy = imukit.simulate({**scenario, "gnss": {"rate_hz": 10.0}}, run=3)
+    again = imukit.simulate({**scenario, "gnss": {"rate_hz": 10.0}}, run=3)
+    np.testing.assert_array_equal(noisy.gnss.values, again.gnss.values)
+    assert imukit.simulate({k: v for k, v in scenario.items() if k != "gnss"}).gnss is None
+    with pytest.raises(ImuError, match="gnss.rate_hz") as e:
+        imukit.simulate({**scenario, "gnss": {"rate_hz": 7.0}})
+    assert e.value.field == "gnss.rate_hz"

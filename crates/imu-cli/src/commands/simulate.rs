@@ -14,6 +14,7 @@ pub fn run(
     scenario: &Path,
     out: &Path,
     truth: Option<&Path>,
+    gnss: Option<&Path>,
     runs: Option<u64>,
 ) -> Result<(), CliError> {
     let spec = ScenarioSpec::from_file(scenario)?;
@@ -21,13 +22,18 @@ pub fn run(
     let files = spec.input_files(base);
     let mut inputs = vec![("scenario file", scenario)];
     inputs.extend(files.iter().map(|(what, p)| (*what, p.as_path())));
-    let run_files: Vec<_> = match runs {
-        Some(n) => (0..n).map(|r| run_path(out, r, n)).collect(),
-        None => vec![out.to_path_buf()],
+    let per_run = |path: &Path| -> Vec<std::path::PathBuf> {
+        match runs {
+            Some(n) => (0..n).map(|r| run_path(path, r, n)).collect(),
+            None => vec![path.to_path_buf()],
+        }
     };
+    let run_files = per_run(out);
+    let gnss_files = gnss.map(per_run).unwrap_or_default();
     let mut outputs: Vec<(&str, &Path)> =
         run_files.iter().map(|p| ("--out", p.as_path())).collect();
     outputs.extend(truth.map(|t| ("--truth", t)));
+    outputs.extend(gnss_files.iter().map(|p| ("--gnss", p.as_path())));
     check_outputs(&inputs, &outputs)?;
     let sc = spec.resolve(base)?;
     for w in &sc.imu.sensors.warnings {
@@ -35,13 +41,15 @@ pub fn run(
     }
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
-        sc.stream_to_csv(None, out, truth)?;
+        sc.stream_to_csv(None, out, truth, gnss)?;
         eprintln!(
-            "imukit: {} samples; IMU readings in {}{}",
+            "imukit: {} samples; IMU readings in {}{}{}",
             sc.t_s.len(),
             out.display(),
             truth
                 .map(|t| format!(", truth in {}", t.display()))
+                .unwrap_or_default(),
+            gnss.map(|g| format!(", GNSS fixes in {}", g.display()))
                 .unwrap_or_default()
         );
         return Ok(());
@@ -62,7 +70,13 @@ pub fn run(
     (0..runs)
         .into_par_iter()
         .try_for_each(|r| -> Result<(), CliError> {
-            sc.stream_to_csv(Some(r), &run_path(out, r, runs), truth.filter(|_| r == 0))?;
+            let gnss_file = gnss.map(|g| run_path(g, r, runs));
+            sc.stream_to_csv(
+                Some(r),
+                &run_path(out, r, runs),
+                truth.filter(|_| r == 0),
+                gnss_file.as_deref(),
+            )?;
             done.fetch_add(1, Ordering::Relaxed);
             progress.inc(1);
             Ok(())

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterator, Sequence
+from typing import Iterator, Optional, Sequence
 
 import numpy as np
 
@@ -51,10 +51,12 @@ class Table:
 
 @dataclass(frozen=True)
 class Simulation:
-    """Truth kinematics and IMU readings of a scenario."""
+    """Truth kinematics and IMU readings of a scenario, and the GNSS fixes of its ``[gnss]``
+    receiver (``None`` without one)."""
 
     truth: Table
     imu: Table
+    gnss: Optional[Table] = None
 
 def _table(out) -> Table:
     columns, values = out

@@ -31,6 +31,8 @@ pub struct Chunk {
     pub truth: Table,
     /// IMU rows (rates or increments).
     pub imu: Table,
+    /// GNSS fixes in this chunk, when the scenario has a receiver.
+    pub gnss: Option<Table>,
 }
 
 impl Scenario {
@@ -51,55 +53,41 @@ impl Scenario {
         }
     }
 
-    /// Streams run `run` into `imu_path` (and the truth into `truth_path`) as CSV; each file
-    /// appears only when complete.
+    /// Streams run `run` into `imu_path` (and the truth into `truth_path`, the GNSS fixes into
+    /// `gnss_path`) as CSV; each file appears only when complete.
     ///
     /// # Errors
-    /// As [`Scenario::stream`], and I/O errors naming the file.
+    /// As [`Scenario::stream`], a GNSS file without a receiver in the scenario, and I/O errors
+    /// naming the file.
     pub fn stream_to_csv(
         &self,
         run: Option<u64>,
         imu_path: &Path,
         truth_path: Option<&Path>,
+        gnss_path: Option<&Path>,
     ) -> Result<()> {
-        let mut imu_file = AtomicFile::create(imu_path)?;
-        let mut truth_file = truth_path.map(AtomicFile::create).transpose()?;
-        let mut first = true;
-        let mut next_row = 2;
-        let (imu_name, truth_name) = (
-            imu_path.display().to_string(),
-            truth_path.map(|p| p.display().to_string()),
-        );
+        if gnss_path.is_some() && self.gnss.is_none() {
+            return Err(crate::error::invalid(
+                "gnss",
+                "a GNSS file was asked for, but the scenario has no [gnss] receiver",
+            ));
+        }
+        let mut imu = CsvSink::create(imu_path)?;
+        let mut truth = truth_path.map(CsvSink::create).transpose()?;
+        let mut gnss = gnss_path.map(CsvSink::create).transpose()?;
         self.stream(run, |chunk| {
-            // Nothing that is not a finite number reaches a file.
-            check_finite_from(&chunk.imu.columns, &chunk.imu.data, &imu_name, next_row)?;
-            if let Some(name) = &truth_name {
-                check_finite_from(&chunk.truth.columns, &chunk.truth.data, name, next_row)?;
+            imu.write(&chunk.imu)?;
+            if let Some(t) = truth.as_mut() {
+                t.write(&chunk.truth)?;
             }
-            next_row += chunk.imu.rows();
-            let w = imu_file.writer();
-            let written = if first {
-                chunk.imu.write_header(w)
-            } else {
-                Ok(())
+            if let (Some(g), Some(fixes)) = (gnss.as_mut(), &chunk.gnss) {
+                g.write(fixes)?;
             }
-            .and_then(|()| chunk.imu.write_body(w));
-            written.map_err(|e| imu_file.error(e))?;
-            if let Some(f) = truth_file.as_mut() {
-                let w = f.writer();
-                let written = if first {
-                    chunk.truth.write_header(w)
-                } else {
-                    Ok(())
-                }
-                .and_then(|()| chunk.truth.write_body(w));
-                written.map_err(|e| f.error(e))?;
-            }
-            first = false;
             Ok(())
         })?;
-        imu_file.commit()?;
-        truth_file.map_or(Ok(()), AtomicFile::commit)
+        imu.commit()?;
+        truth.map_or(Ok(()), CsvSink::commit)?;
+        gnss.map_or(Ok(()), CsvSink::commit)
     }
 
     fn stream_in<N: NavFrame>(
@@ -114,8 +102,10 @@ impl Scenario {
         let output = self.imu.output;
         // The last reading of the previous chunk: increments integrate across the boundary.
         let mut previous: Option<(f64, ImuReading)> = None;
+        let mut receiver = self.gnss_stream(run)?;
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            let (truth_table, readings) = self.on_earth(truth, &mut sensors)?;
+            let (truth_table, readings, gnss) =
+                self.on_earth(truth, &mut sensors, receiver.as_mut())?;
             let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
             let imu = match output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, kind),
@@ -136,6 +126,7 @@ impl Scenario {
             sink(Chunk {
                 truth: truth_table,
                 imu,
+                gnss,
             })
         };
         let t_s = &self.t_s;
@@ -163,6 +154,46 @@ impl Scenario {
                 truth.chunks(STREAM_CHUNK).try_for_each(&mut emit)
             }
         }
+    }
+}
+
+/// One streamed CSV output: the header once, then the chunks' rows, each checked finite and
+/// named by its file row.
+struct CsvSink {
+    file: AtomicFile,
+    name: String,
+    next_row: usize,
+    started: bool,
+}
+
+impl CsvSink {
+    fn create(path: &Path) -> Result<Self> {
+        Ok(Self {
+            file: AtomicFile::create(path)?,
+            name: path.display().to_string(),
+            next_row: 2,
+            started: false,
+        })
+    }
+
+    fn write(&mut self, table: &Table) -> Result<()> {
+        // Nothing that is not a finite number reaches a file.
+        check_finite_from(&table.columns, &table.data, &self.name, self.next_row)?;
+        let w = self.file.writer();
+        let written = if self.started {
+            Ok(())
+        } else {
+            table.write_header(w)
+        }
+        .and_then(|()| table.write_body(w));
+        written.map_err(|e| self.file.error(e))?;
+        self.started = true;
+        self.next_row += table.rows();
+        Ok(())
+    }
+
+    fn commit(self) -> Result<()> {
+        self.file.commit()
     }
 }
 

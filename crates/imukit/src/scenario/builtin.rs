@@ -67,6 +67,7 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         date: None,
         trajectory,
         imu: ImuSpec::default(),
+        gnss: None,
     };
     Ok(match name {
         "figure8" => {

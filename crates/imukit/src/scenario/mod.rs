@@ -19,6 +19,7 @@
 //! ```
 pub mod builtin;
 pub mod earth;
+pub mod gnss;
 pub mod imu;
 pub mod perturb;
 pub mod resolve;
@@ -64,6 +65,8 @@ pub struct Scenario {
     pub trajectory: Trajectory,
     /// The IMU.
     pub imu: ImuSetup,
+    /// The GNSS receiver, if any.
+    pub gnss: Option<gnss::GnssSetup>,
 }
 
 /// Truth and ideal IMU readings of a scenario.
@@ -73,6 +76,9 @@ pub struct Simulation {
     pub truth: Table,
     /// IMU readings, columns per [`ImuKind::columns`](crate::io::table::ImuKind::columns).
     pub imu: Table,
+    /// GNSS fixes ([`gnss::GNSS_COLUMNS`] or, on the WGS-84 Earth,
+    /// [`gnss::GNSS_EARTH_COLUMNS`]), when the scenario has a receiver.
+    pub gnss: Option<Table>,
 }
 
 impl Scenario {
@@ -102,9 +108,12 @@ impl Scenario {
         let mut sensors =
             self.imu
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
-        let (truth_table, readings) = self.on_earth(&truth, &mut sensors)?;
+        let mut receiver = self.gnss_stream(run)?;
+        let (truth_table, readings, gnss) =
+            self.on_earth(&truth, &mut sensors, receiver.as_mut())?;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         let simulation = Simulation {
+            gnss,
             truth: truth_table,
             imu: match self.imu.output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
@@ -125,9 +134,14 @@ impl Scenario {
         &self,
         truth: &[Truth<N>],
         sensors: &mut ReadingStream<'_, N>,
-    ) -> Result<(Table, Vec<ImuReading>)> {
+        receiver: Option<&mut gnss::GnssStream<'_>>,
+    ) -> Result<(Table, Vec<ImuReading>, Option<Table>)> {
         match &self.earth {
-            EarthSetup::Flat => Ok((Table::from_truth(truth), sensors.measure(truth))),
+            EarthSetup::Flat => Ok((
+                Table::from_truth(truth),
+                sensors.measure(truth),
+                receiver.map(|r| r.measure_flat(truth)),
+            )),
             EarthSetup::Wgs84(plane) => {
                 let earth = truth
                     .iter()
@@ -139,9 +153,22 @@ impl Scenario {
                     .map(|(s, e)| TangentPlane::local(s, e))
                     .collect();
                 let readings = sensors.measure_earth(plane, &earth, &local)?;
-                Ok((earth::earth_truth_table(&local, &earth), readings))
+                let fixes = receiver.map(|r| r.measure_earth::<N>(&earth));
+                Ok((earth::earth_truth_table(&local, &earth), readings, fixes))
             }
         }
+    }
+
+    /// The GNSS receiver of run `run`, if the scenario has one.
+    ///
+    /// # Errors
+    /// Invalid receiver parameters.
+    pub(crate) fn gnss_stream(&self, run: Option<u64>) -> Result<Option<gnss::GnssStream<'_>>> {
+        let end = self.t_s.at(self.t_s.len().saturating_sub(1));
+        self.gnss
+            .as_ref()
+            .map(|g| gnss::GnssStream::new(g, run, end))
+            .transpose()
     }
 
     /// Truth and readings of Monte Carlo run `run`: the noise stream is

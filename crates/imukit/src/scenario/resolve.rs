@@ -136,6 +136,7 @@ impl ScenarioSpec {
                 date: self.date.clone().or(b.date),
                 trajectory: b.trajectory,
                 imu: self.imu.or(&b.imu),
+                gnss: self.gnss.clone().or(b.gnss),
             };
             &merged
         } else {
@@ -274,6 +275,11 @@ impl ScenarioSpec {
         };
         // The sensor model is checked now, at this sample rate, before any work.
         imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;
+        let gnss = spec
+            .gnss
+            .as_ref()
+            .map(|g| g.resolve(sample_rate_hz, imu.sensors.seed))
+            .transpose()?;
         Ok(Scenario {
             t_s,
             sample_rate_hz,
@@ -282,6 +288,7 @@ impl ScenarioSpec {
             earth,
             trajectory,
             imu,
+            gnss,
         })
     }
 }

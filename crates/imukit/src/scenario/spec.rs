@@ -106,6 +106,8 @@ pub struct ScenarioSpec {
     /// The IMU.
     #[serde(default)]
     pub imu: ImuSpec,
+    /// A GNSS receiver beside the IMU.
+    pub gnss: Option<crate::scenario::gnss::GnssSpec>,
 }
 
 /// The Earth model of a scenario.

@@ -1,0 +1,202 @@
+//! The GNSS receiver of a scenario end to end: fixes at the antenna (lever arm), stamped late
+//! by the latency, none in outages, on the flat and the WGS-84 Earth; the streamed file equals
+//! the in-memory table; bad `[gnss]` keys are named.
+use std::path::Path;
+
+use imu_core::{Body, Enu, Rotation, Vec3};
+use imukit::{Error, ScenarioSpec, Simulation};
+
+fn run(text: &str) -> Result<Simulation, Error> {
+    ScenarioSpec::from_toml(text, "gnss.toml")?
+        .resolve(Path::new("."))?
+        .simulate()
+}
+
+const FIGURE8: &str =
+    "rate_hz = 100.0\nduration_s = 30.0\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n";
+
+#[test]
+fn exact_fixes_are_the_antennas_truth_stamped_late_and_none_in_an_outage() {
+    let text = format!(
+        "{FIGURE8}[gnss]\nrate_hz = 10.0\nhorizontal_accuracy_m = 0.0\nvertical_accuracy_m = 0.0\n\
+         velocity_accuracy_m_s = 0.0\nlever_arm_m = [0.3, -0.2, 0.5]\nlatency_s = 0.2\n\
+         [[gnss.outages]]\nstart_s = 10.0\nduration_s = 5.0\n"
+    );
+    let sim = run(&text).unwrap();
+    let gnss = sim.gnss.as_ref().unwrap();
+    let col = |t: &imukit::Table, c: &str| t.column(c).unwrap();
+    let stamps = col(gnss, "t_s");
+    // 301 epochs at 10 Hz over 30 s; 50 stamps fall in [10, 15); the last two (30.1, 30.2)
+    // after the run's end.
+    assert_eq!(stamps.len(), 301 - 50 - 2);
+    assert!(stamps.iter().all(|t| !(10.0..15.0).contains(t)));
+    let lever = Vec3::<Body>::new(0.3, -0.2, 0.5);
+    let truth = &sim.truth;
+    for (k, stamp) in stamps.iter().enumerate() {
+        // The epoch is the stamp less the latency, an IMU sample (every 10th).
+        let i = ((stamp - 0.2) * 100.0).round() as usize;
+        assert!((col(truth, "t_s")[i] + 0.2 - stamp).abs() < 1e-12);
+        let q = ["q_w", "q_x", "q_y", "q_z"].map(|c| col(truth, c)[i]);
+        let c_nb = Rotation::<Body, Enu>::from_wxyz(q).unwrap();
+        let w = Vec3::<Body>::from_array(
+            ["omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"].map(|c| col(truth, c)[i]),
+        );
+        let p =
+            Vec3::<Enu>::from_array(["pos_x_m", "pos_y_m", "pos_z_m"].map(|c| col(truth, c)[i]))
+                + c_nb.apply(lever);
+        let v = Vec3::<Enu>::from_array(
+            ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"].map(|c| col(truth, c)[i]),
+        ) + c_nb.apply(w.cross(&lever));
+        let got_p = ["pos_x_m", "pos_y_m", "pos_z_m"].map(|c| col(gnss, c)[k]);
+        let got_v = ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"].map(|c| col(gnss, c)[k]);
+        for j in 0..3 {
+            assert!((got_p[j] - p.to_array()[j]).abs() < 1e-12, "fix {k}");
+            assert!((got_v[j] - v.to_array()[j]).abs() < 1e-12, "fix {k}");
+        }
+    }
+}
+
+#[test]
+fn on_the_earth_fixes_are_geodetic_and_their_errors_are_metres_north_east_down() {
+    let base = "rate_hz = 10.0\nduration_s = 1999.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+        origin = { latitude_deg = 60.0, longitude_deg = 10.0, height_m = 100.0 }\n\
+        [trajectory]\ntype = \"builtin\"\nname = \"static\"\n";
+    let exact = run(&format!(
+        "{base}[gnss]\nhorizontal_accuracy_m = 0.0\nvertical_accuracy_m = 0.0\nvelocity_accuracy_m_s = 0.0\n"
+    ))
+    .unwrap();
+    let g = exact.gnss.unwrap();
+    assert_eq!(
+        g.columns,
+        [
+            "t_s",
+            "lat_rad",
+            "lon_rad",
+            "height_m",
+            "vel_n_m_s",
+            "vel_e_m_s",
+            "vel_d_m_s"
+        ]
+    );
+    let lat = g.column("lat_rad").unwrap();
+    assert!(lat.iter().all(|l| (l - 60f64.to_radians()).abs() < 1e-15));
+    // White errors (decay factor 0: MATLAB's deviation σ√2): 2000 fixes at 1 Hz, σ_h = 1 m.
+    let noisy = run(&format!(
+        "{base}[gnss]\nhorizontal_accuracy_m = 1.0\nvertical_accuracy_m = 2.0\ndecay_factor = 0.0\n"
+    ))
+    .unwrap()
+    .gnss
+    .unwrap();
+    let p = imu_core::earth::Geodetic::from_degrees(60.0, 10.0, 100.0);
+    let (r_n, r_e) = p.radii_m();
+    let n = noisy.rows() as f64;
+    let sd = |v: Vec<f64>, scale: f64, centre: f64| {
+        (v.iter()
+            .map(|x| ((x - centre) * scale).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt()
+    };
+    let north = sd(
+        noisy.column("lat_rad").unwrap(),
+        r_n + 100.0,
+        p.latitude_rad,
+    );
+    let east = sd(
+        noisy.column("lon_rad").unwrap(),
+        (r_e + 100.0) * p.latitude_rad.cos(),
+        p.longitude_rad,
+    );
+    let down = sd(noisy.column("height_m").unwrap(), 1.0, 100.0);
+    let tol = 4.0 / (2.0 * n).sqrt();
+    for (got, want) in [
+        (north, 2f64.sqrt()),
+        (east, 2f64.sqrt()),
+        (down, 2.0 * 2f64.sqrt()),
+    ] {
+        assert!((got / want - 1.0).abs() < tol, "{got} vs {want}");
+    }
+}
+
+#[test]
+fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
+    let text = FIGURE8.replace("duration_s = 30.0", "duration_s = 100.0");
+    let text = format!("{text}[gnss]\nrate_hz = 20.0\n[imu]\nseed = 7\n");
+    let spec = ScenarioSpec::from_toml(&text, "g.toml").unwrap();
+    let sc = spec.resolve(Path::new(".")).unwrap();
+    let dir = std::env::temp_dir().join(format!("imukit-gnss-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (imu, gnss) = (dir.join("imu.csv"), dir.join("gnss.csv"));
+    // 10 001 samples: the stream crosses chunk boundaries (4096).
+    sc.stream_to_csv(None, &imu, None, Some(&gnss)).unwrap();
+    let from_file = imukit::io::table::read_table(&gnss).unwrap();
+    let in_memory = sc.simulate().unwrap().gnss.unwrap();
+    assert_eq!(from_file.columns, in_memory.columns);
+    assert_eq!(from_file.data, in_memory.data);
+    let run1 = sc.simulate_run(1).unwrap().gnss.unwrap();
+    assert_ne!(run1.data, in_memory.data);
+    assert_eq!(run1.data, sc.simulate_run(1).unwrap().gnss.unwrap().data);
+    // The IMU's noise is not disturbed by the receiver: the same readings as without it.
+    let without = ScenarioSpec::from_toml(&text.replace("[gnss]\nrate_hz = 20.0\n", ""), "g.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+        .simulate()
+        .unwrap();
+    assert_eq!(without.imu.data, sc.simulate().unwrap().imu.data);
+}
+
+#[test]
+fn bad_gnss_keys_are_refused_by_name() {
+    let cases = [
+        (
+            "rate_hz = 3.0",
+            "gnss.rate_hz: must divide the scenario's rate_hz",
+        ),
+        ("rate_hz = 200.0", "gnss.rate_hz: must divide"),
+        (
+            "horizontal_accuracy_m = -1.0",
+            "gnss.horizontal_accuracy_m: horizontal_accuracy_m must be a finite number ≥ 0",
+        ),
+        (
+            "decay_factor = 2.0",
+            "gnss.decay_factor: decay_factor must be within [0, 1]",
+        ),
+        (
+            "decay_factor = 0.5\ncorrelation_time_s = 10.0",
+            "gnss.correlation_time_s: give decay_factor",
+        ),
+        (
+            "latency_s = -0.1",
+            "gnss.latency_s: must be a finite number ≥ 0",
+        ),
+        ("lever_arm_m = [0, nan, 0]", "gnss.lever_arm_m"),
+        (
+            "outages = [{ start_s = 1.0, duration_s = 0.0 }]",
+            "gnss.outages[0]: needs a finite start_s and a duration_s > 0",
+        ),
+        ("rate = 1.0", "unknown field `rate`"),
+    ];
+    for (keys, want) in cases {
+        let e = run(&format!("{FIGURE8}[gnss]\n{keys}\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want), "{keys}: {e}");
+    }
+    // A GNSS file without a receiver.
+    let sc = ScenarioSpec::from_toml(FIGURE8, "g.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let dir = std::env::temp_dir();
+    let e = sc
+        .stream_to_csv(
+            None,
+            &dir.join(format!("imukit-nognss-{}.csv", std::process::id())),
+            None,
+            Some(&dir.join(format!("imukit-nognss-g-{}.csv", std::process::id()))),
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the scenario has no [gnss] receiver"), "{e}");
+}
