@@ -33,6 +33,7 @@ pub mod aiding;
 pub mod allan;
 pub mod earth;
 pub mod frame;
+pub mod fusion;
 pub mod ideal;
 pub mod kinematics;
 mod math;

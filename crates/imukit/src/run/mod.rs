@@ -1,9 +1,10 @@
 //! The jobs a user runs: simulate ([`simulate`], [`arrays`] for in-memory arrays), navigate
-//! ([`navigate`], on the WGS-84 Earth [`earth_nav`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
+//! ([`navigate`], on the WGS-84 Earth [`earth_nav`], with GNSS [`fuse`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
 pub mod allan;
 pub mod arrays;
 pub mod compare;
 pub mod earth_nav;
+pub mod fuse;
 pub mod imu_sensor;
 pub mod navigate;
 pub mod orient;

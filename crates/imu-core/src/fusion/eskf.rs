@@ -1,0 +1,411 @@
+//! A loosely coupled error-state Kalman filter: 15 error states — position, velocity, attitude
+//! (a small rotation φ of the navigation frame, `C_true = (I + [φ×]) Ĉ`), accelerometer bias,
+//! gyroscope bias — around a strapdown nominal state on the flat Earth (frame `N`, constant
+//! gravity), with closed-loop correction after every update.
+//!
+//! Propagation per IMU interval `Δt` (rates `ω_m`, `f_m`, biases removed, averaged over the
+//! interval): `q ← q ⊗ exp(ω̂ Δt)`, `v ← v + Ĉ_mid f̂ Δt + g Δt`, `p ← p + ½ (v₀ + v₁) Δt`.
+//! Error dynamics (Groves 2nd ed. §14.2, flat Earth):
+//! `δṗ = δv`, `δv̇ = −[f^n×] φ − Ĉ δb_a − Ĉ n_a`, `φ̇ = −Ĉ δb_g − Ĉ n_g`, `δḃ = n_b`
+//! (random-walk biases). `Φ = I + F Δt + (F Δt)²/2`; `Q_d = ½ (Φ G Q Gᵀ Φᵀ + G Q Gᵀ) Δt`.
+//! Updates: GNSS position and velocity at an antenna lever arm `l`
+//! (`p_a = p + Ĉ l`, `v_a = v + Ĉ (ω̂ × l)`), with `H` from
+//! `δp_a = δp − [(Ĉ l)×] φ` and `δv_a = δv − [(Ĉ(ω̂×l))×] φ + Ĉ [l×] δb_g`; Joseph form,
+//! symmetrised; a chi-square innovation gate (normalised innovation squared, NIS) rejects and
+//! counts outliers.
+use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
+
+use crate::frame::{Body, NavFrame};
+use crate::math;
+use crate::rotation::Rotation;
+use crate::vector::Vec3;
+
+type Mat15 = SMatrix<f64, 15, 15>;
+type Vec15 = SVector<f64, 15>;
+
+/// Continuous-time noise of the IMU as the filter models it (per axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EskfNoise {
+    /// White accelerometer noise, (m/s²)/√Hz (two-sided PSD √q of the continuous process).
+    pub accel_psd: f64,
+    /// White gyroscope noise, (rad/s)/√Hz.
+    pub gyro_psd: f64,
+    /// Accelerometer bias random walk, (m/s²)·√Hz… i.e. m/s³/√Hz.
+    pub accel_bias_psd: f64,
+    /// Gyroscope bias random walk, rad/s²/√Hz.
+    pub gyro_bias_psd: f64,
+}
+
+/// One-sigma uncertainty of the initial state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitialSigma {
+    /// Position, m.
+    pub position_m: f64,
+    /// Velocity, m/s.
+    pub velocity_m_s: f64,
+    /// Attitude (roll, pitch about horizontal axes; yaw), rad.
+    pub attitude_rad: [f64; 3],
+    /// Accelerometer bias, m/s².
+    pub accel_bias_m_s2: f64,
+    /// Gyroscope bias, rad/s.
+    pub gyro_bias_rad_s: f64,
+}
+
+/// The filter's estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EskfState<N> {
+    /// Time, s.
+    pub t_s: f64,
+    /// Position, navigation frame, m.
+    pub position_m: Vec3<N>,
+    /// Velocity, navigation frame, m/s.
+    pub velocity_m_s: Vec3<N>,
+    /// Attitude `C_nb`.
+    pub attitude: Rotation<Body, N>,
+    /// Accelerometer bias, body frame, m/s².
+    pub accel_bias_m_s2: [f64; 3],
+    /// Gyroscope bias, body frame, rad/s.
+    pub gyro_bias_rad_s: [f64; 3],
+}
+
+/// What an update did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UpdateOutcome {
+    /// Normalised innovation squared `yᵀ S⁻¹ y`.
+    pub nis: f64,
+    /// Whether it was applied (false: rejected by the gate).
+    pub accepted: bool,
+}
+
+/// Why the filter refused input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EskfError {
+    /// A value that is not finite, at IMU sample `index` (or update `index`).
+    NotFinite {
+        /// Sample or update index.
+        index: usize,
+    },
+    /// Times that do not increase.
+    TimeNotIncreasing {
+        /// Sample index.
+        index: usize,
+    },
+    /// The innovation covariance could not be inverted or the covariance lost its positive
+    /// definiteness: the filter diverged.
+    Diverged {
+        /// Update index.
+        index: usize,
+    },
+    /// A noise or initial sigma out of range.
+    BadParameter {
+        /// Which.
+        field: &'static str,
+    },
+}
+
+impl core::fmt::Display for EskfError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::NotFinite { index } => write!(f, "sample {index} is not a finite number"),
+            Self::TimeNotIncreasing { index } => {
+                write!(f, "time at sample {index} does not increase")
+            }
+            Self::Diverged { index } => write!(
+                f,
+                "the filter diverged at update {index} (its covariance is no longer positive definite)"
+            ),
+            Self::BadParameter { field } => write!(f, "{field} must be a finite number ≥ 0"),
+        }
+    }
+}
+
+impl core::error::Error for EskfError {}
+
+fn sq(x: f64) -> f64 {
+    x * x
+}
+
+fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
+    nalgebra::Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// The error-state filter.
+#[derive(Clone, Copy, Debug)]
+pub struct Eskf<N: NavFrame> {
+    t: f64,
+    p: Vector3<f64>,
+    v: Vector3<f64>,
+    q: UnitQuaternion<f64>,
+    ba: Vector3<f64>,
+    bg: Vector3<f64>,
+    cov: Mat15,
+    noise: EskfNoise,
+    g: Vector3<f64>,
+    last: Option<(Vector3<f64>, Vector3<f64>)>,
+    samples: usize,
+    updates: usize,
+    rejected: usize,
+    frame: core::marker::PhantomData<N>,
+}
+
+impl<N: NavFrame> Eskf<N> {
+    /// A filter at `initial` (biases zero unless given) with `sigma` initial uncertainty.
+    ///
+    /// # Errors
+    /// Non-finite state, negative or non-finite sigmas or noise.
+    pub fn new(
+        initial: &EskfState<N>,
+        sigma: &InitialSigma,
+        noise: EskfNoise,
+        gravity_m_s2: f64,
+    ) -> Result<Self, EskfError> {
+        let ok = |field, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(EskfError::BadParameter { field })
+            }
+        };
+        ok("accel_psd", noise.accel_psd)?;
+        ok("gyro_psd", noise.gyro_psd)?;
+        ok("accel_bias_psd", noise.accel_bias_psd)?;
+        ok("gyro_bias_psd", noise.gyro_bias_psd)?;
+        ok("gravity_m_s2", gravity_m_s2)?;
+        let mut diag = Vec15::zeros();
+        for i in 0..3 {
+            diag[i] = sq(ok("position sigma", sigma.position_m)?);
+            diag[3 + i] = sq(ok("velocity sigma", sigma.velocity_m_s)?);
+            diag[6 + i] = sq(ok("attitude sigma", sigma.attitude_rad[i])?);
+            diag[9 + i] = sq(ok("accelerometer bias sigma", sigma.accel_bias_m_s2)?);
+            diag[12 + i] = sq(ok("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
+        }
+        let finite = [initial.t_s]
+            .iter()
+            .chain(initial.position_m.as_nalgebra().iter())
+            .chain(initial.velocity_m_s.as_nalgebra().iter())
+            .chain(&initial.accel_bias_m_s2)
+            .chain(&initial.gyro_bias_rad_s)
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(EskfError::NotFinite { index: 0 });
+        }
+        Ok(Self {
+            t: initial.t_s,
+            p: *initial.position_m.as_nalgebra(),
+            v: *initial.velocity_m_s.as_nalgebra(),
+            q: *initial.attitude.quaternion(),
+            ba: Vector3::from(initial.accel_bias_m_s2),
+            bg: Vector3::from(initial.gyro_bias_rad_s),
+            cov: Mat15::from_diagonal(&diag),
+            noise,
+            g: *N::gravity(gravity_m_s2).as_nalgebra(),
+            last: None,
+            samples: 0,
+            updates: 0,
+            rejected: 0,
+            frame: core::marker::PhantomData,
+        })
+    }
+
+    /// The current estimate.
+    #[must_use]
+    pub fn state(&self) -> EskfState<N> {
+        EskfState {
+            t_s: self.t,
+            position_m: Vec3::from_nalgebra(self.p),
+            velocity_m_s: Vec3::from_nalgebra(self.v),
+            attitude: Rotation::assume_from_quaternion(self.q),
+            accel_bias_m_s2: self.ba.into(),
+            gyro_bias_rad_s: self.bg.into(),
+        }
+    }
+
+    /// One-sigma of the 15 error states: position (3), velocity (3), attitude (3, navigation
+    /// axes), accelerometer bias (3), gyroscope bias (3).
+    #[must_use]
+    pub fn sigmas(&self) -> [f64; 15] {
+        core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
+    }
+
+    /// The error covariance (row-major 15 × 15 access by `(i, j)`).
+    #[must_use]
+    pub fn covariance(&self, i: usize, j: usize) -> f64 {
+        self.cov[(i, j)]
+    }
+
+    /// Updates applied and rejected by the gate.
+    #[must_use]
+    pub fn update_counts(&self) -> (usize, usize) {
+        (self.updates, self.rejected)
+    }
+
+    /// Takes IMU sample `(t_s, gyro, accel)` (body, rad/s and specific force m/s²): the first
+    /// sets the start time, each later one propagates over the interval.
+    ///
+    /// # Errors
+    /// Non-finite values or a time that does not increase.
+    pub fn propagate(
+        &mut self,
+        t_s: f64,
+        gyro_rad_s: [f64; 3],
+        accel_m_s2: [f64; 3],
+    ) -> Result<(), EskfError> {
+        let index = self.samples;
+        let finite = [t_s]
+            .iter()
+            .chain(&gyro_rad_s)
+            .chain(&accel_m_s2)
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(EskfError::NotFinite { index });
+        }
+        let (w1, f1) = (Vector3::from(gyro_rad_s), Vector3::from(accel_m_s2));
+        let Some((w0, f0)) = self.last else {
+            self.last = Some((w1, f1));
+            self.t = t_s;
+            self.samples += 1;
+            return Ok(());
+        };
+        let dt = t_s - self.t;
+        if dt.is_nan() || dt <= 0.0 {
+            return Err(EskfError::TimeNotIncreasing { index });
+        }
+        let w = 0.5 * (w0 + w1) - self.bg;
+        let f = 0.5 * (f0 + f1) - self.ba;
+        // Nominal state.
+        let half = self.q * UnitQuaternion::from_scaled_axis(w * (0.5 * dt));
+        let q1 = self.q * UnitQuaternion::from_scaled_axis(w * dt);
+        let v0 = self.v;
+        self.v += (half * f + self.g) * dt;
+        self.p += 0.5 * (v0 + self.v) * dt;
+        // Error state: F at the interval's middle.
+        let c = half.to_rotation_matrix().into_inner();
+        let f_n = c * f;
+        let mut fm = Mat15::zeros();
+        fm.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&nalgebra::Matrix3::identity());
+        fm.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&f_n)));
+        fm.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
+        fm.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
+        let fdt = fm * dt;
+        let phi = Mat15::identity() + fdt + fdt * fdt * 0.5;
+        // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases.
+        let mut gqg = Vec15::zeros();
+        for i in 0..3 {
+            gqg[3 + i] = sq(self.noise.accel_psd);
+            gqg[6 + i] = sq(self.noise.gyro_psd);
+            gqg[9 + i] = sq(self.noise.accel_bias_psd);
+            gqg[12 + i] = sq(self.noise.gyro_bias_psd);
+        }
+        let qc = Mat15::from_diagonal(&gqg);
+        let qd = (phi * qc * phi.transpose() + qc) * (0.5 * dt);
+        self.cov = phi * self.cov * phi.transpose() + qd;
+        self.cov = (self.cov + self.cov.transpose()) * 0.5;
+        self.q = q1;
+        self.t = t_s;
+        self.last = Some((w1, f1));
+        self.samples += 1;
+        Ok(())
+    }
+
+    /// A GNSS position (and, when given, velocity) fix at the current time: `position_m` of the
+    /// antenna at `lever_arm_m` (body) with one-sigma `position_sigma_m` per axis, and the
+    /// antenna velocity with `velocity_sigma_m_s`. Rejected (and counted) when its NIS exceeds
+    /// `gate` (a chi-square quantile for 3 or 6 degrees of freedom; `f64::INFINITY` turns the
+    /// gate off).
+    ///
+    /// # Errors
+    /// Non-finite input, or a covariance that can no longer be inverted (divergence).
+    pub fn update_gnss(
+        &mut self,
+        position_m: Vec3<N>,
+        velocity_m_s: Option<Vec3<N>>,
+        lever_arm_m: Vec3<Body>,
+        position_sigma_m: [f64; 3],
+        velocity_sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let c = self.q.to_rotation_matrix().into_inner();
+        let l = *lever_arm_m.as_nalgebra();
+        let cl = c * l;
+        let w = self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg;
+        let cwl = c * w.cross(&l);
+        let z_p = *position_m.as_nalgebra() - (self.p + cl);
+        let mut finite = z_p.iter().all(|v| v.is_finite());
+        let mut h = SMatrix::<f64, 6, 15>::zeros();
+        let mut y = SVector::<f64, 6>::zeros();
+        let mut r = SVector::<f64, 6>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&nalgebra::Matrix3::identity());
+        h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
+        y.fixed_rows_mut::<3>(0).copy_from(&z_p);
+        for i in 0..3 {
+            r[i] = sq(position_sigma_m[i]);
+        }
+        let m = if let Some(vm) = velocity_m_s {
+            let z_v = *vm.as_nalgebra() - (self.v + cwl);
+            finite &= z_v.iter().all(|v| v.is_finite());
+            h.fixed_view_mut::<3, 3>(3, 3)
+                .copy_from(&nalgebra::Matrix3::identity());
+            h.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&cwl)));
+            h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
+            y.fixed_rows_mut::<3>(3).copy_from(&z_v);
+            for i in 0..3 {
+                r[3 + i] = sq(velocity_sigma_m_s[i]);
+            }
+            6
+        } else {
+            3
+        };
+        let all_sigma = position_sigma_m
+            .iter()
+            .chain(&velocity_sigma_m_s)
+            .all(|s| s.is_finite() && *s > 0.0);
+        if !(finite && all_sigma) {
+            return Err(EskfError::NotFinite { index });
+        }
+        // Only the first m rows are used.
+        for i in m..6 {
+            h.row_mut(i).fill(0.0);
+            y[i] = 0.0;
+            r[i] = 1.0;
+        }
+        let s = h * self.cov * h.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&r);
+        let Some(s_inv) = s.try_inverse() else {
+            return Err(EskfError::Diverged { index });
+        };
+        let nis = (y.transpose() * s_inv * y)[(0, 0)];
+        if !nis.is_finite() || nis < 0.0 {
+            return Err(EskfError::Diverged { index });
+        }
+        if nis > gate {
+            self.rejected += 1;
+            return Ok(UpdateOutcome {
+                nis,
+                accepted: false,
+            });
+        }
+        let k = self.cov * h.transpose() * s_inv;
+        let dx = k * y;
+        let ikh = Mat15::identity() - k * h;
+        let rm = SMatrix::<f64, 6, 6>::from_diagonal(&r);
+        self.cov = ikh * self.cov * ikh.transpose() + k * rm * k.transpose();
+        self.cov = (self.cov + self.cov.transpose()) * 0.5;
+        if (0..15).any(|i| self.cov[(i, i)].is_nan() || self.cov[(i, i)] < 0.0) {
+            return Err(EskfError::Diverged { index });
+        }
+        // Closed loop: inject and reset.
+        self.p += dx.fixed_rows::<3>(0);
+        self.v += dx.fixed_rows::<3>(3);
+        let phi: Vector3<f64> = dx.fixed_rows::<3>(6).into();
+        self.q = UnitQuaternion::from_scaled_axis(phi) * self.q;
+        self.ba += dx.fixed_rows::<3>(9);
+        self.bg += dx.fixed_rows::<3>(12);
+        self.updates += 1;
+        Ok(UpdateOutcome {
+            nis,
+            accepted: true,
+        })
+    }
+}
