@@ -147,6 +147,31 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states) over IMU rates
+    /// and GNSS fixes, the filter's model taken from the scenario that made them ([imu] errors,
+    /// [gnss] accuracy and lever arm); writes the navigation columns, their one-sigma and the
+    /// bias estimates.
+    Fuse {
+        /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
+        imu: PathBuf,
+        /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
+        gnss: PathBuf,
+        /// The initial state: the first row of this truth CSV.
+        #[arg(long)]
+        init: PathBuf,
+        /// The scenario whose [imu] and [gnss] describe the data's errors.
+        #[arg(long)]
+        scenario: PathBuf,
+        /// `flat` (the only one so far).
+        #[arg(long, default_value = "flat")]
+        earth: String,
+        /// Apply every fix (no chi-square innovation gate).
+        #[arg(long)]
+        no_gate: bool,
+        /// Where to write the estimate (CSV).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Errors of an estimate against truth over time: a navigation output (position, velocity,
     /// attitude) or an orientation output (attitude), with RMS, maximum and final values printed.
     Compare {

@@ -1029,3 +1029,87 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     assert_eq!(code, Some(65), "{err}");
     assert!(err.contains("--gnss") && err.contains("--out"), "{err}");
 }
+
+#[test]
+fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
+    let dir = temp_dir("fuse");
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 100.0\nduration_s = 60.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]\nattitude = \"tangent\"\n\
+         [imu]\nkind = \"accel-gyro\"\npreset = \"stim300\"\n\
+         [gnss]\nrate_hz = 5.0\ndecay_factor = 0.0\nhorizontal_accuracy_m = 1.0\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let fuse_to = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "fuse",
+            "imu.csv",
+            "gnss.csv",
+            "--init",
+            "truth.csv",
+            "--scenario",
+            "s.toml",
+            "--out",
+            out,
+        ];
+        args.extend(extra);
+        run_in(&dir, &args)
+    };
+    let (code, err) = fuse_to("nav.csv", &[]);
+    assert_eq!(code, Some(0), "{err}");
+    // 301 fixes, applied or (rarely: the gate is the 99.9 % quantile) rejected.
+    let numbers: Vec<usize> = err
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!(err.contains("fixes ("), "{err}");
+    assert_eq!(numbers[1] + numbers[2], 301, "{err}");
+    assert!(numbers[2] <= 2, "{err}");
+    let header = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    assert!(header.starts_with(
+        "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad,pos_x_sigma_m,"
+    ));
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["compare", "truth.csv", "nav.csv"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8(out.stdout).unwrap();
+    let rms: f64 = report
+        .lines()
+        .find(|l| l.starts_with("position"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    // Fixes of 1 m (1.4 m white, MATLAB's σ√2 at decay 0) at 5 Hz: the filter does better.
+    assert!(rms < 1.0, "{report}");
+    std::fs::remove_file(dir.join("nav.csv")).unwrap();
+    for (out, extra, needle) in [
+        (
+            "nav.csv",
+            vec!["--earth", "wgs84"],
+            "fusion runs on the flat Earth so far",
+        ),
+        ("imu.csv", vec![], "--out"),
+    ] {
+        let (code, err) = fuse_to(out, &extra);
+        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        assert!(err.contains(needle), "{extra:?}: {err}");
+    }
+    assert!(!dir.join("nav.csv").exists());
+}

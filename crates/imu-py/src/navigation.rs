@@ -164,7 +164,61 @@ fn compare<'py>(
 }
 
 /// Adds this module's functions.
+/// Loosely coupled INS/GNSS fusion with the filter's model from a scenario (a dict, as
+/// `simulate_dict` takes, or TOML/JSON text): (estimate table, fixes applied, fixes rejected).
+#[pyfunction]
+#[pyo3(signature = (imu_columns, imu_values, gnss_columns, gnss_values, initial_columns, initial_values,
+                    scenario, *, format = "dict", base_dir = ".", gate = true))]
+#[allow(clippy::too_many_arguments)]
+fn fuse<'py>(
+    py: Python<'py>,
+    imu_columns: Vec<String>,
+    imu_values: PyReadonlyArray2<'py, f64>,
+    gnss_columns: Vec<String>,
+    gnss_values: PyReadonlyArray2<'py, f64>,
+    initial_columns: Vec<String>,
+    initial_values: PyReadonlyArray2<'py, f64>,
+    scenario: &Bound<'py, PyAny>,
+    format: &str,
+    base_dir: &str,
+    gate: bool,
+) -> PyResult<(TableOut<'py>, usize, usize)> {
+    use imukit::ScenarioSpec;
+    use imukit::run::fuse::{FuseSetup, fuse};
+    let spec = match format {
+        "dict" => ScenarioSpec::from_tree(
+            &crate::convert::value_tree(scenario, "scenario")?,
+            "scenario dict",
+        ),
+        "toml" => ScenarioSpec::from_toml(&scenario.extract::<String>()?, "scenario"),
+        "json" => ScenarioSpec::from_json(&scenario.extract::<String>()?, "scenario"),
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "format must be \"dict\", \"toml\" or \"json\", got {other:?}"
+            )));
+        }
+    }
+    .map_err(refused)?;
+    let imu = table_in("imu", imu_columns, &imu_values)?;
+    let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
+    let initial = InitialState::from_table(&table_in("initial", initial_columns, &initial_values)?)
+        .map_err(refused)?;
+    let base = base_dir.to_string();
+    let (table, summary) = py
+        .detach(move || {
+            let sc = spec.resolve(Path::new(&base))?;
+            let mut setup = FuseSetup::from_scenario(&sc)?;
+            if !gate {
+                setup.gate = f64::INFINITY;
+            }
+            fuse(&imu, &gnss, &initial, &setup)
+        })
+        .map_err(refused)?;
+    Ok((table_out(py, table)?, summary.updates, summary.rejected))
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fuse, m)?)?;
     m.add_function(wrap_pyfunction!(planar_dead_reckon, m)?)?;
     m.add_function(wrap_pyfunction!(read_planar, m)?)?;
     m.add_function(wrap_pyfunction!(strapdown, m)?)?;

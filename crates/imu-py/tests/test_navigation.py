@@ -139,3 +139,28 @@ def test_a_scenario_with_a_gnss_receiver_returns_its_fixes():
     with pytest.raises(ImuError, match="gnss.rate_hz") as e:
         imukit.simulate({**scenario, "gnss": {"rate_hz": 7.0}})
     assert e.value.field == "gnss.rate_hz"
+
+
+def test_fuse_keeps_a_car_within_its_stated_uncertainty_through_a_gnss_outage():
+    scenario = {
+        "rate_hz": 100.0, "duration_s": 120.0, "nav_frame": "ENU",
+        "trajectory": {"type": "expression", "position_m": ["60*sin(0.16*t)", "60*(1 - cos(0.16*t))", "2*sin(0.1*t)"],
+                       "attitude": "tangent"},
+        "imu": {"kind": "accel-gyro", "preset": "stim300", "seed": 4},
+        "gnss": {"rate_hz": 5.0, "decay_factor": 0.0, "horizontal_accuracy_m": 1.0, "vertical_accuracy_m": 2.0,
+                 "outages": [{"start_s": 60.0, "duration_s": 30.0}]},
+    }
+    sim = imukit.simulate(scenario)
+    nav = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario)
+    assert list(nav.columns[14:17]) == ["pos_x_sigma_m", "pos_y_sigma_m", "pos_z_sigma_m"]
+    errors, summary = imukit.compare(sim.truth, nav)
+    # With fixes: well inside the fixes' own metre; the stated one-sigma grows through the
+    # outage and the error stays within 3σ of it (per axis) at its end.
+    t = nav["t_s"]
+    k = int(np.argmin(np.abs(t - 89.99)))
+    for axis in "xy":
+        assert abs(errors[f"pos_err_{axis}_m"][k]) < 3 * nav[f"pos_{axis}_sigma_m"][k]
+    assert nav["pos_x_sigma_m"][k] > 3 * nav["pos_x_sigma_m"][int(np.argmin(np.abs(t - 59.0)))]
+    assert summary["position_final_m"] < 1.0
+    with pytest.raises(ImuError, match="no \\[gnss\\] receiver"):
+        imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario={k: v for k, v in scenario.items() if k != "gnss"})

@@ -3,6 +3,7 @@ mod allan;
 mod compare;
 mod demo;
 mod exercise;
+mod fuse;
 mod integrate;
 mod orient;
 mod plot;
@@ -76,6 +77,23 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 integrate::three_d(&common, &opts)
             }
         }
+        Command::Fuse {
+            imu,
+            gnss,
+            init,
+            scenario,
+            earth,
+            no_gate,
+            out,
+        } => fuse::run(&fuse::Args {
+            imu: &imu,
+            gnss: &gnss,
+            init: &init,
+            scenario: &scenario,
+            earth: &earth,
+            no_gate,
+            out: &out,
+        }),
         Command::Orient {
             input,
             filter,

@@ -54,7 +54,7 @@ from ._sensor import (
     preset_params,
     presets,
 )
-from ._navigation import compare, planar_dead_reckon, read_planar, strapdown
+from ._navigation import compare, fuse, planar_dead_reckon, read_planar, strapdown
 from ._monte_carlo import MonteCarlo, monte_carlo
 from ._orientation import (
     AhrsFilter,
@@ -84,6 +84,7 @@ __all__ = [
     "preset_params",
     "loadparams",
     "strapdown",
+    "fuse",
     "compare",
     "planar_dead_reckon",
     "read_planar",

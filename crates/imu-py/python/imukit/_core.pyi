@@ -48,6 +48,7 @@ __all__ = [
     "read_planar",
     "strapdown",
     "compare",
+    "fuse",
     "truth_from_body_rates",
     "truth_from_waypoints",
     "builtin_names",
@@ -199,6 +200,19 @@ def strapdown(
     lon0_deg: Optional[float] = None,
     height0_m: Optional[float] = None,
 ) -> _Table: ...
+def fuse(
+    imu_columns: Sequence[str],
+    imu_values: npt.NDArray[np.float64],
+    gnss_columns: Sequence[str],
+    gnss_values: npt.NDArray[np.float64],
+    initial_columns: Sequence[str],
+    initial_values: npt.NDArray[np.float64],
+    scenario: Any,
+    *,
+    format: str = "dict",
+    base_dir: str = ".",
+    gate: bool = True,
+) -> tuple[_Table, int, int]: ...
 def compare(
     truth_columns: Sequence[str],
     truth: npt.NDArray[np.float64],

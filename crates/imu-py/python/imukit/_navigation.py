@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Mapping, Optional, Sequence, Union
 
 from . import _core
+from ._core import ImuError
 from ._convert import _f64, _table_args, _times
 from ._table import Table, _table
 from ._truth import DEFAULT_GRAVITY_M_S2
@@ -108,3 +110,26 @@ def compare(truth: Table, estimate: Table):
     orientation estimates)."""
     table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate))
     return _table(table), dict(summary)
+
+
+def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True) -> Table:
+    """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
+    GNSS fixes (``imukit.simulate(...).gnss``), flat Earth. The filter's model comes from
+    ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors and its
+    ``[gnss]`` accuracy and lever arm. ``initial`` is a truth Table (its first row). Returns the
+    navigation columns of :func:`strapdown`, their one-sigma (``pos_x_sigma_m`` …
+    ``att_z_sigma_rad``) and the bias estimates (``accel_bias_x_m_s2`` … ``gyro_bias_z_rad_s``);
+    ``gate=False`` applies every fix (else a chi-square gate rejects outliers).
+    """
+    if isinstance(scenario, Mapping):
+        source, fmt, base = dict(scenario), "dict", os.getcwd()
+    else:
+        path = Path(scenario)
+        try:
+            source = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise ImuError(f"{path}: {e.strerror or e}") from None
+        fmt, base = ("json" if path.suffix.lower() == ".json" else "toml"), str(path.parent)
+    table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *_table_args("initial", initial),
+                             source, format=fmt, base_dir=base, gate=bool(gate))
+    return _table(table)

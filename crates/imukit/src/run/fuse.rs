@@ -237,3 +237,106 @@ fn fuse_in<N: NavFrame>(
     let (updates, rejected) = filter.update_counts();
     Ok((table, FuseSummary { updates, rejected }))
 }
+
+/// The filter's model of one sensor triad from its error parameters at `rate_hz`: the
+/// continuous PSD of the white noise and of the bias drift (worst axis), each from the discrete
+/// noise the simulator draws. White: `σ_d = N √β` per sample (`β = fs` single-sided, `fs/2`
+/// double-sided), so `√q = σ_d/√fs`. Random walk `K/√β` per sample: `√q = K √(fs/β)`. Bias
+/// instability `B`: MATLAB's filter (short memory) joins the white noise with its low-frequency
+/// gain, `√q += B·|Σb/Σa|/√fs`; flicker (to `τ_max`) and Gauss–Markov (time `T`) join the drift as
+/// a random walk of the same variance growth, `q += 2B²/T`.
+fn triad_psd(p: &imu_core::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
+    use imu_core::sensor::{BiasInstabilityModel, NoiseType};
+    let beta = match p.noise_type {
+        NoiseType::SingleSided => rate_hz,
+        NoiseType::DoubleSided => rate_hz / 2.0,
+    };
+    let max = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let (n, k, b) = (
+        max(p.noise_density),
+        max(p.random_walk),
+        max(p.bias_instability),
+    );
+    let mut white = n * (beta / rate_hz).sqrt();
+    let mut drift_q = (k * (rate_hz / beta).sqrt()).powi(2);
+    match &p.bias_instability_model {
+        BiasInstabilityModel::Filter(c) => {
+            let gain = c.numerator().iter().sum::<f64>() / c.denominator().iter().sum::<f64>();
+            white = (white.powi(2) + (b * gain.abs()).powi(2) / rate_hz).sqrt();
+        }
+        BiasInstabilityModel::Flicker { tau_max_s, .. } => drift_q += 2.0 * b * b / tau_max_s,
+        BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
+            drift_q += 2.0 * b * b / correlation_time_s;
+        }
+    }
+    (white, drift_q.sqrt())
+}
+
+impl FuseSetup {
+    /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
+    /// IMU's noise ([`triad_psd`]) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
+    /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
+    /// filter assumes uncorrelated fixes). Initial uncertainty: position as the fixes, 0.1 m/s,
+    /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
+    /// 0.01 m/s² and 1e-4 rad/s).
+    ///
+    /// # Errors
+    /// A scenario without `[gnss]`, or on the WGS-84 Earth (fusion there is not implemented yet).
+    pub fn from_scenario(scenario: &crate::Scenario) -> Result<Self> {
+        use imu_core::aiding::PositionNoise;
+        let gnss = scenario.gnss.as_ref().ok_or_else(|| {
+            invalid(
+                "scenario",
+                "has no [gnss] receiver: the filter takes the fixes' accuracy from it",
+            )
+        })?;
+        if !matches!(scenario.earth, crate::scenario::EarthSetup::Flat) {
+            return Err(invalid(
+                "earth",
+                "fusion on the WGS-84 Earth is not implemented yet; fuse on the flat Earth",
+            ));
+        }
+        let rate = scenario.sample_rate_hz;
+        let p = &scenario.imu.sensors.params;
+        let (accel_psd, accel_bias_psd) = triad_psd(&p.accelerometer, rate);
+        let (gyro_psd, gyro_bias_psd) = triad_psd(&p.gyroscope, rate);
+        let g = &gnss.params;
+        let scale = match g.position_noise {
+            PositionNoise::DecayFactor(k) => (2.0 / (1.0 + k)).sqrt(),
+            PositionNoise::GaussMarkov { .. } => 1.0,
+        };
+        // A zero accuracy (exact fixes) still needs a little trust in the model.
+        let floor = |s: f64| s.max(1e-3);
+        let (h, v) = (
+            floor(g.horizontal_accuracy_m * scale),
+            floor(g.vertical_accuracy_m * scale),
+        );
+        let max_abs = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        Ok(Self {
+            nav_frame: scenario.nav_frame,
+            accel_sign: scenario.imu.accel_sign,
+            gravity_m_s2: scenario.gravity_m_s2,
+            noise: EskfNoise {
+                accel_psd,
+                gyro_psd,
+                accel_bias_psd,
+                gyro_bias_psd,
+            },
+            initial_sigma: InitialSigma {
+                position_m: h.max(v),
+                velocity_m_s: 0.1,
+                attitude_rad: [0.01, 0.01, 0.05],
+                accel_bias_m_s2: max_abs(p.accelerometer.constant_bias).max(0.01),
+                gyro_bias_rad_s: max_abs(p.gyroscope.constant_bias).max(1e-4),
+            },
+            gnss_position_sigma_m: [h, h, v],
+            gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
+            lever_arm_m: gnss.lever_arm_m,
+            gate: CHI2_99_9_6DOF,
+        })
+    }
+}
+
+/// The chi-square 99.9 % quantile with 6 degrees of freedom: the default innovation gate of a
+/// position-and-velocity fix (a good fix is rejected once in a thousand).
+pub const CHI2_99_9_6DOF: f64 = 22.457_744_484_825_3;
