@@ -148,8 +148,8 @@ pub enum Command {
         out: PathBuf,
     },
     /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states) over IMU rates
-    /// and GNSS fixes, the filter's model taken from the scenario that made them ([imu] errors,
-    /// [gnss] accuracy and lever arm); writes the navigation columns, their one-sigma and the
+    /// and GNSS fixes, the filter's model taken from the scenario that made them (`[imu]` errors,
+    /// `[gnss]` accuracy and lever arm); writes the navigation columns, their one-sigma and the
     /// bias estimates.
     Fuse {
         /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
@@ -159,7 +159,7 @@ pub enum Command {
         /// The initial state: the first row of this truth CSV.
         #[arg(long)]
         init: PathBuf,
-        /// The scenario whose [imu] and [gnss] describe the data's errors.
+        /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.
         #[arg(long)]
         scenario: PathBuf,
         /// `flat` (the only one so far).

@@ -274,7 +274,7 @@ fn triad_psd(p: &imu_core::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
 
 impl FuseSetup {
     /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
-    /// IMU's noise ([`triad_psd`]) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
+    /// IMU's noise (white and drift PSDs, see `triad_psd`) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
     /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
     /// filter assumes uncorrelated fixes). Initial uncertainty: position as the fixes, 0.1 m/s,
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
