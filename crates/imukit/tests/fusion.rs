@@ -1,7 +1,8 @@
 //! The loosely coupled INS/GNSS filter: with ideal sensors and exact fixes it reproduces the
 //! truth; over 50 seeded Monte Carlo runs its stated uncertainty is honest (average NEES of
-//! position, velocity and attitude inside the two-sided 95 % chi-square bounds) and a filter
-//! told 100× too little process noise fails the same test.
+//! position, velocity and attitude, and average NIS of the fixes, inside the two-sided 95 %
+//! chi-square bounds) and a filter told 100× too little process noise fails the same test;
+//! heading is observable only when the vehicle accelerates horizontally.
 use std::path::Path;
 
 use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma};
@@ -94,9 +95,9 @@ fn chi2_quantile(k: f64, z: f64) -> f64 {
     k * (1.0 - c + z * c.sqrt()).powi(3)
 }
 
-/// Average NEES of position, velocity and attitude at `check_s`, over `runs` runs, with the
-/// filter's process noise scaled by `q_scale`.
-fn average_nees(runs: u64, q_scale: f64) -> [f64; 3] {
+/// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average
+/// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`.
+fn average_nees(runs: u64, q_scale: f64) -> ([f64; 3], f64, usize) {
     // IMU: white noise and bias random walk (single-sided densities: the continuous PSD is N²,
     // so the filter's √q is N). GNSS: white (MATLAB decay factor 0: deviation σ√2).
     let (n_a, n_g, k_a, k_g) = (0.003, 2e-4, 2e-4, 2e-6);
@@ -126,6 +127,7 @@ fn average_nees(runs: u64, q_scale: f64) -> [f64; 3] {
     };
     let check_s = 40.0;
     let mut sums = [0.0; 3];
+    let (mut nis_sum, mut fixes) = (0.0, 0);
     for run in 0..runs {
         let sim = simulate(&text, run);
         let gnss = sim.gnss.as_ref().unwrap();
@@ -178,15 +180,18 @@ fn average_nees(runs: u64, q_scale: f64) -> [f64; 3] {
         for i in 0..t.len() {
             f.propagate(t[i], w[i], a[i]).unwrap();
             while next < g_t.len() && g_t[next] <= t[i] {
-                f.update_gnss(
-                    Vec3::from_array(g_p[next]),
-                    Some(Vec3::from_array(g_v[next])),
-                    Vec3::zeros(),
-                    [sigma_h * s2, sigma_h * s2, sigma_v * s2],
-                    [sigma_vel; 3],
-                    f64::INFINITY,
-                )
-                .unwrap();
+                let outcome = f
+                    .update_gnss(
+                        Vec3::from_array(g_p[next]),
+                        Some(Vec3::from_array(g_v[next])),
+                        Vec3::zeros(),
+                        [sigma_h * s2, sigma_h * s2, sigma_v * s2],
+                        [sigma_vel; 3],
+                        f64::INFINITY,
+                    )
+                    .unwrap();
+                nis_sum += outcome.nis;
+                fixes += 1;
                 next += 1;
             }
             if (t[i] - check_s).abs() < 1e-9 {
@@ -206,7 +211,7 @@ fn average_nees(runs: u64, q_scale: f64) -> [f64; 3] {
             }
         }
     }
-    sums.map(|s| s / runs as f64)
+    (sums.map(|s| s / runs as f64), nis_sum / fixes as f64, fixes)
 }
 
 #[test]
@@ -217,7 +222,7 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
         chi2_quantile(dof, -1.959_964) / runs as f64,
         chi2_quantile(dof, 1.959_964) / runs as f64,
     );
-    let nees = average_nees(runs, 1.0);
+    let (nees, nis, fixes) = average_nees(runs, 1.0);
     eprintln!("average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]");
     for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
         assert!(
@@ -225,11 +230,81 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
             "{name}: average NEES {v} outside [{lo}, {hi}]"
         );
     }
+    // The innovations: each fix's NIS is χ² with 6 degrees of freedom, independent from fix to
+    // fix for a consistent filter; their average over all fixes within the 95 % bounds of
+    // χ²(6·fixes)/fixes.
+    let k = 6.0 * fixes as f64;
+    let (nis_lo, nis_hi) = (
+        chi2_quantile(k, -1.959_964) / fixes as f64,
+        chi2_quantile(k, 1.959_964) / fixes as f64,
+    );
+    eprintln!("average NIS {nis} over {fixes} fixes, 95 % bounds [{nis_lo:.3}, {nis_hi:.3}]");
+    assert!(nis_lo <= nis && nis <= nis_hi, "NIS {nis}");
     // Told 100 times too little process noise, the filter is overconfident.
-    let mistuned = average_nees(runs, 0.01);
-    eprintln!("mistuned (process noise × 0.01): average NEES {mistuned:?}");
+    let (mistuned, mistuned_nis, _) = average_nees(runs, 0.01);
+    eprintln!("mistuned (process noise × 0.01): average NEES {mistuned:?}, NIS {mistuned_nis}");
     assert!(
         mistuned.iter().any(|&v| v > hi),
         "a mistuned filter passed: {mistuned:?}"
     );
+    assert!(mistuned_nis > nis_hi, "{mistuned_nis}");
+}
+
+#[test]
+fn fixes_that_jump_are_rejected_and_ten_in_a_row_are_reported_as_divergence() {
+    let text = scenario("", "decay_factor = 0.0");
+    let sim = simulate(&text, 0);
+    let sc = ScenarioSpec::from_toml(&text, "fusion.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    let initial = InitialState::from_table(&sim.truth).unwrap();
+    let mut gnss = sim.gnss.clone().unwrap();
+    let width = gnss.columns.len();
+    // One fix 200 m off: rejected, the rest applied.
+    gnss.data[50 * width + 1] += 200.0;
+    let (_, summary) = fuse(&sim.imu, &gnss, &initial, &setup).unwrap();
+    assert_eq!((summary.updates, summary.rejected), (200, 1));
+    // From fix 100 on, every fix 200 m off: divergence reported at the tenth, by row.
+    for k in 100..gnss.rows() {
+        gnss.data[k * width + 1] += 200.0;
+    }
+    let e = match fuse(&sim.imu, &gnss, &initial, &setup) {
+        Ok((_, summary)) => panic!("no divergence reported: {summary:?}"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("row 111: 10 fixes in a row rejected by the innovation gate"),
+        "{e}"
+    );
+}
+
+#[test]
+fn heading_is_observable_in_a_turn_and_not_on_a_straight_line_at_constant_speed() {
+    // GNSS position only; the heading's one-sigma after 40 s: in the circle (horizontal
+    // acceleration 1.5 m/s²) it falls far below its 0.05 rad start, on the straight line it
+    // stays near it (only the gyro's noise and the tilt coupling touch it).
+    let run = |path: &str| {
+        let text = scenario("", "decay_factor = 0.0")
+            .replace(
+                "position_m = [\"r*sin(0.16*t + 0.02*sin(0.5*t))\", \"r*(1 - cos(0.16*t + 0.02*sin(0.5*t)))\", \"2*sin(0.1*t)\"]",
+                path,
+            );
+        let sim = simulate(&text, 0);
+        let sc = ScenarioSpec::from_toml(&text, "fusion.toml")
+            .unwrap()
+            .resolve(Path::new("."))
+            .unwrap();
+        let mut setup = FuseSetup::from_scenario(&sc).unwrap();
+        setup.gnss_velocity_sigma_m_s = None;
+        let initial = InitialState::from_table(&sim.truth).unwrap();
+        let (nav, _) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+        *col(&nav, "att_z_sigma_rad").last().unwrap()
+    };
+    let turning = run("position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]");
+    let straight = run("position_m = [\"10*t\", \"0\", \"0\"]");
+    eprintln!("heading one-sigma after 40 s: turning {turning}, straight {straight}");
+    assert!(turning < 0.25 * 0.05, "turning: {turning}");
+    assert!(straight > 0.8 * 0.05, "straight: {straight}");
 }

@@ -184,13 +184,14 @@ fn fuse_in<N: NavFrame>(
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     let mut table = Table::new(&FUSE_COLUMNS);
     let mut next_fix = 0;
+    let mut rejected_in_a_row = 0;
     let mut last_yaw = None;
     for i in 0..t.len() {
         filter
             .propagate(t[i], w[i], f[i].map(|x| sign * x))
             .map_err(|e| filter_error("IMU data", e))?;
         while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
-            filter
+            let outcome = filter
                 .update_gnss(
                     Vec3::from_array(g_p[next_fix]),
                     setup
@@ -202,6 +203,24 @@ fn fuse_in<N: NavFrame>(
                     setup.gate,
                 )
                 .map_err(|e| invalid("GNSS data", format!("row {}: {e}", next_fix + 2)))?;
+            rejected_in_a_row = if outcome.accepted {
+                0
+            } else {
+                rejected_in_a_row + 1
+            };
+            if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
+                return Err(invalid(
+                    "GNSS data",
+                    format!(
+                        "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
+                         gate (the last with NIS {:.1} against {:.1}): the filter has lost the \
+                         fixes or the fixes have jumped; nothing is written",
+                        next_fix + 2,
+                        outcome.nis,
+                        setup.gate
+                    ),
+                ));
+            }
             next_fix += 1;
         }
         let s = filter.state();
@@ -336,6 +355,9 @@ impl FuseSetup {
         })
     }
 }
+
+/// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
+pub const MAX_REJECTED_IN_A_ROW: usize = 10;
 
 /// The chi-square 99.9 % quantile with 6 degrees of freedom: the default innovation gate of a
 /// position-and-velocity fix (a good fix is rejected once in a thousand).
