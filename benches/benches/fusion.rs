@@ -1,0 +1,75 @@
+//! Throughput of the error-state filter per IMU sample (propagation of the nominal state and the
+//! 15 × 15 covariance), and of a GNSS position-and-velocity update, next to the sensor model's
+//! per-sample cost in `sensor.rs`.
+//!
+//! Run: `cargo bench -p imu-benches --bench fusion`.
+#![allow(missing_docs)]
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma};
+use imu_core::{Enu, Rotation, Vec3};
+
+fn filter() -> Eskf<Enu> {
+    let start = EskfState::<Enu> {
+        t_s: 0.0,
+        position_m: Vec3::zeros(),
+        velocity_m_s: Vec3::new(10.0, 0.0, 0.0),
+        attitude: Rotation::identity(),
+        accel_bias_m_s2: [0.0; 3],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let sigma = InitialSigma {
+        position_m: 1.0,
+        velocity_m_s: 0.1,
+        attitude_rad: [0.01, 0.01, 0.05],
+        accel_bias_m_s2: 0.01,
+        gyro_bias_rad_s: 1e-4,
+    };
+    let noise = EskfNoise {
+        accel_psd: 3e-3,
+        gyro_psd: 2e-4,
+        accel_bias_psd: 2e-4,
+        gyro_bias_psd: 2e-6,
+    };
+    Eskf::new(&start, &sigma, noise, 9.81).expect("valid")
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("fusion");
+    let n = 10_000usize;
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function(BenchmarkId::new("propagate", n), |b| {
+        b.iter(|| {
+            let mut f = filter();
+            for k in 0..n {
+                let t = k as f64 * 0.01;
+                f.propagate(t, [0.01, -0.02, 0.1 * t.sin()], [0.2, 1.0, 9.81])
+                    .expect("valid");
+            }
+            f
+        });
+    });
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("gnss_update_position_velocity", |b| {
+        let mut f = filter();
+        f.propagate(0.0, [0.0; 3], [0.0, 0.0, 9.81]).expect("valid");
+        f.propagate(0.01, [0.0; 3], [0.0, 0.0, 9.81])
+            .expect("valid");
+        b.iter(|| {
+            let mut g = f;
+            g.update_gnss(
+                Vec3::new(0.1, 0.2, 0.0),
+                Some(Vec3::new(10.0, 0.0, 0.0)),
+                Vec3::new(0.0, 0.0, -1.0),
+                [1.0, 1.0, 2.0],
+                [0.1; 3],
+                f64::INFINITY,
+            )
+            .expect("valid")
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
