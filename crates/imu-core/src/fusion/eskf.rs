@@ -129,6 +129,47 @@ fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
     nalgebra::Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
+/// The non-zero blocks of `A = FΔt + (FΔt)²/2` (rows/columns in blocks of 3: δp, δv, φ, δb_a,
+/// δb_g): `F₀₁ = I`, `F₁₂ = −[f^n×]`, `F₁₃ = −Ĉ`, `F₂₄ = −Ĉ`, and `F²` adds `(0,2) = −[f^n×]`,
+/// `(0,3) = −Ĉ`, `(1,4) = [f^n×]Ĉ`.
+struct Transition {
+    a01: nalgebra::Matrix3<f64>,
+    a02: nalgebra::Matrix3<f64>,
+    a03: nalgebra::Matrix3<f64>,
+    a12: nalgebra::Matrix3<f64>,
+    a13: nalgebra::Matrix3<f64>,
+    a14: nalgebra::Matrix3<f64>,
+    a24: nalgebra::Matrix3<f64>,
+}
+
+impl Transition {
+    fn new(fx: &nalgebra::Matrix3<f64>, c: &nalgebra::Matrix3<f64>, dt: f64) -> Self {
+        let h = 0.5 * dt * dt;
+        Self {
+            a01: nalgebra::Matrix3::identity() * dt,
+            a02: -fx * h,
+            a03: -c * h,
+            a12: -fx * dt,
+            a13: -c * dt,
+            a14: fx * c * h,
+            a24: -c * dt,
+        }
+    }
+
+    /// `A · m`, block row by block row (rows 3–4 of A are zero).
+    fn times(&self, m: &Mat15) -> Mat15 {
+        let row = |k: usize| m.fixed_view::<3, 15>(3 * k, 0);
+        let mut out = Mat15::zeros();
+        out.fixed_view_mut::<3, 15>(0, 0)
+            .copy_from(&(self.a01 * row(1) + self.a02 * row(2) + self.a03 * row(3)));
+        out.fixed_view_mut::<3, 15>(3, 0)
+            .copy_from(&(self.a12 * row(2) + self.a13 * row(3) + self.a14 * row(4)));
+        out.fixed_view_mut::<3, 15>(6, 0)
+            .copy_from(&(self.a24 * row(4)));
+        out
+    }
+}
+
 /// The error-state filter.
 #[derive(Clone, Copy, Debug)]
 pub struct Eskf<N: NavFrame> {
@@ -278,18 +319,11 @@ impl<N: NavFrame> Eskf<N> {
         let v0 = self.v;
         self.v += (half * f + self.g) * dt;
         self.p += 0.5 * (v0 + self.v) * dt;
-        // Error state: F at the interval's middle.
+        // Error state: Φ = I + A, A = FΔt + (FΔt)²/2 at the interval's middle, kept as its
+        // seven non-zero 3 × 3 blocks; Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ (P symmetric).
         let c = half.to_rotation_matrix().into_inner();
-        let f_n = c * f;
-        let mut fm = Mat15::zeros();
-        fm.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&nalgebra::Matrix3::identity());
-        fm.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&f_n)));
-        fm.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
-        fm.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
-        let fdt = fm * dt;
-        let phi = Mat15::identity() + fdt + fdt * fdt * 0.5;
-        // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases.
+        let a = Transition::new(&skew(&(c * f)), &c, dt);
+        let ap = a.times(&self.cov);
         let mut gqg = Vec15::zeros();
         for i in 0..3 {
             gqg[3 + i] = sq(self.noise.accel_psd);
@@ -297,9 +331,12 @@ impl<N: NavFrame> Eskf<N> {
             gqg[9 + i] = sq(self.noise.accel_bias_psd);
             gqg[12 + i] = sq(self.noise.gyro_bias_psd);
         }
+        // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases;
+        // Q_d = ½ (Φ Q Φᵀ + Q) Δt.
         let qc = Mat15::from_diagonal(&gqg);
-        let qd = (phi * qc * phi.transpose() + qc) * (0.5 * dt);
-        self.cov = phi * self.cov * phi.transpose() + qd;
+        let aq = a.times(&qc);
+        let qd = (qc * 2.0 + aq + aq.transpose() + a.times(&aq.transpose())) * (0.5 * dt);
+        self.cov += ap + ap.transpose() + a.times(&ap.transpose()) + qd;
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
         self.q = q1;
         self.t = t_s;
