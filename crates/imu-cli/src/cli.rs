@@ -33,6 +33,12 @@ pub enum Command {
         /// one per run like the IMU readings).
         #[arg(long)]
         gnss: Option<PathBuf>,
+        /// Where to write the readings of the scenario's `[baro]` barometer (CSV).
+        #[arg(long)]
+        baro: Option<PathBuf>,
+        /// Where to write the readings of the scenario's `[odometer]` (CSV).
+        #[arg(long)]
+        odometer: Option<PathBuf>,
         /// Monte Carlo: this many runs, in parallel on all cores, one output per run
         /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
         #[arg(long)]

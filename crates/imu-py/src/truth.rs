@@ -23,8 +23,14 @@ use crate::convert::{
 };
 use crate::errors::{refused, shape_error};
 
-/// Truth, IMU and (when the scenario has a receiver) GNSS tables of one run.
-type SimulationOut<'py> = (TableOut<'py>, TableOut<'py>, Option<TableOut<'py>>);
+/// Truth, IMU and (when the scenario has them) GNSS, barometer and odometer tables of one run.
+type SimulationOut<'py> = (
+    TableOut<'py>,
+    TableOut<'py>,
+    Option<TableOut<'py>>,
+    Option<TableOut<'py>>,
+    Option<TableOut<'py>>,
+);
 
 /// Runs a resolved scenario spec with the GIL released.
 fn run_spec<'py>(
@@ -44,8 +50,14 @@ fn run_spec<'py>(
             }
         })
         .map_err(refused)?;
-    let gnss = sim.gnss.map(|g| table_out(py, g)).transpose()?;
-    Ok((table_out(py, sim.truth)?, table_out(py, sim.imu)?, gnss))
+    let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();
+    Ok((
+        table_out(py, sim.truth)?,
+        table_out(py, sim.imu)?,
+        optional(sim.gnss)?,
+        optional(sim.baro)?,
+        optional(sim.odometer)?,
+    ))
 }
 
 /// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu, gnss or None)

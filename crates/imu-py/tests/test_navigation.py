@@ -164,3 +164,12 @@ def test_fuse_keeps_a_car_within_its_stated_uncertainty_through_a_gnss_outage():
     assert summary["position_final_m"] < 1.0
     with pytest.raises(ImuError, match="no \\[gnss\\] receiver"):
         imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario={k: v for k, v in scenario.items() if k != "gnss"})
+
+
+def test_a_scenario_with_a_barometer_and_an_odometer_returns_their_readings():
+    sim = imukit.simulate({"rate_hz": 100.0, "duration_s": 20.0, "nav_frame": "NED",
+                           "trajectory": {"type": "expression", "position_m": ["10*t", "0", "-50"], "attitude": "tangent"},
+                           "baro": {"bias_m": 2.0, "noise_m": 0.0}, "odometer": {"scale_factor_error": 0.01, "noise_m_s": 0.0}})
+    np.testing.assert_allclose(sim.baro["baro_height_m"], 52.0, atol=1e-9)
+    np.testing.assert_allclose(sim.odometer["speed_m_s"], 10.1, atol=1e-9)
+    assert sim.gnss is None

@@ -128,7 +128,15 @@ fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
     std::fs::create_dir_all(&dir).unwrap();
     let (imu, gnss) = (dir.join("imu.csv"), dir.join("gnss.csv"));
     // 10 001 samples: the stream crosses chunk boundaries (4096).
-    sc.stream_to_csv(None, &imu, None, Some(&gnss)).unwrap();
+    sc.stream_to_csv(
+        None,
+        &imukit::run::simulate::CsvOutputs {
+            imu: Some(&imu),
+            gnss: Some(&gnss),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let from_file = imukit::io::table::read_table(&gnss).unwrap();
     let in_memory = sc.simulate().unwrap().gnss.unwrap();
     assert_eq!(from_file.columns, in_memory.columns);
@@ -192,11 +200,78 @@ fn bad_gnss_keys_are_refused_by_name() {
     let e = sc
         .stream_to_csv(
             None,
-            &dir.join(format!("imukit-nognss-{}.csv", std::process::id())),
-            None,
-            Some(&dir.join(format!("imukit-nognss-g-{}.csv", std::process::id()))),
+            &imukit::run::simulate::CsvOutputs {
+                imu: Some(&dir.join(format!("imukit-nognss-{}.csv", std::process::id()))),
+                gnss: Some(&dir.join(format!("imukit-nognss-g-{}.csv", std::process::id()))),
+                ..Default::default()
+            },
         )
         .unwrap_err()
         .to_string();
     assert!(e.contains("the scenario has no [gnss] receiver"), "{e}");
+}
+
+#[test]
+fn a_barometer_reads_the_height_and_an_odometer_the_forward_speed_with_their_errors() {
+    // Flying north-east at 10 m/s, 50 m up, for 200 s: 2001 readings at 10 Hz of each.
+    for (frame, z) in [("NED", "-50"), ("ENU", "50")] {
+        let text = format!(
+            "rate_hz = 100.0\nduration_s = 200.0\nnav_frame = \"{frame}\"\n[trajectory]\ntype = \"expression\"\n\
+             position_m = [\"7.0710678118654755*t\", \"7.0710678118654755*t\", \"{z}\"]\nattitude = \"tangent\"\n\
+             [baro]\nbias_m = 2.0\nnoise_m = 0.5\n[odometer]\nscale_factor_error = 0.01\nnoise_m_s = 0.05\n"
+        );
+        let sim = run(&text).unwrap();
+        let (baro, odo) = (sim.baro.unwrap(), sim.odometer.unwrap());
+        assert_eq!((baro.rows(), odo.rows()), (2001, 2001));
+        let stats = |v: Vec<f64>| {
+            let n = v.len() as f64;
+            let m = v.iter().sum::<f64>() / n;
+            (
+                m,
+                (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt(),
+            )
+        };
+        let n = 2001f64;
+        // Means within 4 standard errors σ/√n, deviations within 4 of σ/√(2n).
+        let (m, s) = stats(baro.column("baro_height_m").unwrap());
+        assert!((m - 52.0).abs() < 4.0 * 0.5 / n.sqrt(), "{frame}: {m}");
+        assert!(
+            (s / 0.5 - 1.0).abs() < 4.0 / (2.0 * n).sqrt(),
+            "{frame}: {s}"
+        );
+        let (m, s) = stats(odo.column("speed_m_s").unwrap());
+        assert!((m - 10.1).abs() < 4.0 * 0.05 / n.sqrt(), "{frame}: {m}");
+        assert!(
+            (s / 0.05 - 1.0).abs() < 4.0 / (2.0 * n).sqrt(),
+            "{frame}: {s}"
+        );
+    }
+    // On the Earth the barometer reads the WGS-84 height.
+    let earth = run(
+        "rate_hz = 10.0\nduration_s = 10.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = { latitude_deg = 47.0, longitude_deg = 8.0, height_m = 1200.0 }\n\
+         [trajectory]\ntype = \"builtin\"\nname = \"static\"\n[baro]\nrate_hz = 1.0\nnoise_m = 0.0\n",
+    )
+    .unwrap();
+    let h = earth.baro.unwrap().column("baro_height_m").unwrap();
+    assert!(h.iter().all(|x| (x - 1200.0).abs() < 1e-6), "{h:?}");
+    // Keys are checked by name.
+    for (keys, want) in [
+        (
+            "[baro]\nrate_hz = 3.0",
+            "baro.rate_hz: must be > 0 and divide",
+        ),
+        (
+            "[baro]\nnoise_m = -1.0",
+            "baro.noise_m: must be a finite number ≥ 0",
+        ),
+        (
+            "[odometer]\nscale_factor_error = nan",
+            "odometer.scale_factor_error: must be a finite number",
+        ),
+        ("[odometer]\nrate = 1.0", "unknown field `rate`"),
+    ] {
+        let e = run(&format!("{FIGURE8}{keys}\n")).unwrap_err().to_string();
+        assert!(e.contains(want), "{keys}: {e}");
+    }
 }

@@ -285,7 +285,15 @@ fn a_result_that_is_not_finite_is_never_written() {
     let dir = std::env::temp_dir().join(format!("imukit-notfinite-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("imu.csv");
-    let e = scenario.stream_to_csv(None, &out, None, None).unwrap_err();
+    let e = scenario
+        .stream_to_csv(
+            None,
+            &imukit::run::simulate::CsvOutputs {
+                imu: Some(&out),
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
     assert!(matches!(e, Error::NotFinite { row: 2, .. }), "{e}");
     assert_eq!(e.location().column.as_deref(), Some("accel_x_m_s2"));
     assert!(!out.exists());

@@ -5,6 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use imukit::ScenarioSpec;
 use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
+use imukit::run::simulate::CsvOutputs;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -15,6 +16,8 @@ pub fn run(
     out: &Path,
     truth: Option<&Path>,
     gnss: Option<&Path>,
+    baro: Option<&Path>,
+    odometer: Option<&Path>,
     runs: Option<u64>,
 ) -> Result<(), CliError> {
     let spec = ScenarioSpec::from_file(scenario)?;
@@ -30,10 +33,14 @@ pub fn run(
     };
     let run_files = per_run(out);
     let gnss_files = gnss.map(per_run).unwrap_or_default();
+    let baro_files = baro.map(per_run).unwrap_or_default();
+    let odometer_files = odometer.map(per_run).unwrap_or_default();
     let mut outputs: Vec<(&str, &Path)> =
         run_files.iter().map(|p| ("--out", p.as_path())).collect();
     outputs.extend(truth.map(|t| ("--truth", t)));
     outputs.extend(gnss_files.iter().map(|p| ("--gnss", p.as_path())));
+    outputs.extend(baro_files.iter().map(|p| ("--baro", p.as_path())));
+    outputs.extend(odometer_files.iter().map(|p| ("--odometer", p.as_path())));
     check_outputs(&inputs, &outputs)?;
     let sc = spec.resolve(base)?;
     for w in &sc.imu.sensors.warnings {
@@ -41,7 +48,14 @@ pub fn run(
     }
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
-        sc.stream_to_csv(None, out, truth, gnss)?;
+        let outputs = CsvOutputs {
+            imu: Some(out),
+            truth,
+            gnss,
+            baro,
+            odometer,
+        };
+        sc.stream_to_csv(None, &outputs)?;
         eprintln!(
             "imukit: {} samples; IMU readings in {}{}{}",
             sc.t_s.len(),
@@ -70,12 +84,18 @@ pub fn run(
     (0..runs)
         .into_par_iter()
         .try_for_each(|r| -> Result<(), CliError> {
-            let gnss_file = gnss.map(|g| run_path(g, r, runs));
+            let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
+            let (imu_file, gnss_file, baro_file, odometer_file) =
+                (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
             sc.stream_to_csv(
                 Some(r),
-                &run_path(out, r, runs),
-                truth.filter(|_| r == 0),
-                gnss_file.as_deref(),
+                &CsvOutputs {
+                    imu: Some(&imu_file),
+                    truth: truth.filter(|_| r == 0),
+                    gnss: gnss_file.as_deref(),
+                    baro: baro_file.as_deref(),
+                    odometer: odometer_file.as_deref(),
+                },
             )?;
             done.fetch_add(1, Ordering::Relaxed);
             progress.inc(1);

@@ -48,9 +48,9 @@ def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: in
     """One run (a Dask task or a thread's job): the IMU table, or the path it was written to."""
     text, fmt, origin, base_dir = spec
     if fmt == "dict":
-        truth, imu, _ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run)
+        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run)
     else:
-        truth, imu, _ = _core.simulate_text(text, format=fmt, origin=origin, base_dir=base_dir, run=run)
+        truth, imu, *_ = _core.simulate_text(text, format=fmt, origin=origin, base_dir=base_dir, run=run)
     if out is None:
         return imu, (truth if with_truth else None)
     path = _core.run_path(out, run, runs)

@@ -51,12 +51,14 @@ class Table:
 
 @dataclass(frozen=True)
 class Simulation:
-    """Truth kinematics and IMU readings of a scenario, and the GNSS fixes of its ``[gnss]``
-    receiver (``None`` without one)."""
+    """Truth kinematics and IMU readings of a scenario, and the readings of its aids — the
+    ``[gnss]`` receiver, the ``[baro]`` barometer, the ``[odometer]`` (``None`` without them)."""
 
     truth: Table
     imu: Table
     gnss: Optional[Table] = None
+    baro: Optional[Table] = None
+    odometer: Optional[Table] = None
 
 def _table(out) -> Table:
     columns, values = out

@@ -36,8 +36,10 @@ def simulate(scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] =
             raise ImuError(f"{path}: {e.strerror or e}") from None
         fmt = "json" if path.suffix.lower() == ".json" else "toml"
         out = _core.simulate_text(text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run)
-    truth, imu, gnss = out
-    return Simulation(truth=_table(truth), imu=_table(imu), gnss=None if gnss is None else _table(gnss))
+    truth, imu, gnss, baro, odometer = out
+    optional = lambda t: None if t is None else _table(t)  # noqa: E731
+    return Simulation(truth=_table(truth), imu=_table(imu), gnss=optional(gnss), baro=optional(baro),
+                      odometer=optional(odometer))
 
 def read_csv(path: Union[str, os.PathLike]) -> Table:
     """Every column of an imukit CSV file (truth, IMU readings, navigation output, errors, Allan

@@ -33,6 +33,26 @@ pub struct Chunk {
     pub imu: Table,
     /// GNSS fixes in this chunk, when the scenario has a receiver.
     pub gnss: Option<Table>,
+    /// Barometer readings in this chunk, when the scenario has one.
+    pub baro: Option<Table>,
+    /// Odometer readings in this chunk, when the scenario has one.
+    pub odometer: Option<Table>,
+}
+
+/// Where [`Scenario::stream_to_csv`] writes: the IMU readings, and the truth and the aids'
+/// readings when asked for.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CsvOutputs<'a> {
+    /// IMU readings.
+    pub imu: Option<&'a Path>,
+    /// Truth.
+    pub truth: Option<&'a Path>,
+    /// GNSS fixes (the scenario must have `[gnss]`).
+    pub gnss: Option<&'a Path>,
+    /// Barometer readings (`[baro]`).
+    pub baro: Option<&'a Path>,
+    /// Odometer readings (`[odometer]`).
+    pub odometer: Option<&'a Path>,
 }
 
 impl Scenario {
@@ -53,41 +73,62 @@ impl Scenario {
         }
     }
 
-    /// Streams run `run` into `imu_path` (and the truth into `truth_path`, the GNSS fixes into
-    /// `gnss_path`) as CSV; each file appears only when complete.
+    /// Streams run `run` into the files of `outputs` as CSV; each file appears only when
+    /// complete.
     ///
     /// # Errors
-    /// As [`Scenario::stream`], a GNSS file without a receiver in the scenario, and I/O errors
+    /// As [`Scenario::stream`], an aid's file without that aid in the scenario, and I/O errors
     /// naming the file.
-    pub fn stream_to_csv(
-        &self,
-        run: Option<u64>,
-        imu_path: &Path,
-        truth_path: Option<&Path>,
-        gnss_path: Option<&Path>,
-    ) -> Result<()> {
-        if gnss_path.is_some() && self.gnss.is_none() {
-            return Err(crate::error::invalid(
+    pub fn stream_to_csv(&self, run: Option<u64>, outputs: &CsvOutputs<'_>) -> Result<()> {
+        for (path, present, field, what) in [
+            (
+                outputs.gnss,
+                self.gnss.is_some(),
                 "gnss",
                 "a GNSS file was asked for, but the scenario has no [gnss] receiver",
-            ));
-        }
-        let mut imu = CsvSink::create(imu_path)?;
-        let mut truth = truth_path.map(CsvSink::create).transpose()?;
-        let mut gnss = gnss_path.map(CsvSink::create).transpose()?;
-        self.stream(run, |chunk| {
-            imu.write(&chunk.imu)?;
-            if let Some(t) = truth.as_mut() {
-                t.write(&chunk.truth)?;
+            ),
+            (
+                outputs.baro,
+                self.baro.is_some(),
+                "baro",
+                "a barometer file was asked for, but the scenario has no [baro]",
+            ),
+            (
+                outputs.odometer,
+                self.odometer.is_some(),
+                "odometer",
+                "an odometer file was asked for, but the scenario has no [odometer]",
+            ),
+        ] {
+            if path.is_some() && !present {
+                return Err(crate::error::invalid(field, what));
             }
-            if let (Some(g), Some(fixes)) = (gnss.as_mut(), &chunk.gnss) {
-                g.write(fixes)?;
+        }
+        let open = |p: Option<&Path>| p.map(CsvSink::create).transpose();
+        let (mut imu, mut truth) = (open(outputs.imu)?, open(outputs.truth)?);
+        let (mut gnss, mut baro, mut odometer) = (
+            open(outputs.gnss)?,
+            open(outputs.baro)?,
+            open(outputs.odometer)?,
+        );
+        self.stream(run, |chunk| {
+            for (sink, table) in [
+                (&mut imu, Some(&chunk.imu)),
+                (&mut truth, Some(&chunk.truth)),
+                (&mut gnss, chunk.gnss.as_ref()),
+                (&mut baro, chunk.baro.as_ref()),
+                (&mut odometer, chunk.odometer.as_ref()),
+            ] {
+                if let (Some(s), Some(t)) = (sink.as_mut(), table) {
+                    s.write(t)?;
+                }
             }
             Ok(())
         })?;
-        imu.commit()?;
-        truth.map_or(Ok(()), CsvSink::commit)?;
-        gnss.map_or(Ok(()), CsvSink::commit)
+        for sink in [imu, truth, gnss, baro, odometer].into_iter().flatten() {
+            sink.commit()?;
+        }
+        Ok(())
     }
 
     fn stream_in<N: NavFrame>(
@@ -102,10 +143,15 @@ impl Scenario {
         let output = self.imu.output;
         // The last reading of the previous chunk: increments integrate across the boundary.
         let mut previous: Option<(f64, ImuReading)> = None;
-        let mut receiver = self.gnss_stream(run)?;
+        let mut aids = self.aids(run)?;
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            let (truth_table, readings, gnss) =
-                self.on_earth(truth, &mut sensors, receiver.as_mut())?;
+            let crate::scenario::Stretch {
+                truth: truth_table,
+                readings,
+                gnss,
+                baro,
+                odometer,
+            } = self.on_earth(truth, &mut sensors, &mut aids)?;
             let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
             let imu = match output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, kind),
@@ -127,6 +173,8 @@ impl Scenario {
                 truth: truth_table,
                 imu,
                 gnss,
+                baro,
+                odometer,
             })
         };
         let t_s = &self.t_s;

@@ -68,6 +68,8 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         trajectory,
         imu: ImuSpec::default(),
         gnss: None,
+        baro: None,
+        odometer: None,
     };
     Ok(match name {
         "figure8" => {

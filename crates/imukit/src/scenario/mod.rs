@@ -17,6 +17,7 @@
 //! accel_sign = "specific-force"   # or "matlab"
 //! magnetic_field_ut = [-2.4169, 27.5550, 16.0849]   # nav frame
 //! ```
+pub mod aids;
 pub mod builtin;
 pub mod earth;
 pub mod gnss;
@@ -67,6 +68,27 @@ pub struct Scenario {
     pub imu: ImuSetup,
     /// The GNSS receiver, if any.
     pub gnss: Option<gnss::GnssSetup>,
+    /// The barometer, if any.
+    pub baro: Option<aids::AidSetup>,
+    /// The wheel odometer, if any.
+    pub odometer: Option<aids::AidSetup>,
+}
+
+/// The aiding sensors of one run, each with its state and noise stream.
+#[derive(Debug)]
+pub(crate) struct Aids<'a> {
+    gnss: Option<gnss::GnssStream<'a>>,
+    baro: Option<aids::AidStream>,
+    odometer: Option<aids::AidStream>,
+}
+
+/// One stretch of a run: truth, IMU readings and the aids' readings.
+pub(crate) struct Stretch {
+    pub(crate) truth: Table,
+    pub(crate) readings: Vec<ImuReading>,
+    pub(crate) gnss: Option<Table>,
+    pub(crate) baro: Option<Table>,
+    pub(crate) odometer: Option<Table>,
 }
 
 /// Truth and ideal IMU readings of a scenario.
@@ -79,6 +101,10 @@ pub struct Simulation {
     /// GNSS fixes ([`gnss::GNSS_COLUMNS`] or, on the WGS-84 Earth,
     /// [`gnss::GNSS_EARTH_COLUMNS`]), when the scenario has a receiver.
     pub gnss: Option<Table>,
+    /// Barometer readings ([`aids::BARO_COLUMNS`]), when the scenario has one.
+    pub baro: Option<Table>,
+    /// Odometer readings ([`aids::ODOMETER_COLUMNS`]), when the scenario has one.
+    pub odometer: Option<Table>,
 }
 
 impl Scenario {
@@ -108,12 +134,19 @@ impl Scenario {
         let mut sensors =
             self.imu
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
-        let mut receiver = self.gnss_stream(run)?;
-        let (truth_table, readings, gnss) =
-            self.on_earth(&truth, &mut sensors, receiver.as_mut())?;
+        let mut aids = self.aids(run)?;
+        let Stretch {
+            truth: truth_table,
+            readings,
+            gnss,
+            baro,
+            odometer,
+        } = self.on_earth(&truth, &mut sensors, &mut aids)?;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         let simulation = Simulation {
             gnss,
+            baro,
+            odometer,
             truth: truth_table,
             imu: match self.imu.output {
                 ImuOutput::Rates => Table::from_readings(&t, &readings, self.imu.kind),
@@ -134,14 +167,16 @@ impl Scenario {
         &self,
         truth: &[Truth<N>],
         sensors: &mut ReadingStream<'_, N>,
-        receiver: Option<&mut gnss::GnssStream<'_>>,
-    ) -> Result<(Table, Vec<ImuReading>, Option<Table>)> {
+        aids: &mut Aids<'_>,
+    ) -> Result<Stretch> {
         match &self.earth {
-            EarthSetup::Flat => Ok((
-                Table::from_truth(truth),
-                sensors.measure(truth),
-                receiver.map(|r| r.measure_flat(truth)),
-            )),
+            EarthSetup::Flat => Ok(Stretch {
+                truth: Table::from_truth(truth),
+                readings: sensors.measure(truth),
+                gnss: aids.gnss.as_mut().map(|r| r.measure_flat(truth)),
+                baro: aids.baro.as_mut().map(|b| b.measure(truth, None)),
+                odometer: aids.odometer.as_mut().map(|o| o.measure(truth, None)),
+            }),
             EarthSetup::Wgs84(plane) => {
                 let earth = truth
                     .iter()
@@ -153,22 +188,40 @@ impl Scenario {
                     .map(|(s, e)| TangentPlane::local(s, e))
                     .collect();
                 let readings = sensors.measure_earth(plane, &earth, &local)?;
-                let fixes = receiver.map(|r| r.measure_earth::<N>(&earth));
-                Ok((earth::earth_truth_table(&local, &earth), readings, fixes))
+                let heights: Vec<f64> = earth.iter().map(|e| e.position.height_m).collect();
+                Ok(Stretch {
+                    truth: earth::earth_truth_table(&local, &earth),
+                    readings,
+                    gnss: aids.gnss.as_mut().map(|r| r.measure_earth::<N>(&earth)),
+                    baro: aids
+                        .baro
+                        .as_mut()
+                        .map(|b| b.measure(&local, Some(&heights))),
+                    odometer: aids.odometer.as_mut().map(|o| o.measure(&local, None)),
+                })
             }
         }
     }
 
-    /// The GNSS receiver of run `run`, if the scenario has one.
+    /// The aiding sensors of run `run`, those the scenario has.
     ///
     /// # Errors
     /// Invalid receiver parameters.
-    pub(crate) fn gnss_stream(&self, run: Option<u64>) -> Result<Option<gnss::GnssStream<'_>>> {
+    pub(crate) fn aids(&self, run: Option<u64>) -> Result<Aids<'_>> {
         let end = self.t_s.at(self.t_s.len().saturating_sub(1));
-        self.gnss
-            .as_ref()
-            .map(|g| gnss::GnssStream::new(g, run, end))
-            .transpose()
+        Ok(Aids {
+            gnss: self
+                .gnss
+                .as_ref()
+                .map(|g| gnss::GnssStream::new(g, run, end))
+                .transpose()?,
+            baro: self
+                .baro
+                .map(|b| aids::AidStream::new(b, aids::AidKind::Baro, run)),
+            odometer: self
+                .odometer
+                .map(|o| aids::AidStream::new(o, aids::AidKind::Odometer, run)),
+        })
     }
 
     /// Truth and readings of Monte Carlo run `run`: the noise stream is

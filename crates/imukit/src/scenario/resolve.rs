@@ -137,6 +137,8 @@ impl ScenarioSpec {
                 trajectory: b.trajectory,
                 imu: self.imu.or(&b.imu),
                 gnss: self.gnss.clone().or(b.gnss),
+                baro: self.baro.clone().or(b.baro),
+                odometer: self.odometer.clone().or(b.odometer),
             };
             &merged
         } else {
@@ -280,6 +282,16 @@ impl ScenarioSpec {
             .as_ref()
             .map(|g| g.resolve(sample_rate_hz, imu.sensors.seed))
             .transpose()?;
+        let baro = spec
+            .baro
+            .as_ref()
+            .map(|b| b.resolve(sample_rate_hz, imu.sensors.seed))
+            .transpose()?;
+        let odometer = spec
+            .odometer
+            .as_ref()
+            .map(|o| o.resolve(sample_rate_hz, imu.sensors.seed))
+            .transpose()?;
         Ok(Scenario {
             t_s,
             sample_rate_hz,
@@ -289,6 +301,8 @@ impl ScenarioSpec {
             trajectory,
             imu,
             gnss,
+            baro,
+            odometer,
         })
     }
 }

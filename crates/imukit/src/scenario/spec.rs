@@ -108,6 +108,10 @@ pub struct ScenarioSpec {
     pub imu: ImuSpec,
     /// A GNSS receiver beside the IMU.
     pub gnss: Option<crate::scenario::gnss::GnssSpec>,
+    /// A barometric altimeter.
+    pub baro: Option<crate::scenario::aids::BaroSpec>,
+    /// A wheel odometer.
+    pub odometer: Option<crate::scenario::aids::OdometerSpec>,
 }
 
 /// The Earth model of a scenario.
