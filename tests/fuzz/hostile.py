@@ -227,12 +227,22 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                 'latitude_rad = "0.5"\nlongitude_rad = "0.1"',
             ])
             extra = rng.choice(["", f'magnetic_model = "wmm2025"\ndate = "{rng.choice(["2026-06-01", "2031-01-01", "2026-02-30", "x"])}"\n'])
+            aid = rng.choice([
+                "",
+                f"[gnss]\nrate_hz = {rng.choice(['1.0', '3.0', '10.0', x()])}\nhorizontal_accuracy_m = {x()}\n"
+                f"decay_factor = {rng.choice(['0.0', '0.999', '1.0', x()])}\nlatency_s = {x()}\n"
+                f"outages = [{{ start_s = {x()}, duration_s = {x()} }}]\n",
+                f"[baro]\nrate_hz = {rng.choice(['5.0', x()])}\nnoise_m = {x()}\n[odometer]\nscale_factor_error = {x()}\n",
+            ])
             (work / "e.toml").write_text(
                 f'rate_hz = 10.0\nduration_s = {rng.choice(["1", "5", "0"])}\nnav_frame = "{rng.choice(["NED", "ENU"])}"\n'
                 f'earth = "{rng.choice(["wgs84", "wgs84", "flat"])}"\n'
                 f'origin = {{ latitude_deg = {x()}, longitude_deg = {x()}, height_m = {x()} }}\n{extra}'
-                f'[trajectory]\ntype = "expression"\n{motion}\n')
-            run_cli(r, work, ["simulate", "e.toml", "--out", "eo.csv", "--truth", "et.csv"], ["e.toml"], f"case {k}")
+                f'[trajectory]\ntype = "expression"\n{motion}\n{aid}')
+            extra_out = (["--gnss", "eg.csv"] if "[gnss]" in aid else []) + \
+                (["--baro", "eb.csv", "--odometer", "eod.csv"] if "[baro]" in aid else [])
+            run_cli(r, work, ["simulate", "e.toml", "--out", "eo.csv", "--truth", "et.csv", *extra_out], ["e.toml"],
+                    f"case {k}")
             if (work / "eo.csv").exists() and (work / "et.csv").exists():
                 run_cli(r, work, rng.choice([
                     ["integrate", "eo.csv", "--init", "et.csv", "--earth", "wgs84", "--vertical",
@@ -240,7 +250,7 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                     ["integrate", "eo.csv", "--earth", "wgs84", "--lat0-deg", x(), "--lon0-deg", x(),
                      "--height0-m", x(), "--out", "en.csv"],
                 ]), ["eo.csv", "et.csv"], f"case {k} (navigation)")
-            for leftover in ("eo.csv", "et.csv", "en.csv"):
+            for leftover in ("eo.csv", "et.csv", "en.csv", "eg.csv", "eb.csv", "eod.csv"):
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 
