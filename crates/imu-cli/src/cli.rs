@@ -113,6 +113,10 @@ pub enum Command {
         /// (--gravity-m-s2).
         #[arg(long, default_value = "normal")]
         earth_gravity: String,
+        /// 3D, `--vertical baro`: barometer readings (`t_s, baro_height_m`, as `imukit simulate
+        /// --baro` writes) instead of a `baro_height_m` column in the IMU file.
+        #[arg(long)]
+        baro: Option<PathBuf>,
         /// 3D, `--earth wgs84`: the starting latitude, degrees (with --lon0-deg and
         /// --height0-m; instead of, or over, the --init file's).
         #[arg(long, allow_negative_numbers = true)]

@@ -32,6 +32,8 @@ pub struct Options3d<'a> {
     pub vertical: &'a str,
     pub baro_time_constant_s: f64,
     pub earth_gravity: &'a str,
+    /// `--baro FILE`.
+    pub baro: Option<&'a Path>,
     /// `--lat0-deg`, `--lon0-deg`, `--height0-m`.
     pub geodetic0: (Option<f64>, Option<f64>, Option<f64>),
 }
@@ -94,6 +96,16 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     .map_err(by_flag)?;
     let mut inputs = vec![("input", c.input)];
     inputs.extend(o.init.map(|p| ("--init file", p)));
+    inputs.extend(o.baro.map(|p| ("--baro file", p)));
+    if o.baro.is_some() && o.vertical != "baro" {
+        return Err(Error::Invalid {
+            field: "--baro".into(),
+            message:
+                "feeds the baro-damped vertical channel: use it with --earth wgs84 --vertical baro"
+                    .into(),
+        }
+        .into());
+    }
     check_outputs(&inputs, &[("--out", c.out)])?;
     let mut initial = match o.init {
         Some(p) => InitialState::from_csv(p)?,
@@ -122,6 +134,32 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     // The start options are checked as they are read; what remains is the --init file's row.
     if let Some(p) = o.init {
         initial.check(&format!("{}, row 2", p.display()))?;
+    }
+    if let Some(baro) = o.baro {
+        // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
+        let imu = imukit::run::earth_nav::read_whole(c.input)?;
+        let readings = imukit::io::table::read_table(baro)?;
+        let joined =
+            imukit::run::earth_nav::with_baro_column(&imu, &readings).map_err(|e| match e {
+                Error::Invalid { field, message } if field == "barometer data" => Error::Invalid {
+                    field: baro.display().to_string(),
+                    message,
+                },
+                other => other,
+            })?;
+        let nav = imukit::run::navigate::integrate(&joined, &initial, &setup).map_err(|e| {
+            Error::Invalid {
+                field: c.input.display().to_string(),
+                message: e.to_string(),
+            }
+        })?;
+        nav.write_csv(c.out)?;
+        report(
+            &nav,
+            "strapdown on the WGS-84 Earth, baro-damped height",
+            c.out,
+        );
+        return Ok(());
     }
     // Streamed: memory does not grow with the input file.
     let summary = integrate_csv(c.input, &initial, &setup, c.out).map_err(|e| match e {

@@ -55,6 +55,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             vertical,
             baro_time_constant_s,
             earth_gravity,
+            baro,
             lat0_deg,
             lon0_deg,
             height0_m,
@@ -82,6 +83,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     vertical: &vertical,
                     baro_time_constant_s,
                     earth_gravity: &earth_gravity,
+                    baro: baro.as_deref(),
                     geodetic0: (lat0_deg, lon0_deg, height0_m),
                 };
                 integrate::three_d(&common, &opts)

@@ -231,6 +231,26 @@ fn table<N: NavFrame>(states: &[EarthNavState], origin: &Geodetic) -> Table {
 /// Checks that [`EARTH_NAV_COLUMNS`] extends [`NAV_COLUMNS`].
 const _: () = assert!(EARTH_NAV_COLUMNS.len() == NAV_COLUMNS.len() + 3);
 
+/// Reads an IMU CSV file whole, refused before reading when it could exceed the memory budget
+/// of [`check_in_memory`](crate::scenario::check_in_memory) with what the Earth navigation keeps
+/// per sample.
+///
+/// # Errors
+/// The budget, and the reader's errors naming file, row and column.
+pub fn read_whole(input: &std::path::Path) -> Result<Table> {
+    let bytes = std::fs::metadata(input)
+        .map_err(|source| crate::Error::Io {
+            path: input.into(),
+            source,
+        })?
+        .len();
+    // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
+    // numbers per row come out (the states and the table).
+    let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
+    crate::scenario::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
+    crate::io::table::read_table(input)
+}
+
 /// Integrates the IMU CSV `input` on the Earth into `out` (read whole, within the memory budget
 /// of [`check_in_memory`](crate::scenario::check_in_memory); `out` appears only when complete).
 ///
@@ -242,17 +262,7 @@ pub(crate) fn integrate_earth_csv(
     setup: &NavSetup,
     out: &std::path::Path,
 ) -> Result<crate::run::navigate::NavSummary> {
-    let bytes = std::fs::metadata(input)
-        .map_err(|source| crate::Error::Io {
-            path: input.into(),
-            source,
-        })?
-        .len();
-    // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
-    // numbers per row come out (the states and the table).
-    let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
-    crate::scenario::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
-    let imu = crate::io::table::read_table(input)?;
+    let imu = read_whole(input)?;
     let nav = crate::run::navigate::integrate(&imu, initial, setup)?;
     let rates = ACCEL_COLUMNS
         .iter()
@@ -266,4 +276,56 @@ pub(crate) fn integrate_earth_csv(
         scheme: setup.scheme.for_input(rates, corrections),
         end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
     })
+}
+
+/// `imu` with a [`BARO_COLUMN`] taken from barometer readings `baro` (`t_s, baro_height_m`,
+/// as `imukit simulate --baro` writes): each IMU sample gets the last reading at or before it
+/// (the first reading before the first one).
+///
+/// # Errors
+/// Missing columns, times that do not increase, values that are not finite, an empty file.
+pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
+    let (Some(tb), Some(hb)) = (baro.column("t_s"), baro.column(BARO_COLUMN)) else {
+        return Err(invalid(
+            "barometer data",
+            format!("needs columns t_s and {BARO_COLUMN}"),
+        ));
+    };
+    if tb.is_empty() {
+        return Err(invalid("barometer data", "has no readings"));
+    }
+    for k in 0..tb.len() {
+        if !(tb[k].is_finite() && hb[k].is_finite()) || (k > 0 && tb[k] <= tb[k - 1]) {
+            return Err(invalid(
+                "barometer data",
+                format!(
+                    "row {}: times must increase and values be finite numbers",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    let t = imu
+        .column("t_s")
+        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    let mut columns: Vec<&str> = imu.columns.iter().map(String::as_str).collect();
+    if columns.contains(&BARO_COLUMN) {
+        return Err(invalid(
+            "IMU data",
+            format!("already has a {BARO_COLUMN} column; give the barometer once"),
+        ));
+    }
+    columns.push(BARO_COLUMN);
+    let mut out = Table::new(&columns);
+    let width = imu.columns.len();
+    let mut k = 0;
+    for (i, ti) in t.iter().enumerate() {
+        while k + 1 < tb.len() && tb[k + 1] <= *ti {
+            k += 1;
+        }
+        let mut row = imu.data[i * width..(i + 1) * width].to_vec();
+        row.push(hb[k]);
+        out.push_row(&row);
+    }
+    Ok(out)
 }
