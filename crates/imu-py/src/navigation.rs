@@ -81,7 +81,8 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
                     substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64, earth = "flat",
                     vertical = "free",
                     baro_time_constant_s = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
-                    earth_gravity = "normal", lat0_deg = None, lon0_deg = None, height0_m = None))]
+                    earth_gravity = "normal", lat0_deg = None, lon0_deg = None, height0_m = None,
+                    baro_columns = None, baro_values = None))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
     py: Python<'py>,
@@ -107,6 +108,8 @@ fn strapdown<'py>(
     lat0_deg: Option<f64>,
     lon0_deg: Option<f64>,
     height0_m: Option<f64>,
+    baro_columns: Option<Vec<String>>,
+    baro_values: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<TableOut<'py>> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
     let setup = NavRequest {
@@ -124,7 +127,11 @@ fn strapdown<'py>(
     }
     .setup()
     .map_err(refused)?;
-    let imu = table_in("imu", columns, &values)?;
+    let mut imu = table_in("imu", columns, &values)?;
+    if let (Some(c), Some(v)) = (baro_columns, &baro_values) {
+        imu = imukit::run::earth_nav::with_baro_column(&imu, &table_in("baro", c, v)?)
+            .map_err(refused)?;
+    }
     let initial = match (initial_columns, &initial_values) {
         (Some(c), Some(v)) => InitialState::from_table(&table_in("initial", c, v)?),
         _ => InitialState::from_parts(

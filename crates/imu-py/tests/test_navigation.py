@@ -173,3 +173,20 @@ def test_a_scenario_with_a_barometer_and_an_odometer_returns_their_readings():
     np.testing.assert_allclose(sim.baro["baro_height_m"], 52.0, atol=1e-9)
     np.testing.assert_allclose(sim.odometer["speed_m_s"], 10.1, atol=1e-9)
     assert sim.gnss is None
+
+
+def test_barometer_readings_damp_the_vertical_channel_of_earth_navigation():
+    scenario = {"rate_hz": 10.0, "duration_s": 1200.0, "nav_frame": "NED", "earth": "wgs84",
+                "origin": {"latitude_deg": 45.0, "longitude_deg": 7.0, "height_m": 300.0},
+                "trajectory": {"type": "builtin", "name": "static"},
+                "imu": {"kind": "accel-gyro", "accelerometer": {"ConstantBias": [0.0, 0.0, 0.001]}},
+                "baro": {"noise_m": 0.5}}
+    sim = imukit.simulate(scenario)
+    damped = imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED", earth="wgs84", vertical="baro",
+                              baro=sim.baro)
+    free = imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED", earth="wgs84", vertical="free")
+    assert abs(damped["height_m"][-1] - 300.0) < 2.0
+    assert abs(free["height_m"][-1] - 300.0) > 700.0
+    with pytest.raises(ImuError, match="needs columns t_s and baro_height_m"):
+        imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED", earth="wgs84", vertical="baro",
+                         baro=sim.truth)

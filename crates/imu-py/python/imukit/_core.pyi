@@ -199,6 +199,8 @@ def strapdown(
     lat0_deg: Optional[float] = None,
     lon0_deg: Optional[float] = None,
     height0_m: Optional[float] = None,
+    baro_columns: Optional[Sequence[str]] = None,
+    baro_values: Optional[npt.NDArray[np.float64]] = None,
 ) -> _Table: ...
 def fuse(
     imu_columns: Sequence[str],

@@ -56,6 +56,7 @@ def strapdown(
     vertical: str = "free",
     baro_time_constant_s: float = 100.0,
     earth_gravity: str = "normal",
+    baro: Optional[Table] = None,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
     increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
@@ -76,7 +77,8 @@ def strapdown(
     geodetic position, from a truth Table of a ``wgs84`` scenario (``lat_rad, lon_rad, height_m``)
     or the dict keys ``latitude_deg``, ``longitude_deg``, ``height_m``. ``vertical`` is ``"free"``
     (unstable, as physics says), ``"hold"`` or ``"baro"`` (a third-order loop with time constant
-    ``baro_time_constant_s`` on the IMU table's ``baro_height_m`` column). The output adds
+    ``baro_time_constant_s`` on barometer readings: ``baro=sim.baro`` or the IMU table's
+    ``baro_height_m`` column). The output adds
     ``lat_rad, lon_rad, height_m``; ``pos_*`` stay in the tangent plane of the truth's origin.
     """
     start: dict = {}
@@ -97,7 +99,8 @@ def strapdown(
         *_table_args("imu", imu), **start,
         nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
         accel_sign=accel_sign, scheme=scheme, substeps=int(substeps), earth=earth, vertical=vertical,
-        baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity))
+        baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity,
+        **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro))))))
 
 def compare(truth: Table, estimate: Table):
     """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``.
