@@ -14,17 +14,12 @@
 //! * **Specific force** at lever arm `r`: `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r`
 //!   (a level IMU at rest reads `+g` on its up axis); [`AccelSign::Matlab`] reports `−f_b`.
 //!
-//! The crate is `#![no_std]`: batch functions write into slices the caller owns, per-sample
-//! steppers keep their state in plain structs. The one use of the heap is a bias-instability
-//! filter longer than 8 coefficients (the `alloc` feature, on with `std`); a build without it
-//! never allocates and links no allocator. Float
+//! The crate is `#![no_std]` and never allocates: batch functions write into slices the caller
+//! owns, per-sample steppers keep their state in plain structs; nothing here links `alloc`. Float
 //! math comes from `std` (default feature) or `libm`. Exact analytic trajectories over dual
 //! numbers, which need the standard library, are in `imukit::motion::analytic`.
 #![no_std]
 #![forbid(unsafe_code)]
-
-#[cfg(feature = "alloc")]
-extern crate alloc;
 
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");

@@ -69,7 +69,6 @@ pub struct ImuReading {
 
 /// The drifting state of the three sensors.
 #[derive(Clone, Debug, Default, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct ImuState {
     /// Accelerometer state.
     pub accel: SensorState,
@@ -102,7 +101,6 @@ impl core::error::Error for ImuParamError {
 
 /// A validated IMU error model in navigation frame `N`.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct ImuModel<N> {
     /// Lever arm, accelerometer sign, gravity and magnetic field.
     pub mount: ImuMount<N>,

@@ -10,7 +10,6 @@ const INLINE_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
 
 /// The bias-instability generator, ready to step.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 #[allow(
     clippy::large_enum_variant,
     reason = "built once per model and stepped in place; boxing would need a heap"
@@ -34,24 +33,11 @@ enum BiasFilter {
 /// `values / scale`, padded with zeros to `len` (≤
 /// [`MAX_FILTER_COEFFICIENTS`](crate::sensor::MAX_FILTER_COEFFICIENTS)).
 fn normalised(values: &[f64], scale: f64, len: usize) -> Coefficients {
-    let mut padded = [0.0; 8];
-    #[cfg(feature = "alloc")]
-    let mut long = alloc::vec::Vec::new();
-    let out: &mut [f64] = if len <= padded.len() {
-        &mut padded[..len]
-    } else {
-        #[cfg(feature = "alloc")]
-        {
-            long.resize(len, 0.0);
-            &mut long[..]
-        }
-        #[cfg(not(feature = "alloc"))]
-        unreachable!("FilterCoefficients::new keeps heap-free filters within 8 coefficients")
-    };
-    for (o, v) in out.iter_mut().zip(values) {
+    let mut padded = [0.0; crate::sensor::MAX_FILTER_COEFFICIENTS];
+    for (o, v) in padded[..len].iter_mut().zip(values) {
         *o = v / scale;
     }
-    coefficients(out)
+    coefficients(&padded[..len])
 }
 
 impl BiasFilter {
@@ -63,15 +49,6 @@ impl BiasFilter {
             Self::Cascade {
                 zero, pole, gain, ..
             } => zero.iter().chain(pole).all(|v| v.is_finite()) && gain.is_finite(),
-        }
-    }
-
-    /// Memory one axis needs, values.
-    fn memory(&self) -> usize {
-        match self {
-            Self::FirstOrder { .. } => 1,
-            Self::Iir { b, .. } => b.len().saturating_sub(1),
-            Self::Cascade { .. } => INLINE_STATE,
         }
     }
 
@@ -131,10 +108,7 @@ impl BiasFilter {
             } => {
                 [0, 1, 2].map(|i| cascade_step(zero, pole, sections, x[i], &mut z[i].inline) * gain)
             }
-            Self::Iir { ref b, ref a } => {
-                let n = self.memory();
-                [0, 1, 2].map(|i| iir_step(b, a, x[i], z[i].slots(n)))
-            }
+            Self::Iir { ref b, ref a } => [0, 1, 2].map(|i| iir_step(b, a, x[i], &mut z[i].inline)),
         }
     }
 }
@@ -173,33 +147,10 @@ fn cascade_step(
     v
 }
 
-/// One axis's bias-instability filter memory: inline for the flicker cascade and filters up to
-/// order 32; with `alloc`, longer filters keep theirs on the heap (grown on first use).
-#[derive(Clone, Debug, Default, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
+/// One axis's bias-instability filter memory: the flicker cascade's, or a filter's (order ≤ 7).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct FilterMemory {
     inline: [f64; INLINE_STATE],
-    #[cfg(feature = "alloc")]
-    long: alloc::vec::Vec<f64>,
-}
-
-impl FilterMemory {
-    /// At least `n` values of memory.
-    #[inline]
-    fn slots(&mut self, n: usize) -> &mut [f64] {
-        if n <= INLINE_STATE {
-            return &mut self.inline;
-        }
-        #[cfg(feature = "alloc")]
-        {
-            if self.long.len() < n {
-                self.long.resize(n, 0.0);
-            }
-            &mut self.long
-        }
-        #[cfg(not(feature = "alloc"))]
-        unreachable!("FilterCoefficients::new keeps heap-free filters within 8 coefficients")
-    }
 }
 
 /// Designs the flicker cascade: poles and zeros alternate, log-spaced two per decade between
@@ -267,9 +218,7 @@ impl Default for Environment {
 }
 
 /// What drifts over time: the bias-instability filter state and the random-walk value, per axis.
-/// (`Copy` in a heap-free build; with `alloc` a long filter's memory is on the heap.)
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorState {
     filter: [FilterMemory; 3],
     random_walk: [f64; 3],
@@ -296,7 +245,6 @@ impl SensorState {
 
 /// A validated error model of one triad at a fixed sample rate.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorModel {
     misalignment: [[f64; 3]; 3],
     bias: [f64; 3],

@@ -1,39 +1,18 @@
 //! Error parameters of one sensor triad, as a user writes them (SI units, per axis).
 use crate::sensor::ParamError;
 
-/// Largest number of numerator or denominator coefficients of the bias-instability filter.
-///
-/// With the `alloc` feature (on by default, through `std`) the coefficients and the filter's
-/// state live on the heap and a filter may have up to 4096 coefficients: MATLAB takes any length,
-/// and its own Allan-variance example uses `fractalcoef(500)` (501 denominator coefficients).
-/// Without it (a heap-free embedded build) they live inline and the bound is 8 (order 7).
-#[cfg(feature = "alloc")]
-pub const MAX_FILTER_COEFFICIENTS: usize = 4096;
 /// Largest number of numerator or denominator coefficients of the bias-instability filter
-/// (heap-free build: inline, order up to 7; the `alloc` feature raises it to 4096).
-#[cfg(not(feature = "alloc"))]
+/// (order up to 7), held inline: the core has no heap. MATLAB takes any length; a 1/f floor
+/// (what its `fractalcoef(500)` makes) is `BiasInstabilityModel::Flicker` here.
 pub const MAX_FILTER_COEFFICIENTS: usize = 8;
 
-#[cfg(feature = "alloc")]
-const TOO_LONG: &str = "1 to 4096 numerator and denominator coefficients needed";
-#[cfg(not(feature = "alloc"))]
-const TOO_LONG: &str =
-    "1 to 8 numerator and denominator coefficients needed (a build without `alloc`)";
-const _: () = assert!(MAX_FILTER_COEFFICIENTS == 4096 || MAX_FILTER_COEFFICIENTS == 8);
-
-/// A list of filter coefficients: shared on the heap with `alloc`, inline without.
-#[cfg(feature = "alloc")]
-pub(crate) type Coefficients = alloc::sync::Arc<[f64]>;
-
-/// A list of filter coefficients: shared on the heap with `alloc`, inline without.
-#[cfg(not(feature = "alloc"))]
+/// A list of filter coefficients, inline.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Coefficients {
     values: [f64; MAX_FILTER_COEFFICIENTS],
     len: usize,
 }
 
-#[cfg(not(feature = "alloc"))]
 impl core::ops::Deref for Coefficients {
     type Target = [f64];
     fn deref(&self) -> &[f64] {
@@ -43,19 +22,12 @@ impl core::ops::Deref for Coefficients {
 
 /// `values` stored (the caller has checked the length against [`MAX_FILTER_COEFFICIENTS`]).
 pub(crate) fn coefficients(values: &[f64]) -> Coefficients {
-    #[cfg(feature = "alloc")]
-    {
-        Coefficients::from(values)
-    }
-    #[cfg(not(feature = "alloc"))]
-    {
-        let mut c = Coefficients {
-            values: [0.0; MAX_FILTER_COEFFICIENTS],
-            len: values.len(),
-        };
-        c.values[..values.len()].copy_from_slice(values);
-        c
-    }
+    let mut c = Coefficients {
+        values: [0.0; MAX_FILTER_COEFFICIENTS],
+        len: values.len(),
+    };
+    c.values[..values.len()].copy_from_slice(values);
+    c
 }
 
 /// Power spectral density convention of `noise_density` and `random_walk`.
@@ -70,7 +42,6 @@ pub enum NoiseType {
 
 /// Numerator and denominator of the bias-instability filter (MATLAB `filter(Num, Den, x)`).
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct FilterCoefficients {
     numerator: Coefficients,
     denominator: Coefficients,
@@ -101,7 +72,10 @@ impl FilterCoefficients {
         let too_long = numerator.len() > MAX_FILTER_COEFFICIENTS
             || denominator.len() > MAX_FILTER_COEFFICIENTS;
         if numerator.is_empty() || denominator.is_empty() || too_long {
-            return Err(ParamError::BadFilter { reason: TOO_LONG });
+            return Err(ParamError::BadFilter {
+                reason: "1 to 8 numerator and denominator coefficients needed (for a 1/f floor such as \
+                         MATLAB's fractalcoef gives, use the flicker model)",
+            });
         }
         if let Some(index) = numerator
             .iter()
@@ -139,7 +113,6 @@ impl FilterCoefficients {
 
 /// How the bias-instability drift is generated from `BiasInstability·n`.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub enum BiasInstabilityModel {
     /// MATLAB's `filter(Num, Den, ·)` (default `Num = [1]`, `Den = [1, −0.5]`). Note that this
     /// default is an AR(1) process with a 2-sample correlation: under Allan analysis it looks like
@@ -172,7 +145,6 @@ impl Default for BiasInstabilityModel {
 /// `accelparams`/`gyroparams`/`magparams` fields in SI units of the measurand `[u]`
 /// (m/s², rad/s or µT). The default is an ideal sensor.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(not(feature = "alloc"), derive(Copy))]
 pub struct SensorParams {
     /// Saturation level, `[u]`, > 0 (may be infinite).
     pub measurement_range: f64,
