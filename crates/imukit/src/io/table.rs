@@ -14,6 +14,26 @@ use imu_core::{NavFrame, Truth};
 use crate::error::{Error, Result};
 use crate::io::output::write_atomically;
 
+/// The columns `head` followed by the columns `tail`, for a schema that extends another
+/// (`N` must be their total: checked when the constant is evaluated, at compile time).
+pub const fn concat_columns<const A: usize, const B: usize, const N: usize>(
+    head: [&'static str; A],
+    tail: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(N == A + B, "column count is not the sum of the two lists");
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < A {
+        out[i] = head[i];
+        i += 1;
+    }
+    while i < N {
+        out[i] = tail[i - A];
+        i += 1;
+    }
+    out
+}
+
 /// Truth columns, in order.
 pub const TRUTH_COLUMNS: [&str; 23] = [
     "t_s",

@@ -14,30 +14,16 @@ use imu_core::strapdown::earth::{
 use imu_core::{Body, Ecef, NavFrame, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
-use crate::io::table::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
-use crate::run::navigate::{InitialState, NAV_COLUMNS, NavScheme, NavSetup, euler_unwrapped};
+use crate::io::table::{
+    ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table, concat_columns,
+};
+use crate::run::navigate::{
+    GEODETIC_COLUMNS, InitialState, NAV_COLUMNS, NavScheme, NavSetup, euler_unwrapped,
+};
 use crate::scenario::earth::frd_to_body;
 
 /// Navigation output on the Earth: [`NAV_COLUMNS`] then the geodetic position.
-pub const EARTH_NAV_COLUMNS: [&str; 17] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "pos_z_m",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "vel_z_m_s",
-    "q_w",
-    "q_x",
-    "q_y",
-    "q_z",
-    "yaw_rad",
-    "pitch_rad",
-    "roll_rad",
-    "lat_rad",
-    "lon_rad",
-    "height_m",
-];
+pub const EARTH_NAV_COLUMNS: [&str; 17] = concat_columns(NAV_COLUMNS, GEODETIC_COLUMNS);
 
 /// The barometric height column the baro-damped vertical channel reads from the IMU table.
 pub const BARO_COLUMN: &str = "baro_height_m";
@@ -227,9 +213,6 @@ fn table<N: NavFrame>(states: &[EarthNavState], origin: &Geodetic) -> Table {
     }
     table
 }
-
-/// Checks that [`EARTH_NAV_COLUMNS`] extends [`NAV_COLUMNS`].
-const _: () = assert!(EARTH_NAV_COLUMNS.len() == NAV_COLUMNS.len() + 3);
 
 /// Reads an IMU CSV file whole, refused before reading when it could exceed the memory budget
 /// of [`check_in_memory`](crate::scenario::check_in_memory) with what the Earth navigation keeps

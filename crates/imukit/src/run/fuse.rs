@@ -9,45 +9,32 @@ use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma};
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
-use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table};
+use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
 use crate::run::navigate::{InitialState, NAV_COLUMNS, euler_unwrapped};
 use crate::scenario::NavFrameName;
 use crate::scenario::gnss::GNSS_COLUMNS;
 
 /// Columns of a fused estimate: [`NAV_COLUMNS`], one-sigma columns, bias estimates.
-pub const FUSE_COLUMNS: [&str; 29] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "pos_z_m",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "vel_z_m_s",
-    "q_w",
-    "q_x",
-    "q_y",
-    "q_z",
-    "yaw_rad",
-    "pitch_rad",
-    "roll_rad",
-    "pos_x_sigma_m",
-    "pos_y_sigma_m",
-    "pos_z_sigma_m",
-    "vel_x_sigma_m_s",
-    "vel_y_sigma_m_s",
-    "vel_z_sigma_m_s",
-    "att_x_sigma_rad",
-    "att_y_sigma_rad",
-    "att_z_sigma_rad",
-    "accel_bias_x_m_s2",
-    "accel_bias_y_m_s2",
-    "accel_bias_z_m_s2",
-    "gyro_bias_x_rad_s",
-    "gyro_bias_y_rad_s",
-    "gyro_bias_z_rad_s",
-];
-
-const _: () = assert!(FUSE_COLUMNS.len() == NAV_COLUMNS.len() + 15);
+pub const FUSE_COLUMNS: [&str; 29] = concat_columns(
+    NAV_COLUMNS,
+    [
+        "pos_x_sigma_m",
+        "pos_y_sigma_m",
+        "pos_z_sigma_m",
+        "vel_x_sigma_m_s",
+        "vel_y_sigma_m_s",
+        "vel_z_sigma_m_s",
+        "att_x_sigma_rad",
+        "att_y_sigma_rad",
+        "att_z_sigma_rad",
+        "accel_bias_x_m_s2",
+        "accel_bias_y_m_s2",
+        "accel_bias_z_m_s2",
+        "gyro_bias_x_rad_s",
+        "gyro_bias_y_rad_s",
+        "gyro_bias_z_rad_s",
+    ],
+);
 
 /// How to fuse.
 #[derive(Clone, Copy, Debug, PartialEq)]
