@@ -7,9 +7,12 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_core::sensor::{
-    BiasInstabilityModel, GyroAccelerationInput, ImuModel, ImuReading, ImuState, SeededNormals,
-    SensorParams, SensorSet, Temperatures,
+    BiasInstabilityModel, GyroAccelerationInput, ImuModel, ImuReading, ImuState, InlineBuffer,
+    SeededNormals, SensorSet, Temperatures,
 };
+
+/// The core's inline filter storage, named once for the struct literals below.
+type SensorParams = imu_core::sensor::SensorParams<InlineBuffer>;
 use imu_core::{Body, Enu, EulerZyx, ImuMount, Ned, Rotation, Truth};
 
 fn every_term(model: BiasInstabilityModel) -> SensorParams {

@@ -1,10 +1,14 @@
 //! The sensor error model: each deterministic step against its formula (noise off), seeded
 //! statistics with tolerances from the sample size, chunked = one-shot runs.
 use imu_core::sensor::{
-    Environment, FilterCoefficients, GyroAccelerationInput, ImuModel, ImuState, NoNoise,
-    NoiseSource, NoiseType, ParamError, SeededNormals, SensorModel, SensorParams, SensorSet,
-    SensorState, Temperatures,
+    Environment, FilterBuffer, GyroAccelerationInput, ImuModel, ImuState, InlineBuffer, NoNoise,
+    NoiseSource, NoiseType, ParamError, SeededNormals, SensorModel, SensorSet, SensorState,
+    Temperatures,
 };
+
+/// The core's own storage for filters, named once so struct literals need no annotation.
+type SensorParams = imu_core::sensor::SensorParams<InlineBuffer>;
+type FilterCoefficients = imu_core::sensor::FilterCoefficients<InlineBuffer>;
 use imu_core::{AccelSign, Body, Enu, EulerZyx, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
 
 const U: [f64; 3] = [1.25, -0.5, 9.81];
@@ -806,51 +810,91 @@ fn fractal_denominator(poles: usize, alpha: f64) -> Vec<f64> {
     den
 }
 
-#[test]
-fn a_fractal_filter_has_the_closed_form_impulse_response() {
-    // fractalcoef(7): 8 denominator coefficients, the most the heap-free core holds. Its
-    // impulse response equals the moving-average expansion of (1 − z⁻¹)^{−α/2},
-    // h_k = h_{k−1}·(k − 1 + α/2)/k, exactly for k ≤ 7 (the truncated AR terms only act beyond
-    // the filter's length); later samples follow the recursion with the 8 coefficients.
-    let den = fractal_denominator(7, 1.0);
-    let coeffs = FilterCoefficients::new(&[1.0], &den).unwrap();
-    let p = SensorParams {
+/// Filter storage on the heap, as a crate with `alloc` supplies it (the library crate `imukit`
+/// has its own): any length up to 4096.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct VecBuffer(Vec<f64>);
+
+impl FilterBuffer for VecBuffer {
+    const CAPACITY: usize = 4096;
+    fn zeros(len: usize) -> Option<Self> {
+        (len <= Self::CAPACITY).then(|| Self(vec![0.0; len]))
+    }
+    fn as_slice(&self) -> &[f64] {
+        &self.0
+    }
+    fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.0
+    }
+}
+
+/// MATLAB's `fractalcoef(poles)` run through the model with storage `B`: its impulse response
+/// equals the moving-average expansion of (1 − z⁻¹)^{−α/2}, h_k = h_{k−1}·(k − 1 + α/2)/k,
+/// exactly for k ≤ poles (the truncated AR terms only act beyond the filter's length); later
+/// samples follow the recursion with the poles + 1 coefficients.
+fn assert_fractal_impulse_response<B: FilterBuffer>(poles: usize, samples: usize) {
+    let den = fractal_denominator(poles, 1.0);
+    let coeffs = imu_core::sensor::FilterCoefficients::<B>::new(&[1.0], &den).unwrap();
+    let p = imu_core::sensor::SensorParams::<B> {
         bias_instability: [2.0; 3],
         bias_instability_model: imu_core::sensor::BiasInstabilityModel::Filter(coeffs),
-        ..SensorParams::default()
+        ..Default::default()
     };
     let model = SensorModel::new(&p, 100.0).unwrap();
     let mut state = SensorState::default();
     let mut noise = Impulse(true);
     let mut h = vec![1.0_f64];
-    for k in 0..200 {
+    for k in 0..samples {
         let y = model.measure([0.0; 3], &Environment::default(), &mut state, &mut noise)[0];
         if k > 0 {
-            let next = if k <= 7 {
+            let next = if k <= poles {
                 h[k - 1] * (k as f64 - 0.5) / k as f64
             } else {
-                -(1..=7).map(|j| den[j] * h[k - j]).sum::<f64>()
+                -(1..=poles).map(|j| den[j] * h[k - j]).sum::<f64>()
             };
             h.push(next);
         }
         let want = 2.0 * h[k];
         assert!(
-            (y - want).abs() <= 1e-13 * want.abs().max(1e-3),
-            "sample {k}: {y} vs {want}"
+            (y - want).abs() <= 1e-12 * want.abs().max(1e-3),
+            "fractalcoef({poles}), sample {k}: {y} vs {want}"
         );
     }
 }
 
 #[test]
-fn filters_longer_than_the_bound_are_refused_with_the_bound_named() {
-    // MATLAB's fractalcoef(500) does not fit the heap-free core: refused, the flicker model named.
+fn a_fractal_filter_has_the_closed_form_impulse_response() {
+    // fractalcoef(7): 8 denominator coefficients, the most the core's inline storage holds.
+    assert_fractal_impulse_response::<InlineBuffer>(7, 200);
+}
+
+#[test]
+fn matlabs_fractalcoef_500_runs_with_heap_storage() {
+    // MATLAB's own Allan example: 501 coefficients, memory in the buffer (beyond the inline 32).
+    assert_fractal_impulse_response::<VecBuffer>(500, 1500);
+    // A filter of 20 coefficients keeps its memory inline: the same closed form.
+    assert_fractal_impulse_response::<VecBuffer>(19, 300);
+}
+
+#[test]
+fn filters_longer_than_the_storage_are_refused_with_the_bound_named() {
+    // fractalcoef(500) does not fit the core's inline storage: refused, the flicker model named.
     let den = fractal_denominator(500, 1.0);
     let err = FilterCoefficients::new(&[1.0], &den).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "bias_instability_coefficients: 1 to 8 numerator and denominator coefficients needed (for \
-         a 1/f floor such as MATLAB's fractalcoef gives, use the flicker model)"
+        "bias_instability_coefficients: 501 coefficients, at most 8 taken (a 1/f floor is the \
+         flicker model, at most 16 sections)"
     );
     assert!(FilterCoefficients::new(&[1.0], &den[..8]).is_ok());
     assert!(FilterCoefficients::new(&[1.0], &den[..9]).is_err());
+    assert!(FilterCoefficients::new(&[], &den[..2]).is_err());
+    let long = imu_core::sensor::FilterCoefficients::<VecBuffer>::new(&[1.0], &vec![1.0; 4097]);
+    assert_eq!(
+        long.unwrap_err(),
+        ParamError::TooManyCoefficients {
+            len: 4097,
+            max: 4096
+        }
+    );
 }

@@ -306,11 +306,32 @@ def fractalcoef(poles, alpha=1.0):
     return [1.0], den
 
 
-def test_matlabs_500_pole_fractal_filter_is_refused_with_the_flicker_model_named():
-    # The heap-free core holds 8 coefficients; a 1/f floor is the flicker model's job.
-    assert imukit.ImuSensor("accel-gyro", gyroscope=imukit.GyroParams(
-        bias_instability=0.01, bias_instability_coefficients=fractalcoef(7)))
-    with pytest.raises(ImuError, match="1 to 8 .* use the flicker model") as e:
+def test_matlabs_500_pole_fractal_filter_runs_as_in_matlab():
+    # MATLAB's Allan example: BiasInstabilityCoefficients = fractalcoef(500), 501 coefficients.
+    # With only bias instability on, the gyro reads y = filter(1, den, B·n); filtering y by the
+    # FIR `den` gives B·n back, white with σ = B, only if all 501 coefficients act.
+    num, den = fractalcoef(500)
+    b, n = 0.01, 20000
+    imu = imukit.ImuSensor("accel-gyro", seed=3, gyroscope=imukit.GyroParams(
+        bias_instability=b, bias_instability_coefficients=(num, den)))
+    _, gyro = imu(*level(n))
+    white = np.convolve(gyro[:, 0], den)[:n] / b
+    assert abs(white.std() - 1.0) < 5 / math.sqrt(2 * n)
+    assert abs(white.mean()) < 5 / math.sqrt(n)
+    assert abs(np.corrcoef(white[:-1], white[1:])[0, 1]) < 5 / math.sqrt(n)
+
+    # Slow memory shows in block means: for white noise, 40 means of 500 samples times √500 have
+    # standard deviation 1, estimated to ±1/√78 (5σ: 0.57).
+    def block_spread(x):
+        return x.reshape(40, 500).mean(axis=1).std(ddof=1) * math.sqrt(500)
+
+    assert abs(block_spread(white) - 1.0) < 5 / math.sqrt(78)
+    # Undone with only its first 8 coefficients, the 1/f memory remains: the test can fail.
+    assert block_spread(np.convolve(gyro[:, 0], den[:8])[:n] / b) > 2.0
+
+
+def test_filters_longer_than_4096_coefficients_are_refused_with_the_bound_named():
+    with pytest.raises(ImuError, match="4097 coefficients, at most 4096 taken") as e:
         imukit.ImuSensor("accel-gyro", gyroscope=imukit.GyroParams(
-            bias_instability=0.01, bias_instability_coefficients=fractalcoef(500)))
+            bias_instability=0.01, bias_instability_coefficients=fractalcoef(4096)))
     assert e.value.field.endswith("bias_instability_coefficients")

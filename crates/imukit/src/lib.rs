@@ -19,6 +19,7 @@
 //! | [`motion`] | motions: formula strings with exact derivatives, Rust functions over dual numbers, tracks, waypoints, samples, body rates |
 //! | [`io`] | [`Table`] and CSV files (readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
 //! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
+//! | [`sensor`] | the core's sensor types with bias-instability filters on the heap (any length, as MATLAB) |
 //! | [`error`] | [`Error`]: what went wrong and where |
 //!
 //! ## Simulate a scenario
@@ -92,6 +93,7 @@ pub mod io;
 pub mod motion;
 pub mod run;
 pub mod scenario;
+pub mod sensor;
 
 pub use error::{Error, Result};
 pub use imu_core as core;

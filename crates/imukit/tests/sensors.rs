@@ -2,9 +2,10 @@
 //! temperature profiles, MATLAB's documentation examples, and the errors users meet.
 use std::path::{Path, PathBuf};
 
-use imu_core::sensor::{BiasInstabilityModel, NoiseType, SensorParams};
+use imu_core::sensor::NoiseType;
 use imukit::io::params::{ParamFile, Profile, parse_any_document, read_param_file, to_toml};
 use imukit::io::presets;
+use imukit::sensor::{BiasInstabilityModel, SensorParams};
 use imukit::{ScenarioSpec, Simulation};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -560,4 +561,71 @@ fn increments_output_integrates_each_interval() {
     );
     assert!((dz[100] - std::f64::consts::FRAC_PI_2 * 0.01).abs() < 1e-12);
     assert!(dv[1..].iter().all(|v| (v + 9.81 * 0.01).abs() < 1e-12)); // NED at rest: −g·Δt on z
+}
+
+/// MATLAB's `fractalcoef(poles)` (Kasdin 1995): `Den = [1, a₁, …]`, `a_k = (k − 1 − ½)·a_{k−1}/k`.
+fn fractal_denominator(poles: usize) -> Vec<f64> {
+    let mut den = vec![1.0];
+    for k in 1..=poles {
+        den.push((k as f64 - 1.5) * den[k - 1] / k as f64);
+    }
+    den
+}
+
+#[test]
+fn matlabs_fractalcoef_500_from_a_parameter_file_drives_the_scenario() {
+    // MATLAB's Allan example puts fractalcoef(500) in BiasInstabilityCoefficients. From a MATLAB
+    // JSON file into a scenario: with only bias instability on, the gyro reads
+    // y = filter(1, den, B·n), and filtering y by the FIR `den` gives B·n back, white with σ = B,
+    // only if all 501 coefficients act.
+    let dir = temp_dir("fractal500");
+    let den = fractal_denominator(500);
+    let b = 0.01;
+    let doc = serde_json::json!({"Gyroscope": {
+        "BiasInstability": b,
+        "BiasInstabilityCoefficients": {"Numerator": [1.0], "Denominator": den},
+    }});
+    std::fs::write(dir.join("fractal.json"), doc.to_string()).unwrap();
+    let text = STATIC_NED.replace("duration_s = 9.99", "duration_s = 99.99")
+        + "[imu]\nkind = \"accel-gyro\"\nseed = 4\nparams = \"fractal.json\"\n";
+    let sim = run(&text, &dir).unwrap();
+    let y = sim.imu.column("gyro_x_rad_s").unwrap();
+    let n = y.len();
+    assert_eq!(n, 10_000);
+    let white: Vec<f64> = (0..n)
+        .map(|k| (0..=k.min(500)).map(|j| den[j] * y[k - j]).sum::<f64>() / b)
+        .collect();
+    let mean = white.iter().sum::<f64>() / n as f64;
+    let sd = (white.iter().map(|w| (w - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+    let lag1 = white
+        .windows(2)
+        .map(|w| (w[0] - mean) * (w[1] - mean))
+        .sum::<f64>()
+        / ((n - 1) as f64 * sd * sd);
+    // σ of a sample standard deviation is 1/√(2n), of a mean and a lag-1 correlation 1/√n: 5σ.
+    let n_f = n as f64;
+    assert!((sd - 1.0).abs() < 5.0 / (2.0 * n_f).sqrt(), "sd {sd}");
+    assert!(mean.abs() < 5.0 / n_f.sqrt(), "mean {mean}");
+    assert!(lag1.abs() < 5.0 / n_f.sqrt(), "lag-1 correlation {lag1}");
+    // A parameter file written back keeps all 501 coefficients.
+    let file = read_param_file(&dir.join("fractal.json"), None, Profile::Matlab).unwrap();
+    let BiasInstabilityModel::Filter(c) = &file.params.gyroscope.bias_instability_model else {
+        panic!("a filter was read");
+    };
+    assert_eq!(c.denominator(), den.as_slice());
+    // One coefficient beyond the bound: refused with the file, the key and the bound.
+    let den = fractal_denominator(4096);
+    let doc = serde_json::json!({"Gyroscope": {
+        "BiasInstabilityCoefficients": {"Numerator": [1.0], "Denominator": den},
+    }});
+    std::fs::write(dir.join("long.json"), doc.to_string()).unwrap();
+    let e = read_param_file(&dir.join("long.json"), None, Profile::Matlab)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("long.json")
+            && e.contains("Gyroscope: bias_instability_coefficients")
+            && e.contains("4097 coefficients, at most 4096 taken"),
+        "{e}"
+    );
 }

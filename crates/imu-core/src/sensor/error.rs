@@ -47,10 +47,17 @@ pub enum ParamError {
         /// Axis index.
         index: usize,
     },
-    /// Filter coefficients: empty, too many, or a zero leading denominator coefficient.
+    /// Filter coefficients: empty, or a zero leading denominator coefficient.
     BadFilter {
         /// What is wrong.
         reason: &'static str,
+    },
+    /// More filter coefficients than the storage holds (see `FilterBuffer::CAPACITY`).
+    TooManyCoefficients {
+        /// The longer list's length.
+        len: usize,
+        /// Most coefficients held.
+        max: usize,
     },
 }
 
@@ -64,7 +71,9 @@ impl ParamError {
             | Self::Negative { field, .. }
             | Self::NotPositive { field, .. }
             | Self::OutOfRange { field, .. } => field,
-            Self::BadFilter { .. } => "bias_instability_coefficients",
+            Self::BadFilter { .. } | Self::TooManyCoefficients { .. } => {
+                "bias_instability_coefficients"
+            }
         }
     }
 }
@@ -95,6 +104,11 @@ impl fmt::Display for ParamError {
                 "{field}[{index}] is too large: at this sample rate the model is not finite"
             ),
             Self::BadFilter { reason } => write!(f, "bias_instability_coefficients: {reason}"),
+            Self::TooManyCoefficients { len, max } => write!(
+                f,
+                "bias_instability_coefficients: {len} coefficients, at most {max} taken (a 1/f floor is \
+                 the flicker model, at most 16 sections)"
+            ),
         }
     }
 }

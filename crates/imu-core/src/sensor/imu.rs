@@ -5,7 +5,10 @@ use crate::frame::{Body, NavFrame};
 use crate::ideal::{AccelSign, ImuMount};
 use crate::kinematics::Truth;
 use crate::rotation::Rotation;
-use crate::sensor::{Environment, NoiseSource, ParamError, SensorModel, SensorParams, SensorState};
+use crate::sensor::{
+    Environment, FilterBuffer, InlineBuffer, NoiseSource, ParamError, SensorModel, SensorParams,
+    SensorState,
+};
 use crate::vector::Vec3;
 
 /// Which sensors besides the accelerometer the IMU has (MATLAB's `IMUType`).
@@ -68,14 +71,15 @@ pub struct ImuReading {
 }
 
 /// The drifting state of the three sensors.
+/// `B` stores the bias-instability filters' memory (see [`FilterBuffer`]).
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ImuState {
+pub struct ImuState<B: FilterBuffer = InlineBuffer> {
     /// Accelerometer state.
-    pub accel: SensorState,
+    pub accel: SensorState<B>,
     /// Gyroscope state.
-    pub gyro: SensorState,
+    pub gyro: SensorState<B>,
     /// Magnetometer state.
-    pub mag: SensorState,
+    pub mag: SensorState<B>,
 }
 
 /// A parameter error with the sensor it belongs to.
@@ -101,17 +105,18 @@ impl core::error::Error for ImuParamError {
 
 /// A validated IMU error model in navigation frame `N`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ImuModel<N> {
+/// `B` stores the bias-instability filters (see [`FilterBuffer`]).
+pub struct ImuModel<N, B: FilterBuffer = InlineBuffer> {
     /// Lever arm, accelerometer sign, gravity and magnetic field.
     pub mount: ImuMount<N>,
     sensors: SensorSet,
     gyro_acceleration: GyroAccelerationInput,
-    accel: SensorModel,
-    gyro: SensorModel,
-    mag: SensorModel,
+    accel: SensorModel<B>,
+    gyro: SensorModel<B>,
+    mag: SensorModel<B>,
 }
 
-impl<N: NavFrame> ImuModel<N> {
+impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
     /// Validates the three parameter sets for `sample_rate_hz`.
     ///
     /// # Errors
@@ -120,10 +125,10 @@ impl<N: NavFrame> ImuModel<N> {
         mount: ImuMount<N>,
         sensors: SensorSet,
         gyro_acceleration: GyroAccelerationInput,
-        params: [&SensorParams; 3],
+        params: [&SensorParams<B>; 3],
         sample_rate_hz: f64,
     ) -> Result<Self, ImuParamError> {
-        let build = |sensor: &'static str, p: &SensorParams| {
+        let build = |sensor: &'static str, p: &SensorParams<B>| {
             SensorModel::new(p, sample_rate_hz).map_err(|source| ImuParamError { sensor, source })
         };
         Ok(Self {
@@ -147,7 +152,7 @@ impl<N: NavFrame> ImuModel<N> {
         &self,
         truth: &Truth<N>,
         temperatures: &Temperatures,
-        state: &mut ImuState,
+        state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
     ) -> ImuReading {
         let f_b = self.mount.specific_force(truth);
@@ -175,7 +180,7 @@ impl<N: NavFrame> ImuModel<N> {
         m_b: Vec3<Body>,
         acceleration_n: Vec3<N>,
         temperatures: &Temperatures,
-        state: &mut ImuState,
+        state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
     ) -> ImuReading {
         self.finish(f_b, acceleration_n, w_b, || m_b, temperatures, state, noise)
@@ -195,7 +200,7 @@ impl<N: NavFrame> ImuModel<N> {
         angular_velocity_n: Vec3<N>,
         attitude: &Rotation<Body, N>,
         temperatures: &Temperatures,
-        state: &mut ImuState,
+        state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
     ) -> ImuReading {
         let nav_to_body = attitude.inverse();
@@ -221,7 +226,7 @@ impl<N: NavFrame> ImuModel<N> {
         angular_velocity_n: &[[f64; 3]],
         attitude: &[Rotation<Body, N>],
         temperatures: &Temperatures,
-        state: &mut ImuState,
+        state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
         out: &mut [ImuReading],
     ) {
@@ -246,7 +251,7 @@ impl<N: NavFrame> ImuModel<N> {
         w_b: Vec3<Body>,
         m_b: impl FnOnce() -> Vec3<Body>,
         temperatures: &Temperatures,
-        state: &mut ImuState,
+        state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
     ) -> ImuReading {
         let accel_in = match self.mount.accel_sign {

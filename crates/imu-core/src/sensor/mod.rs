@@ -29,5 +29,6 @@ pub use model::MAX_FLICKER_SECTIONS;
 pub use model::{Environment, SensorModel, SensorState};
 pub use noise::{NoNoise, NoiseSource, SeededNormals};
 pub use params::{
-    BiasInstabilityModel, FilterCoefficients, MAX_FILTER_COEFFICIENTS, NoiseType, SensorParams,
+    BiasInstabilityModel, FilterBuffer, FilterCoefficients, InlineBuffer, MAX_FILTER_COEFFICIENTS,
+    NoiseType, SensorParams,
 };

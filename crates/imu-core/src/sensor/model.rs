@@ -1,11 +1,14 @@
 //! One validated sensor triad and its drifting state.
 use crate::math;
-use crate::sensor::params::{Coefficients, coefficients};
-use crate::sensor::{BiasInstabilityModel, NoiseSource, NoiseType, ParamError, SensorParams};
+use crate::sensor::{
+    BiasInstabilityModel, FilterBuffer, InlineBuffer, NoiseSource, NoiseType, ParamError,
+    SensorParams,
+};
 
 /// Largest number of first-order sections of the flicker bias-instability model.
 pub const MAX_FLICKER_SECTIONS: usize = 16;
-/// Filter memory held inline per axis: the flicker cascade's, or a filter's up to this order.
+/// Filter memory held inline per axis: the flicker cascade's, or a filter's up to this order
+/// (longer filters keep theirs in the [`FilterBuffer`]).
 const INLINE_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
 
 /// The bias-instability generator, ready to step.
@@ -14,13 +17,13 @@ const INLINE_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
     clippy::large_enum_variant,
     reason = "built once per model and stepped in place; boxing would need a heap"
 )]
-enum BiasFilter {
+enum BiasFilter<B: FilterBuffer> {
     /// A first-order `filter([b₀, b₁], [1, a₁], ·)` (MATLAB's default and Gauss–Markov),
     /// unrolled: the hot path.
     FirstOrder { b0: f64, b1: f64, a1: f64 },
     /// MATLAB `filter(b, a, ·)`, coefficients normalised by a₀ and padded with zeros to the
     /// same length, transposed direct form II.
-    Iir { b: Coefficients, a: Coefficients },
+    Iir { b: B, a: B },
     /// Cascade of `(1 − ζ z⁻¹)/(1 − φ z⁻¹)` sections times a gain (flicker noise).
     Cascade {
         zero: [f64; MAX_FLICKER_SECTIONS],
@@ -30,29 +33,33 @@ enum BiasFilter {
     },
 }
 
-/// `values / scale`, padded with zeros to `len` (≤
-/// [`MAX_FILTER_COEFFICIENTS`](crate::sensor::MAX_FILTER_COEFFICIENTS)).
-fn normalised(values: &[f64], scale: f64, len: usize) -> Coefficients {
-    let mut padded = [0.0; crate::sensor::MAX_FILTER_COEFFICIENTS];
-    for (o, v) in padded[..len].iter_mut().zip(values) {
+/// `values / scale`, padded with zeros to `len` (≤ `B::CAPACITY`, as
+/// [`FilterCoefficients`](crate::sensor::FilterCoefficients) checked; empty otherwise).
+fn normalised<B: FilterBuffer>(values: &[f64], scale: f64, len: usize) -> B {
+    let mut padded = B::zeros(len).unwrap_or_default();
+    for (o, v) in padded.as_mut_slice().iter_mut().zip(values) {
         *o = v / scale;
     }
-    coefficients(&padded[..len])
+    padded
 }
 
-impl BiasFilter {
+impl<B: FilterBuffer> BiasFilter<B> {
     /// True when every coefficient is a finite number.
     fn is_finite(&self) -> bool {
         match self {
             Self::FirstOrder { b0, b1, a1 } => [b0, b1, a1].iter().all(|v| v.is_finite()),
-            Self::Iir { b, a } => b.iter().chain(a.iter()).all(|v| v.is_finite()),
+            Self::Iir { b, a } => b
+                .as_slice()
+                .iter()
+                .chain(a.as_slice())
+                .all(|v| v.is_finite()),
             Self::Cascade {
                 zero, pole, gain, ..
             } => zero.iter().chain(pole).all(|v| v.is_finite()) && gain.is_finite(),
         }
     }
 
-    fn new(model: &BiasInstabilityModel, sample_rate_hz: f64) -> Self {
+    fn new(model: &BiasInstabilityModel<B>, sample_rate_hz: f64) -> Self {
         match model {
             BiasInstabilityModel::Filter(c) => {
                 let (num, den) = (c.numerator(), c.denominator());
@@ -88,7 +95,7 @@ impl BiasFilter {
 
     /// One step of the filter on the three axes, each with its own memory.
     #[inline(always)]
-    fn step3(&self, x: [f64; 3], z: &mut [FilterMemory; 3]) -> [f64; 3] {
+    fn step3(&self, x: [f64; 3], z: &mut [FilterMemory<B>; 3]) -> [f64; 3] {
         match *self {
             // The general recursion unrolled for order 1, the same operations in the same order.
             Self::FirstOrder { b0, b1, a1 } => {
@@ -108,17 +115,33 @@ impl BiasFilter {
             } => {
                 [0, 1, 2].map(|i| cascade_step(zero, pole, sections, x[i], &mut z[i].inline) * gain)
             }
-            Self::Iir { ref b, ref a } => [0, 1, 2].map(|i| iir_step(b, a, x[i], &mut z[i].inline)),
+            Self::Iir { ref b, ref a } => iir_step3(b.as_slice(), a.as_slice(), x, z),
         }
     }
 }
 
-/// One step of `filter(b, a, ·)` in transposed direct form II (`b`, `a` of equal length,
-/// `a₀ = 1`) with memory `z` (at least `len − 1` values). Kept out of line: the first-order
-/// and flicker paths are the hot ones, and inlining this loop there slowed them by 10 %.
+/// [`iir_step`] on the three axes, each with its own memory. Kept out of line with it: the
+/// first-order and flicker paths are the hot ones, and inlining this arm there slowed the
+/// flicker path by 15 %.
 #[inline(never)]
+fn iir_step3<B: FilterBuffer>(
+    b: &[f64],
+    a: &[f64],
+    x: [f64; 3],
+    z: &mut [FilterMemory<B>; 3],
+) -> [f64; 3] {
+    [0, 1, 2].map(|i| iir_step(b, a, x[i], z[i].iir(b.len())))
+}
+
+/// One step of `filter(b, a, ·)` in transposed direct form II (`b`, `a` of equal length,
+/// `a₀ = 1`) with memory `z` (`len − 1` values; a shorter memory shortens the filter, which
+/// [`FilterMemory::iir`] never gives).
+#[inline]
 fn iir_step(b: &[f64], a: &[f64], x: f64, z: &mut [f64]) -> f64 {
-    let n = b.len();
+    let n = b.len().min(a.len()).min(z.len() + 1);
+    if n == 0 {
+        return 0.0;
+    }
     let y = b[0] * x + if n > 1 { z[0] } else { 0.0 };
     for k in 1..n {
         let next = if k + 1 < n { z[k] } else { 0.0 };
@@ -147,17 +170,35 @@ fn cascade_step(
     v
 }
 
-/// One axis's bias-instability filter memory: the flicker cascade's, or a filter's (order ≤ 7).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct FilterMemory {
+/// One axis's bias-instability filter memory: the flicker cascade's, or a filter's (inline up to
+/// order 32, in the buffer beyond).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct FilterMemory<B: FilterBuffer> {
     inline: [f64; INLINE_STATE],
+    long: B,
+}
+
+impl<B: FilterBuffer> FilterMemory<B> {
+    /// The memory of a filter with `len` coefficients: inline when it fits, else the buffer,
+    /// sized (zeroed) on first use.
+    #[inline]
+    fn iir(&mut self, len: usize) -> &mut [f64] {
+        let needed = len.saturating_sub(1);
+        if needed <= INLINE_STATE {
+            return &mut self.inline[..needed];
+        }
+        if self.long.as_slice().len() != needed {
+            self.long = B::zeros(needed).unwrap_or_default();
+        }
+        self.long.as_mut_slice()
+    }
 }
 
 /// Designs the flicker cascade: poles and zeros alternate, log-spaced two per decade between
 /// `f_lo = 0.02/τ_max` and `f_hi = min(fs/4, 20/τ_min)` (continuous-time, mapped by `z = e^{sT}`),
 /// so `|H|² ∝ 1/f` in between; the gain makes the two-sided PSD of the output for input `B·n`
 /// equal `B²/(2πf)`, whose Allan deviation is `√(2 ln 2/π)·B ≈ 0.664·B` (IEEE 952, Annex C).
-fn flicker(tau_min_s: f64, tau_max_s: f64, fs: f64) -> BiasFilter {
+fn flicker<B: FilterBuffer>(tau_min_s: f64, tau_max_s: f64, fs: f64) -> BiasFilter<B> {
     let two_pi = 2.0 * core::f64::consts::PI;
     let f_hi = (fs / 4.0).min(20.0 / tau_min_s);
     let f_lo = (0.02 / tau_max_s).min(f_hi / 10.0);
@@ -219,13 +260,13 @@ impl Default for Environment {
 
 /// What drifts over time: the bias-instability filter state and the random-walk value, per axis.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SensorState {
-    filter: [FilterMemory; 3],
+pub struct SensorState<B: FilterBuffer = InlineBuffer> {
+    filter: [FilterMemory<B>; 3],
     random_walk: [f64; 3],
     quantization_residual: [f64; 3],
 }
 
-impl Default for SensorState {
+impl<B: FilterBuffer> Default for SensorState<B> {
     fn default() -> Self {
         Self {
             filter: Default::default(),
@@ -235,7 +276,7 @@ impl Default for SensorState {
     }
 }
 
-impl SensorState {
+impl<B: FilterBuffer> SensorState<B> {
     /// The current random-walk value per axis.
     #[must_use]
     pub fn random_walk(&self) -> [f64; 3] {
@@ -245,12 +286,12 @@ impl SensorState {
 
 /// A validated error model of one triad at a fixed sample rate.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SensorModel {
+pub struct SensorModel<B: FilterBuffer = InlineBuffer> {
     misalignment: [[f64; 3]; 3],
     bias: [f64; 3],
     white_sigma: [f64; 3],
     bias_instability: [f64; 3],
-    bias_filter: BiasFilter,
+    bias_filter: BiasFilter<B>,
     random_walk_sigma: [f64; 3],
     temperature_bias: [f64; 3],
     temperature_scale: [f64; 3],
@@ -260,12 +301,12 @@ pub struct SensorModel {
     quantization_carry: bool,
 }
 
-impl SensorModel {
+impl<B: FilterBuffer> SensorModel<B> {
     /// Validates `params` and precomputes the model for `sample_rate_hz`.
     ///
     /// # Errors
     /// [`ParamError`] naming the field (see [`SensorParams::validate`]) or the sample rate.
-    pub fn new(params: &SensorParams, sample_rate_hz: f64) -> Result<Self, ParamError> {
+    pub fn new(params: &SensorParams<B>, sample_rate_hz: f64) -> Result<Self, ParamError> {
         params.validate()?;
         if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
             return Err(ParamError::NotPositive {
@@ -328,7 +369,7 @@ impl SensorModel {
         &self,
         u: [f64; 3],
         env: &Environment,
-        state: &mut SensorState,
+        state: &mut SensorState<B>,
         noise: &mut impl NoiseSource,
     ) -> [f64; 3] {
         let normals: [f64; 9] = core::array::from_fn(|_| noise.standard_normal());
@@ -346,7 +387,7 @@ impl SensorModel {
         &self,
         u: [f64; 3],
         env: &Environment,
-        state: &mut SensorState,
+        state: &mut SensorState<B>,
         normals: &[f64; 9],
     ) -> [f64; 3] {
         let n_bi = [normals[0], normals[1], normals[2]];

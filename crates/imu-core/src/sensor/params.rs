@@ -1,33 +1,63 @@
 //! Error parameters of one sensor triad, as a user writes them (SI units, per axis).
+use core::fmt;
+
 use crate::sensor::ParamError;
 
-/// Largest number of numerator or denominator coefficients of the bias-instability filter
-/// (order up to 7), held inline: the core has no heap. MATLAB takes any length; a 1/f floor
-/// (what its `fractalcoef(500)` makes) is `BiasInstabilityModel::Flicker` here.
+/// Largest number of numerator or denominator coefficients of the bias-instability filter that
+/// [`InlineBuffer`], the core's own storage, holds (order up to 7): the core has no heap. A crate
+/// with a heap supplies a [`FilterBuffer`] of its own to take longer filters (MATLAB takes any
+/// length; the library crate `imukit` takes thousands).
 pub const MAX_FILTER_COEFFICIENTS: usize = 8;
 
-/// A list of filter coefficients, inline.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Coefficients {
+/// Where a bias-instability filter keeps its coefficients and its memory: a list of `f64` of
+/// fixed length, at most [`Self::CAPACITY`] long.
+///
+/// The sensor types ([`SensorParams`], [`SensorModel`](crate::sensor::SensorModel),
+/// [`SensorState`](crate::sensor::SensorState), [`ImuModel`](crate::sensor::ImuModel),
+/// [`ImuState`](crate::sensor::ImuState)) are generic over it, [`InlineBuffer`] by default. In
+/// expressions Rust does not apply that default by itself: name the type once
+/// (`let p: SensorParams = SensorParams { .. }`) and the rest follows.
+pub trait FilterBuffer: Clone + fmt::Debug + PartialEq + Default {
+    /// Most values one buffer holds (≥ 2).
+    const CAPACITY: usize;
+    /// A buffer of `len` zeros; `None` beyond [`Self::CAPACITY`].
+    fn zeros(len: usize) -> Option<Self>;
+    /// The values.
+    fn as_slice(&self) -> &[f64];
+    /// The values, to write.
+    fn as_mut_slice(&mut self) -> &mut [f64];
+    /// A buffer holding a copy of `values`; `None` beyond [`Self::CAPACITY`].
+    fn from_slice(values: &[f64]) -> Option<Self> {
+        let mut b = Self::zeros(values.len())?;
+        b.as_mut_slice().copy_from_slice(values);
+        Some(b)
+    }
+}
+
+/// The core's filter storage: up to [`MAX_FILTER_COEFFICIENTS`] values, inline.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InlineBuffer {
     values: [f64; MAX_FILTER_COEFFICIENTS],
     len: usize,
 }
 
-impl core::ops::Deref for Coefficients {
-    type Target = [f64];
-    fn deref(&self) -> &[f64] {
+impl FilterBuffer for InlineBuffer {
+    const CAPACITY: usize = MAX_FILTER_COEFFICIENTS;
+
+    fn zeros(len: usize) -> Option<Self> {
+        (len <= MAX_FILTER_COEFFICIENTS).then_some(Self {
+            values: [0.0; MAX_FILTER_COEFFICIENTS],
+            len,
+        })
+    }
+
+    fn as_slice(&self) -> &[f64] {
         &self.values[..self.len]
     }
-}
 
-/// `values` stored (the caller has checked the length against [`MAX_FILTER_COEFFICIENTS`]).
-pub(crate) fn coefficients(values: &[f64]) -> Coefficients {
-    let mut c = Coefficients {
-        values: [0.0; MAX_FILTER_COEFFICIENTS],
-        len: values.len(),
-    };
-    c.values[..values.len()].copy_from_slice(values);
-    c
+    fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.values[..self.len]
+    }
 }
 
 /// Power spectral density convention of `noise_density` and `random_walk`.
@@ -42,39 +72,44 @@ pub enum NoiseType {
 
 /// Numerator and denominator of the bias-instability filter (MATLAB `filter(Num, Den, x)`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct FilterCoefficients {
-    numerator: Coefficients,
-    denominator: Coefficients,
+pub struct FilterCoefficients<B: FilterBuffer = InlineBuffer> {
+    numerator: B,
+    denominator: B,
 }
 
-impl Default for FilterCoefficients {
+impl<B: FilterBuffer> Default for FilterCoefficients<B> {
     /// MATLAB's default: `Num = [1]`, `Den = [1, −0.5]`.
     fn default() -> Self {
         Self::matlab_default()
     }
 }
 
-impl FilterCoefficients {
+impl<B: FilterBuffer> FilterCoefficients<B> {
     /// MATLAB's default: `Num = [1]`, `Den = [1, −0.5]`.
     #[must_use]
     pub fn matlab_default() -> Self {
         Self {
-            numerator: coefficients(&[1.0]),
-            denominator: coefficients(&[1.0, -0.5]),
+            numerator: B::from_slice(&[1.0]).unwrap_or_default(),
+            denominator: B::from_slice(&[1.0, -0.5]).unwrap_or_default(),
         }
     }
 
-    /// Coefficients `numerator` (b₀ … b_m) and `denominator` (a₀ … a_n), a₀ ≠ 0.
+    /// Coefficients `numerator` (b₀ … b_m) and `denominator` (a₀ … a_n), a₀ ≠ 0, each list at
+    /// most [`FilterBuffer::CAPACITY`] long.
     ///
     /// # Errors
-    /// Empty or too long lists ([`MAX_FILTER_COEFFICIENTS`]), non-finite values, a₀ = 0.
+    /// Empty or too long lists, non-finite values, a₀ = 0.
     pub fn new(numerator: &[f64], denominator: &[f64]) -> Result<Self, ParamError> {
-        let too_long = numerator.len() > MAX_FILTER_COEFFICIENTS
-            || denominator.len() > MAX_FILTER_COEFFICIENTS;
-        if numerator.is_empty() || denominator.is_empty() || too_long {
+        if numerator.is_empty() || denominator.is_empty() {
             return Err(ParamError::BadFilter {
-                reason: "1 to 8 numerator and denominator coefficients needed (for a 1/f floor such as \
-                         MATLAB's fractalcoef gives, use the flicker model)",
+                reason: "at least one numerator and one denominator coefficient needed",
+            });
+        }
+        let longest = numerator.len().max(denominator.len());
+        if longest > B::CAPACITY {
+            return Err(ParamError::TooManyCoefficients {
+                len: longest,
+                max: B::CAPACITY,
             });
         }
         if let Some(index) = numerator
@@ -92,32 +127,36 @@ impl FilterCoefficients {
                 reason: "the leading denominator coefficient must not be 0",
             });
         }
+        let too_long = || ParamError::TooManyCoefficients {
+            len: longest,
+            max: B::CAPACITY,
+        };
         Ok(Self {
-            numerator: coefficients(numerator),
-            denominator: coefficients(denominator),
+            numerator: B::from_slice(numerator).ok_or_else(too_long)?,
+            denominator: B::from_slice(denominator).ok_or_else(too_long)?,
         })
     }
 
     /// The numerator coefficients.
     #[must_use]
     pub fn numerator(&self) -> &[f64] {
-        &self.numerator
+        self.numerator.as_slice()
     }
 
     /// The denominator coefficients.
     #[must_use]
     pub fn denominator(&self) -> &[f64] {
-        &self.denominator
+        self.denominator.as_slice()
     }
 }
 
 /// How the bias-instability drift is generated from `BiasInstability·n`.
 #[derive(Clone, Debug, PartialEq)]
-pub enum BiasInstabilityModel {
+pub enum BiasInstabilityModel<B: FilterBuffer = InlineBuffer> {
     /// MATLAB's `filter(Num, Den, ·)` (default `Num = [1]`, `Den = [1, −0.5]`). Note that this
     /// default is an AR(1) process with a 2-sample correlation: under Allan analysis it looks like
     /// extra white noise, not a flat floor.
-    Filter(FilterCoefficients),
+    Filter(FilterCoefficients<B>),
     /// Flicker (1/f) noise whose Allan deviation is `0.664·BiasInstability` for τ between
     /// `tau_min_s` and `tau_max_s` (the datasheet's bias-instability floor), from a cascade of
     /// first-order pole-zero sections (two per decade) driven by one normal per axis.
@@ -135,7 +174,7 @@ pub enum BiasInstabilityModel {
     },
 }
 
-impl Default for BiasInstabilityModel {
+impl<B: FilterBuffer> Default for BiasInstabilityModel<B> {
     fn default() -> Self {
         Self::Filter(FilterCoefficients::matlab_default())
     }
@@ -144,8 +183,10 @@ impl Default for BiasInstabilityModel {
 /// Error parameters of one triad (accelerometer, gyroscope or magnetometer), MATLAB's
 /// `accelparams`/`gyroparams`/`magparams` fields in SI units of the measurand `[u]`
 /// (m/s², rad/s or µT). The default is an ideal sensor.
+///
+/// `B` stores the bias-instability filter (see [`FilterBuffer`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct SensorParams {
+pub struct SensorParams<B: FilterBuffer = InlineBuffer> {
     /// Saturation level, `[u]`, > 0 (may be infinite).
     pub measurement_range: f64,
     /// Quantisation step, `[u]`/LSB, ≥ 0 (0: none).
@@ -159,7 +200,7 @@ pub struct SensorParams {
     /// Bias-instability input amplitude, `[u]`, ≥ 0.
     pub bias_instability: [f64; 3],
     /// How the bias instability is generated (MATLAB's filter by default).
-    pub bias_instability_model: BiasInstabilityModel,
+    pub bias_instability_model: BiasInstabilityModel<B>,
     /// Random walk, `[u]·√Hz`, ≥ 0.
     pub random_walk: [f64; 3],
     /// PSD convention of `noise_density` and `random_walk`.
@@ -175,7 +216,7 @@ pub struct SensorParams {
     pub quantization_carry: bool,
 }
 
-impl Default for SensorParams {
+impl<B: FilterBuffer> Default for SensorParams<B> {
     fn default() -> Self {
         Self {
             measurement_range: f64::INFINITY,
@@ -195,7 +236,7 @@ impl Default for SensorParams {
     }
 }
 
-impl SensorParams {
+impl<B: FilterBuffer> SensorParams<B> {
     /// MATLAB's scalar AxesMisalignment `s`: 100 on the diagonal, `s` elsewhere (percent).
     #[must_use]
     pub const fn misalignment_from_scalar(s: f64) -> [[f64; 3]; 3] {

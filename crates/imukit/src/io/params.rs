@@ -30,12 +30,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use imu_core::AccelSign;
-use imu_core::sensor::{
-    BiasInstabilityModel, FilterCoefficients, GyroAccelerationInput, NoiseType, SensorParams,
-};
+use imu_core::sensor::{GyroAccelerationInput, NoiseType};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
+use crate::sensor::{BiasInstabilityModel, FilterCoefficients, SensorParams};
 
 /// A value as written in a parameter or scenario file or handed over from Python: a boolean, an
 /// integer, a number (infinity allowed where the key allows it; TOML writes `inf`, MATLAB's

@@ -251,8 +251,9 @@ fn fuse_in<N: NavFrame>(
 /// instability `B`: MATLAB's filter (short memory) joins the white noise with its low-frequency
 /// gain, `√q += B·|Σb/Σa|/√fs`; flicker (to `τ_max`) and Gauss–Markov (time `T`) join the drift as
 /// a random walk of the same variance growth, `q += 2B²/T`.
-fn triad_psd(p: &imu_core::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
-    use imu_core::sensor::{BiasInstabilityModel, NoiseType};
+fn triad_psd(p: &crate::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
+    use crate::sensor::BiasInstabilityModel;
+    use imu_core::sensor::NoiseType;
     let beta = match p.noise_type {
         NoiseType::SingleSided => rate_hz,
         NoiseType::DoubleSided => rate_hz / 2.0,

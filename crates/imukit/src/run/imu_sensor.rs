@@ -4,7 +4,8 @@
 //! stream (so a run in chunks equals the run whole). Python's `imukit.ImuSensor` is this object.
 use std::path::Path;
 
-use imu_core::sensor::{ImuModel, ImuState, SeededNormals, Temperatures};
+use crate::sensor::{ImuModel, ImuState};
+use imu_core::sensor::{SeededNormals, Temperatures};
 use imu_core::{AccelSign, Body, DEFAULT_GRAVITY_M_S2, Enu, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};

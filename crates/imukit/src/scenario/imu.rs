@@ -1,6 +1,7 @@
 //! The IMU of a scenario, resolved: mount, sensors and their seeded error model.
 
-use imu_core::sensor::{ImuModel, ImuReading, ImuState, SeededNormals, SensorSet};
+use crate::sensor::{ImuModel, ImuState};
+use imu_core::sensor::{ImuReading, SeededNormals, SensorSet};
 use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 
 use crate::error::{Error, Result};

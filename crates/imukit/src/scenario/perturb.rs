@@ -12,7 +12,7 @@
 //! # truncated-normal: mean, std, lower, upper; uniform: lower, upper;
 //! # selection: values = [...], probabilities = [...] (equal when left out)
 //! ```
-use imu_core::sensor::SensorParams;
+use crate::sensor::SensorParams;
 use rand_core::{Rng, SeedableRng};
 use rand_distr::{Distribution as _, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
