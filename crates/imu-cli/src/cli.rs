@@ -182,6 +182,21 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Which IMU bridges a GNSS outage: a scenario with `[[gnss.outages]]` simulated with each
+    /// IMU preset over seeded Monte Carlo runs (all cores) and fused with its GNSS; writes, per
+    /// preset and time into the first outage, the RMS horizontal position error and the
+    /// filter's one-sigma, and prints them at the outage's end.
+    Study {
+        /// Study file (TOML): `scenario = "S.toml"`, `presets = ["mpu-6050", …]`, `runs = 50`.
+        study: PathBuf,
+        /// Where to write the table (CSV: `t_s` since the outage began, then per preset
+        /// `<preset>_rms_error_m` and `<preset>_sigma_m`).
+        #[arg(long)]
+        out: PathBuf,
+        /// A figure of the table (`.png` or `.svg`).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
     /// Errors of an estimate against truth over time: a navigation output (position, velocity,
     /// attitude) or an orientation output (attitude), with RMS, maximum and final values printed.
     Compare {

@@ -1194,3 +1194,50 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
     assert!(err.contains("bad.csv: row 3: times must increase"), "{err}");
     assert!(!dir.join("x.csv").exists() && !dir.join("y.csv").exists());
 }
+
+#[test]
+fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
+    let dir = temp_dir("study");
+    let scenario =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    std::fs::write(
+        dir.join("study.toml"),
+        format!(
+            "scenario = \"{}\"\npresets = [\"mpu-6050\", \"stim300\"]\nruns = 2\n",
+            scenario.display()
+        ),
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &["study", "study.toml", "--out", "t.csv", "--plot", "t.png"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    // The MPU-6050's 2 % cross-axis sensitivity is beyond the 15-state filter: said, not hidden.
+    assert!(
+        err.contains("mpu-6050") && err.contains("diverged in 2 of 2 runs"),
+        "{err}"
+    );
+    let header = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+    let header = header.lines().next().unwrap();
+    assert_eq!(header, "t_s,stim300_rms_error_m,stim300_sigma_m");
+    assert!(std::fs::metadata(dir.join("t.png")).unwrap().len() > 1000);
+    // A bad figure name is refused before any run; an output over the study file is refused.
+    let (code, err) = run_in(
+        &dir,
+        &["study", "study.toml", "--out", "u.csv", "--plot", "u.gif"],
+    );
+    assert_ne!(code, Some(0));
+    assert!(
+        err.contains("u.gif") && !dir.join("u.csv").exists(),
+        "{err}"
+    );
+    let (code, err) = run_in(&dir, &["study", "study.toml", "--out", "study.toml"]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("study.toml"), "{err}");
+    assert!(
+        std::fs::read_to_string(dir.join("study.toml"))
+            .unwrap()
+            .contains("runs = 2")
+    );
+}

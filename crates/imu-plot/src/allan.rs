@@ -13,7 +13,7 @@ pub const MAX_LOG_AXIS_DECADES: i32 = 300;
 
 /// A log axis from `lo` to `hi` kept within the positive normal numbers and within
 /// [`MAX_LOG_AXIS_DECADES`] below `hi` (values further down are cut off at the axis).
-fn log_range(lo: f64, hi: f64) -> std::ops::Range<f64> {
+pub(crate) fn log_range(lo: f64, hi: f64) -> std::ops::Range<f64> {
     let hi = hi.clamp(f64::MIN_POSITIVE, f64::MAX);
     let lo = lo
         .clamp(f64::MIN_POSITIVE, f64::MAX)

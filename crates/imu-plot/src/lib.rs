@@ -26,12 +26,14 @@ mod figures;
 mod panels;
 pub mod scene;
 pub mod spec;
+mod study;
 
 pub use allan::allan_figure;
 pub use draw::{COLORS, FigureFormat, check_figure_path, rasterise, write_figure};
 pub use figures::plot_files;
 pub use panels::{Trace, trajectories_figure};
 pub use spec::{FramePlan, PanelSpec, TableKind};
+pub use study::study_figure;
 
 /// What went wrong while drawing; `Display` says what and where.
 #[derive(Debug, thiserror::Error)]

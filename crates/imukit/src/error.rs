@@ -37,6 +37,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A Kalman filter that lost its measurements (its covariance no longer positive definite,
+    /// or fixes rejected one after another): the estimate is not written.
+    #[error("{context}: {message}")]
+    Diverged {
+        /// The input and row where it was noticed, e.g. `GNSS data`.
+        context: String,
+        /// What happened.
+        message: String,
+    },
     /// An expression that does not parse.
     #[error("{field}: {source}")]
     Expression {
@@ -185,7 +194,8 @@ impl Error {
             Self::Scenario { .. } => Location::default(),
             Self::Invalid { field: f, .. }
             | Self::Expression { field: f, .. }
-            | Self::BadQuaternion { field: f } => field(f),
+            | Self::BadQuaternion { field: f }
+            | Self::Diverged { context: f, .. } => field(f),
             Self::CsvValue {
                 file: f,
                 row,

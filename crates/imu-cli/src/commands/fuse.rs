@@ -60,6 +60,10 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             field: a.gnss.display().to_string(),
             message,
         },
+        Error::Diverged { context, message } if context == "GNSS data" => Error::Diverged {
+            context: a.gnss.display().to_string(),
+            message,
+        },
         other => other,
     })?;
     nav.write_csv(a.out)?;

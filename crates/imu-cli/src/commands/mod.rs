@@ -10,6 +10,7 @@ mod plot;
 mod presets;
 mod scenario;
 mod simulate;
+mod study;
 
 use crate::CliError;
 use crate::cli::{Cli, Command};
@@ -106,6 +107,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             no_gate,
             out: &out,
         }),
+        Command::Study { study, out, plot } => study::run(&study, &out, plot.as_deref()),
         Command::Orient {
             input,
             filter,

@@ -5,10 +5,10 @@
 //! velocity and attitude (navigation-frame axes), and the bias estimates — one row per IMU
 //! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
-use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma};
+use imu_core::fusion::{Eskf, EskfError, EskfNoise, EskfState, InitialSigma};
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation, Vec3};
 
-use crate::error::{Result, invalid};
+use crate::error::{Error, Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
 use crate::run::navigate::{InitialState, NAV_COLUMNS, euler_unwrapped};
 use crate::scenario::NavFrameName;
@@ -189,16 +189,25 @@ fn fuse_in<N: NavFrame>(
                     [vel_sigma; 3],
                     setup.gate,
                 )
-                .map_err(|e| invalid("GNSS data", format!("row {}: {e}", next_fix + 2)))?;
+                .map_err(|e| {
+                    let message = format!("row {}: {e}", next_fix + 2);
+                    match e {
+                        EskfError::Diverged { .. } => Error::Diverged {
+                            context: "GNSS data".into(),
+                            message,
+                        },
+                        _ => invalid("GNSS data", message),
+                    }
+                })?;
             rejected_in_a_row = if outcome.accepted {
                 0
             } else {
                 rejected_in_a_row + 1
             };
             if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
-                return Err(invalid(
-                    "GNSS data",
-                    format!(
+                return Err(Error::Diverged {
+                    context: "GNSS data".into(),
+                    message: format!(
                         "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
                          gate (the last with NIS {:.1} against {:.1}): the filter has lost the \
                          fixes or the fixes have jumped; nothing is written",
@@ -206,7 +215,7 @@ fn fuse_in<N: NavFrame>(
                         outcome.nis,
                         setup.gate
                     ),
-                ));
+                });
             }
             next_fix += 1;
         }
@@ -249,8 +258,11 @@ fn fuse_in<N: NavFrame>(
 /// noise the simulator draws. White: `σ_d = N √β` per sample (`β = fs` single-sided, `fs/2`
 /// double-sided), so `√q = σ_d/√fs`. Random walk `K/√β` per sample: `√q = K √(fs/β)`. Bias
 /// instability `B`: MATLAB's filter (short memory) joins the white noise with its low-frequency
-/// gain, `√q += B·|Σb/Σa|/√fs`; flicker (to `τ_max`) and Gauss–Markov (time `T`) join the drift as
-/// a random walk of the same variance growth, `q += 2B²/T`.
+/// gain, `√q += B·|Σb/Σa|/√fs`; Gauss–Markov (time `T`) joins the drift as a random walk of the
+/// same variance growth, `q += 2B²/T`; flicker joins it as the random walk whose Allan deviation
+/// `√(qτ/3)` equals the floor `0.664·B` at the floor's geometric centre `√(τ_min τ_max)` (with
+/// `τ_max` instead, the filter was 25 % overconfident through a 30 s outage on the road of the
+/// outage study).
 fn triad_psd(p: &crate::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
     use crate::sensor::BiasInstabilityModel;
     use imu_core::sensor::NoiseType;
@@ -271,7 +283,15 @@ fn triad_psd(p: &crate::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
             let gain = c.numerator().iter().sum::<f64>() / c.denominator().iter().sum::<f64>();
             white = (white.powi(2) + (b * gain.abs()).powi(2) / rate_hz).sqrt();
         }
-        BiasInstabilityModel::Flicker { tau_max_s, .. } => drift_q += 2.0 * b * b / tau_max_s,
+        BiasInstabilityModel::Flicker {
+            tau_min_s,
+            tau_max_s,
+        } => {
+            // A random walk's Allan deviation is √(qτ/3): equal to the flicker floor 0.664·B
+            // at the floor's geometric centre τ_c = √(τ_min τ_max).
+            let tau_c = (tau_min_s * tau_max_s).sqrt();
+            drift_q += 3.0 * (FLICKER_FLOOR * b).powi(2) / tau_c;
+        }
         BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
             drift_q += 2.0 * b * b / correlation_time_s;
         }
@@ -343,6 +363,9 @@ impl FuseSetup {
         })
     }
 }
+
+/// The Allan floor of flicker noise per unit bias instability, `√(2 ln 2/π)` (IEEE 952).
+const FLICKER_FLOOR: f64 = 0.664_282_47;
 
 /// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
 pub const MAX_REJECTED_IN_A_ROW: usize = 10;

@@ -1,5 +1,7 @@
 //! The jobs a user runs: simulate ([`simulate`], [`arrays`] for in-memory arrays), navigate
-//! ([`navigate`], on the WGS-84 Earth [`earth_nav`], with GNSS [`fuse`], [`planar`]), orient ([`orient`]), compare ([`compare`]) and analyse ([`allan`]).
+//! ([`navigate`], on the WGS-84 Earth [`earth_nav`], with GNSS [`fuse`], [`planar`]), orient
+//! ([`orient`]), compare ([`compare`]), analyse ([`allan`]) and compare IMUs through a GNSS
+//! outage ([`study`]).
 pub mod allan;
 pub mod arrays;
 pub mod compare;
@@ -10,3 +12,4 @@ pub mod navigate;
 pub mod orient;
 pub mod planar;
 pub mod simulate;
+pub mod study;
