@@ -76,6 +76,7 @@ done
 target/release/imukit plot "$out/orient_err_ahrsfilter.csv" --out "$out/orient_err.png"
 target/release/imukit exercise --out-dir "$out/exercise"
 target/release/imukit study examples/study/tunnel.toml --out "$out/tunnel.csv" --plot "$out/tunnel.png"
+target/release/imukit study examples/study/tunnel_wheels.toml --out "$out/wheels.csv" --plot "$out/wheels.png"
 
 echo "== NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"
 IMUKIT_BIN="$PWD/target/release/imukit" python benches/compare_numpy.py --sizes 1e4

@@ -178,6 +178,19 @@ pub enum Command {
         /// Apply every fix (no chi-square innovation gate).
         #[arg(long)]
         no_gate: bool,
+        /// Odometer readings (`t_s, speed_m_s`, from `imukit simulate --odometer`); the
+        /// scenario's `[odometer]` gives their accuracy.
+        #[arg(long)]
+        odometer: Option<PathBuf>,
+        /// Barometer readings (`t_s, baro_height_m`, from `imukit simulate --baro`); the
+        /// scenario's `[baro]` gives their accuracy.
+        #[arg(long)]
+        baro: Option<PathBuf>,
+        /// Non-holonomic constraints of a ground vehicle: no sideways or vertical body velocity,
+        /// within this one-sigma (m/s; 0.1 when given without a value), with each odometer
+        /// reading or at 10 Hz.
+        #[arg(long, value_name = "SIGMA_M_S", num_args = 0..=1, default_missing_value = "0.1")]
+        nhc: Option<f64>,
         /// Where to write the estimate (CSV).
         #[arg(long)]
         out: PathBuf,

@@ -1077,7 +1077,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
         .split(|c: char| !c.is_ascii_digit())
         .filter_map(|w| w.parse().ok())
         .collect();
-    assert!(err.contains("fixes ("), "{err}");
+    assert!(err.contains("updates ("), "{err}");
     assert_eq!(numbers[1] + numbers[2], 301, "{err}");
     assert!(numbers[2] <= 2, "{err}");
     let header = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
@@ -1240,4 +1240,95 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
             .unwrap()
             .contains("runs = 2")
     );
+}
+
+#[test]
+fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_ones() {
+    let dir = temp_dir("fuse-aids");
+    let scenario = "rate_hz = 100.0\nduration_s = 30.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]\nattitude = \"tangent\"\n\
+         [imu]\nkind = \"accel-gyro\"\npreset = \"stim300\"\n\
+         [gnss]\nrate_hz = 5.0\ndecay_factor = 0.0\n\
+         [odometer]\nrate_hz = 10.0\n[baro]\nrate_hz = 10.0\n";
+    std::fs::write(dir.join("s.toml"), scenario).unwrap();
+    std::fs::write(
+        dir.join("plain.toml"),
+        scenario.split("[odometer]").next().unwrap(),
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+            "--odometer",
+            "odo.csv",
+            "--baro",
+            "baro.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let fuse = |scenario: &str, extra: &[&str]| {
+        let mut args = vec![
+            "fuse",
+            "imu.csv",
+            "gnss.csv",
+            "--init",
+            "truth.csv",
+            "--scenario",
+            scenario,
+            "--out",
+            "nav.csv",
+        ];
+        args.extend(extra);
+        run_in(&dir, &args)
+    };
+    let (code, err) = fuse(
+        "s.toml",
+        &["--odometer", "odo.csv", "--baro", "baro.csv", "--nhc"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    // 151 fixes, 301 odometer readings with the constraints, 301 heights: one update each.
+    let numbers: Vec<usize> = err
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert_eq!(numbers[1] + numbers[2], 151 + 301 + 301, "{err}");
+    std::fs::remove_file(dir.join("nav.csv")).unwrap();
+    // Bad aids are named by file, row or flag, and nothing is written.
+    let odo = std::fs::read_to_string(dir.join("odo.csv")).unwrap();
+    let mut lines: Vec<&str> = odo.lines().collect();
+    lines.swap(5, 6);
+    std::fs::write(dir.join("odo_back.csv"), lines.join("\n")).unwrap();
+    for (scenario, extra, needles) in [
+        (
+            "plain.toml",
+            vec!["--odometer", "odo.csv"],
+            vec!["odo.csv", "no [odometer]"],
+        ),
+        (
+            "s.toml",
+            vec!["--odometer", "odo_back.csv"],
+            vec!["odo_back.csv", "row 7"],
+        ),
+        ("s.toml", vec!["--nhc=-1"], vec!["--nhc", "> 0"]),
+        (
+            "s.toml",
+            vec!["--baro", "odo.csv"],
+            vec!["odo.csv", "baro_height_m"],
+        ),
+    ] {
+        let (code, err) = fuse(scenario, &extra);
+        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{extra:?}: {err}");
+        }
+        assert!(!dir.join("nav.csv").exists(), "{extra:?}");
+    }
 }

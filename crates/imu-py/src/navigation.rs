@@ -170,12 +170,14 @@ fn compare<'py>(
     Ok((table_out(py, c.table)?, d))
 }
 
-/// Adds this module's functions.
 /// Loosely coupled INS/GNSS fusion with the filter's model from a scenario (a dict, as
-/// `simulate_dict` takes, or TOML/JSON text): (estimate table, fixes applied, fixes rejected).
+/// `simulate_dict` takes, or TOML/JSON text), optionally with odometer and barometer readings
+/// and the non-holonomic constraints: (estimate table, updates applied, updates rejected).
 #[pyfunction]
 #[pyo3(signature = (imu_columns, imu_values, gnss_columns, gnss_values, initial_columns, initial_values,
-                    scenario, *, format = "dict", base_dir = ".", gate = true))]
+                    scenario, *, format = "dict", base_dir = ".", gate = true,
+                    odometer_columns = None, odometer_values = None, baro_columns = None,
+                    baro_values = None, nhc_sigma_m_s = None))]
 #[allow(clippy::too_many_arguments)]
 fn fuse<'py>(
     py: Python<'py>,
@@ -189,9 +191,14 @@ fn fuse<'py>(
     format: &str,
     base_dir: &str,
     gate: bool,
+    odometer_columns: Option<Vec<String>>,
+    odometer_values: Option<PyReadonlyArray2<'py, f64>>,
+    baro_columns: Option<Vec<String>>,
+    baro_values: Option<PyReadonlyArray2<'py, f64>>,
+    nhc_sigma_m_s: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{FuseSetup, fuse};
+    use imukit::run::fuse::{AidTables, FuseSetup, fuse_with};
     let spec = match format {
         "dict" => ScenarioSpec::from_tree(
             &crate::convert::value_tree(scenario, "scenario")?,
@@ -210,6 +217,15 @@ fn fuse<'py>(
     let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
     let initial = InitialState::from_table(&table_in("initial", initial_columns, &initial_values)?)
         .map_err(refused)?;
+    let optional =
+        |name: &str, columns: Option<Vec<String>>, values: &Option<PyReadonlyArray2<'py, f64>>| {
+            match (columns, values) {
+                (Some(c), Some(v)) => table_in(name, c, v).map(Some),
+                _ => Ok(None),
+            }
+        };
+    let odometer = optional("odometer", odometer_columns, &odometer_values)?;
+    let baro = optional("baro", baro_columns, &baro_values)?;
     let base = base_dir.to_string();
     let (table, summary) = py
         .detach(move || {
@@ -218,12 +234,18 @@ fn fuse<'py>(
             if !gate {
                 setup.gate = f64::INFINITY;
             }
-            fuse(&imu, &gnss, &initial, &setup)
+            setup.aiding.nhc_sigma_m_s = nhc_sigma_m_s;
+            let aids = AidTables {
+                odometer: odometer.as_ref(),
+                baro: baro.as_ref(),
+            };
+            fuse_with(&imu, &gnss, aids, &initial, &setup)
         })
         .map_err(refused)?;
     Ok((table_out(py, table)?, summary.updates, summary.rejected))
 }
 
+/// Adds this module's functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fuse, m)?)?;
     m.add_function(wrap_pyfunction!(planar_dead_reckon, m)?)?;

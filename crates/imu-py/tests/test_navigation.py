@@ -1,4 +1,6 @@
 """3D strapdown and comparison from Python."""
+import math
+
 import numpy as np
 import pytest
 
@@ -164,6 +166,35 @@ def test_fuse_keeps_a_car_within_its_stated_uncertainty_through_a_gnss_outage():
     assert summary["position_final_m"] < 1.0
     with pytest.raises(ImuError, match="no \\[gnss\\] receiver"):
         imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario={k: v for k, v in scenario.items() if k != "gnss"})
+
+
+def test_fuse_with_an_odometer_and_the_vehicle_constraints_holds_the_car_through_the_outage():
+    # The same car and outage with a 10 Hz odometer and the non-holonomic constraints: the error
+    # at the outage's end is far below the GNSS-only filter's, like imukit fuse --odometer --nhc.
+    scenario = {
+        "rate_hz": 100.0, "duration_s": 120.0, "nav_frame": "ENU",
+        "trajectory": {"type": "expression", "position_m": ["60*sin(0.16*t)", "60*(1 - cos(0.16*t))", "2*sin(0.1*t)"],
+                       "attitude": "tangent"},
+        "imu": {"kind": "accel-gyro", "preset": "icm-42688-p", "seed": 4},
+        "gnss": {"rate_hz": 5.0, "decay_factor": 0.0, "outages": [{"start_s": 60.0, "duration_s": 30.0}]},
+        "odometer": {"rate_hz": 10.0, "noise_m_s": 0.05},
+    }
+    sim = imukit.simulate(scenario)
+    k = int(np.argmin(np.abs(sim.truth["t_s"] - 89.99)))
+
+    def horizontal_error(nav):
+        return math.hypot(nav["pos_x_m"][k] - sim.truth["pos_x_m"][k], nav["pos_y_m"][k] - sim.truth["pos_y_m"][k])
+
+    alone = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario)
+    wheels = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, odometer=sim.odometer,
+                         nhc_sigma_m_s=0.05)
+    assert wheels["pos_x_sigma_m"][k] < 0.5 * alone["pos_x_sigma_m"][k]
+    assert horizontal_error(wheels) < 3 * math.hypot(wheels["pos_x_sigma_m"][k], wheels["pos_y_sigma_m"][k])
+    with pytest.raises(ImuError, match="nhc_sigma_m_s") as e:
+        imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, nhc_sigma_m_s=0.0)
+    assert e.value.field == "nhc_sigma_m_s"
+    with pytest.raises(ImuError, match="no \\[baro\\]"):
+        imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, baro=sim.odometer)
 
 
 def test_a_scenario_with_a_barometer_and_an_odometer_returns_their_readings():

@@ -69,6 +69,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         gnss_velocity_sigma_m_s: Some(1e-3),
         lever_arm_m: [0.0; 3],
         gate: f64::INFINITY,
+        aiding: Default::default(),
     };
     let initial = InitialState::from_table(&sim.truth).unwrap();
     let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
@@ -96,12 +97,19 @@ fn chi2_quantile(k: f64, z: f64) -> f64 {
 }
 
 /// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average
-/// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`.
-fn average_nees(runs: u64, q_scale: f64) -> ([f64; 3], f64, usize) {
+/// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`; with
+/// `wheels`, an odometer (10 Hz) and the non-holonomic constraints aid the filter too.
+fn average_nees(runs: u64, q_scale: f64, wheels: bool) -> ([f64; 3], f64, usize) {
     // IMU: white noise and bias random walk (single-sided densities: the continuous PSD is N²,
     // so the filter's √q is N). GNSS: white (MATLAB decay factor 0: deviation σ√2).
     let (n_a, n_g, k_a, k_g) = (0.003, 2e-4, 2e-4, 2e-6);
     let (sigma_h, sigma_v, sigma_vel) = (0.8, 1.2, 0.05);
+    let (sigma_odo, sigma_nhc) = (0.05, 0.02);
+    let odometer = if wheels {
+        format!("\n[odometer]\nrate_hz = 10.0\nnoise_m_s = {sigma_odo}")
+    } else {
+        String::new()
+    };
     let text = scenario(
         &format!(
             "[imu.accelerometer]\nNoiseDensity = {n_a}\nRandomWalk = {k_a}\n\
@@ -109,7 +117,7 @@ fn average_nees(runs: u64, q_scale: f64) -> ([f64; 3], f64, usize) {
         ),
         &format!(
             "horizontal_accuracy_m = {sigma_h}\nvertical_accuracy_m = {sigma_v}\n\
-             velocity_accuracy_m_s = {sigma_vel}\ndecay_factor = 0.0"
+             velocity_accuracy_m_s = {sigma_vel}\ndecay_factor = 0.0{odometer}"
         ),
     );
     let noise = EskfNoise {
@@ -176,6 +184,11 @@ fn average_nees(runs: u64, q_scale: f64) -> ([f64; 3], f64, usize) {
             rows3(gnss, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]),
         );
         let s2 = std::f64::consts::SQRT_2;
+        let (odo_t, odo_v) = match &sim.odometer {
+            Some(o) => (col(o, "t_s"), col(o, "speed_m_s")),
+            None => (Vec::new(), Vec::new()),
+        };
+        let mut next_odo = 0;
         let mut next = 0;
         for i in 0..t.len() {
             f.propagate(t[i], w[i], a[i]).unwrap();
@@ -193,6 +206,15 @@ fn average_nees(runs: u64, q_scale: f64) -> ([f64; 3], f64, usize) {
                 nis_sum += outcome.nis;
                 fixes += 1;
                 next += 1;
+            }
+            while next_odo < odo_t.len() && odo_t[next_odo] <= t[i] {
+                f.update_body_velocity(
+                    [Some(odo_v[next_odo]), Some(0.0), Some(0.0)],
+                    [sigma_odo, sigma_nhc, sigma_nhc],
+                    f64::INFINITY,
+                )
+                .unwrap();
+                next_odo += 1;
             }
             if (t[i] - check_s).abs() < 1e-9 {
                 let s = f.state();
@@ -222,7 +244,7 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
         chi2_quantile(dof, -1.959_964) / runs as f64,
         chi2_quantile(dof, 1.959_964) / runs as f64,
     );
-    let (nees, nis, fixes) = average_nees(runs, 1.0);
+    let (nees, nis, fixes) = average_nees(runs, 1.0, false);
     eprintln!("average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]");
     for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
         assert!(
@@ -241,13 +263,36 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
     eprintln!("average NIS {nis} over {fixes} fixes, 95 % bounds [{nis_lo:.3}, {nis_hi:.3}]");
     assert!(nis_lo <= nis && nis <= nis_hi, "NIS {nis}");
     // Told 100 times too little process noise, the filter is overconfident.
-    let (mistuned, mistuned_nis, _) = average_nees(runs, 0.01);
+    let (mistuned, mistuned_nis, _) = average_nees(runs, 0.01, false);
     eprintln!("mistuned (process noise × 0.01): average NEES {mistuned:?}, NIS {mistuned_nis}");
     assert!(
         mistuned.iter().any(|&v| v > hi),
         "a mistuned filter passed: {mistuned:?}"
     );
     assert!(mistuned_nis > nis_hi, "{mistuned_nis}");
+}
+
+#[test]
+fn with_an_odometer_and_the_vehicle_constraints_the_filter_stays_consistent() {
+    // The same 50 runs with a 10 Hz odometer (σ 0.05 m/s) and the non-holonomic constraints
+    // (the car neither slips sideways nor leaves the road; σ 0.02 m/s): the average NEES stays
+    // inside the 95 % bounds.
+    let runs = 50;
+    let dof = 3.0 * runs as f64;
+    let (lo, hi) = (
+        chi2_quantile(dof, -1.959_964) / runs as f64,
+        chi2_quantile(dof, 1.959_964) / runs as f64,
+    );
+    let (nees, _, _) = average_nees(runs, 1.0, true);
+    eprintln!(
+        "with odometer and constraints: average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]"
+    );
+    for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
+        assert!(
+            lo <= v && v <= hi,
+            "{name}: average NEES {v} outside [{lo}, {hi}]"
+        );
+    }
 }
 
 #[test]

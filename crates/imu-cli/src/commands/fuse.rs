@@ -4,7 +4,7 @@ use std::path::Path;
 
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
-use imukit::run::fuse::{FuseSetup, fuse};
+use imukit::run::fuse::{AidTables, FuseSetup, fuse_with};
 use imukit::run::navigate::InitialState;
 use imukit::{Error, ScenarioSpec};
 
@@ -18,6 +18,9 @@ pub struct Args<'a> {
     pub scenario: &'a Path,
     pub earth: &'a str,
     pub no_gate: bool,
+    pub odometer: Option<&'a Path>,
+    pub baro: Option<&'a Path>,
+    pub nhc: Option<f64>,
     pub out: &'a Path,
 }
 
@@ -32,36 +35,52 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         .into());
     }
-    check_outputs(
-        &[
-            ("IMU file", a.imu),
-            ("GNSS file", a.gnss),
-            ("--init file", a.init),
-            ("--scenario", a.scenario),
-        ],
-        &[("--out", a.out)],
-    )?;
+    let mut inputs = vec![
+        ("IMU file", a.imu),
+        ("GNSS file", a.gnss),
+        ("--init file", a.init),
+        ("--scenario", a.scenario),
+    ];
+    inputs.extend(a.odometer.map(|p| ("--odometer", p)));
+    inputs.extend(a.baro.map(|p| ("--baro", p)));
+    check_outputs(&inputs, &[("--out", a.out)])?;
     let base = a.scenario.parent().unwrap_or_else(|| Path::new("."));
     let scenario = ScenarioSpec::from_file(a.scenario)?.resolve(base)?;
     let mut setup = FuseSetup::from_scenario(&scenario)?;
     if a.no_gate {
         setup.gate = f64::INFINITY;
     }
+    setup.aiding.nhc_sigma_m_s = a.nhc;
     let initial = InitialState::from_csv(a.init)?;
     initial.check(&format!("{}, row 2", a.init.display()))?;
     let imu = read_table(a.imu)?;
     let gnss = read_table(a.gnss)?;
-    let (nav, summary) = fuse(&imu, &gnss, &initial, &setup).map_err(|e| match e {
-        Error::Invalid { field, message } if field == "IMU data" => Error::Invalid {
-            field: a.imu.display().to_string(),
+    let odometer = a.odometer.map(read_table).transpose()?;
+    let baro = a.baro.map(read_table).transpose()?;
+    let aids = AidTables {
+        odometer: odometer.as_ref(),
+        baro: baro.as_ref(),
+    };
+    // The library names its inputs by kind; the user knows them by file.
+    let file_of = |context: &str| match context {
+        "IMU data" => Some(a.imu),
+        "GNSS data" => Some(a.gnss),
+        "odometer data" => a.odometer,
+        "barometer data" => a.baro,
+        "nhc_sigma_m_s" => Some(Path::new("--nhc")),
+        _ => None,
+    };
+    let rename = |context: String| match file_of(&context) {
+        Some(p) => p.display().to_string(),
+        None => context,
+    };
+    let (nav, summary) = fuse_with(&imu, &gnss, aids, &initial, &setup).map_err(|e| match e {
+        Error::Invalid { field, message } => Error::Invalid {
+            field: rename(field),
             message,
         },
-        Error::Invalid { field, message } if field == "GNSS data" => Error::Invalid {
-            field: a.gnss.display().to_string(),
-            message,
-        },
-        Error::Diverged { context, message } if context == "GNSS data" => Error::Diverged {
-            context: a.gnss.display().to_string(),
+        Error::Diverged { context, message } => Error::Diverged {
+            context: rename(context),
             message,
         },
         other => other,
@@ -73,7 +92,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             .unwrap_or(f64::NAN)
     };
     eprintln!(
-        "imukit: {} samples fused with {} fixes ({} rejected by the gate); final one-sigma: \
+        "imukit: {} samples fused with {} updates ({} rejected by the gate); final one-sigma: \
          position {:.3} {:.3} {:.3} m; estimate in {}",
         nav.rows(),
         summary.updates,

@@ -12,7 +12,9 @@
 //! (`p_a = p + Ĉ l`, `v_a = v + Ĉ (ω̂ × l)`), with `H` from
 //! `δp_a = δp − [(Ĉ l)×] φ` and `δv_a = δv − [(Ĉ(ω̂×l))×] φ + Ĉ [l×] δb_g`; Joseph form,
 //! symmetrised; a chi-square innovation gate (normalised innovation squared, NIS) rejects and
-//! counts outliers.
+//! counts outliers. Ground-vehicle aiding: body-frame velocity (odometer forward speed,
+//! non-holonomic zero lateral and vertical velocity) with `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`, and
+//! height (barometer) on the frame's up axis.
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
 use crate::frame::{Body, NavFrame};
@@ -408,7 +410,81 @@ impl<N: NavFrame> Eskf<N> {
             y[i] = 0.0;
             r[i] = 1.0;
         }
-        let s = h * self.cov * h.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&r);
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// A body-frame velocity measurement: `measured_m_s[i]`, when given, is the velocity of the
+    /// reference point along body axis `i` with one-sigma `sigma_m_s[i]` — a wheel odometer's
+    /// forward speed on x, and for a ground vehicle that neither slips sideways nor leaves the
+    /// road the non-holonomic constraints, 0 on y and z. With `v_b = Ĉᵀ v`,
+    /// `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`. Gated like [`Self::update_gnss`] (`gate` for as many degrees
+    /// of freedom as rows given).
+    ///
+    /// # Errors
+    /// Non-finite input or sigmas that are not positive, or a covariance that can no longer be
+    /// inverted (divergence).
+    pub fn update_body_velocity(
+        &mut self,
+        measured_m_s: [Option<f64>; 3],
+        sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let ct = self.q.to_rotation_matrix().into_inner().transpose();
+        let predicted = ct * self.v;
+        let h_phi = ct * skew(&self.v);
+        let mut h = SMatrix::<f64, 3, 15>::zeros();
+        let mut y = SVector::<f64, 3>::zeros();
+        let mut r = SVector::<f64, 3>::repeat(1.0);
+        for i in 0..3 {
+            let Some(z) = measured_m_s[i] else { continue };
+            if !(z.is_finite() && sigma_m_s[i].is_finite() && sigma_m_s[i] > 0.0) {
+                return Err(EskfError::NotFinite { index });
+            }
+            h.fixed_view_mut::<1, 3>(i, 3).copy_from(&ct.row(i));
+            h.fixed_view_mut::<1, 3>(i, 6).copy_from(&h_phi.row(i));
+            y[i] = z - predicted[i];
+            r[i] = sq(sigma_m_s[i]);
+        }
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// A height measurement (a barometer): `height_m` of the reference point, up (`N::Z_UP`
+    /// times the frame's z), one-sigma `sigma_m`. Gated with `gate` (one degree of freedom).
+    ///
+    /// # Errors
+    /// Non-finite input, a sigma that is not positive, or divergence.
+    pub fn update_height(
+        &mut self,
+        height_m: f64,
+        sigma_m: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
+            return Err(EskfError::NotFinite { index });
+        }
+        let mut h = SMatrix::<f64, 1, 15>::zeros();
+        h[(0, 2)] = N::Z_UP;
+        let y = SVector::<f64, 1>::new(height_m - N::Z_UP * self.p.z);
+        let r = SVector::<f64, 1>::new(sq(sigma_m));
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// The Kalman correction shared by every update: innovation `y` with model `H` and
+    /// measurement variances `r` (rows with `H = 0`, `y = 0`, `r = 1` are inert); NIS against
+    /// `gate` (rejected and counted above it); Joseph-form covariance, symmetrised; closed-loop
+    /// injection of `δx` into the nominal state, and reset.
+    fn correct<const M: usize>(
+        &mut self,
+        h: &SMatrix<f64, M, 15>,
+        y: &SVector<f64, M>,
+        r: &SVector<f64, M>,
+        gate: f64,
+        index: usize,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let rm = SMatrix::<f64, M, M>::from_diagonal(r);
+        let s = h * self.cov * h.transpose() + rm;
         let Some(s_inv) = s.try_inverse() else {
             return Err(EskfError::Diverged { index });
         };
@@ -426,7 +502,6 @@ impl<N: NavFrame> Eskf<N> {
         let k = self.cov * h.transpose() * s_inv;
         let dx = k * y;
         let ikh = Mat15::identity() - k * h;
-        let rm = SMatrix::<f64, 6, 6>::from_diagonal(&r);
         self.cov = ikh * self.cov * ikh.transpose() + k * rm * k.transpose();
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
         if (0..15).any(|i| self.cov[(i, i)].is_nan() || self.cov[(i, i)] < 0.0) {

@@ -214,6 +214,11 @@ def fuse(
     format: str = "dict",
     base_dir: str = ".",
     gate: bool = True,
+    odometer_columns: Optional[Sequence[str]] = None,
+    odometer_values: Optional[npt.NDArray[np.float64]] = None,
+    baro_columns: Optional[Sequence[str]] = None,
+    baro_values: Optional[npt.NDArray[np.float64]] = None,
+    nhc_sigma_m_s: Optional[float] = None,
 ) -> tuple[_Table, int, int]: ...
 def compare(
     truth_columns: Sequence[str],

@@ -115,14 +115,19 @@ def compare(truth: Table, estimate: Table):
     return _table(table), dict(summary)
 
 
-def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True) -> Table:
+def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True,
+         odometer: Optional[Table] = None, baro: Optional[Table] = None,
+         nhc_sigma_m_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
     GNSS fixes (``imukit.simulate(...).gnss``), flat Earth. The filter's model comes from
-    ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors and its
-    ``[gnss]`` accuracy and lever arm. ``initial`` is a truth Table (its first row). Returns the
-    navigation columns of :func:`strapdown`, their one-sigma (``pos_x_sigma_m`` …
-    ``att_z_sigma_rad``) and the bias estimates (``accel_bias_x_m_s2`` … ``gyro_bias_z_rad_s``);
-    ``gate=False`` applies every fix (else a chi-square gate rejects outliers).
+    ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors, its
+    ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. ``initial`` is a truth
+    Table (its first row). Returns the navigation columns of :func:`strapdown`, their one-sigma
+    (``pos_x_sigma_m`` … ``att_z_sigma_rad``) and the bias estimates (``accel_bias_x_m_s2`` …
+    ``gyro_bias_z_rad_s``); ``gate=False`` applies every update (else a chi-square gate rejects
+    outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),
+    ``nhc_sigma_m_s=0.1`` (the non-holonomic constraints: no sideways or vertical body
+    velocity, with each odometer reading or at 10 Hz) and ``baro=sim.baro`` (height).
     """
     if isinstance(scenario, Mapping):
         source, fmt, base = dict(scenario), "dict", os.getcwd()
@@ -133,6 +138,11 @@ def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True
         except OSError as e:
             raise ImuError(f"{path}: {e.strerror or e}") from None
         fmt, base = ("json" if path.suffix.lower() == ".json" else "toml"), str(path.parent)
+    aids = {}
+    for name, t in (("odometer", odometer), ("baro", baro)):
+        if t is not None:
+            aids.update(zip((f"{name}_columns", f"{name}_values"), _table_args(name, t)))
     table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *_table_args("initial", initial),
-                             source, format=fmt, base_dir=base, gate=bool(gate))
+                             source, format=fmt, base_dir=base, gate=bool(gate),
+                             nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s), **aids)
     return _table(table)

@@ -57,14 +57,55 @@ pub struct FuseSetup {
     pub lever_arm_m: [f64; 3],
     /// Innovation gate: NIS above this chi-square value is rejected (`f64::INFINITY`: off).
     pub gate: f64,
+    /// Ground-vehicle and barometer aiding (all off by default).
+    pub aiding: AidingSetup,
+}
+
+/// How the filter uses aids besides GNSS: one-sigmas of what it is told; `None` is off.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AidingSetup {
+    /// Odometer forward speed, white one-sigma, m/s; a scale-factor error `k` (fraction) is
+    /// added as `|k·v|` in quadrature (the filter does not estimate it).
+    pub odometer: Option<OdometerModel>,
+    /// Non-holonomic constraints: the body's lateral and vertical velocity are 0 within this
+    /// one-sigma, m/s, applied with every odometer reading or, without an odometer, at
+    /// [`NHC_RATE_HZ`].
+    pub nhc_sigma_m_s: Option<f64>,
+    /// Barometric height: white one-sigma, m (a constant bias is not estimated).
+    pub baro_sigma_m: Option<f64>,
+}
+
+/// The odometer as the filter models it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OdometerModel {
+    /// White noise one-sigma, m/s.
+    pub noise_m_s: f64,
+    /// Scale-factor error, fraction.
+    pub scale_factor_error: f64,
+}
+
+/// The smallest one-sigma the filter is told for an aid (exact simulated readings still need a
+/// little trust in the model), in the aid's unit.
+const MIN_SIGMA: f64 = 1e-3;
+
+/// Rate of the non-holonomic constraints when no odometer paces them, Hz.
+pub const NHC_RATE_HZ: f64 = 10.0;
+
+/// Aid readings beside the IMU and GNSS tables.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct AidTables<'a> {
+    /// Odometer readings (`t_s, speed_m_s`, from `imukit simulate --odometer`).
+    pub odometer: Option<&'a Table>,
+    /// Barometer readings (`t_s, baro_height_m`, from `imukit simulate --baro`).
+    pub baro: Option<&'a Table>,
 }
 
 /// What a fusion did besides its table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FuseSummary {
-    /// Fixes applied.
+    /// Updates applied (fixes and aid readings).
     pub updates: usize,
-    /// Fixes rejected by the gate.
+    /// Updates rejected by the gate.
     pub rejected: usize,
 }
 
@@ -84,15 +125,77 @@ pub fn fuse(
     initial: &InitialState,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
+    fuse_with(imu, gnss, AidTables::default(), initial, setup)
+}
+
+/// [`fuse`] with odometer and barometer readings: each table given is used with its model in
+/// `setup.aiding` (a table without a model is refused, not ignored); the non-holonomic
+/// constraints are used when `setup.aiding.nhc_sigma_m_s` is set.
+///
+/// # Errors
+/// As [`fuse`]; an aid table without its columns or with times that do not increase or fall
+/// outside the IMU's span (`odometer data, row …`); an aid table without its model.
+pub fn fuse_with(
+    imu: &Table,
+    gnss: &Table,
+    aids: AidTables<'_>,
+    initial: &InitialState,
+    setup: &FuseSetup,
+) -> Result<(Table, FuseSummary)> {
     match setup.nav_frame {
-        NavFrameName::ENU => fuse_in::<Enu>(imu, gnss, initial, setup),
-        NavFrameName::NED => fuse_in::<Ned>(imu, gnss, initial, setup),
+        NavFrameName::ENU => fuse_in::<Enu>(imu, gnss, aids, initial, setup),
+        NavFrameName::NED => fuse_in::<Ned>(imu, gnss, aids, initial, setup),
     }
 }
+
+/// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
+fn aid_series(
+    table: &Table,
+    what: &str,
+    value: &str,
+    (t0, t1): (f64, f64),
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (Some(t), Some(v)) = (table.column("t_s"), table.column(value)) else {
+        return Err(invalid(
+            format!("{what} data"),
+            format!("missing column(s): needs t_s and {value}"),
+        ));
+    };
+    for (k, (&tk, &vk)) in t.iter().zip(&v).enumerate() {
+        if !tk.is_finite() || !vk.is_finite() || (k > 0 && tk <= t[k - 1]) {
+            return Err(invalid(
+                format!("{what} data"),
+                format!(
+                    "row {}: times must be finite and increase, values finite",
+                    k + 2
+                ),
+            ));
+        }
+        if tk < t0 || tk > t1 {
+            return Err(invalid(
+                format!("{what} data"),
+                format!(
+                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok((t, v))
+}
+
+/// One-degree-of-freedom and two- and three-degree chi-square 99.9 % quantiles: the gates of
+/// height, constraint and odometer-with-constraint updates.
+const CHI2_99_9: [f64; 3] = [
+    10.827_566_170_662_733,
+    13.815_510_557_964_274,
+    16.266_236_196_238_13,
+];
 
 fn fuse_in<N: NavFrame>(
     imu: &Table,
     gnss: &Table,
+    aids: AidTables<'_>,
     initial: &InitialState,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
@@ -140,6 +243,54 @@ fn fuse_in<N: NavFrame>(
             ));
         }
     }
+    let span = (t0, t1);
+    let (odo_t, odo_v) = match (aids.odometer, setup.aiding.odometer) {
+        (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
+        (Some(_), None) => {
+            return Err(invalid(
+                "odometer data",
+                "given, but the scenario has no [odometer]: the filter takes its accuracy from it",
+            ));
+        }
+        (None, _) => (Vec::new(), Vec::new()),
+    };
+    let (baro_t, baro_h) = match (aids.baro, setup.aiding.baro_sigma_m) {
+        (Some(table), Some(_)) => aid_series(table, "barometer", "baro_height_m", span)?,
+        (Some(_), None) => {
+            return Err(invalid(
+                "barometer data",
+                "given, but the scenario has no [baro]: the filter takes its accuracy from it",
+            ));
+        }
+        (None, _) => (Vec::new(), Vec::new()),
+    };
+    let gate_of = |k: usize| {
+        if setup.gate.is_finite() {
+            CHI2_99_9[k]
+        } else {
+            f64::INFINITY
+        }
+    };
+    let aid_error = |what: &str, row: usize, e: EskfError| {
+        let message = format!("row {}: {e}", row + 2);
+        match e {
+            EskfError::Diverged { .. } => Error::Diverged {
+                context: format!("{what} data"),
+                message,
+            },
+            _ => invalid(format!("{what} data"), message),
+        }
+    };
+    let nhc = setup.aiding.nhc_sigma_m_s;
+    if let Some(c) = nhc
+        && !(c.is_finite() && c > 0.0)
+    {
+        return Err(invalid(
+            "nhc_sigma_m_s",
+            format!("must be a finite number > 0 (m/s), got {c}"),
+        ));
+    }
+    let (mut next_odo, mut next_baro, mut next_nhc_t) = (0, 0, t0);
     let attitude = Rotation::<Body, N>::from_wxyz(initial.quaternion).ok_or_else(|| {
         invalid(
             "initial state",
@@ -218,6 +369,41 @@ fn fuse_in<N: NavFrame>(
                 });
             }
             next_fix += 1;
+        }
+        while next_odo < odo_t.len() && odo_t[next_odo] <= t[i] {
+            let speed = odo_v[next_odo];
+            let model = setup.aiding.odometer.unwrap_or(OdometerModel {
+                noise_m_s: 0.0,
+                scale_factor_error: 0.0,
+            });
+            let sigma = model
+                .noise_m_s
+                .hypot(model.scale_factor_error * speed)
+                .max(MIN_SIGMA);
+            let (measured, sigmas, dof) = match nhc {
+                Some(c) => ([Some(speed), Some(0.0), Some(0.0)], [sigma, c, c], 3),
+                None => ([Some(speed), None, None], [sigma, 1.0, 1.0], 1),
+            };
+            filter
+                .update_body_velocity(measured, sigmas, gate_of(dof - 1))
+                .map_err(|e| aid_error("odometer", next_odo, e))?;
+            next_odo += 1;
+        }
+        if let Some(c) = nhc
+            && odo_t.is_empty()
+            && t[i] >= next_nhc_t
+        {
+            filter
+                .update_body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], gate_of(1))
+                .map_err(|e| aid_error("constraint", i, e))?;
+            next_nhc_t = t[i] + 1.0 / NHC_RATE_HZ;
+        }
+        while next_baro < baro_t.len() && baro_t[next_baro] <= t[i] {
+            let sigma = setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA);
+            filter
+                .update_height(baro_h[next_baro], sigma, gate_of(0))
+                .map_err(|e| aid_error("barometer", next_baro, e))?;
+            next_baro += 1;
         }
         let s = filter.state();
         let sig = filter.sigmas();
@@ -305,7 +491,9 @@ impl FuseSetup {
     /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
     /// filter assumes uncorrelated fixes). Initial uncertainty: position as the fixes, 0.1 m/s,
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
-    /// 0.01 m/s² and 1e-4 rad/s).
+    /// 0.01 m/s² and 1e-4 rad/s). Aids: the `[odometer]` noise and scale-factor error, the
+    /// `[baro]` noise with its bias in quadrature (neither estimated); the non-holonomic
+    /// constraints stay off (a scenario does not say its vehicle is on wheels).
     ///
     /// # Errors
     /// A scenario without `[gnss]`, or on the WGS-84 Earth (fusion there is not implemented yet).
@@ -360,6 +548,14 @@ impl FuseSetup {
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: gnss.lever_arm_m,
             gate: CHI2_99_9_6DOF,
+            aiding: AidingSetup {
+                odometer: scenario.odometer.map(|o| OdometerModel {
+                    noise_m_s: o.error.noise,
+                    scale_factor_error: o.error.constant,
+                }),
+                nhc_sigma_m_s: None,
+                baro_sigma_m: scenario.baro.map(|b| b.error.noise.hypot(b.error.constant)),
+            },
         })
     }
 }

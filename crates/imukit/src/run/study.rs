@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
-use crate::run::fuse::{FuseSetup, fuse};
+use crate::run::fuse::{AidTables, FuseSetup, fuse_with};
 use crate::run::navigate::InitialState;
 use crate::scenario::{Scenario, ScenarioSpec};
 
@@ -27,12 +27,20 @@ pub const MAX_RUNS: u64 = 100_000;
 pub struct StudySpec {
     /// The scenario file, relative to the study file: trajectory, `[imu]` (its `preset` is
     /// replaced by each of `presets`; other keys apply to all), `[gnss]` with at least one
-    /// `[[gnss.outages]]`.
+    /// `[[gnss.outages]]`, and `[odometer]` or `[baro]` when the study uses them.
     pub scenario: PathBuf,
     /// IMU presets to compare (`imukit presets`), at least one.
     pub presets: Vec<String>,
     /// Monte Carlo runs per preset, 2 to [`MAX_RUNS`].
     pub runs: u64,
+    /// Aid the filter with the scenario's `[odometer]` (which it must have).
+    #[serde(default)]
+    pub odometer: bool,
+    /// Aid the filter with the scenario's `[baro]` (which it must have).
+    #[serde(default)]
+    pub baro: bool,
+    /// The non-holonomic constraints of a ground vehicle, one-sigma m/s (off when absent).
+    pub nhc_sigma_m_s: Option<f64>,
 }
 
 /// One preset, resolved.
@@ -48,6 +56,8 @@ struct Case {
 pub struct Study {
     cases: Vec<Case>,
     runs: u64,
+    odometer: bool,
+    baro: bool,
     outage: (f64, f64),
     scenario_path: PathBuf,
     input_files: Vec<(&'static str, PathBuf)>,
@@ -120,6 +130,14 @@ impl Study {
     /// As [`Study::from_file`].
     pub fn new(spec: &StudySpec, base_dir: &Path, origin: &str) -> Result<Self> {
         let key = |k: &str| format!("{origin}: {k}");
+        if let Some(c) = spec.nhc_sigma_m_s
+            && !(c.is_finite() && c > 0.0)
+        {
+            return Err(invalid(
+                key("nhc_sigma_m_s"),
+                format!("must be a finite number > 0 (m/s), got {c}"),
+            ));
+        }
         if spec.presets.is_empty() {
             return Err(invalid(key("presets"), "name at least one IMU preset"));
         }
@@ -148,7 +166,8 @@ impl Study {
             let scenario = s
                 .resolve(scenario_dir)
                 .map_err(|e| invalid(key(&format!("presets[{i}]")), e.to_string()))?;
-            let setup = FuseSetup::from_scenario(&scenario)?;
+            let mut setup = FuseSetup::from_scenario(&scenario)?;
+            setup.aiding.nhc_sigma_m_s = spec.nhc_sigma_m_s;
             cases.push(Case {
                 preset: preset.clone(),
                 scenario,
@@ -181,9 +200,23 @@ impl Study {
                 ),
             ));
         }
+        if spec.odometer && first.odometer.is_none() {
+            return Err(invalid(
+                key("odometer"),
+                "its scenario has no [odometer] to aid the filter with",
+            ));
+        }
+        if spec.baro && first.baro.is_none() {
+            return Err(invalid(
+                key("baro"),
+                "its scenario has no [baro] to aid the filter with",
+            ));
+        }
         Ok(Self {
             cases,
             runs: spec.runs,
+            odometer: spec.odometer,
+            baro: spec.baro,
             outage: (start, end),
             input_files: scenario_spec.input_files(scenario_dir),
             scenario_path,
@@ -236,7 +269,11 @@ impl Study {
             .as_ref()
             .ok_or_else(|| invalid("study", "the simulation wrote no GNSS fixes"))?;
         let initial = InitialState::from_table(&sim.truth)?;
-        let nav = match fuse(&sim.imu, gnss, &initial, &c.setup) {
+        let aids = AidTables {
+            odometer: sim.odometer.as_ref().filter(|_| self.odometer),
+            baro: sim.baro.as_ref().filter(|_| self.baro),
+        };
+        let nav = match fuse_with(&sim.imu, gnss, aids, &initial, &c.setup) {
             Ok((nav, _)) => nav,
             Err(Error::Diverged { context, message }) => {
                 return Ok(RunOutcome::Diverged(format!(
