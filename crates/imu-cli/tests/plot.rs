@@ -47,6 +47,20 @@ fn data() -> &'static PathBuf {
         let orient = d.join("orient.csv");
         ok(&imukit(&["orient"], &[&imu, Path::new("--filter"), Path::new("ahrsfilter"), Path::new("--out"), &orient]));
         ok(&imukit(&["compare"], &[&truth, &orient, Path::new("--out"), &d.join("orient_errors.csv")]));
+        // A GNSS-aided car fused: its errors carry the filter's one-sigma.
+        let car = d.join("car.toml");
+        std::fs::write(
+            &car,
+            "rate_hz = 50.0\nduration_s = 30.0\n[trajectory]\ntype = \"expression\"\n\
+             position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]\nattitude = \"tangent\"\n\
+             [imu]\nkind = \"accel-gyro\"\npreset = \"stim300\"\n[gnss]\nrate_hz = 5.0\ndecay_factor = 0.0\n",
+        )
+        .unwrap();
+        let (car_imu, car_truth, car_gnss, car_nav) =
+            (d.join("car_imu.csv"), d.join("car_truth.csv"), d.join("car_gnss.csv"), d.join("car_nav.csv"));
+        ok(&imukit(&["simulate"], &[&car, Path::new("--out"), &car_imu, Path::new("--truth"), &car_truth, Path::new("--gnss"), &car_gnss]));
+        ok(&imukit(&["fuse"], &[&car_imu, &car_gnss, Path::new("--init"), &car_truth, Path::new("--scenario"), &car, Path::new("--out"), &car_nav]));
+        ok(&imukit(&["compare"], &[&car_truth, &car_nav, Path::new("--out"), &d.join("fused_errors.csv")]));
         d
     })
 }
@@ -131,6 +145,33 @@ fn imu_readings_have_accelerometer_gyroscope_and_magnetometer() {
 #[test]
 fn errors_have_position_velocity_and_attitude_panels() {
     assert_eq!(plot(&["errors.csv"], "errors"), ((560, 960), 4 + 3 + 1));
+}
+
+#[test]
+fn errors_of_a_fused_estimate_are_drawn_against_plus_minus_three_sigma() {
+    // The same three panels; position and velocity each add a ±3σ envelope per axis (one
+    // legend key for its pair of dotted lines).
+    assert_eq!(
+        plot(&["fused_errors.csv"], "fused_errors"),
+        ((560, 960), 4 + 3 + 1 + 3 + 3)
+    );
+    let errors = std::fs::read_to_string(data().join("fused_errors.csv")).unwrap();
+    let nav = std::fs::read_to_string(data().join("car_nav.csv")).unwrap();
+    let column = |text: &str, name: &str| -> Vec<String> {
+        let mut lines = text.lines();
+        let k = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c == name)
+            .unwrap();
+        lines
+            .map(|l| l.split(',').nth(k).unwrap().to_string())
+            .collect()
+    };
+    for c in ["pos_x_sigma_m", "vel_z_sigma_m_s", "att_z_sigma_rad"] {
+        assert_eq!(column(&errors, c), column(&nav, c), "{c}");
+    }
 }
 
 #[test]

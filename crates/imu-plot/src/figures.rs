@@ -42,6 +42,28 @@ fn panel(files: &[(String, Table)], spec: &PanelSpec) -> Option<Panel> {
                 });
             }
         }
+        for (c, k) in &spec.envelopes {
+            let Some(sigma) = t.column(c) else { continue };
+            for sign in [3.0, -3.0] {
+                series.push(Series {
+                    label: if sign > 0.0 {
+                        format!(
+                            "±3σ {}",
+                            spec.columns.get(*k).map_or("", |(_, l)| l.as_str())
+                        )
+                    } else {
+                        String::new()
+                    },
+                    points: xs
+                        .iter()
+                        .copied()
+                        .zip(sigma.iter().map(|s| sign * s * spec.scale))
+                        .collect(),
+                    color: *k,
+                    style: 2,
+                });
+            }
+        }
     }
     (!series.is_empty()).then(|| Panel {
         title: spec.title.into(),

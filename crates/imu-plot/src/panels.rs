@@ -96,10 +96,10 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
             2 => chart.draw_series(DashedLineSeries::new(pts, 2, 3, stroke)),
             _ => chart.draw_series(DashedLineSeries::new(pts, 12, 4, stroke)),
         };
-        drawn
-            .map_err(err)?
-            .label(s.label.clone())
-            .legend(key(color));
+        let drawn = drawn.map_err(err)?;
+        if !s.label.is_empty() {
+            drawn.label(s.label.clone()).legend(key(color));
+        }
     }
     draw_legend(&mut chart)
 }

@@ -198,9 +198,14 @@ impl TableKind {
             Self::Errors => {
                 let mut pos = xyz("pos_err", "m");
                 pos.push(own(("pos_err_m", "norm")));
+                let sigma = |prefix: &str, unit: &str| -> Vec<String> {
+                    xyz(prefix, unit).into_iter().map(|(c, _)| c).collect()
+                };
                 vec![
-                    p("Position error", "error (m)", 1.0, &pos),
-                    p("Velocity error", "error (m/s)", 1.0, &xyz("vel_err", "m_s")),
+                    p("Position error", "error (m)", 1.0, &pos)
+                        .with_envelopes(&sigma("pos", "sigma_m")),
+                    p("Velocity error", "error (m/s)", 1.0, &xyz("vel_err", "m_s"))
+                        .with_envelopes(&sigma("vel", "sigma_m_s")),
                     p(
                         "Attitude error",
                         "angle (deg)",
@@ -246,6 +251,9 @@ pub struct PanelSpec {
     /// `(column, legend label)`; columns a table lacks are left out, a panel with none of its
     /// columns is not drawn.
     pub columns: Vec<(String, String)>,
+    /// `(one-sigma column, index of the line it bounds)`: drawn as ±3σ dotted lines in that
+    /// line's colour when the table has the column.
+    pub envelopes: Vec<(String, usize)>,
 }
 
 impl PanelSpec {
@@ -260,7 +268,14 @@ impl PanelSpec {
             y_label,
             scale,
             columns: columns.to_vec(),
+            envelopes: Vec::new(),
         }
+    }
+
+    /// `self` with ±3σ envelopes from `sigma_columns`, one per line in order.
+    fn with_envelopes(mut self, sigma_columns: &[String]) -> Self {
+        self.envelopes = sigma_columns.iter().cloned().zip(0..).collect();
+        self
     }
 }
 

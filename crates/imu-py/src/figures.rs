@@ -17,8 +17,15 @@ fn table_kind(columns: Vec<String>) -> Option<&'static str> {
     TableKind::detect(&columns).map(TableKind::key)
 }
 
-/// A panel for Python: `(title, y_label, scale, [(column, label)])`.
-type PanelOut = (String, String, f64, Vec<(String, String)>);
+/// A panel for Python: `(title, y_label, scale, [(column, label)], [(sigma column, line index)])`
+/// — the last list: ±3σ envelopes, drawn when the table has the column.
+type PanelOut = (
+    String,
+    String,
+    f64,
+    Vec<(String, String)>,
+    Vec<(String, usize)>,
+);
 
 /// The default panels of a kind.
 #[pyfunction]
@@ -33,6 +40,7 @@ fn figure_panels(kind: &str) -> PyResult<Vec<PanelOut>> {
                 p.y_label.to_string(),
                 p.scale,
                 p.columns,
+                p.envelopes,
             )
         })
         .collect())

@@ -73,6 +73,24 @@ def test_imu_errors_and_allan_figures_from_files(sim, tmp_path):
     assert fig.axes[0].get_xscale() == "log" and fig.axes[0].get_yscale() == "log"
 
 
+def test_errors_of_a_fused_estimate_are_drawn_against_three_sigma():
+    scenario = {"rate_hz": 50.0, "duration_s": 30.0,
+                "trajectory": {"type": "expression", "position_m": ["60*sin(0.16*t)", "60*(1 - cos(0.16*t))", "0"],
+                               "attitude": "tangent"},
+                "imu": {"kind": "accel-gyro", "preset": "stim300"},
+                "gnss": {"rate_hz": 5.0, "decay_factor": 0.0}}
+    car = imukit.simulate(scenario)
+    nav = imukit.fuse(car.imu, car.gnss, initial=car.truth, scenario=scenario)
+    errors, _ = imukit.compare(car.truth, nav)
+    np.testing.assert_array_equal(errors["pos_x_sigma_m"], nav["pos_x_sigma_m"])
+    # Position and velocity gain a dotted pair at ±3σ per axis, as imukit plot draws them.
+    fig = ip.figure(errors)
+    assert lines(fig) == [4 + 6, 3 + 6, 1]
+    pos = fig.axes[0].get_lines()
+    np.testing.assert_allclose(pos[4].get_ydata(), 3 * nav["pos_x_sigma_m"])
+    np.testing.assert_allclose(pos[5].get_ydata(), -3 * nav["pos_x_sigma_m"])
+
+
 def test_plain_arrays_by_column_name_plot_like_tables(sim):
     arrays = {c: np.array(sim.imu[c]) for c in sim.imu.columns}
     assert lines(ip.figure(arrays)) == lines(ip.figure(sim.imu)) == [3, 3, 3]

@@ -202,7 +202,7 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None, nav_frame
         ax = fig.add_subplot(nrows, ncols, index, projection="3d" if three_d else None)
         trajectory(*[t for _, t in loaded], labels=[n for n, _ in loaded], ax=ax, nav_frame=nav_frame)
         index += 1
-    for title, y_label, scale, columns in panels:
+    for title, y_label, scale, columns, envelopes in panels:
         ax = fig.add_subplot(nrows, ncols, index)
         index += 1
         for f, (name, t) in enumerate(loaded):
@@ -210,6 +210,12 @@ def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None, nav_frame
                 if column in t and "t_s" in t:
                     text = f"{label} ({name})" if len(loaded) > 1 else label
                     ax.plot(t["t_s"], t[column] * scale, color=f"C{c_k}", linestyle=_STYLES[f % 4], label=text)
+            # ±3σ of a fused estimate's errors (its one-sigma columns), dotted in the line's colour.
+            for sigma, c_k in envelopes:
+                if sigma in t and "t_s" in t:
+                    three = 3.0 * t[sigma] * scale
+                    ax.plot(t["t_s"], three, color=f"C{c_k}", linestyle=":", label=f"±3σ {columns[c_k][1]}")
+                    ax.plot(t["t_s"], -three, color=f"C{c_k}", linestyle=":")
         ax.set_title(title)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(y_label)

@@ -15,6 +15,7 @@ use imu_core::{Body, Enu, Rotation};
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
 use crate::io::table::{CsvRows, Table};
+use crate::run::fuse::SIGMA_COLUMNS;
 use crate::run::navigate::STATE_COLUMNS;
 
 /// Error columns of a navigation estimate.
@@ -148,6 +149,21 @@ fn state_index(names: &[String], kind: EstimateKind) -> Vec<Option<usize>> {
         .collect()
 }
 
+/// Whether an estimate carries the filter's one-sigma ([`SIGMA_COLUMNS`], as `imukit fuse`
+/// writes them): then its errors carry them too, after [`ERROR_COLUMNS`].
+fn has_sigmas(names: &[String], kind: EstimateKind) -> bool {
+    kind == EstimateKind::Navigation && SIGMA_COLUMNS.iter().all(|c| names.iter().any(|n| n == c))
+}
+
+/// The error columns of `kind`, with [`SIGMA_COLUMNS`] when `sigmas`.
+fn output_columns(kind: EstimateKind, sigmas: bool) -> Vec<&'static str> {
+    let mut columns = kind.error_columns().to_vec();
+    if sigmas {
+        columns.extend(SIGMA_COLUMNS);
+    }
+    columns
+}
+
 /// Compares an estimate table with a truth table (see the module docs).
 ///
 /// # Errors
@@ -157,14 +173,28 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
     let kind = EstimateKind::of(&estimate.columns)?;
     check_truth(&truth.columns, kind)?;
     let (mut tr, mut er) = (state_rows(truth, kind), state_rows(estimate, kind));
-    let mut table = Table::new(kind.error_columns());
+    let sigmas: Vec<Vec<f64>> = if has_sigmas(&estimate.columns, kind) {
+        SIGMA_COLUMNS
+            .iter()
+            .filter_map(|c| estimate.column(c))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mut table = Table::new(&output_columns(kind, !sigmas.is_empty()));
+    let mut out = Vec::with_capacity(table.columns.len());
     let summary = compare_rows(
         kind,
         ["truth", "estimate"],
         |row| Ok(tr.next().map(|r| *row = r).is_some()),
         |row| Ok(er.next().map(|r| *row = r).is_some()),
         |e| {
-            table.push_row(e);
+            // One error row per estimate row, in order.
+            let k = table.rows();
+            out.clear();
+            out.extend_from_slice(e);
+            out.extend(sigmas.iter().map(|s| s[k]));
+            table.push_row(&out);
             Ok(())
         },
     )?;
@@ -208,7 +238,7 @@ fn next_state(
         return Ok(false);
     }
     match kind {
-        EstimateKind::Navigation => row.copy_from_slice(buffer),
+        EstimateKind::Navigation => row.copy_from_slice(&buffer[..STATE_COLUMNS.len()]),
         EstimateKind::Orientation => {
             *row = [0.0; 11];
             row[0] = buffer[0];
@@ -224,31 +254,54 @@ fn next_state(
 /// # Errors
 /// As [`compare`], CSV errors naming file, row and column, and I/O errors.
 pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
-    let kind = EstimateKind::of(&crate::io::table::read_header(estimate)?)?;
+    let header = crate::io::table::read_header(estimate)?;
+    let kind = EstimateKind::of(&header)?;
+    let sigmas = has_sigmas(&header, kind);
     let wanted: &[&str] = match kind {
         EstimateKind::Navigation => STATE_COLUMNS,
         EstimateKind::Orientation => &ORIENTATION_COLUMNS,
     };
+    let estimate_wanted: Vec<&str> = wanted
+        .iter()
+        .copied()
+        .chain(SIGMA_COLUMNS.iter().copied().filter(|_| sigmas))
+        .collect();
     let hint = match kind {
         EstimateKind::Navigation => "; the truth needs t_s, pos_*, vel_*, q_*",
         EstimateKind::Orientation => "; the truth needs t_s, q_w, q_x, q_y, q_z",
     };
     let mut truth_rows = CsvRows::open(truth, wanted, hint)?;
-    let mut estimate_rows = CsvRows::open(estimate, wanted, "")?;
+    let mut estimate_rows = CsvRows::open(estimate, &estimate_wanted, "")?;
     let (mut truth_buffer, mut estimate_buffer) =
-        (vec![0.0; wanted.len()], vec![0.0; wanted.len()]);
+        (vec![0.0; wanted.len()], vec![0.0; estimate_wanted.len()]);
     let mut file = out.map(AtomicFile::create).transpose()?;
-    let columns = kind.error_columns();
     if let Some(f) = file.as_mut() {
-        f.write_header(columns)?;
+        f.write_header(&output_columns(kind, sigmas))?;
     }
+    // The estimate row's sigmas, handed from the reader to the writer.
+    let row_sigmas = std::cell::Cell::new([0.0; SIGMA_COLUMNS.len()]);
+    let mut out_row = Vec::new();
     let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
     let summary = compare_rows(
         kind,
         [&truth_name, &estimate_name],
         |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
-        |row| next_state(&mut estimate_rows, &mut estimate_buffer, kind, row),
+        |row| {
+            let more = next_state(&mut estimate_rows, &mut estimate_buffer, kind, row)?;
+            if sigmas && more {
+                let mut s = [0.0; SIGMA_COLUMNS.len()];
+                s.copy_from_slice(&estimate_buffer[wanted.len()..]);
+                row_sigmas.set(s);
+            }
+            Ok(more)
+        },
         |e| match file.as_mut() {
+            Some(f) if sigmas => {
+                out_row.clear();
+                out_row.extend_from_slice(e);
+                out_row.extend(row_sigmas.get());
+                f.write_row(&out_row)
+            }
             Some(f) => f.write_row(e),
             None => Ok(()),
         },

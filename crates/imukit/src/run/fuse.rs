@@ -14,19 +14,25 @@ use crate::run::navigate::{InitialState, NAV_COLUMNS, euler_unwrapped};
 use crate::scenario::NavFrameName;
 use crate::scenario::gnss::GNSS_COLUMNS;
 
-/// Columns of a fused estimate: [`NAV_COLUMNS`], one-sigma columns, bias estimates.
+/// The one-sigma columns of a fused estimate: position, velocity and attitude error, axes of
+/// the navigation frame. `imukit compare` carries them into the errors, which `imukit plot`
+/// draws against ±3σ.
+pub const SIGMA_COLUMNS: [&str; 9] = [
+    "pos_x_sigma_m",
+    "pos_y_sigma_m",
+    "pos_z_sigma_m",
+    "vel_x_sigma_m_s",
+    "vel_y_sigma_m_s",
+    "vel_z_sigma_m_s",
+    "att_x_sigma_rad",
+    "att_y_sigma_rad",
+    "att_z_sigma_rad",
+];
+
+/// Columns of a fused estimate: [`NAV_COLUMNS`], [`SIGMA_COLUMNS`], bias estimates.
 pub const FUSE_COLUMNS: [&str; 29] = concat_columns(
-    NAV_COLUMNS,
+    concat_columns::<14, 9, 23>(NAV_COLUMNS, SIGMA_COLUMNS),
     [
-        "pos_x_sigma_m",
-        "pos_y_sigma_m",
-        "pos_z_sigma_m",
-        "vel_x_sigma_m_s",
-        "vel_y_sigma_m_s",
-        "vel_z_sigma_m_s",
-        "att_x_sigma_rad",
-        "att_y_sigma_rad",
-        "att_z_sigma_rad",
         "accel_bias_x_m_s2",
         "accel_bias_y_m_s2",
         "accel_bias_z_m_s2",
