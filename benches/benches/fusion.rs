@@ -38,17 +38,22 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("fusion");
     let n = 10_000usize;
     group.throughput(Throughput::Elements(n as u64));
-    group.bench_function(BenchmarkId::new("propagate", n), |b| {
-        b.iter(|| {
-            let mut f = filter();
-            for k in 0..n {
-                let t = k as f64 * 0.01;
-                f.propagate(t, [0.01, -0.02, 0.1 * t.sin()], [0.2, 1.0, 9.81])
+    // 100 Hz samples; the covariance with every sample, and at 20 Hz (imukit fuse's default).
+    for (name, interval_s) in [("propagate", 0.0), ("propagate_covariance_20hz", 0.05)] {
+        group.bench_function(BenchmarkId::new(name, n), |b| {
+            b.iter(|| {
+                let mut f = filter()
+                    .with_covariance_interval(interval_s)
                     .expect("valid");
-            }
-            f
+                for k in 0..n {
+                    let t = k as f64 * 0.01;
+                    f.propagate(t, [0.01, -0.02, 0.1 * t.sin()], [0.2, 1.0, 9.81])
+                        .expect("valid");
+                }
+                f
+            });
         });
-    });
+    }
     group.throughput(Throughput::Elements(1));
     group.bench_function("gnss_update_position_velocity", |b| {
         let mut f = filter();

@@ -191,6 +191,10 @@ pub enum Command {
         /// reading or at 10 Hz.
         #[arg(long, value_name = "SIGMA_M_S", num_args = 0..=1, default_missing_value = "0.1")]
         nhc: Option<f64>,
+        /// Propagate the covariance once per this interval and at every update, s (0: every IMU
+        /// sample; default 0.05).
+        #[arg(long)]
+        covariance_interval_s: Option<f64>,
         /// Where to write the estimate (CSV).
         #[arg(long)]
         out: PathBuf,

@@ -1320,6 +1320,11 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
         ("s.toml", vec!["--nhc=-1"], vec!["--nhc", "> 0"]),
         (
             "s.toml",
+            vec!["--covariance-interval-s=nan"],
+            vec!["--covariance-interval-s", "≥ 0"],
+        ),
+        (
+            "s.toml",
             vec!["--baro", "odo.csv"],
             vec!["odo.csv", "baro_height_m"],
         ),

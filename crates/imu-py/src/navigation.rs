@@ -177,7 +177,7 @@ fn compare<'py>(
 #[pyo3(signature = (imu_columns, imu_values, gnss_columns, gnss_values, initial_columns, initial_values,
                     scenario, *, format = "dict", base_dir = ".", gate = true,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
-                    baro_values = None, nhc_sigma_m_s = None))]
+                    baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None))]
 #[allow(clippy::too_many_arguments)]
 fn fuse<'py>(
     py: Python<'py>,
@@ -196,6 +196,7 @@ fn fuse<'py>(
     baro_columns: Option<Vec<String>>,
     baro_values: Option<PyReadonlyArray2<'py, f64>>,
     nhc_sigma_m_s: Option<f64>,
+    covariance_interval_s: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
     use imukit::run::fuse::{AidTables, FuseSetup, fuse_with};
@@ -235,6 +236,9 @@ fn fuse<'py>(
                 setup.gate = f64::INFINITY;
             }
             setup.aiding.nhc_sigma_m_s = nhc_sigma_m_s;
+            if let Some(s) = covariance_interval_s {
+                setup.covariance_interval_s = s;
+            }
             let aids = AidTables {
                 odometer: odometer.as_ref(),
                 baro: baro.as_ref(),

@@ -70,6 +70,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         lever_arm_m: [0.0; 3],
         gate: f64::INFINITY,
         aiding: Default::default(),
+        covariance_interval_s: 0.0,
     };
     let initial = InitialState::from_table(&sim.truth).unwrap();
     let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
@@ -98,8 +99,14 @@ fn chi2_quantile(k: f64, z: f64) -> f64 {
 
 /// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average
 /// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`; with
-/// `wheels`, an odometer (10 Hz) and the non-holonomic constraints aid the filter too.
-fn average_nees(runs: u64, q_scale: f64, wheels: bool) -> ([f64; 3], f64, usize) {
+/// `wheels`, an odometer (10 Hz) and the non-holonomic constraints aid the filter too; the
+/// covariance is stepped every `covariance_interval_s` (0: every sample).
+fn average_nees(
+    runs: u64,
+    q_scale: f64,
+    wheels: bool,
+    covariance_interval_s: f64,
+) -> ([f64; 3], f64, usize) {
     // IMU: white noise and bias random walk (single-sided densities: the continuous PSD is N²,
     // so the filter's √q is N). GNSS: white (MATLAB decay factor 0: deviation σ√2).
     let (n_a, n_g, k_a, k_g) = (0.003, 2e-4, 2e-4, 2e-6);
@@ -173,7 +180,10 @@ fn average_nees(runs: u64, q_scale: f64, wheels: bool) -> ([f64; 3], f64, usize)
             accel_bias_m_s2: [0, 1, 2].map(|_| d(sigma0.accel_bias_m_s2)),
             gyro_bias_rad_s: [0, 1, 2].map(|_| d(sigma0.gyro_bias_rad_s)),
         };
-        let mut f = Eskf::<Enu>::new(&start, &sigma0, noise, 9.81).unwrap();
+        let mut f = Eskf::<Enu>::new(&start, &sigma0, noise, 9.81)
+            .unwrap()
+            .with_covariance_interval(covariance_interval_s)
+            .unwrap();
         let (w, a) = (
             rows3(&sim.imu, ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]),
             rows3(&sim.imu, ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]),
@@ -244,7 +254,7 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
         chi2_quantile(dof, -1.959_964) / runs as f64,
         chi2_quantile(dof, 1.959_964) / runs as f64,
     );
-    let (nees, nis, fixes) = average_nees(runs, 1.0, false);
+    let (nees, nis, fixes) = average_nees(runs, 1.0, false, 0.0);
     eprintln!("average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]");
     for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
         assert!(
@@ -263,7 +273,7 @@ fn the_filter_is_consistent_over_50_runs_and_a_mistuned_one_is_not() {
     eprintln!("average NIS {nis} over {fixes} fixes, 95 % bounds [{nis_lo:.3}, {nis_hi:.3}]");
     assert!(nis_lo <= nis && nis <= nis_hi, "NIS {nis}");
     // Told 100 times too little process noise, the filter is overconfident.
-    let (mistuned, mistuned_nis, _) = average_nees(runs, 0.01, false);
+    let (mistuned, mistuned_nis, _) = average_nees(runs, 0.01, false, 0.0);
     eprintln!("mistuned (process noise × 0.01): average NEES {mistuned:?}, NIS {mistuned_nis}");
     assert!(
         mistuned.iter().any(|&v| v > hi),
@@ -283,10 +293,30 @@ fn with_an_odometer_and_the_vehicle_constraints_the_filter_stays_consistent() {
         chi2_quantile(dof, -1.959_964) / runs as f64,
         chi2_quantile(dof, 1.959_964) / runs as f64,
     );
-    let (nees, _, _) = average_nees(runs, 1.0, true);
+    let (nees, _, _) = average_nees(runs, 1.0, true, 0.0);
     eprintln!(
         "with odometer and constraints: average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]"
     );
+    for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
+        assert!(
+            lo <= v && v <= hi,
+            "{name}: average NEES {v} outside [{lo}, {hi}]"
+        );
+    }
+}
+
+#[test]
+fn with_the_covariance_stepped_at_10_hz_the_filter_stays_consistent() {
+    // The IMU at 50 Hz, the covariance every 0.1 s (5 samples, and at each fix): the same
+    // 50 runs, the same bounds.
+    let runs = 50;
+    let dof = 3.0 * runs as f64;
+    let (lo, hi) = (
+        chi2_quantile(dof, -1.959_964) / runs as f64,
+        chi2_quantile(dof, 1.959_964) / runs as f64,
+    );
+    let (nees, nis, fixes) = average_nees(runs, 1.0, false, 0.1);
+    eprintln!("covariance at 10 Hz: average NEES {nees:?}, NIS {nis} over {fixes} fixes");
     for (name, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
         assert!(
             lo <= v && v <= hi,

@@ -21,6 +21,7 @@ pub struct Args<'a> {
     pub odometer: Option<&'a Path>,
     pub baro: Option<&'a Path>,
     pub nhc: Option<f64>,
+    pub covariance_interval_s: Option<f64>,
     pub out: &'a Path,
 }
 
@@ -51,6 +52,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         setup.gate = f64::INFINITY;
     }
     setup.aiding.nhc_sigma_m_s = a.nhc;
+    if let Some(s) = a.covariance_interval_s {
+        setup.covariance_interval_s = s;
+    }
     let initial = InitialState::from_csv(a.init)?;
     initial.check(&format!("{}, row 2", a.init.display()))?;
     let imu = read_table(a.imu)?;
@@ -68,6 +72,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         "odometer data" => a.odometer,
         "barometer data" => a.baro,
         "nhc_sigma_m_s" => Some(Path::new("--nhc")),
+        "covariance_interval_s" => Some(Path::new("--covariance-interval-s")),
         _ => None,
     };
     let rename = |context: String| match file_of(&context) {

@@ -100,6 +100,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             odometer,
             baro,
             nhc,
+            covariance_interval_s,
             out,
         } => fuse::run(&fuse::Args {
             imu: &imu,
@@ -111,6 +112,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             odometer: odometer.as_deref(),
             baro: baro.as_deref(),
             nhc,
+            covariance_interval_s,
             out: &out,
         }),
         Command::Study { study, out, plot } => study::run(&study, &out, plot.as_deref()),

@@ -185,6 +185,10 @@ pub struct Eskf<N: NavFrame> {
     noise: EskfNoise,
     g: Vector3<f64>,
     last: Option<(Vector3<f64>, Vector3<f64>)>,
+    /// Covariance propagation interval, s (0: every sample).
+    covariance_interval_s: f64,
+    /// Since the last covariance step: its length, `∫ Ĉ f̂ dt` and `∫ Ĉ dt`.
+    pending: (f64, Vector3<f64>, nalgebra::Matrix3<f64>),
     samples: usize,
     updates: usize,
     rejected: usize,
@@ -243,11 +247,32 @@ impl<N: NavFrame> Eskf<N> {
             noise,
             g: *N::gravity(gravity_m_s2).as_nalgebra(),
             last: None,
+            covariance_interval_s: 0.0,
+            pending: (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros()),
             samples: 0,
             updates: 0,
             rejected: 0,
             frame: core::marker::PhantomData,
         })
+    }
+
+    /// Propagates the covariance once per `interval_s` (or at the next update, whichever comes
+    /// first) instead of at every IMU sample: the nominal state still follows every sample, and
+    /// the interval's error dynamics use its mean specific force and attitude (the transition
+    /// of `F` at the mean over `Δt`). The covariance (and [`Self::sigmas`]) then lags the state
+    /// by less than `interval_s`; at 100 Hz an interval of 0.05 s makes propagation about four
+    /// times faster. 0 (the default) steps it with every sample.
+    ///
+    /// # Errors
+    /// An interval that is negative or not finite.
+    pub fn with_covariance_interval(mut self, interval_s: f64) -> Result<Self, EskfError> {
+        if !(interval_s.is_finite() && interval_s >= 0.0) {
+            return Err(EskfError::BadParameter {
+                field: "covariance interval",
+            });
+        }
+        self.covariance_interval_s = interval_s;
+        Ok(self)
     }
 
     /// The current estimate.
@@ -321,10 +346,31 @@ impl<N: NavFrame> Eskf<N> {
         let v0 = self.v;
         self.v += (half * f + self.g) * dt;
         self.p += 0.5 * (v0 + self.v) * dt;
-        // Error state: Φ = I + A, A = FΔt + (FΔt)²/2 at the interval's middle, kept as its
-        // seven non-zero 3 × 3 blocks; Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ (P symmetric).
         let c = half.to_rotation_matrix().into_inner();
-        let a = Transition::new(&skew(&(c * f)), &c, dt);
+        self.pending.0 += dt;
+        self.pending.1 += c * f * dt;
+        self.pending.2 += c * dt;
+        self.q = q1;
+        self.t = t_s;
+        self.last = Some((w1, f1));
+        self.samples += 1;
+        if self.pending.0 >= self.covariance_interval_s * (1.0 - 1e-9) {
+            self.step_covariance();
+        }
+        Ok(())
+    }
+
+    /// One covariance step over the pending interval (nothing when none is pending): `Φ = I + A`,
+    /// `A = FΔt + (FΔt)²/2` with the interval's mean `Ĉf̂` and `Ĉ`, kept as its seven non-zero
+    /// 3 × 3 blocks; `Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ` (P symmetric).
+    fn step_covariance(&mut self) {
+        let (dt, cf, cdt) = self.pending;
+        if dt <= 0.0 {
+            return;
+        }
+        self.pending = (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros());
+        let c = cdt / dt;
+        let a = Transition::new(&skew(&(cf / dt)), &c, dt);
         let ap = a.times(&self.cov);
         let mut gqg = Vec15::zeros();
         for i in 0..3 {
@@ -340,11 +386,6 @@ impl<N: NavFrame> Eskf<N> {
         let qd = (qc * 2.0 + aq + aq.transpose() + a.times(&aq.transpose())) * (0.5 * dt);
         self.cov += ap + ap.transpose() + a.times(&ap.transpose()) + qd;
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
-        self.q = q1;
-        self.t = t_s;
-        self.last = Some((w1, f1));
-        self.samples += 1;
-        Ok(())
     }
 
     /// A GNSS position (and, when given, velocity) fix at the current time: `position_m` of the
@@ -483,6 +524,7 @@ impl<N: NavFrame> Eskf<N> {
         gate: f64,
         index: usize,
     ) -> Result<UpdateOutcome, EskfError> {
+        self.step_covariance();
         let rm = SMatrix::<f64, M, M>::from_diagonal(r);
         let s = h * self.cov * h.transpose() + rm;
         let Some(s_inv) = s.try_inverse() else {

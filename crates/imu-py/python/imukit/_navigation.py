@@ -117,7 +117,7 @@ def compare(truth: Table, estimate: Table):
 
 def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True,
          odometer: Optional[Table] = None, baro: Optional[Table] = None,
-         nhc_sigma_m_s: Optional[float] = None) -> Table:
+         nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
     GNSS fixes (``imukit.simulate(...).gnss``), flat Earth. The filter's model comes from
     ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors, its
@@ -128,6 +128,8 @@ def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True
     outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),
     ``nhc_sigma_m_s=0.1`` (the non-holonomic constraints: no sideways or vertical body
     velocity, with each odometer reading or at 10 Hz) and ``baro=sim.baro`` (height).
+    ``covariance_interval_s`` (default 0.05; 0: every sample) steps the covariance less often
+    than the IMU samples, for speed.
     """
     if isinstance(scenario, Mapping):
         source, fmt, base = dict(scenario), "dict", os.getcwd()
@@ -144,5 +146,7 @@ def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True
             aids.update(zip((f"{name}_columns", f"{name}_values"), _table_args(name, t)))
     table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *_table_args("initial", initial),
                              source, format=fmt, base_dir=base, gate=bool(gate),
-                             nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s), **aids)
+                             nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),
+                             covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
+                             **aids)
     return _table(table)

@@ -65,7 +65,16 @@ pub struct FuseSetup {
     pub gate: f64,
     /// Ground-vehicle and barometer aiding (all off by default).
     pub aiding: AidingSetup,
+    /// The covariance is propagated once per this interval and at every update, s (0: every
+    /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
+    /// covariance of the last step.
+    pub covariance_interval_s: f64,
 }
+
+/// The covariance interval [`FuseSetup::from_scenario`] chooses, s: 20 Hz, four times less
+/// work than every sample at 100 Hz, and the same NEES to three digits in the consistency test
+/// (covariance at 10 Hz there).
+pub const DEFAULT_COVARIANCE_INTERVAL_S: f64 = 0.05;
 
 /// How the filter uses aids besides GNSS: one-sigmas of what it is told; `None` is off.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -319,7 +328,17 @@ fn fuse_in<N: NavFrame>(
         setup.noise,
         setup.gravity_m_s2,
     )
-    .map_err(|e| filter_error("filter", e))?;
+    .map_err(|e| filter_error("filter", e))?
+    .with_covariance_interval(setup.covariance_interval_s)
+    .map_err(|_| {
+        invalid(
+            "covariance_interval_s",
+            format!(
+                "must be a finite number ≥ 0 (s), got {}",
+                setup.covariance_interval_s
+            ),
+        )
+    })?;
     let sign = match setup.accel_sign {
         AccelSign::SpecificForce => 1.0,
         AccelSign::Matlab => -1.0,
@@ -499,7 +518,8 @@ impl FuseSetup {
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
     /// 0.01 m/s² and 1e-4 rad/s). Aids: the `[odometer]` noise and scale-factor error, the
     /// `[baro]` noise with its bias in quadrature (neither estimated); the non-holonomic
-    /// constraints stay off (a scenario does not say its vehicle is on wheels).
+    /// constraints stay off (a scenario does not say its vehicle is on wheels). The covariance
+    /// is stepped every [`DEFAULT_COVARIANCE_INTERVAL_S`].
     ///
     /// # Errors
     /// A scenario without `[gnss]`, or on the WGS-84 Earth (fusion there is not implemented yet).
@@ -562,6 +582,7 @@ impl FuseSetup {
                 nhc_sigma_m_s: None,
                 baro_sigma_m: scenario.baro.map(|b| b.error.noise.hypot(b.error.constant)),
             },
+            covariance_interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
         })
     }
 }
