@@ -79,6 +79,24 @@ pub struct UpdateOutcome {
     pub accepted: bool,
 }
 
+/// One GNSS fix as the filter takes it (see [`Eskf::update_gnss_fix`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssFix<N> {
+    /// Antenna position, navigation frame, m.
+    pub position_m: Vec3<N>,
+    /// Antenna velocity, navigation frame, m/s (`None`: position only).
+    pub velocity_m_s: Option<Vec3<N>>,
+    /// Antenna lever arm, body frame, m.
+    pub lever_arm_m: Vec3<Body>,
+    /// Position one-sigma per axis, m.
+    pub position_sigma_m: [f64; 3],
+    /// Velocity one-sigma per axis, m/s.
+    pub velocity_sigma_m_s: [f64; 3],
+    /// How long before the filter's current time the fix was valid, s (≥ 0): the receiver's
+    /// latency plus the wait for the next IMU sample.
+    pub age_s: f64,
+}
+
 /// Why the filter refused input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EskfError {
@@ -405,30 +423,74 @@ impl<N: NavFrame> Eskf<N> {
         velocity_sigma_m_s: [f64; 3],
         gate: f64,
     ) -> Result<UpdateOutcome, EskfError> {
+        let fix = GnssFix {
+            position_m,
+            velocity_m_s,
+            lever_arm_m,
+            position_sigma_m,
+            velocity_sigma_m_s,
+            age_s: 0.0,
+        };
+        self.update_gnss_fix(&fix, gate)
+    }
+
+    /// [`Self::update_gnss`] for a fix valid `fix.age_s = τ` before the filter's time (latency
+    /// compensation): the antenna is predicted back with the current acceleration
+    /// `a = Ĉf̂ + g`, `p_a = p + Ĉl − τ (v + Ĉ(ω̂×l)) + ½τ² a` and `v_a = v + Ĉ(ω̂×l) − τ a`, so
+    /// `δp_a = δp − τ δv − [(Ĉl)×] φ` and
+    /// `δv_a = δv − [(Ĉ(ω̂×l))×] φ + τ [(Ĉf̂)×] φ + τ Ĉ δb_a + Ĉ [l×] δb_g` (the change of the
+    /// lever-arm terms over `τ` is neglected).
+    ///
+    /// # Errors
+    /// As [`Self::update_gnss`]; an age that is negative or not finite.
+    pub fn update_gnss_fix(
+        &mut self,
+        fix: &GnssFix<N>,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let GnssFix {
+            position_m,
+            velocity_m_s,
+            lever_arm_m,
+            position_sigma_m,
+            velocity_sigma_m_s,
+            age_s,
+        } = *fix;
         let index = self.updates + self.rejected;
+        if !(age_s.is_finite() && age_s >= 0.0) {
+            return Err(EskfError::NotFinite { index });
+        }
         let c = self.q.to_rotation_matrix().into_inner();
         let l = *lever_arm_m.as_nalgebra();
         let cl = c * l;
         let w = self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg;
         let cwl = c * w.cross(&l);
-        let z_p = *position_m.as_nalgebra() - (self.p + cl);
+        let f = self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba;
+        let cf = c * f;
+        let accel = cf + self.g;
+        let z_p = *position_m.as_nalgebra()
+            - (self.p + cl - (self.v + cwl) * age_s + accel * (0.5 * age_s * age_s));
         let mut finite = z_p.iter().all(|v| v.is_finite());
         let mut h = SMatrix::<f64, 6, 15>::zeros();
         let mut y = SVector::<f64, 6>::zeros();
         let mut r = SVector::<f64, 6>::zeros();
         h.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&nalgebra::Matrix3::identity());
+        h.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(nalgebra::Matrix3::identity() * -age_s));
         h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
         y.fixed_rows_mut::<3>(0).copy_from(&z_p);
         for i in 0..3 {
             r[i] = sq(position_sigma_m[i]);
         }
         let m = if let Some(vm) = velocity_m_s {
-            let z_v = *vm.as_nalgebra() - (self.v + cwl);
+            let z_v = *vm.as_nalgebra() - (self.v + cwl - accel * age_s);
             finite &= z_v.iter().all(|v| v.is_finite());
             h.fixed_view_mut::<3, 3>(3, 3)
                 .copy_from(&nalgebra::Matrix3::identity());
-            h.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&cwl)));
+            h.fixed_view_mut::<3, 3>(3, 6)
+                .copy_from(&(-skew(&cwl) + skew(&cf) * age_s));
+            h.fixed_view_mut::<3, 3>(3, 9).copy_from(&(c * age_s));
             h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
             y.fixed_rows_mut::<3>(3).copy_from(&z_v);
             for i in 0..3 {

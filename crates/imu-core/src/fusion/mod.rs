@@ -2,4 +2,4 @@
 //! (15 states, fixed-size matrices, no heap) on the flat-Earth mechanization.
 pub mod eskf;
 
-pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, InitialSigma, UpdateOutcome};
+pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome};

@@ -5,7 +5,7 @@
 //! velocity and attitude (navigation-frame axes), and the bias estimates — one row per IMU
 //! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
-use imu_core::fusion::{Eskf, EskfError, EskfNoise, EskfState, InitialSigma};
+use imu_core::fusion::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma};
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Error, Result, invalid};
@@ -61,6 +61,9 @@ pub struct FuseSetup {
     pub gnss_velocity_sigma_m_s: Option<f64>,
     /// Antenna lever arm, body frame, m.
     pub lever_arm_m: [f64; 3],
+    /// The receiver's latency, s: a fix stamped `t` was valid at `t − latency` (`[gnss]
+    /// latency_s`); the filter compares it with its state predicted back that far.
+    pub gnss_latency_s: f64,
     /// Innovation gate: NIS above this chi-square value is rejected (`f64::INFINITY`: off).
     pub gate: f64,
     /// Ground-vehicle and barometer aiding (all off by default).
@@ -354,27 +357,27 @@ fn fuse_in<N: NavFrame>(
             .propagate(t[i], w[i], f[i].map(|x| sign * x))
             .map_err(|e| filter_error("IMU data", e))?;
         while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
-            let outcome = filter
-                .update_gnss(
-                    Vec3::from_array(g_p[next_fix]),
-                    setup
-                        .gnss_velocity_sigma_m_s
-                        .map(|_| Vec3::from_array(g_v[next_fix])),
-                    lever,
-                    setup.gnss_position_sigma_m,
-                    [vel_sigma; 3],
-                    setup.gate,
-                )
-                .map_err(|e| {
-                    let message = format!("row {}: {e}", next_fix + 2);
-                    match e {
-                        EskfError::Diverged { .. } => Error::Diverged {
-                            context: "GNSS data".into(),
-                            message,
-                        },
-                        _ => invalid("GNSS data", message),
-                    }
-                })?;
+            let fix = GnssFix {
+                position_m: Vec3::from_array(g_p[next_fix]),
+                velocity_m_s: setup
+                    .gnss_velocity_sigma_m_s
+                    .map(|_| Vec3::from_array(g_v[next_fix])),
+                lever_arm_m: lever,
+                position_sigma_m: setup.gnss_position_sigma_m,
+                velocity_sigma_m_s: [vel_sigma; 3],
+                // Valid at its stamp minus the latency; applied at this IMU sample.
+                age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
+            };
+            let outcome = filter.update_gnss_fix(&fix, setup.gate).map_err(|e| {
+                let message = format!("row {}: {e}", next_fix + 2);
+                match e {
+                    EskfError::Diverged { .. } => Error::Diverged {
+                        context: "GNSS data".into(),
+                        message,
+                    },
+                    _ => invalid("GNSS data", message),
+                }
+            })?;
             rejected_in_a_row = if outcome.accepted {
                 0
             } else {
@@ -573,6 +576,7 @@ impl FuseSetup {
             gnss_position_sigma_m: [h, h, v],
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: gnss.lever_arm_m,
+            gnss_latency_s: gnss.latency_s,
             gate: CHI2_99_9_6DOF,
             aiding: AidingSetup {
                 odometer: scenario.odometer.map(|o| OdometerModel {
