@@ -168,7 +168,12 @@ pub enum Command {
         gnss: PathBuf,
         /// The initial state: the first row of this truth CSV.
         #[arg(long)]
-        init: PathBuf,
+        init: Option<PathBuf>,
+        /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
+        /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); the estimate begins
+        /// there.
+        #[arg(long)]
+        align: Option<String>,
         /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.
         #[arg(long)]
         scenario: PathBuf,

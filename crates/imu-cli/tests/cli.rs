@@ -1337,3 +1337,79 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
         assert!(!dir.join("nav.csv").exists(), "{extra:?}");
     }
 }
+
+#[test]
+fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
+    let dir = temp_dir("fuse-align");
+    let scenario =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let scenario = scenario.display().to_string();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            &scenario,
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let fuse = |extra: &[&str]| {
+        let mut args = vec![
+            "fuse",
+            "imu.csv",
+            "gnss.csv",
+            "--scenario",
+            &scenario,
+            "--out",
+            "nav.csv",
+        ];
+        args.extend(extra);
+        run_in(&dir, &args)
+    };
+    let (code, err) = fuse(&["--align", "gnss"]);
+    assert_eq!(code, Some(0), "{err}");
+    // The estimate begins at the first fix at speed (the car starts from rest), not at t = 0.
+    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let t0: f64 = nav
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(t0 > 0.5 && t0 < 5.0, "{t0}");
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["compare", "truth.csv", "nav.csv"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::remove_file(dir.join("nav.csv")).unwrap();
+    for (extra, needles) in [
+        (vec!["--align", "static"], vec!["--align", "north", "gnss"]),
+        (vec!["--align", "sideways"], vec!["--align", "sideways"]),
+        (vec![], vec!["--init", "\"gnss\""]),
+        (
+            vec!["--init", "truth.csv", "--align", "gnss"],
+            vec!["--align", "not both"],
+        ),
+    ] {
+        let (code, err) = fuse(&extra);
+        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{extra:?}: {err}");
+        }
+        assert!(!dir.join("nav.csv").exists());
+    }
+}

@@ -175,7 +175,7 @@ fn compare<'py>(
 /// and the non-holonomic constraints: (estimate table, updates applied, updates rejected).
 #[pyfunction]
 #[pyo3(signature = (imu_columns, imu_values, gnss_columns, gnss_values, initial_columns, initial_values,
-                    scenario, *, format = "dict", base_dir = ".", gate = true,
+                    scenario, *, format = "dict", base_dir = ".", gate = true, align = None,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None))]
 #[allow(clippy::too_many_arguments)]
@@ -185,12 +185,13 @@ fn fuse<'py>(
     imu_values: PyReadonlyArray2<'py, f64>,
     gnss_columns: Vec<String>,
     gnss_values: PyReadonlyArray2<'py, f64>,
-    initial_columns: Vec<String>,
-    initial_values: PyReadonlyArray2<'py, f64>,
+    initial_columns: Option<Vec<String>>,
+    initial_values: Option<PyReadonlyArray2<'py, f64>>,
     scenario: &Bound<'py, PyAny>,
     format: &str,
     base_dir: &str,
     gate: bool,
+    align: Option<String>,
     odometer_columns: Option<Vec<String>>,
     odometer_values: Option<PyReadonlyArray2<'py, f64>>,
     baro_columns: Option<Vec<String>>,
@@ -199,7 +200,7 @@ fn fuse<'py>(
     covariance_interval_s: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{AidTables, FuseSetup, fuse_with};
+    use imukit::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
     let spec = match format {
         "dict" => ScenarioSpec::from_tree(
             &crate::convert::value_tree(scenario, "scenario")?,
@@ -216,8 +217,13 @@ fn fuse<'py>(
     .map_err(refused)?;
     let imu = table_in("imu", imu_columns, &imu_values)?;
     let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
-    let initial = InitialState::from_table(&table_in("initial", initial_columns, &initial_values)?)
-        .map_err(refused)?;
+    let initial = match (initial_columns, &initial_values) {
+        (Some(c), Some(v)) => {
+            Some(InitialState::from_table(&table_in("initial", c, v)?).map_err(refused)?)
+        }
+        _ => None,
+    };
+    Start::choose(initial.as_ref(), align.as_deref()).map_err(refused)?;
     let optional =
         |name: &str, columns: Option<Vec<String>>, values: &Option<PyReadonlyArray2<'py, f64>>| {
             match (columns, values) {
@@ -243,7 +249,8 @@ fn fuse<'py>(
                 odometer: odometer.as_ref(),
                 baro: baro.as_ref(),
             };
-            fuse_with(&imu, &gnss, aids, &initial, &setup)
+            let start = Start::choose(initial.as_ref(), align.as_deref())?;
+            fuse_with(&imu, &gnss, aids, start, &setup)
         })
         .map_err(refused)?;
     Ok((table_out(py, table)?, summary.updates, summary.rejected))

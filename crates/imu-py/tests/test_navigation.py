@@ -197,6 +197,31 @@ def test_fuse_with_an_odometer_and_the_vehicle_constraints_holds_the_car_through
         imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, baro=sim.odometer)
 
 
+def test_fuse_aligns_from_gnss_without_truth():
+    # A car from rest: without initial=, align="gnss" starts the filter at the first fix at
+    # 3 m/s or more (the estimate begins there), heading along its velocity.
+    scenario = {
+        "rate_hz": 100.0, "nav_frame": "NED",
+        "trajectory": {"type": "waypoints", "time_s": [0, 10, 20, 30],
+                       "position_m": [[0, 0, 0], [60, 10, 0], [160, 60, 0], [220, 160, 0]],
+                       "velocity_m_s": [[0, 0, 0], [0, 0, 0]]},
+        "imu": {"kind": "accel-gyro", "preset": "stim300", "seed": 2},
+        "gnss": {"rate_hz": 5.0, "decay_factor": 0.0},
+    }
+    sim = imukit.simulate(scenario)
+    nav = imukit.fuse(sim.imu, sim.gnss, scenario=scenario, align="gnss")
+    speed = np.hypot(sim.gnss["vel_x_m_s"], sim.gnss["vel_y_m_s"])
+    assert nav["t_s"][0] == pytest.approx(sim.gnss["t_s"][np.argmax(speed >= 3.0)])
+    k = int(np.searchsorted(sim.truth["t_s"], nav["t_s"][-1] - 1e-9))
+    yaw_error = (nav["yaw_rad"][-1] - sim.truth["yaw_rad"][k] + math.pi) % (2 * math.pi) - math.pi
+    assert abs(yaw_error) < 3 * nav["att_z_sigma_rad"][-1]
+    with pytest.raises(ImuError, match="north") as e:
+        imukit.fuse(sim.imu, sim.gnss, scenario=scenario, align="static")
+    assert e.value.field == "align"
+    with pytest.raises(ImuError, match="not both"):
+        imukit.fuse(sim.imu, sim.gnss, scenario=scenario, initial=sim.truth, align="gnss")
+
+
 def test_a_scenario_with_a_barometer_and_an_odometer_returns_their_readings():
     sim = imukit.simulate({"rate_hz": 100.0, "duration_s": 20.0, "nav_frame": "NED",
                            "trajectory": {"type": "expression", "position_m": ["10*t", "0", "-50"], "attitude": "tangent"},

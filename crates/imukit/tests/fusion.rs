@@ -423,3 +423,77 @@ fn heading_is_observable_in_a_turn_and_not_on_a_straight_line_at_constant_speed(
     assert!(turning < 0.25 * 0.05, "turning: {turning}");
     assert!(straight > 0.8 * 0.05, "straight: {straight}");
 }
+
+#[test]
+fn aligned_from_gnss_the_filter_starts_without_truth_and_converges() {
+    // The tunnel road from rest, STIM300, fixes of 1.5 m and 0.1 m/s: the filter starts at the
+    // first fix at 3 m/s or more with heading and pitch along its velocity, and its stated
+    // uncertainty holds the error it starts with and the one it converges to.
+    use imukit::run::fuse::{ALIGN_MIN_SPEED_M_S, AidTables, Start, fuse_with};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let sc = imukit::Scenario::from_file(&dir.join("car_tunnel.toml")).unwrap();
+    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    for run in 0..5 {
+        let sim = sc.simulate_run(run).unwrap();
+        let gnss = sim.gnss.as_ref().unwrap();
+        let (nav, _) = fuse_with(
+            &sim.imu,
+            gnss,
+            AidTables::default(),
+            Start::AlignGnss,
+            &setup,
+        )
+        .unwrap();
+        // It begins at the first fix at speed.
+        let (g_t, g_vx, g_vy) = (
+            col(gnss, "t_s"),
+            col(gnss, "vel_x_m_s"),
+            col(gnss, "vel_y_m_s"),
+        );
+        let k = (0..g_t.len())
+            .find(|&k| g_vx[k].hypot(g_vy[k]) >= ALIGN_MIN_SPEED_M_S)
+            .unwrap();
+        let t_nav = col(&nav, "t_s");
+        assert!(
+            (t_nav[0] - g_t[k]).abs() < 1e-9,
+            "{} vs {}",
+            t_nav[0],
+            g_t[k]
+        );
+        let truth_t = col(&sim.truth, "t_s");
+        let at = |t: f64| truth_t.partition_point(|&x| x < t - 1e-9);
+        let yaw_error = |i_nav: usize| {
+            let e = col(&nav, "yaw_rad")[i_nav] - col(&sim.truth, "yaw_rad")[at(t_nav[i_nav])];
+            (e + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        };
+        let yaw_sigma = |i_nav: usize| col(&nav, "att_z_sigma_rad")[i_nav];
+        // The start within 3σ of its stated heading uncertainty; 95 s later (before the
+        // tunnel), heading and position within 3σ, the heading known to better than 0.5°.
+        assert!(
+            yaw_error(0).abs() < 3.0 * yaw_sigma(0),
+            "run {run}: {}",
+            yaw_error(0)
+        );
+        let i = t_nav.partition_point(|&x| x < 95.0);
+        eprintln!(
+            "run {run}: aligned at {:.2} s, heading error {:.4} rad (σ {:.4}); at 95 s {:.5} rad (σ {:.5})",
+            t_nav[0],
+            yaw_error(0),
+            yaw_sigma(0),
+            yaw_error(i),
+            yaw_sigma(i)
+        );
+        assert!(yaw_error(i).abs() < 3.0 * yaw_sigma(i), "run {run}");
+        assert!(
+            yaw_sigma(i) < 0.5_f64.to_radians(),
+            "run {run}: {}",
+            yaw_sigma(i)
+        );
+        for axis in ["x", "y"] {
+            let e = col(&nav, &format!("pos_{axis}_m"))[i]
+                - col(&sim.truth, &format!("pos_{axis}_m"))[at(t_nav[i])];
+            let s = col(&nav, &format!("pos_{axis}_sigma_m"))[i];
+            assert!(e.abs() < 3.0 * s, "run {run}, {axis}: {e} vs σ {s}");
+        }
+    }
+}

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
-use imukit::run::fuse::{AidTables, FuseSetup, fuse_with};
+use imukit::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
 use imukit::run::navigate::InitialState;
 use imukit::{Error, ScenarioSpec};
 
@@ -14,7 +14,8 @@ use super::CliError;
 pub struct Args<'a> {
     pub imu: &'a Path,
     pub gnss: &'a Path,
-    pub init: &'a Path,
+    pub init: Option<&'a Path>,
+    pub align: Option<&'a str>,
     pub scenario: &'a Path,
     pub earth: &'a str,
     pub no_gate: bool,
@@ -39,9 +40,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let mut inputs = vec![
         ("IMU file", a.imu),
         ("GNSS file", a.gnss),
-        ("--init file", a.init),
         ("--scenario", a.scenario),
     ];
+    inputs.extend(a.init.map(|p| ("--init file", p)));
     inputs.extend(a.odometer.map(|p| ("--odometer", p)));
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
@@ -55,8 +56,26 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     if let Some(s) = a.covariance_interval_s {
         setup.covariance_interval_s = s;
     }
-    let initial = InitialState::from_csv(a.init)?;
-    initial.check(&format!("{}, row 2", a.init.display()))?;
+    let initial = match a.init {
+        Some(init) => {
+            let s = InitialState::from_csv(init)?;
+            s.check(&format!("{}, row 2", init.display()))?;
+            Some(s)
+        }
+        None => None,
+    };
+    // Where the filter starts: a truth row, or an alignment from the fixes.
+    let start = Start::choose(initial.as_ref(), a.align).map_err(|e| match e {
+        Error::Invalid { field, message } => Error::Invalid {
+            field: if field == "initial" && a.align.is_none() {
+                "--init".into()
+            } else {
+                "--align".into()
+            },
+            message,
+        },
+        other => other,
+    })?;
     let imu = read_table(a.imu)?;
     let gnss = read_table(a.gnss)?;
     let odometer = a.odometer.map(read_table).transpose()?;
@@ -79,7 +98,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         Some(p) => p.display().to_string(),
         None => context,
     };
-    let (nav, summary) = fuse_with(&imu, &gnss, aids, &initial, &setup).map_err(|e| match e {
+    let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| match e {
         Error::Invalid { field, message } => Error::Invalid {
             field: rename(field),
             message,

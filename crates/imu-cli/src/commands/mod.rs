@@ -94,6 +94,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             imu,
             gnss,
             init,
+            align,
             scenario,
             earth,
             no_gate,
@@ -105,7 +106,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         } => fuse::run(&fuse::Args {
             imu: &imu,
             gnss: &gnss,
-            init: &init,
+            init: init.as_deref(),
+            align: align.as_deref(),
             scenario: &scenario,
             earth: &earth,
             no_gate,

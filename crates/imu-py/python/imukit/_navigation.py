@@ -115,14 +115,17 @@ def compare(truth: Table, estimate: Table):
     return _table(table), dict(summary)
 
 
-def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True,
+def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, align: Optional[str] = None,
+         gate: bool = True,
          odometer: Optional[Table] = None, baro: Optional[Table] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
     GNSS fixes (``imukit.simulate(...).gnss``), flat Earth. The filter's model comes from
     ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors, its
-    ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. ``initial`` is a truth
-    Table (its first row). Returns the navigation columns of :func:`strapdown`, their one-sigma
+    ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. The filter starts from
+    ``initial``, a truth Table (its first row), or without truth from ``align="gnss"``: position,
+    velocity, heading and pitch of the first fix at 3 m/s or more (roll 0), where the estimate
+    begins. Returns the navigation columns of :func:`strapdown`, their one-sigma
     (``pos_x_sigma_m`` … ``att_z_sigma_rad``) and the bias estimates (``accel_bias_x_m_s2`` …
     ``gyro_bias_z_rad_s``); ``gate=False`` applies every update (else a chi-square gate rejects
     outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),
@@ -144,8 +147,10 @@ def fuse(imu: Table, gnss: Table, *, initial: Table, scenario, gate: bool = True
     for name, t in (("odometer", odometer), ("baro", baro)):
         if t is not None:
             aids.update(zip((f"{name}_columns", f"{name}_values"), _table_args(name, t)))
-    table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *_table_args("initial", initial),
+    start = (None, None) if initial is None else _table_args("initial", initial)
+    table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *start,
                              source, format=fmt, base_dir=base, gate=bool(gate),
+                             align=None if align is None else str(align),
                              nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
                              **aids)

@@ -6,7 +6,7 @@
 //! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
 use imu_core::fusion::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma};
-use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation, Vec3};
+use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
@@ -132,6 +132,110 @@ fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
     Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
 }
 
+/// Where the filter starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start<'a> {
+    /// At the first IMU sample, in this state (a truth row).
+    State(&'a InitialState),
+    /// Without truth: at the first GNSS fix whose horizontal speed is at least
+    /// [`ALIGN_MIN_SPEED_M_S`], with position and velocity from the fix and the attitude of a
+    /// vehicle moving nose first (heading and pitch along the fix's velocity, roll 0), each
+    /// with its stated one-sigma (see [`align_from_gnss`]); the estimate begins there.
+    AlignGnss,
+}
+
+impl<'a> Start<'a> {
+    /// The start a user asks for: an initial state (`initial`, a truth row) or an alignment by
+    /// name (`align`), exactly one of them.
+    ///
+    /// # Errors
+    /// Both or neither (field `initial`), or an alignment [`Start::alignment`] refuses.
+    pub fn choose(initial: Option<&'a InitialState>, align: Option<&str>) -> Result<Self> {
+        match (initial, align) {
+            (Some(s), None) => Ok(Self::State(s)),
+            (None, Some(name)) => Self::alignment(name),
+            (Some(_), Some(_)) => Err(invalid(
+                "initial",
+                "give the initial state or an alignment, not both",
+            )),
+            (None, None) => Err(invalid(
+                "initial",
+                "the filter needs a start: the initial state (a truth row) or the alignment \"gnss\"",
+            )),
+        }
+    }
+
+    /// The alignment a user names (`--align`, Python `align=`): `"gnss"`.
+    ///
+    /// # Errors
+    /// `"static"`, with the reason (the flat Earth has no rate for the gyroscopes to find north
+    /// by), and any other name.
+    pub fn alignment(name: &str) -> Result<Self> {
+        match name {
+            "gnss" => Ok(Self::AlignGnss),
+            "static" => Err(invalid(
+                "align",
+                "\"static\": on the flat Earth the gyroscopes cannot find north (the flat model \
+                 has no Earth rate), so a static alignment waits for fusion on the WGS-84 Earth; \
+                 use \"gnss\" (heading from the first fix at speed) or give the initial state",
+            )),
+            other => Err(invalid(
+                "align",
+                format!("{other:?}: give \"gnss\" (or the initial state)"),
+            )),
+        }
+    }
+}
+
+/// The horizontal speed from which a GNSS velocity gives the heading, m/s.
+pub const ALIGN_MIN_SPEED_M_S: f64 = 3.0;
+
+/// One-sigma the alignment from GNSS allows for a vehicle's nose pointing off its velocity
+/// (sideslip, angle of attack) and for its roll, rad.
+pub const ALIGN_ATTITUDE_ALLOWANCE_RAD: [f64; 2] = [0.02, 0.05];
+
+/// The initial state and one-sigma from GNSS fix `k` (position `p`, velocity `v`), taken at
+/// IMU time `t_imu` (the fix was valid `age_s` earlier): position `p + v·age`, velocity `v`,
+/// yaw `atan2(v_y, v_x)`, pitch `atan2(−v_z, |v_h|)` (the body's x axis along `v`, in either
+/// frame), roll 0. One-sigma: position the fix's plus the lever arm's length (the antenna's
+/// offset is not yet known in the navigation frame), velocity the fix's, heading and pitch
+/// `σ_v/|v_h|` and [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[0]` in quadrature, roll
+/// [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[1]`, biases as `setup` has them.
+#[must_use]
+pub fn align_from_gnss(
+    p: [f64; 3],
+    v: [f64; 3],
+    age_s: f64,
+    setup: &FuseSetup,
+) -> (InitialState, InitialSigma) {
+    let horizontal = v[0].hypot(v[1]);
+    let euler = EulerZyx::new(v[1].atan2(v[0]), (-v[2]).atan2(horizontal), 0.0);
+    let q = Rotation::<Body, Enu>::from_euler(euler).to_wxyz();
+    let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
+    let lever = setup.lever_arm_m.iter().map(|l| l * l).sum::<f64>().sqrt();
+    let pos_sigma = setup
+        .gnss_position_sigma_m
+        .iter()
+        .fold(0.0_f64, |a, b| a.max(*b));
+    let angle = (vel_sigma / horizontal)
+        .atan()
+        .hypot(ALIGN_ATTITUDE_ALLOWANCE_RAD[0]);
+    (
+        InitialState {
+            position_m: [0, 1, 2].map(|k| p[k] + v[k] * age_s),
+            velocity_m_s: v,
+            quaternion: q,
+            geodetic: None,
+        },
+        InitialSigma {
+            position_m: pos_sigma + lever,
+            velocity_m_s: vel_sigma,
+            attitude_rad: [ALIGN_ATTITUDE_ALLOWANCE_RAD[1], angle, angle],
+            ..setup.initial_sigma
+        },
+    )
+}
+
 /// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`]) from `initial`.
 ///
 /// # Errors
@@ -143,7 +247,13 @@ pub fn fuse(
     initial: &InitialState,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    fuse_with(imu, gnss, AidTables::default(), initial, setup)
+    fuse_with(
+        imu,
+        gnss,
+        AidTables::default(),
+        Start::State(initial),
+        setup,
+    )
 }
 
 /// [`fuse`] with odometer and barometer readings: each table given is used with its model in
@@ -157,12 +267,12 @@ pub fn fuse_with(
     imu: &Table,
     gnss: &Table,
     aids: AidTables<'_>,
-    initial: &InitialState,
+    start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
     match setup.nav_frame {
-        NavFrameName::ENU => fuse_in::<Enu>(imu, gnss, aids, initial, setup),
-        NavFrameName::NED => fuse_in::<Ned>(imu, gnss, aids, initial, setup),
+        NavFrameName::ENU => fuse_in::<Enu>(imu, gnss, aids, start, setup),
+        NavFrameName::NED => fuse_in::<Ned>(imu, gnss, aids, start, setup),
     }
 }
 
@@ -214,7 +324,7 @@ fn fuse_in<N: NavFrame>(
     imu: &Table,
     gnss: &Table,
     aids: AidTables<'_>,
-    initial: &InitialState,
+    start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
     let t = imu
@@ -308,7 +418,36 @@ fn fuse_in<N: NavFrame>(
             format!("must be a finite number > 0 (m/s), got {c}"),
         ));
     }
-    let (mut next_odo, mut next_baro, mut next_nhc_t) = (0, 0, t0);
+    // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
+    let (first, initial, sigma, mut next_fix) = match start {
+        Start::State(s) => (0, *s, setup.initial_sigma, 0),
+        Start::AlignGnss => {
+            let k = (0..g_t.len())
+                .find(|&k| g_v[k][0].hypot(g_v[k][1]) >= ALIGN_MIN_SPEED_M_S)
+                .ok_or_else(|| {
+                    invalid(
+                        "GNSS data",
+                        format!(
+                            "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: \
+                             the heading cannot be taken from GNSS velocity (give the initial \
+                             state instead)"
+                        ),
+                    )
+                })?;
+            let i0 = t.partition_point(|&ti| ti < g_t[k]).min(t.len() - 1);
+            let age = t[i0] - g_t[k] + setup.gnss_latency_s;
+            let (s, sigma) = align_from_gnss(g_p[k], g_v[k], age, setup);
+            (i0, s, sigma, k + 1)
+        }
+    };
+    let t_first = t[first];
+    let (mut next_odo, mut next_baro, mut next_nhc_t) = (
+        odo_t.partition_point(|&x| x < t_first),
+        baro_t.partition_point(|&x| x < t_first),
+        t_first,
+    );
+    // A quaternion in the ENU sense (the alignment builds it by geometry) is the same rotation
+    // in either frame's own axes.
     let attitude = Rotation::<Body, N>::from_wxyz(initial.quaternion).ok_or_else(|| {
         invalid(
             "initial state",
@@ -316,7 +455,7 @@ fn fuse_in<N: NavFrame>(
         )
     })?;
     let start = EskfState {
-        t_s: t0,
+        t_s: t_first,
         position_m: Vec3::from_array(initial.position_m),
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
         attitude,
@@ -325,23 +464,18 @@ fn fuse_in<N: NavFrame>(
     };
     let filter_error =
         |context: &str, e: imu_core::fusion::EskfError| invalid(context, e.to_string());
-    let mut filter = Eskf::<N>::new(
-        &start,
-        &setup.initial_sigma,
-        setup.noise,
-        setup.gravity_m_s2,
-    )
-    .map_err(|e| filter_error("filter", e))?
-    .with_covariance_interval(setup.covariance_interval_s)
-    .map_err(|_| {
-        invalid(
-            "covariance_interval_s",
-            format!(
-                "must be a finite number ≥ 0 (s), got {}",
-                setup.covariance_interval_s
-            ),
-        )
-    })?;
+    let mut filter = Eskf::<N>::new(&start, &sigma, setup.noise, setup.gravity_m_s2)
+        .map_err(|e| filter_error("filter", e))?
+        .with_covariance_interval(setup.covariance_interval_s)
+        .map_err(|_| {
+            invalid(
+                "covariance_interval_s",
+                format!(
+                    "must be a finite number ≥ 0 (s), got {}",
+                    setup.covariance_interval_s
+                ),
+            )
+        })?;
     let sign = match setup.accel_sign {
         AccelSign::SpecificForce => 1.0,
         AccelSign::Matlab => -1.0,
@@ -349,10 +483,9 @@ fn fuse_in<N: NavFrame>(
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     let mut table = Table::new(&FUSE_COLUMNS);
-    let mut next_fix = 0;
     let mut rejected_in_a_row = 0;
     let mut last_yaw = None;
-    for i in 0..t.len() {
+    for i in first..t.len() {
         filter
             .propagate(t[i], w[i], f[i].map(|x| sign * x))
             .map_err(|e| filter_error("IMU data", e))?;

@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
-use crate::run::fuse::{AidTables, FuseSetup, fuse_with};
+use crate::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
 use crate::run::navigate::InitialState;
 use crate::scenario::{Scenario, ScenarioSpec};
 
@@ -273,7 +273,7 @@ impl Study {
             odometer: sim.odometer.as_ref().filter(|_| self.odometer),
             baro: sim.baro.as_ref().filter(|_| self.baro),
         };
-        let nav = match fuse_with(&sim.imu, gnss, aids, &initial, &c.setup) {
+        let nav = match fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &c.setup) {
             Ok((nav, _)) => nav,
             Err(Error::Diverged { context, message }) => {
                 return Ok(RunOutcome::Diverged(format!(
