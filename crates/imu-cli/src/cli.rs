@@ -160,7 +160,7 @@ pub enum Command {
     /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states) over IMU rates
     /// and GNSS fixes, the filter's model taken from the scenario that made them (`[imu]` errors,
     /// `[gnss]` accuracy and lever arm); writes the navigation columns, their one-sigma and the
-    /// bias estimates.
+    /// bias estimates with their one-sigma.
     Fuse {
         /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
         imu: PathBuf,

@@ -126,8 +126,8 @@ def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, 
     ``initial``, a truth Table (its first row), or without truth from ``align="gnss"``: position,
     velocity, heading and pitch of the first fix at 3 m/s or more (roll 0), where the estimate
     begins. Returns the navigation columns of :func:`strapdown`, their one-sigma
-    (``pos_x_sigma_m`` … ``att_z_sigma_rad``) and the bias estimates (``accel_bias_x_m_s2`` …
-    ``gyro_bias_z_rad_s``); ``gate=False`` applies every update (else a chi-square gate rejects
+    (``pos_x_sigma_m`` … ``att_z_sigma_rad``), the bias estimates (``accel_bias_x_m_s2`` …
+    ``gyro_bias_z_rad_s``) and their one-sigma (``accel_bias_x_sigma_m_s2`` …); ``gate=False`` applies every update (else a chi-square gate rejects
     outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),
     ``nhc_sigma_m_s=0.1`` (the non-holonomic constraints: no sideways or vertical body
     velocity, with each odometer reading or at 10 Hz) and ``baro=sim.baro`` (height).

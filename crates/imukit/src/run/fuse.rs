@@ -29,8 +29,9 @@ pub const SIGMA_COLUMNS: [&str; 9] = [
     "att_z_sigma_rad",
 ];
 
-/// Columns of a fused estimate: [`NAV_COLUMNS`], [`SIGMA_COLUMNS`], bias estimates.
-pub const FUSE_COLUMNS: [&str; 29] = concat_columns(
+/// Columns of a fused estimate: [`NAV_COLUMNS`], [`SIGMA_COLUMNS`], the bias estimates (body
+/// frame) and their one-sigma.
+pub const FUSE_COLUMNS: [&str; 35] = concat_columns(
     concat_columns::<14, 9, 23>(NAV_COLUMNS, SIGMA_COLUMNS),
     [
         "accel_bias_x_m_s2",
@@ -39,6 +40,12 @@ pub const FUSE_COLUMNS: [&str; 29] = concat_columns(
         "gyro_bias_x_rad_s",
         "gyro_bias_y_rad_s",
         "gyro_bias_z_rad_s",
+        "accel_bias_x_sigma_m_s2",
+        "accel_bias_y_sigma_m_s2",
+        "accel_bias_z_sigma_m_s2",
+        "gyro_bias_x_sigma_rad_s",
+        "gyro_bias_y_sigma_rad_s",
+        "gyro_bias_z_sigma_rad_s",
     ],
 );
 
@@ -593,6 +600,7 @@ fn fuse_in<N: NavFrame>(
         row.extend_from_slice(&sig[..9]);
         row.extend_from_slice(&s.accel_bias_m_s2);
         row.extend_from_slice(&s.gyro_bias_rad_s);
+        row.extend_from_slice(&sig[9..]);
         table.push_row(&row);
     }
     table.check_finite("fused navigation")?;
