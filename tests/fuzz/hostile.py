@@ -165,7 +165,7 @@ def cli_cases(rng: random.Random, cases: int) -> list:
         subprocess.run([imukit_bin(), "allan", "imu.csv", "--out", "allan.csv"], cwd=work, check=True, capture_output=True)
         (work / "p.json").write_text(PARAMS)
         valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv")}
-        per = max(1, cases // 6)
+        per = max(1, cases // 7)
 
         r = Run("byte mutations of valid files")
         for k in range(per):
@@ -251,6 +251,44 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                      "--height0-m", x(), "--out", "en.csv"],
                 ]), ["eo.csv", "et.csv"], f"case {k} (navigation)")
             for leftover in ("eo.csv", "et.csv", "en.csv", "eg.csv", "eb.csv", "eod.csv"):
+                (work / leftover).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("fusion and outage studies")
+        for k in range(per):
+            x = lambda: rng.choice(EXTREMES)  # noqa: E731
+            path = rng.choice(["10*t", "60*sin(0.16*t)", "0", "1e7*t"])
+            side = rng.choice(["0", "60*(1 - cos(0.16*t))"])
+            (work / "c.toml").write_text(
+                f'rate_hz = 20.0\nduration_s = {rng.choice(["20", "2", "0"])}\n'
+                f'earth = "{rng.choice(["flat", "flat", "wgs84"])}"\n'
+                'origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 0.0 }\n'
+                f'[trajectory]\ntype = "expression"\nposition_m = ["{path}", "{side}", "0"]\nattitude = "tangent"\n'
+                f'[imu]\nkind = "accel-gyro"\npreset = "{rng.choice(["stim300", "mpu-6050", "ideal"])}"\n'
+                f'[gnss]\nrate_hz = {rng.choice(["5.0", "4.0", x()])}\n'
+                f'horizontal_accuracy_m = {rng.choice(["1.0", x()])}\nlatency_s = {rng.choice(["0.0", "0.2", x()])}\n'
+                f'outages = [{{ start_s = {rng.choice(["5.0", x()])}, duration_s = {rng.choice(["5.0", x()])} }}]\n'
+                f'[odometer]\nrate_hz = 10.0\nnoise_m_s = {rng.choice(["0.05", x()])}\n')
+            made = ["ci.csv", "ct.csv", "cg.csv", "co.csv"]
+            run_cli(r, work, ["simulate", "c.toml", "--out", "ci.csv", "--truth", "ct.csv", "--gnss", "cg.csv",
+                              "--odometer", "co.csv"], ["c.toml"], f"case {k}")
+            if all((work / f).exists() for f in made):
+                (work / "cgm.csv").write_bytes(mutate(rng, (work / "cg.csv").read_bytes()))
+                start = rng.choice([["--init", "ct.csv"], ["--align", rng.choice(["gnss", "static", "x"])], [],
+                                    ["--init", "ct.csv", "--align", "gnss"]])
+                extra = rng.choice([[], ["--odometer", "co.csv"], ["--nhc"], ["--nhc", x()],
+                                    ["--covariance-interval-s", x()], ["--no-gate"], ["--baro", "co.csv"],
+                                    ["--earth", rng.choice(["flat", "wgs84", "mars"])]])
+                run_cli(r, work, ["fuse", "ci.csv", rng.choice(["cg.csv", "cgm.csv"]), *start, "--scenario", "c.toml",
+                                  *extra, "--out", "cn.csv"], [*made, "cgm.csv", "c.toml"], f"case {k} (fusion)")
+                presets = rng.choice(['"stim300"', "", '"nosuch"', '"hg1700", "hg1700"', '"ideal", "mpu-6050"'])
+                (work / "st.toml").write_text(
+                    f'scenario = "c.toml"\npresets = [{presets}]\nruns = {rng.choice(["2", "0", "1", "-1", "1e9", "100001"])}\n'
+                    f'nhc_sigma_m_s = {rng.choice(["0.05", x()])}\nodometer = {rng.choice(["true", "false"])}\n')
+                run_cli(r, work, ["study", "st.toml", "--out", "sn.csv",
+                                  *rng.choice([[], ["--plot", "sn.png"], ["--plot", "sn.gif"]])],
+                        ["st.toml", "c.toml"], f"case {k} (study)")
+            for leftover in (*made, "cgm.csv", "cn.csv", "st.toml", "sn.csv", "sn.png"):
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 

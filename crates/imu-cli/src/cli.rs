@@ -177,9 +177,11 @@ pub enum Command {
         /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.
         #[arg(long)]
         scenario: PathBuf,
-        /// `flat` (the only one so far).
-        #[arg(long, default_value = "flat")]
-        earth: String,
+        /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
+        /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
+        /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.
+        #[arg(long)]
+        earth: Option<String>,
         /// Apply every fix (no chi-square innovation gate).
         #[arg(long)]
         no_gate: bool,

@@ -1100,11 +1100,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
     assert!(rms < 1.0, "{report}");
     std::fs::remove_file(dir.join("nav.csv")).unwrap();
     for (out, extra, needle) in [
-        (
-            "nav.csv",
-            vec!["--earth", "wgs84"],
-            "fusion runs on the flat Earth so far",
-        ),
+        ("nav.csv", vec!["--earth", "wgs84"], "is on the flat Earth"),
         ("imu.csv", vec![], "--out"),
     ] {
         let (code, err) = fuse_to(out, &extra);
@@ -1412,4 +1408,94 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
         }
         assert!(!dir.join("nav.csv").exists());
     }
+}
+
+#[test]
+fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
+    let dir = temp_dir("fuse-earth");
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 100.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }\n\
+         [trajectory]\ntype = \"expression\"\n\
+         position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]\nattitude = \"tangent\"\n\
+         [imu]\nkind = \"accel-gyro\"\npreset = \"stim300\"\n\
+         [gnss]\nrate_hz = 5.0\ndecay_factor = 0.0\nhorizontal_accuracy_m = 1.0\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "fuse",
+            "imu.csv",
+            "gnss.csv",
+            "--init",
+            "truth.csv",
+            "--scenario",
+            "s.toml",
+            "--out",
+            "nav.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let header = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    assert!(
+        header
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",lat_rad,lon_rad,height_m"),
+        "{}",
+        header.lines().next().unwrap()
+    );
+    let out = imukit()
+        .current_dir(&dir)
+        .args(["compare", "truth.csv", "nav.csv"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8(out.stdout).unwrap();
+    let rms: f64 = report
+        .lines()
+        .find(|l| l.starts_with("position"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    assert!(rms < 1.0, "{report}");
+    // Flat fixes given for an Earth scenario are refused by column.
+    std::fs::write(
+        dir.join("flat.csv"),
+        "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n0,0,0,0,0,0,0\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        &dir,
+        &[
+            "fuse",
+            "imu.csv",
+            "flat.csv",
+            "--init",
+            "truth.csv",
+            "--scenario",
+            "s.toml",
+            "--out",
+            "nav2.csv",
+        ],
+    );
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("flat.csv") && err.contains("lat_rad"), "{err}");
+    assert!(!dir.join("nav2.csv").exists());
 }

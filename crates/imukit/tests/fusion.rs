@@ -50,6 +50,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
     let sim = simulate(&text, 0);
     let setup = FuseSetup {
         nav_frame: NavFrameName::ENU,
+        earth: None,
         accel_sign: imu_core::AccelSign::SpecificForce,
         gravity_m_s2: 9.81,
         noise: EskfNoise {
@@ -543,5 +544,114 @@ fn aligned_from_gnss_the_filter_starts_without_truth_and_converges() {
             let s = col(&nav, &format!("pos_{axis}_sigma_m"))[i];
             assert!(e.abs() < 3.0 * s, "run {run}, {axis}: {e} vs σ {s}");
         }
+    }
+}
+
+/// The car of [`scenario`] on the WGS-84 Earth at 45° N (its circle in the tangent plane), in
+/// frame `frame`.
+fn earth_scenario(frame: &str, imu: &str, gnss: &str) -> String {
+    scenario(imu, gnss)
+        .replace(
+            "nav_frame = \"ENU\"\n",
+            &format!(
+                "nav_frame = \"{frame}\"\nearth = \"wgs84\"\n\
+                 origin = {{ latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }}\n"
+            ),
+        )
+        .replace(
+            "2*sin(0.1*t)",
+            if frame == "NED" {
+                "-2*sin(0.1*t)"
+            } else {
+                "2*sin(0.1*t)"
+            },
+        )
+}
+
+#[test]
+fn on_the_earth_ideal_sensors_and_exact_fixes_reproduce_the_truth() {
+    // The Earth filter (Earth rate, transport rate, Coriolis, normal gravity) on the car at
+    // 45° N, both frames: with ideal readings and exact fixes it stays on the truth.
+    for frame in ["ENU", "NED"] {
+        let text = earth_scenario(
+            frame,
+            "",
+            "horizontal_accuracy_m = 0.0\nvertical_accuracy_m = 0.0\nvelocity_accuracy_m_s = 0.0",
+        );
+        let sim = simulate(&text, 0);
+        let sc = ScenarioSpec::from_toml(&text, "earth.toml")
+            .unwrap()
+            .resolve(Path::new("."))
+            .unwrap();
+        let mut setup = FuseSetup::from_scenario(&sc).unwrap();
+        assert!(setup.earth.is_some());
+        setup.gate = f64::INFINITY;
+        let initial = InitialState::from_table(&sim.truth).unwrap();
+        let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+        assert_eq!(summary.updates, 201);
+        assert_eq!(nav.columns.len(), 38);
+        let worst = |a: &str, b: &str| {
+            col(&sim.truth, a)
+                .iter()
+                .zip(col(&nav, b))
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0_f64, f64::max)
+        };
+        let pos = ["pos_x_m", "pos_y_m", "pos_z_m"].map(|c| worst(c, c));
+        let lat = worst("lat_rad", "lat_rad") * 6.4e6;
+        eprintln!("{frame}: worst position error {pos:?} m, latitude {lat:e} m");
+        assert!(pos.iter().all(|e| *e < 5e-3), "{frame}: {pos:?}");
+        assert!(lat < 5e-3, "{frame}: {lat}");
+        assert!(worst("yaw_rad", "yaw_rad") < 1e-4, "{frame}");
+    }
+}
+
+#[test]
+fn on_the_earth_the_errors_match_the_stated_uncertainty_over_50_runs() {
+    // The noisy car at 45° N (IMU white noise and bias random walk, white fixes): at 40 s the
+    // position and velocity errors, normalised by the filter's one-sigma per axis and squared,
+    // average to 1 within the two-sided 95 % bounds of χ²(3·50)/(3·50).
+    let (n_a, n_g, k_a, k_g) = (0.003, 2e-4, 2e-4, 2e-6);
+    let text = earth_scenario(
+        "ENU",
+        &format!(
+            "[imu.accelerometer]\nNoiseDensity = {n_a}\nRandomWalk = {k_a}\n\
+             [imu.gyroscope]\nNoiseDensity = {n_g}\nRandomWalk = {k_g}"
+        ),
+        "horizontal_accuracy_m = 0.8\nvertical_accuracy_m = 1.2\nvelocity_accuracy_m_s = 0.05\n\
+         decay_factor = 0.0",
+    );
+    let sc = ScenarioSpec::from_toml(&text, "earth.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    let runs = 50;
+    let mut sums = [0.0; 2];
+    for run in 0..runs {
+        let sim = sc.simulate_run(run).unwrap();
+        let initial = InitialState::from_table(&sim.truth).unwrap();
+        let (nav, _) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+        let last = nav.rows() - 1;
+        for (k, (quantity, unit)) in [("pos", "m"), ("vel", "m_s")].iter().enumerate() {
+            for axis in ["x", "y", "z"] {
+                let c = format!("{quantity}_{axis}_{unit}");
+                let e = col(&nav, &c)[last] - col(&sim.truth, &c)[last];
+                let s = col(&nav, &format!("{quantity}_{axis}_sigma_{unit}"))[last];
+                sums[k] += (e / s).powi(2);
+            }
+        }
+    }
+    let dof = 3.0 * runs as f64;
+    let (lo, hi) = (
+        chi2_quantile(dof, -1.959_964) / dof,
+        chi2_quantile(dof, 1.959_964) / dof,
+    );
+    let averages = sums.map(|s| s / dof);
+    eprintln!(
+        "on the Earth: normalised squared errors {averages:?}, 95 % bounds [{lo:.3}, {hi:.3}]"
+    );
+    for (name, v) in ["position", "velocity"].iter().zip(averages) {
+        assert!(lo <= v && v <= hi, "{name}: {v} outside [{lo}, {hi}]");
     }
 }

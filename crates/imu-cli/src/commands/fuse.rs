@@ -17,7 +17,7 @@ pub struct Args<'a> {
     pub init: Option<&'a Path>,
     pub align: Option<&'a str>,
     pub scenario: &'a Path,
-    pub earth: &'a str,
+    pub earth: Option<&'a str>,
     pub no_gate: bool,
     pub odometer: Option<&'a Path>,
     pub baro: Option<&'a Path>,
@@ -27,16 +27,6 @@ pub struct Args<'a> {
 }
 
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
-    if a.earth != "flat" {
-        return Err(Error::Invalid {
-            field: "--earth".into(),
-            message: format!(
-                "\"{}\": fusion runs on the flat Earth so far (the WGS-84 filter is the next step)",
-                a.earth
-            ),
-        }
-        .into());
-    }
     let mut inputs = vec![
         ("IMU file", a.imu),
         ("GNSS file", a.gnss),
@@ -49,6 +39,25 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let base = a.scenario.parent().unwrap_or_else(|| Path::new("."));
     let scenario = ScenarioSpec::from_file(a.scenario)?.resolve(base)?;
     let mut setup = FuseSetup::from_scenario(&scenario)?;
+    // The scenario says which Earth; --earth, when given, must agree.
+    let earth = if setup.earth.is_some() {
+        "wgs84"
+    } else {
+        "flat"
+    };
+    if let Some(e) = a.earth
+        && e != earth
+    {
+        return Err(Error::Invalid {
+            field: "--earth".into(),
+            message: format!(
+                "\"{e}\": the scenario {} is on the {earth} Earth, and the filter takes its model \
+                 from it",
+                a.scenario.display()
+            ),
+        }
+        .into());
+    }
     if a.no_gate {
         setup.gate = f64::INFINITY;
     }

@@ -109,7 +109,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             init: init.as_deref(),
             align: align.as_deref(),
             scenario: &scenario,
-            earth: &earth,
+            earth: earth.as_deref(),
             no_gate,
             odometer: odometer.as_deref(),
             baro: baro.as_deref(),

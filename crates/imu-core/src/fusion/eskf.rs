@@ -22,8 +22,8 @@ use crate::math;
 use crate::rotation::Rotation;
 use crate::vector::Vec3;
 
-type Mat15 = SMatrix<f64, 15, 15>;
-type Vec15 = SVector<f64, 15>;
+pub(crate) type Mat15 = SMatrix<f64, 15, 15>;
+pub(crate) type Vec15 = SVector<f64, 15>;
 
 /// Continuous-time noise of the IMU as the filter models it (per axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,11 +141,11 @@ impl core::fmt::Display for EskfError {
 
 impl core::error::Error for EskfError {}
 
-fn sq(x: f64) -> f64 {
+pub(crate) fn sq(x: f64) -> f64 {
     x * x
 }
 
-fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
+pub(crate) fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
     nalgebra::Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
@@ -460,59 +460,23 @@ impl<N: NavFrame> Eskf<N> {
         if !(age_s.is_finite() && age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
         }
-        let c = self.q.to_rotation_matrix().into_inner();
-        let l = *lever_arm_m.as_nalgebra();
-        let cl = c * l;
-        let w = self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg;
-        let cwl = c * w.cross(&l);
-        let f = self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba;
-        let cf = c * f;
-        let accel = cf + self.g;
-        let z_p = *position_m.as_nalgebra()
-            - (self.p + cl - (self.v + cwl) * age_s + accel * (0.5 * age_s * age_s));
-        let mut finite = z_p.iter().all(|v| v.is_finite());
-        let mut h = SMatrix::<f64, 6, 15>::zeros();
-        let mut y = SVector::<f64, 6>::zeros();
-        let mut r = SVector::<f64, 6>::zeros();
-        h.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&nalgebra::Matrix3::identity());
-        h.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(nalgebra::Matrix3::identity() * -age_s));
-        h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
-        y.fixed_rows_mut::<3>(0).copy_from(&z_p);
-        for i in 0..3 {
-            r[i] = sq(position_sigma_m[i]);
-        }
-        let m = if let Some(vm) = velocity_m_s {
-            let z_v = *vm.as_nalgebra() - (self.v + cwl - accel * age_s);
-            finite &= z_v.iter().all(|v| v.is_finite());
-            h.fixed_view_mut::<3, 3>(3, 3)
-                .copy_from(&nalgebra::Matrix3::identity());
-            h.fixed_view_mut::<3, 3>(3, 6)
-                .copy_from(&(-skew(&cwl) + skew(&cf) * age_s));
-            h.fixed_view_mut::<3, 3>(3, 9).copy_from(&(c * age_s));
-            h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
-            y.fixed_rows_mut::<3>(3).copy_from(&z_v);
-            for i in 0..3 {
-                r[3 + i] = sq(velocity_sigma_m_s[i]);
-            }
-            6
-        } else {
-            3
+        let lin = Linearisation {
+            c: self.q.to_rotation_matrix().into_inner(),
+            v: self.v,
+            w_body: self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg,
+            f_body: self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba,
+            g: self.g,
         };
-        let all_sigma = position_sigma_m
-            .iter()
-            .chain(&velocity_sigma_m_s)
-            .all(|s| s.is_finite() && *s > 0.0);
-        if !(finite && all_sigma) {
-            return Err(EskfError::NotFinite { index });
-        }
-        // Only the first m rows are used.
-        for i in m..6 {
-            h.row_mut(i).fill(0.0);
-            y[i] = 0.0;
-            r[i] = 1.0;
-        }
+        let delta_p = *position_m.as_nalgebra() - self.p;
+        let (h, y, r) = gnss_model(
+            &lin,
+            delta_p,
+            velocity_m_s.map(|v| *v.as_nalgebra()),
+            *lever_arm_m.as_nalgebra(),
+            [position_sigma_m, velocity_sigma_m_s],
+            age_s,
+            index,
+        )?;
         self.correct(&h, &y, &r, gate, index)
     }
 
@@ -587,30 +551,14 @@ impl<N: NavFrame> Eskf<N> {
         index: usize,
     ) -> Result<UpdateOutcome, EskfError> {
         self.step_covariance();
-        let rm = SMatrix::<f64, M, M>::from_diagonal(r);
-        let s = h * self.cov * h.transpose() + rm;
-        let Some(s_inv) = s.try_inverse() else {
-            return Err(EskfError::Diverged { index });
-        };
-        let nis = (y.transpose() * s_inv * y)[(0, 0)];
-        if !nis.is_finite() || nis < 0.0 {
-            return Err(EskfError::Diverged { index });
-        }
-        if nis > gate {
+        let (nis, dx) = kalman_update(&mut self.cov, h, y, r, gate, index)?;
+        let Some(dx) = dx else {
             self.rejected += 1;
             return Ok(UpdateOutcome {
                 nis,
                 accepted: false,
             });
-        }
-        let k = self.cov * h.transpose() * s_inv;
-        let dx = k * y;
-        let ikh = Mat15::identity() - k * h;
-        self.cov = ikh * self.cov * ikh.transpose() + k * rm * k.transpose();
-        self.cov = (self.cov + self.cov.transpose()) * 0.5;
-        if (0..15).any(|i| self.cov[(i, i)].is_nan() || self.cov[(i, i)] < 0.0) {
-            return Err(EskfError::Diverged { index });
-        }
+        };
         // Closed loop: inject and reset.
         self.p += dx.fixed_rows::<3>(0);
         self.v += dx.fixed_rows::<3>(3);
@@ -624,4 +572,112 @@ impl<N: NavFrame> Eskf<N> {
             accepted: true,
         })
     }
+}
+
+/// What a measurement model needs of the nominal state: `Ĉ` (body to navigation), the
+/// velocity, the bias-corrected body rate and specific force of the last sample, and gravity.
+pub(crate) struct Linearisation {
+    pub(crate) c: nalgebra::Matrix3<f64>,
+    pub(crate) v: Vector3<f64>,
+    pub(crate) w_body: Vector3<f64>,
+    pub(crate) f_body: Vector3<f64>,
+    pub(crate) g: Vector3<f64>,
+}
+
+/// A GNSS fix's measurement model: `H` (6 × 15), innovation `y` and variances `r`.
+pub(crate) type GnssRows = (SMatrix<f64, 6, 15>, SVector<f64, 6>, SVector<f64, 6>);
+
+/// The GNSS measurement model shared by the flat and the Earth filters: `delta_p` is the fix's
+/// position minus the nominal position in local navigation-frame metres; the antenna at lever
+/// arm `l`, the fix valid `age_s` earlier (see [`Eskf::update_gnss_fix`]); `sigmas` are the
+/// position and velocity one-sigmas. Returns `(H, y, r)` with unused velocity rows inert.
+pub(crate) fn gnss_model(
+    lin: &Linearisation,
+    delta_p: Vector3<f64>,
+    velocity_m_s: Option<Vector3<f64>>,
+    l: Vector3<f64>,
+    sigmas: [[f64; 3]; 2],
+    age_s: f64,
+    index: usize,
+) -> Result<GnssRows, EskfError> {
+    let c = lin.c;
+    let cl = c * l;
+    let cwl = c * lin.w_body.cross(&l);
+    let cf = c * lin.f_body;
+    let accel = cf + lin.g;
+    let z_p = delta_p - (cl - (lin.v + cwl) * age_s + accel * (0.5 * age_s * age_s));
+    let mut finite = z_p.iter().all(|v| v.is_finite());
+    let mut h = SMatrix::<f64, 6, 15>::zeros();
+    let mut y = SVector::<f64, 6>::zeros();
+    let mut r = SVector::<f64, 6>::repeat(1.0);
+    h.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&nalgebra::Matrix3::identity());
+    h.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(nalgebra::Matrix3::identity() * -age_s));
+    h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
+    y.fixed_rows_mut::<3>(0).copy_from(&z_p);
+    for i in 0..3 {
+        r[i] = sq(sigmas[0][i]);
+    }
+    if let Some(vm) = velocity_m_s {
+        let z_v = vm - (lin.v + cwl - accel * age_s);
+        finite &= z_v.iter().all(|v| v.is_finite());
+        h.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&nalgebra::Matrix3::identity());
+        h.fixed_view_mut::<3, 3>(3, 6)
+            .copy_from(&(-skew(&cwl) + skew(&cf) * age_s));
+        h.fixed_view_mut::<3, 3>(3, 9).copy_from(&(c * age_s));
+        h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
+        y.fixed_rows_mut::<3>(3).copy_from(&z_v);
+        for i in 0..3 {
+            r[3 + i] = sq(sigmas[1][i]);
+        }
+    }
+    let all_sigma = sigmas[0]
+        .iter()
+        .chain(&sigmas[1])
+        .all(|s| s.is_finite() && *s > 0.0);
+    if !(finite && all_sigma && age_s.is_finite() && age_s >= 0.0) {
+        return Err(EskfError::NotFinite { index });
+    }
+    Ok((h, y, r))
+}
+
+/// The Kalman correction shared by the filters: innovation `y`, model `H`, measurement
+/// variances `r` (rows with `H = 0`, `y = 0`, `r = 1` are inert); the NIS against `gate`
+/// (`None` correction above it); otherwise the Joseph-form covariance, symmetrised, and the
+/// error-state correction `δx` to inject.
+///
+/// # Errors
+/// An innovation covariance that cannot be inverted, or a covariance that loses its positive
+/// diagonal: divergence at update `index`.
+pub(crate) fn kalman_update<const M: usize>(
+    cov: &mut Mat15,
+    h: &SMatrix<f64, M, 15>,
+    y: &SVector<f64, M>,
+    r: &SVector<f64, M>,
+    gate: f64,
+    index: usize,
+) -> Result<(f64, Option<Vec15>), EskfError> {
+    let rm = SMatrix::<f64, M, M>::from_diagonal(r);
+    let s = h * *cov * h.transpose() + rm;
+    let Some(s_inv) = s.try_inverse() else {
+        return Err(EskfError::Diverged { index });
+    };
+    let nis = (y.transpose() * s_inv * y)[(0, 0)];
+    if !nis.is_finite() || nis < 0.0 {
+        return Err(EskfError::Diverged { index });
+    }
+    if nis > gate {
+        return Ok((nis, None));
+    }
+    let k = *cov * h.transpose() * s_inv;
+    let dx = k * y;
+    let ikh = Mat15::identity() - k * h;
+    *cov = ikh * *cov * ikh.transpose() + k * rm * k.transpose();
+    *cov = (*cov + cov.transpose()) * 0.5;
+    if (0..15).any(|i| cov[(i, i)].is_nan() || cov[(i, i)] < 0.0) {
+        return Err(EskfError::Diverged { index });
+    }
+    Ok((nis, Some(dx)))
 }

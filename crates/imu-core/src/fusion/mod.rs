@@ -1,5 +1,8 @@
 //! Fusion of the IMU with aiding sensors: [`eskf`], a loosely coupled error-state Kalman filter
-//! (15 states, fixed-size matrices, no heap) on the flat-Earth mechanization.
+//! (15 states, fixed-size matrices, no heap) on the flat-Earth mechanization, and [`earth`], the
+//! same filter on the WGS-84 Earth's mechanization.
+pub mod earth;
 pub mod eskf;
 
+pub use earth::{EarthEskf, EarthEskfState, EarthGnssFix};
 pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome};

@@ -392,6 +392,18 @@ impl EarthIncrements {
         })
     }
 
+    /// Replaces the state (a filter's correction), keeping the previous increments that the
+    /// coning and sculling corrections use.
+    ///
+    /// # Errors
+    /// As [`EarthIncrements::new`].
+    pub fn reset(&mut self, state: &EarthNavState) -> Result<(), StrapdownError> {
+        check_initial(state, &self.options)?;
+        self.state = start(state, self.options.vertical);
+        self.t_s = state.t_s;
+        Ok(())
+    }
+
     /// Advances over the interval ending at `t_s` with the increments `dtheta_rad` (∫ω_ib^b dt)
     /// and `dv_m_s` (∫f^b dt), and the barometric height (baro loop only).
     ///

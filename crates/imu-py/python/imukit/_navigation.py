@@ -120,7 +120,8 @@ def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, 
          odometer: Optional[Table] = None, baro: Optional[Table] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
-    GNSS fixes (``imukit.simulate(...).gnss``), flat Earth. The filter's model comes from
+    GNSS fixes (``imukit.simulate(...).gnss``), on the scenario's Earth (flat, or WGS-84 with
+    geodetic fixes and ``lat_rad, lon_rad, height_m`` added to the output). The filter's model comes from
     ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors, its
     ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. The filter starts from
     ``initial``, a truth Table (its first row), or without truth from ``align="gnss"``: position,

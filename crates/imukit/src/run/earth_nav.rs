@@ -55,7 +55,10 @@ fn plane_origin<N: NavFrame>(position_m: [f64; 3], at: &Geodetic) -> Geodetic {
 }
 
 /// The starting state in NED/FRD from a front end's [`InitialState`] (frame `N`).
-fn start<N: NavFrame>(initial: &InitialState, t0: f64) -> Result<(EarthNavState, Geodetic)> {
+pub(crate) fn start<N: NavFrame>(
+    initial: &InitialState,
+    t0: f64,
+) -> Result<(EarthNavState, Geodetic)> {
     let position = initial.geodetic.ok_or_else(|| {
         invalid(
             "initial state",
@@ -178,40 +181,51 @@ fn trapezoid(t: &[f64], w: &[[f64; 3]], f: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[
 
 /// The output rows in frame `N`.
 fn table<N: NavFrame>(states: &[EarthNavState], origin: &Geodetic) -> Table {
-    let from_ned = N::from_ned();
-    let to_body = frd_to_body::<N>();
-    let r0 = origin.to_ecef();
-    let c_te: Rotation<Ecef, N> = origin.ned_to_ecef().inverse().then(&from_ned);
     let mut table = Table::new(&EARTH_NAV_COLUMNS);
     let mut last_yaw = None;
     for s in states {
-        let attitude: Rotation<Body, N> = to_body.inverse().then(&s.attitude).then(&from_ned);
-        let e = euler_unwrapped(&attitude, &mut last_yaw);
-        let p = c_te.apply(s.position.to_ecef() - r0).to_array();
-        let v = from_ned.apply(s.velocity_m_s).to_array();
-        let q = attitude.to_wxyz();
-        let g = &s.position;
-        table.push_row(&[
-            s.t_s,
-            p[0],
-            p[1],
-            p[2],
-            v[0],
-            v[1],
-            v[2],
-            q[0],
-            q[1],
-            q[2],
-            q[3],
-            e.yaw_rad,
-            e.pitch_rad,
-            e.roll_rad,
-            g.latitude_rad,
-            g.longitude_rad,
-            g.height_m,
-        ]);
+        table.push_row(&row::<N>(s, origin, &mut last_yaw));
     }
     table
+}
+
+/// One output row in frame `N`: [`EARTH_NAV_COLUMNS`] of state `s`, positions in the tangent
+/// plane at `origin`, the yaw unwrapped from the previous row's.
+pub(crate) fn row<N: NavFrame>(
+    s: &EarthNavState,
+    origin: &Geodetic,
+    last_yaw: &mut Option<f64>,
+) -> [f64; 17] {
+    let from_ned = N::from_ned();
+    let to_body = frd_to_body::<N>();
+    let c_te: Rotation<Ecef, N> = origin.ned_to_ecef().inverse().then(&from_ned);
+    let attitude: Rotation<Body, N> = to_body.inverse().then(&s.attitude).then(&from_ned);
+    let e = euler_unwrapped(&attitude, last_yaw);
+    let p = c_te
+        .apply(s.position.to_ecef() - origin.to_ecef())
+        .to_array();
+    let v = from_ned.apply(s.velocity_m_s).to_array();
+    let q = attitude.to_wxyz();
+    let g = &s.position;
+    [
+        s.t_s,
+        p[0],
+        p[1],
+        p[2],
+        v[0],
+        v[1],
+        v[2],
+        q[0],
+        q[1],
+        q[2],
+        q[3],
+        e.yaw_rad,
+        e.pitch_rad,
+        e.roll_rad,
+        g.latitude_rad,
+        g.longitude_rad,
+        g.height_m,
+    ]
 }
 
 /// Reads an IMU CSV file whole, refused before reading when it could exceed the memory budget

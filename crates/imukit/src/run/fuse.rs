@@ -54,6 +54,9 @@ pub const FUSE_COLUMNS: [&str; 35] = concat_columns(
 pub struct FuseSetup {
     /// Navigation frame of the tables.
     pub nav_frame: NavFrameName,
+    /// `None`: the flat Earth; on the WGS-84 Earth its gravity model (the fixes are then
+    /// geodetic and the Earth filter runs, see [`crate::run::fuse_earth`]).
+    pub earth: Option<imu_core::earth::GravityModel>,
     /// Sign of the accelerometer columns.
     pub accel_sign: AccelSign,
     /// Gravity magnitude, m/s².
@@ -277,9 +280,46 @@ pub fn fuse_with(
     start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    match setup.nav_frame {
-        NavFrameName::ENU => fuse_in::<Enu>(imu, gnss, aids, start, setup),
-        NavFrameName::NED => fuse_in::<Ned>(imu, gnss, aids, start, setup),
+    use crate::run::fuse_earth::fuse_earth_in;
+    match (setup.nav_frame, setup.earth) {
+        (NavFrameName::ENU, None) => fuse_in::<Enu>(imu, gnss, aids, start, setup),
+        (NavFrameName::NED, None) => fuse_in::<Ned>(imu, gnss, aids, start, setup),
+        (NavFrameName::ENU, Some(g)) => fuse_earth_in::<Enu>(imu, gnss, aids, start, setup, g),
+        (NavFrameName::NED, Some(g)) => fuse_earth_in::<Ned>(imu, gnss, aids, start, setup, g),
+    }
+}
+
+/// GNSS stamps: finite, increasing, inside the IMU's span `[t0, t1]` (the row named).
+pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64)) -> Result<()> {
+    for (k, &tk) in g_t.iter().enumerate() {
+        if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
+            return Err(invalid(
+                "GNSS data",
+                format!("row {}: times must be finite and increase", k + 2),
+            ));
+        }
+        if tk < t0 || tk > t1 {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The divergence report after [`MAX_REJECTED_IN_A_ROW`] fixes rejected one after another.
+pub(crate) fn rejected_in_a_row_error(row: usize, nis: f64, gate: f64) -> Error {
+    Error::Diverged {
+        context: "GNSS data".into(),
+        message: format!(
+            "row {row}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation gate \
+             (the last with NIS {nis:.1} against {gate:.1}): the filter has lost the fixes or the \
+             fixes have jumped; nothing is written"
+        ),
     }
 }
 
@@ -361,23 +401,7 @@ fn fuse_in<N: NavFrame>(
         t.first().copied().unwrap_or(0.0),
         t.last().copied().unwrap_or(0.0),
     );
-    for (k, &tk) in g_t.iter().enumerate() {
-        if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
-            return Err(invalid(
-                "GNSS data",
-                format!("row {}: times must be finite and increase", k + 2),
-            ));
-        }
-        if tk < t0 || tk > t1 {
-            return Err(invalid(
-                "GNSS data",
-                format!(
-                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
-                    k + 2
-                ),
-            ));
-        }
-    }
+    check_fix_times(&g_t, (t0, t1))?;
     let span = (t0, t1);
     let (odo_t, odo_v) = match (aids.odometer, setup.aiding.odometer) {
         (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
@@ -524,17 +548,11 @@ fn fuse_in<N: NavFrame>(
                 rejected_in_a_row + 1
             };
             if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
-                return Err(Error::Diverged {
-                    context: "GNSS data".into(),
-                    message: format!(
-                        "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
-                         gate (the last with NIS {:.1} against {:.1}): the filter has lost the \
-                         fixes or the fixes have jumped; nothing is written",
-                        next_fix + 2,
-                        outcome.nis,
-                        setup.gate
-                    ),
-                });
+                return Err(rejected_in_a_row_error(
+                    next_fix + 2,
+                    outcome.nis,
+                    setup.gate,
+                ));
             }
             next_fix += 1;
         }
@@ -666,7 +684,7 @@ impl FuseSetup {
     /// is stepped every [`DEFAULT_COVARIANCE_INTERVAL_S`].
     ///
     /// # Errors
-    /// A scenario without `[gnss]`, or on the WGS-84 Earth (fusion there is not implemented yet).
+    /// A scenario without `[gnss]`.
     pub fn from_scenario(scenario: &crate::Scenario) -> Result<Self> {
         use imu_core::aiding::PositionNoise;
         let gnss = scenario.gnss.as_ref().ok_or_else(|| {
@@ -675,12 +693,10 @@ impl FuseSetup {
                 "has no [gnss] receiver: the filter takes the fixes' accuracy from it",
             )
         })?;
-        if !matches!(scenario.earth, crate::scenario::EarthSetup::Flat) {
-            return Err(invalid(
-                "earth",
-                "fusion on the WGS-84 Earth is not implemented yet; fuse on the flat Earth",
-            ));
-        }
+        let earth = match &scenario.earth {
+            crate::scenario::EarthSetup::Flat => None,
+            crate::scenario::EarthSetup::Wgs84(plane) => Some(plane.gravity),
+        };
         let rate = scenario.sample_rate_hz;
         let p = &scenario.imu.sensors.params;
         let (accel_psd, accel_bias_psd) = triad_psd(&p.accelerometer, rate);
@@ -699,6 +715,7 @@ impl FuseSetup {
         let max_abs = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
         Ok(Self {
             nav_frame: scenario.nav_frame,
+            earth,
             accel_sign: scenario.imu.accel_sign,
             gravity_m_s2: scenario.gravity_m_s2,
             noise: EskfNoise {

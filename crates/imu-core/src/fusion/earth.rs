@@ -1,0 +1,392 @@
+//! The error-state filter on the WGS-84 Earth: the same 15 error states as [`super::eskf`] —
+//! position (local NED metres), velocity (NED), attitude (a small rotation φ of the NED frame,
+//! `C_true = (I + [φ×]) Ĉ`), accelerometer and gyroscope biases (FRD body) — around the
+//! Earth mechanization of [`crate::strapdown::earth`] (Earth rate, transport rate, Coriolis,
+//! normal gravity; increments by the trapezoid of each interval's rate samples, coning and
+//! sculling corrections).
+//!
+//! Error dynamics (Groves 2nd ed. §14.2.4, local-navigation frame, with the position error in
+//! metres): `δṗ = δv`; `δv̇ = −[f^n×]φ − Ĉ δb_a − [(2ω_ie + ω_en)×] δv + δg`, the gravity
+//! gradient `δg = (−γ/R δp_N, −γ/R δp_E, 2γ/R δp_D)` giving the Schuler oscillation and the
+//! vertical channel's instability; `φ̇ = −[ω_in×]φ − Ĉ δb_g − δω_in`, where
+//! `δω_in = ∂ω_en/∂v δv + ∂ω_ie/∂φ δp_N/(R_N + h)`. `Φ = I + FΔt + (FΔt)²/2` (dense),
+//! `Q_d = ½(Φ Q Φᵀ + Q)Δt`. GNSS updates as the flat filter's, their position innovation in NED
+//! metres: `((φ_m − φ̂)(R_N + h), (λ_m − λ̂)(R_E + h) cos φ, −(h_m − ĥ))`. Corrections are
+//! injected into latitude, longitude and height through the same radii.
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+use super::eskf::{
+    EskfError, EskfNoise, InitialSigma, Linearisation, Mat15, UpdateOutcome, Vec15, gnss_model,
+    kalman_update, skew, sq,
+};
+use crate::earth::rates::{earth_rate_ned, transport_rate_ned};
+use crate::earth::wgs84::OMEGA_IE_RAD_S;
+use crate::earth::{Geodetic, GravityModel};
+use crate::frame::{Body, Ned};
+use crate::math;
+use crate::rotation::Rotation;
+use crate::strapdown::earth::{EarthIncrements, EarthNavState, EarthOptions, VerticalChannel};
+use crate::vector::Vec3;
+
+/// The Earth filter's estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthEskfState {
+    /// Time, attitude `C_nb` (FRD body to local NED), NED velocity and geodetic position.
+    pub nav: EarthNavState,
+    /// Accelerometer bias, FRD body, m/s².
+    pub accel_bias_m_s2: [f64; 3],
+    /// Gyroscope bias, FRD body, rad/s.
+    pub gyro_bias_rad_s: [f64; 3],
+}
+
+/// One GNSS fix on the Earth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthGnssFix {
+    /// Antenna position.
+    pub position: Geodetic,
+    /// Antenna ground velocity, NED, m/s (`None`: position only).
+    pub velocity_m_s: Option<Vec3<Ned>>,
+    /// Antenna lever arm, FRD body, m.
+    pub lever_arm_m: Vec3<Body>,
+    /// Position one-sigma north, east, down, m.
+    pub position_sigma_m: [f64; 3],
+    /// Velocity one-sigma per axis, m/s.
+    pub velocity_sigma_m_s: [f64; 3],
+    /// How long before the filter's time the fix was valid, s (≥ 0).
+    pub age_s: f64,
+}
+
+/// The error-state filter on the WGS-84 Earth.
+#[derive(Clone, Copy, Debug)]
+pub struct EarthEskf {
+    mechanization: EarthIncrements,
+    nav: EarthNavState,
+    ba: Vector3<f64>,
+    bg: Vector3<f64>,
+    cov: Mat15,
+    noise: EskfNoise,
+    gravity: GravityModel,
+    last: Option<(Vector3<f64>, Vector3<f64>)>,
+    covariance_interval_s: f64,
+    /// Since the last covariance step: its length, `∫ Ĉ f̂ dt` and `∫ Ĉ dt`.
+    pending: (f64, Vector3<f64>, Matrix3<f64>),
+    samples: usize,
+    updates: usize,
+    rejected: usize,
+}
+
+impl EarthEskf {
+    /// A filter at `initial` (biases zero) with `sigma` initial uncertainty (position in
+    /// metres on each NED axis), the IMU `noise` and `gravity`.
+    ///
+    /// # Errors
+    /// Non-finite state, a latitude beyond ±89.9°, sigmas or noise that are negative or not
+    /// finite.
+    pub fn new(
+        initial: &EarthNavState,
+        sigma: &InitialSigma,
+        noise: EskfNoise,
+        gravity: GravityModel,
+    ) -> Result<Self, EskfError> {
+        let options = EarthOptions {
+            gravity,
+            vertical: VerticalChannel::Free,
+            ..EarthOptions::default()
+        };
+        let mechanization = EarthIncrements::new(initial, options)
+            .map_err(|_| EskfError::NotFinite { index: 0 })?;
+        let ok = |field, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(EskfError::BadParameter { field })
+            }
+        };
+        ok("accel_psd", noise.accel_psd)?;
+        ok("gyro_psd", noise.gyro_psd)?;
+        ok("accel_bias_psd", noise.accel_bias_psd)?;
+        ok("gyro_bias_psd", noise.gyro_bias_psd)?;
+        let mut diag = Vec15::zeros();
+        for i in 0..3 {
+            diag[i] = sq(ok("position sigma", sigma.position_m)?);
+            diag[3 + i] = sq(ok("velocity sigma", sigma.velocity_m_s)?);
+            diag[6 + i] = sq(ok("attitude sigma", sigma.attitude_rad[i])?);
+            diag[9 + i] = sq(ok("accelerometer bias sigma", sigma.accel_bias_m_s2)?);
+            diag[12 + i] = sq(ok("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
+        }
+        Ok(Self {
+            mechanization,
+            nav: *initial,
+            ba: Vector3::zeros(),
+            bg: Vector3::zeros(),
+            cov: Mat15::from_diagonal(&diag),
+            noise,
+            gravity,
+            last: None,
+            covariance_interval_s: 0.0,
+            pending: (0.0, Vector3::zeros(), Matrix3::zeros()),
+            samples: 0,
+            updates: 0,
+            rejected: 0,
+        })
+    }
+
+    /// As [`super::Eskf::with_covariance_interval`].
+    ///
+    /// # Errors
+    /// An interval that is negative or not finite.
+    pub fn with_covariance_interval(mut self, interval_s: f64) -> Result<Self, EskfError> {
+        if !(interval_s.is_finite() && interval_s >= 0.0) {
+            return Err(EskfError::BadParameter {
+                field: "covariance interval",
+            });
+        }
+        self.covariance_interval_s = interval_s;
+        Ok(self)
+    }
+
+    /// The current estimate.
+    #[must_use]
+    pub fn state(&self) -> EarthEskfState {
+        EarthEskfState {
+            nav: self.nav,
+            accel_bias_m_s2: self.ba.into(),
+            gyro_bias_rad_s: self.bg.into(),
+        }
+    }
+
+    /// One-sigma of the 15 error states: position north, east, down (m), velocity (NED),
+    /// attitude (NED axes), accelerometer bias, gyroscope bias (FRD).
+    #[must_use]
+    pub fn sigmas(&self) -> [f64; 15] {
+        core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
+    }
+
+    /// The error covariance entry `(i, j)`.
+    #[must_use]
+    pub fn covariance(&self, i: usize, j: usize) -> f64 {
+        self.cov[(i, j)]
+    }
+
+    /// Updates applied and rejected by the gate.
+    #[must_use]
+    pub fn update_counts(&self) -> (usize, usize) {
+        (self.updates, self.rejected)
+    }
+
+    /// Takes IMU sample `(t_s, gyro, accel)` (FRD body, rad/s and specific force m/s²): the
+    /// first sets the start, each later one advances the mechanization over the interval with
+    /// the trapezoid of the two samples, biases removed.
+    ///
+    /// # Errors
+    /// Non-finite values, a time that does not increase, a latitude beyond ±89.9°.
+    pub fn propagate(
+        &mut self,
+        t_s: f64,
+        gyro_rad_s: [f64; 3],
+        accel_m_s2: [f64; 3],
+    ) -> Result<(), EskfError> {
+        let index = self.samples;
+        let finite = [t_s]
+            .iter()
+            .chain(&gyro_rad_s)
+            .chain(&accel_m_s2)
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(EskfError::NotFinite { index });
+        }
+        let (w1, f1) = (Vector3::from(gyro_rad_s), Vector3::from(accel_m_s2));
+        let Some((w0, f0)) = self.last else {
+            self.last = Some((w1, f1));
+            self.samples += 1;
+            return Ok(());
+        };
+        let dt = t_s - self.nav.t_s;
+        if dt.is_nan() || dt <= 0.0 {
+            return Err(EskfError::TimeNotIncreasing { index });
+        }
+        let w = 0.5 * (w0 + w1) - self.bg;
+        let f = 0.5 * (f0 + f1) - self.ba;
+        let c0 = self
+            .nav
+            .attitude
+            .quaternion()
+            .to_rotation_matrix()
+            .into_inner();
+        self.nav = self
+            .mechanization
+            .step(t_s, (w * dt).into(), (f * dt).into(), 0.0)
+            .map_err(|_| EskfError::NotFinite { index })?;
+        let c1 = self
+            .nav
+            .attitude
+            .quaternion()
+            .to_rotation_matrix()
+            .into_inner();
+        let c = (c0 + c1) * 0.5;
+        self.pending.0 += dt;
+        self.pending.1 += c * f * dt;
+        self.pending.2 += c * dt;
+        self.last = Some((w1, f1));
+        self.samples += 1;
+        if self.pending.0 >= self.covariance_interval_s * (1.0 - 1e-9) {
+            self.step_covariance();
+        }
+        Ok(())
+    }
+
+    /// One covariance step over the pending interval with the dense transition of the Earth
+    /// error dynamics at the current position and velocity.
+    fn step_covariance(&mut self) {
+        let (dt, cf, cdt) = self.pending;
+        if dt <= 0.0 {
+            return;
+        }
+        self.pending = (0.0, Vector3::zeros(), Matrix3::zeros());
+        let c = cdt / dt;
+        let f_n = cf / dt;
+        let p = &self.nav.position;
+        let v = self.nav.velocity_m_s;
+        let (r_n, r_e) = p.radii_m();
+        let (rho_n, rho_e) = (r_n + p.height_m, r_e + p.height_m);
+        let gamma = self.gravity.magnitude_m_s2(p);
+        let r = math::sqrt(r_n * r_e) + p.height_m;
+        let w_ie = *earth_rate_ned(p).as_nalgebra();
+        let w_en = *transport_rate_ned(p, v).as_nalgebra();
+        let (sin_l, cos_l) = (math::sin(p.latitude_rad), math::cos(p.latitude_rad));
+        let tan_l = sin_l / cos_l;
+        let mut f = Mat15::zeros();
+        f.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&Matrix3::identity());
+        f.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&Matrix3::from_diagonal(&Vector3::new(
+                -gamma / r,
+                -gamma / r,
+                2.0 * gamma / r,
+            )));
+        f.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(-skew(&(2.0 * w_ie + w_en))));
+        f.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&f_n)));
+        f.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
+        // −∂ω_ie/∂φ · δp_N/(R_N + h).
+        f[(6, 0)] = OMEGA_IE_RAD_S * sin_l / rho_n;
+        f[(8, 0)] = OMEGA_IE_RAD_S * cos_l / rho_n;
+        // −∂ω_en/∂v.
+        f[(6, 4)] = -1.0 / rho_e;
+        f[(7, 3)] = 1.0 / rho_n;
+        f[(8, 4)] = tan_l / rho_e;
+        f.fixed_view_mut::<3, 3>(6, 6)
+            .copy_from(&(-skew(&(w_ie + w_en))));
+        f.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
+        let a = f * dt;
+        let phi = Mat15::identity() + a + a * a * 0.5;
+        let mut q = Vec15::zeros();
+        for i in 0..3 {
+            q[3 + i] = sq(self.noise.accel_psd);
+            q[6 + i] = sq(self.noise.gyro_psd);
+            q[9 + i] = sq(self.noise.accel_bias_psd);
+            q[12 + i] = sq(self.noise.gyro_bias_psd);
+        }
+        let qc = Mat15::from_diagonal(&q);
+        let qd = (phi * qc * phi.transpose() + qc) * (0.5 * dt);
+        self.cov = phi * self.cov * phi.transpose() + qd;
+        self.cov = (self.cov + self.cov.transpose()) * 0.5;
+    }
+
+    /// A GNSS fix (see [`EarthGnssFix`]), gated with `gate` as the flat filter's.
+    ///
+    /// # Errors
+    /// Non-finite input, sigmas that are not positive, an age that is negative, divergence.
+    pub fn update_gnss(
+        &mut self,
+        fix: &EarthGnssFix,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let p = &self.nav.position;
+        let (r_n, r_e) = p.radii_m();
+        let m = &fix.position;
+        let delta_p = Vector3::new(
+            (m.latitude_rad - p.latitude_rad) * (r_n + p.height_m),
+            wrap_pi(m.longitude_rad - p.longitude_rad)
+                * (r_e + p.height_m)
+                * math::cos(p.latitude_rad),
+            -(m.height_m - p.height_m),
+        );
+        let lin = Linearisation {
+            c: self
+                .nav
+                .attitude
+                .quaternion()
+                .to_rotation_matrix()
+                .into_inner(),
+            v: *self.nav.velocity_m_s.as_nalgebra(),
+            w_body: self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg,
+            f_body: self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba,
+            g: Vector3::new(0.0, 0.0, self.gravity.magnitude_m_s2(p)),
+        };
+        let (h, y, r) = gnss_model(
+            &lin,
+            delta_p,
+            fix.velocity_m_s.map(|v| *v.as_nalgebra()),
+            *fix.lever_arm_m.as_nalgebra(),
+            [fix.position_sigma_m, fix.velocity_sigma_m_s],
+            fix.age_s,
+            index,
+        )?;
+        self.step_covariance();
+        let (nis, dx) = kalman_update(&mut self.cov, &h, &y, &r, gate, index)?;
+        let Some(dx) = dx else {
+            self.rejected += 1;
+            return Ok(UpdateOutcome {
+                nis,
+                accepted: false,
+            });
+        };
+        self.inject(&dx, index)?;
+        self.updates += 1;
+        Ok(UpdateOutcome {
+            nis,
+            accepted: true,
+        })
+    }
+
+    /// Closed loop: the error estimate into the nominal state (position through the radii),
+    /// and the mechanization restarted from it (its coning and sculling memory kept).
+    fn inject(&mut self, dx: &Vec15, index: usize) -> Result<(), EskfError> {
+        let p = self.nav.position;
+        let (r_n, r_e) = p.radii_m();
+        let position = Geodetic {
+            latitude_rad: p.latitude_rad + dx[0] / (r_n + p.height_m),
+            longitude_rad: p.longitude_rad
+                + dx[1] / ((r_e + p.height_m) * math::cos(p.latitude_rad)),
+            height_m: p.height_m - dx[2],
+        };
+        let phi = Vector3::new(dx[6], dx[7], dx[8]);
+        let q = UnitQuaternion::from_scaled_axis(phi) * *self.nav.attitude.quaternion();
+        self.nav = EarthNavState {
+            t_s: self.nav.t_s,
+            attitude: Rotation::assume_from_quaternion(q),
+            velocity_m_s: Vec3::from_nalgebra(
+                *self.nav.velocity_m_s.as_nalgebra() + Vector3::new(dx[3], dx[4], dx[5]),
+            ),
+            position,
+        };
+        self.ba += Vector3::new(dx[9], dx[10], dx[11]);
+        self.bg += Vector3::new(dx[12], dx[13], dx[14]);
+        self.mechanization
+            .reset(&self.nav)
+            .map_err(|_| EskfError::Diverged { index })
+    }
+}
+
+/// An angle difference wrapped to (−π, π].
+fn wrap_pi(a: f64) -> f64 {
+    let two_pi = 2.0 * core::f64::consts::PI;
+    let d = a - two_pi * math::round(a / two_pi);
+    if d <= -core::f64::consts::PI {
+        d + two_pi
+    } else {
+        d
+    }
+}

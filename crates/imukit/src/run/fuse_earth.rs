@@ -1,0 +1,241 @@
+//! Loosely coupled INS/GNSS fusion on the WGS-84 Earth: the core's Earth filter
+//! ([`imu_core::fusion::earth`]) over an IMU table (rates, frame `N`'s body convention) and a
+//! GNSS table of geodetic fixes ([`GNSS_EARTH_COLUMNS`]), as [`super::fuse`] does on the flat
+//! Earth. Output: [`FUSE_EARTH_COLUMNS`] — the flat fusion's columns (positions in the tangent
+//! plane at the start's origin, velocity, attitude and one-sigmas on frame `N`'s axes, biases in
+//! its body convention) and `lat_rad, lon_rad, height_m`.
+use imu_core::earth::{Geodetic, GravityModel};
+use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError};
+use imu_core::strapdown::earth::EarthNavState;
+use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+
+use crate::error::{Error, Result, invalid};
+use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
+use crate::run::earth_nav;
+use crate::run::fuse::{
+    ALIGN_MIN_SPEED_M_S, AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, MAX_REJECTED_IN_A_ROW,
+    Start, align_from_gnss, check_fix_times, rejected_in_a_row_error,
+};
+use crate::run::navigate::GEODETIC_COLUMNS;
+use crate::scenario::earth::frd_to_body;
+use crate::scenario::gnss::GNSS_EARTH_COLUMNS;
+
+/// Columns of a fused estimate on the Earth: [`FUSE_COLUMNS`] then the geodetic position.
+pub const FUSE_EARTH_COLUMNS: [&str; 38] = concat_columns(FUSE_COLUMNS, GEODETIC_COLUMNS);
+
+fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
+    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
+    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
+}
+
+/// A geodetic position from radians and metres.
+fn geodetic(latitude_rad: f64, longitude_rad: f64, height_m: f64) -> Geodetic {
+    Geodetic {
+        latitude_rad,
+        longitude_rad,
+        height_m,
+    }
+}
+
+/// A vector of one-sigmas on NED (or FRD) axes, on frame `N`'s (its body convention's) axes:
+/// the frames differ by a signed permutation, so the magnitudes move.
+fn sigmas_to<N: NavFrame>(ned: [f64; 3]) -> [f64; 3] {
+    N::from_ned()
+        .apply(Vec3::<Ned>::from_array(ned))
+        .to_array()
+        .map(f64::abs)
+}
+
+/// Fuses on the Earth (see the module docs); `gravity` is the scenario's model.
+///
+/// # Errors
+/// As [`super::fuse::fuse_with`]; odometer, barometer and constraint aids (not yet on the
+/// Earth); a start without a geodetic position.
+pub(crate) fn fuse_earth_in<N: NavFrame>(
+    imu: &Table,
+    gnss: &Table,
+    aids: AidTables<'_>,
+    start: Start<'_>,
+    setup: &FuseSetup,
+    gravity: GravityModel,
+) -> Result<(Table, FuseSummary)> {
+    if aids.odometer.is_some() || aids.baro.is_some() || setup.aiding.nhc_sigma_m_s.is_some() {
+        return Err(invalid(
+            "earth",
+            "on the WGS-84 Earth the filter takes GNSS fixes only so far: odometer, barometer and \
+             the vehicle constraints aid it on the flat Earth",
+        ));
+    }
+    let t = imu
+        .column("t_s")
+        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    let (Some(f), Some(w)) = (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS)) else {
+        return Err(invalid(
+            "IMU data",
+            "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
+        ));
+    };
+    let missing: Vec<&str> = GNSS_EARTH_COLUMNS
+        .iter()
+        .copied()
+        .filter(|c| !gnss.columns.iter().any(|h| h == c))
+        .collect();
+    if !missing.is_empty() {
+        return Err(invalid(
+            "GNSS data",
+            format!(
+                "missing column(s) {} (fixes on the WGS-84 Earth are geodetic)",
+                missing.join(", ")
+            ),
+        ));
+    }
+    let g_t = gnss.column("t_s").unwrap_or_default();
+    let g_p = triples(gnss, &["lat_rad", "lon_rad", "height_m"]).unwrap_or_default();
+    let g_v = triples(gnss, &["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]).unwrap_or_default();
+    let (t0, t1) = (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(0.0),
+    );
+    check_fix_times(&g_t, (t0, t1))?;
+    if let Some(k) = (0..g_p.len()).find(|&k| {
+        let [lat, lon, h] = g_p[k];
+        !(lat.abs() <= imu_core::earth::MAX_LATITUDE_RAD && lon.is_finite() && h.is_finite())
+    }) {
+        return Err(invalid(
+            "GNSS data",
+            format!(
+                "row {}: the latitude must be within ±89.9° and the longitude and height finite",
+                k + 2
+            ),
+        ));
+    }
+    let to_frd = frd_to_body::<N>().inverse();
+    let sign = match setup.accel_sign {
+        imu_core::AccelSign::SpecificForce => 1.0,
+        imu_core::AccelSign::Matlab => -1.0,
+    };
+    let frd = |a: [f64; 3], s: f64| to_frd.apply(Vec3::from_array(a.map(|x| s * x))).to_array();
+    // The first sample, state, tangent-plane origin and one-sigma; fixes before `next_fix` used.
+    let (first, s0, origin, sigma, mut next_fix) = match start {
+        Start::State(initial) => {
+            let (s, origin) = earth_nav::start::<N>(initial, t0)?;
+            (0, s, origin, setup.initial_sigma, 0)
+        }
+        Start::AlignGnss => {
+            let k = (0..g_t.len())
+                .find(|&k| g_v[k][0].hypot(g_v[k][1]) >= ALIGN_MIN_SPEED_M_S)
+                .ok_or_else(|| {
+                    invalid(
+                        "GNSS data",
+                        format!(
+                            "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: \
+                             the heading cannot be taken from GNSS velocity (give the initial \
+                             state instead)"
+                        ),
+                    )
+                })?;
+            let i0 = t.partition_point(|&ti| ti < g_t[k]).min(t.len() - 1);
+            let age = t[i0] - g_t[k] + setup.gnss_latency_s;
+            let (_, sigma) = align_from_gnss([0.0; 3], g_v[k], age, setup);
+            let [lat, lon, h] = g_p[k];
+            let v = g_v[k];
+            let (r_n, r_e) = geodetic(lat, lon, h).radii_m();
+            let position = geodetic(
+                lat + v[0] * age / (r_n + h),
+                lon + v[1] * age / ((r_e + h) * lat.cos()),
+                h - v[2] * age,
+            );
+            let euler = EulerZyx::new(v[1].atan2(v[0]), (-v[2]).atan2(v[0].hypot(v[1])), 0.0);
+            let s = EarthNavState {
+                t_s: t[i0],
+                attitude: Rotation::<Body, Ned>::from_euler(euler),
+                velocity_m_s: Vec3::from_array(v),
+                position,
+            };
+            (i0, s, position, sigma, k + 1)
+        }
+    };
+    let s0 = EarthNavState {
+        t_s: t[first],
+        ..s0
+    };
+    let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
+    let mut filter = EarthEskf::new(&s0, &sigma, setup.noise, gravity)
+        .map_err(|e| filter_error("filter", e))?
+        .with_covariance_interval(setup.covariance_interval_s)
+        .map_err(|_| {
+            invalid(
+                "covariance_interval_s",
+                format!(
+                    "must be a finite number ≥ 0 (s), got {}",
+                    setup.covariance_interval_s
+                ),
+            )
+        })?;
+    let lever = Vec3::<Body>::from_array(frd(setup.lever_arm_m, 1.0));
+    let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
+    let to_body = frd_to_body::<N>();
+    let bias_to = |b: [f64; 3]| to_body.apply(Vec3::<Body>::from_array(b)).to_array();
+    let bias_sigma_to = |b: [f64; 3]| bias_to(b).map(f64::abs);
+    let mut table = Table::new(&FUSE_EARTH_COLUMNS);
+    let mut rejected_in_a_row = 0;
+    let mut last_yaw = None;
+    for i in first..t.len() {
+        filter
+            .propagate(t[i], frd(w[i], 1.0), frd(f[i], sign))
+            .map_err(|e| filter_error("IMU data", e))?;
+        while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
+            let [lat, lon, h] = g_p[next_fix];
+            let fix = EarthGnssFix {
+                position: geodetic(lat, lon, h),
+                velocity_m_s: setup
+                    .gnss_velocity_sigma_m_s
+                    .map(|_| Vec3::from_array(g_v[next_fix])),
+                lever_arm_m: lever,
+                position_sigma_m: setup.gnss_position_sigma_m,
+                velocity_sigma_m_s: [vel_sigma; 3],
+                age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
+            };
+            let outcome = filter.update_gnss(&fix, setup.gate).map_err(|e| {
+                let message = format!("row {}: {e}", next_fix + 2);
+                match e {
+                    EskfError::Diverged { .. } => Error::Diverged {
+                        context: "GNSS data".into(),
+                        message,
+                    },
+                    _ => invalid("GNSS data", message),
+                }
+            })?;
+            rejected_in_a_row = if outcome.accepted {
+                0
+            } else {
+                rejected_in_a_row + 1
+            };
+            if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
+                return Err(rejected_in_a_row_error(
+                    next_fix + 2,
+                    outcome.nis,
+                    setup.gate,
+                ));
+            }
+            next_fix += 1;
+        }
+        let s = filter.state();
+        let sig = filter.sigmas();
+        let nav = earth_nav::row::<N>(&s.nav, &origin, &mut last_yaw);
+        let mut row = Vec::with_capacity(FUSE_EARTH_COLUMNS.len());
+        row.extend_from_slice(&nav[..14]);
+        for k in 0..3 {
+            row.extend(sigmas_to::<N>([sig[3 * k], sig[3 * k + 1], sig[3 * k + 2]]));
+        }
+        row.extend(bias_to(s.accel_bias_m_s2));
+        row.extend(bias_to(s.gyro_bias_rad_s));
+        row.extend(bias_sigma_to([sig[9], sig[10], sig[11]]));
+        row.extend(bias_sigma_to([sig[12], sig[13], sig[14]]));
+        row.extend_from_slice(&nav[14..]);
+        table.push_row(&row);
+    }
+    table.check_finite("fused navigation")?;
+    let (updates, rejected) = filter.update_counts();
+    Ok((table, FuseSummary { updates, rejected }))
+}
