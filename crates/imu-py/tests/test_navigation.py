@@ -222,6 +222,27 @@ def test_fuse_aligns_from_gnss_without_truth():
         imukit.fuse(sim.imu, sim.gnss, scenario=scenario, initial=sim.truth, align="gnss")
 
 
+def test_fuse_on_the_wgs84_earth_takes_geodetic_fixes():
+    scenario = {
+        "rate_hz": 100.0, "duration_s": 60.0, "nav_frame": "ENU", "earth": "wgs84",
+        "origin": {"latitude_deg": 45.0, "longitude_deg": 7.0, "height_m": 300.0},
+        "trajectory": {"type": "expression", "position_m": ["60*sin(0.16*t)", "60*(1 - cos(0.16*t))", "0"],
+                       "attitude": "tangent"},
+        "imu": {"kind": "accel-gyro", "preset": "stim300", "seed": 1},
+        "gnss": {"rate_hz": 5.0, "decay_factor": 0.0, "horizontal_accuracy_m": 1.0},
+    }
+    sim = imukit.simulate(scenario)
+    assert "lat_rad" in sim.gnss.columns
+    nav = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario)
+    assert list(nav.columns[-3:]) == ["lat_rad", "lon_rad", "height_m"]
+    errors, summary = imukit.compare(sim.truth, nav)
+    assert summary["position_rms_m"] < 1.0
+    # The geodetic output and the tangent-plane one describe the same place (1 m ≈ 1.6e-7 rad).
+    k = -1
+    north = (nav["lat_rad"][k] - sim.truth["lat_rad"][k]) * 6.37e6
+    assert abs(north - errors["pos_err_y_m"][k]) < 0.01
+
+
 def test_a_scenario_with_a_barometer_and_an_odometer_returns_their_readings():
     sim = imukit.simulate({"rate_hz": 100.0, "duration_s": 20.0, "nav_frame": "NED",
                            "trajectory": {"type": "expression", "position_m": ["10*t", "0", "-50"], "attitude": "tangent"},
