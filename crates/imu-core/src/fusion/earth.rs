@@ -17,7 +17,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::eskf::{
     EskfError, EskfNoise, InitialSigma, Linearisation, Mat15, UpdateOutcome, Vec15, gnss_model,
-    kalman_update, skew, sq,
+    initial_covariance, kalman_update, skew, sq,
 };
 use crate::earth::rates::{earth_rate_ned, transport_rate_ned};
 use crate::earth::wgs84::OMEGA_IE_RAD_S;
@@ -95,31 +95,13 @@ impl EarthEskf {
         };
         let mechanization = EarthIncrements::new(initial, options)
             .map_err(|_| EskfError::NotFinite { index: 0 })?;
-        let ok = |field, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(v)
-            } else {
-                Err(EskfError::BadParameter { field })
-            }
-        };
-        ok("accel_psd", noise.accel_psd)?;
-        ok("gyro_psd", noise.gyro_psd)?;
-        ok("accel_bias_psd", noise.accel_bias_psd)?;
-        ok("gyro_bias_psd", noise.gyro_bias_psd)?;
-        let mut diag = Vec15::zeros();
-        for i in 0..3 {
-            diag[i] = sq(ok("position sigma", sigma.position_m)?);
-            diag[3 + i] = sq(ok("velocity sigma", sigma.velocity_m_s)?);
-            diag[6 + i] = sq(ok("attitude sigma", sigma.attitude_rad[i])?);
-            diag[9 + i] = sq(ok("accelerometer bias sigma", sigma.accel_bias_m_s2)?);
-            diag[12 + i] = sq(ok("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
-        }
+        let cov = initial_covariance(sigma, &noise)?;
         Ok(Self {
             mechanization,
             nav: *initial,
             ba: Vector3::zeros(),
             bg: Vector3::zeros(),
-            cov: Mat15::from_diagonal(&diag),
+            cov,
             noise,
             gravity,
             last: None,

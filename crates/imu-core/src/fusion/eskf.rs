@@ -224,26 +224,8 @@ impl<N: NavFrame> Eskf<N> {
         noise: EskfNoise,
         gravity_m_s2: f64,
     ) -> Result<Self, EskfError> {
-        let ok = |field, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(v)
-            } else {
-                Err(EskfError::BadParameter { field })
-            }
-        };
-        ok("accel_psd", noise.accel_psd)?;
-        ok("gyro_psd", noise.gyro_psd)?;
-        ok("accel_bias_psd", noise.accel_bias_psd)?;
-        ok("gyro_bias_psd", noise.gyro_bias_psd)?;
-        ok("gravity_m_s2", gravity_m_s2)?;
-        let mut diag = Vec15::zeros();
-        for i in 0..3 {
-            diag[i] = sq(ok("position sigma", sigma.position_m)?);
-            diag[3 + i] = sq(ok("velocity sigma", sigma.velocity_m_s)?);
-            diag[6 + i] = sq(ok("attitude sigma", sigma.attitude_rad[i])?);
-            diag[9 + i] = sq(ok("accelerometer bias sigma", sigma.accel_bias_m_s2)?);
-            diag[12 + i] = sq(ok("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
-        }
+        let cov = initial_covariance(sigma, &noise)?;
+        non_negative("gravity_m_s2", gravity_m_s2)?;
         let finite = [initial.t_s]
             .iter()
             .chain(initial.position_m.as_nalgebra().iter())
@@ -261,7 +243,7 @@ impl<N: NavFrame> Eskf<N> {
             q: *initial.attitude.quaternion(),
             ba: Vector3::from(initial.accel_bias_m_s2),
             bg: Vector3::from(initial.gyro_bias_rad_s),
-            cov: Mat15::from_diagonal(&diag),
+            cov,
             noise,
             g: *N::gravity(gravity_m_s2).as_nalgebra(),
             last: None,
@@ -572,6 +554,42 @@ impl<N: NavFrame> Eskf<N> {
             accepted: true,
         })
     }
+}
+
+/// `v` when it is a finite number ≥ 0, else a refusal naming `field`.
+fn non_negative(field: &'static str, v: f64) -> Result<f64, EskfError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(EskfError::BadParameter { field })
+    }
+}
+
+/// The initial covariance (diagonal, from `sigma`) after checking `sigma` and `noise`, for
+/// both filters.
+///
+/// # Errors
+/// A sigma or noise density that is negative or not finite, named.
+pub(crate) fn initial_covariance(
+    sigma: &InitialSigma,
+    noise: &EskfNoise,
+) -> Result<Mat15, EskfError> {
+    non_negative("accel_psd", noise.accel_psd)?;
+    non_negative("gyro_psd", noise.gyro_psd)?;
+    non_negative("accel_bias_psd", noise.accel_bias_psd)?;
+    non_negative("gyro_bias_psd", noise.gyro_bias_psd)?;
+    let mut diag = Vec15::zeros();
+    for i in 0..3 {
+        diag[i] = sq(non_negative("position sigma", sigma.position_m)?);
+        diag[3 + i] = sq(non_negative("velocity sigma", sigma.velocity_m_s)?);
+        diag[6 + i] = sq(non_negative("attitude sigma", sigma.attitude_rad[i])?);
+        diag[9 + i] = sq(non_negative(
+            "accelerometer bias sigma",
+            sigma.accel_bias_m_s2,
+        )?);
+        diag[12 + i] = sq(non_negative("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
+    }
+    Ok(Mat15::from_diagonal(&diag))
 }
 
 /// What a measurement model needs of the nominal state: `Ĉ` (body to navigation), the

@@ -311,16 +311,42 @@ pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64)) -> Result<()> {
     Ok(())
 }
 
-/// The divergence report after [`MAX_REJECTED_IN_A_ROW`] fixes rejected one after another.
-pub(crate) fn rejected_in_a_row_error(row: usize, nis: f64, gate: f64) -> Error {
-    Error::Diverged {
-        context: "GNSS data".into(),
-        message: format!(
-            "row {row}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation gate \
-             (the last with NIS {nis:.1} against {gate:.1}): the filter has lost the fixes or the \
-             fixes have jumped; nothing is written"
-        ),
+/// The filter's refusal of reading `index` (0-based) of `what` (`GNSS`, `odometer`, …) as an
+/// error naming its row: a divergence as [`Error::Diverged`], bad input as invalid data.
+pub(crate) fn filter_refusal(what: &str, index: usize, e: EskfError) -> Error {
+    let (context, message) = (format!("{what} data"), format!("row {}: {e}", index + 2));
+    match e {
+        EskfError::Diverged { .. } => Error::Diverged { context, message },
+        _ => invalid(context, message),
     }
+}
+
+/// Counts fix `index`'s outcome: fixes rejected one after another (`in_a_row`) up to
+/// [`MAX_REJECTED_IN_A_ROW`] are a divergence, reported instead of an estimate.
+///
+/// # Errors
+/// The filter's refusal ([`filter_refusal`]) or the divergence.
+pub(crate) fn count_fix(
+    outcome: std::result::Result<imu_core::fusion::UpdateOutcome, EskfError>,
+    index: usize,
+    in_a_row: &mut usize,
+    gate: f64,
+) -> Result<()> {
+    let outcome = outcome.map_err(|e| filter_refusal("GNSS", index, e))?;
+    *in_a_row = if outcome.accepted { 0 } else { *in_a_row + 1 };
+    if *in_a_row >= MAX_REJECTED_IN_A_ROW {
+        return Err(Error::Diverged {
+            context: "GNSS data".into(),
+            message: format!(
+                "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation gate \
+                 (the last with NIS {:.1} against {gate:.1}): the filter has lost the fixes or the \
+                 fixes have jumped; nothing is written",
+                index + 2,
+                outcome.nis
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
@@ -430,16 +456,6 @@ fn fuse_in<N: NavFrame>(
             f64::INFINITY
         }
     };
-    let aid_error = |what: &str, row: usize, e: EskfError| {
-        let message = format!("row {}: {e}", row + 2);
-        match e {
-            EskfError::Diverged { .. } => Error::Diverged {
-                context: format!("{what} data"),
-                message,
-            },
-            _ => invalid(format!("{what} data"), message),
-        }
-    };
     let nhc = setup.aiding.nhc_sigma_m_s;
     if let Some(c) = nhc
         && !(c.is_finite() && c > 0.0)
@@ -532,28 +548,12 @@ fn fuse_in<N: NavFrame>(
                 // Valid at its stamp minus the latency; applied at this IMU sample.
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
             };
-            let outcome = filter.update_gnss_fix(&fix, setup.gate).map_err(|e| {
-                let message = format!("row {}: {e}", next_fix + 2);
-                match e {
-                    EskfError::Diverged { .. } => Error::Diverged {
-                        context: "GNSS data".into(),
-                        message,
-                    },
-                    _ => invalid("GNSS data", message),
-                }
-            })?;
-            rejected_in_a_row = if outcome.accepted {
-                0
-            } else {
-                rejected_in_a_row + 1
-            };
-            if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
-                return Err(rejected_in_a_row_error(
-                    next_fix + 2,
-                    outcome.nis,
-                    setup.gate,
-                ));
-            }
+            count_fix(
+                filter.update_gnss_fix(&fix, setup.gate),
+                next_fix,
+                &mut rejected_in_a_row,
+                setup.gate,
+            )?;
             next_fix += 1;
         }
         while next_odo < odo_t.len() && odo_t[next_odo] <= t[i] {
@@ -572,7 +572,7 @@ fn fuse_in<N: NavFrame>(
             };
             filter
                 .update_body_velocity(measured, sigmas, gate_of(dof - 1))
-                .map_err(|e| aid_error("odometer", next_odo, e))?;
+                .map_err(|e| filter_refusal("odometer", next_odo, e))?;
             next_odo += 1;
         }
         if let Some(c) = nhc
@@ -581,14 +581,14 @@ fn fuse_in<N: NavFrame>(
         {
             filter
                 .update_body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], gate_of(1))
-                .map_err(|e| aid_error("constraint", i, e))?;
+                .map_err(|e| filter_refusal("constraint", i, e))?;
             next_nhc_t = t[i] + 1.0 / NHC_RATE_HZ;
         }
         while next_baro < baro_t.len() && baro_t[next_baro] <= t[i] {
             let sigma = setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA);
             filter
                 .update_height(baro_h[next_baro], sigma, gate_of(0))
-                .map_err(|e| aid_error("barometer", next_baro, e))?;
+                .map_err(|e| filter_refusal("barometer", next_baro, e))?;
             next_baro += 1;
         }
         let s = filter.state();

@@ -9,12 +9,12 @@ use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError};
 use imu_core::strapdown::earth::EarthNavState;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
-use crate::error::{Error, Result, invalid};
+use crate::error::{Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
 use crate::run::earth_nav;
 use crate::run::fuse::{
-    ALIGN_MIN_SPEED_M_S, AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, MAX_REJECTED_IN_A_ROW,
-    Start, align_from_gnss, check_fix_times, rejected_in_a_row_error,
+    ALIGN_MIN_SPEED_M_S, AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, Start, align_from_gnss,
+    check_fix_times, count_fix,
 };
 use crate::run::navigate::GEODETIC_COLUMNS;
 use crate::scenario::earth::frd_to_body;
@@ -196,28 +196,12 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
                 velocity_sigma_m_s: [vel_sigma; 3],
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
             };
-            let outcome = filter.update_gnss(&fix, setup.gate).map_err(|e| {
-                let message = format!("row {}: {e}", next_fix + 2);
-                match e {
-                    EskfError::Diverged { .. } => Error::Diverged {
-                        context: "GNSS data".into(),
-                        message,
-                    },
-                    _ => invalid("GNSS data", message),
-                }
-            })?;
-            rejected_in_a_row = if outcome.accepted {
-                0
-            } else {
-                rejected_in_a_row + 1
-            };
-            if rejected_in_a_row >= MAX_REJECTED_IN_A_ROW {
-                return Err(rejected_in_a_row_error(
-                    next_fix + 2,
-                    outcome.nis,
-                    setup.gate,
-                ));
-            }
+            count_fix(
+                filter.update_gnss(&fix, setup.gate),
+                next_fix,
+                &mut rejected_in_a_row,
+                setup.gate,
+            )?;
             next_fix += 1;
         }
         let s = filter.state();

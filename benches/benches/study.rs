@@ -1,0 +1,40 @@
+//! Runs per second of the outage study (`imukit study`): one run of the example tunnel road
+//! (15 001 samples at 100 Hz: simulated truth and STIM300 readings, GNSS, then fused), on one
+//! core; `imukit study` spreads runs over all cores.
+//!
+//! Run: `cargo bench -p imu-benches --bench study`.
+#![allow(missing_docs)]
+
+use std::path::Path;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use imukit::run::study::{Study, StudySpec};
+
+fn bench(c: &mut Criterion) {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut group = c.benchmark_group("study");
+    group.sample_size(10);
+    for (name, odometer) in [("tunnel_run", false), ("tunnel_run_with_wheels", true)] {
+        let spec = StudySpec {
+            scenario: "car_tunnel.toml".into(),
+            presets: vec!["stim300".into()],
+            runs: 2,
+            odometer,
+            baro: false,
+            nhc_sigma_m_s: odometer.then_some(0.05),
+        };
+        let study = Study::new(&spec, &examples, "bench").expect("the example study resolves");
+        group.throughput(Throughput::Elements(1));
+        group.bench_function(name, |b| {
+            let mut run = 0;
+            b.iter(|| {
+                run += 1;
+                study.run_one(0, run).expect("a run")
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
