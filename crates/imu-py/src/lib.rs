@@ -10,6 +10,7 @@ mod navigation;
 mod orientation;
 mod rotations;
 mod sensor;
+mod study;
 mod truth;
 
 use pyo3::prelude::*;
@@ -25,5 +26,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     orientation::register(m)?;
     io::register(m)?;
     figures::register(m)?;
+    study::register(m)?;
     Ok(())
 }

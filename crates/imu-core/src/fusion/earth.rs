@@ -16,8 +16,8 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::eskf::{
-    EskfError, EskfNoise, InitialSigma, Linearisation, Mat15, UpdateOutcome, Vec15, gnss_model,
-    initial_covariance, kalman_update, skew, sq,
+    EskfError, EskfNoise, InitialSigma, Linearisation, Mat15, UpdateOutcome, Vec15,
+    body_velocity_model, gnss_model, initial_covariance, kalman_update, skew, sq,
 };
 use crate::earth::rates::{earth_rate_ned, transport_rate_ned};
 use crate::earth::wgs84::OMEGA_IE_RAD_S;
@@ -316,8 +316,65 @@ impl EarthEskf {
             fix.age_s,
             index,
         )?;
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// Body-frame velocity (odometer forward speed, non-holonomic constraints), as
+    /// [`super::Eskf::update_body_velocity`] (FRD body axes: x forward, y right, z down).
+    ///
+    /// # Errors
+    /// As [`super::Eskf::update_body_velocity`].
+    pub fn update_body_velocity(
+        &mut self,
+        measured_m_s: [Option<f64>; 3],
+        sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let c = self
+            .nav
+            .attitude
+            .quaternion()
+            .to_rotation_matrix()
+            .into_inner();
+        let v = *self.nav.velocity_m_s.as_nalgebra();
+        let (h, y, r) = body_velocity_model(&c, &v, measured_m_s, sigma_m_s, index)?;
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// A height above the ellipsoid (a barometer on the Earth), one-sigma `sigma_m`: `δh = −δp_D`.
+    ///
+    /// # Errors
+    /// Non-finite input, a sigma that is not positive, or divergence.
+    pub fn update_height(
+        &mut self,
+        height_m: f64,
+        sigma_m: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
+            return Err(EskfError::NotFinite { index });
+        }
+        let mut h = nalgebra::SMatrix::<f64, 1, 15>::zeros();
+        h[(0, 2)] = -1.0;
+        let y = nalgebra::SVector::<f64, 1>::new(height_m - self.nav.position.height_m);
+        let r = nalgebra::SVector::<f64, 1>::new(sq(sigma_m));
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// The correction shared by the updates: pending covariance stepped, Kalman update, the
+    /// closed-loop injection, counts.
+    fn correct<const M: usize>(
+        &mut self,
+        h: &nalgebra::SMatrix<f64, M, 15>,
+        y: &nalgebra::SVector<f64, M>,
+        r: &nalgebra::SVector<f64, M>,
+        gate: f64,
+        index: usize,
+    ) -> Result<UpdateOutcome, EskfError> {
         self.step_covariance();
-        let (nis, dx) = kalman_update(&mut self.cov, &h, &y, &r, gate, index)?;
+        let (nis, dx) = kalman_update(&mut self.cov, h, y, r, gate, index)?;
         let Some(dx) = dx else {
             self.rejected += 1;
             return Ok(UpdateOutcome {

@@ -479,22 +479,8 @@ impl<N: NavFrame> Eskf<N> {
         gate: f64,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
-        let ct = self.q.to_rotation_matrix().into_inner().transpose();
-        let predicted = ct * self.v;
-        let h_phi = ct * skew(&self.v);
-        let mut h = SMatrix::<f64, 3, 15>::zeros();
-        let mut y = SVector::<f64, 3>::zeros();
-        let mut r = SVector::<f64, 3>::repeat(1.0);
-        for i in 0..3 {
-            let Some(z) = measured_m_s[i] else { continue };
-            if !(z.is_finite() && sigma_m_s[i].is_finite() && sigma_m_s[i] > 0.0) {
-                return Err(EskfError::NotFinite { index });
-            }
-            h.fixed_view_mut::<1, 3>(i, 3).copy_from(&ct.row(i));
-            h.fixed_view_mut::<1, 3>(i, 6).copy_from(&h_phi.row(i));
-            y[i] = z - predicted[i];
-            r[i] = sq(sigma_m_s[i]);
-        }
+        let c = self.q.to_rotation_matrix().into_inner();
+        let (h, y, r) = body_velocity_model(&c, &self.v, measured_m_s, sigma_m_s, index)?;
         self.correct(&h, &y, &r, gate, index)
     }
 
@@ -602,8 +588,8 @@ pub(crate) struct Linearisation {
     pub(crate) g: Vector3<f64>,
 }
 
-/// A GNSS fix's measurement model: `H` (6 × 15), innovation `y` and variances `r`.
-pub(crate) type GnssRows = (SMatrix<f64, 6, 15>, SVector<f64, 6>, SVector<f64, 6>);
+/// A measurement model of `M` rows: `H` (M × 15), innovation `y` and variances `r`.
+pub(crate) type Rows<const M: usize> = (SMatrix<f64, M, 15>, SVector<f64, M>, SVector<f64, M>);
 
 /// The GNSS measurement model shared by the flat and the Earth filters: `delta_p` is the fix's
 /// position minus the nominal position in local navigation-frame metres; the antenna at lever
@@ -617,7 +603,7 @@ pub(crate) fn gnss_model(
     sigmas: [[f64; 3]; 2],
     age_s: f64,
     index: usize,
-) -> Result<GnssRows, EskfError> {
+) -> Result<Rows<6>, EskfError> {
     let c = lin.c;
     let cl = c * l;
     let cwl = c * lin.w_body.cross(&l);
@@ -657,6 +643,37 @@ pub(crate) fn gnss_model(
         .all(|s| s.is_finite() && *s > 0.0);
     if !(finite && all_sigma && age_s.is_finite() && age_s >= 0.0) {
         return Err(EskfError::NotFinite { index });
+    }
+    Ok((h, y, r))
+}
+
+/// A body-velocity measurement's model, shared by the filters: rows `i` with a measurement;
+/// `v_b = Ĉᵀ v`, so `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ` (see [`Eskf::update_body_velocity`]).
+///
+/// # Errors
+/// A measurement that is not finite or a sigma that is not positive.
+pub(crate) fn body_velocity_model(
+    c: &nalgebra::Matrix3<f64>,
+    v: &Vector3<f64>,
+    measured_m_s: [Option<f64>; 3],
+    sigma_m_s: [f64; 3],
+    index: usize,
+) -> Result<Rows<3>, EskfError> {
+    let ct = c.transpose();
+    let predicted = ct * v;
+    let h_phi = ct * skew(v);
+    let mut h = SMatrix::<f64, 3, 15>::zeros();
+    let mut y = SVector::<f64, 3>::zeros();
+    let mut r = SVector::<f64, 3>::repeat(1.0);
+    for i in 0..3 {
+        let Some(z) = measured_m_s[i] else { continue };
+        if !(z.is_finite() && sigma_m_s[i].is_finite() && sigma_m_s[i] > 0.0) {
+            return Err(EskfError::NotFinite { index });
+        }
+        h.fixed_view_mut::<1, 3>(i, 3).copy_from(&ct.row(i));
+        h.fixed_view_mut::<1, 3>(i, 6).copy_from(&h_phi.row(i));
+        y[i] = z - predicted[i];
+        r[i] = sq(sigma_m_s[i]);
     }
     Ok((h, y, r))
 }

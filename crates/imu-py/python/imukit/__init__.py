@@ -17,7 +17,7 @@ unknown).
 
 The package is split by area as the compiled core is: ``_truth`` (scenarios and truth),
 ``_rotations``, ``_sensor`` (``ImuSensor``, parameters, presets, Allan), ``_navigation``,
-``_orientation``, ``_monte_carlo``, ``plot``, ``compat``; this file only re-exports.
+``_orientation``, ``_monte_carlo``, ``_study``, ``plot``, ``compat``; this file only re-exports.
 """
 from __future__ import annotations
 
@@ -56,6 +56,7 @@ from ._sensor import (
 )
 from ._navigation import compare, fuse, planar_dead_reckon, read_planar, strapdown
 from ._monte_carlo import MonteCarlo, monte_carlo
+from ._study import PresetSummary, StudyResult, study
 from ._orientation import (
     AhrsFilter,
     ComplementaryFilter,
@@ -72,6 +73,9 @@ __all__ = [
     "Simulation",
     "simulate",
     "monte_carlo",
+    "study",
+    "StudyResult",
+    "PresetSummary",
     "MonteCarlo",
     "ImuSensor",
     "AccelParams",

@@ -8,6 +8,9 @@ _Table = tuple[list[str], npt.NDArray[np.float64]]
 
 __all__ = [
     "ImuError",
+    "study_plan",
+    "study_run",
+    "study_summarise",
     "DEFAULT_GRAVITY_M_S2",
     "read_csv",
     "write_csv",
@@ -293,3 +296,18 @@ def ecompass(
     accel_sign: str = "matlab",
 ) -> npt.NDArray[np.float64]: ...
 def quaternion_distance(q1: npt.NDArray[np.float64], q2: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def study_plan(path: str) -> tuple[list[str], int]: ...
+def study_run(
+    path: str, case: int, run: int
+) -> tuple[
+    Optional[npt.NDArray[np.float64]],
+    Optional[npt.NDArray[np.float64]],
+    Optional[npt.NDArray[np.float64]],
+    Optional[str],
+]: ...
+def study_summarise(
+    path: str,
+    outcomes: Sequence[
+        Sequence[tuple[Optional[Sequence[float]], Optional[Sequence[float]], Optional[Sequence[float]], Optional[str]]]
+    ],
+) -> tuple[_Table, list[tuple[str, int, int, Optional[float], Optional[float], float]]]: ...

@@ -10,6 +10,7 @@ use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
+use crate::run::fuse_aids::AidStreams;
 use crate::run::navigate::{InitialState, NAV_COLUMNS, euler_unwrapped};
 use crate::scenario::NavFrameName;
 use crate::scenario::gnss::GNSS_COLUMNS;
@@ -111,10 +112,6 @@ pub struct OdometerModel {
     /// Scale-factor error, fraction.
     pub scale_factor_error: f64,
 }
-
-/// The smallest one-sigma the filter is told for an aid (exact simulated readings still need a
-/// little trust in the model), in the aid's unit.
-const MIN_SIGMA: f64 = 1e-3;
 
 /// Rate of the non-holonomic constraints when no odometer paces them, Hz.
 pub const NHC_RATE_HZ: f64 = 10.0;
@@ -349,50 +346,6 @@ pub(crate) fn count_fix(
     Ok(())
 }
 
-/// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
-fn aid_series(
-    table: &Table,
-    what: &str,
-    value: &str,
-    (t0, t1): (f64, f64),
-) -> Result<(Vec<f64>, Vec<f64>)> {
-    let (Some(t), Some(v)) = (table.column("t_s"), table.column(value)) else {
-        return Err(invalid(
-            format!("{what} data"),
-            format!("missing column(s): needs t_s and {value}"),
-        ));
-    };
-    for (k, (&tk, &vk)) in t.iter().zip(&v).enumerate() {
-        if !tk.is_finite() || !vk.is_finite() || (k > 0 && tk <= t[k - 1]) {
-            return Err(invalid(
-                format!("{what} data"),
-                format!(
-                    "row {}: times must be finite and increase, values finite",
-                    k + 2
-                ),
-            ));
-        }
-        if tk < t0 || tk > t1 {
-            return Err(invalid(
-                format!("{what} data"),
-                format!(
-                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
-                    k + 2
-                ),
-            ));
-        }
-    }
-    Ok((t, v))
-}
-
-/// One-degree-of-freedom and two- and three-degree chi-square 99.9 % quantiles: the gates of
-/// height, constraint and odometer-with-constraint updates.
-const CHI2_99_9: [f64; 3] = [
-    10.827_566_170_662_733,
-    13.815_510_557_964_274,
-    16.266_236_196_238_13,
-];
-
 fn fuse_in<N: NavFrame>(
     imu: &Table,
     gnss: &Table,
@@ -428,43 +381,7 @@ fn fuse_in<N: NavFrame>(
         t.last().copied().unwrap_or(0.0),
     );
     check_fix_times(&g_t, (t0, t1))?;
-    let span = (t0, t1);
-    let (odo_t, odo_v) = match (aids.odometer, setup.aiding.odometer) {
-        (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
-        (Some(_), None) => {
-            return Err(invalid(
-                "odometer data",
-                "given, but the scenario has no [odometer]: the filter takes its accuracy from it",
-            ));
-        }
-        (None, _) => (Vec::new(), Vec::new()),
-    };
-    let (baro_t, baro_h) = match (aids.baro, setup.aiding.baro_sigma_m) {
-        (Some(table), Some(_)) => aid_series(table, "barometer", "baro_height_m", span)?,
-        (Some(_), None) => {
-            return Err(invalid(
-                "barometer data",
-                "given, but the scenario has no [baro]: the filter takes its accuracy from it",
-            ));
-        }
-        (None, _) => (Vec::new(), Vec::new()),
-    };
-    let gate_of = |k: usize| {
-        if setup.gate.is_finite() {
-            CHI2_99_9[k]
-        } else {
-            f64::INFINITY
-        }
-    };
-    let nhc = setup.aiding.nhc_sigma_m_s;
-    if let Some(c) = nhc
-        && !(c.is_finite() && c > 0.0)
-    {
-        return Err(invalid(
-            "nhc_sigma_m_s",
-            format!("must be a finite number > 0 (m/s), got {c}"),
-        ));
-    }
+    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
     let (first, initial, sigma, mut next_fix) = match start {
         Start::State(s) => (0, *s, setup.initial_sigma, 0),
@@ -488,11 +405,7 @@ fn fuse_in<N: NavFrame>(
         }
     };
     let t_first = t[first];
-    let (mut next_odo, mut next_baro, mut next_nhc_t) = (
-        odo_t.partition_point(|&x| x < t_first),
-        baro_t.partition_point(|&x| x < t_first),
-        t_first,
-    );
+    aid_streams.start_at(t_first);
     // A quaternion in the ENU sense (the alignment builds it by geometry) is the same rotation
     // in either frame's own axes.
     let attitude = Rotation::<Body, N>::from_wxyz(initial.quaternion).ok_or_else(|| {
@@ -556,41 +469,7 @@ fn fuse_in<N: NavFrame>(
             )?;
             next_fix += 1;
         }
-        while next_odo < odo_t.len() && odo_t[next_odo] <= t[i] {
-            let speed = odo_v[next_odo];
-            let model = setup.aiding.odometer.unwrap_or(OdometerModel {
-                noise_m_s: 0.0,
-                scale_factor_error: 0.0,
-            });
-            let sigma = model
-                .noise_m_s
-                .hypot(model.scale_factor_error * speed)
-                .max(MIN_SIGMA);
-            let (measured, sigmas, dof) = match nhc {
-                Some(c) => ([Some(speed), Some(0.0), Some(0.0)], [sigma, c, c], 3),
-                None => ([Some(speed), None, None], [sigma, 1.0, 1.0], 1),
-            };
-            filter
-                .update_body_velocity(measured, sigmas, gate_of(dof - 1))
-                .map_err(|e| filter_refusal("odometer", next_odo, e))?;
-            next_odo += 1;
-        }
-        if let Some(c) = nhc
-            && odo_t.is_empty()
-            && t[i] >= next_nhc_t
-        {
-            filter
-                .update_body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], gate_of(1))
-                .map_err(|e| filter_refusal("constraint", i, e))?;
-            next_nhc_t = t[i] + 1.0 / NHC_RATE_HZ;
-        }
-        while next_baro < baro_t.len() && baro_t[next_baro] <= t[i] {
-            let sigma = setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA);
-            filter
-                .update_height(baro_h[next_baro], sigma, gate_of(0))
-                .map_err(|e| filter_refusal("barometer", next_baro, e))?;
-            next_baro += 1;
-        }
+        aid_streams.apply(&mut filter, t[i], i)?;
         let s = filter.state();
         let sig = filter.sigmas();
         let e = euler_unwrapped(&s.attitude, &mut last_yaw);

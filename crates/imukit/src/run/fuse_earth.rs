@@ -3,7 +3,8 @@
 //! GNSS table of geodetic fixes ([`GNSS_EARTH_COLUMNS`]), as [`super::fuse`] does on the flat
 //! Earth. Output: [`FUSE_EARTH_COLUMNS`] — the flat fusion's columns (positions in the tangent
 //! plane at the start's origin, velocity, attitude and one-sigmas on frame `N`'s axes, biases in
-//! its body convention) and `lat_rad, lon_rad, height_m`.
+//! its body convention) and `lat_rad, lon_rad, height_m`. Odometer, barometer (the ellipsoidal
+//! height) and the constraints aid it as on the flat Earth (the same code, `fuse_aids`).
 use imu_core::earth::{Geodetic, GravityModel};
 use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError};
 use imu_core::strapdown::earth::EarthNavState;
@@ -16,6 +17,7 @@ use crate::run::fuse::{
     ALIGN_MIN_SPEED_M_S, AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, Start, align_from_gnss,
     check_fix_times, count_fix,
 };
+use crate::run::fuse_aids::AidStreams;
 use crate::run::navigate::GEODETIC_COLUMNS;
 use crate::scenario::earth::frd_to_body;
 use crate::scenario::gnss::GNSS_EARTH_COLUMNS;
@@ -49,8 +51,7 @@ fn sigmas_to<N: NavFrame>(ned: [f64; 3]) -> [f64; 3] {
 /// Fuses on the Earth (see the module docs); `gravity` is the scenario's model.
 ///
 /// # Errors
-/// As [`super::fuse::fuse_with`]; odometer, barometer and constraint aids (not yet on the
-/// Earth); a start without a geodetic position.
+/// As [`super::fuse::fuse_with`]; a start without a geodetic position.
 pub(crate) fn fuse_earth_in<N: NavFrame>(
     imu: &Table,
     gnss: &Table,
@@ -59,13 +60,6 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
     setup: &FuseSetup,
     gravity: GravityModel,
 ) -> Result<(Table, FuseSummary)> {
-    if aids.odometer.is_some() || aids.baro.is_some() || setup.aiding.nhc_sigma_m_s.is_some() {
-        return Err(invalid(
-            "earth",
-            "on the WGS-84 Earth the filter takes GNSS fixes only so far: odometer, barometer and \
-             the vehicle constraints aid it on the flat Earth",
-        ));
-    }
     let t = imu
         .column("t_s")
         .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
@@ -97,6 +91,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         t.last().copied().unwrap_or(0.0),
     );
     check_fix_times(&g_t, (t0, t1))?;
+    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     if let Some(k) = (0..g_p.len()).find(|&k| {
         let [lat, lon, h] = g_p[k];
         !(lat.abs() <= imu_core::earth::MAX_LATITUDE_RAD && lon.is_finite() && h.is_finite())
@@ -159,6 +154,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         t_s: t[first],
         ..s0
     };
+    aid_streams.start_at(t[first]);
     let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
     let mut filter = EarthEskf::new(&s0, &sigma, setup.noise, gravity)
         .map_err(|e| filter_error("filter", e))?
@@ -204,6 +200,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
             )?;
             next_fix += 1;
         }
+        aid_streams.apply(&mut filter, t[i], i)?;
         let s = filter.state();
         let sig = filter.sigmas();
         let nav = earth_nav::row::<N>(&s.nav, &origin, &mut last_yaw);

@@ -7,6 +7,7 @@ pub mod arrays;
 pub mod compare;
 pub mod earth_nav;
 pub mod fuse;
+mod fuse_aids;
 pub mod fuse_earth;
 pub mod imu_sensor;
 pub mod navigate;

@@ -1,0 +1,111 @@
+//! The outage study for Python (`imukit.study`): the plan, one run and the summary of a study
+//! file, so that Python can spread the runs over threads or Dask workers.
+use std::path::Path;
+
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+
+use crate::convert::{TableOut, table_out};
+use crate::errors::refused;
+
+/// One run of an outage study (`imukit study`'s file at `path`): preset number `case`, run
+/// `run` → `(t_s, horizontal_error_m, horizontal_sigma_m, None)` through the first outage, or
+/// `(None, None, None, message)` when the filter diverged.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn study_run<'py>(
+    py: Python<'py>,
+    path: &str,
+    case: usize,
+    run: u64,
+) -> PyResult<(
+    Option<Bound<'py, PyArray1<f64>>>,
+    Option<Bound<'py, PyArray1<f64>>>,
+    Option<Bound<'py, PyArray1<f64>>>,
+    Option<String>,
+)> {
+    use imukit::run::study::{RunOutcome, Study};
+    let path = Path::new(path).to_path_buf();
+    let outcome = py
+        .detach(move || Study::from_file(&path)?.run_one(case, run))
+        .map_err(refused)?;
+    Ok(match outcome {
+        RunOutcome::Outage(r) => (
+            Some(r.t_s.into_pyarray(py)),
+            Some(r.horizontal_error_m.into_pyarray(py)),
+            Some(r.horizontal_sigma_m.into_pyarray(py)),
+            None,
+        ),
+        RunOutcome::Diverged(message) => (None, None, None, Some(message)),
+    })
+}
+
+/// The study at `path`: its presets and runs per preset.
+#[pyfunction]
+fn study_plan(path: &str) -> PyResult<(Vec<String>, u64)> {
+    let s = imukit::run::study::Study::from_file(Path::new(path)).map_err(refused)?;
+    Ok((s.presets().map(str::to_string).collect(), s.runs()))
+}
+
+/// The study's table and per-preset summaries from every run's outcome, `outcomes[case][run]` as
+/// [`study_run`] returns them.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn study_summarise<'py>(
+    py: Python<'py>,
+    path: &str,
+    outcomes: Vec<
+        Vec<(
+            Option<Vec<f64>>,
+            Option<Vec<f64>>,
+            Option<Vec<f64>>,
+            Option<String>,
+        )>,
+    >,
+) -> PyResult<(
+    TableOut<'py>,
+    Vec<(String, usize, usize, Option<f64>, Option<f64>, f64)>,
+)> {
+    use imukit::run::study::{OutageRun, RunOutcome, Study};
+    let study = Study::from_file(Path::new(path)).map_err(refused)?;
+    let outcomes: Vec<Vec<RunOutcome>> = outcomes
+        .into_iter()
+        .map(|runs| {
+            runs.into_iter()
+                .map(|(t, e, s, message)| match (t, e, s) {
+                    (Some(t_s), Some(horizontal_error_m), Some(horizontal_sigma_m)) => {
+                        RunOutcome::Outage(OutageRun {
+                            t_s,
+                            horizontal_error_m,
+                            horizontal_sigma_m,
+                        })
+                    }
+                    _ => RunOutcome::Diverged(message.unwrap_or_default()),
+                })
+                .collect()
+        })
+        .collect();
+    let (table, summaries) = study.summarise(&outcomes).map_err(refused)?;
+    let summaries = summaries
+        .into_iter()
+        .map(|m| {
+            (
+                m.preset,
+                m.completed,
+                m.diverged.0,
+                m.rms_error_m,
+                m.sigma_m,
+                m.outage_s,
+            )
+        })
+        .collect();
+    Ok((table_out(py, table)?, summaries))
+}
+
+/// Adds this module's functions.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(study_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(study_run, m)?)?;
+    m.add_function(wrap_pyfunction!(study_summarise, m)?)?;
+    Ok(())
+}

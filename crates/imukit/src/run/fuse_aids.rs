@@ -1,0 +1,240 @@
+//! The aids of a fusion besides GNSS — odometer readings, barometer readings and the
+//! non-holonomic constraints — read, checked and applied at their times, the same way for the
+//! flat filter and the Earth filter ([`AidUpdates`]).
+use imu_core::NavFrame;
+use imu_core::fusion::{EarthEskf, Eskf, EskfError, UpdateOutcome};
+
+use crate::error::{Result, invalid};
+use crate::io::table::Table;
+use crate::run::fuse::{AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, filter_refusal};
+
+/// The smallest one-sigma the filter is told for an aid (exact simulated readings still need a
+/// little trust in the model), in the aid's unit.
+const MIN_SIGMA: f64 = 1e-3;
+
+/// One-degree-of-freedom and two- and three-degree chi-square 99.9 % quantiles: the gates of
+/// height, constraint and odometer-with-constraint updates.
+const CHI2_99_9: [f64; 3] = [
+    10.827_566_170_662_733,
+    13.815_510_557_964_274,
+    16.266_236_196_238_13,
+];
+
+/// The updates aids make, on either filter.
+pub(crate) trait AidUpdates {
+    /// Body-frame velocity rows (x forward in both body conventions).
+    fn body_velocity(
+        &mut self,
+        measured_m_s: [Option<f64>; 3],
+        sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError>;
+    /// A height: the frame's up coordinate on the flat Earth, the ellipsoidal height on WGS-84.
+    fn height(
+        &mut self,
+        height_m: f64,
+        sigma_m: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError>;
+}
+
+impl<N: NavFrame> AidUpdates for Eskf<N> {
+    fn body_velocity(
+        &mut self,
+        measured_m_s: [Option<f64>; 3],
+        sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_body_velocity(measured_m_s, sigma_m_s, gate)
+    }
+    fn height(
+        &mut self,
+        height_m: f64,
+        sigma_m: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_height(height_m, sigma_m, gate)
+    }
+}
+
+impl AidUpdates for EarthEskf {
+    fn body_velocity(
+        &mut self,
+        measured_m_s: [Option<f64>; 3],
+        sigma_m_s: [f64; 3],
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_body_velocity(measured_m_s, sigma_m_s, gate)
+    }
+    fn height(
+        &mut self,
+        height_m: f64,
+        sigma_m: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_height(height_m, sigma_m, gate)
+    }
+}
+
+/// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
+fn aid_series(
+    table: &Table,
+    what: &str,
+    value: &str,
+    (t0, t1): (f64, f64),
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (Some(t), Some(v)) = (table.column("t_s"), table.column(value)) else {
+        return Err(invalid(
+            format!("{what} data"),
+            format!("missing column(s): needs t_s and {value}"),
+        ));
+    };
+    for (k, (&tk, &vk)) in t.iter().zip(&v).enumerate() {
+        if !tk.is_finite() || !vk.is_finite() || (k > 0 && tk <= t[k - 1]) {
+            return Err(invalid(
+                format!("{what} data"),
+                format!(
+                    "row {}: times must be finite and increase, values finite",
+                    k + 2
+                ),
+            ));
+        }
+        if tk < t0 || tk > t1 {
+            return Err(invalid(
+                format!("{what} data"),
+                format!(
+                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok((t, v))
+}
+
+/// The aids of one fusion: readings, models and where each stream has got to.
+pub(crate) struct AidStreams {
+    odometer: (Vec<f64>, Vec<f64>),
+    baro: (Vec<f64>, Vec<f64>),
+    odometer_model: OdometerModel,
+    baro_sigma_m: f64,
+    nhc_sigma_m_s: Option<f64>,
+    gate_on: bool,
+    next: (usize, usize),
+    next_nhc_t: f64,
+}
+
+impl AidStreams {
+    /// The aid tables given, checked against the IMU's span, with the models of `setup` (an
+    /// aid table without its model is refused, not ignored).
+    ///
+    /// # Errors
+    /// A table without its columns or model, times that do not increase or fall outside the
+    /// span, a constraint sigma that is not positive.
+    pub(crate) fn new(aids: AidTables<'_>, setup: &FuseSetup, span: (f64, f64)) -> Result<Self> {
+        let odometer = match (aids.odometer, setup.aiding.odometer) {
+            (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
+            (Some(_), None) => {
+                return Err(invalid(
+                    "odometer data",
+                    "given, but the scenario has no [odometer]: the filter takes its accuracy from it",
+                ));
+            }
+            (None, _) => (Vec::new(), Vec::new()),
+        };
+        let baro = match (aids.baro, setup.aiding.baro_sigma_m) {
+            (Some(table), Some(_)) => aid_series(table, "barometer", "baro_height_m", span)?,
+            (Some(_), None) => {
+                return Err(invalid(
+                    "barometer data",
+                    "given, but the scenario has no [baro]: the filter takes its accuracy from it",
+                ));
+            }
+            (None, _) => (Vec::new(), Vec::new()),
+        };
+        let nhc = setup.aiding.nhc_sigma_m_s;
+        if let Some(c) = nhc
+            && !(c.is_finite() && c > 0.0)
+        {
+            return Err(invalid(
+                "nhc_sigma_m_s",
+                format!("must be a finite number > 0 (m/s), got {c}"),
+            ));
+        }
+        Ok(Self {
+            odometer,
+            baro,
+            odometer_model: setup.aiding.odometer.unwrap_or(OdometerModel {
+                noise_m_s: 0.0,
+                scale_factor_error: 0.0,
+            }),
+            baro_sigma_m: setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA),
+            nhc_sigma_m_s: nhc,
+            gate_on: setup.gate.is_finite(),
+            next: (0, 0),
+            next_nhc_t: span.0,
+        })
+    }
+
+    /// Skips the readings before the filter's first sample at `t_first`.
+    pub(crate) fn start_at(&mut self, t_first: f64) {
+        self.next = (
+            self.odometer.0.partition_point(|&x| x < t_first),
+            self.baro.0.partition_point(|&x| x < t_first),
+        );
+        self.next_nhc_t = t_first;
+    }
+
+    /// The χ² 99.9 % gate for `dof` rows (none when the fusion's gate is off).
+    fn gate(&self, dof: usize) -> f64 {
+        if self.gate_on {
+            CHI2_99_9[dof - 1]
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Every aid reading up to IMU sample `i` at `t_s`: odometer speeds (with the constraints
+    /// when they are on), the constraints alone at [`NHC_RATE_HZ`] without an odometer, heights.
+    ///
+    /// # Errors
+    /// The filter's refusal, naming the aid and its row ([`filter_refusal`]).
+    pub(crate) fn apply(&mut self, filter: &mut impl AidUpdates, t_s: f64, i: usize) -> Result<()> {
+        let (odo_t, odo_v) = (&self.odometer.0, &self.odometer.1);
+        while self.next.0 < odo_t.len() && odo_t[self.next.0] <= t_s {
+            let k = self.next.0;
+            let speed = odo_v[k];
+            let m = self.odometer_model;
+            let sigma = m
+                .noise_m_s
+                .hypot(m.scale_factor_error * speed)
+                .max(MIN_SIGMA);
+            let (measured, sigmas, dof) = match self.nhc_sigma_m_s {
+                Some(c) => ([Some(speed), Some(0.0), Some(0.0)], [sigma, c, c], 3),
+                None => ([Some(speed), None, None], [sigma, 1.0, 1.0], 1),
+            };
+            filter
+                .body_velocity(measured, sigmas, self.gate(dof))
+                .map_err(|e| filter_refusal("odometer", k, e))?;
+            self.next.0 += 1;
+        }
+        if let Some(c) = self.nhc_sigma_m_s
+            && odo_t.is_empty()
+            && t_s >= self.next_nhc_t
+        {
+            filter
+                .body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], self.gate(2))
+                .map_err(|e| filter_refusal("constraint", i, e))?;
+            self.next_nhc_t = t_s + 1.0 / NHC_RATE_HZ;
+        }
+        let (baro_t, baro_h) = (&self.baro.0, &self.baro.1);
+        while self.next.1 < baro_t.len() && baro_t[self.next.1] <= t_s {
+            let k = self.next.1;
+            filter
+                .height(baro_h[k], self.baro_sigma_m, self.gate(1))
+                .map_err(|e| filter_refusal("barometer", k, e))?;
+            self.next.1 += 1;
+        }
+        Ok(())
+    }
+}
