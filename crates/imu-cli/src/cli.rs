@@ -170,8 +170,9 @@ pub enum Command {
         #[arg(long)]
         init: Option<PathBuf>,
         /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
-        /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); the estimate begins
-        /// there.
+        /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); `static` (WGS-84
+        /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s. The
+        /// estimate begins there.
         #[arg(long)]
         align: Option<String>,
         /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.

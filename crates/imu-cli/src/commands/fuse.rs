@@ -100,6 +100,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         "odometer data" => a.odometer,
         "barometer data" => a.baro,
         "nhc_sigma_m_s" => Some(Path::new("--nhc")),
+        "align" => Some(Path::new("--align")),
         "covariance_interval_s" => Some(Path::new("--covariance-interval-s")),
         _ => None,
     };

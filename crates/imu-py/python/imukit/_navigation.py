@@ -125,8 +125,9 @@ def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, 
     ``scenario`` — the dict or scenario file that made the data: its ``[imu]`` errors, its
     ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. The filter starts from
     ``initial``, a truth Table (its first row), or without truth from ``align="gnss"``: position,
-    velocity, heading and pitch of the first fix at 3 m/s or more (roll 0), where the estimate
-    begins. Returns the navigation columns of :func:`strapdown`, their one-sigma
+    velocity, heading and pitch of the first fix at 3 m/s or more (roll 0), or ``align="static"``
+    on the WGS-84 Earth (at rest: levelling and gyrocompassing over the first 60 s); the estimate
+    begins there. Returns the navigation columns of :func:`strapdown`, their one-sigma
     (``pos_x_sigma_m`` … ``att_z_sigma_rad``), the bias estimates (``accel_bias_x_m_s2`` …
     ``gyro_bias_z_rad_s``) and their one-sigma (``accel_bias_x_sigma_m_s2`` …); ``gate=False`` applies every update (else a chi-square gate rejects
     outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),

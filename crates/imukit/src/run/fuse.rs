@@ -66,6 +66,11 @@ pub struct FuseSetup {
     pub noise: EskfNoise,
     /// Initial uncertainty.
     pub initial_sigma: InitialSigma,
+    /// The part's own bias figures (accelerometer m/s², gyroscope rad/s): its constant bias and
+    /// bias-instability floor in quadrature, per worst axis. A static alignment states its
+    /// accuracy from them (the filter's `initial_sigma` keeps wider floors for parts that give
+    /// no figure).
+    pub part_bias: [f64; 2],
     /// GNSS position one-sigma (x, y, z of the frame), m.
     pub gnss_position_sigma_m: [f64; 3],
     /// GNSS velocity one-sigma per axis, m/s (`None`: position only).
@@ -149,7 +154,18 @@ pub enum Start<'a> {
     /// vehicle moving nose first (heading and pitch along the fix's velocity, roll 0), each
     /// with its stated one-sigma (see [`align_from_gnss`]); the estimate begins there.
     AlignGnss,
+    /// Without truth, at rest, on the WGS-84 Earth: levelling from the mean specific force and
+    /// gyrocompassing from the mean body rate (the Earth rate's horizontal part points north)
+    /// over the first `duration_s`, position from the fixes; the estimate begins at its end.
+    /// Refused on the flat Earth, whose model has no Earth rate.
+    AlignStatic {
+        /// How long the vehicle stands still at the start, s.
+        duration_s: f64,
+    },
 }
+
+/// How long `--align static` averages, s.
+pub const STATIC_ALIGN_S: f64 = 60.0;
 
 impl<'a> Start<'a> {
     /// The start a user asks for: an initial state (`initial`, a truth row) or an alignment by
@@ -172,23 +188,20 @@ impl<'a> Start<'a> {
         }
     }
 
-    /// The alignment a user names (`--align`, Python `align=`): `"gnss"`.
+    /// The alignment a user names (`--align`, Python `align=`): `"gnss"` or `"static"`
+    /// ([`STATIC_ALIGN_S`] at rest).
     ///
     /// # Errors
-    /// `"static"`, with the reason (the flat Earth has no rate for the gyroscopes to find north
-    /// by), and any other name.
+    /// Any other name.
     pub fn alignment(name: &str) -> Result<Self> {
         match name {
             "gnss" => Ok(Self::AlignGnss),
-            "static" => Err(invalid(
-                "align",
-                "\"static\": on the flat Earth the gyroscopes cannot find north (the flat model \
-                 has no Earth rate), so a static alignment waits for fusion on the WGS-84 Earth; \
-                 use \"gnss\" (heading from the first fix at speed) or give the initial state",
-            )),
+            "static" => Ok(Self::AlignStatic {
+                duration_s: STATIC_ALIGN_S,
+            }),
             other => Err(invalid(
                 "align",
-                format!("{other:?}: give \"gnss\" (or the initial state)"),
+                format!("{other:?}: give \"gnss\" or \"static\" (or the initial state)"),
             )),
         }
     }
@@ -286,8 +299,9 @@ pub fn fuse_with(
     }
 }
 
-/// GNSS stamps: finite, increasing, inside the IMU's span `[t0, t1]` (the row named).
-pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64)) -> Result<()> {
+/// GNSS stamps: finite, increasing, inside the IMU's span `[t0, t1]` (the row named), and not
+/// more frequent on average than the IMU's `samples` (fixes are applied at IMU samples).
+pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<()> {
     for (k, &tk) in g_t.iter().enumerate() {
         if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
             return Err(invalid(
@@ -301,6 +315,25 @@ pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64)) -> Result<()> {
                 format!(
                     "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
                     k + 2
+                ),
+            ));
+        }
+    }
+    if let (Some(&first), Some(&last)) = (g_t.first(), g_t.last())
+        && g_t.len() > 1
+        && samples > 1
+    {
+        let (fix_dt, imu_dt) = (
+            (last - first) / (g_t.len() - 1) as f64,
+            (t1 - t0) / (samples - 1) as f64,
+        );
+        if fix_dt < imu_dt {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "fixes come every {fix_dt} s, more often than the IMU's samples (every \
+                     {imu_dt} s): the filter applies fixes at IMU samples, so the IMU must be the \
+                     faster sensor"
                 ),
             ));
         }
@@ -380,11 +413,19 @@ fn fuse_in<N: NavFrame>(
         t.first().copied().unwrap_or(0.0),
         t.last().copied().unwrap_or(0.0),
     );
-    check_fix_times(&g_t, (t0, t1))?;
+    check_fix_times(&g_t, (t0, t1), t.len())?;
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
     let (first, initial, sigma, mut next_fix) = match start {
         Start::State(s) => (0, *s, setup.initial_sigma, 0),
+        Start::AlignStatic { .. } => {
+            return Err(invalid(
+                "align",
+                "\"static\": on the flat Earth the gyroscopes cannot find north (the flat model \
+                 has no Earth rate); a static alignment needs a scenario on the WGS-84 Earth — \
+                 use \"gnss\" (heading from the first fix at speed) or give the initial state",
+            ));
+        }
         Start::AlignGnss => {
             let k = (0..g_t.len())
                 .find(|&k| g_v[k][0].hypot(g_v[k][1]) >= ALIGN_MIN_SPEED_M_S)
@@ -610,6 +651,12 @@ impl FuseSetup {
                 accel_bias_m_s2: max_abs(p.accelerometer.constant_bias).max(0.01),
                 gyro_bias_rad_s: max_abs(p.gyroscope.constant_bias).max(1e-4),
             },
+            part_bias: [
+                max_abs(p.accelerometer.constant_bias)
+                    .hypot(FLICKER_FLOOR * max_abs(p.accelerometer.bias_instability)),
+                max_abs(p.gyroscope.constant_bias)
+                    .hypot(FLICKER_FLOOR * max_abs(p.gyroscope.bias_instability)),
+            ],
             gnss_position_sigma_m: [h, h, v],
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: gnss.lever_arm_m,

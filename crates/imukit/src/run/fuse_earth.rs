@@ -5,8 +5,9 @@
 //! plane at the start's origin, velocity, attitude and one-sigmas on frame `N`'s axes, biases in
 //! its body convention) and `lat_rad, lon_rad, height_m`. Odometer, barometer (the ellipsoidal
 //! height) and the constraints aid it as on the flat Earth (the same code, `fuse_aids`).
+use imu_core::earth::wgs84::OMEGA_IE_RAD_S;
 use imu_core::earth::{Geodetic, GravityModel};
-use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError};
+use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError, InitialSigma};
 use imu_core::strapdown::earth::EarthNavState;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
@@ -46,6 +47,74 @@ fn sigmas_to<N: NavFrame>(ned: [f64; 3]) -> [f64; 3] {
         .apply(Vec3::<Ned>::from_array(ned))
         .to_array()
         .map(f64::abs)
+}
+
+/// The GNSS speed above which a vehicle is not at rest for the static alignment, m/s.
+const STATIC_SPEED_M_S: f64 = 0.5;
+
+/// Levelling and gyrocompassing from the mean specific force `f` and body rate `w` (FRD) of a
+/// vehicle at rest for `duration_s` at `position`: roll `atan2(−f_y, −f_z)`, pitch
+/// `atan2(f_x, √(f_y² + f_z²))`; the rate levelled by them, `ω_l = R_y(θ) R_x(φ) ω`, is the Earth
+/// rate `(Ω cos φ cos ψ, −Ω cos φ sin ψ, −Ω sin φ)`, so yaw `ψ = atan2(−ω_l,y, ω_l,x)`. Stated
+/// one-sigma: tilt the part's accelerometer bias over g with the white noise averaged, heading
+/// the part's gyroscope bias and averaged white noise over `Ω cos φ` (Groves 2nd ed. §5.6);
+/// the filter then starts with the part's biases as their uncertainty.
+///
+/// # Errors
+/// A specific force far from gravity (not at rest), or a gyroscope whose stated heading
+/// accuracy would be worse than 0.2 rad.
+fn gyrocompass(
+    f: [f64; 3],
+    w: [f64; 3],
+    position: &Geodetic,
+    duration_s: f64,
+    setup: &FuseSetup,
+) -> Result<(EulerZyx, InitialSigma)> {
+    let g = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let gamma = imu_core::earth::normal_gravity_m_s2(position);
+    if (g - gamma).abs() > 0.05 * gamma {
+        return Err(invalid(
+            "align",
+            format!(
+                "\"static\": the mean specific force is {g:.3} m/s², not gravity ({gamma:.3}): \
+                 the vehicle is not at rest"
+            ),
+        ));
+    }
+    let roll = (-f[1]).atan2(-f[2]);
+    let pitch = f[0].atan2(f[1].hypot(f[2]));
+    let level = Rotation::<Body, Body>::from_euler(EulerZyx::new(0.0, pitch, roll));
+    let wl = level.apply(Vec3::from_array(w)).to_array();
+    let yaw = (-wl[1]).atan2(wl[0]);
+    let horizontal = OMEGA_IE_RAD_S * position.latitude_rad.cos();
+    let noise = setup.noise;
+    let [accel_bias, gyro_bias] = setup.part_bias;
+    let heading = gyro_bias.hypot(noise.gyro_psd / duration_s.sqrt()) / horizontal;
+    if heading.is_nan() || heading >= 0.2 {
+        return Err(invalid(
+            "align",
+            format!(
+                "\"static\": this gyroscope (bias {gyro_bias:.2e} rad/s) cannot find north against \
+                 the Earth rate's {horizontal:.2e} rad/s here; use \"gnss\" or give the initial \
+                 state"
+            ),
+        ));
+    }
+    let tilt = accel_bias.hypot(noise.accel_psd / duration_s.sqrt()) / gamma;
+    Ok((
+        EulerZyx::new(yaw, pitch, roll),
+        InitialSigma {
+            position_m: setup
+                .gnss_position_sigma_m
+                .iter()
+                .fold(0.0_f64, |a, b| a.max(*b)),
+            velocity_m_s: 0.05,
+            attitude_rad: [tilt, tilt, heading],
+            // What the averages took for the attitude stays a bias the filter must learn.
+            accel_bias_m_s2: accel_bias.max(1e-6),
+            gyro_bias_rad_s: gyro_bias.max(1e-9),
+        },
+    ))
 }
 
 /// Fuses on the Earth (see the module docs); `gravity` is the scenario's model.
@@ -90,7 +159,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         t.first().copied().unwrap_or(0.0),
         t.last().copied().unwrap_or(0.0),
     );
-    check_fix_times(&g_t, (t0, t1))?;
+    check_fix_times(&g_t, (t0, t1), t.len())?;
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     if let Some(k) = (0..g_p.len()).find(|&k| {
         let [lat, lon, h] = g_p[k];
@@ -115,6 +184,59 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         Start::State(initial) => {
             let (s, origin) = earth_nav::start::<N>(initial, t0)?;
             (0, s, origin, setup.initial_sigma, 0)
+        }
+        Start::AlignStatic { duration_s } => {
+            let i0 = t.partition_point(|&ti| ti < t0 + duration_s);
+            if i0 < 2 || i0 >= t.len() {
+                return Err(invalid(
+                    "align",
+                    format!(
+                        "\"static\" averages the first {duration_s} s at rest: the IMU data must \
+                         last longer"
+                    ),
+                ));
+            }
+            let fixes = g_t.partition_point(|&x| x <= t[i0]);
+            if fixes == 0 {
+                return Err(invalid(
+                    "GNSS data",
+                    format!(
+                        "no fix in the first {duration_s} s: the static alignment takes its \
+                         position from the fixes"
+                    ),
+                ));
+            }
+            if let Some(k) = (0..fixes).find(|&k| {
+                let v = g_v[k];
+                v[0].hypot(v[1]).hypot(v[2]) > STATIC_SPEED_M_S
+            }) {
+                return Err(invalid(
+                    "GNSS data",
+                    format!(
+                        "row {}: the vehicle moves ({:.2} m/s) during the static alignment's first \
+                         {duration_s} s",
+                        k + 2,
+                        g_v[k][0].hypot(g_v[k][1]).hypot(g_v[k][2])
+                    ),
+                ));
+            }
+            let mean = |v: &[[f64; 3]], s: f64| -> [f64; 3] {
+                let sum = v[..i0]
+                    .iter()
+                    .fold([0.0; 3], |a, x| [0, 1, 2].map(|j| a[j] + x[j]));
+                frd(sum.map(|x| x / i0 as f64), s)
+            };
+            let [lat, lon, h] = g_p[fixes - 1];
+            let position = geodetic(lat, lon, h);
+            let (euler, sigma) =
+                gyrocompass(mean(&f, sign), mean(&w, 1.0), &position, t[i0] - t0, setup)?;
+            let s = EarthNavState {
+                t_s: t[i0],
+                attitude: Rotation::<Body, Ned>::from_euler(euler),
+                velocity_m_s: Vec3::zeros(),
+                position,
+            };
+            (i0, s, position, sigma, fixes)
         }
         Start::AlignGnss => {
             let k = (0..g_t.len())
