@@ -697,9 +697,11 @@ fn through_a_20_minute_outage_on_the_earth_the_filter_knows_its_drift() {
     // The Earth filter's error model carries the Schuler feedback (gravity gradient, Earth rate),
     // and over 30 runs, each starting from an attitude drawn from the filter's initial
     // uncertainty (0.01 rad of tilt, 0.05 rad of heading), the RMS horizontal error at the
-    // outage's end matches its one-sigma within 25 %. (It is kilometres: at rest the heading is
-    // barely observed in 2 minutes, and a heading error ψ tilts the frame at Ω cos φ · ψ, here
-    // like a 0.5 °/h gyroscope bias; a gyrocompass alignment would remove it.)
+    // outage's end is not above the filter's one-sigma, nor far below: between 0.6 and 1.1 of it.
+    // (The filter is conservative here: it models the part's flicker bias instability as a random
+    // walk, whose spread keeps growing where flicker's does not. The error is kilometres: at rest
+    // the heading is barely observed in 2 minutes, and a heading error ψ tilts the frame at
+    // Ω cos φ · ψ, here like a 0.5 °/h gyroscope bias; a gyrocompass alignment removes it.)
     let text = "rate_hz = 10.0\nduration_s = 1320.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
                 origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }\n\
                 [trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
@@ -739,7 +741,7 @@ fn through_a_20_minute_outage_on_the_earth_the_filter_knows_its_drift() {
     eprintln!(
         "HG9900 after 20 min without GNSS: RMS horizontal error {rms:.2} m, filter {sigma:.2} m"
     );
-    assert!((rms / sigma - 1.0).abs() < 0.25, "{rms} vs {sigma}");
+    assert!((0.6..=1.1).contains(&(rms / sigma)), "{rms} vs {sigma}");
 }
 
 #[test]
@@ -784,7 +786,8 @@ fn a_navigation_grade_imu_at_rest_finds_north_and_then_holds_it_through_the_outa
     // gyrocompassing, then the filter. Its heading error after the alignment lies within 3σ of
     // what it states (1.5 mrad: the gyroscope's white noise averaged over 60 s, over the Earth
     // rate's horizontal part), and 20 minutes without GNSS now cost a few hundred metres instead
-    // of the 5 km of a 0.05 rad heading, with the error matching the filter's sigma.
+    // of the 5 km of a 0.05 rad heading, the error between 0.6 and 1.1 of the filter's sigma (as
+    // in the test above, the flicker model makes it conservative).
     use imukit::run::fuse::{AidTables, Start, fuse_with};
     let text = "rate_hz = 10.0\nduration_s = 1320.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
                 origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }\n\
@@ -829,5 +832,120 @@ fn a_navigation_grade_imu_at_rest_finds_north_and_then_holds_it_through_the_outa
         "HG9900 gyrocompassed, 20 min without GNSS: RMS horizontal error {rms:.2} m, filter {sigma:.2} m"
     );
     assert!(rms < 500.0, "{rms}");
-    assert!((rms / sigma - 1.0).abs() < 0.3, "{rms} vs {sigma}");
+    assert!((0.6..=1.1).contains(&(rms / sigma)), "{rms} vs {sigma}");
+}
+
+#[test]
+fn without_fixes_an_accelerometer_bias_swings_with_schulers_period() {
+    // At rest at 45° N, heading north, an accelerometer bias b on the forward (north) axis and
+    // nothing else; one fix at the start, then none for 42 minutes (half a Schuler period).
+    // Both the estimate's error (the Earth mechanization) and the filter's north one-sigma
+    // (its error model, told σ_b = b) follow the closed form b/ω²·(1 − cos ωt), ω² = γ/(R_N + h):
+    // 84.4 minutes per swing, not the 59.7 a doubled gravity gradient would give.
+    let b = 1e-3;
+    let text = format!(
+        "rate_hz = 10.0\nduration_s = 2532.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = {{ latitude_deg = 45.0, longitude_deg = 7.0, height_m = 0.0 }}\n\
+         [trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+         [imu]\nkind = \"accel-gyro\"\n[imu.accelerometer]\nconstant_bias_m_s2 = [{b}, 0.0, 0.0]\n\
+         [gnss]\nrate_hz = 1.0\ndecay_factor = 0.0\n\
+         [[gnss.outages]]\nstart_s = 0.5\nduration_s = 3000.0\n"
+    );
+    let sc = ScenarioSpec::from_toml(&text, "schuler.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let mut setup = FuseSetup::from_scenario(&sc).unwrap();
+    setup.initial_sigma = InitialSigma {
+        position_m: 1e-6,
+        velocity_m_s: 1e-9,
+        attitude_rad: [1e-12; 3],
+        accel_bias_m_s2: b,
+        gyro_bias_rad_s: 1e-15,
+    };
+    let sim = simulate(&text, 0);
+    let initial = InitialState::from_table(&sim.truth).unwrap();
+    let (nav, _) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+    let origin = imu_core::earth::Geodetic::from_degrees(45.0, 7.0, 0.0);
+    let (r_n, _) = origin.radii_m();
+    let omega = (imu_core::earth::normal_gravity_m_s2(&origin) / r_n).sqrt();
+    let t = col(&nav, "t_s");
+    let (err, sigma) = (
+        col(&nav, "pos_x_m")
+            .iter()
+            .zip(col(&sim.truth, "pos_x_m"))
+            .map(|(e, x)| e - x)
+            .collect::<Vec<_>>(),
+        col(&nav, "pos_x_sigma_m"),
+    );
+    for minutes in [10.0, 21.0, 30.0, 42.0] {
+        let i = t.partition_point(|&x| x < minutes * 60.0);
+        let want = b / (omega * omega) * (1.0 - (omega * t[i]).cos());
+        eprintln!(
+            "{minutes} min: error {:.2} m, σ {:.2} m, closed form {want:.2} m",
+            err[i], sigma[i]
+        );
+        assert!(
+            (err[i] - want).abs() < 0.02 * want,
+            "error at {minutes} min: {} vs {want}",
+            err[i]
+        );
+        assert!(
+            (sigma[i] - want).abs() < 0.02 * want,
+            "σ at {minutes} min: {} vs {want}",
+            sigma[i]
+        );
+    }
+}
+
+#[test]
+fn without_fixes_a_heading_error_drifts_as_the_filter_says() {
+    // At rest at 45° N, ideal sensors, the start's heading off by ψ₀ = 1 mrad and the filter told
+    // σ_ψ = ψ₀: the estimate's horizontal error (the mechanization) and the filter's one-sigma
+    // (its error model: the Earth rate's horizontal part turning the heading error into tilt,
+    // the Schuler loop, Coriolis) agree through 42 minutes.
+    let psi0 = 1e-3;
+    let text = "rate_hz = 10.0\nduration_s = 2532.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+         origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 0.0 }\n\
+         [trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+         [imu]\nkind = \"accel-gyro\"\n\
+         [gnss]\nrate_hz = 1.0\ndecay_factor = 0.0\n\
+         [[gnss.outages]]\nstart_s = 0.5\nduration_s = 3000.0\n";
+    let sc = ScenarioSpec::from_toml(text, "heading.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let mut setup = FuseSetup::from_scenario(&sc).unwrap();
+    setup.initial_sigma = InitialSigma {
+        position_m: 1e-6,
+        velocity_m_s: 1e-9,
+        attitude_rad: [1e-12, 1e-12, psi0],
+        accel_bias_m_s2: 1e-15,
+        gyro_bias_rad_s: 1e-15,
+    };
+    let sim = simulate(text, 0);
+    let mut initial = InitialState::from_table(&sim.truth).unwrap();
+    // Ĉ = (I − [φ×]) C: the estimate's heading off by −ψ₀ about down.
+    let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        initial.quaternion[0],
+        initial.quaternion[1],
+        initial.quaternion[2],
+        initial.quaternion[3],
+    ));
+    let start =
+        nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(0.0, 0.0, -psi0)) * q;
+    initial.quaternion = [start.w, start.i, start.j, start.k];
+    let (nav, _) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+    let t = col(&nav, "t_s");
+    for minutes in [10.0, 21.0, 30.0, 42.0] {
+        let i = t.partition_point(|&x| x < minutes * 60.0);
+        let e = |c: &str| col(&nav, c)[i] - col(&sim.truth, c)[i];
+        let err = e("pos_x_m").hypot(e("pos_y_m"));
+        let sigma = col(&nav, "pos_x_sigma_m")[i].hypot(col(&nav, "pos_y_sigma_m")[i]);
+        eprintln!("{minutes} min: horizontal error {err:.2} m, filter σ {sigma:.2} m");
+        assert!(
+            (err - sigma).abs() < 0.05 * sigma,
+            "{minutes} min: {err} vs {sigma}"
+        );
+    }
 }
