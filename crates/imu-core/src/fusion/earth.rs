@@ -17,7 +17,7 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::eskf::{
-    EskfError, EskfNoise, InitialSigma, Linearisation, Mat15, UpdateOutcome, Vec15,
+    EskfError, EskfNoise, InitialSigma, Intake, Linearisation, Mat15, UpdateOutcome, Vec15,
     body_velocity_model, gnss_model, initial_covariance, kalman_update, skew, sq,
 };
 use crate::earth::rates::{earth_rate_ned, transport_rate_ned};
@@ -67,11 +67,7 @@ pub struct EarthEskf {
     cov: Mat15,
     noise: EskfNoise,
     gravity: GravityModel,
-    last: Option<(Vector3<f64>, Vector3<f64>)>,
-    covariance_interval_s: f64,
-    /// Since the last covariance step: its length, `∫ Ĉ f̂ dt` and `∫ Ĉ dt`.
-    pending: (f64, Vector3<f64>, Matrix3<f64>),
-    samples: usize,
+    intake: Intake,
     updates: usize,
     rejected: usize,
 }
@@ -105,10 +101,7 @@ impl EarthEskf {
             cov,
             noise,
             gravity,
-            last: None,
-            covariance_interval_s: 0.0,
-            pending: (0.0, Vector3::zeros(), Matrix3::zeros()),
-            samples: 0,
+            intake: Intake::new(),
             updates: 0,
             rejected: 0,
         })
@@ -119,12 +112,7 @@ impl EarthEskf {
     /// # Errors
     /// An interval that is negative or not finite.
     pub fn with_covariance_interval(mut self, interval_s: f64) -> Result<Self, EskfError> {
-        if !(interval_s.is_finite() && interval_s >= 0.0) {
-            return Err(EskfError::BadParameter {
-                field: "covariance interval",
-            });
-        }
-        self.covariance_interval_s = interval_s;
+        self.intake.set_interval(interval_s)?;
         Ok(self)
     }
 
@@ -169,27 +157,14 @@ impl EarthEskf {
         gyro_rad_s: [f64; 3],
         accel_m_s2: [f64; 3],
     ) -> Result<(), EskfError> {
-        let index = self.samples;
-        let finite = [t_s]
-            .iter()
-            .chain(&gyro_rad_s)
-            .chain(&accel_m_s2)
-            .all(|v| v.is_finite());
-        if !finite {
-            return Err(EskfError::NotFinite { index });
-        }
-        let (w1, f1) = (Vector3::from(gyro_rad_s), Vector3::from(accel_m_s2));
-        let Some((w0, f0)) = self.last else {
-            self.last = Some((w1, f1));
-            self.samples += 1;
+        let index = self.intake.samples();
+        let Some((dt, w, f)) = self
+            .intake
+            .take(self.nav.t_s, t_s, gyro_rad_s, accel_m_s2)?
+        else {
             return Ok(());
         };
-        let dt = t_s - self.nav.t_s;
-        if dt.is_nan() || dt <= 0.0 {
-            return Err(EskfError::TimeNotIncreasing { index });
-        }
-        let w = 0.5 * (w0 + w1) - self.bg;
-        let f = 0.5 * (f0 + f1) - self.ba;
+        let (w, f) = (w - self.bg, f - self.ba);
         let c0 = self
             .nav
             .attitude
@@ -207,12 +182,7 @@ impl EarthEskf {
             .to_rotation_matrix()
             .into_inner();
         let c = (c0 + c1) * 0.5;
-        self.pending.0 += dt;
-        self.pending.1 += c * f * dt;
-        self.pending.2 += c * dt;
-        self.last = Some((w1, f1));
-        self.samples += 1;
-        if self.pending.0 >= self.covariance_interval_s * (1.0 - 1e-9) {
+        if self.intake.accumulate(dt, &c, &f) {
             self.step_covariance();
         }
         Ok(())
@@ -221,13 +191,9 @@ impl EarthEskf {
     /// One covariance step over the pending interval with the dense transition of the Earth
     /// error dynamics at the current position and velocity.
     fn step_covariance(&mut self) {
-        let (dt, cf, cdt) = self.pending;
-        if dt <= 0.0 {
+        let Some((dt, f_n, c)) = self.intake.take_pending() else {
             return;
-        }
-        self.pending = (0.0, Vector3::zeros(), Matrix3::zeros());
-        let c = cdt / dt;
-        let f_n = cf / dt;
+        };
         let p = &self.nav.position;
         let v = self.nav.velocity_m_s;
         let (r_n, r_e) = p.radii_m();
@@ -302,8 +268,8 @@ impl EarthEskf {
                 .to_rotation_matrix()
                 .into_inner(),
             v: *self.nav.velocity_m_s.as_nalgebra(),
-            w_body: self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg,
-            f_body: self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba,
+            w_body: self.intake.last().0 - self.bg,
+            f_body: self.intake.last().1 - self.ba,
             g: Vector3::new(0.0, 0.0, self.gravity.magnitude_m_s2(p)),
         };
         let (h, y, r) = gnss_model(

@@ -202,12 +202,7 @@ pub struct Eskf<N: NavFrame> {
     cov: Mat15,
     noise: EskfNoise,
     g: Vector3<f64>,
-    last: Option<(Vector3<f64>, Vector3<f64>)>,
-    /// Covariance propagation interval, s (0: every sample).
-    covariance_interval_s: f64,
-    /// Since the last covariance step: its length, `∫ Ĉ f̂ dt` and `∫ Ĉ dt`.
-    pending: (f64, Vector3<f64>, nalgebra::Matrix3<f64>),
-    samples: usize,
+    intake: Intake,
     updates: usize,
     rejected: usize,
     frame: core::marker::PhantomData<N>,
@@ -246,10 +241,7 @@ impl<N: NavFrame> Eskf<N> {
             cov,
             noise,
             g: *N::gravity(gravity_m_s2).as_nalgebra(),
-            last: None,
-            covariance_interval_s: 0.0,
-            pending: (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros()),
-            samples: 0,
+            intake: Intake::new(),
             updates: 0,
             rejected: 0,
             frame: core::marker::PhantomData,
@@ -266,12 +258,7 @@ impl<N: NavFrame> Eskf<N> {
     /// # Errors
     /// An interval that is negative or not finite.
     pub fn with_covariance_interval(mut self, interval_s: f64) -> Result<Self, EskfError> {
-        if !(interval_s.is_finite() && interval_s >= 0.0) {
-            return Err(EskfError::BadParameter {
-                field: "covariance interval",
-            });
-        }
-        self.covariance_interval_s = interval_s;
+        self.intake.set_interval(interval_s)?;
         Ok(self)
     }
 
@@ -318,28 +305,11 @@ impl<N: NavFrame> Eskf<N> {
         gyro_rad_s: [f64; 3],
         accel_m_s2: [f64; 3],
     ) -> Result<(), EskfError> {
-        let index = self.samples;
-        let finite = [t_s]
-            .iter()
-            .chain(&gyro_rad_s)
-            .chain(&accel_m_s2)
-            .all(|v| v.is_finite());
-        if !finite {
-            return Err(EskfError::NotFinite { index });
-        }
-        let (w1, f1) = (Vector3::from(gyro_rad_s), Vector3::from(accel_m_s2));
-        let Some((w0, f0)) = self.last else {
-            self.last = Some((w1, f1));
+        let Some((dt, w, f)) = self.intake.take(self.t, t_s, gyro_rad_s, accel_m_s2)? else {
             self.t = t_s;
-            self.samples += 1;
             return Ok(());
         };
-        let dt = t_s - self.t;
-        if dt.is_nan() || dt <= 0.0 {
-            return Err(EskfError::TimeNotIncreasing { index });
-        }
-        let w = 0.5 * (w0 + w1) - self.bg;
-        let f = 0.5 * (f0 + f1) - self.ba;
+        let (w, f) = (w - self.bg, f - self.ba);
         // Nominal state.
         let half = self.q * UnitQuaternion::from_scaled_axis(w * (0.5 * dt));
         let q1 = self.q * UnitQuaternion::from_scaled_axis(w * dt);
@@ -347,14 +317,9 @@ impl<N: NavFrame> Eskf<N> {
         self.v += (half * f + self.g) * dt;
         self.p += 0.5 * (v0 + self.v) * dt;
         let c = half.to_rotation_matrix().into_inner();
-        self.pending.0 += dt;
-        self.pending.1 += c * f * dt;
-        self.pending.2 += c * dt;
         self.q = q1;
         self.t = t_s;
-        self.last = Some((w1, f1));
-        self.samples += 1;
-        if self.pending.0 >= self.covariance_interval_s * (1.0 - 1e-9) {
+        if self.intake.accumulate(dt, &c, &f) {
             self.step_covariance();
         }
         Ok(())
@@ -364,13 +329,10 @@ impl<N: NavFrame> Eskf<N> {
     /// `A = FΔt + (FΔt)²/2` with the interval's mean `Ĉf̂` and `Ĉ`, kept as its seven non-zero
     /// 3 × 3 blocks; `Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ` (P symmetric).
     fn step_covariance(&mut self) {
-        let (dt, cf, cdt) = self.pending;
-        if dt <= 0.0 {
+        let Some((dt, cf, c)) = self.intake.take_pending() else {
             return;
-        }
-        self.pending = (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros());
-        let c = cdt / dt;
-        let a = Transition::new(&skew(&(cf / dt)), &c, dt);
+        };
+        let a = Transition::new(&skew(&cf), &c, dt);
         let ap = a.times(&self.cov);
         let mut gqg = Vec15::zeros();
         for i in 0..3 {
@@ -445,8 +407,8 @@ impl<N: NavFrame> Eskf<N> {
         let lin = Linearisation {
             c: self.q.to_rotation_matrix().into_inner(),
             v: self.v,
-            w_body: self.last.map_or(Vector3::zeros(), |(w, _)| w) - self.bg,
-            f_body: self.last.map_or(Vector3::zeros(), |(_, f)| f) - self.ba,
+            w_body: self.intake.last().0 - self.bg,
+            f_body: self.intake.last().1 - self.ba,
             g: self.g,
         };
         let delta_p = *position_m.as_nalgebra() - self.p;
@@ -715,4 +677,109 @@ pub(crate) fn kalman_update<const M: usize>(
         return Err(EskfError::Diverged { index });
     }
     Ok((nis, Some(dx)))
+}
+
+/// An IMU interval: its length, s, and the mean body rate and specific force of its two samples.
+pub(crate) type Interval = (f64, Vector3<f64>, Vector3<f64>);
+
+/// What both filters keep between IMU samples: the last sample, and the covariance schedule —
+/// its interval and, since its last step, the time and the sums `∫ Ĉ f̂ dt`, `∫ Ĉ dt`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Intake {
+    last: Option<(Vector3<f64>, Vector3<f64>)>,
+    interval_s: f64,
+    pending: (f64, Vector3<f64>, nalgebra::Matrix3<f64>),
+    samples: usize,
+}
+
+impl Intake {
+    pub(crate) fn new() -> Self {
+        Self {
+            last: None,
+            interval_s: 0.0,
+            pending: (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros()),
+            samples: 0,
+        }
+    }
+
+    /// The covariance interval, s (finite, ≥ 0; 0: every sample).
+    pub(crate) fn set_interval(&mut self, interval_s: f64) -> Result<(), EskfError> {
+        if !(interval_s.is_finite() && interval_s >= 0.0) {
+            return Err(EskfError::BadParameter {
+                field: "covariance interval",
+            });
+        }
+        self.interval_s = interval_s;
+        Ok(())
+    }
+
+    /// Samples taken so far (the next one's index).
+    pub(crate) fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// The last sample's body rate and specific force, as measured.
+    pub(crate) fn last(&self) -> (Vector3<f64>, Vector3<f64>) {
+        self.last.unwrap_or((Vector3::zeros(), Vector3::zeros()))
+    }
+
+    /// Takes sample `(t_s, gyro, accel)` after the one at `t_prev_s`: `None` for the first,
+    /// else the interval and the two samples' mean rate and specific force.
+    ///
+    /// # Errors
+    /// Non-finite values or a time that does not increase (the sample's index named).
+    pub(crate) fn take(
+        &mut self,
+        t_prev_s: f64,
+        t_s: f64,
+        gyro_rad_s: [f64; 3],
+        accel_m_s2: [f64; 3],
+    ) -> Result<Option<Interval>, EskfError> {
+        let index = self.samples;
+        let finite = [t_s]
+            .iter()
+            .chain(&gyro_rad_s)
+            .chain(&accel_m_s2)
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(EskfError::NotFinite { index });
+        }
+        let (w1, f1) = (Vector3::from(gyro_rad_s), Vector3::from(accel_m_s2));
+        let previous = self.last.replace((w1, f1));
+        let Some((w0, f0)) = previous else {
+            self.samples += 1;
+            return Ok(None);
+        };
+        let dt = t_s - t_prev_s;
+        if dt.is_nan() || dt <= 0.0 {
+            self.last = previous;
+            return Err(EskfError::TimeNotIncreasing { index });
+        }
+        self.samples += 1;
+        Ok(Some((dt, 0.5 * (w0 + w1), 0.5 * (f0 + f1))))
+    }
+
+    /// Adds an interval `dt` with attitude `c` and specific force `f` (bias-corrected, body) to
+    /// the pending covariance step; true when the step is due.
+    pub(crate) fn accumulate(
+        &mut self,
+        dt: f64,
+        c: &nalgebra::Matrix3<f64>,
+        f: &Vector3<f64>,
+    ) -> bool {
+        self.pending.0 += dt;
+        self.pending.1 += c * f * dt;
+        self.pending.2 += c * dt;
+        self.pending.0 >= self.interval_s * (1.0 - 1e-9)
+    }
+
+    /// The pending interval (its length, mean `Ĉf̂` and mean `Ĉ`), cleared; `None` when empty.
+    pub(crate) fn take_pending(&mut self) -> Option<(f64, Vector3<f64>, nalgebra::Matrix3<f64>)> {
+        let (dt, cf, cdt) = self.pending;
+        if dt <= 0.0 {
+            return None;
+        }
+        self.pending = (0.0, Vector3::zeros(), nalgebra::Matrix3::zeros());
+        Some((dt, cf / dt, cdt / dt))
+    }
 }

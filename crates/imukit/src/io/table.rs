@@ -181,6 +181,21 @@ impl Table {
         check_finite(&self.columns, &self.data, what)
     }
 
+    /// Three columns read row by row as `[a, b, c]` (an x, y, z triple); `None` when one is
+    /// missing.
+    #[must_use]
+    pub fn triples(&self, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
+        let c: Vec<Vec<f64>> = names
+            .iter()
+            .map(|n| self.column(n))
+            .collect::<Option<_>>()?;
+        Some(
+            (0..self.rows())
+                .map(|i| [c[0][i], c[1][i], c[2][i]])
+                .collect(),
+        )
+    }
+
     /// An empty table with these columns.
     #[must_use]
     pub fn new(columns: &[&str]) -> Self {

@@ -85,11 +85,6 @@ pub(crate) fn start<N: NavFrame>(
     Ok((state, plane_origin::<N>(initial.position_m, &position)))
 }
 
-fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
-    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
-    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
-}
-
 /// Integrates an IMU table (rates or increments, frame `N`'s body convention) on the Earth.
 ///
 /// # Errors
@@ -131,7 +126,7 @@ pub(crate) fn integrate_earth_in<N: NavFrame>(
     let mut out = vec![EarthNavState::default(); t.len()];
     let corrections = setup.options.coning || setup.options.sculling;
     let result = if let (Some(f), Some(w)) =
-        (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
+        (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
     {
         let (f, w) = (frd(f, sign), frd(w, 1.0));
         match setup.scheme.for_input(true, corrections) {
@@ -144,8 +139,7 @@ pub(crate) fn integrate_earth_in<N: NavFrame>(
                 strapdown_increments_earth(t, &dth, &dv, baro.as_deref(), &s0, options, &mut out)
             }
         }
-    } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
-    {
+    } else if let (Some(dv), Some(dth)) = (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS)) {
         if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
             return Err(invalid(
                 "IMU data",

@@ -139,11 +139,6 @@ pub struct FuseSummary {
     pub rejected: usize,
 }
 
-fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
-    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
-    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
-}
-
 /// Where the filter starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Start<'a> {
@@ -351,6 +346,94 @@ pub(crate) fn filter_refusal(what: &str, index: usize, e: EskfError) -> Error {
     }
 }
 
+/// What both fusions read: IMU times and rates (frame `N`'s body convention, as in the table),
+/// GNSS stamps, positions (three columns) and velocities, checked.
+pub(crate) struct FusionInputs {
+    pub(crate) t: Vec<f64>,
+    pub(crate) f: Vec<[f64; 3]>,
+    pub(crate) w: Vec<[f64; 3]>,
+    pub(crate) g_t: Vec<f64>,
+    pub(crate) g_p: Vec<[f64; 3]>,
+    pub(crate) g_v: Vec<[f64; 3]>,
+}
+
+impl FusionInputs {
+    /// Reads `imu` (rates) and `gnss` (`columns`: `t_s`, three position and three velocity
+    /// columns; `hint` follows the list of missing ones) and checks the stamps
+    /// ([`check_fix_times`]).
+    ///
+    /// # Errors
+    /// Missing columns, named; the stamps' refusals.
+    pub(crate) fn read(imu: &Table, gnss: &Table, columns: &[&str; 7], hint: &str) -> Result<Self> {
+        let t = imu
+            .column("t_s")
+            .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+        let (Some(f), Some(w)) = (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS)) else {
+            return Err(invalid(
+                "IMU data",
+                "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
+            ));
+        };
+        let missing: Vec<&str> = columns
+            .iter()
+            .copied()
+            .filter(|c| !gnss.columns.iter().any(|h| h == c))
+            .collect();
+        if !missing.is_empty() {
+            return Err(invalid(
+                "GNSS data",
+                format!("missing column(s) {}{hint}", missing.join(", ")),
+            ));
+        }
+        let g_t = gnss.column("t_s").unwrap_or_default();
+        let g_p = gnss
+            .triples(&[columns[1], columns[2], columns[3]])
+            .unwrap_or_default();
+        let g_v = gnss
+            .triples(&[columns[4], columns[5], columns[6]])
+            .unwrap_or_default();
+        check_fix_times(&g_t, (t[0], t[t.len() - 1]), t.len())?;
+        Ok(Self {
+            t,
+            f,
+            w,
+            g_t,
+            g_p,
+            g_v,
+        })
+    }
+
+    /// The IMU's span `[t₀, t₁]`, s.
+    pub(crate) fn span(&self) -> (f64, f64) {
+        (self.t[0], self.t[self.t.len() - 1])
+    }
+
+    /// For the alignment from GNSS: the first fix `k` at [`ALIGN_MIN_SPEED_M_S`] or more, the
+    /// IMU sample `i0` it is applied at, and its age there (latency included), s.
+    ///
+    /// # Errors
+    /// No fix that fast.
+    pub(crate) fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
+        let k = self
+            .g_v
+            .iter()
+            .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
+            .ok_or_else(|| {
+                invalid(
+                    "GNSS data",
+                    format!(
+                        "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
+                         heading cannot be taken from GNSS velocity (give the initial state \
+                         instead)"
+                    ),
+                )
+            })?;
+        let t = &self.t;
+        let i0 = t.partition_point(|&ti| ti < self.g_t[k]).min(t.len() - 1);
+        Ok((k, i0, t[i0] - self.g_t[k] + latency_s))
+    }
+}
+
 /// Counts fix `index`'s outcome: fixes rejected one after another (`in_a_row`) up to
 /// [`MAX_REJECTED_IN_A_ROW`] are a divergence, reported instead of an estimate.
 ///
@@ -386,34 +469,16 @@ fn fuse_in<N: NavFrame>(
     start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    let t = imu
-        .column("t_s")
-        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
-    let (Some(f), Some(w)) = (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS)) else {
-        return Err(invalid(
-            "IMU data",
-            "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
-        ));
-    };
-    let missing: Vec<&str> = GNSS_COLUMNS
-        .iter()
-        .copied()
-        .filter(|c| !gnss.columns.iter().any(|h| h == c))
-        .collect();
-    if !missing.is_empty() {
-        return Err(invalid(
-            "GNSS data",
-            format!("missing column(s) {}", missing.join(", ")),
-        ));
-    }
-    let g_t = gnss.column("t_s").unwrap_or_default();
-    let g_p = triples(gnss, &["pos_x_m", "pos_y_m", "pos_z_m"]).unwrap_or_default();
-    let g_v = triples(gnss, &["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]).unwrap_or_default();
-    let (t0, t1) = (
-        t.first().copied().unwrap_or(0.0),
-        t.last().copied().unwrap_or(0.0),
-    );
-    check_fix_times(&g_t, (t0, t1), t.len())?;
+    let inputs = FusionInputs::read(imu, gnss, &GNSS_COLUMNS, "")?;
+    let FusionInputs {
+        t,
+        f,
+        w,
+        g_t,
+        g_p,
+        g_v,
+    } = &inputs;
+    let (t0, t1) = inputs.span();
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
     let (first, initial, sigma, mut next_fix) = match start {
@@ -427,20 +492,7 @@ fn fuse_in<N: NavFrame>(
             ));
         }
         Start::AlignGnss => {
-            let k = (0..g_t.len())
-                .find(|&k| g_v[k][0].hypot(g_v[k][1]) >= ALIGN_MIN_SPEED_M_S)
-                .ok_or_else(|| {
-                    invalid(
-                        "GNSS data",
-                        format!(
-                            "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: \
-                             the heading cannot be taken from GNSS velocity (give the initial \
-                             state instead)"
-                        ),
-                    )
-                })?;
-            let i0 = t.partition_point(|&ti| ti < g_t[k]).min(t.len() - 1);
-            let age = t[i0] - g_t[k] + setup.gnss_latency_s;
+            let (k, i0, age) = inputs.first_fix_at_speed(setup.gnss_latency_s)?;
             let (s, sigma) = align_from_gnss(g_p[k], g_v[k], age, setup);
             (i0, s, sigma, k + 1)
         }

@@ -12,11 +12,11 @@ use imu_core::strapdown::earth::EarthNavState;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
-use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
+use crate::io::table::{Table, concat_columns};
 use crate::run::earth_nav;
 use crate::run::fuse::{
-    ALIGN_MIN_SPEED_M_S, AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, Start, align_from_gnss,
-    check_fix_times, count_fix,
+    AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, FusionInputs, Start, align_from_gnss,
+    count_fix,
 };
 use crate::run::fuse_aids::AidStreams;
 use crate::run::navigate::GEODETIC_COLUMNS;
@@ -25,11 +25,6 @@ use crate::scenario::gnss::GNSS_EARTH_COLUMNS;
 
 /// Columns of a fused estimate on the Earth: [`FUSE_COLUMNS`] then the geodetic position.
 pub const FUSE_EARTH_COLUMNS: [&str; 38] = concat_columns(FUSE_COLUMNS, GEODETIC_COLUMNS);
-
-fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
-    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
-    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
-}
 
 /// A geodetic position from radians and metres.
 fn geodetic(latitude_rad: f64, longitude_rad: f64, height_m: f64) -> Geodetic {
@@ -129,37 +124,21 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
     setup: &FuseSetup,
     gravity: GravityModel,
 ) -> Result<(Table, FuseSummary)> {
-    let t = imu
-        .column("t_s")
-        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
-    let (Some(f), Some(w)) = (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS)) else {
-        return Err(invalid(
-            "IMU data",
-            "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
-        ));
-    };
-    let missing: Vec<&str> = GNSS_EARTH_COLUMNS
-        .iter()
-        .copied()
-        .filter(|c| !gnss.columns.iter().any(|h| h == c))
-        .collect();
-    if !missing.is_empty() {
-        return Err(invalid(
-            "GNSS data",
-            format!(
-                "missing column(s) {} (fixes on the WGS-84 Earth are geodetic)",
-                missing.join(", ")
-            ),
-        ));
-    }
-    let g_t = gnss.column("t_s").unwrap_or_default();
-    let g_p = triples(gnss, &["lat_rad", "lon_rad", "height_m"]).unwrap_or_default();
-    let g_v = triples(gnss, &["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]).unwrap_or_default();
-    let (t0, t1) = (
-        t.first().copied().unwrap_or(0.0),
-        t.last().copied().unwrap_or(0.0),
-    );
-    check_fix_times(&g_t, (t0, t1), t.len())?;
+    let inputs = FusionInputs::read(
+        imu,
+        gnss,
+        &GNSS_EARTH_COLUMNS,
+        " (fixes on the WGS-84 Earth are geodetic)",
+    )?;
+    let FusionInputs {
+        t,
+        f,
+        w,
+        g_t,
+        g_p,
+        g_v,
+    } = &inputs;
+    let (t0, t1) = inputs.span();
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
     if let Some(k) = (0..g_p.len()).find(|&k| {
         let [lat, lon, h] = g_p[k];
@@ -229,7 +208,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
             let [lat, lon, h] = g_p[fixes - 1];
             let position = geodetic(lat, lon, h);
             let (euler, sigma) =
-                gyrocompass(mean(&f, sign), mean(&w, 1.0), &position, t[i0] - t0, setup)?;
+                gyrocompass(mean(f, sign), mean(w, 1.0), &position, t[i0] - t0, setup)?;
             let s = EarthNavState {
                 t_s: t[i0],
                 attitude: Rotation::<Body, Ned>::from_euler(euler),
@@ -239,20 +218,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
             (i0, s, position, sigma, fixes)
         }
         Start::AlignGnss => {
-            let k = (0..g_t.len())
-                .find(|&k| g_v[k][0].hypot(g_v[k][1]) >= ALIGN_MIN_SPEED_M_S)
-                .ok_or_else(|| {
-                    invalid(
-                        "GNSS data",
-                        format!(
-                            "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: \
-                             the heading cannot be taken from GNSS velocity (give the initial \
-                             state instead)"
-                        ),
-                    )
-                })?;
-            let i0 = t.partition_point(|&ti| ti < g_t[k]).min(t.len() - 1);
-            let age = t[i0] - g_t[k] + setup.gnss_latency_s;
+            let (k, i0, age) = inputs.first_fix_at_speed(setup.gnss_latency_s)?;
             let (_, sigma) = align_from_gnss([0.0; 3], g_v[k], age, setup);
             let [lat, lon, h] = g_p[k];
             let v = g_v[k];

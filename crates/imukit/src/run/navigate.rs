@@ -519,11 +519,6 @@ impl NavRequest<'_> {
     }
 }
 
-fn triples(t: &Table, names: &[&str; 3]) -> Option<Vec<[f64; 3]>> {
-    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n)).collect::<Option<_>>()?;
-    Some((0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect())
-}
-
 /// Integrates an IMU table (rates or increments) from `initial`.
 ///
 /// # Errors
@@ -579,7 +574,7 @@ fn integrate_in<N: NavFrame>(
     let mut out = vec![NavState::<N>::default(); t.len()];
     let corrections = setup.options.coning || setup.options.sculling;
     let result = if let (Some(f), Some(w)) =
-        (triples(imu, &ACCEL_COLUMNS), triples(imu, &GYRO_COLUMNS))
+        (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
     {
         match setup.scheme.for_input(true, corrections) {
             NavScheme::ConingSculling => {
@@ -596,8 +591,7 @@ fn integrate_in<N: NavFrame>(
             ),
             NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
         }
-    } else if let (Some(dv), Some(dth)) = (triples(imu, &DV_COLUMNS), triples(imu, &DTHETA_COLUMNS))
-    {
+    } else if let (Some(dv), Some(dth)) = (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS)) {
         if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
             return Err(invalid(
                 "IMU data",
