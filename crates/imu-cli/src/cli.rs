@@ -203,6 +203,15 @@ pub enum Command {
         /// sample; default 0.05).
         #[arg(long)]
         covariance_interval_s: Option<f64>,
+        /// Also estimate the IMU's scale-factor and misalignment matrices (33 error states
+        /// instead of 15; their one-sigma at the start from the part's `axes_misalignment_pct`);
+        /// the estimate gains their columns.
+        #[arg(long)]
+        sensor_errors: bool,
+        /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
+        /// zero-rate updates at every sample there calibrate the gyroscope biases.
+        #[arg(long, value_name = "SECONDS")]
+        rest_s: Option<f64>,
         /// Where to write the estimate (CSV).
         #[arg(long)]
         out: PathBuf,

@@ -5,7 +5,7 @@
 //! heading is observable only when the vehicle accelerates horizontally.
 use std::path::Path;
 
-use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma};
+use imu_core::fusion::{Eskf, EskfNoise, EskfState, InitialSigma, SensorErrorSigma};
 use imu_core::sensor::{NoiseSource, SeededNormals};
 use imu_core::{Body, Enu, Rotation, Vec3};
 use imukit::run::fuse::{FuseSetup, fuse};
@@ -48,7 +48,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         "horizontal_accuracy_m = 0.0\nvertical_accuracy_m = 0.0\nvelocity_accuracy_m_s = 0.0",
     );
     let sim = simulate(&text, 0);
-    let setup = FuseSetup {
+    let base = FuseSetup {
         nav_frame: NavFrameName::ENU,
         earth: None,
         accel_sign: imu_core::AccelSign::SpecificForce,
@@ -74,9 +74,29 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         gate: f64::INFINITY,
         aiding: Default::default(),
         covariance_interval_s: 0.0,
+        estimate_sensor_errors: false,
+        sensor_error_sigma: SensorErrorSigma {
+            accel_scale_factor: 1e-3,
+            accel_misalignment: 1e-3,
+            gyro_scale_factor: 1e-3,
+            gyro_misalignment: 1e-3,
+            gyro_g_sensitivity: 1e-5,
+        },
+        rest_s: 0.0,
     };
+    // The 15-state filter and the one that also estimates the sensor matrices (which stay 0).
+    for estimate_sensor_errors in [false, true] {
+        let setup = FuseSetup {
+            estimate_sensor_errors,
+            ..base
+        };
+        reproduces_the_truth(&sim, &setup);
+    }
+}
+
+fn reproduces_the_truth(sim: &Simulation, setup: &FuseSetup) {
     let initial = InitialState::from_table(&sim.truth).unwrap();
-    let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
+    let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, setup).unwrap();
     assert_eq!(summary.updates, 201);
     let (truth_p, est_p) = (
         rows3(&sim.truth, ["pos_x_m", "pos_y_m", "pos_z_m"]),
@@ -92,6 +112,14 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
     assert!(worst < 5e-3, "worst position error {worst:e} m");
     let bias = col(&nav, "accel_bias_x_m_s2");
     assert!(bias.iter().all(|b| b.abs() < 1e-3), "{:?}", bias.last());
+    if setup.estimate_sensor_errors {
+        for name in ["accel_scale_factor_x", "gyro_misalignment_zx"] {
+            let m = col(&nav, name);
+            assert!(m.iter().all(|v| v.abs() < 1e-4), "{name}: {:?}", m.last());
+        }
+    } else {
+        assert!(nav.column("accel_scale_factor_x").is_none());
+    }
 }
 
 /// Wilson–Hilferty: the chi-square quantile with `k` degrees of freedom at standard normal `z`.

@@ -18,6 +18,8 @@ fn study(presets: &[&str], runs: u64) -> Study {
         odometer: false,
         baro: false,
         nhc_sigma_m_s: None,
+        sensor_errors: false,
+        rest_s: 0.0,
     };
     Study::new(&spec, &examples(), "test study").unwrap()
 }
@@ -126,6 +128,8 @@ fn an_odometer_and_the_vehicle_constraints_shrink_the_drift_through_the_tunnel()
             odometer: wheels,
             baro: false,
             nhc_sigma_m_s: wheels.then_some(0.05),
+            sensor_errors: false,
+            rest_s: 0.0,
         };
         let s = Study::new(&spec, &examples(), "wheels study").unwrap();
         let (_, summaries) = s.summarise(&s.run_all().unwrap()).unwrap();

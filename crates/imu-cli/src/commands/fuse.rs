@@ -23,6 +23,8 @@ pub struct Args<'a> {
     pub baro: Option<&'a Path>,
     pub nhc: Option<f64>,
     pub covariance_interval_s: Option<f64>,
+    pub sensor_errors: bool,
+    pub rest_s: Option<f64>,
     pub out: &'a Path,
 }
 
@@ -65,6 +67,10 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     if let Some(s) = a.covariance_interval_s {
         setup.covariance_interval_s = s;
     }
+    setup.estimate_sensor_errors = a.sensor_errors;
+    if let Some(s) = a.rest_s {
+        setup.rest_s = s;
+    }
     let initial = match a.init {
         Some(init) => {
             let s = InitialState::from_csv(init)?;
@@ -102,6 +108,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         "nhc_sigma_m_s" => Some(Path::new("--nhc")),
         "align" => Some(Path::new("--align")),
         "covariance_interval_s" => Some(Path::new("--covariance-interval-s")),
+        "rest_s" => Some(Path::new("--rest-s")),
         _ => None,
     };
     let rename = |context: String| match file_of(&context) {

@@ -102,6 +102,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             baro,
             nhc,
             covariance_interval_s,
+            sensor_errors,
+            rest_s,
             out,
         } => fuse::run(&fuse::Args {
             imu: &imu,
@@ -115,6 +117,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             baro: baro.as_deref(),
             nhc,
             covariance_interval_s,
+            sensor_errors,
+            rest_s,
             out: &out,
         }),
         Command::Study { study, out, plot } => study::run(&study, &out, plot.as_deref()),

@@ -17,8 +17,13 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::eskf::{
-    EskfError, EskfNoise, InitialSigma, Intake, Linearisation, Mat15, UpdateOutcome, Vec15,
-    body_velocity_model, gnss_model, initial_covariance, kalman_update, skew, sq,
+    Cov, EskfError, EskfNoise, InitialSigma, Intake, Linearisation, StateVec, UpdateOutcome,
+    body_velocity_model, gnss_model, initial_covariance, kalman_update, process_noise,
+    set_sensor_variances, skew, sq, zero_rate_model,
+};
+use super::sensor_errors::{
+    ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, SensorErrorEstimate, SensorErrorSigma,
+    SensorErrors,
 };
 use crate::earth::rates::{earth_rate_ned, transport_rate_ned};
 use crate::earth::wgs84::OMEGA_IE_RAD_S;
@@ -57,14 +62,16 @@ pub struct EarthGnssFix {
     pub age_s: f64,
 }
 
-/// The error-state filter on the WGS-84 Earth.
+/// The error-state filter on the WGS-84 Earth, of `S` states as [`super::Eskf`]: 15 (the
+/// default) or 36 with the sensors' scale-factor, misalignment and g-sensitivity errors.
 #[derive(Clone, Copy, Debug)]
-pub struct EarthEskf {
+pub struct EarthEskf<const S: usize = BASE_STATES> {
     mechanization: EarthIncrements,
     nav: EarthNavState,
     ba: Vector3<f64>,
     bg: Vector3<f64>,
-    cov: Mat15,
+    errors: SensorErrors,
+    cov: Cov<S>,
     noise: EskfNoise,
     gravity: GravityModel,
     intake: Intake,
@@ -72,7 +79,7 @@ pub struct EarthEskf {
     rejected: usize,
 }
 
-impl EarthEskf {
+impl<const S: usize> EarthEskf<S> {
     /// A filter at `initial` (biases zero) with `sigma` initial uncertainty (position in
     /// metres on each NED axis), the IMU `noise` and `gravity`.
     ///
@@ -98,6 +105,7 @@ impl EarthEskf {
             nav: *initial,
             ba: Vector3::zeros(),
             bg: Vector3::zeros(),
+            errors: SensorErrors::new(),
             cov,
             noise,
             gravity,
@@ -116,6 +124,21 @@ impl EarthEskf {
         Ok(self)
     }
 
+    /// As [`super::Eskf::with_sensor_error_sigma`].
+    ///
+    /// # Errors
+    /// A 15-state filter, or a sigma that is negative or not finite.
+    pub fn with_sensor_error_sigma(mut self, sigma: &SensorErrorSigma) -> Result<Self, EskfError> {
+        set_sensor_variances(&mut self.cov, sigma)?;
+        Ok(self)
+    }
+
+    /// The estimated sensor errors (zero in a 15-state filter).
+    #[must_use]
+    pub fn sensor_errors(&self) -> SensorErrorEstimate {
+        self.errors.estimate()
+    }
+
     /// The current estimate.
     #[must_use]
     pub fn state(&self) -> EarthEskfState {
@@ -126,10 +149,11 @@ impl EarthEskf {
         }
     }
 
-    /// One-sigma of the 15 error states: position north, east, down (m), velocity (NED),
-    /// attitude (NED axes), accelerometer bias, gyroscope bias (FRD).
+    /// One-sigma of the error states: position north, east, down (m), velocity (NED),
+    /// attitude (NED axes), accelerometer bias, gyroscope bias (FRD), and with 36 states the
+    /// sensor errors.
     #[must_use]
-    pub fn sigmas(&self) -> [f64; 15] {
+    pub fn sigmas(&self) -> [f64; S] {
         core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
     }
 
@@ -164,7 +188,7 @@ impl EarthEskf {
         else {
             return Ok(());
         };
-        let (w, f) = (w - self.bg, f - self.ba);
+        let (w, f) = self.errors.correct(w - self.bg, f - self.ba);
         let c0 = self
             .nav
             .attitude
@@ -182,6 +206,9 @@ impl EarthEskf {
             .to_rotation_matrix()
             .into_inner();
         let c = (c0 + c1) * 0.5;
+        if S == FULL_STATES {
+            self.errors.accumulate(dt, &c, &w, &f);
+        }
         if self.intake.accumulate(dt, &c, &f) {
             self.step_covariance();
         }
@@ -204,7 +231,7 @@ impl EarthEskf {
         let w_en = *transport_rate_ned(p, v).as_nalgebra();
         let (sin_l, cos_l) = (math::sin(p.latitude_rad), math::cos(p.latitude_rad));
         let tan_l = sin_l / cos_l;
-        let mut f = Mat15::zeros();
+        let mut f = Cov::<S>::zeros();
         f.fixed_view_mut::<3, 3>(0, 3)
             .copy_from(&Matrix3::identity());
         // The gravity model's error: vertical only (the horizontal Schuler feedback comes from
@@ -225,16 +252,14 @@ impl EarthEskf {
         f.fixed_view_mut::<3, 3>(6, 6)
             .copy_from(&(-skew(&(w_ie + w_en))));
         f.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
-        let a = f * dt;
-        let phi = Mat15::identity() + a + a * a * 0.5;
-        let mut q = Vec15::zeros();
-        for i in 0..3 {
-            q[3 + i] = sq(self.noise.accel_psd);
-            q[6 + i] = sq(self.noise.gyro_psd);
-            q[9 + i] = sq(self.noise.accel_bias_psd);
-            q[12 + i] = sq(self.noise.gyro_bias_psd);
+        if S == FULL_STATES {
+            let (cda, cdg) = self.errors.take_pending(dt);
+            f.fixed_view_mut::<3, 9>(3, ACCEL_MATRIX).copy_from(&(-cda));
+            f.fixed_view_mut::<3, 12>(6, GYRO_ERRORS).copy_from(&(-cdg));
         }
-        let qc = Mat15::from_diagonal(&q);
+        let a = f * dt;
+        let phi = Cov::<S>::identity() + a + a * a * 0.5;
+        let qc = Cov::<S>::from_diagonal(&process_noise::<S>(&self.noise));
         let qd = (phi * qc * phi.transpose() + qc) * (0.5 * dt);
         self.cov = phi * self.cov * phi.transpose() + qd;
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
@@ -253,6 +278,8 @@ impl EarthEskf {
         let p = &self.nav.position;
         let (r_n, r_e) = p.radii_m();
         let m = &fix.position;
+        let (w_last, f_last) = self.intake.last();
+        let (w_body, f_body) = self.errors.correct(w_last - self.bg, f_last - self.ba);
         let delta_p = Vector3::new(
             (m.latitude_rad - p.latitude_rad) * (r_n + p.height_m),
             wrap_pi(m.longitude_rad - p.longitude_rad)
@@ -268,8 +295,8 @@ impl EarthEskf {
                 .to_rotation_matrix()
                 .into_inner(),
             v: *self.nav.velocity_m_s.as_nalgebra(),
-            w_body: self.intake.last().0 - self.bg,
-            f_body: self.intake.last().1 - self.ba,
+            w_body,
+            f_body,
             g: Vector3::new(0.0, 0.0, self.gravity.magnitude_m_s2(p)),
         };
         let (h, y, r) = gnss_model(
@@ -321,10 +348,41 @@ impl EarthEskf {
         if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
             return Err(EskfError::NotFinite { index });
         }
-        let mut h = nalgebra::SMatrix::<f64, 1, 15>::zeros();
+        let mut h = nalgebra::SMatrix::<f64, 1, S>::zeros();
         h[(0, 2)] = -1.0;
         let y = nalgebra::SVector::<f64, 1>::new(height_m - self.nav.position.height_m);
         let r = nalgebra::SVector::<f64, 1>::new(sq(sigma_m));
+        self.correct(&h, &y, &r, gate, index)
+    }
+
+    /// A zero-angular-rate update (the vehicle stands still on the Earth): the last gyroscope
+    /// sample reads the Earth rate in body axes, `Ĉᵀ ω_ie`, through the sensor errors, within
+    /// one-sigma `sigma_rad_s` per axis (see [`super::Eskf::update_zero_rate`]).
+    ///
+    /// # Errors
+    /// A sigma that is not positive, no sample taken yet, or divergence.
+    pub fn update_zero_rate(
+        &mut self,
+        sigma_rad_s: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let c = self
+            .nav
+            .attitude
+            .quaternion()
+            .to_rotation_matrix()
+            .into_inner();
+        let w_ie_body = c.transpose() * *earth_rate_ned(&self.nav.position).as_nalgebra();
+        let (h, y, r) = zero_rate_model(
+            self.intake.last_sample(),
+            &self.bg,
+            &self.ba,
+            &self.errors,
+            &w_ie_body,
+            sigma_rad_s,
+            index,
+        )?;
         self.correct(&h, &y, &r, gate, index)
     }
 
@@ -332,7 +390,7 @@ impl EarthEskf {
     /// closed-loop injection, counts.
     fn correct<const M: usize>(
         &mut self,
-        h: &nalgebra::SMatrix<f64, M, 15>,
+        h: &nalgebra::SMatrix<f64, M, S>,
         y: &nalgebra::SVector<f64, M>,
         r: &nalgebra::SVector<f64, M>,
         gate: f64,
@@ -357,7 +415,7 @@ impl EarthEskf {
 
     /// Closed loop: the error estimate into the nominal state (position through the radii),
     /// and the mechanization restarted from it (its coning and sculling memory kept).
-    fn inject(&mut self, dx: &Vec15, index: usize) -> Result<(), EskfError> {
+    fn inject(&mut self, dx: &StateVec<S>, index: usize) -> Result<(), EskfError> {
         let p = self.nav.position;
         let (r_n, r_e) = p.radii_m();
         let position = Geodetic {
@@ -378,6 +436,9 @@ impl EarthEskf {
         };
         self.ba += Vector3::new(dx[9], dx[10], dx[11]);
         self.bg += Vector3::new(dx[12], dx[13], dx[14]);
+        if !self.errors.inject(dx) {
+            return Err(EskfError::Diverged { index });
+        }
         self.mechanization
             .reset(&self.nav)
             .map_err(|_| EskfError::Diverged { index })

@@ -22,8 +22,15 @@ use crate::math;
 use crate::rotation::Rotation;
 use crate::vector::Vec3;
 
-pub(crate) type Mat15 = SMatrix<f64, 15, 15>;
-pub(crate) type Vec15 = SVector<f64, 15>;
+use super::sensor_errors::{
+    ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, GyroJacobian, SensorErrorEstimate,
+    SensorErrorSigma, SensorErrors, d_gyro, d_matrix,
+};
+
+/// The error covariance of `S` states.
+pub(crate) type Cov<const S: usize> = SMatrix<f64, S, S>;
+/// An error-state vector of `S` states.
+pub(crate) type StateVec<const S: usize> = SVector<f64, S>;
 
 /// Continuous-time noise of the IMU as the filter models it (per axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,8 +157,10 @@ pub(crate) fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
 }
 
 /// The non-zero blocks of `A = FΔt + (FΔt)²/2` (rows/columns in blocks of 3: δp, δv, φ, δb_a,
-/// δb_g): `F₀₁ = I`, `F₁₂ = −[f^n×]`, `F₁₃ = −Ĉ`, `F₂₄ = −Ĉ`, and `F²` adds `(0,2) = −[f^n×]`,
-/// `(0,3) = −Ĉ`, `(1,4) = [f^n×]Ĉ`.
+/// δb_g, then the sensor errors δm_a (9) and δm_g (12), see [`super::sensor_errors`]):
+/// `F₀₁ = I`, `F₁₂ = −[f^n×]`, `F₁₃ = −Ĉ`, `F₂₄ = −Ĉ`, `F₁₅ = −Ĉ D_a`, `F₂₆ = −Ĉ D_g`, and `F²`
+/// adds `(0,2) = −[f^n×]`, `(0,3) = −Ĉ`, `(1,4) = [f^n×]Ĉ`, `(0,5) = −Ĉ D_a`,
+/// `(1,6) = [f^n×] Ĉ D_g`.
 struct Transition {
     a01: nalgebra::Matrix3<f64>,
     a02: nalgebra::Matrix3<f64>,
@@ -160,10 +169,25 @@ struct Transition {
     a13: nalgebra::Matrix3<f64>,
     a14: nalgebra::Matrix3<f64>,
     a24: nalgebra::Matrix3<f64>,
+    /// `(a05, a15, a16, a26)` with the sensor errors.
+    sensor: Option<SensorBlocks>,
 }
 
+/// The transition's sensor-error blocks `a05`, `a15` (3 × 9) and `a16`, `a26` (3 × 12).
+type SensorBlocks = (
+    SMatrix<f64, 3, 9>,
+    SMatrix<f64, 3, 9>,
+    GyroJacobian,
+    GyroJacobian,
+);
+
 impl Transition {
-    fn new(fx: &nalgebra::Matrix3<f64>, c: &nalgebra::Matrix3<f64>, dt: f64) -> Self {
+    fn new(
+        fx: &nalgebra::Matrix3<f64>,
+        c: &nalgebra::Matrix3<f64>,
+        sensor: Option<(SMatrix<f64, 3, 9>, GyroJacobian)>,
+        dt: f64,
+    ) -> Self {
         let h = 0.5 * dt * dt;
         Self {
             a01: nalgebra::Matrix3::identity() * dt,
@@ -173,33 +197,44 @@ impl Transition {
             a13: -c * dt,
             a14: fx * c * h,
             a24: -c * dt,
+            sensor: sensor.map(|(cda, cdg)| (-cda * h, -cda * dt, fx * cdg * h, -cdg * dt)),
         }
     }
 
-    /// `A · m`, block row by block row (rows 3–4 of A are zero).
-    fn times(&self, m: &Mat15) -> Mat15 {
-        let row = |k: usize| m.fixed_view::<3, 15>(3 * k, 0);
-        let mut out = Mat15::zeros();
-        out.fixed_view_mut::<3, 15>(0, 0)
-            .copy_from(&(self.a01 * row(1) + self.a02 * row(2) + self.a03 * row(3)));
-        out.fixed_view_mut::<3, 15>(3, 0)
-            .copy_from(&(self.a12 * row(2) + self.a13 * row(3) + self.a14 * row(4)));
-        out.fixed_view_mut::<3, 15>(6, 0)
-            .copy_from(&(self.a24 * row(4)));
+    /// `A · m`, block row by block row (rows 3–4 and the sensor rows of A are zero).
+    fn times<const S: usize>(&self, m: &Cov<S>) -> Cov<S> {
+        let row = |k: usize| m.fixed_view::<3, S>(3 * k, 0);
+        let mut r0 = self.a01 * row(1) + self.a02 * row(2) + self.a03 * row(3);
+        let mut r1 = self.a12 * row(2) + self.a13 * row(3) + self.a14 * row(4);
+        let mut r2 = self.a24 * row(4);
+        if let Some((a05, a15, a16, a26)) = &self.sensor {
+            let accel = m.fixed_view::<9, S>(ACCEL_MATRIX, 0);
+            let gyro = m.fixed_view::<12, S>(GYRO_ERRORS, 0);
+            r0 += a05 * accel;
+            r1 += a15 * accel + a16 * gyro;
+            r2 += a26 * gyro;
+        }
+        let mut out = Cov::<S>::zeros();
+        out.fixed_view_mut::<3, S>(0, 0).copy_from(&r0);
+        out.fixed_view_mut::<3, S>(3, 0).copy_from(&r1);
+        out.fixed_view_mut::<3, S>(6, 0).copy_from(&r2);
         out
     }
 }
 
-/// The error-state filter.
+/// The error-state filter of `S` states: [`BASE_STATES`] (15, the default) or [`FULL_STATES`]
+/// (36, with the sensors' scale-factor, misalignment and g-sensitivity errors, see
+/// [`super::sensor_errors`]); any other `S` does not compile.
 #[derive(Clone, Copy, Debug)]
-pub struct Eskf<N: NavFrame> {
+pub struct Eskf<N: NavFrame, const S: usize = BASE_STATES> {
     t: f64,
     p: Vector3<f64>,
     v: Vector3<f64>,
     q: UnitQuaternion<f64>,
     ba: Vector3<f64>,
     bg: Vector3<f64>,
-    cov: Mat15,
+    errors: SensorErrors,
+    cov: Cov<S>,
     noise: EskfNoise,
     g: Vector3<f64>,
     intake: Intake,
@@ -208,8 +243,10 @@ pub struct Eskf<N: NavFrame> {
     frame: core::marker::PhantomData<N>,
 }
 
-impl<N: NavFrame> Eskf<N> {
-    /// A filter at `initial` (biases zero unless given) with `sigma` initial uncertainty.
+impl<N: NavFrame, const S: usize> Eskf<N, S> {
+    /// A filter at `initial` (biases zero unless given) with `sigma` initial uncertainty (the
+    /// sensor errors of a 36-state filter start at zero, known exactly until
+    /// [`Self::with_sensor_error_sigma`]).
     ///
     /// # Errors
     /// Non-finite state, negative or non-finite sigmas or noise.
@@ -238,6 +275,7 @@ impl<N: NavFrame> Eskf<N> {
             q: *initial.attitude.quaternion(),
             ba: Vector3::from(initial.accel_bias_m_s2),
             bg: Vector3::from(initial.gyro_bias_rad_s),
+            errors: SensorErrors::new(),
             cov,
             noise,
             g: *N::gravity(gravity_m_s2).as_nalgebra(),
@@ -262,6 +300,21 @@ impl<N: NavFrame> Eskf<N> {
         Ok(self)
     }
 
+    /// The initial one-sigma of the sensor errors (36 states; see [`super::sensor_errors`]).
+    ///
+    /// # Errors
+    /// A 15-state filter, or a sigma that is negative or not finite.
+    pub fn with_sensor_error_sigma(mut self, sigma: &SensorErrorSigma) -> Result<Self, EskfError> {
+        set_sensor_variances(&mut self.cov, sigma)?;
+        Ok(self)
+    }
+
+    /// The estimated sensor errors (zero in a 15-state filter).
+    #[must_use]
+    pub fn sensor_errors(&self) -> SensorErrorEstimate {
+        self.errors.estimate()
+    }
+
     /// The current estimate.
     #[must_use]
     pub fn state(&self) -> EskfState<N> {
@@ -275,14 +328,15 @@ impl<N: NavFrame> Eskf<N> {
         }
     }
 
-    /// One-sigma of the 15 error states: position (3), velocity (3), attitude (3, navigation
-    /// axes), accelerometer bias (3), gyroscope bias (3).
+    /// One-sigma of the error states: position (3), velocity (3), attitude (3, navigation
+    /// axes), accelerometer bias (3), gyroscope bias (3), and with 36 states the sensor
+    /// errors `M_a`, `M_g` (9 each, row-major) and `k` (3).
     #[must_use]
-    pub fn sigmas(&self) -> [f64; 15] {
+    pub fn sigmas(&self) -> [f64; S] {
         core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
     }
 
-    /// The error covariance (row-major 15 × 15 access by `(i, j)`).
+    /// The error covariance entry `(i, j)` (`S × S`).
     #[must_use]
     pub fn covariance(&self, i: usize, j: usize) -> f64 {
         self.cov[(i, j)]
@@ -309,7 +363,7 @@ impl<N: NavFrame> Eskf<N> {
             self.t = t_s;
             return Ok(());
         };
-        let (w, f) = (w - self.bg, f - self.ba);
+        let (w, f) = self.errors.correct(w - self.bg, f - self.ba);
         // Nominal state.
         let half = self.q * UnitQuaternion::from_scaled_axis(w * (0.5 * dt));
         let q1 = self.q * UnitQuaternion::from_scaled_axis(w * dt);
@@ -319,6 +373,9 @@ impl<N: NavFrame> Eskf<N> {
         let c = half.to_rotation_matrix().into_inner();
         self.q = q1;
         self.t = t_s;
+        if S == FULL_STATES {
+            self.errors.accumulate(dt, &c, &w, &f);
+        }
         if self.intake.accumulate(dt, &c, &f) {
             self.step_covariance();
         }
@@ -332,18 +389,12 @@ impl<N: NavFrame> Eskf<N> {
         let Some((dt, cf, c)) = self.intake.take_pending() else {
             return;
         };
-        let a = Transition::new(&skew(&cf), &c, dt);
+        let sensor = (S == FULL_STATES).then(|| self.errors.take_pending(dt));
+        let a = Transition::new(&skew(&cf), &c, sensor, dt);
         let ap = a.times(&self.cov);
-        let mut gqg = Vec15::zeros();
-        for i in 0..3 {
-            gqg[3 + i] = sq(self.noise.accel_psd);
-            gqg[6 + i] = sq(self.noise.gyro_psd);
-            gqg[9 + i] = sq(self.noise.accel_bias_psd);
-            gqg[12 + i] = sq(self.noise.gyro_bias_psd);
-        }
         // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases;
         // Q_d = ½ (Φ Q Φᵀ + Q) Δt.
-        let qc = Mat15::from_diagonal(&gqg);
+        let qc = Cov::<S>::from_diagonal(&process_noise(&self.noise));
         let aq = a.times(&qc);
         let qd = (qc * 2.0 + aq + aq.transpose() + a.times(&aq.transpose())) * (0.5 * dt);
         self.cov += ap + ap.transpose() + a.times(&ap.transpose()) + qd;
@@ -404,11 +455,13 @@ impl<N: NavFrame> Eskf<N> {
         if !(age_s.is_finite() && age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
         }
+        let (w_last, f_last) = self.intake.last();
+        let (w_body, f_body) = self.errors.correct(w_last - self.bg, f_last - self.ba);
         let lin = Linearisation {
             c: self.q.to_rotation_matrix().into_inner(),
             v: self.v,
-            w_body: self.intake.last().0 - self.bg,
-            f_body: self.intake.last().1 - self.ba,
+            w_body,
+            f_body,
             g: self.g,
         };
         let delta_p = *position_m.as_nalgebra() - self.p;
@@ -461,7 +514,7 @@ impl<N: NavFrame> Eskf<N> {
         if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
             return Err(EskfError::NotFinite { index });
         }
-        let mut h = SMatrix::<f64, 1, 15>::zeros();
+        let mut h = SMatrix::<f64, 1, S>::zeros();
         h[(0, 2)] = N::Z_UP;
         let y = SVector::<f64, 1>::new(height_m - N::Z_UP * self.p.z);
         let r = SVector::<f64, 1>::new(sq(sigma_m));
@@ -472,9 +525,35 @@ impl<N: NavFrame> Eskf<N> {
     /// measurement variances `r` (rows with `H = 0`, `y = 0`, `r = 1` are inert); NIS against
     /// `gate` (rejected and counted above it); Joseph-form covariance, symmetrised; closed-loop
     /// injection of `δx` into the nominal state, and reset.
+    /// A zero-angular-rate update (the vehicle stands still): the last gyroscope sample is
+    /// what the gyroscopes read of a body at rest on the flat Earth, `b_g` (and the
+    /// g-sensitivity's `k ∘ f`) plus noise of one-sigma `sigma_rad_s` per axis (one sample's
+    /// white noise): `y = ω_m − b̂_g − k̂ ∘ f̂`, `H = I` on the gyroscope bias (and `diag(f̂)` on
+    /// `k`). Gated with `gate` (three degrees of freedom).
+    ///
+    /// # Errors
+    /// A sigma that is not positive, no sample taken yet, or divergence.
+    pub fn update_zero_rate(
+        &mut self,
+        sigma_rad_s: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        let index = self.updates + self.rejected;
+        let (h, y, r) = zero_rate_model(
+            self.intake.last_sample(),
+            &self.bg,
+            &self.ba,
+            &self.errors,
+            &Vector3::zeros(),
+            sigma_rad_s,
+            index,
+        )?;
+        self.correct(&h, &y, &r, gate, index)
+    }
+
     fn correct<const M: usize>(
         &mut self,
-        h: &SMatrix<f64, M, 15>,
+        h: &SMatrix<f64, M, S>,
         y: &SVector<f64, M>,
         r: &SVector<f64, M>,
         gate: f64,
@@ -496,6 +575,9 @@ impl<N: NavFrame> Eskf<N> {
         self.q = UnitQuaternion::from_scaled_axis(phi) * self.q;
         self.ba += dx.fixed_rows::<3>(9);
         self.bg += dx.fixed_rows::<3>(12);
+        if !self.errors.inject(&dx) {
+            return Err(EskfError::Diverged { index });
+        }
         self.updates += 1;
         Ok(UpdateOutcome {
             nis,
@@ -518,15 +600,21 @@ fn non_negative(field: &'static str, v: f64) -> Result<f64, EskfError> {
 ///
 /// # Errors
 /// A sigma or noise density that is negative or not finite, named.
-pub(crate) fn initial_covariance(
+pub(crate) fn initial_covariance<const S: usize>(
     sigma: &InitialSigma,
     noise: &EskfNoise,
-) -> Result<Mat15, EskfError> {
+) -> Result<Cov<S>, EskfError> {
+    const {
+        assert!(
+            S == BASE_STATES || S == FULL_STATES,
+            "the filters have 15 or 36 error states"
+        );
+    }
     non_negative("accel_psd", noise.accel_psd)?;
     non_negative("gyro_psd", noise.gyro_psd)?;
     non_negative("accel_bias_psd", noise.accel_bias_psd)?;
     non_negative("gyro_bias_psd", noise.gyro_bias_psd)?;
-    let mut diag = Vec15::zeros();
+    let mut diag = StateVec::<S>::zeros();
     for i in 0..3 {
         diag[i] = sq(non_negative("position sigma", sigma.position_m)?);
         diag[3 + i] = sq(non_negative("velocity sigma", sigma.velocity_m_s)?);
@@ -537,7 +625,79 @@ pub(crate) fn initial_covariance(
         )?);
         diag[12 + i] = sq(non_negative("gyroscope bias sigma", sigma.gyro_bias_rad_s)?);
     }
-    Ok(Mat15::from_diagonal(&diag))
+    Ok(Cov::<S>::from_diagonal(&diag))
+}
+
+/// Sets the initial variances of the sensor errors in `cov` (36 states).
+///
+/// # Errors
+/// A 15-state covariance, or a sigma that is negative or not finite.
+pub(crate) fn set_sensor_variances<const S: usize>(
+    cov: &mut Cov<S>,
+    sigma: &SensorErrorSigma,
+) -> Result<(), EskfError> {
+    if S != FULL_STATES {
+        return Err(EskfError::BadParameter {
+            field: "sensor error sigma (only a filter of 36 states has the sensor errors)",
+        });
+    }
+    let variances = sigma.variances().ok_or(EskfError::BadParameter {
+        field: "sensor error sigma",
+    })?;
+    for (k, v) in variances.iter().enumerate() {
+        cov[(ACCEL_MATRIX + k, ACCEL_MATRIX + k)] = *v;
+    }
+    Ok(())
+}
+
+/// The diagonal of the continuous process noise `G Q Gᵀ`: velocity and attitude white noise,
+/// bias random walks; none on position and the sensor matrices.
+pub(crate) fn process_noise<const S: usize>(noise: &EskfNoise) -> StateVec<S> {
+    let mut q = StateVec::<S>::zeros();
+    for i in 0..3 {
+        q[3 + i] = sq(noise.accel_psd);
+        q[6 + i] = sq(noise.gyro_psd);
+        q[9 + i] = sq(noise.accel_bias_psd);
+        q[12 + i] = sq(noise.gyro_bias_psd);
+    }
+    q
+}
+
+/// The zero-angular-rate model shared by the filters: `sample` (the last raw gyroscope and
+/// accelerometer readings, `None` before the first) of a body turning at `w_true` (body axes:
+/// 0 on the flat Earth, the Earth rate on WGS-84) with biases `b̂_g`, `b̂_a` and sensor errors
+/// `errors`: `y = ω_m − b̂_g − ((I + M̂_g) ω + k̂ ∘ f̂)`, `H = [I on δb_g, D_g on δm_g]`,
+/// `R = σ² I`.
+///
+/// # Errors
+/// No sample, a sigma that is not positive.
+pub(crate) fn zero_rate_model<const S: usize>(
+    sample: Option<(Vector3<f64>, Vector3<f64>)>,
+    bg: &Vector3<f64>,
+    ba: &Vector3<f64>,
+    errors: &SensorErrors,
+    w_true: &Vector3<f64>,
+    sigma_rad_s: f64,
+    index: usize,
+) -> Result<Rows<3, S>, EskfError> {
+    let Some((w_m, f_m)) = sample else {
+        return Err(EskfError::NotFinite { index });
+    };
+    let (_, f) = errors.correct(Vector3::zeros(), f_m - ba);
+    if !(sigma_rad_s.is_finite() && sigma_rad_s > 0.0) {
+        return Err(EskfError::BadParameter {
+            field: "zero-rate sigma",
+        });
+    }
+    let mut h = SMatrix::<f64, 3, S>::zeros();
+    h.fixed_view_mut::<3, 3>(0, 12)
+        .copy_from(&nalgebra::Matrix3::identity());
+    if S == FULL_STATES {
+        h.fixed_view_mut::<3, 12>(0, GYRO_ERRORS)
+            .copy_from(&d_gyro(w_true, &f));
+    }
+    let y = w_m - bg - errors.gyro_reading(w_true, &f);
+    Ok((h, y, SVector::<f64, 3>::repeat(sq(sigma_rad_s))))
 }
 
 /// What a measurement model needs of the nominal state: `Ĉ` (body to navigation), the
@@ -550,14 +710,17 @@ pub(crate) struct Linearisation {
     pub(crate) g: Vector3<f64>,
 }
 
-/// A measurement model of `M` rows: `H` (M × 15), innovation `y` and variances `r`.
-pub(crate) type Rows<const M: usize> = (SMatrix<f64, M, 15>, SVector<f64, M>, SVector<f64, M>);
+/// A measurement model of `M` rows: `H` (M × S), innovation `y` and variances `r`.
+pub(crate) type Rows<const M: usize, const S: usize> =
+    (SMatrix<f64, M, S>, SVector<f64, M>, SVector<f64, M>);
 
 /// The GNSS measurement model shared by the flat and the Earth filters: `delta_p` is the fix's
 /// position minus the nominal position in local navigation-frame metres; the antenna at lever
 /// arm `l`, the fix valid `age_s` earlier (see [`Eskf::update_gnss_fix`]); `sigmas` are the
-/// position and velocity one-sigmas. Returns `(H, y, r)` with unused velocity rows inert.
-pub(crate) fn gnss_model(
+/// position and velocity one-sigmas. Returns `(H, y, r)` with unused velocity rows inert. With
+/// the sensor errors the velocity rows also see them through the lever arm
+/// (`Ĉ [l×] D_g δm_g`) and the latency (`τ Ĉ D_a δm_a`).
+pub(crate) fn gnss_model<const S: usize>(
     lin: &Linearisation,
     delta_p: Vector3<f64>,
     velocity_m_s: Option<Vector3<f64>>,
@@ -565,7 +728,7 @@ pub(crate) fn gnss_model(
     sigmas: [[f64; 3]; 2],
     age_s: f64,
     index: usize,
-) -> Result<Rows<6>, EskfError> {
+) -> Result<Rows<6, S>, EskfError> {
     let c = lin.c;
     let cl = c * l;
     let cwl = c * lin.w_body.cross(&l);
@@ -573,7 +736,7 @@ pub(crate) fn gnss_model(
     let accel = cf + lin.g;
     let z_p = delta_p - (cl - (lin.v + cwl) * age_s + accel * (0.5 * age_s * age_s));
     let mut finite = z_p.iter().all(|v| v.is_finite());
-    let mut h = SMatrix::<f64, 6, 15>::zeros();
+    let mut h = SMatrix::<f64, 6, S>::zeros();
     let mut y = SVector::<f64, 6>::zeros();
     let mut r = SVector::<f64, 6>::repeat(1.0);
     h.fixed_view_mut::<3, 3>(0, 0)
@@ -594,6 +757,12 @@ pub(crate) fn gnss_model(
             .copy_from(&(-skew(&cwl) + skew(&cf) * age_s));
         h.fixed_view_mut::<3, 3>(3, 9).copy_from(&(c * age_s));
         h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
+        if S == FULL_STATES {
+            h.fixed_view_mut::<3, 9>(3, ACCEL_MATRIX)
+                .copy_from(&(c * d_matrix(&lin.f_body) * age_s));
+            h.fixed_view_mut::<3, 12>(3, GYRO_ERRORS)
+                .copy_from(&(c * skew(&l) * d_gyro(&lin.w_body, &lin.f_body)));
+        }
         y.fixed_rows_mut::<3>(3).copy_from(&z_v);
         for i in 0..3 {
             r[3 + i] = sq(sigmas[1][i]);
@@ -614,17 +783,17 @@ pub(crate) fn gnss_model(
 ///
 /// # Errors
 /// A measurement that is not finite or a sigma that is not positive.
-pub(crate) fn body_velocity_model(
+pub(crate) fn body_velocity_model<const S: usize>(
     c: &nalgebra::Matrix3<f64>,
     v: &Vector3<f64>,
     measured_m_s: [Option<f64>; 3],
     sigma_m_s: [f64; 3],
     index: usize,
-) -> Result<Rows<3>, EskfError> {
+) -> Result<Rows<3, S>, EskfError> {
     let ct = c.transpose();
     let predicted = ct * v;
     let h_phi = ct * skew(v);
-    let mut h = SMatrix::<f64, 3, 15>::zeros();
+    let mut h = SMatrix::<f64, 3, S>::zeros();
     let mut y = SVector::<f64, 3>::zeros();
     let mut r = SVector::<f64, 3>::repeat(1.0);
     for i in 0..3 {
@@ -648,14 +817,14 @@ pub(crate) fn body_velocity_model(
 /// # Errors
 /// An innovation covariance that cannot be inverted, or a covariance that loses its positive
 /// diagonal: divergence at update `index`.
-pub(crate) fn kalman_update<const M: usize>(
-    cov: &mut Mat15,
-    h: &SMatrix<f64, M, 15>,
+pub(crate) fn kalman_update<const M: usize, const S: usize>(
+    cov: &mut Cov<S>,
+    h: &SMatrix<f64, M, S>,
     y: &SVector<f64, M>,
     r: &SVector<f64, M>,
     gate: f64,
     index: usize,
-) -> Result<(f64, Option<Vec15>), EskfError> {
+) -> Result<(f64, Option<StateVec<S>>), EskfError> {
     let rm = SMatrix::<f64, M, M>::from_diagonal(r);
     let s = h * *cov * h.transpose() + rm;
     let Some(s_inv) = s.try_inverse() else {
@@ -670,10 +839,10 @@ pub(crate) fn kalman_update<const M: usize>(
     }
     let k = *cov * h.transpose() * s_inv;
     let dx = k * y;
-    let ikh = Mat15::identity() - k * h;
+    let ikh = Cov::<S>::identity() - k * h;
     *cov = ikh * *cov * ikh.transpose() + k * rm * k.transpose();
     *cov = (*cov + cov.transpose()) * 0.5;
-    if (0..15).any(|i| cov[(i, i)].is_nan() || cov[(i, i)] < 0.0) {
+    if (0..S).any(|i| cov[(i, i)].is_nan() || cov[(i, i)] < 0.0) {
         return Err(EskfError::Diverged { index });
     }
     Ok((nis, Some(dx)))
@@ -721,6 +890,11 @@ impl Intake {
     /// The last sample's body rate and specific force, as measured.
     pub(crate) fn last(&self) -> (Vector3<f64>, Vector3<f64>) {
         self.last.unwrap_or((Vector3::zeros(), Vector3::zeros()))
+    }
+
+    /// The last sample's body rate and specific force as measured, `None` before the first.
+    pub(crate) fn last_sample(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        self.last
     }
 
     /// Takes sample `(t_s, gyro, accel)` after the one at `t_prev_s`: `None` for the first,

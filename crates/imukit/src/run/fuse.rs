@@ -5,7 +5,10 @@
 //! velocity and attitude (navigation-frame axes), and the bias estimates — one row per IMU
 //! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
-use imu_core::fusion::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma};
+use imu_core::fusion::{
+    BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
+    SensorErrorEstimate, SensorErrorSigma,
+};
 use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Error, Result, invalid};
@@ -50,6 +53,65 @@ pub const FUSE_COLUMNS: [&str; 35] = concat_columns(
     ],
 );
 
+/// The columns a fused estimate gains when the filter estimates the IMU's scale-factor,
+/// misalignment and g-sensitivity errors ([`FuseSetup::estimate_sensor_errors`]): for the
+/// accelerometer then the gyroscope, row by row, a diagonal entry of `M` as
+/// `<triad>_scale_factor_<axis>` and an off-diagonal one as `<triad>_misalignment_<row><column>`
+/// (fractions: the reading is `(I + M) x + b`), then the gyroscopes' g-sensitivity
+/// `gyro_g_sensitivity_<axis>_rad_s_per_m_s2`, then the same names with `_sigma` for their
+/// one-sigma (before the unit).
+#[must_use]
+pub fn sensor_error_columns() -> Vec<String> {
+    let axes = ["x", "y", "z"];
+    // (name, unit suffix)
+    let mut names: Vec<(String, &str)> = ["accel", "gyro"]
+        .iter()
+        .flat_map(|triad| {
+            (0..9).map(move |k| {
+                let (r, c) = (k / 3, k % 3);
+                if r == c {
+                    (format!("{triad}_scale_factor_{}", axes[r]), "")
+                } else {
+                    (format!("{triad}_misalignment_{}{}", axes[r], axes[c]), "")
+                }
+            })
+        })
+        .collect();
+    names.extend(axes.map(|a| (format!("gyro_g_sensitivity_{a}"), "_rad_s_per_m_s2")));
+    let values = names.iter().map(|(n, u)| format!("{n}{u}"));
+    let sigmas = names.iter().map(|(n, u)| format!("{n}_sigma{u}"));
+    values.chain(sigmas).collect()
+}
+
+/// The column names of a fused estimate: `base` and, with the sensor matrices,
+/// [`sensor_error_columns`].
+pub(crate) fn fused_columns(base: &[&str], sensor_errors: bool) -> Vec<String> {
+    let mut columns: Vec<String> = base.iter().map(|c| (*c).to_string()).collect();
+    if sensor_errors {
+        columns.extend(sensor_error_columns());
+    }
+    columns
+}
+
+/// Appends the sensor errors' estimates and one-sigmas (`sigmas`: the 21 states in order) to
+/// `row`, on body axes that differ from the filter's by the signs `axis_sign` (a diagonal
+/// signed permutation: `M'ᵢⱼ = sᵢ sⱼ Mᵢⱼ`; `k'ᵢ = kᵢ`).
+pub(crate) fn push_sensor_errors(
+    row: &mut Vec<f64>,
+    estimate: &SensorErrorEstimate,
+    sigmas: &[f64],
+    axis_sign: [f64; 3],
+) {
+    for m in [&estimate.accel, &estimate.gyro] {
+        for k in 0..9 {
+            let (r, c) = (k / 3, k % 3);
+            row.push(axis_sign[r] * axis_sign[c] * m[r][c]);
+        }
+    }
+    row.extend_from_slice(&estimate.gyro_g_sensitivity);
+    row.extend_from_slice(sigmas);
+}
+
 /// How to fuse.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FuseSetup {
@@ -84,6 +146,19 @@ pub struct FuseSetup {
     pub gate: f64,
     /// Ground-vehicle and barometer aiding (all off by default).
     pub aiding: AidingSetup,
+    /// Estimate the IMU's scale-factor, misalignment and g-sensitivity errors: 36 error states
+    /// instead of 15 (see `imu_core::fusion::sensor_errors`), starting from
+    /// `sensor_error_sigma`; the estimate gains [`sensor_error_columns`]. Off by default.
+    pub estimate_sensor_errors: bool,
+    /// Their initial one-sigma: the part's own figures (`axes_misalignment_pct`,
+    /// `acceleration_bias`; worst entry), at least [`MIN_SENSOR_ERROR_SIGMA`] and
+    /// [`MIN_G_SENSITIVITY_SIGMA`].
+    pub sensor_error_sigma: SensorErrorSigma,
+    /// The vehicle stands still for the IMU's first `rest_s` seconds: the filter is told so
+    /// at every sample there (zero velocity within [`REST_VELOCITY_SIGMA_M_S`], zero angular
+    /// rate within one sample's gyroscope noise), which calibrates the gyroscope biases
+    /// before the vehicle moves. 0 (the default): no rest.
+    pub rest_s: f64,
     /// The covariance is propagated once per this interval and at every update, s (0: every
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
@@ -117,6 +192,17 @@ pub struct OdometerModel {
     /// Scale-factor error, fraction.
     pub scale_factor_error: f64,
 }
+
+/// The least initial one-sigma of a scale-factor or misalignment entry the filter estimates
+/// (a fraction: 100 ppm), for parts whose parameters state none.
+pub const MIN_SENSOR_ERROR_SIGMA: f64 = 1e-4;
+
+/// The least initial one-sigma of the gyroscopes' g-sensitivity the filter estimates,
+/// (rad/s)/(m/s²) (about 0.001 °/s per g).
+pub const MIN_G_SENSITIVITY_SIGMA: f64 = 1e-6;
+
+/// One-sigma of the zero-velocity update at rest, m/s.
+pub const REST_VELOCITY_SIGMA_M_S: f64 = 1e-3;
 
 /// Rate of the non-holonomic constraints when no odometer paces them, Hz.
 pub const NHC_RATE_HZ: f64 = 10.0;
@@ -286,11 +372,18 @@ pub fn fuse_with(
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
     use crate::run::fuse_earth::fuse_earth_in;
-    match (setup.nav_frame, setup.earth) {
-        (NavFrameName::ENU, None) => fuse_in::<Enu>(imu, gnss, aids, start, setup),
-        (NavFrameName::NED, None) => fuse_in::<Ned>(imu, gnss, aids, start, setup),
-        (NavFrameName::ENU, Some(g)) => fuse_earth_in::<Enu>(imu, gnss, aids, start, setup, g),
-        (NavFrameName::NED, Some(g)) => fuse_earth_in::<Ned>(imu, gnss, aids, start, setup, g),
+    use NavFrameName::{ENU, NED};
+    const B: usize = BASE_STATES;
+    const F: usize = FULL_STATES;
+    match (setup.nav_frame, setup.earth, setup.estimate_sensor_errors) {
+        (ENU, None, false) => fuse_in::<Enu, B>(imu, gnss, aids, start, setup),
+        (NED, None, false) => fuse_in::<Ned, B>(imu, gnss, aids, start, setup),
+        (ENU, None, true) => fuse_in::<Enu, F>(imu, gnss, aids, start, setup),
+        (NED, None, true) => fuse_in::<Ned, F>(imu, gnss, aids, start, setup),
+        (ENU, Some(g), false) => fuse_earth_in::<Enu, B>(imu, gnss, aids, start, setup, g),
+        (NED, Some(g), false) => fuse_earth_in::<Ned, B>(imu, gnss, aids, start, setup, g),
+        (ENU, Some(g), true) => fuse_earth_in::<Enu, F>(imu, gnss, aids, start, setup, g),
+        (NED, Some(g), true) => fuse_earth_in::<Ned, F>(imu, gnss, aids, start, setup, g),
     }
 }
 
@@ -462,7 +555,7 @@ pub(crate) fn count_fix(
     Ok(())
 }
 
-fn fuse_in<N: NavFrame>(
+fn fuse_in<N: NavFrame, const S: usize>(
     imu: &Table,
     gnss: &Table,
     aids: AidTables<'_>,
@@ -479,7 +572,7 @@ fn fuse_in<N: NavFrame>(
         g_v,
     } = &inputs;
     let (t0, t1) = inputs.span();
-    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
+    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
     // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
     let (first, initial, sigma, mut next_fix) = match start {
         Start::State(s) => (0, *s, setup.initial_sigma, 0),
@@ -517,25 +610,28 @@ fn fuse_in<N: NavFrame>(
     };
     let filter_error =
         |context: &str, e: imu_core::fusion::EskfError| invalid(context, e.to_string());
-    let mut filter = Eskf::<N>::new(&start, &sigma, setup.noise, setup.gravity_m_s2)
+    let filter = Eskf::<N, S>::new(&start, &sigma, setup.noise, setup.gravity_m_s2)
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
-        .map_err(|_| {
-            invalid(
-                "covariance_interval_s",
-                format!(
-                    "must be a finite number ≥ 0 (s), got {}",
-                    setup.covariance_interval_s
-                ),
-            )
-        })?;
+        .map_err(|_| covariance_interval_refusal(setup))?;
+    let mut filter = if S == FULL_STATES {
+        filter
+            .with_sensor_error_sigma(&setup.sensor_error_sigma)
+            .map_err(|e| filter_error("sensor_error_sigma", e))?
+    } else {
+        filter
+    };
     let sign = match setup.accel_sign {
         AccelSign::SpecificForce => 1.0,
         AccelSign::Matlab => -1.0,
     };
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
-    let mut table = Table::new(&FUSE_COLUMNS);
+    let columns = fused_columns(&FUSE_COLUMNS, S == FULL_STATES);
+    let mut table = Table {
+        columns,
+        data: Vec::new(),
+    };
     let mut rejected_in_a_row = 0;
     let mut last_yaw = None;
     for i in first..t.len() {
@@ -590,12 +686,47 @@ fn fuse_in<N: NavFrame>(
         row.extend_from_slice(&sig[..9]);
         row.extend_from_slice(&s.accel_bias_m_s2);
         row.extend_from_slice(&s.gyro_bias_rad_s);
-        row.extend_from_slice(&sig[9..]);
+        row.extend_from_slice(&sig[9..15]);
+        if S == FULL_STATES {
+            push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..], [1.0; 3]);
+        }
         table.push_row(&row);
     }
     table.check_finite("fused navigation")?;
     let (updates, rejected) = filter.update_counts();
     Ok((table, FuseSummary { updates, rejected }))
+}
+
+/// The refusal of `setup`'s covariance interval.
+pub(crate) fn covariance_interval_refusal(setup: &FuseSetup) -> Error {
+    invalid(
+        "covariance_interval_s",
+        format!(
+            "must be a finite number ≥ 0 (s), got {}",
+            setup.covariance_interval_s
+        ),
+    )
+}
+
+/// The initial one-sigma of a triad's scale-factor and misalignment entries from its
+/// `axes_misalignment_pct` (`100 (I + M)`): the largest `|Mᵢᵢ|` and the largest `|Mᵢⱼ|`, each
+/// at least [`MIN_SENSOR_ERROR_SIGMA`].
+fn matrix_sigma(p: &crate::sensor::SensorParams) -> (f64, f64) {
+    let a = &p.axes_misalignment_pct;
+    let (mut scale, mut cross) = (0.0_f64, 0.0_f64);
+    for (r, row) in a.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            if r == c {
+                scale = scale.max((v / 100.0 - 1.0).abs());
+            } else {
+                cross = cross.max((v / 100.0).abs());
+            }
+        }
+    }
+    (
+        scale.max(MIN_SENSOR_ERROR_SIGMA),
+        cross.max(MIN_SENSOR_ERROR_SIGMA),
+    )
 }
 
 /// The filter's model of one sensor triad from its error parameters at `rate_hz`: the
@@ -685,6 +816,8 @@ impl FuseSetup {
             floor(g.vertical_accuracy_m * scale),
         );
         let max_abs = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        let (accel_scale_factor, accel_misalignment) = matrix_sigma(&p.accelerometer);
+        let (gyro_scale_factor, gyro_misalignment) = matrix_sigma(&p.gyroscope);
         Ok(Self {
             nav_frame: scenario.nav_frame,
             earth,
@@ -723,6 +856,16 @@ impl FuseSetup {
                 baro_sigma_m: scenario.baro.map(|b| b.error.noise.hypot(b.error.constant)),
             },
             covariance_interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
+            estimate_sensor_errors: false,
+            sensor_error_sigma: SensorErrorSigma {
+                accel_scale_factor,
+                accel_misalignment,
+                gyro_scale_factor,
+                gyro_misalignment,
+                gyro_g_sensitivity: max_abs(p.gyroscope.acceleration_bias)
+                    .max(MIN_G_SENSITIVITY_SIGMA),
+            },
+            rest_s: 0.0,
         })
     }
 }

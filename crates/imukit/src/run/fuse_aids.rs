@@ -1,16 +1,22 @@
-//! The aids of a fusion besides GNSS — odometer readings, barometer readings and the
-//! non-holonomic constraints — read, checked and applied at their times, the same way for the
-//! flat filter and the Earth filter ([`AidUpdates`]).
+//! The aids of a fusion besides GNSS — odometer readings, barometer readings, the
+//! non-holonomic constraints and a rest at the start (zero velocity and zero angular rate) —
+//! read, checked and applied at their times, the same way for the flat filter and the Earth
+//! filter ([`AidUpdates`]).
 use imu_core::NavFrame;
 use imu_core::fusion::{EarthEskf, Eskf, EskfError, UpdateOutcome};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
-use crate::run::fuse::{AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, filter_refusal};
+use crate::run::fuse::{
+    AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, REST_VELOCITY_SIGMA_M_S, filter_refusal,
+};
 
 /// The smallest one-sigma the filter is told for an aid (exact simulated readings still need a
 /// little trust in the model), in the aid's unit.
 const MIN_SIGMA: f64 = 1e-3;
+
+/// The least one-sigma of a zero-rate update, rad/s (for noiseless gyroscopes).
+const MIN_RATE_SIGMA: f64 = 1e-9;
 
 /// One-degree-of-freedom and two- and three-degree chi-square 99.9 % quantiles: the gates of
 /// height, constraint and odometer-with-constraint updates.
@@ -36,9 +42,16 @@ pub(crate) trait AidUpdates {
         sigma_m: f64,
         gate: f64,
     ) -> std::result::Result<UpdateOutcome, EskfError>;
+    /// The body at rest turns only with the Earth (the last gyroscope sample, one-sigma
+    /// `sigma_rad_s`).
+    fn zero_rate(
+        &mut self,
+        sigma_rad_s: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError>;
 }
 
-impl<N: NavFrame> AidUpdates for Eskf<N> {
+impl<N: NavFrame, const S: usize> AidUpdates for Eskf<N, S> {
     fn body_velocity(
         &mut self,
         measured_m_s: [Option<f64>; 3],
@@ -55,9 +68,16 @@ impl<N: NavFrame> AidUpdates for Eskf<N> {
     ) -> std::result::Result<UpdateOutcome, EskfError> {
         self.update_height(height_m, sigma_m, gate)
     }
+    fn zero_rate(
+        &mut self,
+        sigma_rad_s: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_zero_rate(sigma_rad_s, gate)
+    }
 }
 
-impl AidUpdates for EarthEskf {
+impl<const S: usize> AidUpdates for EarthEskf<S> {
     fn body_velocity(
         &mut self,
         measured_m_s: [Option<f64>; 3],
@@ -73,6 +93,13 @@ impl AidUpdates for EarthEskf {
         gate: f64,
     ) -> std::result::Result<UpdateOutcome, EskfError> {
         self.update_height(height_m, sigma_m, gate)
+    }
+    fn zero_rate(
+        &mut self,
+        sigma_rad_s: f64,
+        gate: f64,
+    ) -> std::result::Result<UpdateOutcome, EskfError> {
+        self.update_zero_rate(sigma_rad_s, gate)
     }
 }
 
@@ -120,6 +147,8 @@ pub(crate) struct AidStreams {
     baro_sigma_m: f64,
     nhc_sigma_m_s: Option<f64>,
     gate_on: bool,
+    /// The end of the rest at the start, s, and one sample's gyroscope noise, rad/s.
+    rest: (f64, f64),
     next: (usize, usize),
     next_nhc_t: f64,
 }
@@ -130,8 +159,13 @@ impl AidStreams {
     ///
     /// # Errors
     /// A table without its columns or model, times that do not increase or fall outside the
-    /// span, a constraint sigma that is not positive.
-    pub(crate) fn new(aids: AidTables<'_>, setup: &FuseSetup, span: (f64, f64)) -> Result<Self> {
+    /// span, a constraint sigma that is not positive, a rest that is negative or not finite.
+    pub(crate) fn new(
+        aids: AidTables<'_>,
+        setup: &FuseSetup,
+        span: (f64, f64),
+        samples: usize,
+    ) -> Result<Self> {
         let odometer = match (aids.odometer, setup.aiding.odometer) {
             (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
             (Some(_), None) => {
@@ -161,6 +195,15 @@ impl AidStreams {
                 format!("must be a finite number > 0 (m/s), got {c}"),
             ));
         }
+        if !(setup.rest_s.is_finite() && setup.rest_s >= 0.0) {
+            return Err(invalid(
+                "rest_s",
+                format!("must be a finite number ≥ 0 (s), got {}", setup.rest_s),
+            ));
+        }
+        // One sample's white gyroscope noise: √q over the IMU's interval.
+        let interval_s = (span.1 - span.0) / samples.saturating_sub(1).max(1) as f64;
+        let gyro_sample_sigma = (setup.noise.gyro_psd / interval_s.sqrt()).max(MIN_RATE_SIGMA);
         Ok(Self {
             odometer,
             baro,
@@ -171,6 +214,7 @@ impl AidStreams {
             baro_sigma_m: setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA),
             nhc_sigma_m_s: nhc,
             gate_on: setup.gate.is_finite(),
+            rest: (span.0 + setup.rest_s, gyro_sample_sigma),
             next: (0, 0),
             next_nhc_t: span.0,
         })
@@ -200,6 +244,14 @@ impl AidStreams {
     /// # Errors
     /// The filter's refusal, naming the aid and its row ([`filter_refusal`]).
     pub(crate) fn apply(&mut self, filter: &mut impl AidUpdates, t_s: f64, i: usize) -> Result<()> {
+        if t_s < self.rest.0 {
+            filter
+                .body_velocity([Some(0.0); 3], [REST_VELOCITY_SIGMA_M_S; 3], self.gate(3))
+                .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;
+            filter
+                .zero_rate(self.rest.1, self.gate(3))
+                .map_err(|e| filter_refusal("IMU (at rest, zero rate)", i, e))?;
+        }
         let (odo_t, odo_v) = (&self.odometer.0, &self.odometer.1);
         while self.next.0 < odo_t.len() && odo_t[self.next.0] <= t_s {
             let k = self.next.0;

@@ -7,7 +7,7 @@
 //! height) and the constraints aid it as on the flat Earth (the same code, `fuse_aids`).
 use imu_core::earth::wgs84::OMEGA_IE_RAD_S;
 use imu_core::earth::{Geodetic, GravityModel};
-use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError, InitialSigma};
+use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError, FULL_STATES, InitialSigma};
 use imu_core::strapdown::earth::EarthNavState;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
@@ -16,7 +16,7 @@ use crate::io::table::{Table, concat_columns};
 use crate::run::earth_nav;
 use crate::run::fuse::{
     AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, FusionInputs, Start, align_from_gnss,
-    count_fix,
+    count_fix, covariance_interval_refusal, fused_columns, push_sensor_errors,
 };
 use crate::run::fuse_aids::AidStreams;
 use crate::run::navigate::GEODETIC_COLUMNS;
@@ -116,7 +116,7 @@ fn gyrocompass(
 ///
 /// # Errors
 /// As [`super::fuse::fuse_with`]; a start without a geodetic position.
-pub(crate) fn fuse_earth_in<N: NavFrame>(
+pub(crate) fn fuse_earth_in<N: NavFrame, const S: usize>(
     imu: &Table,
     gnss: &Table,
     aids: AidTables<'_>,
@@ -139,7 +139,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         g_v,
     } = &inputs;
     let (t0, t1) = inputs.span();
-    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1))?;
+    let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
     if let Some(k) = (0..g_p.len()).find(|&k| {
         let [lat, lon, h] = g_p[k];
         !(lat.abs() <= imu_core::earth::MAX_LATITUDE_RAD && lon.is_finite() && h.is_finite())
@@ -244,24 +244,28 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
     };
     aid_streams.start_at(t[first]);
     let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
-    let mut filter = EarthEskf::new(&s0, &sigma, setup.noise, gravity)
+    let filter = EarthEskf::<S>::new(&s0, &sigma, setup.noise, gravity)
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
-        .map_err(|_| {
-            invalid(
-                "covariance_interval_s",
-                format!(
-                    "must be a finite number ≥ 0 (s), got {}",
-                    setup.covariance_interval_s
-                ),
-            )
-        })?;
+        .map_err(|_| covariance_interval_refusal(setup))?;
+    let mut filter = if S == FULL_STATES {
+        filter
+            .with_sensor_error_sigma(&setup.sensor_error_sigma)
+            .map_err(|e| filter_error("sensor_error_sigma", e))?
+    } else {
+        filter
+    };
     let lever = Vec3::<Body>::from_array(frd(setup.lever_arm_m, 1.0));
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     let to_body = frd_to_body::<N>();
     let bias_to = |b: [f64; 3]| to_body.apply(Vec3::<Body>::from_array(b)).to_array();
     let bias_sigma_to = |b: [f64; 3]| bias_to(b).map(f64::abs);
-    let mut table = Table::new(&FUSE_EARTH_COLUMNS);
+    // FRD and the table's body axes differ by a diagonal signed permutation.
+    let axis_sign = bias_to([1.0; 3]);
+    let mut table = Table {
+        columns: fused_columns(&FUSE_EARTH_COLUMNS, S == FULL_STATES),
+        data: Vec::new(),
+    };
     let mut rejected_in_a_row = 0;
     let mut last_yaw = None;
     for i in first..t.len() {
@@ -302,6 +306,9 @@ pub(crate) fn fuse_earth_in<N: NavFrame>(
         row.extend(bias_sigma_to([sig[9], sig[10], sig[11]]));
         row.extend(bias_sigma_to([sig[12], sig[13], sig[14]]));
         row.extend_from_slice(&nav[14..]);
+        if S == FULL_STATES {
+            push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..], axis_sign);
+        }
         table.push_row(&row);
     }
     table.check_finite("fused navigation")?;

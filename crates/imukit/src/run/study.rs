@@ -41,6 +41,14 @@ pub struct StudySpec {
     pub baro: bool,
     /// The non-holonomic constraints of a ground vehicle, one-sigma m/s (off when absent).
     pub nhc_sigma_m_s: Option<f64>,
+    /// The filter also estimates each IMU's scale-factor and misalignment matrices (33 states;
+    /// see [`FuseSetup::estimate_sensor_errors`]).
+    #[serde(default)]
+    pub sensor_errors: bool,
+    /// The vehicle stands still for the first this many seconds, and the filter is told so
+    /// (see [`FuseSetup::rest_s`]); 0 when absent.
+    #[serde(default)]
+    pub rest_s: f64,
 }
 
 /// One preset, resolved.
@@ -138,6 +146,12 @@ impl Study {
                 format!("must be a finite number > 0 (m/s), got {c}"),
             ));
         }
+        if !(spec.rest_s.is_finite() && spec.rest_s >= 0.0) {
+            return Err(invalid(
+                key("rest_s"),
+                format!("must be a finite number ≥ 0 (s), got {}", spec.rest_s),
+            ));
+        }
         if spec.presets.is_empty() {
             return Err(invalid(key("presets"), "name at least one IMU preset"));
         }
@@ -168,6 +182,8 @@ impl Study {
                 .map_err(|e| invalid(key(&format!("presets[{i}]")), e.to_string()))?;
             let mut setup = FuseSetup::from_scenario(&scenario)?;
             setup.aiding.nhc_sigma_m_s = spec.nhc_sigma_m_s;
+            setup.estimate_sensor_errors = spec.sensor_errors;
+            setup.rest_s = spec.rest_s;
             cases.push(Case {
                 preset: preset.clone(),
                 scenario,
