@@ -24,6 +24,7 @@ fn bench(c: &mut Criterion) {
             nhc_sigma_m_s: odometer.then_some(0.05),
             sensor_errors: false,
             rest_s: 0.0,
+            draw_parts: true,
         };
         let study = Study::new(&spec, &examples, "bench").expect("the example study resolves");
         group.throughput(Throughput::Elements(1));

@@ -1369,7 +1369,8 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     };
     let (code, err) = fuse(&["--align", "gnss"]);
     assert_eq!(code, Some(0), "{err}");
-    // The estimate begins at the first fix at speed (the car starts from rest), not at t = 0.
+    // The estimate begins at the first fix at speed (the car waits 20 s, then drives), not at
+    // t = 0.
     let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
     let t0: f64 = nav
         .lines()
@@ -1380,7 +1381,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!(t0 > 0.5 && t0 < 5.0, "{t0}");
+    assert!(t0 > 20.5 && t0 < 25.0, "{t0}");
     let out = imukit()
         .current_dir(&dir)
         .args(["compare", "truth.csv", "nav.csv"])
@@ -1400,6 +1401,10 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
             vec!["--init", "truth.csv", "--align", "gnss"],
             vec!["--align", "not both"],
         ),
+        (
+            vec!["--init", "truth.csv", "--rest-s=-1"],
+            vec!["--rest-s", "≥ 0"],
+        ),
     ] {
         let (code, err) = fuse(&extra);
         assert_eq!(code, Some(65), "{extra:?}: {err}");
@@ -1408,6 +1413,14 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
         }
         assert!(!dir.join("nav.csv").exists());
     }
+    // Told of the wait and estimating the sensor errors: their columns follow the biases'.
+    let (code, err) = fuse(&["--init", "truth.csv", "--rest-s", "20", "--sensor-errors"]);
+    assert_eq!(code, Some(0), "{err}");
+    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let header: Vec<&str> = nav.lines().next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 35 + 42, "{header:?}");
+    assert_eq!(header[35], "accel_scale_factor_x");
+    assert_eq!(header[76], "gyro_g_sensitivity_z_sigma_rad_s_per_m_s2");
 }
 
 #[test]

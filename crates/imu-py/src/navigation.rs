@@ -177,7 +177,8 @@ fn compare<'py>(
 #[pyo3(signature = (imu_columns, imu_values, gnss_columns, gnss_values, initial_columns, initial_values,
                     scenario, *, format = "dict", base_dir = ".", gate = true, align = None,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
-                    baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None))]
+                    baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
+                    sensor_errors = false, rest_s = None))]
 #[allow(clippy::too_many_arguments)]
 fn fuse<'py>(
     py: Python<'py>,
@@ -198,6 +199,8 @@ fn fuse<'py>(
     baro_values: Option<PyReadonlyArray2<'py, f64>>,
     nhc_sigma_m_s: Option<f64>,
     covariance_interval_s: Option<f64>,
+    sensor_errors: bool,
+    rest_s: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
     use imukit::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
@@ -244,6 +247,10 @@ fn fuse<'py>(
             setup.aiding.nhc_sigma_m_s = nhc_sigma_m_s;
             if let Some(s) = covariance_interval_s {
                 setup.covariance_interval_s = s;
+            }
+            setup.estimate_sensor_errors = sensor_errors;
+            if let Some(s) = rest_s {
+                setup.rest_s = s;
             }
             let aids = AidTables {
                 odometer: odometer.as_ref(),

@@ -197,6 +197,35 @@ def test_fuse_with_an_odometer_and_the_vehicle_constraints_holds_the_car_through
         imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, baro=sim.odometer)
 
 
+def test_fuse_of_a_consumer_imu_needs_the_rest_and_the_sensor_error_states():
+    # The example road with an MPU-6050 (±20 °/s turn-on bias, 2 % cross-axis sensitivity): the
+    # 15-state filter loses the fixes; told of the 20 s wait before the drive and estimating the
+    # scale factors, misalignment and g-sensitivity, it holds the car through the tunnel within
+    # its stated uncertainty — as imukit fuse --rest-s 20 --sensor-errors.
+    from pathlib import Path
+    import tomllib
+    path = Path(__file__).resolve().parents[3] / "examples" / "car_tunnel.toml"
+    scenario = tomllib.loads(path.read_text())
+    scenario["imu"]["preset"] = "mpu-6050"
+    sim = imukit.simulate(scenario)
+    with pytest.raises(ImuError, match="rejected by the innovation gate"):
+        imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario)
+    nav = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, rest_s=20.0, sensor_errors=True)
+    assert "gyro_g_sensitivity_z_rad_s_per_m_s2" in nav.columns
+    assert "accel_misalignment_zx_sigma" in nav.columns
+    k = int(np.argmin(np.abs(nav["t_s"] - 149.99)))
+    error = math.hypot(nav["pos_x_m"][k] - sim.truth["pos_x_m"][k], nav["pos_y_m"][k] - sim.truth["pos_y_m"][k])
+    assert error < 3 * math.hypot(nav["pos_x_sigma_m"][k], nav["pos_y_sigma_m"][k])
+    # After the rest the z gyroscope's reading at rest is known: its bias plus its g-sensitivity
+    # times gravity (the two are told apart only on the road).
+    i = int(np.argmin(np.abs(nav["t_s"] - 19.99)))
+    at_rest = nav["gyro_bias_z_rad_s"][i] + 9.81 * nav["gyro_g_sensitivity_z_rad_s_per_m_s2"][i]
+    assert abs(at_rest - (0.349066 + 9.81 * 0.000177974)) < 1e-4
+    with pytest.raises(ImuError, match="rest_s") as e:
+        imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=scenario, rest_s=-1.0)
+    assert e.value.field == "rest_s"
+
+
 def test_fuse_aligns_from_gnss_without_truth():
     # A car from rest: without initial=, align="gnss" starts the filter at the first fix at
     # 3 m/s or more (the estimate begins there), heading along its velocity.

@@ -837,10 +837,13 @@ pub(crate) fn kalman_update<const M: usize, const S: usize>(
     if nis > gate {
         return Ok((nis, None));
     }
-    let k = *cov * h.transpose() * s_inv;
+    let pht = *cov * h.transpose();
+    let k = pht * s_inv;
     let dx = k * y;
-    let ikh = Cov::<S>::identity() - k * h;
-    *cov = ikh * *cov * ikh.transpose() + k * rm * k.transpose();
+    // Joseph form `(I − KH) P (I − KH)ᵀ + K R Kᵀ`, multiplied out in an order that keeps every
+    // product thin (S × M or M × S): `A = P − K (HP)`, then `A − (A Hᵀ) Kᵀ`.
+    let a = *cov - k * pht.transpose();
+    *cov = a - (a * h.transpose()) * k.transpose() + k * rm * k.transpose();
     *cov = (*cov + cov.transpose()) * 0.5;
     if (0..S).any(|i| cov[(i, i)].is_nan() || cov[(i, i)] < 0.0) {
         return Err(EskfError::Diverged { index });

@@ -224,6 +224,8 @@ def fuse(
     baro_values: Optional[npt.NDArray[np.float64]] = None,
     nhc_sigma_m_s: Optional[float] = None,
     covariance_interval_s: Optional[float] = None,
+    sensor_errors: bool = False,
+    rest_s: Optional[float] = None,
 ) -> tuple[_Table, int, int]: ...
 def compare(
     truth_columns: Sequence[str],

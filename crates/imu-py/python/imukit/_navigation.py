@@ -118,7 +118,8 @@ def compare(truth: Table, estimate: Table):
 def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, align: Optional[str] = None,
          gate: bool = True,
          odometer: Optional[Table] = None, baro: Optional[Table] = None,
-         nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None) -> Table:
+         nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
+         sensor_errors: bool = False, rest_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
     GNSS fixes (``imukit.simulate(...).gnss``), on the scenario's Earth (flat, or WGS-84 with
     geodetic fixes and ``lat_rad, lon_rad, height_m`` added to the output). The filter's model comes from
@@ -134,7 +135,12 @@ def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, 
     ``nhc_sigma_m_s=0.1`` (the non-holonomic constraints: no sideways or vertical body
     velocity, with each odometer reading or at 10 Hz) and ``baro=sim.baro`` (height).
     ``covariance_interval_s`` (default 0.05; 0: every sample) steps the covariance less often
-    than the IMU samples, for speed.
+    than the IMU samples, for speed. ``sensor_errors=True`` also estimates the IMU's scale
+    factors, misalignment and gyroscope g-sensitivity (36 states, their one-sigma at the start
+    from the part's figures; columns ``accel_scale_factor_x`` … ``gyro_g_sensitivity_z_rad_s_per_m_s2``
+    and their ``…_sigma`` added). ``rest_s=20`` tells the filter the vehicle stands still for the
+    first 20 s (zero-velocity and zero-rate updates at every sample: the gyroscope biases are
+    calibrated before the drive) — a consumer IMU needs both.
     """
     if isinstance(scenario, Mapping):
         source, fmt, base = dict(scenario), "dict", os.getcwd()
@@ -155,5 +161,7 @@ def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, 
                              align=None if align is None else str(align),
                              nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
+                             sensor_errors=bool(sensor_errors),
+                             rest_s=None if rest_s is None else float(rest_s),
                              **aids)
     return _table(table)

@@ -732,7 +732,8 @@ fn matrix_sigma(p: &crate::sensor::SensorParams) -> (f64, f64) {
 /// The filter's model of one sensor triad from its error parameters at `rate_hz`: the
 /// continuous PSD of the white noise and of the bias drift (worst axis), each from the discrete
 /// noise the simulator draws. White: `σ_d = N √β` per sample (`β = fs` single-sided, `fs/2`
-/// double-sided), so `√q = σ_d/√fs`. Random walk `K/√β` per sample: `√q = K √(fs/β)`. Bias
+/// double-sided), so `√q = σ_d/√fs`; quantisation to a step `r` adds white noise of variance
+/// `r²/12` per sample (Widrow's model; for the ICM-42688-P's gyroscopes a fifth of the noise). Random walk `K/√β` per sample: `√q = K √(fs/β)`. Bias
 /// instability `B`: MATLAB's filter (short memory) joins the white noise with its low-frequency
 /// gain, `√q += B·|Σb/Σa|/√fs`; Gauss–Markov (time `T`) joins the drift as a random walk of the
 /// same variance growth, `q += 2B²/T`; flicker joins it as the random walk whose Allan deviation
@@ -752,7 +753,8 @@ fn triad_psd(p: &crate::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
         max(p.random_walk),
         max(p.bias_instability),
     );
-    let mut white = n * (beta / rate_hz).sqrt();
+    let mut white =
+        (n * n * beta / rate_hz + p.resolution * p.resolution / (12.0 * rate_hz)).sqrt();
     let mut drift_q = (k * (rate_hz / beta).sqrt()).powi(2);
     match &p.bias_instability_model {
         BiasInstabilityModel::Filter(c) => {

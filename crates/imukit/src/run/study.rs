@@ -49,6 +49,17 @@ pub struct StudySpec {
     /// (see [`FuseSetup::rest_s`]); 0 when absent.
     #[serde(default)]
     pub rest_s: f64,
+    /// Each run draws its own part of each preset's type (constant biases, scale factors,
+    /// misalignment and g-sensitivity from normal distributions whose one-sigma are the
+    /// preset's figures, see `scenario::perturb::drawn_part`): the study then speaks of the
+    /// parts one may buy, not of one part. On by default; `false` simulates the preset's
+    /// figures in every run (MATLAB's fixed parameters).
+    #[serde(default = "drawn")]
+    pub draw_parts: bool,
+}
+
+fn drawn() -> bool {
+    true
 }
 
 /// One preset, resolved.
@@ -177,9 +188,10 @@ impl Study {
             }
             let mut s = scenario_spec.clone();
             s.imu.preset = Some(preset.clone());
-            let scenario = s
+            let mut scenario = s
                 .resolve(scenario_dir)
                 .map_err(|e| invalid(key(&format!("presets[{i}]")), e.to_string()))?;
+            scenario.imu.sensors.draw_parts = spec.draw_parts;
             let mut setup = FuseSetup::from_scenario(&scenario)?;
             setup.aiding.nhc_sigma_m_s = spec.nhc_sigma_m_s;
             setup.estimate_sensor_errors = spec.sensor_errors;

@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::scenario::earth::TangentPlane;
-use crate::scenario::perturb::perturbed;
+use crate::scenario::perturb::{drawn_part, perturbed};
 use crate::scenario::sensors::SensorSetup;
 use imu_core::earth::EarthTruth;
 
@@ -112,7 +112,10 @@ impl ImuSetup {
         run: Option<u64>,
     ) -> Result<ReadingStream<'_, N>> {
         let seed = self.sensors.seed;
-        let params = perturbed(&self.sensors.params, &self.sensors.perturbations, seed, run)?;
+        let mut params = perturbed(&self.sensors.params, &self.sensors.perturbations, seed, run)?;
+        if self.sensors.draw_parts {
+            params = drawn_part(&params, seed, run)?;
+        }
         Ok(ReadingStream {
             model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
             noise: run.map_or_else(

@@ -302,6 +302,56 @@ impl Perturbation {
     }
 }
 
+/// The generator of run `run` (`None`: the single run of `imukit simulate` without `--runs`)
+/// on the stream `salt` of `seed`: streams of different salts are independent.
+fn run_stream(seed: u64, run: Option<u64>, salt: u64) -> Xoshiro256PlusPlus {
+    let mut z = (seed ^ salt) ^ run.map_or(u64::MAX, |r| r.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    Xoshiro256PlusPlus::seed_from_u64(z ^ (z >> 31))
+}
+
+/// A part of the same type as `base`, drawn for `run` — what a Monte Carlo over parts (an
+/// outage study) simulates instead of one part in every run: each axis's constant bias, each
+/// entry of the axes' scale-factor and misalignment errors (`axes_misalignment_pct` about
+/// `100·I`) and each axis's gyroscope g-sensitivity from `N(0, s²)`, `s` the magnitude `base`
+/// gives that axis or entry (the datasheet's figure taken as one-sigma; 0 stays 0). The
+/// accelerometer and the gyroscope are drawn (the magnetometer is left as given), from a
+/// stream of (`seed`, `run`) of its own.
+///
+/// # Errors
+/// A draw that makes a parameter invalid, named with the run.
+pub fn drawn_part(base: &ImuParams, seed: u64, run: Option<u64>) -> Result<ImuParams> {
+    const SALT: u64 = 0x5041_5254_4452_4157;
+    let mut rng = run_stream(seed, run, SALT);
+    let mut normal = |s: f64| {
+        let n: f64 = StandardNormal.sample(&mut rng);
+        s * n
+    };
+    let mut out = base.clone();
+    for sensor in [Sensor::Accelerometer, Sensor::Gyroscope] {
+        let p = out.get_mut(sensor);
+        p.constant_bias = p.constant_bias.map(|b| normal(b.abs()));
+        for (r, row) in p.axes_misalignment_pct.iter_mut().enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                let nominal = if r == c { 100.0 } else { 0.0 };
+                *v = nominal + normal((*v - nominal).abs());
+            }
+        }
+        if sensor == Sensor::Gyroscope {
+            p.acceleration_bias = p.acceleration_bias.map(|k| normal(k.abs()));
+        }
+        p.validate().map_err(|e| {
+            let which = run.map_or_else(|| "the run".to_string(), |r| format!("run {r}"));
+            invalid(
+                format!("drawn part ({})", sensor.key()),
+                format!("{which}: the draw is invalid: {e}"),
+            )
+        })?;
+    }
+    Ok(out)
+}
+
 /// The parameters of a run: `base` with every perturbation drawn from the stream of
 /// (`seed`, `run`) — `run = None` is the single run of `imukit simulate` without `--runs`.
 ///
@@ -317,10 +367,7 @@ pub fn perturbed(
         return Ok(base.clone());
     }
     const SALT: u64 = 0x5045_5254_5552_4221;
-    let mut z = (seed ^ SALT) ^ run.map_or(u64::MAX, |r| r.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(z ^ (z >> 31));
+    let mut rng = run_stream(seed, run, SALT);
     let mut out = base.clone();
     for p in perturbations {
         let params = out.get_mut(p.sensor);

@@ -148,6 +148,10 @@ pub struct SensorSetup {
     pub temperature: Temperature,
     /// Monte Carlo perturbations of the parameters.
     pub perturbations: Vec<Perturbation>,
+    /// Each Monte Carlo run draws its own part of this type (see
+    /// [`crate::scenario::perturb::drawn_part`]), after the perturbations; off: every run
+    /// simulates the same part (MATLAB's fixed parameters). An outage study turns it on.
+    pub draw_parts: bool,
     /// What a MATLAB parameter file had that was skipped, for the front end to show.
     pub warnings: Vec<String>,
 }
@@ -161,6 +165,7 @@ impl Default for SensorSetup {
             seed: 0,
             temperature: Temperature::default(),
             perturbations: Vec::new(),
+            draw_parts: false,
             warnings: Vec::new(),
         }
     }
@@ -237,6 +242,7 @@ impl SensorSetup {
                 .enumerate()
                 .map(|(i, p)| Perturbation::from_spec(p, i))
                 .collect::<Result<_>>()?,
+            draw_parts: false,
             warnings: file.map(|f| f.warnings).unwrap_or_default(),
         })
     }
