@@ -1,6 +1,7 @@
 //! Runs per second of the outage study (`imukit study`): one run of the example tunnel road
-//! (15 001 samples at 100 Hz: simulated truth and STIM300 readings, GNSS, then fused), on one
-//! core; `imukit study` spreads runs over all cores.
+//! (17 001 samples at 100 Hz: simulated truth and STIM300 readings, GNSS, then fused), on one
+//! core — with the 15-state filter, with wheels, and as the example studies run it (the 20 s
+//! rest and the 36 states); `imukit study` spreads runs over all cores.
 //!
 //! Run: `cargo bench -p imu-benches --bench study`.
 #![allow(missing_docs)]
@@ -14,7 +15,11 @@ fn bench(c: &mut Criterion) {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut group = c.benchmark_group("study");
     group.sample_size(10);
-    for (name, odometer) in [("tunnel_run", false), ("tunnel_run_with_wheels", true)] {
+    for (name, odometer, full) in [
+        ("tunnel_run", false, false),
+        ("tunnel_run_with_wheels", true, false),
+        ("tunnel_run_rest_and_36_states", false, true),
+    ] {
         let spec = StudySpec {
             scenario: "car_tunnel.toml".into(),
             presets: vec!["stim300".into()],
@@ -22,8 +27,8 @@ fn bench(c: &mut Criterion) {
             odometer,
             baro: false,
             nhc_sigma_m_s: odometer.then_some(0.05),
-            sensor_errors: false,
-            rest_s: 0.0,
+            sensor_errors: full,
+            rest_s: if full { 20.0 } else { 0.0 },
             draw_parts: true,
         };
         let study = Study::new(&spec, &examples, "bench").expect("the example study resolves");

@@ -278,13 +278,16 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                                     ["--init", "ct.csv", "--align", "gnss"]])
                 extra = rng.choice([[], ["--odometer", "co.csv"], ["--nhc"], ["--nhc", x()],
                                     ["--covariance-interval-s", x()], ["--no-gate"], ["--baro", "co.csv"],
-                                    ["--earth", rng.choice(["flat", "wgs84", "mars"])]])
+                                    ["--earth", rng.choice(["flat", "wgs84", "mars"])],
+                                    ["--sensor-errors"], [f"--rest-s={x()}"], ["--rest-s", "5", "--sensor-errors"]])
                 run_cli(r, work, ["fuse", "ci.csv", rng.choice(["cg.csv", "cgm.csv"]), *start, "--scenario", "c.toml",
                                   *extra, "--out", "cn.csv"], [*made, "cgm.csv", "c.toml"], f"case {k} (fusion)")
                 presets = rng.choice(['"stim300"', "", '"nosuch"', '"hg1700", "hg1700"', '"ideal", "mpu-6050"'])
                 (work / "st.toml").write_text(
                     f'scenario = "c.toml"\npresets = [{presets}]\nruns = {rng.choice(["2", "0", "1", "-1", "1e9", "100001"])}\n'
-                    f'nhc_sigma_m_s = {rng.choice(["0.05", x()])}\nodometer = {rng.choice(["true", "false"])}\n')
+                    f'nhc_sigma_m_s = {rng.choice(["0.05", x()])}\nodometer = {rng.choice(["true", "false"])}\n'
+                    f'rest_s = {rng.choice(["0", "5", x()])}\nsensor_errors = {rng.choice(["true", "false", "1"])}\n'
+                    f'draw_parts = {rng.choice(["true", "false", "2"])}\n')
                 run_cli(r, work, ["study", "st.toml", "--out", "sn.csv",
                                   *rng.choice([[], ["--plot", "sn.png"], ["--plot", "sn.gif"]])],
                         ["st.toml", "c.toml"], f"case {k} (study)")

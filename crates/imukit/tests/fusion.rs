@@ -529,7 +529,7 @@ fn heading_is_observable_in_a_turn_and_not_on_a_straight_line_at_constant_speed(
 
 #[test]
 fn the_biases_of_a_tactical_imu_converge_on_the_road_before_the_tunnel() {
-    // STIM300 on the tunnel road, GNSS only: by 95 s each accelerometer and gyroscope bias
+    // STIM300 on the tunnel road, GNSS only: by 115 s each accelerometer and gyroscope bias
     // estimate is within 3σ of the part's constant bias and its one-sigma is well below its
     // start (the turns and speed changes make them observable), over five runs. The part's
     // scale-factor and cross-axis errors are set perfect here: acting on gravity and the turns
@@ -618,7 +618,7 @@ fn aligned_from_gnss_the_filter_starts_without_truth_and_converges() {
             (e + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
         };
         let yaw_sigma = |i_nav: usize| col(&nav, "att_z_sigma_rad")[i_nav];
-        // The start within 3σ of its stated heading uncertainty; 95 s later (before the
+        // The start within 3σ of its stated heading uncertainty; at 115 s (before the
         // tunnel), heading and position within 3σ, the heading known to better than 0.5°.
         assert!(
             yaw_error(0).abs() < 3.0 * yaw_sigma(0),
@@ -627,7 +627,7 @@ fn aligned_from_gnss_the_filter_starts_without_truth_and_converges() {
         );
         let i = t_nav.partition_point(|&x| x < 115.0);
         eprintln!(
-            "run {run}: aligned at {:.2} s, heading error {:.4} rad (σ {:.4}); at 95 s {:.5} rad (σ {:.5})",
+            "run {run}: aligned at {:.2} s, heading error {:.4} rad (σ {:.4}); at 115 s {:.5} rad (σ {:.5})",
             t_nav[0],
             yaw_error(0),
             yaw_sigma(0),

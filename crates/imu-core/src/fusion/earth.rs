@@ -188,7 +188,7 @@ impl<const S: usize> EarthEskf<S> {
         else {
             return Ok(());
         };
-        let (w, f) = self.errors.correct(w - self.bg, f - self.ba);
+        let (w, f) = self.errors.correct::<S>(w - self.bg, f - self.ba);
         let c0 = self
             .nav
             .attitude
@@ -279,7 +279,7 @@ impl<const S: usize> EarthEskf<S> {
         let (r_n, r_e) = p.radii_m();
         let m = &fix.position;
         let (w_last, f_last) = self.intake.last();
-        let (w_body, f_body) = self.errors.correct(w_last - self.bg, f_last - self.ba);
+        let (w_body, f_body) = self.errors.correct::<S>(w_last - self.bg, f_last - self.ba);
         let delta_p = Vector3::new(
             (m.latitude_rad - p.latitude_rad) * (r_n + p.height_m),
             wrap_pi(m.longitude_rad - p.longitude_rad)

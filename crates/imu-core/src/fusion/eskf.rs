@@ -363,7 +363,7 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
             self.t = t_s;
             return Ok(());
         };
-        let (w, f) = self.errors.correct(w - self.bg, f - self.ba);
+        let (w, f) = self.errors.correct::<S>(w - self.bg, f - self.ba);
         // Nominal state.
         let half = self.q * UnitQuaternion::from_scaled_axis(w * (0.5 * dt));
         let q1 = self.q * UnitQuaternion::from_scaled_axis(w * dt);
@@ -456,7 +456,7 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
             return Err(EskfError::NotFinite { index });
         }
         let (w_last, f_last) = self.intake.last();
-        let (w_body, f_body) = self.errors.correct(w_last - self.bg, f_last - self.ba);
+        let (w_body, f_body) = self.errors.correct::<S>(w_last - self.bg, f_last - self.ba);
         let lin = Linearisation {
             c: self.q.to_rotation_matrix().into_inner(),
             v: self.v,
@@ -683,7 +683,7 @@ pub(crate) fn zero_rate_model<const S: usize>(
     let Some((w_m, f_m)) = sample else {
         return Err(EskfError::NotFinite { index });
     };
-    let (_, f) = errors.correct(Vector3::zeros(), f_m - ba);
+    let (_, f) = errors.correct::<S>(Vector3::zeros(), f_m - ba);
     if !(sigma_rad_s.is_finite() && sigma_rad_s > 0.0) {
         return Err(EskfError::BadParameter {
             field: "zero-rate sigma",

@@ -145,12 +145,16 @@ impl SensorErrors {
     }
 
     /// Body rate and specific force with the errors removed, from readings whose biases are
-    /// already removed: `f̂ = (I + M̂_a)⁻¹ f`, `ω̂ = (I + M̂_g)⁻¹ (ω − k̂ ∘ f̂)`.
-    pub(crate) fn correct(
+    /// already removed: `f̂ = (I + M̂_a)⁻¹ f`, `ω̂ = (I + M̂_g)⁻¹ (ω − k̂ ∘ f̂)` in a filter of
+    /// [`FULL_STATES`]; a filter of `S` = 15 states takes the readings as they are.
+    pub(crate) fn correct<const S: usize>(
         &self,
         gyro: Vector3<f64>,
         accel: Vector3<f64>,
     ) -> (Vector3<f64>, Vector3<f64>) {
+        if S < FULL_STATES {
+            return (gyro, accel);
+        }
         let f = self.accel_inv * accel;
         (
             self.gyro_inv * (gyro - self.g_sensitivity.component_mul(&f)),
