@@ -217,11 +217,13 @@ pub enum Command {
         out: PathBuf,
     },
     /// Which IMU bridges a GNSS outage: a scenario with `[[gnss.outages]]` simulated with each
-    /// IMU preset over seeded Monte Carlo runs (all cores) and fused with its GNSS; writes, per
-    /// preset and time into the first outage, the RMS horizontal position error and the
-    /// filter's one-sigma, and prints them at the outage's end.
+    /// IMU preset over seeded Monte Carlo runs (all cores; each run a part of the preset's type)
+    /// and fused with its GNSS; writes, per preset and time into the first outage, the RMS
+    /// horizontal position error and the filter's one-sigma, and prints them at the outage's
+    /// end.
     Study {
-        /// Study file (TOML): `scenario = "S.toml"`, `presets = ["mpu-6050", …]`, `runs = 50`.
+        /// Study file (TOML): `scenario = "S.toml"`, `presets = ["mpu-6050", …]`, `runs = 100`;
+        /// optional `rest_s`, `sensor_errors`, `odometer`, `baro`, `nhc_sigma_m_s`, `draw_parts`.
         study: PathBuf,
         /// Where to write the table (CSV: `t_s` since the outage began, then per preset
         /// `<preset>_rms_error_m` and `<preset>_sigma_m`).
