@@ -31,7 +31,7 @@
 //! truth_from_motion(&Circle, &t, AnalyticOptions::default(), &mut out).unwrap();
 //! assert!((out[1].omega_b_rad_s.z() - 0.5).abs() < 1e-12);
 //! ```
-use num_dual::{Dual2, Dual3, DualNum, DualStruct};
+use num_dual::{Dual2, Dual3, DualNum};
 
 use imu_core::kinematics::euler::{body_angular_acceleration, body_rate, unwrap_near};
 use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
@@ -60,13 +60,53 @@ pub fn atan2<D: Scalar>(y: D, x: D) -> D {
     D::from(yr.atan2(xr)) + (branch - D::from(branch.re()))
 }
 
+/// A motion's exact derivatives at one time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MotionPoint {
+    /// Per axis of the position (navigation frame): position, velocity, acceleration and jerk
+    /// (m, m/s, m/s², m/s³).
+    pub position: [[f64; 4]; 3],
+    /// Per z-y-x Euler angle (yaw, pitch, roll): angle, rate and angular acceleration (rad,
+    /// rad/s, rad/s²); `None` for the tangent attitude.
+    pub euler: Option<[[f64; 3]; 3]>,
+}
+
 /// An analytic motion: position of S (navigation frame, m) and optional Euler angles (rad).
 pub trait Motion {
     /// Position `[x, y, z]` of the reference point S at time `t` (s), navigation frame, m.
     fn position<D: Scalar>(&self, t: D) -> [D; 3];
     /// z-y-x Euler angles `[yaw, pitch, roll]` (rad) at time `t`, or `None` for the tangent attitude.
     fn euler<D: Scalar>(&self, t: D) -> Option<[D; 3]>;
+    /// The derivatives at each time of `t_s` into `out` (resized to fit): by default
+    /// [`dual_derivatives`], the position over a third-order and the angles over a
+    /// second-order dual number, one time after another. A motion may compute the same numbers
+    /// faster over the whole slice (formulas do, compiled).
+    fn derivatives(&self, t_s: &[f64], out: &mut Vec<MotionPoint>)
+    where
+        Self: Sized,
+    {
+        dual_derivatives(self, t_s, out);
+    }
 }
+
+/// [`Motion::derivatives`] over dual numbers, one time after another.
+pub fn dual_derivatives<M: Motion>(motion: &M, t_s: &[f64], out: &mut Vec<MotionPoint>) {
+    out.clear();
+    out.extend(t_s.iter().map(|&t| {
+        let p = motion.position(Dual3::new(t, 1.0, 0.0, 0.0));
+        let euler = motion
+            .euler(Dual2::new(t, 1.0, 0.0))
+            .map(|e| e.map(|d| [d.re, d.v1, d.v2]));
+        MotionPoint {
+            position: p.map(|d| [d.re, d.v1, d.v2, d.v3]),
+            euler,
+        }
+    }));
+}
+
+/// Times whose derivatives [`truth_from_motion`] and the streamed simulation ask a motion for
+/// at once.
+pub const DERIVATIVE_CHUNK: usize = 256;
 
 /// Options of [`truth_from_motion`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +130,7 @@ pub struct AnalyticStepper<'m, M> {
     tracker: TangentTracker,
     index: usize,
     last_yaw: Option<f64>,
+    point: Vec<MotionPoint>,
 }
 
 impl<'m, M: Motion> AnalyticStepper<'m, M> {
@@ -101,6 +142,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
             tracker: TangentTracker::new(options.min_speed_m_s),
             index: 0,
             last_yaw: None,
+            point: Vec::with_capacity(1),
         }
     }
 
@@ -110,16 +152,25 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
     /// # Errors
     /// Non-finite results, gimbal lock in Euler angles, vertical tangent.
     pub fn step<N: NavFrame>(&mut self, t_s: f64) -> Result<(Truth<N>, bool), KinematicsError> {
+        self.motion.derivatives(&[t_s], &mut self.point);
+        let point = self.point[0];
+        self.step_at(t_s, &point)
+    }
+
+    /// [`Self::step`] with the motion's derivatives at `t_s` already evaluated (by
+    /// [`Motion::derivatives`], many times at once).
+    ///
+    /// # Errors
+    /// As [`Self::step`].
+    pub fn step_at<N: NavFrame>(
+        &mut self,
+        t_s: f64,
+        point: &MotionPoint,
+    ) -> Result<(Truth<N>, bool), KinematicsError> {
         let index = self.index;
         self.index += 1;
-        let p = self.motion.position(Dual3::new(t_s, 1.0, 0.0, 0.0));
-        let part = |f: fn(&Dual3<f64>) -> f64| -> [f64; 3] { [f(&p[0]), f(&p[1]), f(&p[2])] };
-        let (pos, vel, acc, jerk) = (
-            part(|d| d.re()),
-            part(|d| d.v1),
-            part(|d| d.v2),
-            part(|d| d.v3),
-        );
+        let part = |k: usize| -> [f64; 3] { point.position.map(|axis| axis[k]) };
+        let (pos, vel, acc, jerk) = (part(0), part(1), part(2), part(3));
         if !pos.iter().chain(&vel).chain(&acc).all(|c| c.is_finite()) {
             return Err(KinematicsError::NotFinite {
                 field: "position_m",
@@ -133,10 +184,10 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
             acceleration_m_s2: Vec3::from_array(acc),
             ..Truth::default()
         };
-        let (euler, rate, accel) = match self.motion.euler(Dual2::new(t_s, 1.0, 0.0)) {
+        let (euler, rate, accel) = match point.euler {
             Some(e) => {
-                let ang = |f: fn(&Dual2<f64>) -> f64| EulerZyx::new(f(&e[0]), f(&e[1]), f(&e[2]));
-                let mut euler = ang(|d| d.re());
+                let ang = |k: usize| EulerZyx::new(e[0][k], e[1][k], e[2][k]);
+                let mut euler = ang(0);
                 if !euler.to_array().iter().all(|c| c.is_finite()) {
                     return Err(KinematicsError::NotFinite {
                         field: "euler_rad",
@@ -153,7 +204,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                     euler.yaw_rad = unwrap_near(euler.yaw_rad, last);
                 }
                 self.last_yaw = Some(euler.yaw_rad);
-                (euler, ang(|d| d.v1), ang(|d| d.v2))
+                (euler, ang(1), ang(2))
             }
             None => match self.tracker.update(index, vel, acc, jerk)? {
                 Some(a) => (a.euler, a.rate, a.accel),
@@ -194,11 +245,19 @@ pub fn truth_from_motion<M: Motion, N: NavFrame>(
     check_times(t_s)?;
     let mut stepper = AnalyticStepper::new(motion, options);
     let mut first_valid = None;
-    for (i, (&t, slot)) in t_s.iter().zip(out.iter_mut()).enumerate() {
-        let (truth, valid) = stepper.step(t)?;
-        *slot = truth;
-        if valid {
-            first_valid.get_or_insert(i);
+    let mut points = Vec::with_capacity(DERIVATIVE_CHUNK);
+    for (c, (times, slots)) in t_s
+        .chunks(DERIVATIVE_CHUNK)
+        .zip(out.chunks_mut(DERIVATIVE_CHUNK))
+        .enumerate()
+    {
+        motion.derivatives(times, &mut points);
+        for (k, ((&t, slot), point)) in times.iter().zip(slots).zip(&points).enumerate() {
+            let (truth, valid) = stepper.step_at(t, point)?;
+            *slot = truth;
+            if valid {
+                first_valid.get_or_insert(c * DERIVATIVE_CHUNK + k);
+            }
         }
     }
     backfill_standstill(out, first_valid);

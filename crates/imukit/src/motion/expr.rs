@@ -164,8 +164,9 @@ fn tokenize(src: &str) -> Result<Vec<Token>, ExprError> {
     Ok(out)
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Func1 {
+/// A function of one argument.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Func1 {
     Sin,
     Cos,
     Tan,
@@ -184,8 +185,9 @@ enum Func1 {
     Abs,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Func2 {
+/// A function of two arguments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Func2 {
     Atan2,
     Hypot,
     Pow,
@@ -229,8 +231,9 @@ fn func2(name: &str) -> Option<Func2> {
 const FUNCTION_NAMES: &str = "sin, cos, tan, asin, acos, atan, atan2, sinh, cosh, tanh, exp, ln, \
      log, log10, log2, sqrt, cbrt, abs, hypot, pow, min, max, if, piecewise";
 
+/// A parsed formula's tree.
 #[derive(Clone, Debug)]
-enum Node {
+pub(crate) enum Node {
     Num(f64),
     T,
     Neg(Box<Node>),
@@ -247,8 +250,9 @@ enum Node {
     Piecewise(Vec<(Cond, Node)>, Box<Node>),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum CmpOp {
+/// A comparison.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum CmpOp {
     Lt,
     Le,
     Gt,
@@ -257,8 +261,9 @@ enum CmpOp {
     Ne,
 }
 
+/// A condition of `if` and `piecewise`, decided on values.
 #[derive(Clone, Debug)]
-enum Cond {
+pub(crate) enum Cond {
     Cmp(CmpOp, Node, Node),
     And(Box<Cond>, Box<Cond>),
     Or(Box<Cond>, Box<Cond>),
@@ -743,6 +748,11 @@ impl Expr {
     #[must_use]
     pub fn source(&self) -> &str {
         &self.source
+    }
+
+    /// The parsed tree (for [`crate::motion::compiled`]).
+    pub(crate) fn root(&self) -> &Node {
+        &self.root
     }
 
     /// The value at time `t` over any scalar (`f64` or a dual number for exact derivatives).

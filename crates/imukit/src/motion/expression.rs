@@ -9,7 +9,10 @@ use imu_core::{Ecef, NavFrame, Rotation};
 
 use num_dual::DualNum;
 
-use crate::motion::analytic::{Motion, Scalar, atan2};
+use std::sync::OnceLock;
+
+use crate::motion::analytic::{Motion, MotionPoint, Scalar, atan2, dual_derivatives};
+use crate::motion::compiled::{Order, Program};
 use crate::motion::expr::Expr;
 use crate::scenario::NavFrameName;
 
@@ -62,6 +65,9 @@ impl GeodeticPlane {
     }
 }
 
+/// The position formulas' program and the angles' (when given).
+type Compiled = (Program, Option<Program>);
+
 /// A motion given by formulas of time.
 #[derive(Clone, Debug)]
 pub struct ExpressionMotion {
@@ -72,6 +78,9 @@ pub struct ExpressionMotion {
     pub attitude: ExpressionAttitude,
     /// Geodetic formulas and their tangent plane.
     pub geodetic: Option<GeodeticPlane>,
+    /// The position formulas compiled for third derivatives and the angles' for second, on
+    /// first use.
+    compiled: OnceLock<Option<Box<Compiled>>>,
 }
 
 /// `M · v` for a constant matrix and a dual vector.
@@ -115,6 +124,43 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
+    /// A motion of these formulas.
+    #[must_use]
+    pub fn new(
+        position: [Expr; 3],
+        attitude: ExpressionAttitude,
+        geodetic: Option<GeodeticPlane>,
+    ) -> Self {
+        Self {
+            position,
+            attitude,
+            geodetic,
+            compiled: OnceLock::new(),
+        }
+    }
+
+    /// The position formulas compiled for third derivatives (as over `Dual3`) and, when
+    /// given, the Euler angles' for second (as over `Dual2`); `None` for formulas too large to
+    /// compile (see [`Program::compile`]).
+    fn programs(&self) -> Option<&Compiled> {
+        self.compiled
+            .get_or_init(|| {
+                let position: Vec<&Expr> = self.position.iter().collect();
+                let angles = match &self.attitude {
+                    ExpressionAttitude::Euler(e) => {
+                        let e: Vec<&Expr> = e.iter().collect();
+                        Some(Program::compile(&e, Order::Second)?)
+                    }
+                    _ => None,
+                };
+                Some(Box::new((
+                    Program::compile(&position, Order::Third)?,
+                    angles,
+                )))
+            })
+            .as_deref()
+    }
+
     /// The tangent attitude relative to the local level for geodetic formulas: yaw and pitch of
     /// the ground velocity `v^n = C_ne dr^e/dt` (NED; the frame's convention for ENU), no roll.
     /// The velocity's own derivatives come from evaluating the formulas once more over a dual
@@ -163,6 +209,32 @@ impl ExpressionMotion {
 }
 
 impl Motion for ExpressionMotion {
+    /// The compiled formulas over the whole slice (the same numbers as [`dual_derivatives`],
+    /// see [`crate::motion::compiled`]); formulas placed on the WGS-84 Earth, whose position
+    /// goes through the ellipsoid, over dual numbers.
+    fn derivatives(&self, t_s: &[f64], out: &mut Vec<MotionPoint>) {
+        let (position, angles) = match (&self.geodetic, self.programs()) {
+            (None | Some(GeodeticPlane::Unplaced), Some(p)) => p,
+            _ => return dual_derivatives(self, t_s, out),
+        };
+        let (mut p, mut e) = (Vec::new(), Vec::new());
+        position.eval(t_s, &mut p);
+        if let Some(angles) = angles {
+            angles.eval(t_s, &mut e);
+        }
+        out.clear();
+        out.extend(p.chunks_exact(3).enumerate().map(|(i, j)| MotionPoint {
+            position: [j[0], j[1], j[2]],
+            euler: match &self.attitude {
+                ExpressionAttitude::Tangent => None,
+                ExpressionAttitude::Level => Some([[0.0; 3]; 3]),
+                ExpressionAttitude::Euler(_) => {
+                    Some([0, 1, 2].map(|k| [e[3 * i + k][0], e[3 * i + k][1], e[3 * i + k][2]]))
+                }
+            },
+        }));
+    }
+
     fn position<D: Scalar>(&self, t: D) -> [D; 3] {
         let p = self.formulas(t);
         match self.geodetic {

@@ -3,6 +3,7 @@
 //! any of them resolves to.
 pub mod analytic;
 pub mod body_rates;
+pub mod compiled;
 pub mod expr;
 pub mod expression;
 pub mod sampled;

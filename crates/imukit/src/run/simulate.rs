@@ -9,7 +9,7 @@
 //! integrated whole; then everything is streamed.
 use std::path::Path;
 
-use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, Motion};
+use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, DERIVATIVE_CHUNK, Motion};
 use imu_core::kinematics::sampled::backfill_standstill;
 use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
@@ -258,19 +258,28 @@ fn motion_chunks<M: Motion, N: NavFrame>(
     let mut stepper = AnalyticStepper::new(motion, options);
     let mut buffer: Vec<Truth<N>> = Vec::with_capacity(STREAM_CHUNK);
     let mut moving = false;
-    for k in 0..t_s.len() {
-        let (truth, valid) = stepper
-            .step::<N>(t_s.at(k))
-            .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
-        buffer.push(truth);
-        if valid && !moving {
-            moving = true;
-            let first = buffer.len() - 1;
-            backfill_standstill(&mut buffer, Some(first));
-        }
-        if moving && buffer.len() >= STREAM_CHUNK {
-            emit(&buffer)?;
-            buffer.clear();
+    let (mut times, mut points) = (
+        Vec::with_capacity(DERIVATIVE_CHUNK),
+        Vec::with_capacity(DERIVATIVE_CHUNK),
+    );
+    for start in (0..t_s.len()).step_by(DERIVATIVE_CHUNK) {
+        times.clear();
+        times.extend((start..t_s.len().min(start + DERIVATIVE_CHUNK)).map(|k| t_s.at(k)));
+        motion.derivatives(&times, &mut points);
+        for (&t, point) in times.iter().zip(&points) {
+            let (truth, valid) = stepper
+                .step_at::<N>(t, point)
+                .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
+            buffer.push(truth);
+            if valid && !moving {
+                moving = true;
+                let first = buffer.len() - 1;
+                backfill_standstill(&mut buffer, Some(first));
+            }
+            if moving && buffer.len() >= STREAM_CHUNK {
+                emit(&buffer)?;
+                buffer.clear();
+            }
         }
     }
     if buffer.is_empty() {

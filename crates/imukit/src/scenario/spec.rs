@@ -534,10 +534,10 @@ impl ExpressionSpec {
                 ExpressionAttitude::Euler(Box::new([e(0)?, e(1)?, e(2)?]))
             }
         };
-        Ok(ExpressionMotion {
+        Ok(ExpressionMotion::new(
             position,
             attitude,
-            geodetic: geodetic_formulas.then_some(GeodeticPlane::Unplaced),
-        })
+            geodetic_formulas.then_some(GeodeticPlane::Unplaced),
+        ))
     }
 }
