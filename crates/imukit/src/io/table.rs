@@ -280,16 +280,26 @@ impl Table {
     #[must_use]
     pub fn from_readings(t_s: &[f64], readings: &[ImuReading], kind: ImuKind) -> Self {
         let mut t = Self::new(&kind.columns());
+        let width = t.columns.len();
+        t.data.reserve(readings.len() * width);
         for (ti, r) in t_s.iter().zip(readings) {
-            let mut row = vec![*ti];
-            row.extend(r.accel_m_s2);
+            // The kind's column order: t, accelerometer, then gyroscope and magnetometer when
+            // it has them (at most ten values).
+            let mut row = [0.0; 10];
+            let mut k = 0;
+            let mut put = |v: &[f64]| {
+                row[k..k + v.len()].copy_from_slice(v);
+                k += v.len();
+            };
+            put(&[*ti]);
+            put(&r.accel_m_s2);
             if kind.has_gyro() {
-                row.extend(r.gyro_rad_s);
+                put(&r.gyro_rad_s);
             }
             if kind.has_mag() {
-                row.extend(r.mag_ut);
+                put(&r.mag_ut);
             }
-            t.push_row(&row);
+            t.push_row(&row[..k]);
         }
         t
     }
