@@ -182,3 +182,23 @@ def test_wrong_lengths_and_empty_inputs_name_the_argument():
         imukit.planar_dead_reckon(np.arange(3.0), np.zeros(3), np.zeros(3), np.zeros(3), position0_m=[0, 0, 0])
     with pytest.raises(ImuError, match="need at least 3 samples, got 0"):
         imukit.allan_deviation(np.zeros(0), 100.0)
+
+
+def test_tables_become_pandas_and_polars_frames_and_read_reads_by_extension(tmp_path):
+    import pandas as pd
+    import polars as pl
+    sim = imukit.simulate({"trajectory": {"type": "builtin", "name": "figure8"}})
+    df = sim.truth.to_pandas()
+    assert isinstance(df, pd.DataFrame) and list(df.columns) == list(sim.truth.columns)
+    # The same memory, no copy.
+    assert np.shares_memory(df.to_numpy(), sim.truth.values)
+    assert df["vel_x_m_s"].iloc[5] == sim.truth["vel_x_m_s"][5]
+    frame = sim.imu.to_polars()
+    assert isinstance(frame, pl.DataFrame) and frame.columns == list(sim.imu.columns)
+    assert frame["gyro_z_rad_s"].to_numpy().tolist() == sim.imu["gyro_z_rad_s"].tolist()
+    path = tmp_path / "imu.csv"
+    np.savetxt(path, sim.imu.values, delimiter=",", header=",".join(sim.imu.columns), comments="", fmt="%.17g")
+    back = imukit.read(path)
+    assert back.columns == sim.imu.columns and np.array_equal(back.values, sim.imu.values)
+    with pytest.raises(imukit.ImuError, match="cannot read '.xlsx'"):
+        imukit.read(tmp_path / "imu.xlsx")

@@ -46,6 +46,24 @@ class Table:
         """``{name: column}``."""
         return {c: self[c] for c in self.columns}
 
+    def to_pandas(self):
+        """A pandas ``DataFrame`` of the columns over the table's own memory (no copy; like the
+        table it is read-only until pandas copies on a write). Needs pandas."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("Table.to_pandas needs pandas (pip install pandas)") from None
+        return pd.DataFrame(self.values, columns=list(self.columns), copy=False)
+
+    def to_polars(self):
+        """A polars ``DataFrame`` of the columns. polars keeps each column contiguous, so the
+        row-major values are copied once, column by column. Needs polars."""
+        try:
+            import polars as pl
+        except ImportError:
+            raise ImportError("Table.to_polars needs polars (pip install polars)") from None
+        return pl.DataFrame({c: self.values[:, k] for k, c in enumerate(self.columns)})
+
     def __repr__(self) -> str:
         return f"Table({len(self)} rows: {', '.join(self.columns)})"
 

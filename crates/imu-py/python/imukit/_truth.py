@@ -46,6 +46,15 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
     return _table(_core.read_csv(str(path)))
 
+def read(path: Union[str, os.PathLike]) -> Table:
+    """An imukit table file as a :class:`Table`, its format by its extension: ``.csv`` (as
+    :func:`read_csv`). Any other extension is refused with the formats read."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".csv":
+        return read_csv(path)
+    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables (read: .csv)")
+
+
 def builtin_scenarios() -> list:
     """Names of the built-in scenarios."""
     return list(_core.builtin_names())
