@@ -285,11 +285,12 @@ def imukit_binary() -> str:
         Path(__file__).resolve().parents[1] / "target" / "release" / "imukit")
 
 
-def cli_formula_time(n, prm, work: Path) -> float:
-    """`imukit simulate` of the formula scenario, readings to CSV (process start and writing included)."""
+def cli_formula_time(n, prm, work: Path, ext: str = "csv") -> float:
+    """`imukit simulate` of the formula scenario, readings to a file of format ``ext`` (process
+    start and writing included)."""
     spec = work / "formulas.json"
     spec.write_text(json.dumps(formula_scenario(n, prm)))
-    out = work / "formula_imu.csv"
+    out = work / f"formula_imu.{ext}"
     return best_of(lambda: subprocess.run([imukit_binary(), "simulate", str(spec), "--out", str(out)], check=True,
                                           capture_output=True), 1)
 
@@ -324,8 +325,8 @@ def main() -> None:
     print("agreement: noise-free outputs equal to rounding; drift variances match theory in both")
     prm = params(noise=True)
     print("time ratios, NumPy / imukit (> 1: imukit is faster); one core on both sides")
-    print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'samples, Python':>16} "
-          f"{'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
+    print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
+          f"{'samples, Python':>16} {'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
     python_model_s, numpy_model_s = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         for size in args.sizes:
@@ -336,6 +337,7 @@ def main() -> None:
                                                            np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_fpy = best_of(lambda: imukit_formula_pipeline(n, prm), repeat)
             fcli = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp)):>20.2f}"
+            fpq = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'parquet'):>24.2f}"
             t_np = best_of(lambda: numpy_pipeline(t, pos, euler, prm,
                                                   np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_py = best_of(lambda: imukit_pipeline(t, pos, euler, prm), repeat)
@@ -348,7 +350,7 @@ def main() -> None:
             t_model_np = best_of(lambda: numpy_model(*ref_in, prm), repeat)
             t_model_py = best_of(lambda: imu(*ours_in, out=out), repeat)
             python_model_s[n], numpy_model_s[n] = t_model_py, t_model_np
-            print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {t_np / t_py:>16.2f} {cli:>26} "
+            print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {fpq:>24} {t_np / t_py:>16.2f} {cli:>26} "
                   f"{t_model_np / t_model_py:>20.2f}")
     if args.rust:
         rust = rust_matlab_call_ns_per_sample()

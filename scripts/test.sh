@@ -11,7 +11,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
-python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1" "scipy>=1.7" "pandas>=2" "polars>=0.20"
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1" "scipy>=1.7" "pandas>=2" "polars>=0.20" "pyarrow>=14"
 
 echo "== Format and lints"
 cargo fmt --all -- --check

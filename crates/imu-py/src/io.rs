@@ -1,4 +1,5 @@
-//! Files: imukit CSV tables in and out, and the file names of Monte Carlo runs.
+//! Files: imukit tables in and out (CSV, Parquet by extension), and the file names of Monte
+//! Carlo runs.
 use std::path::Path;
 
 use imukit::Table;
@@ -13,6 +14,25 @@ use crate::errors::refused;
 #[pyfunction]
 fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
     table_out(py, read_table(Path::new(path)).map_err(refused)?)
+}
+
+/// Every column of a table file, its format by its extension (`.parquet`, else CSV).
+#[pyfunction]
+fn read_table_file<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
+    let t = py.detach(|| read_table(Path::new(path))).map_err(refused)?;
+    table_out(py, t)
+}
+
+/// Writes a table in the format its path's extension names (`.parquet`, else CSV), atomically.
+#[pyfunction]
+fn write_table_file(
+    py: Python<'_>,
+    path: &str,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'_, f64>,
+) -> PyResult<()> {
+    let t: Table = table_in("values", columns, &values)?;
+    py.detach(move || t.write(Path::new(path))).map_err(refused)
 }
 
 /// Writes a table as an imukit CSV (shortest round-trip numbers, atomically).
@@ -38,6 +58,8 @@ fn run_path(out: &str, run: u64, runs: u64) -> String {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(read_table_file, m)?)?;
+    m.add_function(wrap_pyfunction!(write_table_file, m)?)?;
     m.add_function(wrap_pyfunction!(run_path, m)?)?;
     Ok(())
 }

@@ -128,9 +128,9 @@ fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
     std::fs::create_dir_all(&dir).unwrap();
     let (imu, gnss) = (dir.join("imu.csv"), dir.join("gnss.csv"));
     // 10 001 samples: the stream crosses chunk boundaries (4096).
-    sc.stream_to_csv(
+    sc.stream_to_files(
         None,
-        &imukit::run::simulate::CsvOutputs {
+        &imukit::run::simulate::StreamOutputs {
             imu: Some(&imu),
             gnss: Some(&gnss),
             ..Default::default()
@@ -198,9 +198,9 @@ fn bad_gnss_keys_are_refused_by_name() {
         .unwrap();
     let dir = std::env::temp_dir();
     let e = sc
-        .stream_to_csv(
+        .stream_to_files(
             None,
-            &imukit::run::simulate::CsvOutputs {
+            &imukit::run::simulate::StreamOutputs {
                 imu: Some(&dir.join(format!("imukit-nognss-{}.csv", std::process::id()))),
                 gnss: Some(&dir.join(format!("imukit-nognss-g-{}.csv", std::process::id()))),
                 ..Default::default()

@@ -286,9 +286,9 @@ fn a_result_that_is_not_finite_is_never_written() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("imu.csv");
     let e = scenario
-        .stream_to_csv(
+        .stream_to_files(
             None,
-            &imukit::run::simulate::CsvOutputs {
+            &imukit::run::simulate::StreamOutputs {
                 imu: Some(&out),
                 ..Default::default()
             },

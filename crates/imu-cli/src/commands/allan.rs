@@ -56,7 +56,7 @@ pub fn run(
         },
         other => other,
     })?;
-    result.table.write_csv(out)?;
+    result.table.write(out)?;
     if let Some(p) = plot {
         imu_plot::allan_figure(p, &result)?;
     }

@@ -126,7 +126,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         },
         other => other,
     })?;
-    nav.write_csv(a.out)?;
+    nav.write(a.out)?;
     let last = |c: &str| {
         nav.column(c)
             .and_then(|v| v.last().copied())

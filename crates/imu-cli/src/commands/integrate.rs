@@ -73,7 +73,7 @@ pub fn planar(c: &Common<'_>, scheme: &str, heading0_rad: f64) -> Result<(), Cli
         field: c.input.display().to_string(),
         message: e.to_string(),
     })?;
-    nav.write_csv(c.out)?;
+    nav.write(c.out)?;
     report(&nav, &format!("{scheme} scheme"), c.out);
     Ok(())
 }
@@ -153,7 +153,7 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
                 message: e.to_string(),
             }
         })?;
-        nav.write_csv(c.out)?;
+        nav.write(c.out)?;
         report(
             &nav,
             "strapdown on the WGS-84 Earth, baro-damped height",

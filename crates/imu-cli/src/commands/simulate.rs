@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use imukit::ScenarioSpec;
 use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
-use imukit::run::simulate::CsvOutputs;
+use imukit::run::simulate::StreamOutputs;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -46,16 +46,28 @@ pub fn run(
     for w in &sc.imu.sensors.warnings {
         eprintln!("imukit: warning: {w}");
     }
+    // What made the files, for formats that carry it (Parquet).
+    let metadata = vec![
+        (
+            imukit::io::parquet::SCENARIO_KEY.to_string(),
+            std::fs::read_to_string(scenario).unwrap_or_default(),
+        ),
+        (
+            imukit::io::parquet::NAV_FRAME_KEY.to_string(),
+            sc.nav_frame.name().to_string(),
+        ),
+    ];
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
-        let outputs = CsvOutputs {
+        let outputs = StreamOutputs {
             imu: Some(out),
             truth,
             gnss,
             baro,
             odometer,
+            metadata: &metadata,
         };
-        sc.stream_to_csv(None, &outputs)?;
+        sc.stream_to_files(None, &outputs)?;
         eprintln!(
             "imukit: {} samples; IMU readings in {}{}{}",
             sc.t_s.len(),
@@ -87,14 +99,15 @@ pub fn run(
             let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
             let (imu_file, gnss_file, baro_file, odometer_file) =
                 (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
-            sc.stream_to_csv(
+            sc.stream_to_files(
                 Some(r),
-                &CsvOutputs {
+                &StreamOutputs {
                     imu: Some(&imu_file),
                     truth: truth.filter(|_| r == 0),
                     gnss: gnss_file.as_deref(),
                     baro: baro_file.as_deref(),
                     odometer: odometer_file.as_deref(),
+                    metadata: &metadata,
                 },
             )?;
             done.fetch_add(1, Ordering::Relaxed);

@@ -42,7 +42,7 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
         per_preset.push(it.by_ref().take(runs as usize).collect::<Vec<_>>());
     }
     let (table, summaries) = s.summarise(&per_preset)?;
-    table.write_csv(out)?;
+    table.write(out)?;
     if let Some(p) = plot {
         imu_plot::study_figure(p, &table)?;
     }

@@ -46,6 +46,12 @@ class Table:
         """``{name: column}``."""
         return {c: self[c] for c in self.columns}
 
+    def write(self, path) -> None:
+        """Writes the table in the format the path's extension names — Parquet for ``.parquet``,
+        CSV otherwise — atomically (imukit's own writer, as the command line's)."""
+        from . import _core
+        _core.write_table_file(str(path), list(self.columns), self.values)
+
     def to_pandas(self):
         """A pandas ``DataFrame`` of the columns over the table's own memory (no copy; like the
         table it is read-only until pandas copies on a write). Needs pandas."""

@@ -47,12 +47,13 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     return _table(_core.read_csv(str(path)))
 
 def read(path: Union[str, os.PathLike]) -> Table:
-    """An imukit table file as a :class:`Table`, its format by its extension: ``.csv`` (as
-    :func:`read_csv`). Any other extension is refused with the formats read."""
+    """An imukit table file as a :class:`Table`, its format by its extension: ``.parquet``
+    (float64 columns, as ``imukit simulate --out x.parquet`` writes them) or ``.csv``. Any other
+    extension is refused with the formats read."""
     suffix = Path(path).suffix.lower()
-    if suffix == ".csv":
-        return read_csv(path)
-    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables (read: .csv)")
+    if suffix in (".csv", ".parquet"):
+        return _table(_core.read_table_file(str(path)))
+    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables (read: .csv, .parquet)")
 
 
 def builtin_scenarios() -> list:

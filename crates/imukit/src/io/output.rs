@@ -7,6 +7,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result, invalid};
+use crate::io::parquet::{ParquetSink, is_parquet};
 use crate::io::table::{check_finite, write_rows};
 
 /// The longest file name most file systems take, bytes.
@@ -41,6 +42,8 @@ pub struct AtomicFile {
     /// The temporary name; `None` for a special file written directly.
     tmp: Option<PathBuf>,
     writer: Option<BufWriter<File>>,
+    /// A Parquet table being written (it holds the writer until the commit).
+    parquet: Option<ParquetSink>,
 }
 
 impl AtomicFile {
@@ -71,6 +74,7 @@ impl AtomicFile {
                 rows: 0,
                 tmp: None,
                 writer: Some(BufWriter::new(file)),
+                parquet: None,
             });
         }
         let tmp = temporary_path(path);
@@ -81,7 +85,47 @@ impl AtomicFile {
             rows: 0,
             tmp: Some(tmp),
             writer: Some(BufWriter::new(file)),
+            parquet: None,
         })
+    }
+
+    /// The file's path (its final name).
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Starts a table of `columns` in the format the path's extension names: Parquet for
+    /// `.parquet` (with `metadata` in the file), else a CSV header line.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file; the Parquet writer's refusal.
+    pub fn begin_table(&mut self, columns: &[String], metadata: &[(String, String)]) -> Result<()> {
+        self.columns = columns.to_vec();
+        if is_parquet(&self.path) {
+            let writer = self.writer.take().expect("a table is begun once");
+            self.parquet = Some(ParquetSink::create(writer, &self.path, columns, metadata)?);
+            return Ok(());
+        }
+        let w = self.writer();
+        let written = w
+            .write_all(columns.join(",").as_bytes())
+            .and_then(|()| w.write_all(b"\n"));
+        written.map_err(|e| self.error(e))
+    }
+
+    /// Appends row-major `data` (rows of the table's width) to the table begun; the caller has
+    /// checked the values finite.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file; the Parquet writer's refusal.
+    pub fn write_table_rows(&mut self, data: &[f64]) -> Result<()> {
+        if let Some(p) = self.parquet.as_mut() {
+            return p.write(data);
+        }
+        let width = self.columns.len().max(1);
+        let written = write_rows(self.writer(), data, width, b",");
+        written.map_err(|e| self.error(e))
     }
 
     /// The buffered writer.
@@ -92,17 +136,13 @@ impl AtomicFile {
         self.writer.as_mut().expect("the writer lives until commit")
     }
 
-    /// Writes the CSV header line of `columns`.
+    /// Starts a table of `columns` ([`Self::begin_table`] without metadata).
     ///
     /// # Errors
-    /// [`Error::Io`] naming the file.
+    /// As [`Self::begin_table`].
     pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
-        self.columns = columns.iter().map(|c| (*c).to_string()).collect();
-        let w = self.writer();
-        let written = w
-            .write_all(columns.join(",").as_bytes())
-            .and_then(|()| w.write_all(b"\n"));
-        written.map_err(|e| self.error(e))
+        let columns: Vec<String> = columns.iter().map(|c| (*c).to_string()).collect();
+        self.begin_table(&columns, &[])
     }
 
     /// Writes one CSV row of `values` (shortest round-trip form).
@@ -124,15 +164,15 @@ impl AtomicFile {
                     ..
                 } => Error::NotFinite {
                     what,
-                    row: self.rows + 1,
+                    // A CSV file's header is its row 1; a Parquet file has none.
+                    row: self.rows + usize::from(self.parquet.is_none()),
                     column,
                     value,
                 },
                 other => other,
             });
         }
-        let written = write_rows(self.writer(), values, values.len(), b",");
-        written.map_err(|e| self.error(e))
+        self.write_table_rows(values)
     }
 
     /// An I/O error of this file.
@@ -149,6 +189,9 @@ impl AtomicFile {
     /// # Errors
     /// [`Error::Io`] naming the file (the temporary file is then removed).
     pub fn commit(mut self) -> Result<()> {
+        if let Some(p) = self.parquet.take() {
+            self.writer = Some(p.finish()?);
+        }
         let result = (|| -> std::io::Result<()> {
             let file = match self.writer.take() {
                 Some(w) => Some(

@@ -304,6 +304,19 @@ impl Table {
         t
     }
 
+    /// Writes the table in the format its path's extension names — Parquet for `.parquet`
+    /// ([`crate::io::parquet`]), CSV otherwise — atomically.
+    ///
+    /// # Errors
+    /// A value that is not finite; [`Error::Io`] naming the file.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        if crate::io::parquet::is_parquet(path) {
+            crate::io::parquet::write_table(self, path, &[])
+        } else {
+            self.write_csv(path)
+        }
+    }
+
     /// Writes the table as CSV with a header row, atomically (temporary file, then rename).
     ///
     /// # Errors
@@ -443,6 +456,9 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
 /// # Errors
 /// Unreadable or empty file, a column name that appears twice.
 pub fn read_header(path: &Path) -> Result<Vec<String>> {
+    if crate::io::parquet::is_parquet(path) {
+        return crate::io::parquet::column_names(path);
+    }
     let mut r = reader(path)?;
     let h = r.headers().map_err(|e| csv_error(path, &e))?;
     let names: Vec<String> = h.iter().map(|s| s.trim().to_string()).collect();
@@ -506,11 +522,15 @@ fn csv_error(path: &Path, e: &csv::Error) -> Error {
     }
 }
 
-/// Reads every column of a CSV file with a header row.
+/// Reads every column of a table file: Parquet for `.parquet`
+/// ([`crate::io::parquet::read_table`]), else CSV with a header row.
 ///
 /// # Errors
 /// As [`read_columns`]: values that are not finite numbers, malformed or empty files.
 pub fn read_table(path: &Path) -> Result<Table> {
+    if crate::io::parquet::is_parquet(path) {
+        return crate::io::parquet::read_table(path);
+    }
     let header = read_header(path)?;
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
     read_table_columns(path, &names, "")
@@ -521,6 +541,31 @@ pub fn read_table(path: &Path) -> Result<Table> {
 /// # Errors
 /// As [`read_columns`].
 pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Table> {
+    if crate::io::parquet::is_parquet(path) {
+        let whole = crate::io::parquet::read_table(path)?;
+        let missing: Vec<String> = names
+            .iter()
+            .filter(|c| !whole.columns.iter().any(|h| h == *c))
+            .map(|c| (*c).to_string())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::MissingColumns {
+                file: path.into(),
+                missing,
+                hint: hint.into(),
+            });
+        }
+        let picked: Vec<Vec<f64>> = names
+            .iter()
+            .map(|c| whole.column(c).unwrap_or_default())
+            .collect();
+        let mut t = Table::new(names);
+        t.data.reserve(whole.rows() * names.len());
+        for i in 0..whole.rows() {
+            t.data.extend(picked.iter().map(|c| c[i]));
+        }
+        return Ok(t);
+    }
     let mut rows = CsvRows::open(path, names, hint)?;
     let mut t = Table::new(names);
     let mut row = vec![0.0; names.len()];
@@ -542,6 +587,36 @@ pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Tab
 /// Missing columns (all named at once, with `hint`), values that are not finite numbers (file,
 /// row, column), malformed or empty files.
 pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
+    if crate::io::parquet::is_parquet(path) {
+        let whole = crate::io::parquet::read_table(path)?;
+        let missing: Vec<String> = required
+            .iter()
+            .filter(|c| whole.column(c).is_none())
+            .map(|c| (*c).to_string())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::MissingColumns {
+                file: path.into(),
+                missing,
+                hint: hint.into(),
+            });
+        }
+        let header: HashMap<String, usize> = whole
+            .columns
+            .iter()
+            .enumerate()
+            .map(|(k, n)| (n.clone(), k))
+            .collect();
+        let mut values = vec![Vec::new(); header.len()];
+        for name in required {
+            values[header[*name]] = whole.column(name).unwrap_or_default();
+        }
+        return Ok(CsvColumns {
+            file: path.into(),
+            header,
+            values,
+        });
+    }
     let mut rows = CsvRows::open(path, required, hint)?;
     let header: HashMap<String, usize> = rows
         .names
@@ -569,11 +644,19 @@ pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvCol
     })
 }
 
-/// The named columns of a CSV file, row by row (memory does not grow with the file).
+/// Where [`CsvRows`] reads: a CSV file, or a Parquet file's rows.
+#[derive(Debug)]
+enum RowSource {
+    Csv(csv::Reader<File>),
+    Parquet(crate::io::parquet::ParquetRows),
+}
+
+/// The named columns of a CSV (or Parquet) file, row by row (memory does not grow with the
+/// file).
 #[derive(Debug)]
 pub struct CsvRows {
     path: PathBuf,
-    reader: csv::Reader<File>,
+    reader: RowSource,
     record: csv::StringRecord,
     /// The header's column names.
     names: Vec<String>,
@@ -610,9 +693,14 @@ impl CsvRows {
             .iter()
             .map(|c| (index.get(*c).copied().unwrap_or(0), (*c).to_string()))
             .collect();
+        let reader = if crate::io::parquet::is_parquet(path) {
+            RowSource::Parquet(crate::io::parquet::ParquetRows::open(path)?.1)
+        } else {
+            RowSource::Csv(reader(path)?)
+        };
         Ok(Self {
             path: path.into(),
-            reader: reader(path)?,
+            reader,
             record: csv::StringRecord::new(),
             names,
             wanted,
@@ -625,7 +713,11 @@ impl CsvRows {
     /// # Errors
     /// Values that are not finite numbers (file, row, column), malformed rows.
     pub fn next_row(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
-        match self.reader.read_record(&mut self.record) {
+        let reader = match &mut self.reader {
+            RowSource::Csv(r) => r,
+            RowSource::Parquet(rows) => return rows.next_row(&self.wanted, out),
+        };
+        match reader.read_record(&mut self.record) {
             Ok(false) => return Ok(None),
             Ok(true) => {}
             Err(e) => return Err(csv_error(&self.path, &e)),

@@ -260,7 +260,7 @@ pub(crate) fn integrate_earth_csv(
         .chain(&GYRO_COLUMNS)
         .all(|c| imu.columns.iter().any(|h| h == c));
     let corrections = setup.options.coning || setup.options.sculling;
-    nav.write_csv(out)?;
+    nav.write(out)?;
     let last = |c: &str| nav.column(c).and_then(|v| v.last().copied()).unwrap_or(0.0);
     Ok(crate::run::navigate::NavSummary {
         rows: nav.rows(),

@@ -16,6 +16,7 @@ use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
 use crate::io::output::AtomicFile;
+use crate::io::parquet::is_parquet;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
@@ -39,10 +40,10 @@ pub struct Chunk {
     pub odometer: Option<Table>,
 }
 
-/// Where [`Scenario::stream_to_csv`] writes: the IMU readings, and the truth and the aids'
+/// Where [`Scenario::stream_to_files`] writes: the IMU readings, and the truth and the aids'
 /// readings when asked for.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct CsvOutputs<'a> {
+pub struct StreamOutputs<'a> {
     /// IMU readings.
     pub imu: Option<&'a Path>,
     /// Truth.
@@ -53,6 +54,8 @@ pub struct CsvOutputs<'a> {
     pub baro: Option<&'a Path>,
     /// Odometer readings (`[odometer]`).
     pub odometer: Option<&'a Path>,
+    /// Key-value metadata of Parquet outputs (what made them: the scenario, its frame).
+    pub metadata: &'a [(String, String)],
 }
 
 impl Scenario {
@@ -79,7 +82,7 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::stream`], an aid's file without that aid in the scenario, and I/O errors
     /// naming the file.
-    pub fn stream_to_csv(&self, run: Option<u64>, outputs: &CsvOutputs<'_>) -> Result<()> {
+    pub fn stream_to_files(&self, run: Option<u64>, outputs: &StreamOutputs<'_>) -> Result<()> {
         for (path, present, field, what) in [
             (
                 outputs.gnss,
@@ -104,7 +107,10 @@ impl Scenario {
                 return Err(crate::error::invalid(field, what));
             }
         }
-        let open = |p: Option<&Path>| p.map(CsvSink::create).transpose();
+        let open = |p: Option<&Path>| {
+            p.map(|p| TableSink::create(p, outputs.metadata))
+                .transpose()
+        };
         let (mut imu, mut truth) = (open(outputs.imu)?, open(outputs.truth)?);
         let (mut gnss, mut baro, mut odometer) = (
             open(outputs.gnss)?,
@@ -205,21 +211,24 @@ impl Scenario {
     }
 }
 
-/// One streamed CSV output: the header once, then the chunks' rows, each checked finite and
-/// named by its file row.
-struct CsvSink {
+/// One streamed output, CSV or Parquet by its extension ([`AtomicFile::begin_table`]): the
+/// columns once, then the chunks' rows, each checked finite and named by its file row.
+struct TableSink {
     file: AtomicFile,
     name: String,
+    /// The next row's number in the file (a CSV file's header is row 1).
     next_row: usize,
+    metadata: Vec<(String, String)>,
     started: bool,
 }
 
-impl CsvSink {
-    fn create(path: &Path) -> Result<Self> {
+impl TableSink {
+    fn create(path: &Path, metadata: &[(String, String)]) -> Result<Self> {
         Ok(Self {
             file: AtomicFile::create(path)?,
             name: path.display().to_string(),
-            next_row: 2,
+            next_row: if is_parquet(path) { 1 } else { 2 },
+            metadata: metadata.to_vec(),
             started: false,
         })
     }
@@ -227,15 +236,11 @@ impl CsvSink {
     fn write(&mut self, table: &Table) -> Result<()> {
         // Nothing that is not a finite number reaches a file.
         check_finite_from(&table.columns, &table.data, &self.name, self.next_row)?;
-        let w = self.file.writer();
-        let written = if self.started {
-            Ok(())
-        } else {
-            table.write_header(w)
+        if !self.started {
+            self.file.begin_table(&table.columns, &self.metadata)?;
+            self.started = true;
         }
-        .and_then(|()| table.write_body(w));
-        written.map_err(|e| self.file.error(e))?;
-        self.started = true;
+        self.file.write_table_rows(&table.data)?;
         self.next_row += table.rows();
         Ok(())
     }

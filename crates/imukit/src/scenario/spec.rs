@@ -30,6 +30,17 @@ pub enum NavFrameName {
     NED,
 }
 
+impl NavFrameName {
+    /// `"ENU"` or `"NED"`, as a scenario writes it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ENU => "ENU",
+            Self::NED => "NED",
+        }
+    }
+}
+
 /// Accelerometer sign convention, by name.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]

@@ -1,0 +1,377 @@
+//! Tables as Apache Parquet files (Apache Arrow's `parquet` crate): one float64 column per
+//! table column, named as in the CSV contract, Snappy-compressed, rows in row groups of
+//! [`ROW_GROUP`]; what made the file (the scenario, the navigation frame, the command) in the
+//! file's key-value metadata. Chosen by the output path's extension (`.parquet`), written as
+//! every output is: under a temporary name, renamed into place when complete. Read back bit for
+//! bit (float64 stays float64), by imukit and by pyarrow, pandas and polars.
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+use std::sync::Arc;
+
+use arrow_array::{Array, ArrayRef, Float64Array, RecordBatch};
+use arrow_schema::{DataType, Field, Schema};
+use parquet::arrow::ArrowWriter;
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use parquet::basic::Compression;
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterProperties;
+
+use crate::error::{Error, Result};
+use crate::io::output::AtomicFile;
+use crate::io::table::Table;
+
+/// Metadata key of the scenario a file was simulated from (its text as given).
+pub const SCENARIO_KEY: &str = "imukit.scenario";
+/// Metadata key of the navigation frame of a file's columns (`ENU` or `NED`).
+pub const NAV_FRAME_KEY: &str = "imukit.nav_frame";
+
+/// Rows per row group (and per write): memory stays flat however long the table.
+pub const ROW_GROUP: usize = 65_536;
+
+/// Whether `path` names a Parquet file (its extension, any case).
+#[must_use]
+pub fn is_parquet(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"))
+}
+
+fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::CsvFormat {
+        file: path.into(),
+        message: format!("Parquet: {e}"),
+    }
+}
+
+/// A Parquet table being written row group by row group (the rows buffered column by column
+/// until a group is full).
+pub struct ParquetSink {
+    writer: ArrowWriter<BufWriter<File>>,
+    schema: Arc<Schema>,
+    columns: Vec<Vec<f64>>,
+    path: std::path::PathBuf,
+}
+
+impl std::fmt::Debug for ParquetSink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ParquetSink")
+            .field("path", &self.path)
+            .field("columns", &self.schema.fields().len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl ParquetSink {
+    /// A sink writing `columns` into `writer` (the file at `path`), with `metadata` as
+    /// key-value pairs.
+    ///
+    /// # Errors
+    /// The Parquet writer's refusal, naming the file.
+    pub fn create(
+        writer: BufWriter<File>,
+        path: &Path,
+        columns: &[String],
+        metadata: &[(String, String)],
+    ) -> Result<Self> {
+        let path = path.to_path_buf();
+        // The metadata both in the Arrow schema (pyarrow, pandas and polars show it there) and
+        // in the file's key-value pairs.
+        let schema = Arc::new(Schema::new_with_metadata(
+            columns
+                .iter()
+                .map(|c| Field::new(c, DataType::Float64, false))
+                .collect::<Vec<_>>(),
+            metadata
+                .iter()
+                .cloned()
+                .collect::<std::collections::HashMap<String, String>>(),
+        ));
+        let props = WriterProperties::builder()
+            .set_compression(Compression::SNAPPY)
+            .set_key_value_metadata(Some(
+                metadata
+                    .iter()
+                    .map(|(k, v)| KeyValue::new(k.clone(), v.clone()))
+                    .collect(),
+            ))
+            .build();
+        let writer = ArrowWriter::try_new(writer, Arc::clone(&schema), Some(props))
+            .map_err(|e| format_error(&path, e))?;
+        Ok(Self {
+            writer,
+            columns: vec![Vec::with_capacity(ROW_GROUP); columns.len()],
+            schema,
+            path,
+        })
+    }
+
+    /// Appends row-major `data` (rows of the schema's width), flushing full row groups.
+    ///
+    /// # Errors
+    /// The Parquet writer's refusal, naming the file.
+    pub fn write(&mut self, data: &[f64]) -> Result<()> {
+        let width = self.columns.len().max(1);
+        for row in data.chunks_exact(width) {
+            for (c, v) in self.columns.iter_mut().zip(row) {
+                c.push(*v);
+            }
+            if self.columns[0].len() >= ROW_GROUP {
+                self.flush()?;
+            }
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if self.columns.first().is_none_or(Vec::is_empty) {
+            return Ok(());
+        }
+        let arrays: Vec<ArrayRef> = self
+            .columns
+            .iter_mut()
+            .map(|c| Arc::new(Float64Array::from(std::mem::take(c))) as ArrayRef)
+            .collect();
+        let batch = RecordBatch::try_new(Arc::clone(&self.schema), arrays)
+            .map_err(|e| format_error(&self.path, e))?;
+        self.writer
+            .write(&batch)
+            .and_then(|()| self.writer.flush())
+            .map_err(|e| format_error(&self.path, e))
+    }
+
+    /// Writes what is buffered and the footer, and gives the writer back.
+    ///
+    /// # Errors
+    /// The Parquet writer's refusal, naming the file.
+    pub fn finish(mut self) -> Result<BufWriter<File>> {
+        self.flush()?;
+        self.writer
+            .into_inner()
+            .map_err(|e| format_error(&self.path, e))
+    }
+}
+
+/// Writes `table` as a Parquet file at `path` with `metadata`, atomically; every value must be
+/// finite (refused, naming row and column, before the file is made).
+///
+/// # Errors
+/// A value that is not finite; the writer's or the file system's refusal, naming the file.
+pub fn write_table(table: &Table, path: &Path, metadata: &[(String, String)]) -> Result<()> {
+    // Rows are numbered from 1: a Parquet file has no header row.
+    crate::io::table::check_finite_from(
+        &table.columns,
+        &table.data,
+        &path.display().to_string(),
+        1,
+    )?;
+    let mut file = AtomicFile::create(path)?;
+    file.begin_table(&table.columns, metadata)?;
+    file.write_table_rows(&table.data)?;
+    file.commit()
+}
+
+/// A Parquet file's key-value metadata.
+///
+/// # Errors
+/// An unreadable or malformed file.
+pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>> {
+    let builder = builder(path)?;
+    Ok(builder
+        .metadata()
+        .file_metadata()
+        .key_value_metadata()
+        .map(|kv| {
+            kv.iter()
+                .map(|k| (k.key.clone(), k.value.clone().unwrap_or_default()))
+                .collect()
+        })
+        .unwrap_or_default())
+}
+
+fn builder(path: &Path) -> Result<ParquetRecordBatchReaderBuilder<File>> {
+    let file = File::open(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format_error(path, e))
+}
+
+/// Every column of a Parquet table: float64 columns without nulls, finite values (a column of
+/// another type, a null or a value that is not finite is refused with its column and row).
+///
+/// # Errors
+/// As above; an unreadable or malformed file; a file without rows.
+pub fn read_table(path: &Path) -> Result<Table> {
+    let builder = builder(path)?;
+    let names = float64_names(path, builder.schema())?;
+    let reader = builder.build().map_err(|e| format_error(path, e))?;
+    let names_ref: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut table = Table::new(&names_ref);
+    let mut rows_before = 0usize;
+    for batch in reader {
+        let batch = batch.map_err(|e| format_error(path, e))?;
+        let columns: Vec<&Float64Array> = batch
+            .columns()
+            .iter()
+            .map(|c| {
+                c.as_any()
+                    .downcast_ref::<Float64Array>()
+                    .expect("float64 columns, checked in the schema")
+            })
+            .collect();
+        for (name, c) in names.iter().zip(&columns) {
+            if let Some(i) = (0..c.len()).find(|&i| c.is_null(i)) {
+                return Err(format_error(
+                    path,
+                    format!(
+                        "row {}, column {name}: no value (null)",
+                        rows_before + i + 1
+                    ),
+                ));
+            }
+        }
+        table.data.reserve(batch.num_rows() * names.len());
+        for i in 0..batch.num_rows() {
+            for c in &columns {
+                table.data.push(c.value(i));
+            }
+        }
+        rows_before += batch.num_rows();
+    }
+    if table.rows() == 0 {
+        return Err(format_error(path, "no rows"));
+    }
+    let width = names.len();
+    if let Some(k) = table.data.iter().position(|v| !v.is_finite()) {
+        return Err(format_error(
+            path,
+            format!(
+                "row {}, column {}: {} is not a finite number",
+                k / width + 1,
+                names[k % width],
+                table.data[k]
+            ),
+        ));
+    }
+    Ok(table)
+}
+
+/// The column names of a Parquet table (refused: a column that is not float64).
+///
+/// # Errors
+/// An unreadable or malformed file; a column of another type.
+pub fn column_names(path: &Path) -> Result<Vec<String>> {
+    let builder = builder(path)?;
+    float64_names(path, builder.schema())
+}
+
+fn float64_names(path: &Path, schema: &Schema) -> Result<Vec<String>> {
+    if let Some(f) = schema
+        .fields()
+        .iter()
+        .find(|f| f.data_type() != &DataType::Float64)
+    {
+        return Err(format_error(
+            path,
+            format!(
+                "column {} is {}, not float64 (imukit's tables are numbers)",
+                f.name(),
+                f.data_type()
+            ),
+        ));
+    }
+    Ok(schema.fields().iter().map(|f| f.name().clone()).collect())
+}
+
+/// A Parquet table read row by row, a row group's batch at a time (memory does not grow with
+/// the file).
+pub struct ParquetRows {
+    path: std::path::PathBuf,
+    reader: parquet::arrow::arrow_reader::ParquetRecordBatchReader,
+    batch: Vec<Float64Array>,
+    next: usize,
+    row: usize,
+}
+
+impl std::fmt::Debug for ParquetRows {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ParquetRows")
+            .field("path", &self.path)
+            .field("row", &self.row)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ParquetRows {
+    /// Opens `path`: its column names and the rows.
+    ///
+    /// # Errors
+    /// As [`column_names`].
+    pub fn open(path: &Path) -> Result<(Vec<String>, Self)> {
+        let builder = builder(path)?;
+        let names = float64_names(path, builder.schema())?;
+        let reader = builder.build().map_err(|e| format_error(path, e))?;
+        Ok((
+            names,
+            Self {
+                path: path.into(),
+                reader,
+                batch: Vec::new(),
+                next: 0,
+                row: 0,
+            },
+        ))
+    }
+
+    /// The next row's columns `wanted` (indices in the file, with their names) into `out`, and
+    /// its 1-based row number; `None` at the end.
+    ///
+    /// # Errors
+    /// A null or a value that is not finite (row and column named), a malformed file.
+    pub fn next_row(
+        &mut self,
+        wanted: &[(usize, String)],
+        out: &mut [f64],
+    ) -> Result<Option<usize>> {
+        while self.batch.first().is_none_or(|c| self.next >= c.len()) {
+            let Some(batch) = self.reader.next() else {
+                return Ok(None);
+            };
+            let batch = batch.map_err(|e| format_error(&self.path, e))?;
+            self.batch = batch
+                .columns()
+                .iter()
+                .map(|c| {
+                    c.as_any()
+                        .downcast_ref::<Float64Array>()
+                        .expect("float64 columns, checked in the schema")
+                        .clone()
+                })
+                .collect();
+            self.next = 0;
+            if self.batch.is_empty() {
+                return Ok(None);
+            }
+        }
+        self.row += 1;
+        for ((k, name), slot) in wanted.iter().zip(out.iter_mut()) {
+            let c = &self.batch[*k];
+            let v = if c.is_null(self.next) {
+                f64::NAN
+            } else {
+                c.value(self.next)
+            };
+            if !v.is_finite() {
+                return Err(Error::CsvValue {
+                    file: self.path.clone(),
+                    row: self.row,
+                    column: name.clone(),
+                    message: format!("{v} is not a finite number (or no value)"),
+                });
+            }
+            *slot = v;
+        }
+        self.next += 1;
+        Ok(Some(self.row))
+    }
+}
