@@ -357,17 +357,24 @@ pub fn write_rows(
     width: usize,
     separator: &[u8],
 ) -> std::io::Result<()> {
+    // Rows are formatted into one local buffer (ryu straight into it) and handed to the writer
+    // a block at a time: no call into the writer per field.
     let mut buf = ryu::Buffer::new();
-    for row in data.chunks(width) {
+    let mut text: Vec<u8> = Vec::with_capacity(64 * 1024);
+    for row in data.chunks(width.max(1)) {
         for (k, v) in row.iter().enumerate() {
             if k > 0 {
-                w.write_all(separator)?;
+                text.extend_from_slice(separator);
             }
-            w.write_all(buf.format(*v).as_bytes())?;
+            text.extend_from_slice(buf.format(*v).as_bytes());
         }
-        w.write_all(b"\n")?;
+        text.push(b'\n');
+        if text.len() >= 60 * 1024 {
+            w.write_all(&text)?;
+            text.clear();
+        }
     }
-    Ok(())
+    w.write_all(&text)
 }
 
 /// One truth sample in [`TRUTH_COLUMNS`] order.
