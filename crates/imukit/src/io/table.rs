@@ -548,31 +548,6 @@ pub fn read_table(path: &Path) -> Result<Table> {
 /// # Errors
 /// As [`read_columns`].
 pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Table> {
-    if crate::io::parquet::is_parquet(path) {
-        let whole = crate::io::parquet::read_table(path)?;
-        let missing: Vec<String> = names
-            .iter()
-            .filter(|c| !whole.columns.iter().any(|h| h == *c))
-            .map(|c| (*c).to_string())
-            .collect();
-        if !missing.is_empty() {
-            return Err(Error::MissingColumns {
-                file: path.into(),
-                missing,
-                hint: hint.into(),
-            });
-        }
-        let picked: Vec<Vec<f64>> = names
-            .iter()
-            .map(|c| whole.column(c).unwrap_or_default())
-            .collect();
-        let mut t = Table::new(names);
-        t.data.reserve(whole.rows() * names.len());
-        for i in 0..whole.rows() {
-            t.data.extend(picked.iter().map(|c| c[i]));
-        }
-        return Ok(t);
-    }
     let mut rows = CsvRows::open(path, names, hint)?;
     let mut t = Table::new(names);
     let mut row = vec![0.0; names.len()];
@@ -594,36 +569,6 @@ pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Tab
 /// Missing columns (all named at once, with `hint`), values that are not finite numbers (file,
 /// row, column), malformed or empty files.
 pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
-    if crate::io::parquet::is_parquet(path) {
-        let whole = crate::io::parquet::read_table(path)?;
-        let missing: Vec<String> = required
-            .iter()
-            .filter(|c| whole.column(c).is_none())
-            .map(|c| (*c).to_string())
-            .collect();
-        if !missing.is_empty() {
-            return Err(Error::MissingColumns {
-                file: path.into(),
-                missing,
-                hint: hint.into(),
-            });
-        }
-        let header: HashMap<String, usize> = whole
-            .columns
-            .iter()
-            .enumerate()
-            .map(|(k, n)| (n.clone(), k))
-            .collect();
-        let mut values = vec![Vec::new(); header.len()];
-        for name in required {
-            values[header[*name]] = whole.column(name).unwrap_or_default();
-        }
-        return Ok(CsvColumns {
-            file: path.into(),
-            header,
-            values,
-        });
-    }
     let mut rows = CsvRows::open(path, required, hint)?;
     let header: HashMap<String, usize> = rows
         .names
