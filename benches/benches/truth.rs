@@ -1,5 +1,5 @@
-//! Truth + ideal IMU throughput (samples/s) on the figure-8: exact (formula strings over
-//! dual numbers) and sampled (finite differences, order 6, tangent attitude).
+//! Truth + ideal IMU throughput (samples/s) on the figure-8: exact (formula strings, compiled)
+//! and sampled (finite differences, order 6, tangent attitude); and the exact truth alone.
 //!
 //! Run: `cargo bench -p imu-benches --bench truth`.
 #![allow(missing_docs)]
@@ -37,6 +37,12 @@ fn bench_truth(c: &mut Criterion) {
                 truth_from_motion(&motion, t, AnalyticOptions::default(), &mut truth)
                     .expect("truth");
                 mount.read_into(&truth, &mut readings);
+            });
+        });
+        group.bench_with_input(BenchmarkId::new("exact_truth_only", n), &t, |b, t| {
+            b.iter(|| {
+                truth_from_motion(&motion, t, AnalyticOptions::default(), &mut truth)
+                    .expect("truth");
             });
         });
         if n >= 10 {

@@ -10,11 +10,18 @@ use crate::math;
 use crate::rotation::EulerZyx;
 use crate::vector::Vec3;
 
-/// Body rate `ω_b` (rad/s) from Euler angles `e` and their rates `d` (rad/s, as `EulerZyx`).
-#[must_use]
-pub fn body_rate(e: EulerZyx, d: EulerZyx) -> Vec3<Body> {
-    let (sp, cp) = (math::sin(e.pitch_rad), math::cos(e.pitch_rad));
-    let (sr, cr) = (math::sin(e.roll_rad), math::cos(e.roll_rad));
+/// `(sin p, cos p, sin r, cos r)` of the pitch and roll of `e`.
+fn pitch_roll_sin_cos(e: EulerZyx) -> [f64; 4] {
+    [
+        math::sin(e.pitch_rad),
+        math::cos(e.pitch_rad),
+        math::sin(e.roll_rad),
+        math::cos(e.roll_rad),
+    ]
+}
+
+/// `ω_b` from the rates `d` and the pitch's and roll's sines and cosines.
+fn rate_from([sp, cp, sr, cr]: [f64; 4], d: EulerZyx) -> Vec3<Body> {
     let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
     Vec3::new(
         rd - yd * sp,
@@ -23,12 +30,9 @@ pub fn body_rate(e: EulerZyx, d: EulerZyx) -> Vec3<Body> {
     )
 }
 
-/// Body angular acceleration `α_b = dω_b/dt` (rad/s²) from Euler angles `e`, their rates `d`
-/// (rad/s) and second derivatives `dd` (rad/s²).
-#[must_use]
-pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
-    let (sp, cp) = (math::sin(e.pitch_rad), math::cos(e.pitch_rad));
-    let (sr, cr) = (math::sin(e.roll_rad), math::cos(e.roll_rad));
+/// `α_b` from the rates `d`, second derivatives `dd` and the pitch's and roll's sines and
+/// cosines.
+fn acceleration_from([sp, cp, sr, cr]: [f64; 4], d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
     let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
     let (ydd, pdd, rdd) = (dd.yaw_rad, dd.pitch_rad, dd.roll_rad);
     Vec3::new(
@@ -36,6 +40,31 @@ pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3
         pdd * cr - pd * rd * sr + ydd * cp * sr - yd * pd * sp * sr + yd * rd * cp * cr,
         -pdd * sr - pd * rd * cr + ydd * cp * cr - yd * pd * sp * cr - yd * rd * cp * sr,
     )
+}
+
+/// Body rate `ω_b` (rad/s) from Euler angles `e` and their rates `d` (rad/s, as `EulerZyx`).
+#[must_use]
+pub fn body_rate(e: EulerZyx, d: EulerZyx) -> Vec3<Body> {
+    rate_from(pitch_roll_sin_cos(e), d)
+}
+
+/// Body angular acceleration `α_b = dω_b/dt` (rad/s²) from Euler angles `e`, their rates `d`
+/// (rad/s) and second derivatives `dd` (rad/s²).
+#[must_use]
+pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
+    acceleration_from(pitch_roll_sin_cos(e), d, dd)
+}
+
+/// [`body_rate`] and [`body_angular_acceleration`] together, the same numbers with the
+/// pitch's and roll's sines and cosines taken once.
+#[must_use]
+pub fn body_rate_and_acceleration(
+    e: EulerZyx,
+    d: EulerZyx,
+    dd: EulerZyx,
+) -> (Vec3<Body>, Vec3<Body>) {
+    let sc = pitch_roll_sin_cos(e);
+    (rate_from(sc, d), acceleration_from(sc, d, dd))
 }
 
 /// `angle` plus the multiple of 2π that brings it closest to `reference` (rad): yaw unwrapping

@@ -66,6 +66,16 @@ impl<N: NavFrame> Truth<N> {
             && self.omega_b_rad_s.is_finite()
             && self.alpha_b_rad_s2.is_finite()
     }
+
+    /// Sets the attitude from z-y-x Euler angles `euler` (rad), and the body rate and body
+    /// angular acceleration from the angles' first and second time derivatives `rate` (rad/s)
+    /// and `accel` (rad/s²) (see [`euler::body_rate_and_acceleration`]).
+    pub fn set_euler_motion(&mut self, euler: EulerZyx, rate: EulerZyx, accel: EulerZyx) {
+        self.euler = euler;
+        self.attitude = Rotation::from_euler(euler);
+        (self.omega_b_rad_s, self.alpha_b_rad_s2) =
+            euler::body_rate_and_acceleration(euler, rate, accel);
+    }
 }
 
 /// Checks that sample times are finite and strictly increasing.

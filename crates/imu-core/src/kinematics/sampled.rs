@@ -8,7 +8,6 @@
 use nalgebra::Quaternion;
 
 use crate::frame::{Body, NavFrame};
-use crate::kinematics::euler::{body_angular_acceleration, body_rate};
 use crate::kinematics::finite_diff::{self, derivatives_at};
 use crate::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
 use crate::kinematics::{KinematicsError, Truth, check_times};
@@ -270,10 +269,7 @@ fn euler_at<N: NavFrame>(
         euler.yaw_rad = math::unwrap_near(euler.yaw_rad, y);
     }
     let (d, dd) = (EulerZyx::from_array(d), EulerZyx::from_array(dd));
-    s.euler = euler;
-    s.attitude = Rotation::from_euler(euler);
-    s.omega_b_rad_s = body_rate(euler, d);
-    s.alpha_b_rad_s2 = body_angular_acceleration(euler, d, dd);
+    s.set_euler_motion(euler, d, dd);
 }
 
 /// Attitude, body rate and angular acceleration of sample `i` of a quaternion path (checked).
@@ -325,9 +321,7 @@ fn tangent_path<N: NavFrame>(
         let (d, dd) = derivatives_at(t_s, i, options.order, |j| out[j].euler.to_array());
         let (d, dd) = (EulerZyx::from_array(d), EulerZyx::from_array(dd));
         let s = &mut out[i];
-        s.attitude = Rotation::from_euler(s.euler);
-        s.omega_b_rad_s = body_rate(s.euler, d);
-        s.alpha_b_rad_s2 = body_angular_acceleration(s.euler, d, dd);
+        s.set_euler_motion(s.euler, d, dd);
     }
     Ok(())
 }

@@ -33,7 +33,7 @@
 //! ```
 use num_dual::{Dual2, Dual3, DualNum};
 
-use imu_core::kinematics::euler::{body_angular_acceleration, body_rate, unwrap_near};
+use imu_core::kinematics::euler::unwrap_near;
 use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
 use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
 use imu_core::kinematics::{KinematicsError, Truth, check_times};
@@ -167,6 +167,22 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
         t_s: f64,
         point: &MotionPoint,
     ) -> Result<(Truth<N>, bool), KinematicsError> {
+        let mut truth = Truth::default();
+        let valid = self.step_into(t_s, point, &mut truth)?;
+        Ok((truth, valid))
+    }
+
+    /// [`Self::step_at`] written into `truth` (every field set; returns whether the attitude is
+    /// valid, see [`Self::step`]).
+    ///
+    /// # Errors
+    /// As [`Self::step`].
+    pub fn step_into<N: NavFrame>(
+        &mut self,
+        t_s: f64,
+        point: &MotionPoint,
+        truth: &mut Truth<N>,
+    ) -> Result<bool, KinematicsError> {
         let index = self.index;
         self.index += 1;
         let part = |k: usize| -> [f64; 3] { point.position.map(|axis| axis[k]) };
@@ -177,13 +193,10 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                 index,
             });
         }
-        let mut truth = Truth::<N> {
-            t_s,
-            position_m: Vec3::from_array(pos),
-            velocity_m_s: Vec3::from_array(vel),
-            acceleration_m_s2: Vec3::from_array(acc),
-            ..Truth::default()
-        };
+        truth.t_s = t_s;
+        truth.position_m = Vec3::from_array(pos);
+        truth.velocity_m_s = Vec3::from_array(vel);
+        truth.acceleration_m_s2 = Vec3::from_array(acc);
         let (euler, rate, accel) = match point.euler {
             Some(e) => {
                 let ang = |k: usize| EulerZyx::new(e[0][k], e[1][k], e[2][k]);
@@ -208,20 +221,24 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
             }
             None => match self.tracker.update(index, vel, acc, jerk)? {
                 Some(a) => (a.euler, a.rate, a.accel),
-                None => return Ok((truth, false)),
+                None => {
+                    let zero = EulerZyx::default();
+                    truth.euler = zero;
+                    truth.attitude = Rotation::identity();
+                    truth.omega_b_rad_s = Vec3::zeros();
+                    truth.alpha_b_rad_s2 = Vec3::zeros();
+                    return Ok(false);
+                }
             },
         };
-        truth.euler = euler;
-        truth.attitude = Rotation::from_euler(euler);
-        truth.omega_b_rad_s = body_rate(euler, rate);
-        truth.alpha_b_rad_s2 = body_angular_acceleration(euler, rate, accel);
+        truth.set_euler_motion(euler, rate, accel);
         if !truth.is_finite() {
             return Err(KinematicsError::NotFinite {
                 field: "truth",
                 index,
             });
         }
-        Ok((truth, true))
+        Ok(true)
     }
 }
 
@@ -253,9 +270,7 @@ pub fn truth_from_motion<M: Motion, N: NavFrame>(
     {
         motion.derivatives(times, &mut points);
         for (k, ((&t, slot), point)) in times.iter().zip(slots).zip(&points).enumerate() {
-            let (truth, valid) = stepper.step_at(t, point)?;
-            *slot = truth;
-            if valid {
+            if stepper.step_into(t, point, slot)? {
                 first_valid.get_or_insert(c * DERIVATIVE_CHUNK + k);
             }
         }

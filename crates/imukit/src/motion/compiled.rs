@@ -161,6 +161,13 @@ impl Op {
     }
 }
 
+/// The registers a [`Program`] works in, kept between calls of [`Program::eval_in`].
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    registers: Vec<[Jet; CHUNK]>,
+    pairs: Vec<[(f64, f64); CHUNK]>,
+}
+
 /// Several formulas compiled together (see the module documentation).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Program {
@@ -407,19 +414,33 @@ impl Program {
     /// The formulas at each time of `t_s`: `out[i * outputs + k]` is formula `k` at `t_s[i]`
     /// (resized to fit).
     pub fn eval(&self, t_s: &[f64], out: &mut Vec<Jet>) {
+        self.eval_in(t_s, out, &mut Scratch::default());
+    }
+
+    /// [`Self::eval`] in the registers of `scratch`, grown once and kept for the next call (a
+    /// caller that evaluates chunk after chunk allocates nothing after the first).
+    pub fn eval_in(&self, t_s: &[f64], out: &mut Vec<Jet>, scratch: &mut Scratch) {
         let m = self.outputs.len();
         out.clear();
         out.resize(t_s.len() * m, [0.0; 4]);
-        let mut regs = vec![[[0.0; 4]; CHUNK]; self.registers];
-        let mut pairs = vec![[(0.0, 0.0); CHUNK]; self.pairs];
+        // Every register and pair slot is written before it is read (the program is in
+        // order), so what an earlier call left there is never seen.
+        if scratch.registers.len() < self.registers {
+            scratch.registers.resize(self.registers, [[0.0; 4]; CHUNK]);
+        }
+        if scratch.pairs.len() < self.pairs {
+            scratch.pairs.resize(self.pairs, [(0.0, 0.0); CHUNK]);
+        }
+        let regs = &mut scratch.registers[..self.registers];
+        let pairs = &mut scratch.pairs[..self.pairs];
         for (c, times) in t_s.chunks(CHUNK).enumerate() {
             let n = times.len();
             for &(op, r) in &self.steps {
-                let (out, regs) = split(&mut regs, r as usize);
+                let (out, regs) = split(regs, r as usize);
                 let out = &mut out[..n];
                 match self.order {
-                    Order::Second => run::<Second>(op, out, &regs, &mut pairs, times),
-                    Order::Third => run::<Third>(op, out, &regs, &mut pairs, times),
+                    Order::Second => run::<Second>(op, out, &regs, pairs, times),
+                    Order::Third => run::<Third>(op, out, &regs, pairs, times),
                 }
             }
             for (i, row) in out[c * CHUNK * m..(c * CHUNK + n) * m]

@@ -9,10 +9,11 @@ use imu_core::{Ecef, NavFrame, Rotation};
 
 use num_dual::DualNum;
 
+use std::cell::RefCell;
 use std::sync::OnceLock;
 
 use crate::motion::analytic::{Motion, MotionPoint, Scalar, atan2, dual_derivatives};
-use crate::motion::compiled::{Order, Program};
+use crate::motion::compiled::{Jet, Order, Program, Scratch};
 use crate::motion::expr::Expr;
 use crate::scenario::NavFrameName;
 
@@ -63,6 +64,19 @@ impl GeodeticPlane {
             enu,
         }
     }
+}
+
+/// What [`ExpressionMotion::derivatives`] evaluates in, kept per thread between calls: the
+/// programs' registers and their jets.
+#[derive(Default)]
+struct EvalScratch {
+    registers: Scratch,
+    p: Vec<Jet>,
+    e: Vec<Jet>,
+}
+
+thread_local! {
+    static EVAL_SCRATCH: RefCell<EvalScratch> = RefCell::new(EvalScratch::default());
 }
 
 /// The position formulas' program and the angles' (when given).
@@ -124,6 +138,22 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
+    /// The jets of the position formulas `p` (three per time) and of the angles `e` into
+    /// [`MotionPoint`]s.
+    fn points(&self, p: &[Jet], e: &[Jet], out: &mut Vec<MotionPoint>) {
+        out.clear();
+        out.extend(p.chunks_exact(3).enumerate().map(|(i, j)| MotionPoint {
+            position: [j[0], j[1], j[2]],
+            euler: match &self.attitude {
+                ExpressionAttitude::Tangent => None,
+                ExpressionAttitude::Level => Some([[0.0; 3]; 3]),
+                ExpressionAttitude::Euler(_) => {
+                    Some([0, 1, 2].map(|k| [e[3 * i + k][0], e[3 * i + k][1], e[3 * i + k][2]]))
+                }
+            },
+        }));
+    }
+
     /// A motion of these formulas.
     #[must_use]
     pub fn new(
@@ -217,22 +247,14 @@ impl Motion for ExpressionMotion {
             (None | Some(GeodeticPlane::Unplaced), Some(p)) => p,
             _ => return dual_derivatives(self, t_s, out),
         };
-        let (mut p, mut e) = (Vec::new(), Vec::new());
-        position.eval(t_s, &mut p);
-        if let Some(angles) = angles {
-            angles.eval(t_s, &mut e);
-        }
-        out.clear();
-        out.extend(p.chunks_exact(3).enumerate().map(|(i, j)| MotionPoint {
-            position: [j[0], j[1], j[2]],
-            euler: match &self.attitude {
-                ExpressionAttitude::Tangent => None,
-                ExpressionAttitude::Level => Some([[0.0; 3]; 3]),
-                ExpressionAttitude::Euler(_) => {
-                    Some([0, 1, 2].map(|k| [e[3 * i + k][0], e[3 * i + k][1], e[3 * i + k][2]]))
-                }
-            },
-        }));
+        EVAL_SCRATCH.with_borrow_mut(|s| {
+            let EvalScratch { registers, p, e } = s;
+            position.eval_in(t_s, p, registers);
+            if let Some(angles) = angles {
+                angles.eval_in(t_s, e, registers);
+            }
+            self.points(p, e, out);
+        });
     }
 
     fn position<D: Scalar>(&self, t: D) -> [D; 3] {

@@ -272,10 +272,11 @@ fn motion_chunks<M: Motion, N: NavFrame>(
         times.extend((start..t_s.len().min(start + DERIVATIVE_CHUNK)).map(|k| t_s.at(k)));
         motion.derivatives(&times, &mut points);
         for (&t, point) in times.iter().zip(&points) {
-            let (truth, valid) = stepper
-                .step_at::<N>(t, point)
+            buffer.push(Truth::default());
+            let slot = buffer.last_mut().expect("just pushed");
+            let valid = stepper
+                .step_into::<N>(t, point, slot)
                 .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
-            buffer.push(truth);
             if valid && !moving {
                 moving = true;
                 let first = buffer.len() - 1;
