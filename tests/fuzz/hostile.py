@@ -12,7 +12,8 @@ says no cleanly.
 
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
 long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
-(extreme origins, geodetic formulas, dates, vertical channels); output paths that collide with
+(extreme origins, geodetic formulas, dates, vertical channels); mutated and truncated Parquet,
+``.npy`` and ``.npz`` tables fed to the commands that read tables; output paths that collide with
 inputs, special files and folders; Python calls with NaN, inf, huge and misshapen arguments. Prints one line per
 class and a closing ``N passed, M failed`` line; exits 1 on any failure.
 """
@@ -295,37 +296,40 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 
-        r = Run("Parquet files, mutated")
-        base = work / "pq.toml"
-        base.write_text('rate_hz = 50.0\nduration_s = 4.0\n[trajectory]\ntype = "builtin"\nname = "figure8"\n'
-                        '[imu]\nkind = "accel-gyro"\npreset = "mpu-6050"\n')
-        run_cli(r, work, ["simulate", "pq.toml", "--out", "pi.parquet", "--truth", "pt.parquet"], ["pq.toml"],
-                "Parquet seed files")
-        good = {n: (work / n).read_bytes() for n in ("pi.parquet", "pt.parquet") if (work / n).exists()}
-        for k in range(per if good else 0):
-            name = rng.choice(sorted(good))
-            data = good[name]
-            if rng.random() < 0.5:
-                data = mutate(rng, data)
-            else:  # a truncated file, or its footer's bytes flipped
-                cut = rng.randrange(len(data))
-                data = data[:cut] if rng.random() < 0.5 else data[:cut] + bytes([data[cut] ^ 0xFF]) + data[cut + 1:]
-            (work / "m.parquet").write_bytes(data)
-            other = "pt.parquet" if name == "pi.parquet" else "pi.parquet"
-            args = rng.choice([
-                ["integrate", "m.parquet", "--init", "pt.parquet", "--out", "mo.parquet"],
-                ["integrate", "pi.parquet", "--init", "m.parquet", "--out", "mo.csv"],
-                ["compare", "m.parquet", other, "--out", "mo.parquet"],
-                ["allan", "m.parquet", "--out", "mo.csv"],
-                ["plot", "m.parquet", "--out", "mo.png"],
-                ["orient", "m.parquet", "--filter", "imufilter", "--out", "mo.parquet"],
-            ])
-            run_cli(r, work, args, ["m.parquet", *good], f"case {k} (Parquet)")
-            for leftover in ("m.parquet", "mo.parquet", "mo.csv", "mo.png"):
-                (work / leftover).unlink(missing_ok=True)
-        for n in ("pq.toml", *good):
-            (work / n).unlink(missing_ok=True)
-        runs.append(r)
+        for fmt in ("parquet", "npy", "npz"):
+            r = Run(f"{fmt} files, mutated")
+            base = work / "pq.toml"
+            base.write_text('rate_hz = 50.0\nduration_s = 4.0\n[trajectory]\ntype = "builtin"\nname = "figure8"\n'
+                            '[imu]\nkind = "accel-gyro"\npreset = "mpu-6050"\n')
+            seeds = (f"pi.{fmt}", f"pt.{fmt}")
+            run_cli(r, work, ["simulate", "pq.toml", "--out", seeds[0], "--truth", seeds[1]], ["pq.toml"],
+                    f"{fmt} seed files")
+            good = {n: (work / n).read_bytes() for n in seeds if (work / n).exists()}
+            m, mo = f"m.{fmt}", f"mo.{fmt}"
+            for k in range(per if good else 0):
+                name = rng.choice(sorted(good))
+                data = good[name]
+                if rng.random() < 0.5:
+                    data = mutate(rng, data)
+                else:  # a truncated file, or one byte flipped
+                    cut = rng.randrange(len(data))
+                    data = data[:cut] if rng.random() < 0.5 else data[:cut] + bytes([data[cut] ^ 0xFF]) + data[cut + 1:]
+                (work / m).write_bytes(data)
+                other = seeds[1] if name == seeds[0] else seeds[0]
+                args = rng.choice([
+                    ["integrate", m, "--init", seeds[1], "--out", mo],
+                    ["integrate", seeds[0], "--init", m, "--out", "mo.csv"],
+                    ["compare", m, other, "--out", mo],
+                    ["allan", m, "--out", "mo.csv"],
+                    ["plot", m, "--out", "mo.png"],
+                    ["orient", m, "--filter", "imufilter", "--out", mo],
+                ])
+                run_cli(r, work, args, [m, *good], f"case {k} ({fmt})")
+                for leftover in (m, mo, "mo.csv", "mo.png"):
+                    (work / leftover).unlink(missing_ok=True)
+            for n in ("pq.toml", *good):
+                (work / n).unlink(missing_ok=True)
+            runs.append(r)
 
         r = Run("colliding and special output paths")
         (work / "folder").mkdir(exist_ok=True)

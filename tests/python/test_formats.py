@@ -1,6 +1,7 @@
-"""Binary outputs: ``imukit simulate`` writes Parquet when the output's extension says so — the
-CSV contract's column names, float64, the scenario and navigation frame in the metadata — and
-pyarrow, pandas, polars and ``imukit.read`` read it back bit for bit equal to the CSV output."""
+"""Binary outputs: ``imukit simulate`` writes Parquet, ``.npy`` or ``.npz`` when the output's
+extension says so — the CSV contract's column names, float64 (Parquet also carries the scenario
+and navigation frame in its metadata) — and pyarrow, pandas, polars, NumPy and ``imukit.read``
+read them back bit for bit equal to the CSV output; the commands read what NumPy saves."""
 import subprocess
 
 import numpy as np
@@ -61,3 +62,55 @@ def test_tables_write_parquet_and_the_commands_read_it(tmp_path):
     pq.write_table(pa.table({"t_s": [0.0, 1.0], "label": ["a", "b"]}), tmp_path / "bad.parquet")
     with pytest.raises(imukit.ImuError, match="column label is Utf8"):
         imukit.read(tmp_path / "bad.parquet")
+
+
+def test_numpy_outputs_read_back_bit_for_bit_in_numpy_and_pandas(tmp_path):
+    scenario = ROOT / "examples" / "expression.toml"
+    for ext in ("csv", "npy", "npz"):
+        subprocess.run([imukit_bin(), "simulate", str(scenario), "--out", str(tmp_path / f"imu.{ext}"),
+                        "--truth", str(tmp_path / f"truth.{ext}")], check=True, capture_output=True)
+    for name in ("imu", "truth"):
+        csv = imukit.read(tmp_path / f"{name}.csv")
+        # .npy: one structured array, a float64 field per column, named as in the CSV.
+        records = np.load(tmp_path / f"{name}.npy")
+        assert records.dtype.names == csv.columns
+        assert all(records.dtype[n] == np.dtype("<f8") for n in csv.columns)
+        assert records.shape == (csv.values.shape[0],)
+        for k, n in enumerate(csv.columns):
+            assert np.array_equal(records[n], csv.values[:, k]), n
+        assert np.array_equal(pd.DataFrame(records).to_numpy(), csv.values)
+        # .npz: one one-dimensional float64 array per column, as numpy.savez writes them.
+        with np.load(tmp_path / f"{name}.npz") as archive:
+            assert tuple(archive.files) == csv.columns
+            assert np.array_equal(pd.DataFrame(dict(archive)).to_numpy(), csv.values)
+        for ext in ("npy", "npz"):
+            ours = imukit.read(tmp_path / f"{name}.{ext}")
+            assert ours.columns == csv.columns and np.array_equal(ours.values, csv.values)
+
+
+def test_commands_read_numpy_files_made_by_numpy(tmp_path):
+    sim = imukit.simulate(ROOT / "examples" / "expression.toml")
+    sim.truth.write(tmp_path / "truth.csv")
+    sim.imu.write(tmp_path / "imu.csv")
+    # As a NumPy user would save them: savez, savez_compressed, a structured array.
+    np.savez(tmp_path / "imu.npz", **sim.imu.to_dict())
+    np.savez_compressed(tmp_path / "truth.npz", **sim.truth.to_dict())
+    np.save(tmp_path / "truth.npy", np.rec.fromarrays([sim.truth[c] for c in sim.truth.columns],
+                                                      names=list(sim.truth.columns)))
+    outs = {}
+    for imu, truth in (("imu.csv", "truth.csv"), ("imu.npz", "truth.npz"), ("imu.npz", "truth.npy")):
+        out = tmp_path / f"nav-{imu}-{truth}.npy"
+        run = subprocess.run([imukit_bin(), "integrate", str(tmp_path / imu), "--init", str(tmp_path / truth),
+                              "--out", str(out)], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        outs[(imu, truth)] = imukit.read(out)
+    first, *rest = outs.values()
+    for other in rest:
+        assert other.columns == first.columns and np.array_equal(other.values, first.values)
+    # A plain 2-D array has no column names: refused, saying so.
+    np.save(tmp_path / "plain.npy", sim.imu.values)
+    with pytest.raises(imukit.ImuError, match="not a table"):
+        imukit.read(tmp_path / "plain.npy")
+    # Unknown extensions are refused with the formats read.
+    with pytest.raises(imukit.ImuError, match=r"\.npy, \.npz"):
+        imukit.read(tmp_path / "imu.xlsx")

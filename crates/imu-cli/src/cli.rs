@@ -5,7 +5,15 @@ use clap::{Parser, Subcommand};
 
 /// A fast, exact and reproducible IMU simulator.
 #[derive(Debug, Parser)]
-#[command(name = "imukit", version, about, long_about = None)]
+#[command(
+    name = "imukit",
+    version,
+    about,
+    long_about = None,
+    after_help = "Tables (readings, truth, estimates, errors) are CSV unless a file's extension \
+                  says otherwise, when written and when read: .parquet (Apache Parquet), .npy (a \
+                  NumPy structured array), .npz (a NumPy archive, one array per column)."
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -23,20 +31,20 @@ pub enum Command {
     Simulate {
         /// The scenario file.
         scenario: PathBuf,
-        /// Where to write the IMU readings (CSV).
+        /// Where to write the IMU readings (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,
-        /// Where to write the truth (CSV).
+        /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         truth: Option<PathBuf>,
         /// Where to write the GNSS fixes of the scenario's `[gnss]` receiver (CSV; with --runs,
         /// one per run like the IMU readings).
         #[arg(long)]
         gnss: Option<PathBuf>,
-        /// Where to write the readings of the scenario's `[baro]` barometer (CSV).
+        /// Where to write the readings of the scenario's `[baro]` barometer (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         baro: Option<PathBuf>,
-        /// Where to write the readings of the scenario's `[odometer]` (CSV).
+        /// Where to write the readings of the scenario's `[odometer]` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         odometer: Option<PathBuf>,
         /// Monte Carlo: this many runs, in parallel on all cores, one output per run
@@ -127,7 +135,7 @@ pub enum Command {
         /// 3D, `--earth wgs84`: the starting height above the WGS-84 ellipsoid, m.
         #[arg(long, allow_negative_numbers = true)]
         height0_m: Option<f64>,
-        /// Where to write the trajectory (CSV).
+        /// Where to write the trajectory (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,
     },
@@ -212,7 +220,7 @@ pub enum Command {
         /// zero-rate updates at every sample there calibrate the gyroscope biases.
         #[arg(long, value_name = "SECONDS")]
         rest_s: Option<f64>,
-        /// Where to write the estimate (CSV).
+        /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,
     },
@@ -240,7 +248,7 @@ pub enum Command {
         truth: PathBuf,
         /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
-        /// Where to write the errors over time (CSV).
+        /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -274,7 +282,7 @@ pub enum Command {
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,
-        /// Where to write `tau_s, adev_<column>…` (CSV).
+        /// Where to write `tau_s, adev_<column>…` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,
         /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).

@@ -48,15 +48,26 @@ fn finite(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Values beyond ±this are drawn at the edge: the axis's span stays a finite number.
+const AXIS_LIMIT: f64 = 1e300;
+
+/// An axis range holding `values` with a margin. The margin is at least a billionth of the
+/// values' magnitude, so the tick marks' spacing is always more than the numbers' own
+/// resolution (a range of a few ulps at 1e283 would leave the tick search stepping by
+/// nothing).
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
-    if !lo.is_finite() {
+    if !lo.is_finite() || !hi.is_finite() {
         return (0.0, 1.0);
     }
+    let (lo, hi) = (
+        lo.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+        hi.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+    );
     let pad = if hi > lo {
-        0.05 * (hi - lo)
+        (0.05 * (hi - lo)).max(1e-9 * lo.abs().max(hi.abs()))
     } else {
         0.5 * lo.abs().max(1e-9)
     };
@@ -272,4 +283,50 @@ pub fn is_3d(traces: &[Trace]) -> bool {
 /// A figure of trajectories in the plane, start and end marked (the exercise's figure).
 pub fn trajectories_figure(path: &Path, title: &str, traces: &[Trace]) -> Result<(), PlotError> {
     write_figure(path, 900, 640, |root| draw_plan_view(root, title, traces))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_ranges_of_extreme_values_are_finite_and_wider_than_their_resolution() {
+        let (lo, hi) = range([-1.4e308, 8e283, 3.0].into_iter());
+        assert!(
+            lo.is_finite() && hi.is_finite() && lo < -1e300 && hi > 8e283,
+            "{lo} {hi}"
+        );
+        // Two values an ulp apart at 1e283: the margin is a billionth of their size.
+        let x = 1e283_f64;
+        let (lo, hi) = range([x, f64::from_bits(x.to_bits() + 1)].into_iter());
+        assert!((hi - lo) / x > 1.9e-9, "{lo} {hi}");
+        // A constant keeps half its size either side, as before.
+        assert_eq!(range([9.8, 9.8].into_iter()), (4.9, 14.700000000000001));
+    }
+
+    #[test]
+    fn a_panel_of_extreme_values_is_drawn() {
+        let mut svg = String::new();
+        let panel = Panel {
+            title: "t".into(),
+            x_label: "t (s)".into(),
+            y_label: "y".into(),
+            series: vec![Series {
+                label: "a".into(),
+                points: vec![
+                    (0.0, -1.45e308),
+                    (8e283, 1e283),
+                    (-1.7e259, 2e300),
+                    (1.0, 1e283),
+                ],
+                color: 0,
+                style: 0,
+            }],
+        };
+        {
+            let area = SVGBackend::with_string(&mut svg, (400, 300)).into_drawing_area();
+            draw_panel(&area, &panel).unwrap();
+        }
+        assert!(svg.contains("<svg"));
+    }
 }

@@ -23,7 +23,7 @@ fn read_table_file<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> 
     table_out(py, t)
 }
 
-/// Writes a table in the format its path's extension names (`.parquet`, else CSV), atomically.
+/// Writes a table in the format its path's extension names (`.parquet`, `.npy`, `.npz`, else CSV), atomically.
 #[pyfunction]
 fn write_table_file(
     py: Python<'_>,

@@ -48,7 +48,8 @@ class Table:
 
     def write(self, path) -> None:
         """Writes the table in the format the path's extension names — Parquet for ``.parquet``,
-        CSV otherwise — atomically (imukit's own writer, as the command line's)."""
+        NumPy for ``.npy`` (a structured array) and ``.npz`` (an array per column), CSV
+        otherwise — atomically (imukit's own writer, as the command line's)."""
         from . import _core
         _core.write_table_file(str(path), list(self.columns), self.values)
 

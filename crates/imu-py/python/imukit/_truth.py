@@ -47,13 +47,19 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     return _table(_core.read_csv(str(path)))
 
 def read(path: Union[str, os.PathLike]) -> Table:
-    """An imukit table file as a :class:`Table`, its format by its extension: ``.parquet``
-    (float64 columns, as ``imukit simulate --out x.parquet`` writes them) or ``.csv``. Any other
-    extension is refused with the formats read."""
+    """An imukit table file as a :class:`Table`, its format by its extension: ``.csv``,
+    ``.parquet`` (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy``
+    (a structured array of float64 fields) or ``.npz`` (one float64 array per column, as
+    ``numpy.savez`` writes them). Any other extension is refused with the formats read."""
     suffix = Path(path).suffix.lower()
-    if suffix in (".csv", ".parquet"):
+    if suffix in TABLE_FORMATS:
         return _table(_core.read_table_file(str(path)))
-    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables (read: .csv, .parquet)")
+    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
+                   f"(read: {', '.join(TABLE_FORMATS)})")
+
+
+#: The extensions of the table files imukit reads and writes.
+TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz")
 
 
 def builtin_scenarios() -> list:

@@ -7,7 +7,10 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result, invalid};
-use crate::io::parquet::{ParquetSink, is_parquet};
+use crate::io::TableFormat;
+use crate::io::npy::NpySink;
+use crate::io::npz::NpzSink;
+use crate::io::parquet::ParquetSink;
 use crate::io::table::{check_finite, write_rows};
 
 /// The longest file name most file systems take, bytes.
@@ -44,6 +47,10 @@ pub struct AtomicFile {
     writer: Option<BufWriter<File>>,
     /// A Parquet table being written (it holds the writer until the commit).
     parquet: Option<ParquetSink>,
+    /// A `.npy` table being written (on a handle of its own to the same file).
+    npy: Option<NpySink>,
+    /// A `.npz` table being gathered (the archive is written at the commit).
+    npz: Option<NpzSink>,
 }
 
 impl AtomicFile {
@@ -75,6 +82,8 @@ impl AtomicFile {
                 tmp: None,
                 writer: Some(BufWriter::new(file)),
                 parquet: None,
+                npy: None,
+                npz: None,
             });
         }
         let tmp = temporary_path(path);
@@ -86,6 +95,8 @@ impl AtomicFile {
             tmp: Some(tmp),
             writer: Some(BufWriter::new(file)),
             parquet: None,
+            npy: None,
+            npz: None,
         })
     }
 
@@ -95,17 +106,34 @@ impl AtomicFile {
         &self.path
     }
 
-    /// Starts a table of `columns` in the format the path's extension names: Parquet for
-    /// `.parquet` (with `metadata` in the file), else a CSV header line.
+    /// Starts a table of `columns` in the format the path's extension names
+    /// ([`TableFormat`]): Parquet (with `metadata` in the file), `.npy` or `.npz` (which have no
+    /// place for it), else a CSV header line.
     ///
     /// # Errors
     /// [`Error::Io`] naming the file; the Parquet writer's refusal.
     pub fn begin_table(&mut self, columns: &[String], metadata: &[(String, String)]) -> Result<()> {
         self.columns = columns.to_vec();
-        if is_parquet(&self.path) {
-            let writer = self.writer.take().expect("a table is begun once");
-            self.parquet = Some(ParquetSink::create(writer, &self.path, columns, metadata)?);
-            return Ok(());
+        match TableFormat::of(&self.path) {
+            TableFormat::Parquet => {
+                let writer = self.writer.take().expect("a table is begun once");
+                self.parquet = Some(ParquetSink::create(writer, &self.path, columns, metadata)?);
+                return Ok(());
+            }
+            TableFormat::Npy => {
+                let file = self
+                    .writer
+                    .as_ref()
+                    .expect("the writer lives until commit")
+                    .get_ref();
+                self.npy = Some(NpySink::create(file, &self.path, columns)?);
+                return Ok(());
+            }
+            TableFormat::Npz => {
+                self.npz = Some(NpzSink::create(&self.path, columns)?);
+                return Ok(());
+            }
+            TableFormat::Csv => {}
         }
         let w = self.writer();
         let written = w
@@ -122,6 +150,12 @@ impl AtomicFile {
     pub fn write_table_rows(&mut self, data: &[f64]) -> Result<()> {
         if let Some(p) = self.parquet.as_mut() {
             return p.write(data);
+        }
+        if let Some(n) = self.npy.as_mut() {
+            return n.write(data);
+        }
+        if let Some(n) = self.npz.as_mut() {
+            return n.write(data);
         }
         let width = self.columns.len().max(1);
         let written = write_rows(self.writer(), data, width, b",");
@@ -164,8 +198,7 @@ impl AtomicFile {
                     ..
                 } => Error::NotFinite {
                     what,
-                    // A CSV file's header is its row 1; a Parquet file has none.
-                    row: self.rows + usize::from(self.parquet.is_none()),
+                    row: self.rows + TableFormat::of(&self.path).first_row() - 1,
                     column,
                     value,
                 },
@@ -191,6 +224,13 @@ impl AtomicFile {
     pub fn commit(mut self) -> Result<()> {
         if let Some(p) = self.parquet.take() {
             self.writer = Some(p.finish()?);
+        }
+        if let Some(n) = self.npy.take() {
+            n.finish()?;
+        }
+        if let Some(n) = self.npz.take() {
+            let writer = self.writer.take().expect("the writer lives until commit");
+            self.writer = Some(n.finish(writer)?);
         }
         let result = (|| -> std::io::Result<()> {
             let file = match self.writer.take() {

@@ -32,8 +32,7 @@ pub const ROW_GROUP: usize = 65_536;
 /// Whether `path` names a Parquet file (its extension, any case).
 #[must_use]
 pub fn is_parquet(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"))
+    crate::io::TableFormat::of(path) == crate::io::TableFormat::Parquet
 }
 
 fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {

@@ -12,6 +12,7 @@ use imu_core::sensor::ImuReading;
 use imu_core::{NavFrame, Truth};
 
 use crate::error::{Error, Result};
+use crate::io::TableFormat;
 use crate::io::output::write_atomically;
 
 /// The columns `head` followed by the columns `tail`, for a schema that extends another
@@ -304,17 +305,27 @@ impl Table {
         t
     }
 
-    /// Writes the table in the format its path's extension names — Parquet for `.parquet`
-    /// ([`crate::io::parquet`]), CSV otherwise — atomically.
+    /// Writes the table in the format its path's extension names ([`TableFormat`]: Parquet
+    /// for `.parquet`, NumPy for `.npy` and `.npz`, CSV otherwise), atomically.
     ///
     /// # Errors
     /// A value that is not finite; [`Error::Io`] naming the file.
     pub fn write(&self, path: &Path) -> Result<()> {
-        if crate::io::parquet::is_parquet(path) {
-            crate::io::parquet::write_table(self, path, &[])
-        } else {
-            self.write_csv(path)
+        match TableFormat::of(path) {
+            TableFormat::Parquet => crate::io::parquet::write_table(self, path, &[]),
+            TableFormat::Npy | TableFormat::Npz => self.write_binary(path),
+            TableFormat::Csv => self.write_csv(path),
         }
+    }
+
+    /// Writes the table as `.npy` or `.npz` (by the path's extension), atomically; every value
+    /// must be finite (refused, naming row and column, before the file is made).
+    fn write_binary(&self, path: &Path) -> Result<()> {
+        check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
+        let mut file = crate::io::output::AtomicFile::create(path)?;
+        file.begin_table(&self.columns, &[])?;
+        file.write_table_rows(&self.data)?;
+        file.commit()
     }
 
     /// Writes the table as CSV with a header row, atomically (temporary file, then rename).
@@ -458,13 +469,17 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
     out.with_file_name(format!("{stem}_run{run:0digits$}{ext}"))
 }
 
-/// The header of a CSV file (trimmed names).
+/// The column names of a table file: a CSV file's header (trimmed names), a Parquet, `.npy` or
+/// `.npz` file's fields or members ([`TableFormat`]).
 ///
 /// # Errors
 /// Unreadable or empty file, a column name that appears twice.
 pub fn read_header(path: &Path) -> Result<Vec<String>> {
-    if crate::io::parquet::is_parquet(path) {
-        return crate::io::parquet::column_names(path);
+    match TableFormat::of(path) {
+        TableFormat::Parquet => return crate::io::parquet::column_names(path),
+        TableFormat::Npy => return crate::io::npy::column_names(path),
+        TableFormat::Npz => return crate::io::npz::column_names(path),
+        TableFormat::Csv => {}
     }
     let mut r = reader(path)?;
     let h = r.headers().map_err(|e| csv_error(path, &e))?;
@@ -529,14 +544,16 @@ fn csv_error(path: &Path, e: &csv::Error) -> Error {
     }
 }
 
-/// Reads every column of a table file: Parquet for `.parquet`
-/// ([`crate::io::parquet::read_table`]), else CSV with a header row.
+/// Reads every column of a table file in the format its extension names ([`TableFormat`]):
+/// Parquet, `.npy`, `.npz`, else CSV with a header row.
 ///
 /// # Errors
 /// As [`read_columns`]: values that are not finite numbers, malformed or empty files.
 pub fn read_table(path: &Path) -> Result<Table> {
-    if crate::io::parquet::is_parquet(path) {
-        return crate::io::parquet::read_table(path);
+    match TableFormat::of(path) {
+        TableFormat::Parquet => return crate::io::parquet::read_table(path),
+        TableFormat::Npz => return crate::io::npz::read_table(path),
+        TableFormat::Npy | TableFormat::Csv => {}
     }
     let header = read_header(path)?;
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
@@ -596,14 +613,17 @@ pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvCol
     })
 }
 
-/// Where [`CsvRows`] reads: a CSV file, or a Parquet file's rows.
+/// Where [`CsvRows`] reads: a CSV file, a Parquet file's rows or a `.npy` file's records.
 #[derive(Debug)]
 enum RowSource {
     Csv(csv::Reader<File>),
     Parquet(crate::io::parquet::ParquetRows),
+    Npy(crate::io::npy::NpyRows),
+    /// A table read whole (a `.npz` archive), and the rows given so far.
+    Whole(Table, usize),
 }
 
-/// The named columns of a CSV (or Parquet) file, row by row (memory does not grow with the
+/// The named columns of a CSV (or Parquet, or `.npy`) file, row by row (memory does not grow with the
 /// file).
 #[derive(Debug)]
 pub struct CsvRows {
@@ -645,10 +665,13 @@ impl CsvRows {
             .iter()
             .map(|c| (index.get(*c).copied().unwrap_or(0), (*c).to_string()))
             .collect();
-        let reader = if crate::io::parquet::is_parquet(path) {
-            RowSource::Parquet(crate::io::parquet::ParquetRows::open(path)?.1)
-        } else {
-            RowSource::Csv(reader(path)?)
+        let reader = match TableFormat::of(path) {
+            TableFormat::Parquet => {
+                RowSource::Parquet(crate::io::parquet::ParquetRows::open(path)?.1)
+            }
+            TableFormat::Npy => RowSource::Npy(crate::io::npy::NpyRows::open(path)?.1),
+            TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
+            TableFormat::Csv => RowSource::Csv(reader(path)?),
         };
         Ok(Self {
             path: path.into(),
@@ -668,6 +691,18 @@ impl CsvRows {
         let reader = match &mut self.reader {
             RowSource::Csv(r) => r,
             RowSource::Parquet(rows) => return rows.next_row(&self.wanted, out),
+            RowSource::Npy(rows) => return rows.next_row(&self.wanted, out),
+            RowSource::Whole(table, given) => {
+                let width = table.columns.len();
+                let Some(row) = table.data.chunks_exact(width).nth(*given) else {
+                    return Ok(None);
+                };
+                for ((k, _), slot) in self.wanted.iter().zip(out.iter_mut()) {
+                    *slot = row[*k];
+                }
+                *given += 1;
+                return Ok(Some(*given));
+            }
         };
         match reader.read_record(&mut self.record) {
             Ok(false) => return Ok(None),

@@ -15,8 +15,8 @@ use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
+use crate::io::TableFormat;
 use crate::io::output::AtomicFile;
-use crate::io::parquet::is_parquet;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
@@ -211,7 +211,7 @@ impl Scenario {
     }
 }
 
-/// One streamed output, CSV or Parquet by its extension ([`AtomicFile::begin_table`]): the
+/// One streamed output, CSV, Parquet or `.npy` by its extension ([`AtomicFile::begin_table`]): the
 /// columns once, then the chunks' rows, each checked finite and named by its file row.
 struct TableSink {
     file: AtomicFile,
@@ -227,7 +227,7 @@ impl TableSink {
         Ok(Self {
             file: AtomicFile::create(path)?,
             name: path.display().to_string(),
-            next_row: if is_parquet(path) { 1 } else { 2 },
+            next_row: TableFormat::of(path).first_row(),
             metadata: metadata.to_vec(),
             started: false,
         })
