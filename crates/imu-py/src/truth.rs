@@ -44,10 +44,7 @@ fn run_spec<'py>(
     let sim = py
         .detach(move || {
             let sc = spec.resolve(Path::new(&base))?;
-            match run {
-                Some(r) => sc.simulate_run(r),
-                None => sc.simulate(),
-            }
+            sc.simulate_streamed(run)
         })
         .map_err(refused)?;
     let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();

@@ -1,5 +1,6 @@
-//! A streamed simulation equals the whole one bit for bit: every trajectory type, rates and
-//! increments, a Monte Carlo run, chunk boundaries inside a tangent-attitude standstill.
+//! A streamed simulation equals the whole one bit for bit, chunk by chunk and gathered into
+//! tables: every trajectory type, rates and increments, a Monte Carlo run, chunk boundaries
+//! inside a tangent-attitude standstill, the aids' readings, the WGS-84 Earth.
 use std::path::Path;
 
 use imukit::run::simulate::STREAM_CHUNK;
@@ -28,6 +29,9 @@ fn assert_same(sc: &Scenario, run: Option<u64>, min_chunks: usize, what: &str) {
     assert!(chunks >= min_chunks, "{what}: {chunks} chunks");
     assert!(truth == whole.truth.data, "{what}: truth differs");
     assert!(imu == whole.imu.data, "{what}: IMU readings differ");
+    // The streamed chunks gathered into tables (what Python's simulate returns): every table.
+    let gathered = sc.simulate_streamed(run).unwrap();
+    assert!(gathered == whole, "{what}: the gathered tables differ");
 }
 
 fn builtin_at(name: &str, rate_hz: f64, duration_s: f64, imu: &str) -> Scenario {
@@ -104,6 +108,8 @@ fn example_files_stream_to_the_same_numbers() {
         "track.toml",
         "expression.toml",
         "piecewise.toml",
+        "car_tunnel.toml",
+        "earth_flight.toml",
     ] {
         let sc = Scenario::from_file(&examples.join(f)).unwrap();
         assert_same(&sc, None, 1, f);

@@ -87,6 +87,9 @@ impl ParquetSink {
         ));
         let props = WriterProperties::builder()
             .set_compression(Compression::SNAPPY)
+            // Measured values rarely repeat: a dictionary costs a hash per value and is
+            // dropped once it fills; plain float64 pages are written at once.
+            .set_dictionary_enabled(false)
             .set_key_value_metadata(Some(
                 metadata
                     .iter()

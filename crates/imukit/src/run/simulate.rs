@@ -137,6 +137,58 @@ impl Scenario {
         Ok(())
     }
 
+    /// The streamed simulation of run `run` (or the plain seed) gathered into whole tables: the
+    /// numbers of [`Scenario::simulate`] / [`Scenario::simulate_run`] bit for bit, made a chunk
+    /// at a time (each chunk's truth measured while it is in cache, no per-sample truth and
+    /// readings held beside the tables), with room for the tables reserved at once.
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`].
+    pub fn simulate_streamed(&self, run: Option<u64>) -> Result<crate::Simulation> {
+        crate::scenario::check_in_memory(
+            self.t_s.len(),
+            crate::scenario::STREAMED_BYTES_PER_SAMPLE,
+            "duration_s",
+        )?;
+        let n = self.t_s.len();
+        let mut whole: Option<crate::Simulation> = None;
+        let append = |into: &mut Option<Table>, from: Option<Table>| {
+            if let (Some(a), Some(b)) = (into.as_mut(), from) {
+                a.data.extend_from_slice(&b.data);
+            }
+        };
+        self.stream(run, |chunk| {
+            match whole.as_mut() {
+                None => {
+                    let reserve = |mut t: Table| {
+                        t.data
+                            .reserve(n * t.columns.len() - t.data.len().min(n * t.columns.len()));
+                        t
+                    };
+                    whole = Some(crate::Simulation {
+                        truth: reserve(chunk.truth),
+                        imu: reserve(chunk.imu),
+                        gnss: chunk.gnss,
+                        baro: chunk.baro,
+                        odometer: chunk.odometer,
+                    });
+                }
+                Some(w) => {
+                    w.truth.data.extend_from_slice(&chunk.truth.data);
+                    w.imu.data.extend_from_slice(&chunk.imu.data);
+                    append(&mut w.gnss, chunk.gnss);
+                    append(&mut w.baro, chunk.baro);
+                    append(&mut w.odometer, chunk.odometer);
+                }
+            }
+            Ok(())
+        })?;
+        let simulation = whole.ok_or_else(|| crate::error::invalid("duration_s", "no samples"))?;
+        simulation.truth.check_finite("truth")?;
+        simulation.imu.check_finite("IMU readings")?;
+        Ok(simulation)
+    }
+
     fn stream_in<N: NavFrame>(
         &self,
         run: Option<u64>,
