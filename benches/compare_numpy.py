@@ -39,6 +39,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+import tomllib
 from pathlib import Path
 from typing import Optional
 
@@ -47,37 +48,26 @@ from scipy.signal import lfilter
 
 import imukit
 
-FS = 100.0
-G = 9.81
-TEMPERATURE = 35.0
-MAG_NED = np.array([27.5550, -2.4169, -16.0849])
+# The job, its motion and its sensors: one file, read by this script and by the Rust bench.
+JOB = tomllib.loads((Path(__file__).resolve().parent / "formula_job.toml").read_text())
+FS = JOB["rate_hz"]
+G = JOB["gravity_m_s2"]
+TEMPERATURE = JOB["imu"]["temperature_c"]
+MAG_NED = np.array(JOB["imu"]["magnetic_field_ut"])
+SENSORS = ("accelerometer", "gyroscope", "magnetometer")
+NOISE = ("NoiseDensity", "BiasInstability", "RandomWalk")
 
 
 def params(noise: bool) -> dict:
     """MATLAB property values of the three sensors; the noise terms zeroed when ``noise`` is off."""
-    k = 1.0 if noise else 0.0
-    common = dict(AxesMisalignment=[[100.0, 0.2, -0.1], [0.3, 100.0, 0.1], [-0.2, 0.1, 100.0]],
-                  TemperatureScaleFactor=[0.02, 0.03, 0.01])
-    return {
-        "accelerometer": dict(common, MeasurementRange=200.0, Resolution=1e-6, ConstantBias=[0.05, -0.03, 0.02],
-                              NoiseDensity=3e-3 * k, BiasInstability=2e-3 * k, RandomWalk=1e-4 * k,
-                              TemperatureBias=[1e-3, 2e-3, 3e-3]),
-        "gyroscope": dict(common, MeasurementRange=40.0, Resolution=1e-7, ConstantBias=[1e-3, -2e-3, 5e-4],
-                          NoiseDensity=1e-4 * k, BiasInstability=5e-5 * k, RandomWalk=1e-6 * k,
-                          TemperatureBias=[1e-4, 1e-4, 2e-4], AccelerationBias=[1e-4, 2e-4, 3e-4]),
-        "magnetometer": dict(common, MeasurementRange=1000.0, Resolution=1e-3, ConstantBias=[0.5, -0.4, 0.3],
-                             NoiseDensity=0.05 * k, BiasInstability=0.02 * k, RandomWalk=1e-3 * k,
-                             TemperatureBias=[0.01, 0.02, 0.03]),
-    }
+    return {s: {k: (v if noise or k not in NOISE else 0.0) for k, v in JOB["imu"][s].items()} for s in SENSORS}
 
 
-W = 2 * np.pi / 20.0
+W = JOB["trajectory"]["constants"]["w"]
+assert W == 2 * np.pi / 20.0, "the NumPy reference's derivatives are written for w = 2π/20"
 
 # The motion as formula strings (NED, z-y-x Euler angles), as a user writes it for imukit.
-FORMULAS = {
-    "position_m": ["10*sin(w*t)", "5*sin(2*w*t)", "-2 + 0.5*sin(3*w*t)"],
-    "yaw_rad": "0.8*sin(w*t)", "pitch_rad": "0.2*sin(2*w*t)", "roll_rad": "0.3*sin(w*t + 0.5)",
-}
+FORMULAS = {k: JOB["trajectory"][k] for k in ("position_m", "yaw_rad", "pitch_rad", "roll_rad")}
 
 
 def trajectory(n: int):
@@ -166,13 +156,8 @@ def numpy_formula_pipeline(n, prm, normals):
 # --- imukit ---------------------------------------------------------------------------------
 
 def formula_scenario(n: int, prm, seed=1) -> dict:
-    """``FORMULAS`` as an imukit scenario of ``n`` samples with the sensors of ``prm``."""
-    return {
-        "rate_hz": FS, "duration_s": (n - 1) / FS, "nav_frame": "NED", "gravity_m_s2": G,
-        "trajectory": {"type": "expression", "constants": {"w": W}, **FORMULAS},
-        "imu": {"kind": "accel-gyro-mag", "profile": "matlab", "seed": seed, "temperature_c": TEMPERATURE,
-                "magnetic_field_ut": MAG_NED.tolist(), **prm},
-    }
+    """The job of ``formula_job.toml`` over ``n`` samples with the sensors of ``prm``."""
+    return {**JOB, "duration_s": (n - 1) / FS, "imu": {**JOB["imu"], "seed": seed, **prm}}
 
 
 def imukit_formula_pipeline(n, prm, seed=1):

@@ -1,0 +1,53 @@
+//! The whole pipeline of the formula job (`benches/formula_job.toml`: formula strings in; exact
+//! truth; accelerometer, gyroscope and magnetometer with MATLAB imuSensor's full error model
+//! out), as `imukit simulate` runs it without the process start: streamed to a file of each
+//! format (CSV, Parquet, `.npy`, `.npz`), and gathered into tables as Python's
+//! `imukit.simulate` returns them. Samples per second.
+//!
+//! Run: `cargo bench -p imu-benches --bench pipeline`.
+#![allow(missing_docs)]
+
+use std::path::Path;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imukit::run::simulate::StreamOutputs;
+use imukit::{Scenario, ScenarioSpec};
+
+const JOB: &str = include_str!("../formula_job.toml");
+
+fn job(samples: usize) -> Scenario {
+    let mut spec = ScenarioSpec::from_toml(JOB, "formula_job.toml").expect("the job parses");
+    let rate = spec.rate_hz.expect("the job has a rate");
+    spec.duration_s = Some((samples - 1) as f64 / rate);
+    spec.resolve(Path::new(".")).expect("the job resolves")
+}
+
+fn bench_pipeline(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("imukit-bench-pipeline-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let mut group = c.benchmark_group("formula_job");
+    group.sample_size(10);
+    let n = 200_000;
+    let sc = job(n);
+    group.throughput(Throughput::Elements(n as u64));
+    for ext in ["csv", "parquet", "npy", "npz"] {
+        let out = dir.join(format!("imu.{ext}"));
+        group.bench_function(BenchmarkId::new("to_file", ext), |b| {
+            b.iter(|| {
+                let outputs = StreamOutputs {
+                    imu: Some(&out),
+                    ..StreamOutputs::default()
+                };
+                sc.stream_to_files(None, &outputs).expect("written");
+            });
+        });
+    }
+    group.bench_function(BenchmarkId::new("tables", "truth+imu"), |b| {
+        b.iter(|| sc.simulate_streamed(None).expect("simulated"));
+    });
+    group.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+criterion_group!(benches, bench_pipeline);
+criterion_main!(benches);
