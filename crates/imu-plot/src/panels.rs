@@ -40,11 +40,14 @@ fn thin<T: Copy>(v: Vec<T>) -> Vec<T> {
     every(&v, stride_for(v.len(), MAX_POINTS))
 }
 
+/// The finite points, each coordinate within ±[`AXIS_LIMIT`] (where [`range`] puts the axes,
+/// so every point maps inside the drawing).
 fn finite(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let clamp = |v: f64| v.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     points
         .iter()
-        .copied()
         .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|&(x, y)| (clamp(x), clamp(y)))
         .collect()
 }
 
