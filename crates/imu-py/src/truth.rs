@@ -129,10 +129,17 @@ fn truth_from_expressions<'py>(
         min_speed_m_s,
     };
     let nav = self::nav_frame("nav_frame", nav_frame)?;
-    let table = py
-        .detach(move || arrays::truth_from_expressions(&t, &spec, nav))
-        .map_err(refused)?;
-    table_out(py, table)
+    let out = PyArray2::<f64>::zeros(py, [t.len(), TRUTH_COLUMNS.len()], false);
+    {
+        let mut guard = out.readwrite();
+        let values = guard
+            .as_slice_mut()
+            .map_err(|e| shape_error(e.to_string()))?;
+        py.detach(move || arrays::truth_from_expressions_into(t, &spec, nav, values))
+            .map_err(refused)?;
+    }
+    let columns = TRUTH_COLUMNS.iter().map(|c| (*c).to_string()).collect();
+    Ok((columns, out))
 }
 
 /// The attitude arguments of `truth_from_samples` as the library's attitude.

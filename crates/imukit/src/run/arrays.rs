@@ -10,6 +10,7 @@ use crate::error::{Error, Result, invalid};
 use crate::io::table::ImuKind;
 use crate::io::table::{TRUTH_COLUMNS, Table};
 use crate::motion::{SampledAttitudeData, SampledPath, Trajectory};
+use crate::run::simulate::motion_chunks;
 use crate::scenario::resolve::finite_vec;
 use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName, parse_name};
 
@@ -27,23 +28,43 @@ fn finite_truth<N: NavFrame>(truth: &[Truth<N>]) -> Result<Table> {
     Ok(table)
 }
 
-/// Exact truth at `t_s` from formulas.
+/// Exact truth at `t_s` from formulas, written row by row into `out` (`n` rows of
+/// [`TRUTH_COLUMNS`], row-major), a chunk at a time as `imukit simulate` streams it: no truth
+/// vector or table of the whole series is built on the way.
 ///
 /// # Errors
-/// Unparsable formulas, non-increasing times, gimbal lock, non-finite results.
-pub fn truth_from_expressions(
-    t_s: &[f64],
+/// Unparsable formulas, non-increasing times, gimbal lock, non-finite results; an `out` of the
+/// wrong length.
+pub fn truth_from_expressions_into(
+    t_s: Vec<f64>,
     spec: &ExpressionSpec,
     nav: NavFrameName,
-) -> Result<Table> {
+    out: &mut [f64],
+) -> Result<()> {
+    const WIDTH: usize = TRUTH_COLUMNS.len();
+    if out.len() != t_s.len() * WIDTH {
+        return Err(invalid(
+            "output",
+            format!("has {} values, expected {} × {WIDTH}", out.len(), t_s.len()),
+        ));
+    }
     let min_speed_m_s =
         crate::scenario::resolve::check_min_speed("min_speed_m_s", spec.min_speed_m_s)?;
-    let traj = Trajectory::Expression(spec.motion()?, AnalyticOptions { min_speed_m_s });
-    in_frame(
-        nav,
-        || finite_truth(&traj.truth::<Enu>(t_s)?),
-        || finite_truth(&traj.truth::<Ned>(t_s)?),
-    )
+    let motion = spec.motion()?;
+    let options = AnalyticOptions { min_speed_m_s };
+    let what = "trajectory (expression)";
+    imu_core::kinematics::check_times(&t_s).map_err(|e| crate::motion::with_time(&t_s, e, what))?;
+    let times = crate::scenario::SampleTimes::Listed(t_s);
+    let mut rows = out.chunks_exact_mut(WIDTH);
+    match nav {
+        NavFrameName::ENU => motion_chunks::<_, Enu>(&motion, options, &times, what, &mut |c| {
+            fill_rows(c, &mut rows)
+        }),
+        NavFrameName::NED => motion_chunks::<_, Ned>(&motion, options, &times, what, &mut |c| {
+            fill_rows(c, &mut rows)
+        }),
+    }?;
+    crate::io::table::check_finite(&TRUTH_COLUMNS, out, "truth")
 }
 
 /// Truth from sampled arrays by finite differences, written row by row into `out` (`n` rows of

@@ -305,7 +305,7 @@ impl TableSink {
 /// Exact truth of `motion` at `t_s` in chunks, as `truth_from_motion` computes it whole: the
 /// leading tangent-attitude standstill is held until the body first moves, then given that
 /// attitude.
-fn motion_chunks<M: Motion, N: NavFrame>(
+pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
     motion: &M,
     options: AnalyticOptions,
     t_s: &SampleTimes,
