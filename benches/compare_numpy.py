@@ -311,7 +311,7 @@ def main() -> None:
     prm = params(noise=True)
     print("time ratios, NumPy / imukit (> 1: imukit is faster); one core on both sides")
     print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
-          f"{'samples, Python':>16} {'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
+          f"{'formulas, CLI (.npy)':>20} {'samples, Python':>16} {'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
     python_model_s, numpy_model_s = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         for size in args.sizes:
@@ -323,6 +323,7 @@ def main() -> None:
             t_fpy = best_of(lambda: imukit_formula_pipeline(n, prm), repeat)
             fcli = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp)):>20.2f}"
             fpq = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'parquet'):>24.2f}"
+            fnpy = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'npy'):>20.2f}"
             t_np = best_of(lambda: numpy_pipeline(t, pos, euler, prm,
                                                   np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_py = best_of(lambda: imukit_pipeline(t, pos, euler, prm), repeat)
@@ -335,7 +336,7 @@ def main() -> None:
             t_model_np = best_of(lambda: numpy_model(*ref_in, prm), repeat)
             t_model_py = best_of(lambda: imu(*ours_in, out=out), repeat)
             python_model_s[n], numpy_model_s[n] = t_model_py, t_model_np
-            print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {fpq:>24} {t_np / t_py:>16.2f} {cli:>26} "
+            print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {fpq:>24} {fnpy:>20} {t_np / t_py:>16.2f} {cli:>26} "
                   f"{t_model_np / t_model_py:>20.2f}")
     if args.rust:
         rust = rust_matlab_call_ns_per_sample()
