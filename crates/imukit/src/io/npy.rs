@@ -20,17 +20,11 @@ use crate::error::{Error, Result};
 
 /// NumPy's own limit on a header's length (`max_header_size` of `numpy.load`), bytes: a longer
 /// header is refused before it is read.
-const MAX_HEADER_BYTES: usize = 10_000;
+pub(crate) const MAX_HEADER_BYTES: usize = 10_000;
 
-/// The field type of every column: little-endian float64.
-fn float64() -> TypeStr {
-    "<f8".parse().expect("a valid type string")
-}
-
-/// Whether `path` names a NumPy `.npy` file (its extension, any case).
-#[must_use]
-pub fn is_npy(path: &Path) -> bool {
-    crate::io::TableFormat::of(path) == crate::io::TableFormat::Npy
+/// The type of every column: little-endian float64.
+pub(crate) fn float64() -> DType {
+    DType::Plain("<f8".parse::<TypeStr>().expect("a valid type string"))
 }
 
 fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -67,7 +61,7 @@ impl npyz::Serialize for Record {
 
     fn writer(dtype: &DType) -> std::result::Result<RecordWriter, npyz::DTypeError> {
         match dtype {
-            DType::Record(fields) if fields.iter().all(|f| f.dtype == DType::Plain(float64())) => {
+            DType::Record(fields) if fields.iter().all(|f| f.dtype == float64()) => {
                 Ok(RecordWriter {
                     width: fields.len(),
                 })
@@ -111,7 +105,7 @@ impl NpySink {
                 .iter()
                 .map(|name| npyz::Field {
                     name: name.clone(),
-                    dtype: DType::Plain(float64()),
+                    dtype: float64(),
                 })
                 .collect(),
         );
@@ -176,7 +170,7 @@ fn open(path: &Path) -> Result<(Vec<String>, u64, BufReader<File>)> {
     let header = NpyHeader::from_reader(&mut reader).map_err(|e| format_error(path, e))?;
     let names = match header.dtype() {
         DType::Record(fields) => {
-            if let Some(f) = fields.iter().find(|f| f.dtype != DType::Plain(float64())) {
+            if let Some(f) = fields.iter().find(|f| f.dtype != float64()) {
                 return Err(format_error(
                     path,
                     format!(

@@ -14,11 +14,12 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-use npyz::{DType, NpyHeader, TypeStr, WriterBuilder};
+use npyz::{NpyHeader, WriterBuilder};
 use zip::CompressionMethod;
 use zip::write::SimpleFileOptions;
 
 use crate::error::{Error, Result};
+use crate::io::npy::{MAX_HEADER_BYTES, float64};
 use crate::io::table::Table;
 
 /// Bytes of rows a writer keeps in memory before moving them to its temporary file.
@@ -27,13 +28,6 @@ const BLOCK_BYTES: usize = 8 << 20;
 /// The largest factor by which deflate expands data (1032:1): a member declaring more is
 /// refused before it is read.
 const MAX_DEFLATE_RATIO: u64 = 1032;
-
-/// NumPy's own limit on an `.npy` header's length, bytes.
-const MAX_HEADER_BYTES: u64 = 10_000;
-
-fn float64() -> DType {
-    DType::Plain("<f8".parse::<TypeStr>().expect("a valid type string"))
-}
 
 fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::CsvFormat {
@@ -146,7 +140,7 @@ impl NpzSink {
             source,
         };
         let zip_error = |e: zip::result::ZipError| format_error(&path, e);
-        let member_bytes = 8 * rows as u64 + MAX_HEADER_BYTES;
+        let member_bytes = 8 * rows as u64 + MAX_HEADER_BYTES as u64;
         let options = SimpleFileOptions::default()
             .compression_method(CompressionMethod::Stored)
             .large_file(member_bytes >= u64::from(u32::MAX));

@@ -29,12 +29,6 @@ pub const NAV_FRAME_KEY: &str = "imukit.nav_frame";
 /// Rows per row group (and per write): memory stays flat however long the table.
 pub const ROW_GROUP: usize = 65_536;
 
-/// Whether `path` names a Parquet file (its extension, any case).
-#[must_use]
-pub fn is_parquet(path: &Path) -> bool {
-    crate::io::TableFormat::of(path) == crate::io::TableFormat::Parquet
-}
-
 fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::CsvFormat {
         file: path.into(),
