@@ -31,6 +31,11 @@ pub struct TangentAngles {
 /// `θ̇ = (h a_z − v_z ḣ)/|v|²`; pitch = −θ. Second derivatives by the quotient rule.
 #[must_use]
 pub fn tangent_angles(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> TangentAngles {
+    tangent_angles_at(v, a, j, math::sqrt(v[0] * v[0] + v[1] * v[1]))
+}
+
+/// [`tangent_angles`] given the horizontal speed `h = √(v_x² + v_y²)` (m/s) already taken.
+fn tangent_angles_at(v: [f64; 3], a: [f64; 3], j: [f64; 3], h: f64) -> TangentAngles {
     let [vx, vy, vz] = v;
     let [ax, ay, az] = a;
     let [jx, jy, jz] = j;
@@ -42,7 +47,6 @@ pub fn tangent_angles(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> TangentAngles {
     let yaw_rate = n / d;
     let yaw_acc = (n_dot * d - n * d_dot) / (d * d);
     // Pitch.
-    let h = math::sqrt(d);
     let h_dot = (vx * ax + vy * ay) / h;
     let h_ddot = (ax * ax + ay * ay + vx * jx + vy * jy - h_dot * h_dot) / h;
     let d2 = d + vz * vz;
@@ -100,7 +104,7 @@ impl TangentTracker {
         if horizontal < self.min_speed_m_s {
             return Err(KinematicsError::VerticalTangent { index });
         }
-        let mut angles = tangent_angles(v, a, j);
+        let mut angles = tangent_angles_at(v, a, j, horizontal);
         if let Some(last) = self.last {
             angles.euler.yaw_rad = math::unwrap_near(angles.euler.yaw_rad, last.yaw_rad);
         }
