@@ -18,7 +18,6 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
 use crate::error::{Error, Result};
-use crate::io::output::AtomicFile;
 use crate::io::table::Table;
 
 /// Metadata key of the scenario a file was simulated from (its text as given).
@@ -147,23 +146,14 @@ impl ParquetSink {
     }
 }
 
-/// Writes `table` as a Parquet file at `path` with `metadata`, atomically; every value must be
+/// Writes `table` as a Parquet file at `path` (named `.parquet`) with `metadata`, atomically
+/// ([`Table::write`]'s binary path); every value must be
 /// finite (refused, naming row and column, before the file is made).
 ///
 /// # Errors
 /// A value that is not finite; the writer's or the file system's refusal, naming the file.
 pub fn write_table(table: &Table, path: &Path, metadata: &[(String, String)]) -> Result<()> {
-    // Rows are numbered from 1: a Parquet file has no header row.
-    crate::io::table::check_finite_from(
-        &table.columns,
-        &table.data,
-        &path.display().to_string(),
-        1,
-    )?;
-    let mut file = AtomicFile::create(path)?;
-    file.begin_table(&table.columns, metadata)?;
-    file.write_table_rows(&table.data)?;
-    file.commit()
+    table.write_binary(path, metadata)
 }
 
 /// A Parquet file's key-value metadata.

@@ -312,18 +312,24 @@ impl Table {
     /// A value that is not finite; [`Error::Io`] naming the file.
     pub fn write(&self, path: &Path) -> Result<()> {
         match TableFormat::of(path) {
-            TableFormat::Parquet => crate::io::parquet::write_table(self, path, &[]),
-            TableFormat::Npy | TableFormat::Npz => self.write_binary(path),
+            TableFormat::Parquet | TableFormat::Npy | TableFormat::Npz => {
+                self.write_binary(path, &[])
+            }
             TableFormat::Csv => self.write_csv(path),
         }
     }
 
-    /// Writes the table as `.npy` or `.npz` (by the path's extension), atomically; every value
-    /// must be finite (refused, naming row and column, before the file is made).
-    fn write_binary(&self, path: &Path) -> Result<()> {
+    /// Writes the table in the binary format its path's extension names (Parquet, `.npy`,
+    /// `.npz`), with `metadata` where the format has room for it, atomically; every value must
+    /// be finite (refused, naming row and column — rows from 1, no header row — before the file
+    /// is made).
+    ///
+    /// # Errors
+    /// A value that is not finite; the writer's or the file system's refusal, naming the file.
+    pub(crate) fn write_binary(&self, path: &Path, metadata: &[(String, String)]) -> Result<()> {
         check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
         let mut file = crate::io::output::AtomicFile::create(path)?;
-        file.begin_table(&self.columns, &[])?;
+        file.begin_table(&self.columns, metadata)?;
         file.write_table_rows(&self.data)?;
         file.commit()
     }

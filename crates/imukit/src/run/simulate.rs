@@ -162,7 +162,7 @@ impl Scenario {
                 None => {
                     let reserve = |mut t: Table| {
                         t.data
-                            .reserve(n * t.columns.len() - t.data.len().min(n * t.columns.len()));
+                            .reserve((n * t.columns.len()).saturating_sub(t.data.len()));
                         t
                     };
                     whole = Some(crate::Simulation {
