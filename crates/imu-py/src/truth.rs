@@ -32,7 +32,8 @@ type SimulationOut<'py> = (
     Option<TableOut<'py>>,
 );
 
-/// Runs a resolved scenario spec with the GIL released.
+/// Runs a resolved scenario spec with the GIL released, the truth and IMU rows written straight
+/// into NumPy arrays (NumPy's allocator: huge pages where the kernel offers them).
 fn run_spec<'py>(
     py: Python<'py>,
     spec: ScenarioSpec,
@@ -41,19 +42,34 @@ fn run_spec<'py>(
 ) -> PyResult<SimulationOut<'py>> {
     let run = run.map(|r| non_negative("run", r)).transpose()?;
     let base = base_dir.to_string();
-    let sim = py
+    let (scenario, shape) = py
         .detach(move || {
             let sc = spec.resolve(Path::new(&base))?;
-            sc.simulate_streamed(run)
+            let shape = sc.gathered_shape()?;
+            Ok::<_, imukit::Error>((sc, shape))
         })
         .map_err(refused)?;
+    let truth = PyArray2::<f64>::zeros(py, [shape.rows, shape.truth_columns.len()], false);
+    let imu = PyArray2::<f64>::zeros(py, [shape.rows, shape.imu_columns.len()], false);
+    let aids = {
+        let (mut truth_rw, mut imu_rw) = (truth.readwrite(), imu.readwrite());
+        let truth_values = truth_rw
+            .as_slice_mut()
+            .map_err(|e| shape_error(e.to_string()))?;
+        let imu_values = imu_rw
+            .as_slice_mut()
+            .map_err(|e| shape_error(e.to_string()))?;
+        py.detach(move || scenario.simulate_streamed_into(run, truth_values, imu_values))
+            .map_err(refused)?
+    };
+    let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect();
     let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();
     Ok((
-        table_out(py, sim.truth)?,
-        table_out(py, sim.imu)?,
-        optional(sim.gnss)?,
-        optional(sim.baro)?,
-        optional(sim.odometer)?,
+        (names(shape.truth_columns), truth),
+        (names(shape.imu_columns), imu),
+        optional(aids.gnss)?,
+        optional(aids.baro)?,
+        optional(aids.odometer)?,
     ))
 }
 

@@ -115,3 +115,25 @@ fn example_files_stream_to_the_same_numbers() {
         assert_same(&sc, None, 1, f);
     }
 }
+
+#[test]
+fn gathering_into_the_callers_memory_checks_the_shape_first() {
+    let sc = builtin_at("figure8", 50.0, 3.0, "");
+    let shape = sc.gathered_shape().unwrap();
+    assert_eq!(shape.rows, 151);
+    assert_eq!(shape.imu_columns.len(), 10, "{:?}", shape.imu_columns);
+    assert_eq!(shape.truth_columns.len(), 23);
+    let (mut truth, mut imu) = (vec![0.0; 151 * 23], vec![0.0; 151 * 10 - 1]);
+    match sc.simulate_streamed_into(None, &mut truth, &mut imu) {
+        Err(imukit::Error::Invalid { field, message }) => {
+            assert_eq!(field, "imu");
+            assert!(message.contains("1509 values, expected 151 rows × 10"), "{message}");
+        }
+        other => panic!("a short IMU buffer was taken: {other:?}"),
+    }
+    assert!(truth.iter().all(|v| *v == 0.0), "written before the shape was checked");
+    let mut imu = vec![0.0; 151 * 10];
+    sc.simulate_streamed_into(None, &mut truth, &mut imu).unwrap();
+    let whole = sc.simulate().unwrap();
+    assert!(truth == whole.truth.data && imu == whole.imu.data);
+}

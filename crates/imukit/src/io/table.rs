@@ -84,6 +84,29 @@ pub enum ImuOutput {
     Increments,
 }
 
+impl ImuOutput {
+    /// Column names of readings of `kind` in this form: the time, then the accelerometer's
+    /// (specific force or Δv) and, when `kind` has them, the gyroscope's (rate or Δθ) and the
+    /// magnetometer's.
+    #[must_use]
+    pub fn columns(self, kind: ImuKind) -> Vec<&'static str> {
+        match self {
+            Self::Rates => kind.columns(),
+            Self::Increments => {
+                let mut c = vec!["t_s"];
+                c.extend(DV_COLUMNS);
+                if kind.has_gyro() {
+                    c.extend(DTHETA_COLUMNS);
+                }
+                if kind.has_mag() {
+                    c.extend(MAG_COLUMNS);
+                }
+                c
+            }
+        }
+    }
+}
+
 /// Which sensors an IMU has (MATLAB's `IMUType`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -254,15 +277,7 @@ impl Table {
         let gyro: Vec<[f64; 3]> = readings.iter().map(|r| r.gyro_rad_s).collect();
         trapezoid(t_s, &accel, &mut dv);
         trapezoid(t_s, &gyro, &mut dtheta);
-        let mut columns = vec!["t_s"];
-        columns.extend(DV_COLUMNS);
-        if kind.has_gyro() {
-            columns.extend(DTHETA_COLUMNS);
-        }
-        if kind.has_mag() {
-            columns.extend(MAG_COLUMNS);
-        }
-        let mut t = Self::new(&columns);
+        let mut t = Self::new(&ImuOutput::Increments.columns(kind));
         for k in 0..n {
             let mut row = vec![t_s[k]];
             row.extend(dv[k]);

@@ -40,6 +40,29 @@ pub struct Chunk {
     pub odometer: Option<Table>,
 }
 
+/// The rows and columns of the truth and IMU tables a whole run gathers
+/// ([`Scenario::gathered_shape`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GatheredShape {
+    /// Samples (rows of each table).
+    pub rows: usize,
+    /// Truth columns ([`crate::scenario::EarthSetup::truth_columns`]).
+    pub truth_columns: Vec<&'static str>,
+    /// IMU columns ([`ImuOutput::columns`]).
+    pub imu_columns: Vec<&'static str>,
+}
+
+/// The aids' readings of a whole run, when the scenario has them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AidTables {
+    /// GNSS fixes.
+    pub gnss: Option<Table>,
+    /// Barometer readings.
+    pub baro: Option<Table>,
+    /// Odometer readings.
+    pub odometer: Option<Table>,
+}
+
 /// Where [`Scenario::stream_to_files`] writes: the IMU readings, and the truth and the aids'
 /// readings when asked for.
 #[derive(Clone, Copy, Debug, Default)]
@@ -140,53 +163,116 @@ impl Scenario {
     /// The streamed simulation of run `run` (or the plain seed) gathered into whole tables: the
     /// numbers of [`Scenario::simulate`] / [`Scenario::simulate_run`] bit for bit, made a chunk
     /// at a time (each chunk's truth measured while it is in cache, no per-sample truth and
-    /// readings held beside the tables), with room for the tables reserved at once.
+    /// readings held beside the tables). See [`Scenario::simulate_streamed_into`].
     ///
     /// # Errors
     /// As [`Scenario::simulate`].
     pub fn simulate_streamed(&self, run: Option<u64>) -> Result<crate::Simulation> {
-        crate::scenario::check_in_memory(
-            self.t_s.len(),
-            crate::scenario::STREAMED_BYTES_PER_SAMPLE,
-            "duration_s",
-        )?;
-        let n = self.t_s.len();
-        let mut whole: Option<crate::Simulation> = None;
-        let append = |into: &mut Option<Table>, from: Option<Table>| {
-            if let (Some(a), Some(b)) = (into.as_mut(), from) {
-                a.data.extend_from_slice(&b.data);
-            }
+        let shape = self.gathered_shape()?;
+        let mut truth = vec![0.0; shape.rows * shape.truth_columns.len()];
+        let mut imu = vec![0.0; shape.rows * shape.imu_columns.len()];
+        let aids = self.simulate_streamed_into(run, &mut truth, &mut imu)?;
+        let table = |columns: Vec<&str>, data| Table {
+            columns: columns.into_iter().map(str::to_string).collect(),
+            data,
         };
-        self.stream(run, |chunk| {
-            match whole.as_mut() {
-                None => {
-                    let reserve = |mut t: Table| {
-                        t.data
-                            .reserve((n * t.columns.len()).saturating_sub(t.data.len()));
-                        t
-                    };
-                    whole = Some(crate::Simulation {
-                        truth: reserve(chunk.truth),
-                        imu: reserve(chunk.imu),
-                        gnss: chunk.gnss,
-                        baro: chunk.baro,
-                        odometer: chunk.odometer,
-                    });
-                }
-                Some(w) => {
-                    w.truth.data.extend_from_slice(&chunk.truth.data);
-                    w.imu.data.extend_from_slice(&chunk.imu.data);
-                    append(&mut w.gnss, chunk.gnss);
-                    append(&mut w.baro, chunk.baro);
-                    append(&mut w.odometer, chunk.odometer);
-                }
+        Ok(crate::Simulation {
+            truth: table(shape.truth_columns, truth),
+            imu: table(shape.imu_columns, imu),
+            gnss: aids.gnss,
+            baro: aids.baro,
+            odometer: aids.odometer,
+        })
+    }
+
+    /// The shape of the gathered truth and IMU tables, refused before anything is allocated when
+    /// they would not fit in memory (`IMUKIT_MAX_MEMORY_GB`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] on `duration_s` when the tables are too large.
+    pub fn gathered_shape(&self) -> Result<GatheredShape> {
+        let rows = self.t_s.len();
+        let truth_columns = self.earth.truth_columns();
+        let imu_columns = self.imu.output.columns(self.imu.kind);
+        let bytes_per_sample =
+            core::mem::size_of::<f64>() * (truth_columns.len() + imu_columns.len());
+        crate::scenario::check_in_memory(rows, bytes_per_sample, "duration_s")?;
+        Ok(GatheredShape {
+            rows,
+            truth_columns,
+            imu_columns,
+        })
+    }
+
+    /// [`Scenario::simulate_streamed`] written into the caller's memory (a NumPy array, say):
+    /// `truth` and `imu` are row-major, [`GatheredShape::rows`] rows of the shape's columns; each
+    /// chunk is checked finite (rows named from 2, as below a header) and copied in as it is
+    /// made. Returns the aids' tables.
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`]; buffers of the wrong length.
+    pub fn simulate_streamed_into(
+        &self,
+        run: Option<u64>,
+        truth: &mut [f64],
+        imu: &mut [f64],
+    ) -> Result<AidTables> {
+        let shape = self.gathered_shape()?;
+        for (name, buffer, width) in [
+            ("truth", &*truth, shape.truth_columns.len()),
+            ("imu", &*imu, shape.imu_columns.len()),
+        ] {
+            if buffer.len() != shape.rows * width {
+                return Err(crate::error::invalid(
+                    name,
+                    format!(
+                        "has {} values, expected {} rows × {width}",
+                        buffer.len(),
+                        shape.rows
+                    ),
+                ));
             }
+        }
+        let mut aids = AidTables::default();
+        let append = |into: &mut Option<Table>, from: Option<Table>| match (into.as_mut(), from) {
+            (Some(a), Some(b)) => a.data.extend_from_slice(&b.data),
+            (None, b) => *into = b,
+            (Some(_), None) => {}
+        };
+        let mut rows = 0;
+        self.stream(run, |chunk| {
+            let n = chunk.imu.rows();
+            for (what, into, from) in [
+                ("truth", &mut *truth, &chunk.truth),
+                ("IMU readings", &mut *imu, &chunk.imu),
+            ] {
+                check_finite_from(&from.columns, &from.data, what, rows + 2)?;
+                let width = from.columns.len();
+                into.get_mut(rows * width..(rows + n) * width)
+                    .ok_or_else(|| {
+                        crate::error::invalid(what, "the run made more rows than its sample times")
+                    })?
+                    .copy_from_slice(&from.data);
+            }
+            append(&mut aids.gnss, chunk.gnss);
+            append(&mut aids.baro, chunk.baro);
+            append(&mut aids.odometer, chunk.odometer);
+            rows += n;
             Ok(())
         })?;
-        let simulation = whole.ok_or_else(|| crate::error::invalid("duration_s", "no samples"))?;
-        simulation.truth.check_finite("truth")?;
-        simulation.imu.check_finite("IMU readings")?;
-        Ok(simulation)
+        if rows == 0 {
+            return Err(crate::error::invalid("duration_s", "no samples"));
+        }
+        if rows != shape.rows {
+            return Err(crate::error::invalid(
+                "duration_s",
+                format!(
+                    "the run made {rows} rows of its {} sample times",
+                    shape.rows
+                ),
+            ));
+        }
+        Ok(aids)
     }
 
     fn stream_in<N: NavFrame>(

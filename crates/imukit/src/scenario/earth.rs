@@ -35,6 +35,27 @@ pub enum EarthSetup {
     Wgs84(Box<TangentPlane>),
 }
 
+impl EarthSetup {
+    /// The truth table's columns on this Earth: [`TRUTH_COLUMNS`], then on the WGS-84 Earth
+    /// [`EARTH_TRUTH_COLUMNS`].
+    #[must_use]
+    pub fn truth_columns(&self) -> Vec<&'static str> {
+        match self {
+            Self::Flat => TRUTH_COLUMNS.to_vec(),
+            Self::Wgs84(_) => earth_truth_columns(),
+        }
+    }
+}
+
+/// [`TRUTH_COLUMNS`], then [`EARTH_TRUTH_COLUMNS`]: the truth table on the WGS-84 Earth.
+fn earth_truth_columns() -> Vec<&'static str> {
+    TRUTH_COLUMNS
+        .iter()
+        .chain(&EARTH_TRUTH_COLUMNS)
+        .copied()
+        .collect()
+}
+
 /// The tangent plane at a point of the WGS-84 ellipsoid, the gravity model and the magnetic
 /// field.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -313,11 +334,7 @@ impl TangentPlane {
 /// samples, then [`EARTH_TRUTH_COLUMNS`].
 #[must_use]
 pub fn earth_truth_table<N: NavFrame>(local: &[Truth<N>], earth: &[EarthTruth]) -> Table {
-    let names: Vec<&str> = TRUTH_COLUMNS
-        .iter()
-        .chain(&EARTH_TRUTH_COLUMNS)
-        .copied()
-        .collect();
+    let names = earth_truth_columns();
     let mut t = Table::new(&names);
     t.data.reserve(local.len() * names.len());
     for (s, e) in local.iter().zip(earth) {

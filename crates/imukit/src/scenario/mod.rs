@@ -49,9 +49,6 @@ use crate::motion::Trajectory;
 /// (9), and both as tables (23 and up to 10 columns), with the times.
 const IN_MEMORY_BYTES_PER_SAMPLE: usize = 8 * (23 + 9 + 23 + 10 + 1);
 
-/// Bytes per sample of [`Scenario::simulate_streamed`]: the truth and IMU tables only.
-pub(crate) const STREAMED_BYTES_PER_SAMPLE: usize = 8 * (23 + 10);
-
 /// A resolved, runnable scenario.
 #[derive(Clone, Debug)]
 pub struct Scenario {
