@@ -317,7 +317,7 @@ fn gif(scene: &Scene, opts: &AnimateOptions) -> Result<Vec<u8>, String> {
 }
 
 fn html(scene: &Scene, opts: &AnimateOptions) -> String {
-    let num = |v: f64| ryu::Buffer::new().format(v).to_string();
+    let num = |v: f64| zmij::Buffer::new().format(v).to_string();
     let list = |v: &[f64]| v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(",");
     let path = scene
         .path()

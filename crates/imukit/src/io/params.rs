@@ -692,7 +692,7 @@ fn fmt1(x: f64) -> String {
     if x.is_infinite() {
         "\"inf\"".into()
     } else {
-        ryu::Buffer::new().format(x).to_string()
+        zmij::Buffer::new().format(x).to_string()
     }
 }
 

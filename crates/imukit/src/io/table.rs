@@ -1,7 +1,7 @@
 //! The CSV schema (docs/design.md §7) and column tables shared by the CLI and Python.
 //!
 //! A [`Table`] is named columns over row-major `f64` data. CSV output uses shortest round-trip
-//! formatting (`ryu`), so a written file reads back bit for bit, and is written to a temporary file
+//! formatting (`zmij`), so a written file reads back bit for bit, and is written to a temporary file
 //! that is renamed into place only when complete.
 use std::collections::HashMap;
 use std::fs::File;
@@ -389,9 +389,9 @@ pub fn write_rows(
     width: usize,
     separator: &[u8],
 ) -> std::io::Result<()> {
-    // Rows are formatted into one local buffer (ryu straight into it) and handed to the writer
+    // Rows are formatted into one local buffer (zmij straight into it) and handed to the writer
     // a block at a time: no call into the writer per field.
-    let mut buf = ryu::Buffer::new();
+    let mut buf = zmij::Buffer::new();
     let mut text: Vec<u8> = Vec::with_capacity(64 * 1024);
     for row in data.chunks(width.max(1)) {
         for (k, v) in row.iter().enumerate() {
