@@ -127,13 +127,20 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
     match sc.simulate_streamed_into(None, &mut truth, &mut imu) {
         Err(imukit::Error::Invalid { field, message }) => {
             assert_eq!(field, "imu");
-            assert!(message.contains("1509 values, expected 151 rows × 10"), "{message}");
+            assert!(
+                message.contains("1509 values, expected 151 rows × 10"),
+                "{message}"
+            );
         }
         other => panic!("a short IMU buffer was taken: {other:?}"),
     }
-    assert!(truth.iter().all(|v| *v == 0.0), "written before the shape was checked");
+    assert!(
+        truth.iter().all(|v| *v == 0.0),
+        "written before the shape was checked"
+    );
     let mut imu = vec![0.0; 151 * 10];
-    sc.simulate_streamed_into(None, &mut truth, &mut imu).unwrap();
+    sc.simulate_streamed_into(None, &mut truth, &mut imu)
+        .unwrap();
     let whole = sc.simulate().unwrap();
     assert!(truth == whole.truth.data && imu == whole.imu.data);
 }

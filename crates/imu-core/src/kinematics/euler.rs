@@ -10,61 +10,85 @@ use crate::math;
 use crate::rotation::EulerZyx;
 use crate::vector::Vec3;
 
-/// `(sin p, cos p, sin r, cos r)` of the pitch and roll of `e`.
-fn pitch_roll_sin_cos(e: EulerZyx) -> [f64; 4] {
-    [
-        math::sin(e.pitch_rad),
-        math::cos(e.pitch_rad),
-        math::sin(e.roll_rad),
-        math::cos(e.roll_rad),
-    ]
+/// The sines and cosines of an attitude's pitch and roll: what the body rate and its derivative
+/// need of the angles themselves (and `cos p` tells gimbal lock).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PitchRollTrig {
+    /// `sin(pitch)`.
+    pub sin_pitch: f64,
+    /// `cos(pitch)`.
+    pub cos_pitch: f64,
+    /// `sin(roll)`.
+    pub sin_roll: f64,
+    /// `cos(roll)`.
+    pub cos_roll: f64,
 }
 
-/// `ω_b` from the rates `d` and the pitch's and roll's sines and cosines.
-fn rate_from([sp, cp, sr, cr]: [f64; 4], d: EulerZyx) -> Vec3<Body> {
-    let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
-    Vec3::new(
-        rd - yd * sp,
-        pd * cr + yd * cp * sr,
-        -pd * sr + yd * cp * cr,
-    )
-}
+impl PitchRollTrig {
+    /// The sines and cosines of the pitch and roll of `e`.
+    #[must_use]
+    pub fn of(e: EulerZyx) -> Self {
+        Self {
+            sin_pitch: math::sin(e.pitch_rad),
+            cos_pitch: math::cos(e.pitch_rad),
+            sin_roll: math::sin(e.roll_rad),
+            cos_roll: math::cos(e.roll_rad),
+        }
+    }
 
-/// `α_b` from the rates `d`, second derivatives `dd` and the pitch's and roll's sines and
-/// cosines.
-fn acceleration_from([sp, cp, sr, cr]: [f64; 4], d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
-    let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
-    let (ydd, pdd, rdd) = (dd.yaw_rad, dd.pitch_rad, dd.roll_rad);
-    Vec3::new(
-        rdd - ydd * sp - yd * pd * cp,
-        pdd * cr - pd * rd * sr + ydd * cp * sr - yd * pd * sp * sr + yd * rd * cp * cr,
-        -pdd * sr - pd * rd * cr + ydd * cp * cr - yd * pd * sp * cr - yd * rd * cp * sr,
-    )
+    /// True when `|cos(pitch)|` is below `tol`, where z-y-x Euler rates are singular (as
+    /// [`EulerZyx::is_near_gimbal_lock`]).
+    #[must_use]
+    pub fn is_near_gimbal_lock(&self, tol: f64) -> bool {
+        math::abs(self.cos_pitch) < tol
+    }
+
+    /// `ω_b` from the rates `d`.
+    fn rate(&self, d: EulerZyx) -> Vec3<Body> {
+        let (sp, cp, sr, cr) = (self.sin_pitch, self.cos_pitch, self.sin_roll, self.cos_roll);
+        let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
+        Vec3::new(
+            rd - yd * sp,
+            pd * cr + yd * cp * sr,
+            -pd * sr + yd * cp * cr,
+        )
+    }
+
+    /// `α_b` from the rates `d` and second derivatives `dd`.
+    fn acceleration(&self, d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
+        let (sp, cp, sr, cr) = (self.sin_pitch, self.cos_pitch, self.sin_roll, self.cos_roll);
+        let (yd, pd, rd) = (d.yaw_rad, d.pitch_rad, d.roll_rad);
+        let (ydd, pdd, rdd) = (dd.yaw_rad, dd.pitch_rad, dd.roll_rad);
+        Vec3::new(
+            rdd - ydd * sp - yd * pd * cp,
+            pdd * cr - pd * rd * sr + ydd * cp * sr - yd * pd * sp * sr + yd * rd * cp * cr,
+            -pdd * sr - pd * rd * cr + ydd * cp * cr - yd * pd * sp * cr - yd * rd * cp * sr,
+        )
+    }
 }
 
 /// Body rate `ω_b` (rad/s) from Euler angles `e` and their rates `d` (rad/s, as `EulerZyx`).
 #[must_use]
 pub fn body_rate(e: EulerZyx, d: EulerZyx) -> Vec3<Body> {
-    rate_from(pitch_roll_sin_cos(e), d)
+    PitchRollTrig::of(e).rate(d)
 }
 
 /// Body angular acceleration `α_b = dω_b/dt` (rad/s²) from Euler angles `e`, their rates `d`
 /// (rad/s) and second derivatives `dd` (rad/s²).
 #[must_use]
 pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3<Body> {
-    acceleration_from(pitch_roll_sin_cos(e), d, dd)
+    PitchRollTrig::of(e).acceleration(d, dd)
 }
 
-/// [`body_rate`] and [`body_angular_acceleration`] together, the same numbers with the
-/// pitch's and roll's sines and cosines taken once.
+/// [`body_rate`] and [`body_angular_acceleration`] together, from the sines and cosines `trig`
+/// of the angles' pitch and roll (taken once for both).
 #[must_use]
 pub fn body_rate_and_acceleration(
-    e: EulerZyx,
+    trig: &PitchRollTrig,
     d: EulerZyx,
     dd: EulerZyx,
 ) -> (Vec3<Body>, Vec3<Body>) {
-    let sc = pitch_roll_sin_cos(e);
-    (rate_from(sc, d), acceleration_from(sc, d, dd))
+    (trig.rate(d), trig.acceleration(d, dd))
 }
 
 /// `angle` plus the multiple of 2π that brings it closest to `reference` (rad): yaw unwrapping

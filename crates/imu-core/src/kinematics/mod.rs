@@ -71,10 +71,22 @@ impl<N: NavFrame> Truth<N> {
     /// angular acceleration from the angles' first and second time derivatives `rate` (rad/s)
     /// and `accel` (rad/s²) (see [`euler::body_rate_and_acceleration`]).
     pub fn set_euler_motion(&mut self, euler: EulerZyx, rate: EulerZyx, accel: EulerZyx) {
+        self.set_euler_motion_with(euler, &euler::PitchRollTrig::of(euler), rate, accel);
+    }
+
+    /// [`Self::set_euler_motion`] with the pitch's and roll's sines and cosines `trig` of
+    /// `euler` already taken (for a gimbal-lock check, say).
+    pub fn set_euler_motion_with(
+        &mut self,
+        euler: EulerZyx,
+        trig: &euler::PitchRollTrig,
+        rate: EulerZyx,
+        accel: EulerZyx,
+    ) {
         self.euler = euler;
         self.attitude = Rotation::from_euler(euler);
         (self.omega_b_rad_s, self.alpha_b_rad_s2) =
-            euler::body_rate_and_acceleration(euler, rate, accel);
+            euler::body_rate_and_acceleration(trig, rate, accel);
     }
 }
 

@@ -33,7 +33,7 @@
 //! ```
 use num_dual::{Dual2, Dual3, DualNum};
 
-use imu_core::kinematics::euler::unwrap_near;
+use imu_core::kinematics::euler::{PitchRollTrig, unwrap_near};
 use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
 use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
 use imu_core::kinematics::{KinematicsError, Truth, check_times};
@@ -197,7 +197,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
         truth.position_m = Vec3::from_array(pos);
         truth.velocity_m_s = Vec3::from_array(vel);
         truth.acceleration_m_s2 = Vec3::from_array(acc);
-        let (euler, rate, accel) = match point.euler {
+        let (euler, trig, rate, accel) = match point.euler {
             Some(e) => {
                 let ang = |k: usize| EulerZyx::new(e[0][k], e[1][k], e[2][k]);
                 let mut euler = ang(0);
@@ -207,7 +207,9 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                         index,
                     });
                 }
-                if euler.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
+                // The pitch's cosine, taken once: the gimbal-lock check's and ω's and α's.
+                let trig = PitchRollTrig::of(euler);
+                if trig.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
                     return Err(KinematicsError::GimbalLock {
                         index,
                         pitch_rad: euler.pitch_rad,
@@ -217,10 +219,10 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                     euler.yaw_rad = unwrap_near(euler.yaw_rad, last);
                 }
                 self.last_yaw = Some(euler.yaw_rad);
-                (euler, ang(1), ang(2))
+                (euler, trig, ang(1), ang(2))
             }
             None => match self.tracker.update(index, vel, acc, jerk)? {
-                Some(a) => (a.euler, a.rate, a.accel),
+                Some(a) => (a.euler, PitchRollTrig::of(a.euler), a.rate, a.accel),
                 None => {
                     let zero = EulerZyx::default();
                     truth.euler = zero;
@@ -231,7 +233,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                 }
             },
         };
-        truth.set_euler_motion(euler, rate, accel);
+        truth.set_euler_motion_with(euler, &trig, rate, accel);
         if !truth.is_finite() {
             return Err(KinematicsError::NotFinite {
                 field: "truth",
