@@ -32,8 +32,31 @@ fn formula_scenarios() -> Vec<(String, Scenario)> {
         let spec: ScenarioSpec = builtin::spec(name).unwrap();
         out.push((name.to_string(), spec.resolve(Path::new(".")).unwrap()));
     }
+    out.push(("the formula job".to_string(), formula_job()));
     out.retain(|(_, s)| matches!(s.trajectory, Trajectory::Expression(..)));
     out
+}
+
+/// The benchmarks' formula job (`benches/formula_job.toml`), 30 s of it: positions and angles
+/// that take the sines of the same numbers.
+fn formula_job() -> Scenario {
+    let text = include_str!("../../../benches/formula_job.toml")
+        .replace("duration_s = 10.0", "duration_s = 30.0");
+    ScenarioSpec::from_toml(&text, "formula_job.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+}
+
+#[test]
+fn a_number_whose_sine_positions_and_angles_both_take_gets_one_sin_cos() {
+    let job = formula_job();
+    let Trajectory::Expression(motion, _) = &job.trajectory else {
+        unreachable!()
+    };
+    // sin(w t), sin(2 w t), sin(3 w t) in the positions; sin(w t), sin(2 w t), sin(w t + 0.5) in
+    // the angles: four distinct numbers, not six.
+    assert_eq!(motion.compiled().unwrap().sin_cos_per_sample(), 4);
 }
 
 fn same(a: f64, b: f64) -> bool {

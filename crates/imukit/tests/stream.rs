@@ -11,8 +11,8 @@ fn streamed(sc: &Scenario, run: Option<u64>) -> (Vec<f64>, Vec<f64>, usize) {
     let (mut truth, mut imu, mut chunks) = (Vec::new(), Vec::new(), 0);
     sc.stream(run, |c| {
         assert!(c.truth.columns.len() * STREAM_CHUNK >= c.truth.data.len() || chunks == 0);
-        truth.extend(c.truth.data);
-        imu.extend(c.imu.data);
+        truth.extend_from_slice(&c.truth.data);
+        imu.extend_from_slice(&c.imu.data);
         chunks += 1;
         Ok(())
     })

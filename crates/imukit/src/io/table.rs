@@ -156,7 +156,7 @@ impl ImuKind {
 }
 
 /// Named columns over row-major data.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Table {
     /// Column names.
     pub columns: Vec<String>,
@@ -259,12 +259,32 @@ impl Table {
     /// Truth samples as a table with [`TRUTH_COLUMNS`].
     #[must_use]
     pub fn from_truth<N: NavFrame>(truth: &[Truth<N>]) -> Self {
-        let mut t = Self::new(&TRUTH_COLUMNS);
-        t.data.reserve(truth.len() * TRUTH_COLUMNS.len());
-        for s in truth {
-            t.push_row(&truth_row(s));
-        }
+        let mut t = Self::new(&[]);
+        t.refill_truth(truth);
         t
+    }
+
+    /// Makes this table [`Self::from_truth`]`(truth)` in the memory it already has (a streamed
+    /// run refills one table chunk after chunk).
+    pub fn refill_truth<N: NavFrame>(&mut self, truth: &[Truth<N>]) {
+        self.set_columns(&TRUTH_COLUMNS);
+        self.data.clear();
+        self.data.reserve(truth.len() * TRUTH_COLUMNS.len());
+        for s in truth {
+            self.push_row(&truth_row(s));
+        }
+    }
+
+    /// Sets the column names (kept when already equal), leaving the data alone.
+    fn set_columns(&mut self, columns: &[&str]) {
+        if !self
+            .columns
+            .iter()
+            .map(String::as_str)
+            .eq(columns.iter().copied())
+        {
+            self.columns = columns.iter().map(|c| (*c).to_string()).collect();
+        }
     }
 
     /// Readings as Δv/Δθ increments ([`ImuOutput::Increments`]).
@@ -295,9 +315,17 @@ impl Table {
     /// Readings with their times as a table with the columns of `kind`.
     #[must_use]
     pub fn from_readings(t_s: &[f64], readings: &[ImuReading], kind: ImuKind) -> Self {
-        let mut t = Self::new(&kind.columns());
-        let width = t.columns.len();
-        t.data.reserve(readings.len() * width);
+        let mut t = Self::new(&[]);
+        t.refill_readings(t_s, readings, kind);
+        t
+    }
+
+    /// Makes this table [`Self::from_readings`]`(t_s, readings, kind)` in the memory it already
+    /// has.
+    pub fn refill_readings(&mut self, t_s: &[f64], readings: &[ImuReading], kind: ImuKind) {
+        self.set_columns(&kind.columns());
+        self.data.clear();
+        self.data.reserve(readings.len() * self.columns.len());
         for (ti, r) in t_s.iter().zip(readings) {
             // The kind's column order: t, accelerometer, then gyroscope and magnetometer when
             // it has them (at most ten values).
@@ -315,9 +343,8 @@ impl Table {
             if kind.has_mag() {
                 put(&r.mag_ut);
             }
-            t.push_row(&row[..k]);
+            self.push_row(&row[..k]);
         }
-        t
     }
 
     /// Writes the table in the format its path's extension names ([`TableFormat`]: Parquet

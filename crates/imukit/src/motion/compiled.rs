@@ -29,8 +29,8 @@ pub const CHUNK: usize = 64;
 /// would need more is evaluated over dual numbers instead.
 pub const MAX_REGISTERS: usize = 4096;
 
-/// Which dual numbers' arithmetic a program follows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which dual numbers' arithmetic a program (or a group of its formulas) follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Order {
     /// Second derivatives, as num-dual's `Dual2` (the jets' fourth entry is 0).
     Second,
@@ -171,9 +171,8 @@ pub struct Scratch {
 /// Several formulas compiled together (see the module documentation).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Program {
-    order: Order,
-    /// `(operation on registers, register it writes)`, in order.
-    steps: Vec<(Op, u32)>,
+    /// `(arithmetic, operation on registers, register it writes)`, in order.
+    steps: Vec<(Order, Op, u32)>,
     /// The register holding each formula's value at the end.
     outputs: Vec<u32>,
     registers: usize,
@@ -181,23 +180,24 @@ pub struct Program {
     pairs: usize,
 }
 
-/// Builds the value list: one entry per distinct operation.
+/// Builds the value list: one entry per distinct operation in each arithmetic.
 struct Builder {
+    /// The arithmetic of the formulas being added.
     order: Order,
-    ops: Vec<Op>,
-    known: HashMap<Key, u32>,
+    ops: Vec<(Order, Op)>,
+    known: HashMap<(Order, Key), u32>,
 }
 
 impl Builder {
     /// The value of `op`: an earlier equal one, a folded constant, or a new entry.
     fn push(&mut self, op: Op) -> u32 {
         let op = self.fold(op);
-        let key = op.key();
+        let key = (self.order, op.key());
         if let Some(&v) = self.known.get(&key) {
             return v;
         }
         let v = self.ops.len() as u32;
-        self.ops.push(op);
+        self.ops.push((self.order, op));
         self.known.insert(key, v);
         v
     }
@@ -207,7 +207,7 @@ impl Builder {
     fn fold(&self, op: Op) -> Op {
         let mut constants = Vec::with_capacity(3);
         for v in op.operands() {
-            match self.ops[v as usize] {
+            match self.ops[v as usize].1 {
                 Op::Const(c) => constants.push([c, 0.0, 0.0, 0.0]),
                 _ => return op,
             }
@@ -303,12 +303,26 @@ impl Program {
     /// [`MAX_REGISTERS`] registers at once.
     #[must_use]
     pub fn compile(formulas: &[&Expr], order: Order) -> Option<Self> {
+        Self::compile_groups(&[(formulas, order)])
+    }
+
+    /// Groups of formulas, each in its own arithmetic, compiled into one program whose outputs
+    /// are the groups' formulas in turn (a motion's positions in [`Order::Third`], its angles in
+    /// [`Order::Second`]). Subexpressions are shared within an arithmetic; across them, a `sin`
+    /// or `cos` of the same value takes the one `sin_cos` — a value (a jet's first entry) is the
+    /// same number in either arithmetic, so this changes no result. `None` as [`Self::compile`].
+    #[must_use]
+    pub fn compile_groups(groups: &[(&[&Expr], Order)]) -> Option<Self> {
         let mut b = Builder {
-            order,
+            order: Order::Third,
             ops: Vec::new(),
             known: HashMap::new(),
         };
-        let values: Vec<u32> = formulas.iter().map(|f| b.node(f.root())).collect();
+        let mut values: Vec<u32> = Vec::new();
+        for (formulas, order) in groups {
+            b.order = *order;
+            values.extend(formulas.iter().map(|f| b.node(f.root())));
+        }
         // Keep only what the outputs need.
         let mut needed = vec![false; b.ops.len()];
         for &v in &values {
@@ -316,39 +330,49 @@ impl Program {
         }
         for i in (0..b.ops.len()).rev() {
             if needed[i] {
-                for v in b.ops[i].operands() {
+                for v in b.ops[i].1.operands() {
                     needed[v as usize] = true;
                 }
             }
         }
-        // `sin` and `cos` of the same value: one `sin_cos` for both.
+        // Which values are the same number whatever the arithmetic: the same operation on the
+        // same numbers (a value lane never reads a derivative lane).
+        let mut class = vec![0u32; b.ops.len()];
+        let mut classes: HashMap<Key, u32> = HashMap::new();
+        for (i, (_, op)) in b.ops.iter().enumerate() {
+            let key = op.map(|v| class[v as usize]).key();
+            let next = classes.len() as u32;
+            class[i] = *classes.entry(key).or_insert(next);
+        }
+        // `sin` and `cos` of the same number: one `sin_cos` for all of them, the first one's.
         let mut pairs = 0u32;
-        let mut first_of: HashMap<u32, usize> = HashMap::new();
+        let mut first_of: HashMap<u32, (usize, Option<u32>)> = HashMap::new();
         for (i, &need) in needed.iter().enumerate() {
-            let Op::F1(f @ (Func1::Sin | Func1::Cos), a) = b.ops[i] else {
+            let (_, Op::F1(f @ (Func1::Sin | Func1::Cos), a)) = b.ops[i] else {
                 continue;
             };
             if !need {
                 continue;
             }
-            match first_of.get(&a) {
-                Some(&j) => {
-                    if let Op::F1(g, _) = b.ops[j]
-                        && g != f
-                    {
-                        b.ops[j] = Op::SinCos(g, a, pairs);
-                        b.ops[i] = Op::FromPair(f, a, pairs);
+            match first_of.get_mut(&class[a as usize]) {
+                Some((j, slot)) => {
+                    let k = *slot.get_or_insert_with(|| {
+                        if let (_, Op::F1(g, x)) = b.ops[*j] {
+                            b.ops[*j].1 = Op::SinCos(g, x, pairs);
+                        }
                         pairs += 1;
-                    }
+                        pairs - 1
+                    });
+                    b.ops[i].1 = Op::FromPair(f, a, k);
                 }
                 None => {
-                    first_of.insert(a, i);
+                    first_of.insert(class[a as usize], (i, None));
                 }
             }
         }
         // Each value's last reader (outputs live to the end).
         let mut last_use = vec![0usize; b.ops.len()];
-        for (i, op) in b.ops.iter().enumerate() {
+        for (i, (_, op)) in b.ops.iter().enumerate() {
             for v in op.operands() {
                 last_use[v as usize] = i;
             }
@@ -362,7 +386,7 @@ impl Program {
         let mut releases: Vec<Vec<u32>> = vec![Vec::new(); b.ops.len()];
         let mut registers = 0usize;
         let mut steps = Vec::new();
-        for (i, op) in b.ops.iter().enumerate() {
+        for (i, &(order, op)) in b.ops.iter().enumerate() {
             if !needed[i] {
                 continue;
             }
@@ -373,7 +397,7 @@ impl Program {
             if registers > MAX_REGISTERS {
                 return None;
             }
-            steps.push((op.map(|v| register[v as usize]), r));
+            steps.push((order, op.map(|v| register[v as usize]), r));
             register[i] = r;
             // Operands whose last reader this is give their registers back (after the write:
             // an operation never writes the register it reads).
@@ -385,7 +409,6 @@ impl Program {
             free.append(&mut releases[i]);
         }
         Some(Self {
-            order,
             steps,
             outputs: values.iter().map(|&v| register[v as usize]).collect(),
             registers,
@@ -403,6 +426,21 @@ impl Program {
     #[must_use]
     pub fn len(&self) -> usize {
         self.steps.len()
+    }
+
+    /// libm `sin_cos` calls per sample: one for each distinct number whose sine or cosine a
+    /// formula takes, in whichever arithmetic.
+    #[must_use]
+    pub fn sin_cos_per_sample(&self) -> usize {
+        self.steps
+            .iter()
+            .filter(|(_, op, _)| {
+                matches!(
+                    op,
+                    Op::SinCos(..) | Op::F1(Func1::Sin | Func1::Cos | Func1::Tan, _)
+                )
+            })
+            .count()
     }
 
     /// Whether the program has no operation.
@@ -435,10 +473,10 @@ impl Program {
         let pairs = &mut scratch.pairs[..self.pairs];
         for (c, times) in t_s.chunks(CHUNK).enumerate() {
             let n = times.len();
-            for &(op, r) in &self.steps {
+            for &(order, op, r) in &self.steps {
                 let (out, regs) = split(regs, r as usize);
                 let out = &mut out[..n];
-                match self.order {
+                match order {
                     Order::Second => run::<Second>(op, out, &regs, pairs, times),
                     Order::Third => run::<Third>(op, out, &regs, pairs, times),
                 }

@@ -67,20 +67,19 @@ impl GeodeticPlane {
 }
 
 /// What [`ExpressionMotion::derivatives`] evaluates in, kept per thread between calls: the
-/// programs' registers and their jets.
+/// program's registers and its jets.
 #[derive(Default)]
 struct EvalScratch {
     registers: Scratch,
-    p: Vec<Jet>,
-    e: Vec<Jet>,
+    jets: Vec<Jet>,
 }
 
 thread_local! {
     static EVAL_SCRATCH: RefCell<EvalScratch> = RefCell::new(EvalScratch::default());
 }
 
-/// The position formulas' program and the angles' (when given).
-type Compiled = (Program, Option<Program>);
+/// The position formulas and the angles (when given), compiled into one program.
+type Compiled = Program;
 
 /// A motion given by formulas of time.
 #[derive(Clone, Debug)]
@@ -138,17 +137,17 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
-    /// The jets of the position formulas `p` (three per time) and of the angles `e` into
-    /// [`MotionPoint`]s.
-    fn points(&self, p: &[Jet], e: &[Jet], out: &mut Vec<MotionPoint>) {
+    /// The program's jets, `width` per time (the three positions, then the three angles when
+    /// given), into [`MotionPoint`]s.
+    fn points(&self, jets: &[Jet], width: usize, out: &mut Vec<MotionPoint>) {
         out.clear();
-        out.extend(p.chunks_exact(3).enumerate().map(|(i, j)| MotionPoint {
+        out.extend(jets.chunks_exact(width).map(|j| MotionPoint {
             position: [j[0], j[1], j[2]],
             euler: match &self.attitude {
                 ExpressionAttitude::Tangent => None,
                 ExpressionAttitude::Level => Some([[0.0; 3]; 3]),
                 ExpressionAttitude::Euler(_) => {
-                    Some([0, 1, 2].map(|k| [e[3 * i + k][0], e[3 * i + k][1], e[3 * i + k][2]]))
+                    Some([3, 4, 5].map(|k| [j[k][0], j[k][1], j[k][2]]))
                 }
             },
         }));
@@ -170,23 +169,19 @@ impl ExpressionMotion {
     }
 
     /// The position formulas compiled for third derivatives (as over `Dual3`) and, when
-    /// given, the Euler angles' for second (as over `Dual2`); `None` for formulas too large to
-    /// compile (see [`Program::compile`]).
-    fn programs(&self) -> Option<&Compiled> {
+    /// given, the Euler angles' for second (as over `Dual2`), one program whose outputs are the
+    /// three positions, then the three angles; `None` for formulas too large to compile (see
+    /// [`Program::compile_groups`]).
+    fn program(&self) -> Option<&Compiled> {
         self.compiled
             .get_or_init(|| {
                 let position: Vec<&Expr> = self.position.iter().collect();
-                let angles = match &self.attitude {
-                    ExpressionAttitude::Euler(e) => {
-                        let e: Vec<&Expr> = e.iter().collect();
-                        Some(Program::compile(&e, Order::Second)?)
-                    }
-                    _ => None,
+                let angles: Vec<&Expr> = match &self.attitude {
+                    ExpressionAttitude::Euler(e) => e.iter().collect(),
+                    _ => Vec::new(),
                 };
-                Some(Box::new((
-                    Program::compile(&position, Order::Third)?,
-                    angles,
-                )))
+                Program::compile_groups(&[(&position, Order::Third), (&angles, Order::Second)])
+                    .map(Box::new)
             })
             .as_deref()
     }
@@ -238,22 +233,30 @@ impl ExpressionMotion {
     }
 }
 
+impl ExpressionMotion {
+    /// The compiled program of the formulas (positions, then angles), when they compile and are
+    /// not placed on the Earth; `None` where they are evaluated over dual numbers.
+    #[must_use]
+    pub fn compiled(&self) -> Option<&Program> {
+        match &self.geodetic {
+            None | Some(GeodeticPlane::Unplaced) => self.program(),
+            Some(GeodeticPlane::Placed { .. }) => None,
+        }
+    }
+}
+
 impl Motion for ExpressionMotion {
     /// The compiled formulas over the whole slice (the same numbers as [`dual_derivatives`],
     /// see [`crate::motion::compiled`]); formulas placed on the WGS-84 Earth, whose position
     /// goes through the ellipsoid, over dual numbers.
     fn derivatives(&self, t_s: &[f64], out: &mut Vec<MotionPoint>) {
-        let (position, angles) = match (&self.geodetic, self.programs()) {
-            (None | Some(GeodeticPlane::Unplaced), Some(p)) => p,
-            _ => return dual_derivatives(self, t_s, out),
+        let Some(program) = self.compiled() else {
+            return dual_derivatives(self, t_s, out);
         };
         EVAL_SCRATCH.with_borrow_mut(|s| {
-            let EvalScratch { registers, p, e } = s;
-            position.eval_in(t_s, p, registers);
-            if let Some(angles) = angles {
-                angles.eval_in(t_s, e, registers);
-            }
-            self.points(p, e, out);
+            let EvalScratch { registers, jets } = s;
+            program.eval_in(t_s, jets, registers);
+            self.points(jets, program.outputs(), out);
         });
     }
 

@@ -91,7 +91,7 @@ impl Scenario {
     pub fn stream(
         &self,
         run: Option<u64>,
-        mut sink: impl FnMut(Chunk) -> Result<()>,
+        mut sink: impl FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
         match self.nav_frame {
             NavFrameName::ENU => self.stream_in::<Enu>(run, &mut sink),
@@ -234,9 +234,9 @@ impl Scenario {
             }
         }
         let mut aids = AidTables::default();
-        let append = |into: &mut Option<Table>, from: Option<Table>| match (into.as_mut(), from) {
+        let append = |into: &mut Option<Table>, from: Option<&Table>| match (into.as_mut(), from) {
             (Some(a), Some(b)) => a.data.extend_from_slice(&b.data),
-            (None, b) => *into = b,
+            (None, b) => *into = b.cloned(),
             (Some(_), None) => {}
         };
         let mut rows = 0;
@@ -254,9 +254,9 @@ impl Scenario {
                     })?
                     .copy_from_slice(&from.data);
             }
-            append(&mut aids.gnss, chunk.gnss);
-            append(&mut aids.baro, chunk.baro);
-            append(&mut aids.odometer, chunk.odometer);
+            append(&mut aids.gnss, chunk.gnss.as_ref());
+            append(&mut aids.baro, chunk.baro.as_ref());
+            append(&mut aids.odometer, chunk.odometer.as_ref());
             rows += n;
             Ok(())
         })?;
@@ -278,7 +278,7 @@ impl Scenario {
     fn stream_in<N: NavFrame>(
         &self,
         run: Option<u64>,
-        sink: &mut dyn FnMut(Chunk) -> Result<()>,
+        sink: &mut dyn FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
         let mut sensors =
             self.imu
@@ -288,38 +288,47 @@ impl Scenario {
         // The last reading of the previous chunk: increments integrate across the boundary.
         let mut previous: Option<(f64, ImuReading)> = None;
         let mut aids = self.aids(run)?;
+        // One stretch, one chunk and one list of times, refilled chunk after chunk: nothing of
+        // the size of a chunk is allocated per chunk on the flat Earth.
+        let mut stretch = crate::scenario::Stretch::default();
+        let mut chunk = Chunk {
+            truth: Table::default(),
+            imu: Table::default(),
+            gnss: None,
+            baro: None,
+            odometer: None,
+        };
+        let mut t: Vec<f64> = Vec::new();
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            let crate::scenario::Stretch {
-                truth: truth_table,
-                readings,
-                gnss,
-                baro,
-                odometer,
-            } = self.on_earth(truth, &mut sensors, &mut aids)?;
-            let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
-            let imu = match output {
-                ImuOutput::Rates => Table::from_readings(&t, &readings, kind),
-                ImuOutput::Increments => match previous {
-                    None => Table::from_increments(&t, &readings, kind),
-                    Some((t0, r0)) => {
-                        let (mut t1, mut r1) = (vec![t0], vec![r0]);
-                        t1.extend(&t);
-                        r1.extend(&readings);
-                        let mut table = Table::from_increments(&t1, &r1, kind);
-                        let width = table.columns.len();
-                        table.data.drain(..width);
-                        table
+            self.on_earth(truth, &mut sensors, &mut aids, &mut stretch)?;
+            let readings = &stretch.readings;
+            t.clear();
+            t.extend(truth.iter().map(|s| s.t_s));
+            match output {
+                ImuOutput::Rates => chunk.imu.refill_readings(&t, readings, kind),
+                ImuOutput::Increments => {
+                    chunk.imu = match previous {
+                        None => Table::from_increments(&t, readings, kind),
+                        Some((t0, r0)) => {
+                            let (mut t1, mut r1) = (vec![t0], vec![r0]);
+                            t1.extend(&t);
+                            r1.extend(readings);
+                            let mut table = Table::from_increments(&t1, &r1, kind);
+                            let width = table.columns.len();
+                            table.data.drain(..width);
+                            table
+                        }
                     }
-                },
-            };
+                }
+            }
             previous = t.last().copied().zip(readings.last().copied());
-            sink(Chunk {
-                truth: truth_table,
-                imu,
-                gnss,
-                baro,
-                odometer,
-            })
+            // The stretch's truth table becomes the chunk's; the chunk's last one is refilled
+            // next time.
+            std::mem::swap(&mut chunk.truth, &mut stretch.truth);
+            chunk.gnss = stretch.gnss.take();
+            chunk.baro = stretch.baro.take();
+            chunk.odometer = stretch.odometer.take();
+            sink(&chunk)
         };
         let t_s = &self.t_s;
         match &self.trajectory {

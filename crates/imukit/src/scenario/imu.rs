@@ -193,13 +193,18 @@ impl<N: NavFrame> ReadingStream<'_, N> {
 
     /// The readings of the next samples of truth.
     pub fn measure(&mut self, truth: &[Truth<N>]) -> Vec<ImuReading> {
-        truth
-            .iter()
-            .map(|s| {
-                let temperatures = self.setup.sensors.temperature.at(s.t_s);
-                self.model
-                    .measure(s, &temperatures, &mut self.state, &mut self.noise)
-            })
-            .collect()
+        let mut readings = Vec::with_capacity(truth.len());
+        self.measure_into(truth, &mut readings);
+        readings
+    }
+
+    /// [`Self::measure`] into `readings` (cleared first; its memory kept).
+    pub fn measure_into(&mut self, truth: &[Truth<N>], readings: &mut Vec<ImuReading>) {
+        readings.clear();
+        readings.extend(truth.iter().map(|s| {
+            let temperatures = self.setup.sensors.temperature.at(s.t_s);
+            self.model
+                .measure(s, &temperatures, &mut self.state, &mut self.noise)
+        }));
     }
 }

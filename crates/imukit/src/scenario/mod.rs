@@ -83,6 +83,7 @@ pub(crate) struct Aids<'a> {
 }
 
 /// One stretch of a run: truth, IMU readings and the aids' readings.
+#[derive(Default)]
 pub(crate) struct Stretch {
     pub(crate) truth: Table,
     pub(crate) readings: Vec<ImuReading>,
@@ -135,13 +136,15 @@ impl Scenario {
             self.imu
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
         let mut aids = self.aids(run)?;
+        let mut stretch = Stretch::default();
+        self.on_earth(&truth, &mut sensors, &mut aids, &mut stretch)?;
         let Stretch {
             truth: truth_table,
             readings,
             gnss,
             baro,
             odometer,
-        } = self.on_earth(&truth, &mut sensors, &mut aids)?;
+        } = stretch;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
         let simulation = Simulation {
             gnss,
@@ -159,7 +162,8 @@ impl Scenario {
     }
 
     /// Tangent-plane (or flat) truth samples on the scenario's Earth: the truth table and the
-    /// readings, the sensors' state carried on.
+    /// readings, the sensors' state carried on, written into `out` (on the flat Earth in the
+    /// memory its truth table and readings already have: a streamed run reuses one).
     ///
     /// # Errors
     /// A sample off the Earth or beyond ±89.9° of latitude (WGS-84), with its time.
@@ -168,15 +172,17 @@ impl Scenario {
         truth: &[Truth<N>],
         sensors: &mut ReadingStream<'_, N>,
         aids: &mut Aids<'_>,
-    ) -> Result<Stretch> {
+        out: &mut Stretch,
+    ) -> Result<()> {
         match &self.earth {
-            EarthSetup::Flat => Ok(Stretch {
-                truth: Table::from_truth(truth),
-                readings: sensors.measure(truth),
-                gnss: aids.gnss.as_mut().map(|r| r.measure_flat(truth)),
-                baro: aids.baro.as_mut().map(|b| b.measure(truth, None)),
-                odometer: aids.odometer.as_mut().map(|o| o.measure(truth, None)),
-            }),
+            EarthSetup::Flat => {
+                out.truth.refill_truth(truth);
+                sensors.measure_into(truth, &mut out.readings);
+                out.gnss = aids.gnss.as_mut().map(|r| r.measure_flat(truth));
+                out.baro = aids.baro.as_mut().map(|b| b.measure(truth, None));
+                out.odometer = aids.odometer.as_mut().map(|o| o.measure(truth, None));
+                Ok(())
+            }
             EarthSetup::Wgs84(plane) => {
                 let earth = truth
                     .iter()
@@ -189,7 +195,7 @@ impl Scenario {
                     .collect();
                 let readings = sensors.measure_earth(plane, &earth, &local)?;
                 let heights: Vec<f64> = earth.iter().map(|e| e.position.height_m).collect();
-                Ok(Stretch {
+                *out = Stretch {
                     truth: earth::earth_truth_table(&local, &earth),
                     readings,
                     gnss: aids.gnss.as_mut().map(|r| r.measure_earth::<N>(&earth)),
@@ -198,7 +204,8 @@ impl Scenario {
                         .as_mut()
                         .map(|b| b.measure(&local, Some(&heights))),
                     odometer: aids.odometer.as_mut().map(|o| o.measure(&local, None)),
-                })
+                };
+                Ok(())
             }
         }
     }
