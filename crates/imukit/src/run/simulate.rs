@@ -88,14 +88,21 @@ impl Scenario {
     ///
     /// # Errors
     /// The core's refusal (with the time), invalid parameters, or the sink's error.
-    pub fn stream(
+    pub fn stream(&self, run: Option<u64>, sink: impl FnMut(&Chunk) -> Result<()>) -> Result<()> {
+        self.stream_with(run, true, sink)
+    }
+
+    /// [`Self::stream`], the chunks' truth tables left empty unless `truth_table` (on the flat
+    /// Earth: a run whose truth nobody writes does not tabulate it).
+    fn stream_with(
         &self,
         run: Option<u64>,
+        truth_table: bool,
         mut sink: impl FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
         match self.nav_frame {
-            NavFrameName::ENU => self.stream_in::<Enu>(run, &mut sink),
-            NavFrameName::NED => self.stream_in::<Ned>(run, &mut sink),
+            NavFrameName::ENU => self.stream_in::<Enu>(run, truth_table, &mut sink),
+            NavFrameName::NED => self.stream_in::<Ned>(run, truth_table, &mut sink),
         }
     }
 
@@ -140,7 +147,7 @@ impl Scenario {
             open(outputs.baro)?,
             open(outputs.odometer)?,
         );
-        self.stream(run, |chunk| {
+        self.stream_with(run, truth.is_some(), |chunk| {
             for (sink, table) in [
                 (&mut imu, Some(&chunk.imu)),
                 (&mut truth, Some(&chunk.truth)),
@@ -278,6 +285,7 @@ impl Scenario {
     fn stream_in<N: NavFrame>(
         &self,
         run: Option<u64>,
+        truth_table: bool,
         sink: &mut dyn FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
         let mut sensors =
@@ -300,7 +308,7 @@ impl Scenario {
         };
         let mut t: Vec<f64> = Vec::new();
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            self.on_earth(truth, &mut sensors, &mut aids, &mut stretch)?;
+            self.on_earth(truth, &mut sensors, &mut aids, truth_table, &mut stretch)?;
             let readings = &stretch.readings;
             t.clear();
             t.extend(truth.iter().map(|s| s.t_s));

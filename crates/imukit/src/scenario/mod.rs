@@ -137,7 +137,7 @@ impl Scenario {
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
         let mut aids = self.aids(run)?;
         let mut stretch = Stretch::default();
-        self.on_earth(&truth, &mut sensors, &mut aids, &mut stretch)?;
+        self.on_earth(&truth, &mut sensors, &mut aids, true, &mut stretch)?;
         let Stretch {
             truth: truth_table,
             readings,
@@ -163,7 +163,8 @@ impl Scenario {
 
     /// Tangent-plane (or flat) truth samples on the scenario's Earth: the truth table and the
     /// readings, the sensors' state carried on, written into `out` (on the flat Earth in the
-    /// memory its truth table and readings already have: a streamed run reuses one).
+    /// memory its truth table and readings already have: a streamed run reuses one; the truth
+    /// table left empty there unless `truth_table`).
     ///
     /// # Errors
     /// A sample off the Earth or beyond ±89.9° of latitude (WGS-84), with its time.
@@ -172,11 +173,16 @@ impl Scenario {
         truth: &[Truth<N>],
         sensors: &mut ReadingStream<'_, N>,
         aids: &mut Aids<'_>,
+        truth_table: bool,
         out: &mut Stretch,
     ) -> Result<()> {
         match &self.earth {
             EarthSetup::Flat => {
-                out.truth.refill_truth(truth);
+                if truth_table {
+                    out.truth.refill_truth(truth);
+                } else {
+                    out.truth.refill_truth::<N>(&[]);
+                }
                 sensors.measure_into(truth, &mut out.readings);
                 out.gnss = aids.gnss.as_mut().map(|r| r.measure_flat(truth));
                 out.baro = aids.baro.as_mut().map(|b| b.measure(truth, None));
