@@ -92,19 +92,27 @@ impl ImuOutput {
     pub fn columns(self, kind: ImuKind) -> Vec<&'static str> {
         match self {
             Self::Rates => kind.columns(),
-            Self::Increments => {
-                let mut c = vec!["t_s"];
-                c.extend(DV_COLUMNS);
-                if kind.has_gyro() {
-                    c.extend(DTHETA_COLUMNS);
-                }
-                if kind.has_mag() {
-                    c.extend(MAG_COLUMNS);
-                }
-                c
-            }
+            Self::Increments => reading_columns(kind, DV_COLUMNS, DTHETA_COLUMNS),
         }
     }
+}
+
+/// `t_s`, the accelerometer's columns, then the gyroscope's and the magnetometer's when `kind`
+/// has them.
+fn reading_columns(
+    kind: ImuKind,
+    accel: [&'static str; 3],
+    gyro: [&'static str; 3],
+) -> Vec<&'static str> {
+    let mut c = vec!["t_s"];
+    c.extend(accel);
+    if kind.has_gyro() {
+        c.extend(gyro);
+    }
+    if kind.has_mag() {
+        c.extend(MAG_COLUMNS);
+    }
+    c
 }
 
 /// Which sensors an IMU has (MATLAB's `IMUType`).
@@ -143,15 +151,7 @@ impl ImuKind {
     /// Column names of readings of this kind.
     #[must_use]
     pub fn columns(self) -> Vec<&'static str> {
-        let mut c = vec!["t_s"];
-        c.extend(ACCEL_COLUMNS);
-        if self.has_gyro() {
-            c.extend(GYRO_COLUMNS);
-        }
-        if self.has_mag() {
-            c.extend(MAG_COLUMNS);
-        }
-        c
+        reading_columns(self, ACCEL_COLUMNS, GYRO_COLUMNS)
     }
 }
 
