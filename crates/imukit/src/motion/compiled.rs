@@ -429,7 +429,7 @@ impl Program {
     }
 
     /// libm `sin_cos` calls per sample: one for each distinct number whose sine or cosine a
-    /// formula takes, in whichever arithmetic.
+    /// formula takes, in whichever arithmetic, and one for each tangent.
     #[must_use]
     pub fn sin_cos_per_sample(&self) -> usize {
         self.steps

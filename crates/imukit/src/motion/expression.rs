@@ -78,9 +78,6 @@ thread_local! {
     static EVAL_SCRATCH: RefCell<EvalScratch> = RefCell::new(EvalScratch::default());
 }
 
-/// The position formulas and the angles (when given), compiled into one program.
-type Compiled = Program;
-
 /// A motion given by formulas of time.
 #[derive(Clone, Debug)]
 pub struct ExpressionMotion {
@@ -93,7 +90,7 @@ pub struct ExpressionMotion {
     pub geodetic: Option<GeodeticPlane>,
     /// The position formulas compiled for third derivatives and the angles' for second, on
     /// first use.
-    compiled: OnceLock<Option<Box<Compiled>>>,
+    compiled: OnceLock<Option<Box<Program>>>,
 }
 
 /// `M · v` for a constant matrix and a dual vector.
@@ -170,9 +167,14 @@ impl ExpressionMotion {
 
     /// The position formulas compiled for third derivatives (as over `Dual3`) and, when
     /// given, the Euler angles' for second (as over `Dual2`), one program whose outputs are the
-    /// three positions, then the three angles; `None` for formulas too large to compile (see
-    /// [`Program::compile_groups`]).
-    fn program(&self) -> Option<&Compiled> {
+    /// three positions, then the three angles (compiled on first use). `None` where the
+    /// formulas are evaluated over dual numbers: placed on the Earth, or too large to compile
+    /// (see [`Program::compile_groups`]).
+    #[must_use]
+    pub fn compiled(&self) -> Option<&Program> {
+        if matches!(self.geodetic, Some(GeodeticPlane::Placed { .. })) {
+            return None;
+        }
         self.compiled
             .get_or_init(|| {
                 let position: Vec<&Expr> = self.position.iter().collect();
@@ -230,18 +232,6 @@ impl ExpressionMotion {
             self.position[1].eval(t),
             self.position[2].eval(t),
         ]
-    }
-}
-
-impl ExpressionMotion {
-    /// The compiled program of the formulas (positions, then angles), when they compile and are
-    /// not placed on the Earth; `None` where they are evaluated over dual numbers.
-    #[must_use]
-    pub fn compiled(&self) -> Option<&Program> {
-        match &self.geodetic {
-            None | Some(GeodeticPlane::Unplaced) => self.program(),
-            Some(GeodeticPlane::Placed { .. }) => None,
-        }
     }
 }
 

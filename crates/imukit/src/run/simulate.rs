@@ -26,7 +26,7 @@ pub const STREAM_CHUNK: usize = 4096;
 
 /// One chunk of a streamed simulation: truth rows and IMU rows, the columns of
 /// [`crate::Simulation`]'s tables.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Chunk {
     /// Truth rows.
     pub truth: Table,
@@ -299,13 +299,7 @@ impl Scenario {
         // One stretch, one chunk and one list of times, refilled chunk after chunk: nothing of
         // the size of a chunk is allocated per chunk on the flat Earth.
         let mut stretch = crate::scenario::Stretch::default();
-        let mut chunk = Chunk {
-            truth: Table::default(),
-            imu: Table::default(),
-            gnss: None,
-            baro: None,
-            odometer: None,
-        };
+        let mut chunk = Chunk::default();
         let mut t: Vec<f64> = Vec::new();
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
             self.on_earth(truth, &mut sensors, &mut aids, truth_table, &mut stretch)?;
