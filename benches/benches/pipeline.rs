@@ -2,7 +2,8 @@
 //! truth; accelerometer, gyroscope and magnetometer with MATLAB imuSensor's full error model
 //! out), as `imukit simulate` runs it without the process start: streamed to a file of each
 //! format (CSV, Parquet, `.npy`, `.npz`), and gathered into tables as Python's
-//! `imukit.simulate` returns them. Samples per second.
+//! `imukit.simulate` returns them. Samples per second, on one thread; `two_threads` adds the
+//! truth a chunk ahead on a second one (what a single run does when a second core is free).
 //!
 //! Run: `cargo bench -p imu-benches --bench pipeline`.
 #![allow(missing_docs)]
@@ -10,6 +11,7 @@
 use std::path::Path;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imukit::run::pipeline::RunThreads;
 use imukit::run::simulate::StreamOutputs;
 use imukit::{Scenario, ScenarioSpec};
 
@@ -30,21 +32,27 @@ fn bench_pipeline(c: &mut Criterion) {
     let n = 200_000;
     let sc = job(n);
     group.throughput(Throughput::Elements(n as u64));
-    for ext in ["csv", "parquet", "npy", "npz"] {
-        let out = dir.join(format!("imu.{ext}"));
-        group.bench_function(BenchmarkId::new("to_file", ext), |b| {
-            b.iter(|| {
-                let outputs = StreamOutputs {
-                    imu: Some(&out),
-                    ..StreamOutputs::default()
-                };
-                sc.stream_to_files(None, &outputs).expect("written");
+    for (threads, name) in [(RunThreads::One, ""), (RunThreads::Two, "_two_threads")] {
+        for ext in ["csv", "parquet", "npy", "npz"] {
+            let out = dir.join(format!("imu.{ext}"));
+            group.bench_function(BenchmarkId::new(format!("to_file{name}"), ext), |b| {
+                b.iter(|| {
+                    let outputs = StreamOutputs {
+                        imu: Some(&out),
+                        ..StreamOutputs::default()
+                    };
+                    sc.stream_to_files(None, threads, &outputs)
+                        .expect("written");
+                });
             });
-        });
+        }
+        group.bench_function(
+            BenchmarkId::new(format!("tables{name}"), "truth+imu"),
+            |b| {
+                b.iter(|| sc.simulate_streamed(None, threads).expect("simulated"));
+            },
+        );
     }
-    group.bench_function(BenchmarkId::new("tables", "truth+imu"), |b| {
-        b.iter(|| sc.simulate_streamed(None).expect("simulated"));
-    });
     group.finish();
     let _ = std::fs::remove_dir_all(&dir);
 }

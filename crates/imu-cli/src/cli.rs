@@ -51,6 +51,11 @@ pub enum Command {
         /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
         #[arg(long)]
         runs: Option<u64>,
+        /// Use at most this many threads (default: every core this process may use). A single
+        /// run uses up to two, the truth a chunk ahead of the sensors and the files; with
+        /// --runs, this many runs go at a time. The numbers are the same however many.
+        #[arg(long, allow_negative_numbers = true)]
+        threads: Option<i64>,
     },
     /// Strapdown navigation (3D) or planar dead reckoning (`--planar`) of IMU data.
     Integrate {

@@ -999,6 +999,70 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
 }
 
 #[test]
+fn simulate_writes_the_same_bytes_on_one_thread_or_two_and_refuses_no_thread() {
+    let dir = temp_dir("threads");
+    // Five streamed chunks of the figure-8, with sensor noise: the truth crosses to the second
+    // thread chunk by chunk while the noise is drawn on the first.
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 2000.0\nduration_s = 10.0\n[trajectory]\ntype = \"builtin\"\n\
+         name = \"figure8\"\n[imu]\nseed = 7\n[imu.accelerometer]\nNoiseDensity = 3e-3\n\
+         BiasInstability = 2e-3\nRandomWalk = 1e-4\n[imu.gyroscope]\nNoiseDensity = 1e-4\n",
+    )
+    .unwrap();
+    let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
+    for (threads, tag) in [(None, "auto"), (Some("1"), "one"), (Some("2"), "two")] {
+        let (imu, truth) = (format!("imu_{tag}.npy"), format!("truth_{tag}.csv"));
+        let mut args = vec!["simulate", "s.toml", "--out", &imu, "--truth", &truth];
+        args.extend(threads.map(|n| ["--threads", n]).into_iter().flatten());
+        let (code, err) = run_in(&dir, &args);
+        assert_eq!(code, Some(0), "{tag}: {err}");
+    }
+    // Every row: 20 001 samples of ten float64 columns after NumPy's header (< 1 KiB here).
+    let header = read("imu_one.npy").len() - 20_001 * 10 * 8;
+    assert!((64..1024).contains(&header), "{header}");
+    for tag in ["auto", "two"] {
+        assert!(
+            read(&format!("imu_{tag}.npy")) == read("imu_one.npy"),
+            "{tag}: IMU"
+        );
+        assert!(
+            read(&format!("truth_{tag}.csv")) == read("truth_one.csv"),
+            "{tag}: truth"
+        );
+    }
+    // Monte Carlo runs at most --threads at a time, each run the same as with every core.
+    for (threads, out) in [("1", "mc_one.csv"), ("8", "mc_many.csv")] {
+        let args = [
+            "simulate",
+            "s.toml",
+            "--out",
+            out,
+            "--runs",
+            "2",
+            "--threads",
+            threads,
+        ];
+        assert_eq!(run_in(&dir, &args).0, Some(0), "{threads}");
+    }
+    for r in ["0", "1"] {
+        assert!(read(&format!("mc_one_run000{r}.csv")) == read(&format!("mc_many_run000{r}.csv")));
+    }
+    for bad in ["0", "-1"] {
+        let (code, err) = run_in(
+            &dir,
+            &["simulate", "s.toml", "--out", "bad.csv", "--threads", bad],
+        );
+        assert_eq!(code, Some(65), "{bad}: {err}");
+        assert!(
+            err.contains(&format!("--threads: must be ≥ 1 thread, got {bad}")),
+            "{err}"
+        );
+        assert!(!dir.join("bad.csv").exists());
+    }
+}
+
+#[test]
 fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     let dir = temp_dir("gnss-simulate");
     std::fs::write(

@@ -12,6 +12,7 @@ use imukit::io::table::TRUTH_COLUMNS;
 use imukit::motion::waypoints::Waypoints;
 use imukit::motion::{BodyRatesData, SampledAttitudeData};
 use imukit::run::arrays::{self, IdealRequest};
+use imukit::run::pipeline::RunThreads;
 use imukit::scenario::{ExpressionSpec, Formula, builtin};
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -32,15 +33,18 @@ type SimulationOut<'py> = (
     Option<TableOut<'py>>,
 );
 
-/// Runs a resolved scenario spec with the GIL released, the truth and IMU rows written straight
-/// into NumPy arrays (NumPy's allocator: huge pages where the kernel offers them).
+/// Runs a resolved scenario spec on at most `threads` threads with the GIL released, the truth
+/// and IMU rows written straight into NumPy arrays (NumPy's allocator: huge pages where the
+/// kernel offers them).
 fn run_spec<'py>(
     py: Python<'py>,
     spec: ScenarioSpec,
     base_dir: &str,
     run: Option<i64>,
+    threads: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
     let run = run.map(|r| non_negative("run", r)).transpose()?;
+    let threads = RunThreads::at_most(threads, "threads").map_err(refused)?;
     let base = base_dir.to_string();
     let (scenario, shape) = py
         .detach(move || {
@@ -59,7 +63,7 @@ fn run_spec<'py>(
         let imu_values = imu_rw
             .as_slice_mut()
             .map_err(|e| shape_error(e.to_string()))?;
-        py.detach(move || scenario.simulate_streamed_into(run, truth_values, imu_values))
+        py.detach(move || scenario.simulate_streamed_into(run, threads, truth_values, imu_values))
             .map_err(refused)?
     };
     let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect();
@@ -76,7 +80,7 @@ fn run_spec<'py>(
 /// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu, gnss or None)
 /// tables.
 #[pyfunction]
-#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None))]
+#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None, threads = None))]
 fn simulate_text<'py>(
     py: Python<'py>,
     text: &str,
@@ -84,6 +88,7 @@ fn simulate_text<'py>(
     origin: &str,
     base_dir: &str,
     run: Option<i64>,
+    threads: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
     let spec = match format {
         "toml" => ScenarioSpec::from_toml(text, origin),
@@ -95,23 +100,24 @@ fn simulate_text<'py>(
         }
     }
     .map_err(refused)?;
-    run_spec(py, spec, base_dir, run)
+    run_spec(py, spec, base_dir, run, threads)
 }
 
 /// Resolves and runs a scenario given as a dict (keys as in a file, values typed: `inf` and
 /// integers kept); returns (truth, imu) tables.
 #[pyfunction]
-#[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None))]
+#[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None, threads = None))]
 fn simulate_dict<'py>(
     py: Python<'py>,
     scenario: &Bound<'py, PyAny>,
     origin: &str,
     base_dir: &str,
     run: Option<i64>,
+    threads: Option<i64>,
 ) -> PyResult<SimulationOut<'py>> {
     let tree = value_tree(scenario, "scenario")?;
     let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
-    run_spec(py, spec, base_dir, run)
+    run_spec(py, spec, base_dir, run, threads)
 }
 
 /// Exact truth from formula strings at the times `t_s`.

@@ -196,6 +196,25 @@ def test_simulate_writes_its_tables_into_arrays_numpy_owns():
     np.testing.assert_array_equal(sim.truth["t_s"], sim.imu["t_s"])
 
 
+def test_simulate_gives_the_same_numbers_on_one_thread_or_two():
+    # Several chunks, with noise: the truth is made a chunk ahead on a second thread by default
+    # (when a core is free) and the noise is drawn on the first, in sample order.
+    scenario = {"rate_hz": 500.0, "duration_s": 30.0, "trajectory": {"type": "builtin", "name": "figure8"},
+                "imu": {"seed": 3, "accelerometer": {"NoiseDensity": 3e-3, "RandomWalk": 1e-4},
+                        "gyroscope": {"NoiseDensity": 1e-4, "BiasInstability": 5e-5}}}
+    one = imukit.simulate(scenario, threads=1)
+    assert one.imu.values.shape == (15001, 10)
+    reseeded = imukit.simulate({**scenario, "imu": {**scenario["imu"], "seed": 4}}, threads=1)
+    assert not np.array_equal(reseeded.imu.values, one.imu.values)  # there is noise to draw
+    for threads in (None, 2, 16):
+        other = imukit.simulate(scenario, threads=threads)
+        np.testing.assert_array_equal(other.imu.values, one.imu.values)
+        np.testing.assert_array_equal(other.truth.values, one.truth.values)
+    for bad in (0, -2):
+        with pytest.raises(imukit.ImuError, match=f"threads: must be ≥ 1 thread, got {bad}"):
+            imukit.simulate(scenario, threads=bad)
+
+
 def test_tables_become_pandas_and_polars_frames_and_read_reads_by_extension(tmp_path):
     import pandas as pd
     import polars as pl

@@ -130,6 +130,7 @@ fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
     // 10 001 samples: the stream crosses chunk boundaries (4096).
     sc.stream_to_files(
         None,
+        imukit::run::pipeline::RunThreads::Auto,
         &imukit::run::simulate::StreamOutputs {
             imu: Some(&imu),
             gnss: Some(&gnss),
@@ -200,6 +201,7 @@ fn bad_gnss_keys_are_refused_by_name() {
     let e = sc
         .stream_to_files(
             None,
+            imukit::run::pipeline::RunThreads::Auto,
             &imukit::run::simulate::StreamOutputs {
                 imu: Some(&dir.join(format!("imukit-nognss-{}.csv", std::process::id()))),
                 gnss: Some(&dir.join(format!("imukit-nognss-g-{}.csv", std::process::id()))),

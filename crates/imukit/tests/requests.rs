@@ -288,6 +288,7 @@ fn a_result_that_is_not_finite_is_never_written() {
     let e = scenario
         .stream_to_files(
             None,
+            imukit::run::pipeline::RunThreads::Auto,
             &imukit::run::simulate::StreamOutputs {
                 imu: Some(&out),
                 ..Default::default()

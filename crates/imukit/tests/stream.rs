@@ -1,15 +1,17 @@
 //! A streamed simulation equals the whole one bit for bit, chunk by chunk and gathered into
-//! tables: every trajectory type, rates and increments, a Monte Carlo run, chunk boundaries
-//! inside a tangent-attitude standstill, the aids' readings, the WGS-84 Earth.
+//! tables, on one thread and on two (the truth a chunk ahead): every trajectory type, rates and
+//! increments, a Monte Carlo run, chunk boundaries inside a tangent-attitude standstill, the
+//! aids' readings, the WGS-84 Earth.
 use std::path::Path;
 
+use imukit::run::pipeline::RunThreads;
 use imukit::run::simulate::STREAM_CHUNK;
 use imukit::scenario::builtin;
 use imukit::{Scenario, ScenarioSpec};
 
-fn streamed(sc: &Scenario, run: Option<u64>) -> (Vec<f64>, Vec<f64>, usize) {
+fn streamed(sc: &Scenario, run: Option<u64>, threads: RunThreads) -> (Vec<f64>, Vec<f64>, usize) {
     let (mut truth, mut imu, mut chunks) = (Vec::new(), Vec::new(), 0);
-    sc.stream(run, |c| {
+    sc.stream(run, threads, |c| {
         assert!(c.truth.columns.len() * STREAM_CHUNK >= c.truth.data.len() || chunks == 0);
         truth.extend_from_slice(&c.truth.data);
         imu.extend_from_slice(&c.imu.data);
@@ -25,13 +27,25 @@ fn assert_same(sc: &Scenario, run: Option<u64>, min_chunks: usize, what: &str) {
         Some(r) => sc.simulate_run(r).unwrap(),
         None => sc.simulate().unwrap(),
     };
-    let (truth, imu, chunks) = streamed(sc, run);
-    assert!(chunks >= min_chunks, "{what}: {chunks} chunks");
-    assert!(truth == whole.truth.data, "{what}: truth differs");
-    assert!(imu == whole.imu.data, "{what}: IMU readings differ");
-    // The streamed chunks gathered into tables (what Python's simulate returns): every table.
-    let gathered = sc.simulate_streamed(run).unwrap();
-    assert!(gathered == whole, "{what}: the gathered tables differ");
+    for threads in [RunThreads::One, RunThreads::Two] {
+        let (truth, imu, chunks) = streamed(sc, run, threads);
+        assert!(chunks >= min_chunks, "{what} {threads:?}: {chunks} chunks");
+        assert!(
+            truth == whole.truth.data,
+            "{what} {threads:?}: truth differs"
+        );
+        assert!(
+            imu == whole.imu.data,
+            "{what} {threads:?}: IMU readings differ"
+        );
+        // The streamed chunks gathered into tables (what Python's simulate returns): every
+        // table.
+        let gathered = sc.simulate_streamed(run, threads).unwrap();
+        assert!(
+            gathered == whole,
+            "{what} {threads:?}: the gathered tables differ"
+        );
+    }
 }
 
 fn builtin_at(name: &str, rate_hz: f64, duration_s: f64, imu: &str) -> Scenario {
@@ -124,7 +138,7 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
     assert_eq!(shape.imu_columns.len(), 10, "{:?}", shape.imu_columns);
     assert_eq!(shape.truth_columns.len(), 23);
     let (mut truth, mut imu) = (vec![0.0; 151 * 23], vec![0.0; 151 * 10 - 1]);
-    match sc.simulate_streamed_into(None, &mut truth, &mut imu) {
+    match sc.simulate_streamed_into(None, RunThreads::Two, &mut truth, &mut imu) {
         Err(imukit::Error::Invalid { field, message }) => {
             assert_eq!(field, "imu");
             assert!(
@@ -139,7 +153,7 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
         "written before the shape was checked"
     );
     let mut imu = vec![0.0; 151 * 10];
-    sc.simulate_streamed_into(None, &mut truth, &mut imu)
+    sc.simulate_streamed_into(None, RunThreads::Two, &mut truth, &mut imu)
         .unwrap();
     let whole = sc.simulate().unwrap();
     assert!(truth == whole.truth.data && imu == whole.imu.data);

@@ -26,6 +26,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             baro,
             odometer,
             runs,
+            threads,
         } => simulate::run(
             &scenario,
             &out,
@@ -34,6 +35,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             baro.as_deref(),
             odometer.as_deref(),
             runs,
+            threads,
         ),
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),

@@ -1,16 +1,19 @@
-//! `imukit simulate SCENARIO --out IMU.csv [--truth TRUTH.csv] [--runs N]`.
+//! `imukit simulate SCENARIO --out IMU.csv [--truth TRUTH.csv] [--runs N] [--threads N]`.
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imukit::ScenarioSpec;
 use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
+use imukit::run::pipeline::RunThreads;
 use imukit::run::simulate::StreamOutputs;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::CliError;
 
+// The command's own arguments, one by one, as the command line gives them.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     scenario: &Path,
     out: &Path,
@@ -19,7 +22,10 @@ pub fn run(
     baro: Option<&Path>,
     odometer: Option<&Path>,
     runs: Option<u64>,
+    threads: Option<i64>,
 ) -> Result<(), CliError> {
+    // One run's stages, or the runs at a time: refused before anything is read if below 1.
+    let run_threads = RunThreads::at_most(threads, "--threads")?;
     let spec = ScenarioSpec::from_file(scenario)?;
     let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let files = spec.input_files(base);
@@ -67,7 +73,7 @@ pub fn run(
             odometer,
             metadata: &metadata,
         };
-        sc.stream_to_files(None, &outputs)?;
+        sc.stream_to_files(None, run_threads, &outputs)?;
         eprintln!(
             "imukit: {} samples; IMU readings in {}{}{}",
             sc.t_s.len(),
@@ -93,27 +99,42 @@ pub fn run(
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let done = AtomicU64::new(0);
-    (0..runs)
-        .into_par_iter()
-        .try_for_each(|r| -> Result<(), CliError> {
-            let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
-            let (imu_file, gnss_file, baro_file, odometer_file) =
-                (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
-            sc.stream_to_files(
-                Some(r),
-                &StreamOutputs {
-                    imu: Some(&imu_file),
-                    truth: truth.filter(|_| r == 0),
-                    gnss: gnss_file.as_deref(),
-                    baro: baro_file.as_deref(),
-                    odometer: odometer_file.as_deref(),
-                    metadata: &metadata,
-                },
-            )?;
-            done.fetch_add(1, Ordering::Relaxed);
-            progress.inc(1);
-            Ok(())
+    // Runs at a time: every core, or at most --threads of them; each run on one thread.
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    let pool_threads = threads.map_or(cores, |n| {
+        usize::try_from(n).unwrap_or(usize::MAX).min(cores)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(pool_threads)
+        .build()
+        .map_err(|e| imukit::Error::Invalid {
+            field: "--threads".into(),
+            message: format!("could not start {pool_threads} threads: {e}"),
         })?;
+    pool.install(|| {
+        (0..runs)
+            .into_par_iter()
+            .try_for_each(|r| -> Result<(), CliError> {
+                let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
+                let (imu_file, gnss_file, baro_file, odometer_file) =
+                    (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
+                sc.stream_to_files(
+                    Some(r),
+                    RunThreads::One,
+                    &StreamOutputs {
+                        imu: Some(&imu_file),
+                        truth: truth.filter(|_| r == 0),
+                        gnss: gnss_file.as_deref(),
+                        baro: baro_file.as_deref(),
+                        odometer: odometer_file.as_deref(),
+                        metadata: &metadata,
+                    },
+                )?;
+                done.fetch_add(1, Ordering::Relaxed);
+                progress.inc(1);
+                Ok(())
+            })
+    })?;
     progress.finish_and_clear();
     eprintln!(
         "imukit: {} runs of {} samples; IMU readings in {} … {}",

@@ -69,10 +69,21 @@ class ImuError(ValueError):
     column: Optional[str]
 
 def simulate_text(
-    text: str, *, format: str = "toml", origin: str = "scenario", base_dir: str = ".", run: Optional[int] = None
+    text: str,
+    *,
+    format: str = "toml",
+    origin: str = "scenario",
+    base_dir: str = ".",
+    run: Optional[int] = None,
+    threads: Optional[int] = None,
 ) -> tuple[_Table, _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
 def simulate_dict(
-    scenario: dict[str, Any], *, origin: str = "scenario dict", base_dir: str = ".", run: Optional[int] = None
+    scenario: dict[str, Any],
+    *,
+    origin: str = "scenario dict",
+    base_dir: str = ".",
+    run: Optional[int] = None,
+    threads: Optional[int] = None,
 ) -> tuple[_Table, _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
 def truth_from_expressions(
     t_s: npt.NDArray[np.float64],

@@ -47,10 +47,13 @@ def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[Any, str
 def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: int, with_truth: bool):
     """One run (a Dask task or a thread's job): the IMU table, or the path it was written to."""
     text, fmt, origin, base_dir = spec
+    # The runs are what goes in parallel: each keeps to the one thread it is given.
     if fmt == "dict":
-        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run)
+        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1)
     else:
-        truth, imu, *_ = _core.simulate_text(text, format=fmt, origin=origin, base_dir=base_dir, run=run)
+        truth, imu, *_ = _core.simulate_text(
+            text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1
+        )
     if out is None:
         return imu, (truth if with_truth else None)
     path = _core.run_path(out, run, runs)

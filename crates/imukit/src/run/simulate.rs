@@ -19,6 +19,7 @@ use crate::io::TableFormat;
 use crate::io::output::AtomicFile;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
+use crate::run::pipeline::{RunThreads, run_in_stages};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 
 /// Samples per streamed chunk.
@@ -82,14 +83,19 @@ pub struct StreamOutputs<'a> {
 }
 
 impl Scenario {
-    /// Runs the scenario (Monte Carlo run `run`, or the plain seed) and hands each chunk to
-    /// `sink` in order; the chunks together equal [`Scenario::simulate`] /
-    /// [`Scenario::simulate_run`].
+    /// Runs the scenario (Monte Carlo run `run`, or the plain seed) on `threads` and hands each
+    /// chunk to `sink` in order, on the caller's thread; the chunks together equal
+    /// [`Scenario::simulate`] / [`Scenario::simulate_run`] however many threads made them.
     ///
     /// # Errors
     /// The core's refusal (with the time), invalid parameters, or the sink's error.
-    pub fn stream(&self, run: Option<u64>, sink: impl FnMut(&Chunk) -> Result<()>) -> Result<()> {
-        self.stream_with(run, true, sink)
+    pub fn stream(
+        &self,
+        run: Option<u64>,
+        threads: RunThreads,
+        sink: impl FnMut(&Chunk) -> Result<()>,
+    ) -> Result<()> {
+        self.stream_with(run, threads, true, sink)
     }
 
     /// [`Self::stream`], the chunks' truth tables left empty unless `truth_table` (on the flat
@@ -97,22 +103,28 @@ impl Scenario {
     fn stream_with(
         &self,
         run: Option<u64>,
+        threads: RunThreads,
         truth_table: bool,
         mut sink: impl FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
         match self.nav_frame {
-            NavFrameName::ENU => self.stream_in::<Enu>(run, truth_table, &mut sink),
-            NavFrameName::NED => self.stream_in::<Ned>(run, truth_table, &mut sink),
+            NavFrameName::ENU => self.stream_in::<Enu>(run, threads, truth_table, &mut sink),
+            NavFrameName::NED => self.stream_in::<Ned>(run, threads, truth_table, &mut sink),
         }
     }
 
-    /// Streams run `run` into the files of `outputs` as CSV; each file appears only when
-    /// complete.
+    /// Streams run `run` on `threads` into the files of `outputs` (CSV, Parquet, `.npy` or `.npz`
+    /// by extension); each file appears only when complete.
     ///
     /// # Errors
     /// As [`Scenario::stream`], an aid's file without that aid in the scenario, and I/O errors
     /// naming the file.
-    pub fn stream_to_files(&self, run: Option<u64>, outputs: &StreamOutputs<'_>) -> Result<()> {
+    pub fn stream_to_files(
+        &self,
+        run: Option<u64>,
+        threads: RunThreads,
+        outputs: &StreamOutputs<'_>,
+    ) -> Result<()> {
         for (path, present, field, what) in [
             (
                 outputs.gnss,
@@ -147,7 +159,7 @@ impl Scenario {
             open(outputs.baro)?,
             open(outputs.odometer)?,
         );
-        self.stream_with(run, truth.is_some(), |chunk| {
+        self.stream_with(run, threads, truth.is_some(), |chunk| {
             for (sink, table) in [
                 (&mut imu, Some(&chunk.imu)),
                 (&mut truth, Some(&chunk.truth)),
@@ -167,18 +179,22 @@ impl Scenario {
         Ok(())
     }
 
-    /// The streamed simulation of run `run` (or the plain seed) gathered into whole tables: the
-    /// numbers of [`Scenario::simulate`] / [`Scenario::simulate_run`] bit for bit, made a chunk
-    /// at a time (each chunk's truth measured while it is in cache, no per-sample truth and
-    /// readings held beside the tables). See [`Scenario::simulate_streamed_into`].
+    /// The streamed simulation of run `run` (or the plain seed) on `threads`, gathered into whole
+    /// tables: the numbers of [`Scenario::simulate`] / [`Scenario::simulate_run`] bit for bit,
+    /// made a chunk at a time (each chunk's truth measured while it is in cache, no per-sample
+    /// truth and readings held beside the tables). See [`Scenario::simulate_streamed_into`].
     ///
     /// # Errors
     /// As [`Scenario::simulate`].
-    pub fn simulate_streamed(&self, run: Option<u64>) -> Result<crate::Simulation> {
+    pub fn simulate_streamed(
+        &self,
+        run: Option<u64>,
+        threads: RunThreads,
+    ) -> Result<crate::Simulation> {
         let shape = self.gathered_shape()?;
         let mut truth = vec![0.0; shape.rows * shape.truth_columns.len()];
         let mut imu = vec![0.0; shape.rows * shape.imu_columns.len()];
-        let aids = self.simulate_streamed_into(run, &mut truth, &mut imu)?;
+        let aids = self.simulate_streamed_into(run, threads, &mut truth, &mut imu)?;
         let table = |columns: Vec<&str>, data| Table {
             columns: columns.into_iter().map(str::to_string).collect(),
             data,
@@ -221,6 +237,7 @@ impl Scenario {
     pub fn simulate_streamed_into(
         &self,
         run: Option<u64>,
+        threads: RunThreads,
         truth: &mut [f64],
         imu: &mut [f64],
     ) -> Result<AidTables> {
@@ -247,7 +264,7 @@ impl Scenario {
             (Some(_), None) => {}
         };
         let mut rows = 0;
-        self.stream(run, |chunk| {
+        self.stream(run, threads, |chunk| {
             let n = chunk.imu.rows();
             for (what, into, from) in [
                 ("truth", &mut *truth, &chunk.truth),
@@ -285,6 +302,7 @@ impl Scenario {
     fn stream_in<N: NavFrame>(
         &self,
         run: Option<u64>,
+        threads: RunThreads,
         truth_table: bool,
         sink: &mut dyn FnMut(&Chunk) -> Result<()>,
     ) -> Result<()> {
@@ -333,30 +351,31 @@ impl Scenario {
             sink(&chunk)
         };
         let t_s = &self.t_s;
-        match &self.trajectory {
+        let produce = |emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>| match &self.trajectory {
             Trajectory::Expression(m, o) => {
-                motion_chunks(m, *o, t_s, "trajectory (expression)", &mut emit)
+                motion_chunks(m, *o, t_s, "trajectory (expression)", emit)
             }
             Trajectory::Track(k) => motion_chunks(
                 k,
                 AnalyticOptions::default(),
                 t_s,
                 "trajectory (track)",
-                &mut emit,
+                emit,
             ),
             Trajectory::Waypoints(w) => motion_chunks(
                 w,
                 AnalyticOptions::default(),
                 t_s,
                 "trajectory (waypoints)",
-                &mut emit,
+                emit,
             ),
-            Trajectory::Samples(path) => path.truth_chunks(STREAM_CHUNK, &mut emit),
+            Trajectory::Samples(path) => path.truth_chunks(STREAM_CHUNK, emit),
             Trajectory::BodyRates(_) => {
                 let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;
-                truth.chunks(STREAM_CHUNK).try_for_each(&mut emit)
+                truth.chunks(STREAM_CHUNK).try_for_each(emit)
             }
-        }
+        };
+        run_in_stages(threads, produce, &mut emit)
     }
 }
 

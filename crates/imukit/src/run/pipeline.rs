@@ -1,0 +1,186 @@
+//! One run on two threads: the truth of the next chunk is made on a second thread while the
+//! caller's thread measures, tabulates and writes the previous one (a two-stage pipeline).
+//!
+//! Each stage runs on one thread and keeps its order, so the numbers are those of a single
+//! thread bit for bit: the truth is the same function of the sample times, and the sensors draw
+//! their noise on the caller's thread in sample order, from the same stream. What changes is the
+//! wall-clock time, when a second core is free (see docs/design.md §1 for the figures).
+//!
+//! Memory stays flat: at most two finished chunks wait between the stages, and their buffers go
+//! back to the producer to be refilled.
+use std::num::NonZeroUsize;
+use std::sync::mpsc;
+
+use crate::error::{Error, Result, invalid};
+
+/// How many threads one streamed run uses ([`crate::Scenario::stream`] and the calls built on
+/// it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RunThreads {
+    /// Truth, sensors and outputs on the caller's thread.
+    One,
+    /// The truth a chunk ahead on a second thread; sensors and outputs on the caller's.
+    Two,
+    /// [`RunThreads::Two`] when this process may use more than one core
+    /// ([`std::thread::available_parallelism`]: affinity masks and cgroup quotas count), else
+    /// [`RunThreads::One`].
+    #[default]
+    Auto,
+}
+
+impl RunThreads {
+    /// From the most threads a user lets one run use (as a command line or Python gives it),
+    /// named `field` in the error: `None` is [`RunThreads::Auto`], 1 is [`RunThreads::One`], 2
+    /// or more [`RunThreads::Two`] (a run has two stages to share out).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] on `field` for a count below 1.
+    pub fn at_most(count: Option<i64>, field: &str) -> Result<Self> {
+        match count {
+            None => Ok(Self::Auto),
+            Some(1) => Ok(Self::One),
+            Some(n) if n >= 2 => Ok(Self::Two),
+            Some(n) => Err(invalid(field, format!("must be ≥ 1 thread, got {n}"))),
+        }
+    }
+
+    /// Whether the run is split over two threads.
+    #[must_use]
+    pub fn pipelined(self) -> bool {
+        match self {
+            Self::One => false,
+            Self::Two => true,
+            Self::Auto => std::thread::available_parallelism().map_or(1, NonZeroUsize::get) >= 2,
+        }
+    }
+}
+
+/// What a stage hands each chunk to.
+pub(crate) type Stage<'a, T> = &'a mut dyn FnMut(&[T]) -> Result<()>;
+
+/// The chunks `produce` hands its callback, given to `consume` in the same order: on the
+/// caller's thread when `threads` is one, else `produce` on a second thread (a copy of each
+/// chunk crosses over). The first error in that order wins — the consumer's for the chunks it
+/// was given, then the producer's — as when both run on one thread.
+///
+/// # Errors
+/// Whatever `produce` or `consume` returns.
+pub(crate) fn run_in_stages<T: Clone + Send>(
+    threads: RunThreads,
+    produce: impl FnOnce(Stage<'_, T>) -> Result<()> + Send,
+    consume: Stage<'_, T>,
+) -> Result<()> {
+    if !threads.pipelined() {
+        return produce(consume);
+    }
+    std::thread::scope(|scope| {
+        // Two finished chunks may wait; the consumer hands emptied buffers back.
+        let (full_tx, full_rx) = mpsc::sync_channel::<Vec<T>>(2);
+        let (empty_tx, empty_rx) = mpsc::channel::<Vec<T>>();
+        let producer = scope.spawn(move || {
+            produce(&mut |chunk: &[T]| {
+                let mut buffer = empty_rx.try_recv().unwrap_or_default();
+                buffer.clear();
+                buffer.extend_from_slice(chunk);
+                // Refused only once the consumer has stopped, with an error of its own that
+                // takes precedence over this one.
+                full_tx.send(buffer).map_err(|_| stopped())
+            })
+        });
+        let mut consumed = Ok(());
+        for buffer in &full_rx {
+            if let Err(e) = consume(&buffer) {
+                consumed = Err(e);
+                break;
+            }
+            // The producer may have finished and gone: then nobody needs the buffer back.
+            let _ = empty_tx.send(buffer);
+        }
+        // A producer waiting to send learns that nobody will receive, and stops.
+        drop(full_rx);
+        let produced = producer
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        consumed.and(produced)
+    })
+}
+
+fn stopped() -> Error {
+    invalid("run", "the consumer of the truth stopped")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn numbers(n: usize) -> impl FnOnce(Stage<'_, u64>) -> Result<()> {
+        move |emit| {
+            let all: Vec<u64> = (0..n as u64).collect();
+            all.chunks(7).try_for_each(emit)
+        }
+    }
+
+    #[test]
+    fn both_ways_give_the_chunks_in_order() {
+        for threads in [RunThreads::One, RunThreads::Two] {
+            let mut seen = Vec::new();
+            run_in_stages(threads, numbers(100), &mut |c: &[u64]| {
+                seen.push(c.to_vec());
+                Ok(())
+            })
+            .expect("runs");
+            assert_eq!(seen.len(), 15, "{threads:?}");
+            assert_eq!(seen.concat(), (0..100).collect::<Vec<u64>>(), "{threads:?}");
+        }
+    }
+
+    #[test]
+    fn the_consumers_error_wins_and_stops_the_producer() {
+        let mut calls = 0;
+        let err = run_in_stages(RunThreads::Two, numbers(10_000), &mut |_: &[u64]| {
+            calls += 1;
+            if calls == 3 {
+                Err(invalid("sink", "full"))
+            } else {
+                Ok(())
+            }
+        })
+        .expect_err("the sink refuses");
+        assert_eq!(err.to_string(), "sink: full");
+        assert_eq!(calls, 3);
+    }
+
+    #[test]
+    fn the_producers_error_comes_after_the_chunks_it_made() {
+        let produce = |emit: Stage<'_, u64>| {
+            emit(&[1, 2])?;
+            emit(&[3])?;
+            Err(invalid("trajectory", "breaks at t = 3 s"))
+        };
+        let mut seen = Vec::new();
+        let err = run_in_stages(RunThreads::Two, produce, &mut |c: &[u64]| {
+            seen.extend_from_slice(c);
+            Ok(())
+        })
+        .expect_err("the producer refuses");
+        assert_eq!(err.to_string(), "trajectory: breaks at t = 3 s");
+        assert_eq!(seen, [1, 2, 3]);
+    }
+
+    #[test]
+    fn a_users_count_of_threads_caps_the_stages_and_less_than_one_is_refused_by_name() {
+        let at_most = |n| RunThreads::at_most(n, "--threads").ok();
+        assert_eq!(at_most(None), Some(RunThreads::Auto));
+        assert_eq!(at_most(Some(1)), Some(RunThreads::One));
+        assert_eq!(at_most(Some(2)), Some(RunThreads::Two));
+        assert_eq!(at_most(Some(64)), Some(RunThreads::Two));
+        for n in [0, -3] {
+            let err = RunThreads::at_most(Some(n), "--threads").expect_err("no thread");
+            assert_eq!(
+                err.to_string(),
+                format!("--threads: must be ≥ 1 thread, got {n}")
+            );
+        }
+        assert!(!RunThreads::One.pipelined() && RunThreads::Two.pipelined());
+    }
+}
