@@ -26,7 +26,9 @@ numbers that the formula path then was. The formula job is the first column now.
 ``--rust`` also runs the criterion bench of the same call in Rust and prints the Python/Rust
 time ratio at 10⁶ samples.
 
-Run (prints tables of time ratios; one core: both sides are single-threaded):
+Run (prints tables of time ratios; first one core — both sides single-threaded, imukit with
+``threads=1`` / ``--threads 1`` — then the formula job with imukit on every core it may use, where
+one run makes its truth a chunk ahead on a second thread):
     python benches/compare_numpy.py                     # N = 10⁴ … 10⁶
     python benches/compare_numpy.py --sizes 1e4 1e5 1e6 1e7 --rust
 """
@@ -160,8 +162,8 @@ def formula_scenario(n: int, prm, seed=1) -> dict:
     return {**JOB, "duration_s": (n - 1) / FS, "imu": {**JOB["imu"], "seed": seed, **prm}}
 
 
-def imukit_formula_pipeline(n, prm, seed=1):
-    sim = imukit.simulate(formula_scenario(n, prm, seed))
+def imukit_formula_pipeline(n, prm, seed=1, threads=1):
+    sim = imukit.simulate(formula_scenario(n, prm, seed), threads=threads)
     v = sim.imu.values
     return v[:, 1:4], v[:, 4:7], v[:, 7:10]
 
@@ -270,14 +272,15 @@ def imukit_binary() -> str:
         Path(__file__).resolve().parents[1] / "target" / "release" / "imukit")
 
 
-def cli_formula_time(n, prm, work: Path, ext: str = "csv") -> float:
+def cli_formula_time(n, prm, work: Path, ext: str = "csv", threads: Optional[int] = 1) -> float:
     """`imukit simulate` of the formula scenario, readings to a file of format ``ext`` (process
-    start and writing included)."""
+    start and writing included), on ``threads`` (None: every core it may use)."""
     spec = work / "formulas.json"
     spec.write_text(json.dumps(formula_scenario(n, prm)))
     out = work / f"formula_imu.{ext}"
-    return best_of(lambda: subprocess.run([imukit_binary(), "simulate", str(spec), "--out", str(out)], check=True,
-                                          capture_output=True), 1)
+    cap = [] if threads is None else ["--threads", str(threads)]
+    return best_of(lambda: subprocess.run([imukit_binary(), "simulate", str(spec), "--out", str(out), *cap],
+                                          check=True, capture_output=True), 1)
 
 
 def cli_time(t, pos, euler, prm, work: Path) -> float:
@@ -295,8 +298,8 @@ def cli_time(t, pos, euler, prm, work: Path) -> float:
     spec = work / "scenario.json"
     spec.write_text(json.dumps(scenario))
     out = work / "imu.csv"
-    return best_of(lambda: subprocess.run([binary, "simulate", str(spec), "--out", str(out)], check=True,
-                                          capture_output=True), 1)
+    return best_of(lambda: subprocess.run([binary, "simulate", str(spec), "--out", str(out), "--threads", "1"],
+                                          check=True, capture_output=True), 1)
 
 
 def main() -> None:
@@ -313,6 +316,7 @@ def main() -> None:
     print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
           f"{'formulas, CLI (.npy)':>20} {'samples, Python':>16} {'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
     python_model_s, numpy_model_s = {}, {}
+    every_core = {}  # N → (NumPy time, imukit times on every core: Python, CSV, Parquet, .npy)
     with tempfile.TemporaryDirectory() as tmp:
         for size in args.sizes:
             n = int(size)
@@ -338,6 +342,17 @@ def main() -> None:
             python_model_s[n], numpy_model_s[n] = t_model_py, t_model_np
             print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {fpq:>24} {fnpy:>20} {t_np / t_py:>16.2f} {cli:>26} "
                   f"{t_model_np / t_model_py:>20.2f}")
+            every_core[n] = (t_fnp, best_of(lambda: imukit_formula_pipeline(n, prm, threads=None), repeat),
+                             *(None if args.no_cli else cli_formula_time(n, prm, Path(tmp), ext, threads=None)
+                               for ext in ("csv", "parquet", "npy")))
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    print(f"the formula job with imukit on every core it may use ({cores} here: one run puts its truth a chunk "
+          "ahead on a second thread, same numbers); NumPy as above, single-threaded")
+    print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
+          f"{'formulas, CLI (.npy)':>20}")
+    for n, (t_fnp, *ours) in every_core.items():
+        cells = ["" if t is None else f"{t_fnp / t:.2f}" for t in ours]
+        print(f"{n:>10} {cells[0]:>17} {cells[1]:>20} {cells[2]:>24} {cells[3]:>20}")
     if args.rust:
         rust = rust_matlab_call_ns_per_sample()
         n = 1_000_000
