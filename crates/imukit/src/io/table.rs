@@ -561,9 +561,11 @@ fn reader(path: &Path) -> Result<csv::Reader<File>> {
         path: path.into(),
         source,
     })?;
+    // Fields are trimmed where they are parsed ([`CsvRows::next_row`]): the csv crate's own
+    // trimming of fields makes a new record per row.
     Ok(csv::ReaderBuilder::new()
         .has_headers(true)
-        .trim(csv::Trim::All)
+        .trim(csv::Trim::Headers)
         .comment(Some(b'#'))
         .from_reader(file))
 }
@@ -677,7 +679,7 @@ enum RowSource {
 pub struct CsvRows {
     path: PathBuf,
     reader: RowSource,
-    record: csv::StringRecord,
+    record: csv::ByteRecord,
     /// The header's column names.
     names: Vec<String>,
     /// (field index, column name) of each requested column, in request order.
@@ -724,7 +726,7 @@ impl CsvRows {
         Ok(Self {
             path: path.into(),
             reader,
-            record: csv::StringRecord::new(),
+            record: csv::ByteRecord::new(),
             names,
             wanted,
         })
@@ -752,23 +754,28 @@ impl CsvRows {
                 return Ok(Some(*given));
             }
         };
-        match reader.read_record(&mut self.record) {
+        match reader.read_byte_record(&mut self.record) {
             Ok(false) => return Ok(None),
             Ok(true) => {}
             Err(e) => return Err(csv_error(&self.path, &e)),
         }
         let row = self.record.position().map_or(0, |p| p.line() as usize);
         for ((k, name), slot) in self.wanted.iter().zip(out.iter_mut()) {
-            let text = self.record.get(*k).unwrap_or("");
+            let field = self.record.get(*k).unwrap_or_default();
             let bad = |message: String| Error::CsvValue {
                 file: self.path.clone(),
                 row,
                 column: name.clone(),
                 message,
             };
-            let v: f64 = text
-                .parse()
-                .map_err(|_| bad(format!("not a number: \"{text}\"")))?;
+            // Whitespace around a value, Unicode's definition, as the csv crate's trimming had it.
+            let text = std::str::from_utf8(field).map(str::trim);
+            let not_a_number = || {
+                let lossy = String::from_utf8_lossy(field);
+                bad(format!("not a number: \"{}\"", lossy.trim()))
+            };
+            let text = text.map_err(|_| not_a_number())?;
+            let v: f64 = text.parse().map_err(|_| not_a_number())?;
             if !v.is_finite() {
                 return Err(bad(format!("not a finite number: \"{text}\"")));
             }
@@ -812,5 +819,38 @@ mod tests {
                 "width {width}"
             );
         }
+    }
+
+    #[test]
+    fn values_are_read_with_whitespace_trimmed_and_bad_ones_named_by_row_and_column() {
+        let dir = std::env::temp_dir().join(format!("imukit-table-trim-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a temporary folder");
+        let path = dir.join("t.csv");
+        // Spaces, a tab and no-break spaces (Unicode whitespace) around names and values.
+        std::fs::write(&path, " t_s ,\tx\n 0.5 ,\u{a0}-2\u{a0}\n1,\t3e2 \n").expect("written");
+        let columns = read_columns(&path, &["t_s", "x"], "").expect("read");
+        assert_eq!(columns.get("t_s"), [0.5, 1.0].as_slice());
+        assert_eq!(columns.get("x"), [-2.0, 300.0].as_slice());
+        for (row2, message) in [
+            (
+                b" 2, 1.0x".as_slice(),
+                "t.csv, row 3, column x: not a number: \"1.0x\"",
+            ),
+            (
+                b"2,inf",
+                "t.csv, row 3, column x: not a finite number: \"inf\"",
+            ),
+            (
+                b"2,\xff1",
+                "t.csv, row 3, column x: not a number: \"\u{fffd}1\"",
+            ),
+        ] {
+            let mut text = b"t_s,x\n1,2\n".to_vec();
+            text.extend_from_slice(row2);
+            std::fs::write(&path, &text).expect("written");
+            let err = read_columns(&path, &["t_s", "x"], "").expect_err("a bad value");
+            assert!(err.to_string().ends_with(message), "{err}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
