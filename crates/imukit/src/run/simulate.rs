@@ -6,7 +6,8 @@
 //! memory does not grow with the duration (only the leading standstill of a tangent attitude is
 //! held until the body first moves). Sampled trajectories are read whole (their samples) and
 //! differentiated chunk by chunk (whole for a tangent attitude); body-rate trajectories are
-//! integrated whole; then everything is streamed.
+//! integrated whole; then everything is streamed. With [`RunThreads`] two, the truth is made a
+//! chunk ahead on a second thread ([`crate::run::pipeline`]); the numbers do not change.
 use std::path::Path;
 
 use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, DERIVATIVE_CHUNK, Motion};
@@ -19,7 +20,7 @@ use crate::io::TableFormat;
 use crate::io::output::AtomicFile;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
-use crate::run::pipeline::{RunThreads, run_in_stages};
+use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 
 /// Samples per streamed chunk.
@@ -351,7 +352,7 @@ impl Scenario {
             sink(&chunk)
         };
         let t_s = &self.t_s;
-        let produce = |emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>| match &self.trajectory {
+        let produce = |emit: Stage<'_, Truth<N>>| match &self.trajectory {
             Trajectory::Expression(m, o) => {
                 motion_chunks(m, *o, t_s, "trajectory (expression)", emit)
             }
