@@ -213,6 +213,13 @@ def test_simulate_gives_the_same_numbers_on_one_thread_or_two():
     for bad in (0, -2):
         with pytest.raises(imukit.ImuError, match=f"threads: must be ≥ 1 thread, got {bad}"):
             imukit.simulate(scenario, threads=bad)
+    # A cap beyond any machine is every core; counts that are not whole numbers are named.
+    np.testing.assert_array_equal(imukit.simulate(scenario, threads=10**30).imu.values, one.imu.values)
+    for name, bad in (("threads", True), ("threads", 2.0), ("run", "1"), ("run", 1.5)):
+        with pytest.raises(TypeError, match=f"{name} must be a whole number, got {type(bad).__name__}"):
+            imukit.simulate(scenario, **{name: bad})
+    with pytest.raises(ValueError, match=r"run must be between -2\*\*63 and 2\*\*63 - 1"):
+        imukit.simulate(scenario, run=2**64)
 
 
 def test_tables_become_pandas_and_polars_frames_and_read_reads_by_extension(tmp_path):

@@ -2,6 +2,7 @@
 right number of dimensions (the core checks their shapes and names the argument), and tables."""
 from __future__ import annotations
 
+import numbers
 from typing import Optional
 
 import numpy as np
@@ -41,3 +42,19 @@ def _table_args(name: str, t) -> tuple:
     if not isinstance(t, Table):
         raise TypeError(f"{name} must be an imukit.Table, got {type(t).__name__}")
     return list(t.columns), np.ascontiguousarray(t.values)
+
+
+def _whole(name: str, v, *, at_most: bool = False) -> Optional[int]:
+    """An optional whole-number argument for the core: ``None``, or an integer (a bool is not a
+    count) in the 64-bit range the core takes. ``at_most``: a cap, so a larger one is the
+    largest (``threads=10**30`` is "every core"); otherwise a larger one is refused by name."""
+    if v is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+        raise TypeError(f"{name} must be a whole number, got {type(v).__name__} {v!r}")
+    v, top = int(v), 2**63 - 1
+    if at_most and v > top:
+        return top
+    if not -top - 1 <= v <= top:
+        raise ValueError(f"{name} must be between -2**63 and 2**63 - 1, got {v}")
+    return v

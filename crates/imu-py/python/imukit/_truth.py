@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Mapping, Optional, Sequence, Union
 
 from . import _core
-from ._convert import _f64, _table_args, _times
+from ._convert import _f64, _table_args, _times, _whole
 from ._core import ImuError
 from ._table import Simulation, Table, _table
 
@@ -30,6 +30,7 @@ def simulate(
     >>> float(sim.imu["accel_z_m_s2"][0])
     9.81
     """
+    run, threads = _whole("run", run), _whole("threads", threads, at_most=True)
     if isinstance(scenario, Mapping):
         out = _core.simulate_dict(dict(scenario), base_dir=os.getcwd(), run=run, threads=threads)
     else:
