@@ -64,7 +64,8 @@ pub(crate) type Stage<'a, T> = &'a mut dyn FnMut(&[T]) -> Result<()>;
 /// was given, then the producer's — as when both run on one thread.
 ///
 /// # Errors
-/// Whatever `produce` or `consume` returns.
+/// Whatever `produce` or `consume` returns; [`Error::Invalid`] on `threads` when the system
+/// refuses a second thread.
 pub(crate) fn run_in_stages<T: Clone + Send>(
     threads: RunThreads,
     produce: impl FnOnce(Stage<'_, T>) -> Result<()> + Send,
@@ -77,16 +78,24 @@ pub(crate) fn run_in_stages<T: Clone + Send>(
         // Two finished chunks may wait; the consumer hands emptied buffers back.
         let (full_tx, full_rx) = mpsc::sync_channel::<Vec<T>>(2);
         let (empty_tx, empty_rx) = mpsc::channel::<Vec<T>>();
-        let producer = scope.spawn(move || {
-            produce(&mut |chunk: &[T]| {
-                let mut buffer = empty_rx.try_recv().unwrap_or_default();
-                buffer.clear();
-                buffer.extend_from_slice(chunk);
-                // Refused only once the consumer has stopped, with an error of its own that
-                // takes precedence over this one.
-                full_tx.send(buffer).map_err(|_| stopped())
+        let producer = std::thread::Builder::new()
+            .name("imukit-truth".into())
+            .spawn_scoped(scope, move || {
+                produce(&mut |chunk: &[T]| {
+                    let mut buffer = empty_rx.try_recv().unwrap_or_default();
+                    buffer.clear();
+                    buffer.extend_from_slice(chunk);
+                    // Refused only once the consumer has stopped, with an error of its own
+                    // that takes precedence over this one.
+                    full_tx.send(buffer).map_err(|_| stopped())
+                })
             })
-        });
+            .map_err(|e| {
+                invalid(
+                    "threads",
+                    format!("could not start a second thread ({e}); one thread would do"),
+                )
+            })?;
         let mut consumed = Ok(());
         for buffer in &full_rx {
             if let Err(e) = consume(&buffer) {
