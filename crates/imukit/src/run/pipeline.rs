@@ -22,11 +22,17 @@ pub enum RunThreads {
     /// The truth a chunk ahead on a second thread; sensors and outputs on the caller's.
     Two,
     /// [`RunThreads::Two`] when this process may use more than one core
-    /// ([`std::thread::available_parallelism`]: affinity masks and cgroup quotas count), else
-    /// [`RunThreads::One`].
+    /// ([`std::thread::available_parallelism`]: affinity masks and cgroup quotas count) and the
+    /// run has at least [`AUTO_MIN_CHUNKS`] chunks, else [`RunThreads::One`].
     #[default]
     Auto,
 }
+
+/// The fewest chunks for which [`RunThreads::Auto`] starts a second thread: a shorter run has
+/// too little to overlap for the thread's start (0.15–0.25 ms here) to pay — a run of three
+/// chunks (10⁴ samples of the formula job from Python) took as long on two threads as on one,
+/// and a run of a few samples three times as long.
+pub const AUTO_MIN_CHUNKS: usize = 4;
 
 impl RunThreads {
     /// From the most threads a user lets one run use (as a command line or Python gives it),
@@ -44,13 +50,16 @@ impl RunThreads {
         }
     }
 
-    /// Whether the run is split over two threads.
+    /// Whether a run of `chunks` chunks is split over two threads.
     #[must_use]
-    pub fn pipelined(self) -> bool {
+    pub fn pipelined(self, chunks: usize) -> bool {
         match self {
             Self::One => false,
             Self::Two => true,
-            Self::Auto => std::thread::available_parallelism().map_or(1, NonZeroUsize::get) >= 2,
+            Self::Auto => {
+                chunks >= AUTO_MIN_CHUNKS
+                    && std::thread::available_parallelism().map_or(1, NonZeroUsize::get) >= 2
+            }
         }
     }
 }
@@ -58,8 +67,9 @@ impl RunThreads {
 /// What a stage hands each chunk to.
 pub(crate) type Stage<'a, T> = &'a mut dyn FnMut(&[T]) -> Result<()>;
 
-/// The chunks `produce` hands its callback, given to `consume` in the same order: on the
-/// caller's thread when `threads` is one, else `produce` on a second thread (a copy of each
+/// The chunks `produce` hands its callback (about `chunks` of them), given to `consume` in the
+/// same order: on the caller's thread when `threads` is one for that many, else `produce` on a
+/// second thread (a copy of each
 /// chunk crosses over). The first error in that order wins — the consumer's for the chunks it
 /// was given, then the producer's — as when both run on one thread.
 ///
@@ -68,10 +78,11 @@ pub(crate) type Stage<'a, T> = &'a mut dyn FnMut(&[T]) -> Result<()>;
 /// refuses a second thread.
 pub(crate) fn run_in_stages<T: Clone + Send>(
     threads: RunThreads,
+    chunks: usize,
     produce: impl FnOnce(Stage<'_, T>) -> Result<()> + Send,
     consume: Stage<'_, T>,
 ) -> Result<()> {
-    if !threads.pipelined() {
+    if !threads.pipelined(chunks) {
         return produce(consume);
     }
     std::thread::scope(|scope| {
@@ -133,7 +144,7 @@ mod tests {
     fn both_ways_give_the_chunks_in_order() {
         for threads in [RunThreads::One, RunThreads::Two] {
             let mut seen = Vec::new();
-            run_in_stages(threads, numbers(100), &mut |c: &[u64]| {
+            run_in_stages(threads, 15, numbers(100), &mut |c: &[u64]| {
                 seen.push(c.to_vec());
                 Ok(())
             })
@@ -146,14 +157,19 @@ mod tests {
     #[test]
     fn the_consumers_error_wins_and_stops_the_producer() {
         let mut calls = 0;
-        let err = run_in_stages(RunThreads::Two, numbers(10_000), &mut |_: &[u64]| {
-            calls += 1;
-            if calls == 3 {
-                Err(invalid("sink", "full"))
-            } else {
-                Ok(())
-            }
-        })
+        let err = run_in_stages(
+            RunThreads::Two,
+            1429,
+            numbers(10_000),
+            &mut |_: &[u64]| {
+                calls += 1;
+                if calls == 3 {
+                    Err(invalid("sink", "full"))
+                } else {
+                    Ok(())
+                }
+            },
+        )
         .expect_err("the sink refuses");
         assert_eq!(err.to_string(), "sink: full");
         assert_eq!(calls, 3);
@@ -167,7 +183,7 @@ mod tests {
             Err(invalid("trajectory", "breaks at t = 3 s"))
         };
         let mut seen = Vec::new();
-        let err = run_in_stages(RunThreads::Two, produce, &mut |c: &[u64]| {
+        let err = run_in_stages(RunThreads::Two, 2, produce, &mut |c: &[u64]| {
             seen.extend_from_slice(c);
             Ok(())
         })
@@ -190,6 +206,7 @@ mod tests {
                 format!("--threads: must be ≥ 1 thread, got {n}")
             );
         }
-        assert!(!RunThreads::One.pipelined() && RunThreads::Two.pipelined());
+        assert!(!RunThreads::One.pipelined(100) && RunThreads::Two.pipelined(1));
+        assert!(!RunThreads::Auto.pipelined(AUTO_MIN_CHUNKS - 1));
     }
 }

@@ -376,7 +376,12 @@ impl Scenario {
                 truth.chunks(STREAM_CHUNK).try_for_each(emit)
             }
         };
-        run_in_stages(threads, produce, &mut emit)
+        run_in_stages(
+            threads,
+            t_s.len().div_ceil(STREAM_CHUNK),
+            produce,
+            &mut emit,
+        )
     }
 }
 
