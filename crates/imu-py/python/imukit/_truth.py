@@ -23,9 +23,9 @@ def simulate(
     directory). The numbers equal those of ``imukit simulate`` bit for bit. ``run=r`` gives
     Monte Carlo run ``r`` (noise drawn from (seed, r)), the same as file ``r`` of
     ``imukit simulate --runs``. ``threads`` caps the threads the run uses: by default two when a
-    second core is free and the run is long enough (16 384 samples or more; the truth made a
-    chunk ahead of the sensors), ``threads=1`` keeps it on
-    one; the numbers are the same either way.
+    second core is free and the run is longer than 12 288 samples (three chunks; the truth is
+    made a chunk ahead of the sensors), ``threads=1`` keeps it on one; the numbers are the same
+    either way.
 
     >>> sim = simulate({"trajectory": {"type": "builtin", "name": "static"}})
     >>> float(sim.imu["accel_z_m_s2"][0])
