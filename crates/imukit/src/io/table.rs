@@ -768,13 +768,14 @@ impl CsvRows {
                 column: name.clone(),
                 message,
             };
-            // Whitespace around a value, Unicode's definition, as the csv crate's trimming had it.
-            let text = std::str::from_utf8(field).map(str::trim);
             let not_a_number = || {
                 let lossy = String::from_utf8_lossy(field);
                 bad(format!("not a number: \"{}\"", lossy.trim()))
             };
-            let text = text.map_err(|_| not_a_number())?;
+            // Whitespace around a value, Unicode's definition, as the csv crate's trimming had it.
+            let text = std::str::from_utf8(field)
+                .map_err(|_| not_a_number())?
+                .trim();
             let v: f64 = text.parse().map_err(|_| not_a_number())?;
             if !v.is_finite() {
                 return Err(bad(format!("not a finite number: \"{text}\"")));
