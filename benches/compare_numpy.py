@@ -12,9 +12,10 @@ rounding with the noise terms at zero, and in distribution with noise (the white
 bias-instability parts have the variances theory gives, in both).
 
 Three comparisons per size: the job a user has most often — formula strings of the motion in,
-readings out (imukit: ``imukit.simulate`` of an ``expression`` trajectory, truth with exact
-derivatives from the compiled formulas, then the sensors; NumPy: the same motion written with
-hand-derived closed-form derivatives, then the same error model) — the pipeline from sampled
+readings out (imukit: ``imukit.simulate(..., truth=False)`` of an ``expression`` trajectory,
+truth with exact derivatives from the compiled formulas, then the sensors, the readings kept as
+the NumPy reference keeps only its readings; NumPy: the same motion written with hand-derived
+closed-form derivatives, then the same error model) — the pipeline from sampled
 positions and angles (truth by differentiation, MATLAB ``gradient``, + error model), and the
 error model alone on prepared inputs (NumPy: body-frame inputs, its normals included; imukit:
 MATLAB's call shape into a reused output buffer, the rotations to the body frame included).
@@ -163,7 +164,8 @@ def formula_scenario(n: int, prm, seed=1) -> dict:
 
 
 def imukit_formula_pipeline(n, prm, seed=1, threads=1):
-    sim = imukit.simulate(formula_scenario(n, prm, seed), threads=threads)
+    """Readings only, like the NumPy reference (the CLI's ``--out`` without ``--truth``)."""
+    sim = imukit.simulate(formula_scenario(n, prm, seed), threads=threads, truth=False)
     v = sim.imu.values
     return v[:, 1:4], v[:, 4:7], v[:, 7:10]
 

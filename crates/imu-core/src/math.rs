@@ -9,6 +9,17 @@ pub(crate) fn sin(x: f64) -> f64 {
 pub(crate) fn cos(x: f64) -> f64 {
     Float::cos(x)
 }
+/// `(sin x, cos x)`. An angle of exactly zero (either sign) is answered without the library
+/// call, as `(x, 1)`: what the call returns, bit for bit, at a seventh of its cost. Zero angles
+/// are common: the tangent attitude's roll, a level or unrolled motion.
+#[inline]
+pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
+    if x == 0.0 {
+        (x, 1.0)
+    } else {
+        Float::sin_cos(x)
+    }
+}
 #[inline]
 pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     Float::atan2(y, x)

@@ -130,14 +130,22 @@ impl<From: Frame, To: Frame> Rotation<From, To> {
         )))
     }
     /// The rotation with z-y-x Euler angles `e` of `From` relative to `To`.
+    ///
+    /// `q = q_z(yaw) ⊗ q_y(pitch) ⊗ q_x(roll)` from the half angles' sines and cosines: the
+    /// products of nalgebra's `UnitQuaternion::from_euler_angles(roll, pitch, yaw)` in its order,
+    /// so the same numbers bit for bit, with the sine and cosine of a zero angle taken without a
+    /// library call (`math::sin_cos`).
     #[must_use]
     pub fn from_euler(e: EulerZyx) -> Self {
-        // nalgebra applies roll, then pitch, then yaw about fixed axes: Rz·Ry·Rx.
-        Self::assume_from_quaternion(UnitQuaternion::from_euler_angles(
-            e.roll_rad,
-            e.pitch_rad,
-            e.yaw_rad,
-        ))
+        let (sr, cr) = math::sin_cos(e.roll_rad * 0.5);
+        let (sp, cp) = math::sin_cos(e.pitch_rad * 0.5);
+        let (sy, cy) = math::sin_cos(e.yaw_rad * 0.5);
+        Self::assume_from_quaternion(UnitQuaternion::new_unchecked(Quaternion::new(
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        )))
     }
     /// From a direction cosine matrix (row-major) assumed orthonormal.
     #[must_use]

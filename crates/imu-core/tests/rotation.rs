@@ -36,6 +36,25 @@ proptest! {
     }
 }
 
+proptest! {
+    /// `Rotation::from_euler` forms nalgebra's products itself (to skip the library call for zero
+    /// angles): the quaternion must stay nalgebra's bit for bit, zeros of either sign included.
+    #[test]
+    fn euler_quaternion_is_nalgebras_bit_for_bit(
+        yaw in -7.0f64..7.0, pitch in -1.6f64..1.6, roll in -4.0f64..4.0, zeros in 0u8..27
+    ) {
+        // Each angle as drawn, +0 or −0 (the base-3 digits of `zeros`).
+        let pick = |a: f64, digit: u8| [a, 0.0, -0.0][usize::from(digit % 3)];
+        let e = EulerZyx::new(pick(yaw, zeros), pick(pitch, zeros / 3), pick(roll, zeros / 9));
+        let ours = Rotation::<Body, Enu>::from_euler(e).to_wxyz();
+        let q = nalgebra::UnitQuaternion::from_euler_angles(e.roll_rad, e.pitch_rad, e.yaw_rad);
+        let theirs = [q.w, q.i, q.j, q.k];
+        for k in 0..4 {
+            prop_assert_eq!(ours[k].to_bits(), theirs[k].to_bits(), "component {} of {:?}", k, e);
+        }
+    }
+}
+
 #[test]
 fn yaw_90_in_ned_maps_body_x_to_east() {
     let c = Rotation::<Body, Ned>::from_euler(EulerZyx::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0));

@@ -24,9 +24,10 @@ use crate::convert::{
 };
 use crate::errors::{refused, shape_error};
 
-/// Truth, IMU and (when the scenario has them) GNSS, barometer and odometer tables of one run.
+/// Truth (unless left out), IMU and (when the scenario has them) GNSS, barometer and odometer
+/// tables of one run.
 type SimulationOut<'py> = (
-    TableOut<'py>,
+    Option<TableOut<'py>>,
     TableOut<'py>,
     Option<TableOut<'py>>,
     Option<TableOut<'py>>,
@@ -34,14 +35,15 @@ type SimulationOut<'py> = (
 );
 
 /// Runs a resolved scenario spec on at most `threads` threads with the GIL released, the truth
-/// and IMU rows written straight into NumPy arrays (NumPy's allocator: huge pages where the
-/// kernel offers them).
+/// (when `truth`) and IMU rows written straight into NumPy arrays (NumPy's allocator: huge pages
+/// where the kernel offers them).
 fn run_spec<'py>(
     py: Python<'py>,
     spec: ScenarioSpec,
     base_dir: &str,
     run: Option<i64>,
     threads: Option<i64>,
+    truth: bool,
 ) -> PyResult<SimulationOut<'py>> {
     let run = run.map(|r| non_negative("run", r)).transpose()?;
     let threads = RunThreads::at_most(threads, "threads").map_err(refused)?;
@@ -53,13 +55,16 @@ fn run_spec<'py>(
             Ok::<_, imukit::Error>((sc, shape))
         })
         .map_err(refused)?;
-    let truth = PyArray2::<f64>::zeros(py, [shape.rows, shape.truth_columns.len()], false);
+    let truth =
+        truth.then(|| PyArray2::<f64>::zeros(py, [shape.rows, shape.truth_columns.len()], false));
     let imu = PyArray2::<f64>::zeros(py, [shape.rows, shape.imu_columns.len()], false);
     let aids = {
-        let (mut truth_rw, mut imu_rw) = (truth.readwrite(), imu.readwrite());
+        let mut truth_rw = truth.as_ref().map(|t| t.readwrite());
+        let mut imu_rw = imu.readwrite();
         let truth_values = truth_rw
-            .as_slice_mut()
-            .map_err(|e| shape_error(e.to_string()))?;
+            .as_mut()
+            .map(|t| t.as_slice_mut().map_err(|e| shape_error(e.to_string())))
+            .transpose()?;
         let imu_values = imu_rw
             .as_slice_mut()
             .map_err(|e| shape_error(e.to_string()))?;
@@ -69,7 +74,7 @@ fn run_spec<'py>(
     let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect();
     let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();
     Ok((
-        (names(shape.truth_columns), truth),
+        truth.map(|t| (names(shape.truth_columns), t)),
         (names(shape.imu_columns), imu),
         optional(aids.gnss)?,
         optional(aids.baro)?,
@@ -77,10 +82,12 @@ fn run_spec<'py>(
     ))
 }
 
-/// Resolves and runs a scenario given as TOML or JSON text; returns (truth, imu, gnss or None)
-/// tables.
+/// Resolves and runs a scenario given as TOML or JSON text; returns the (truth or None unless
+/// `truth`, imu, gnss, baro, odometer or None) tables.
 #[pyfunction]
-#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None, threads = None))]
+#[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None, threads = None,
+                    truth = true))]
+#[allow(clippy::too_many_arguments)]
 fn simulate_text<'py>(
     py: Python<'py>,
     text: &str,
@@ -89,6 +96,7 @@ fn simulate_text<'py>(
     base_dir: &str,
     run: Option<i64>,
     threads: Option<i64>,
+    truth: bool,
 ) -> PyResult<SimulationOut<'py>> {
     let spec = match format {
         "toml" => ScenarioSpec::from_toml(text, origin),
@@ -100,13 +108,14 @@ fn simulate_text<'py>(
         }
     }
     .map_err(refused)?;
-    run_spec(py, spec, base_dir, run, threads)
+    run_spec(py, spec, base_dir, run, threads, truth)
 }
 
 /// Resolves and runs a scenario given as a dict (keys as in a file, values typed: `inf` and
-/// integers kept); returns (truth, imu) tables.
+/// integers kept); returns the tables as [`simulate_text`].
 #[pyfunction]
-#[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None, threads = None))]
+#[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None, threads = None,
+                    truth = true))]
 fn simulate_dict<'py>(
     py: Python<'py>,
     scenario: &Bound<'py, PyAny>,
@@ -114,10 +123,11 @@ fn simulate_dict<'py>(
     base_dir: &str,
     run: Option<i64>,
     threads: Option<i64>,
+    truth: bool,
 ) -> PyResult<SimulationOut<'py>> {
     let tree = value_tree(scenario, "scenario")?;
     let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
-    run_spec(py, spec, base_dir, run, threads)
+    run_spec(py, spec, base_dir, run, threads, truth)
 }
 
 /// Exact truth from formula strings at the times `t_s`.

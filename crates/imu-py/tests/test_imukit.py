@@ -1,4 +1,5 @@
 """The Python face of imukit: closed-form values, sign anchors, MATLAB gradient parity, errors."""
+import json
 import math
 
 import numpy as np
@@ -220,6 +221,28 @@ def test_simulate_gives_the_same_numbers_on_one_thread_or_two():
             imukit.simulate(scenario, **{name: bad})
     with pytest.raises(ValueError, match=r"run must be between -2\*\*63 and 2\*\*63 - 1"):
         imukit.simulate(scenario, run=2**64)
+
+
+def test_readings_alone_are_the_readings_of_a_run_with_its_truth(tmp_path):
+    scenario = {"rate_hz": 400.0, "duration_s": 25.0, "trajectory": {"type": "builtin", "name": "figure8"},
+                "imu": {"seed": 5, "accelerometer": {"NoiseDensity": 3e-3, "BiasInstability": 2e-3},
+                        "gyroscope": {"NoiseDensity": 1e-4, "RandomWalk": 1e-6}}}
+    whole = imukit.simulate(scenario, run=2)
+    for threads in (1, None):
+        alone = imukit.simulate(scenario, run=2, threads=threads, truth=False)
+        assert alone.truth is None
+        np.testing.assert_array_equal(alone.imu.values, whole.imu.values)
+        assert alone.imu.columns == whole.imu.columns
+    path = tmp_path / "job.json"
+    path.write_text(json.dumps(scenario))
+    np.testing.assert_array_equal(imukit.simulate(path, run=2, truth=False).imu.values, whole.imu.values)
+    for bad in (0, 1, "no", None):
+        with pytest.raises(TypeError, match=f"truth must be True or False, got {type(bad).__name__}"):
+            imukit.simulate(scenario, truth=bad)
+    # Monte Carlo keeps the truth of one run only; its readings are the runs' own.
+    mc = imukit.monte_carlo({**scenario, "duration_s": 2.0}, runs=3, first_run=1)
+    np.testing.assert_array_equal(mc.truth.values, imukit.simulate({**scenario, "duration_s": 2.0}).truth.values)
+    np.testing.assert_array_equal(mc.imu[1], imukit.simulate({**scenario, "duration_s": 2.0}, run=2).imu.values)
 
 
 def test_tables_become_pandas_and_polars_frames_and_read_reads_by_extension(tmp_path):

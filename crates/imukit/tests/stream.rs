@@ -138,7 +138,7 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
     assert_eq!(shape.imu_columns.len(), 10, "{:?}", shape.imu_columns);
     assert_eq!(shape.truth_columns.len(), 23);
     let (mut truth, mut imu) = (vec![0.0; 151 * 23], vec![0.0; 151 * 10 - 1]);
-    match sc.simulate_streamed_into(None, RunThreads::Two, &mut truth, &mut imu) {
+    match sc.simulate_streamed_into(None, RunThreads::Two, Some(&mut truth), &mut imu) {
         Err(imukit::Error::Invalid { field, message }) => {
             assert_eq!(field, "imu");
             assert!(
@@ -153,8 +153,37 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
         "written before the shape was checked"
     );
     let mut imu = vec![0.0; 151 * 10];
-    sc.simulate_streamed_into(None, RunThreads::Two, &mut truth, &mut imu)
+    sc.simulate_streamed_into(None, RunThreads::Two, Some(&mut truth), &mut imu)
         .unwrap();
     let whole = sc.simulate().unwrap();
     assert!(truth == whole.truth.data && imu == whole.imu.data);
+}
+
+#[test]
+fn readings_alone_are_the_readings_of_a_run_with_its_truth() {
+    let noisy = "[imu.accelerometer]\nNoiseDensity = 0.01\nBiasInstability = 0.002\n\
+                 [imu.gyroscope]\nNoiseDensity = 0.001\nRandomWalk = 1e-4";
+    let figure8 = builtin_at("figure8", 400.0, 25.0, noisy);
+    let flight = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/earth_flight.toml");
+    for (sc, what) in [
+        (figure8, "the figure-8"),
+        (Scenario::from_file(&flight).unwrap(), "the WGS-84 flight"),
+    ] {
+        let shape = sc.gathered_shape().unwrap();
+        assert!(shape.rows > 2 * STREAM_CHUNK, "{what}: {} rows", shape.rows);
+        let width = shape.imu_columns.len();
+        let mut truth = vec![0.0; shape.rows * shape.truth_columns.len()];
+        let mut with = vec![0.0; shape.rows * width];
+        let mut alone = vec![f64::NAN; shape.rows * width];
+        sc.simulate_streamed_into(Some(3), RunThreads::Two, Some(&mut truth), &mut with)
+            .unwrap();
+        sc.simulate_streamed_into(Some(3), RunThreads::One, None, &mut alone)
+            .unwrap();
+        assert!(
+            with.iter()
+                .zip(&alone)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{what}: the readings changed without the truth"
+        );
+    }
 }

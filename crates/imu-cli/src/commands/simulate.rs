@@ -73,7 +73,8 @@ pub fn run(
             odometer,
             metadata: &metadata,
         };
-        sc.stream_to_files(None, run_threads, &outputs)?;
+        sc.stream_to_files(None, run_threads, &outputs)
+            .map_err(threads_by_flag)?;
         eprintln!(
             "imukit: {} samples; IMU readings in {}{}{}",
             sc.t_s.len(),
@@ -144,4 +145,34 @@ pub fn run(
         run_path(out, runs - 1, runs).display()
     );
     Ok(())
+}
+
+/// The library names its `threads` setting (a refused second thread) by the field; here it is
+/// the flag that set it.
+fn threads_by_flag(e: imukit::Error) -> imukit::Error {
+    match e {
+        imukit::Error::Invalid { ref field, .. } if field == "threads" => crate::error::by_flag(e),
+        other => other,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::threads_by_flag;
+
+    #[test]
+    fn a_refused_second_thread_is_named_by_the_flag_and_other_fields_are_left() {
+        let named = |field: &str| match threads_by_flag(imukit::Error::Invalid {
+            field: field.into(),
+            message: "m".into(),
+        }) {
+            imukit::Error::Invalid { field, .. } => field,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(named("threads"), "--threads");
+        assert_eq!(
+            named("imu.gyroscope.NoiseDensity"),
+            "imu.gyroscope.NoiseDensity"
+        );
+    }
 }

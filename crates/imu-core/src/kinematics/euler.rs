@@ -28,11 +28,13 @@ impl PitchRollTrig {
     /// The sines and cosines of the pitch and roll of `e`.
     #[must_use]
     pub fn of(e: EulerZyx) -> Self {
+        let (sin_pitch, cos_pitch) = math::sin_cos(e.pitch_rad);
+        let (sin_roll, cos_roll) = math::sin_cos(e.roll_rad);
         Self {
-            sin_pitch: math::sin(e.pitch_rad),
-            cos_pitch: math::cos(e.pitch_rad),
-            sin_roll: math::sin(e.roll_rad),
-            cos_roll: math::cos(e.roll_rad),
+            sin_pitch,
+            cos_pitch,
+            sin_roll,
+            cos_roll,
         }
     }
 

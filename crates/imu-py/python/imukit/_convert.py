@@ -44,6 +44,14 @@ def _table_args(name: str, t) -> tuple:
     return list(t.columns), np.ascontiguousarray(t.values)
 
 
+def _flag(name: str, v) -> bool:
+    """A yes/no argument: ``True`` or ``False`` (NumPy's bools too), not a number or a string
+    that would be taken as one."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    raise TypeError(f"{name} must be True or False, got {type(v).__name__} {v!r}")
+
+
 def _whole(name: str, v, *, at_most: bool = False) -> Optional[int]:
     """An optional whole-number argument for the core: ``None``, or an integer (a bool is not a
     count) in the 64-bit range the core takes. ``at_most``: a cap, so a larger one is the

@@ -76,7 +76,8 @@ def simulate_text(
     base_dir: str = ".",
     run: Optional[int] = None,
     threads: Optional[int] = None,
-) -> tuple[_Table, _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
+    truth: bool = True,
+) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
 def simulate_dict(
     scenario: dict[str, Any],
     *,
@@ -84,7 +85,8 @@ def simulate_dict(
     base_dir: str = ".",
     run: Optional[int] = None,
     threads: Optional[int] = None,
-) -> tuple[_Table, _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
+    truth: bool = True,
+) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
 def truth_from_expressions(
     t_s: npt.NDArray[np.float64],
     position_m: Sequence[str],

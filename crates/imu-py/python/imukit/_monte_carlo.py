@@ -48,14 +48,17 @@ def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: in
     """One run (a Dask task or a thread's job): the IMU table, or the path it was written to."""
     text, fmt, origin, base_dir = spec
     # The runs are what goes in parallel: each keeps to the one thread it is given.
+    # The truth is the same in every run: it is tabulated for the one that returns it.
+    keep = with_truth and out is None
     if fmt == "dict":
-        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1)
+        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1,
+                                             truth=keep)
     else:
         truth, imu, *_ = _core.simulate_text(
-            text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1
+            text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1, truth=keep
         )
     if out is None:
-        return imu, (truth if with_truth else None)
+        return imu, truth
     path = _core.run_path(out, run, runs)
     _core.write_csv(path, list(imu[0]), np.ascontiguousarray(imu[1]))
     return path, None
@@ -110,5 +113,5 @@ def monte_carlo(
 
     columns = tuple(results[0][0][0])
     imu = np.stack([values for (_, values), _ in results])
-    truth_columns, truth_values = results[0][1]
+    truth_columns, truth_values = results[0][1]  # run 0 kept its truth table
     return MonteCarlo(runs=np.array(ids), columns=columns, imu=imu, truth=Table(truth_columns, truth_values))

@@ -77,9 +77,10 @@ class Table:
 @dataclass(frozen=True)
 class Simulation:
     """Truth kinematics and IMU readings of a scenario, and the readings of its aids — the
-    ``[gnss]`` receiver, the ``[baro]`` barometer, the ``[odometer]`` (``None`` without them)."""
+    ``[gnss]`` receiver, the ``[baro]`` barometer, the ``[odometer]`` (``None`` without them).
+    ``truth`` is ``None`` when the run kept only its readings (``simulate(..., truth=False)``)."""
 
-    truth: Table
+    truth: Optional[Table]
     imu: Table
     gnss: Optional[Table] = None
     baro: Optional[Table] = None

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Mapping, Optional, Sequence, Union
 
 from . import _core
-from ._convert import _f64, _table_args, _times, _whole
+from ._convert import _f64, _flag, _table_args, _times, _whole
 from ._core import ImuError
 from ._table import Simulation, Table, _table
 
@@ -15,7 +15,11 @@ DEFAULT_GRAVITY_M_S2: float = _core.DEFAULT_GRAVITY_M_S2  # m/s², MATLAB imuSen
 
 
 def simulate(
-    scenario: Union[str, os.PathLike, Mapping], *, run: Optional[int] = None, threads: Optional[int] = None
+    scenario: Union[str, os.PathLike, Mapping],
+    *,
+    run: Optional[int] = None,
+    threads: Optional[int] = None,
+    truth: bool = True,
 ) -> Simulation:
     """Runs a scenario: a path to a TOML/JSON scenario file, or a dict with the same keys.
 
@@ -25,15 +29,21 @@ def simulate(
     ``imukit simulate --runs``. ``threads`` caps the threads the run uses: by default two when a
     second core is free and the run is longer than 12 288 samples (three chunks; the truth is
     made a chunk ahead of the sensors), ``threads=1`` keeps it on one; the numbers are the same
-    either way.
+    either way. ``truth=False`` keeps only the readings (``Simulation.truth`` is ``None``): the
+    same readings, without the truth table's 23 columns (184 MB a million samples) and the time
+    to fill them, as ``imukit simulate --out`` without ``--truth``.
 
     >>> sim = simulate({"trajectory": {"type": "builtin", "name": "static"}})
     >>> float(sim.imu["accel_z_m_s2"][0])
     9.81
+    >>> simulate({"trajectory": {"type": "builtin", "name": "static"}}, truth=False).truth is None
+    True
     """
     run, threads = _whole("run", run), _whole("threads", threads, at_most=True)
+    keep_truth = _flag("truth", truth)
     if isinstance(scenario, Mapping):
-        out = _core.simulate_dict(dict(scenario), base_dir=os.getcwd(), run=run, threads=threads)
+        out = _core.simulate_dict(dict(scenario), base_dir=os.getcwd(), run=run, threads=threads,
+                                  truth=keep_truth)
     else:
         path = Path(scenario)
         try:
@@ -42,12 +52,13 @@ def simulate(
             raise ImuError(f"{path}: {e.strerror or e}") from None
         fmt = "json" if path.suffix.lower() == ".json" else "toml"
         out = _core.simulate_text(
-            text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run, threads=threads
+            text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run, threads=threads,
+            truth=keep_truth,
         )
-    truth, imu, gnss, baro, odometer = out
+    truth_out, imu, gnss, baro, odometer = out
     optional = lambda t: None if t is None else _table(t)  # noqa: E731
-    return Simulation(truth=_table(truth), imu=_table(imu), gnss=optional(gnss), baro=optional(baro),
-                      odometer=optional(odometer))
+    return Simulation(truth=optional(truth_out), imu=_table(imu), gnss=optional(gnss),
+                      baro=optional(baro), odometer=optional(odometer))
 
 def read_csv(path: Union[str, os.PathLike]) -> Table:
     """Every column of an imukit CSV file (truth, IMU readings, navigation output, errors, Allan

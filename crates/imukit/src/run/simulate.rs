@@ -195,7 +195,7 @@ impl Scenario {
         let shape = self.gathered_shape()?;
         let mut truth = vec![0.0; shape.rows * shape.truth_columns.len()];
         let mut imu = vec![0.0; shape.rows * shape.imu_columns.len()];
-        let aids = self.simulate_streamed_into(run, threads, &mut truth, &mut imu)?;
+        let aids = self.simulate_streamed_into(run, threads, Some(&mut truth), &mut imu)?;
         let table = |columns: Vec<&str>, data| Table {
             columns: columns.into_iter().map(str::to_string).collect(),
             data,
@@ -231,7 +231,8 @@ impl Scenario {
     /// [`Scenario::simulate_streamed`] written into the caller's memory (a NumPy array, say):
     /// `truth` and `imu` are row-major, [`GatheredShape::rows`] rows of the shape's columns; each
     /// chunk is checked finite (rows named from 2, as below a header) and copied in as it is
-    /// made. Returns the aids' tables.
+    /// made. Without a `truth` buffer only the readings are kept (the truth is made chunk by
+    /// chunk for them, and on the flat Earth not tabulated). Returns the aids' tables.
     ///
     /// # Errors
     /// As [`Scenario::simulate`]; buffers of the wrong length.
@@ -239,14 +240,15 @@ impl Scenario {
         &self,
         run: Option<u64>,
         threads: RunThreads,
-        truth: &mut [f64],
+        mut truth: Option<&mut [f64]>,
         imu: &mut [f64],
     ) -> Result<AidTables> {
         let shape = self.gathered_shape()?;
         for (name, buffer, width) in [
-            ("truth", &*truth, shape.truth_columns.len()),
-            ("imu", &*imu, shape.imu_columns.len()),
+            ("truth", truth.as_deref(), shape.truth_columns.len()),
+            ("imu", Some(&*imu), shape.imu_columns.len()),
         ] {
+            let Some(buffer) = buffer else { continue };
             if buffer.len() != shape.rows * width {
                 return Err(crate::error::invalid(
                     name,
@@ -265,12 +267,13 @@ impl Scenario {
             (Some(_), None) => {}
         };
         let mut rows = 0;
-        self.stream(run, threads, |chunk| {
+        self.stream_with(run, threads, truth.is_some(), |chunk| {
             let n = chunk.imu.rows();
             for (what, into, from) in [
-                ("truth", &mut *truth, &chunk.truth),
-                ("IMU readings", &mut *imu, &chunk.imu),
+                ("truth", truth.as_deref_mut(), &chunk.truth),
+                ("IMU readings", Some(&mut *imu), &chunk.imu),
             ] {
+                let Some(into) = into else { continue };
                 check_finite_from(&from.columns, &from.data, what, rows + 2)?;
                 let width = from.columns.len();
                 into.get_mut(rows * width..(rows + n) * width)
