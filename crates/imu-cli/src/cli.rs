@@ -53,8 +53,8 @@ pub enum Command {
         runs: Option<u64>,
         /// Use at most this many threads (default: every core this process may use). A single
         /// run uses up to two, the truth a chunk ahead of the sensors and the files (by default
-        /// beyond 12 288 samples); with --runs, this many runs go at a time. The numbers are the
-        /// same however many.
+        /// from 1 537 samples, four chunks); with --runs, this many runs go at a time. The
+        /// numbers are the same however many.
         #[arg(long, allow_negative_numbers = true)]
         threads: Option<i64>,
     },

@@ -160,6 +160,33 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
 }
 
 #[test]
+fn a_short_run_streams_in_smaller_chunks_with_the_same_numbers() {
+    use imukit::run::simulate::{MIN_STREAM_CHUNK, stream_chunk};
+    assert_eq!(stream_chunk(100), MIN_STREAM_CHUNK);
+    assert_eq!(stream_chunk(10_000), 1250);
+    assert_eq!(stream_chunk(10_000_000), STREAM_CHUNK);
+    // 10 000 noisy samples: eight chunks of 1 250, the same numbers as the whole run on one
+    // thread or two (and the chunks are that long).
+    let noisy = "[imu.accelerometer]\nNoiseDensity = 0.01\nRandomWalk = 1e-3\n\
+                 [imu.gyroscope]\nNoiseDensity = 0.001\nBiasInstability = 1e-4";
+    let sc = builtin_at("figure8", 1000.0, 9.999, noisy);
+    assert_eq!(sc.t_s.len(), 10_000);
+    let whole = sc.simulate_run(4).unwrap();
+    for threads in [RunThreads::One, RunThreads::Two] {
+        let mut lengths = Vec::new();
+        let mut imu = Vec::new();
+        sc.stream(Some(4), threads, |c| {
+            lengths.push(c.imu.rows());
+            imu.extend_from_slice(&c.imu.data);
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(lengths, vec![1250; 8], "{threads:?}");
+        assert!(imu == whole.imu.data, "{threads:?}: the readings differ");
+    }
+}
+
+#[test]
 fn readings_alone_are_the_readings_of_a_run_with_its_truth() {
     let noisy = "[imu.accelerometer]\nNoiseDensity = 0.01\nBiasInstability = 0.002\n\
                  [imu.gyroscope]\nNoiseDensity = 0.001\nRandomWalk = 1e-4";

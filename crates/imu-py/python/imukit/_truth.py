@@ -27,9 +27,9 @@ def simulate(
     directory). The numbers equal those of ``imukit simulate`` bit for bit. ``run=r`` gives
     Monte Carlo run ``r`` (noise drawn from (seed, r)), the same as file ``r`` of
     ``imukit simulate --runs``. ``threads`` caps the threads the run uses: by default two when a
-    second core is free and the run is longer than 12 288 samples (three chunks; the truth is
-    made a chunk ahead of the sensors), ``threads=1`` keeps it on one; the numbers are the same
-    either way. ``truth=False`` keeps only the readings (``Simulation.truth`` is ``None``): the
+    second core is free and the run has 1 537 samples or more (four chunks; the truth is made a
+    chunk ahead of the sensors), ``threads=1`` keeps it on one; the numbers are the same either
+    way. ``truth=False`` keeps only the readings (``Simulation.truth`` is ``None``): the
     same readings, without the truth table's 23 columns (184 MB a million samples) and the time
     to fill them, as ``imukit simulate --out`` without ``--truth``.
 

@@ -56,13 +56,18 @@ pub fn truth_from_expressions_into(
     imu_core::kinematics::check_times(&t_s).map_err(|e| crate::motion::with_time(&t_s, e, what))?;
     let times = crate::scenario::SampleTimes::Listed(t_s);
     let mut rows = out.chunks_exact_mut(WIDTH);
+    let chunk = crate::run::simulate::STREAM_CHUNK;
     match nav {
-        NavFrameName::ENU => motion_chunks::<_, Enu>(&motion, options, &times, what, &mut |c| {
-            fill_rows(c, &mut rows)
-        }),
-        NavFrameName::NED => motion_chunks::<_, Ned>(&motion, options, &times, what, &mut |c| {
-            fill_rows(c, &mut rows)
-        }),
+        NavFrameName::ENU => {
+            motion_chunks::<_, Enu>(&motion, options, &times, chunk, what, &mut |c| {
+                fill_rows(c, &mut rows)
+            })
+        }
+        NavFrameName::NED => {
+            motion_chunks::<_, Ned>(&motion, options, &times, chunk, what, &mut |c| {
+                fill_rows(c, &mut rows)
+            })
+        }
     }?;
     crate::io::table::check_finite(&TRUTH_COLUMNS, out, "truth")
 }

@@ -23,8 +23,19 @@ use crate::motion::{Trajectory, with_time};
 use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 
-/// Samples per streamed chunk.
+/// Samples per streamed chunk, at most.
 pub const STREAM_CHUNK: usize = 4096;
+
+/// Samples per streamed chunk, at least (unless the run is shorter).
+pub const MIN_STREAM_CHUNK: usize = 512;
+
+/// The chunk a run of `samples` samples is streamed in: [`STREAM_CHUNK`] for a long run, and an
+/// eighth of the run for a shorter one (at least [`MIN_STREAM_CHUNK`]), so that a run of 10⁴
+/// samples is still eight chunks for two threads to overlap. The numbers do not depend on it.
+#[must_use]
+pub fn stream_chunk(samples: usize) -> usize {
+    samples.div_ceil(8).clamp(MIN_STREAM_CHUNK, STREAM_CHUNK)
+}
 
 /// One chunk of a streamed simulation: truth rows and IMU rows, the columns of
 /// [`crate::Simulation`]'s tables.
@@ -355,14 +366,16 @@ impl Scenario {
             sink(&chunk)
         };
         let t_s = &self.t_s;
+        let size = stream_chunk(t_s.len());
         let produce = |emit: Stage<'_, Truth<N>>| match &self.trajectory {
             Trajectory::Expression(m, o) => {
-                motion_chunks(m, *o, t_s, "trajectory (expression)", emit)
+                motion_chunks(m, *o, t_s, size, "trajectory (expression)", emit)
             }
             Trajectory::Track(k) => motion_chunks(
                 k,
                 AnalyticOptions::default(),
                 t_s,
+                size,
                 "trajectory (track)",
                 emit,
             ),
@@ -370,21 +383,17 @@ impl Scenario {
                 w,
                 AnalyticOptions::default(),
                 t_s,
+                size,
                 "trajectory (waypoints)",
                 emit,
             ),
-            Trajectory::Samples(path) => path.truth_chunks(STREAM_CHUNK, emit),
+            Trajectory::Samples(path) => path.truth_chunks(size, emit),
             Trajectory::BodyRates(_) => {
                 let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;
-                truth.chunks(STREAM_CHUNK).try_for_each(emit)
+                truth.chunks(size).try_for_each(emit)
             }
         };
-        run_in_stages(
-            threads,
-            t_s.len().div_ceil(STREAM_CHUNK),
-            produce,
-            &mut emit,
-        )
+        run_in_stages(threads, t_s.len().div_ceil(size), produce, &mut emit)
     }
 }
 
@@ -427,18 +436,19 @@ impl TableSink {
     }
 }
 
-/// Exact truth of `motion` at `t_s` in chunks, as `truth_from_motion` computes it whole: the
-/// leading tangent-attitude standstill is held until the body first moves, then given that
-/// attitude.
+/// Exact truth of `motion` at `t_s` in chunks of `chunk` samples, as `truth_from_motion`
+/// computes it whole: the leading tangent-attitude standstill is held until the body first
+/// moves, then given that attitude.
 pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
     motion: &M,
     options: AnalyticOptions,
     t_s: &SampleTimes,
+    chunk: usize,
     what: &str,
     emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
 ) -> Result<()> {
     let mut stepper = AnalyticStepper::new(motion, options);
-    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(STREAM_CHUNK);
+    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(chunk);
     let mut moving = false;
     let (mut times, mut points) = (
         Vec::with_capacity(DERIVATIVE_CHUNK),
@@ -459,7 +469,7 @@ pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
                 let first = buffer.len() - 1;
                 backfill_standstill(&mut buffer, Some(first));
             }
-            if moving && buffer.len() >= STREAM_CHUNK {
+            if moving && buffer.len() >= chunk {
                 emit(&buffer)?;
                 buffer.clear();
             }
