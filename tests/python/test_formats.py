@@ -28,6 +28,11 @@ def test_parquet_outputs_read_back_everywhere_with_their_metadata(tmp_path):
         meta = {k.decode(): v.decode() for k, v in table.schema.metadata.items()}
         assert meta["imukit.nav_frame"] == "ENU"
         assert meta["imukit.scenario"] == scenario.read_text()
+        # Snappy over byte-stream-split float64 pages (every column).
+        chunks = pq.ParquetFile(parquet).metadata.row_group(0)
+        for c in range(chunks.num_columns):
+            assert chunks.column(c).compression == "SNAPPY"
+            assert "BYTE_STREAM_SPLIT" in chunks.column(c).encodings, chunks.column(c).encodings
         # Bit for bit: float64 in, float64 out, against the CSV's shortest round-trip text.
         assert np.array_equal(table.to_pandas().to_numpy(), csv.values)
         assert np.array_equal(pd.read_parquet(parquet).to_numpy(), csv.values)

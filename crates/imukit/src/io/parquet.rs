@@ -83,6 +83,12 @@ impl ParquetSink {
             // Measured values rarely repeat: a dictionary costs a hash per value and is
             // dropped once it fills; plain float64 pages are written at once.
             .set_dictionary_enabled(false)
+            // The bytes of each place gathered together (all first bytes, then all second
+            // bytes, ...): the exponents and leading digits of float64 measurements repeat, so
+            // Snappy finds them. 10⁶ samples of the comparison's formula job: truth 165 → 85
+            // MB, readings 67 → 61 MB, written in 0.73 instead of 0.83 s. pyarrow, pandas and
+            // polars read it (tests); Snappy is kept as the codec every reader has.
+            .set_encoding(parquet::basic::Encoding::BYTE_STREAM_SPLIT)
             .set_key_value_metadata(Some(
                 metadata
                     .iter()
