@@ -32,6 +32,20 @@ def test_runs_do_not_depend_on_threads_and_equal_single_runs():
     assert list(tail.runs) == [4, 5]
 
 
+def test_runs_write_their_readings_into_the_gathered_array():
+    # What monte_carlo does locally: the shape first, then each run into its slot.
+    from imukit import _core
+    rows, columns = _core.simulation_shape(SCENARIO, format="dict", origin="test", base_dir=".")
+    whole = imukit.simulate(SCENARIO, run=3)
+    assert (rows, tuple(columns)) == (whole.imu.values.shape[0], whole.imu.columns)
+    gathered = np.full((2, rows, len(columns)), np.nan)
+    _, (names, filled), *_ = _core.simulate_dict(SCENARIO, run=3, truth=False, imu_out=gathered[1])
+    assert names == list(columns) and np.shares_memory(filled, gathered)
+    assert np.array_equal(gathered[1], whole.imu.values) and np.isnan(gathered[0]).all()
+    with pytest.raises(ValueError, match=r"imu_out has shape \[400, 10\], the run makes \[401, 10\]"):
+        _core.simulate_dict(SCENARIO, run=3, imu_out=gathered[0, 1:])
+
+
 def test_dask_cluster_gives_the_local_results_bit_for_bit(tmp_path):
     distributed = pytest.importorskip("distributed")
     local = imukit.monte_carlo(SCENARIO, runs=4)

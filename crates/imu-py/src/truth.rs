@@ -14,7 +14,7 @@ use imukit::motion::{BodyRatesData, SampledAttitudeData};
 use imukit::run::arrays::{self, IdealRequest};
 use imukit::run::pipeline::RunThreads;
 use imukit::scenario::{ExpressionSpec, Formula, builtin};
-use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -34,9 +34,25 @@ type SimulationOut<'py> = (
     Option<TableOut<'py>>,
 );
 
+/// A scenario spec from TOML or JSON text.
+fn text_spec(text: &str, format: &str, origin: &str) -> PyResult<ScenarioSpec> {
+    match format {
+        "toml" => ScenarioSpec::from_toml(text, origin),
+        "json" => ScenarioSpec::from_json(text, origin),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "format must be \"toml\" or \"json\", got {other:?}"
+            )));
+        }
+    }
+    .map_err(refused)
+}
+
 /// Runs a resolved scenario spec on at most `threads` threads with the GIL released, the truth
 /// (when `truth`) and IMU rows written straight into NumPy arrays (NumPy's allocator: huge pages
-/// where the kernel offers them).
+/// where the kernel offers them), the IMU rows into `imu_out` when given (a Monte Carlo run's
+/// slot of the gathered array, of the run's shape).
+#[allow(clippy::too_many_arguments)]
 fn run_spec<'py>(
     py: Python<'py>,
     spec: ScenarioSpec,
@@ -44,6 +60,7 @@ fn run_spec<'py>(
     run: Option<i64>,
     threads: Option<i64>,
     truth: bool,
+    imu_out: Option<Bound<'py, PyArray2<f64>>>,
 ) -> PyResult<SimulationOut<'py>> {
     let run = run.map(|r| non_negative("run", r)).transpose()?;
     let threads = RunThreads::at_most(threads, "threads").map_err(refused)?;
@@ -57,7 +74,17 @@ fn run_spec<'py>(
         .map_err(refused)?;
     let truth =
         truth.then(|| PyArray2::<f64>::zeros(py, [shape.rows, shape.truth_columns.len()], false));
-    let imu = PyArray2::<f64>::zeros(py, [shape.rows, shape.imu_columns.len()], false);
+    let imu_shape = [shape.rows, shape.imu_columns.len()];
+    let imu = match imu_out {
+        Some(out) if out.shape() == imu_shape => out,
+        Some(out) => {
+            return Err(shape_error(format!(
+                "imu_out has shape {:?}, the run makes {imu_shape:?}",
+                out.shape()
+            )));
+        }
+        None => PyArray2::<f64>::zeros(py, imu_shape, false),
+    };
     let aids = {
         let mut truth_rw = truth.as_ref().map(|t| t.readwrite());
         let mut imu_rw = imu.readwrite();
@@ -86,7 +113,7 @@ fn run_spec<'py>(
 /// `truth`, imu, gnss, baro, odometer or None) tables.
 #[pyfunction]
 #[pyo3(signature = (text, *, format = "toml", origin = "scenario", base_dir = ".", run = None, threads = None,
-                    truth = true))]
+                    truth = true, imu_out = None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_text<'py>(
     py: Python<'py>,
@@ -97,25 +124,18 @@ fn simulate_text<'py>(
     run: Option<i64>,
     threads: Option<i64>,
     truth: bool,
+    imu_out: Option<Bound<'py, PyArray2<f64>>>,
 ) -> PyResult<SimulationOut<'py>> {
-    let spec = match format {
-        "toml" => ScenarioSpec::from_toml(text, origin),
-        "json" => ScenarioSpec::from_json(text, origin),
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "format must be \"toml\" or \"json\", got {other:?}"
-            )));
-        }
-    }
-    .map_err(refused)?;
-    run_spec(py, spec, base_dir, run, threads, truth)
+    let spec = text_spec(text, format, origin)?;
+    run_spec(py, spec, base_dir, run, threads, truth, imu_out)
 }
 
 /// Resolves and runs a scenario given as a dict (keys as in a file, values typed: `inf` and
 /// integers kept); returns the tables as [`simulate_text`].
 #[pyfunction]
 #[pyo3(signature = (scenario, *, origin = "scenario dict", base_dir = ".", run = None, threads = None,
-                    truth = true))]
+                    truth = true, imu_out = None))]
+#[allow(clippy::too_many_arguments)]
 fn simulate_dict<'py>(
     py: Python<'py>,
     scenario: &Bound<'py, PyAny>,
@@ -124,10 +144,36 @@ fn simulate_dict<'py>(
     run: Option<i64>,
     threads: Option<i64>,
     truth: bool,
+    imu_out: Option<Bound<'py, PyArray2<f64>>>,
 ) -> PyResult<SimulationOut<'py>> {
     let tree = value_tree(scenario, "scenario")?;
     let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
-    run_spec(py, spec, base_dir, run, threads, truth)
+    run_spec(py, spec, base_dir, run, threads, truth, imu_out)
+}
+
+/// The rows and IMU columns one run of a scenario makes (TOML or JSON text, or a dict with
+/// `format = "dict"`), refused as a run would be, without running it: what a caller allocates
+/// for many runs' readings.
+#[pyfunction]
+#[pyo3(signature = (scenario, *, format, origin, base_dir))]
+fn simulation_shape(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    format: &str,
+    origin: &str,
+    base_dir: &str,
+) -> PyResult<(usize, Vec<String>)> {
+    let spec = if format == "dict" {
+        ScenarioSpec::from_tree(&value_tree(scenario, "scenario")?, origin).map_err(refused)?
+    } else {
+        text_spec(&scenario.extract::<String>()?, format, origin)?
+    };
+    let base = base_dir.to_string();
+    let shape = py
+        .detach(move || spec.resolve(Path::new(&base))?.gathered_shape())
+        .map_err(refused)?;
+    let columns = shape.imu_columns.into_iter().map(str::to_string).collect();
+    Ok((shape.rows, columns))
 }
 
 /// Exact truth from formula strings at the times `t_s`.
@@ -418,6 +464,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_GRAVITY_M_S2", imu_core::DEFAULT_GRAVITY_M_S2)?;
     m.add_function(wrap_pyfunction!(simulate_text, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(simulation_shape, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_expressions, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_samples, m)?)?;
     m.add_function(wrap_pyfunction!(ideal_imu, m)?)?;

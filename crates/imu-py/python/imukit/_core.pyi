@@ -1,5 +1,5 @@
 """Type stubs of the compiled core (checked with ``python -m mypy.stubtest imukit._core``)."""
-from typing import Any, Optional, Sequence, final
+from typing import Any, Optional, Sequence, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,7 @@ __all__ = [
     "quaternion_distance",
     "simulate_text",
     "simulate_dict",
+    "simulation_shape",
     "animation_scene",
     "points_enu",
     "poses_enu",
@@ -77,6 +78,7 @@ def simulate_text(
     run: Optional[int] = None,
     threads: Optional[int] = None,
     truth: bool = True,
+    imu_out: Optional[npt.NDArray[np.float64]] = None,
 ) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
 def simulate_dict(
     scenario: dict[str, Any],
@@ -86,7 +88,11 @@ def simulate_dict(
     run: Optional[int] = None,
     threads: Optional[int] = None,
     truth: bool = True,
+    imu_out: Optional[npt.NDArray[np.float64]] = None,
 ) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
+def simulation_shape(
+    scenario: Union[str, dict[str, Any]], *, format: str, origin: str, base_dir: str
+) -> tuple[int, list[str]]: ...
 def truth_from_expressions(
     t_s: npt.NDArray[np.float64],
     position_m: Sequence[str],

@@ -44,18 +44,21 @@ def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[Any, str
     return text, fmt, str(path), str(path.parent.resolve())
 
 
-def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: int, with_truth: bool):
-    """One run (a Dask task or a thread's job): the IMU table, or the path it was written to."""
+def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: int, with_truth: bool,
+         imu_out: Optional[np.ndarray] = None):
+    """One run (a Dask task or a thread's job): the IMU table (written into ``imu_out`` when
+    given: its slot of the gathered array), or the path it was written to."""
     text, fmt, origin, base_dir = spec
     # The runs are what goes in parallel: each keeps to the one thread it is given.
     # The truth is the same in every run: it is tabulated for the one that returns it.
     keep = with_truth and out is None
     if fmt == "dict":
         truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1,
-                                             truth=keep)
+                                             truth=keep, imu_out=imu_out)
     else:
         truth, imu, *_ = _core.simulate_text(
-            text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1, truth=keep
+            text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1, truth=keep,
+            imu_out=imu_out,
         )
     if out is None:
         return imu, truth
@@ -81,7 +84,8 @@ def monte_carlo(
     the workers need imukit installed, and any file the scenario refers to (a samples CSV, a
     parameter file) at the same path.
 
-    Returns a :class:`MonteCarlo` (the IMU readings of every run stacked, and the truth), or,
+    Returns a :class:`MonteCarlo` (the IMU readings of every run in one array, which the runs
+    write into in place on this machine's cores, and the truth), or,
     with ``out="dir/imu.csv"``, writes each run where it ran as ``dir/imu_run0007.csv`` (the
     CLI's names) and returns the paths.
 
@@ -101,9 +105,17 @@ def monte_carlo(
     if target is not None:
         Path(target).parent.mkdir(parents=True, exist_ok=True)
     with_truth = [k == 0 for k in range(runs)]
+    slots: List[Optional[np.ndarray]] = [None] * runs
+    if client is None and target is None:
+        # Each run writes its readings straight into its slot of the gathered array: no copy,
+        # and no second array of every run's readings at the end.
+        text, fmt, origin, base_dir = spec
+        rows, imu_columns = _core.simulation_shape(text, format=fmt, origin=origin, base_dir=base_dir)
+        gathered = np.empty((runs, rows, len(imu_columns)))
+        slots = list(gathered)
     if client is None:
         with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
-            results = list(pool.map(_run, [spec] * runs, ids, [target] * runs, [total] * runs, with_truth))
+            results = list(pool.map(_run, [spec] * runs, ids, [target] * runs, [total] * runs, with_truth, slots))
     else:
         futures = client.map(_run, [spec] * runs, ids, [target] * runs, [total] * runs, with_truth, pure=False)
         results = client.gather(futures)
@@ -112,6 +124,6 @@ def monte_carlo(
     from . import Table
 
     columns = tuple(results[0][0][0])
-    imu = np.stack([values for (_, values), _ in results])
+    imu = gathered if client is None else np.stack([values for (_, values), _ in results])
     truth_columns, truth_values = results[0][1]  # run 0 kept its truth table
     return MonteCarlo(runs=np.array(ids), columns=columns, imu=imu, truth=Table(truth_columns, truth_values))
