@@ -1,5 +1,6 @@
-//! Streamed simulation: truth and readings in chunks of [`STREAM_CHUNK`] samples, the same
-//! numbers as [`Scenario::simulate`] bit for bit, written as they are made.
+//! Streamed simulation: truth and readings in chunks of up to [`STREAM_CHUNK`] samples
+//! ([`stream_chunk`]), the same numbers as [`Scenario::simulate`] bit for bit, written as they
+//! are made.
 //!
 //! Analytic trajectories (expression, track, waypoints, and the built-ins made of them) are
 //! evaluated sample by sample with the core's [`AnalyticStepper`] at times computed on demand, so
