@@ -48,6 +48,11 @@ fn text_spec(text: &str, format: &str, origin: &str) -> PyResult<ScenarioSpec> {
     .map_err(refused)
 }
 
+/// A scenario spec from a dict (keys as in a file, values typed: `inf` and integers kept).
+fn dict_spec(scenario: &Bound<'_, PyAny>, origin: &str) -> PyResult<ScenarioSpec> {
+    ScenarioSpec::from_tree(&value_tree(scenario, "scenario")?, origin).map_err(refused)
+}
+
 /// Runs a resolved scenario spec on at most `threads` threads with the GIL released, the truth
 /// (when `truth`) and IMU rows written straight into NumPy arrays (NumPy's allocator: huge pages
 /// where the kernel offers them), the IMU rows into `imu_out` when given (a Monte Carlo run's
@@ -146,8 +151,7 @@ fn simulate_dict<'py>(
     truth: bool,
     imu_out: Option<Bound<'py, PyArray2<f64>>>,
 ) -> PyResult<SimulationOut<'py>> {
-    let tree = value_tree(scenario, "scenario")?;
-    let spec = ScenarioSpec::from_tree(&tree, origin).map_err(refused)?;
+    let spec = dict_spec(scenario, origin)?;
     run_spec(py, spec, base_dir, run, threads, truth, imu_out)
 }
 
@@ -164,7 +168,7 @@ fn simulation_shape(
     base_dir: &str,
 ) -> PyResult<(usize, Vec<String>)> {
     let spec = if format == "dict" {
-        ScenarioSpec::from_tree(&value_tree(scenario, "scenario")?, origin).map_err(refused)?
+        dict_spec(scenario, origin)?
     } else {
         text_spec(&scenario.extract::<String>()?, format, origin)?
     };

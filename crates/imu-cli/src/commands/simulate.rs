@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use imukit::ScenarioSpec;
 use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
-use imukit::run::pipeline::RunThreads;
+use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -101,7 +101,7 @@ pub fn run(
     );
     let done = AtomicU64::new(0);
     // Runs at a time: every core, or at most --threads of them; each run on one thread.
-    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    let cores = available_cores();
     let pool_threads = threads.map_or(cores, |n| {
         usize::try_from(n).unwrap_or(usize::MAX).min(cores)
     });

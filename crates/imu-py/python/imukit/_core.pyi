@@ -5,6 +5,8 @@ import numpy as np
 import numpy.typing as npt
 
 _Table = tuple[list[str], npt.NDArray[np.float64]]
+#: A run's tables: truth (None when not kept), IMU, and the GNSS, barometer and odometer ones.
+_Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]
 
 __all__ = [
     "ImuError",
@@ -79,7 +81,7 @@ def simulate_text(
     threads: Optional[int] = None,
     truth: bool = True,
     imu_out: Optional[npt.NDArray[np.float64]] = None,
-) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
+) -> _Simulation: ...
 def simulate_dict(
     scenario: dict[str, Any],
     *,
@@ -89,7 +91,7 @@ def simulate_dict(
     threads: Optional[int] = None,
     truth: bool = True,
     imu_out: Optional[npt.NDArray[np.float64]] = None,
-) -> tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]: ...
+) -> _Simulation: ...
 def simulation_shape(
     scenario: Union[str, dict[str, Any]], *, format: str, origin: str, base_dir: str
 ) -> tuple[int, list[str]]: ...

@@ -34,6 +34,13 @@ pub enum RunThreads {
 /// 512, [`crate::run::simulate::stream_chunk`]) 0.37 ms against 0.34 ms on one.
 pub const AUTO_MIN_CHUNKS: usize = 4;
 
+/// The cores this process may use ([`std::thread::available_parallelism`]: affinity masks and
+/// cgroup quotas count), 1 when the system does not say.
+#[must_use]
+pub fn available_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, NonZeroUsize::get)
+}
+
 impl RunThreads {
     /// From the most threads a user lets one run use (as a command line or Python gives it),
     /// named `field` in the error: `None` is [`RunThreads::Auto`], 1 is [`RunThreads::One`], 2
@@ -56,10 +63,7 @@ impl RunThreads {
         match self {
             Self::One => false,
             Self::Two => true,
-            Self::Auto => {
-                chunks >= AUTO_MIN_CHUNKS
-                    && std::thread::available_parallelism().map_or(1, NonZeroUsize::get) >= 2
-            }
+            Self::Auto => chunks >= AUTO_MIN_CHUNKS && available_cores() >= 2,
         }
     }
 }
