@@ -36,6 +36,7 @@ pub mod orientation;
 pub mod rotation;
 pub mod sensor;
 pub mod strapdown;
+pub mod trig;
 pub mod vector;
 
 pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, NavFrame, Ned};

@@ -12,6 +12,29 @@ use crate::frame::Frame;
 use crate::math;
 use crate::vector::Vec3;
 
+/// `(sin, cos)` of half of each z-y-x Euler angle: what the attitude's quaternion is made of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfAngleTrig {
+    /// Of half the yaw.
+    pub yaw: (f64, f64),
+    /// Of half the pitch.
+    pub pitch: (f64, f64),
+    /// Of half the roll.
+    pub roll: (f64, f64),
+}
+
+impl HalfAngleTrig {
+    /// Of the half angles of `e`, from the library's `sin_cos` (a zero angle without the call).
+    #[must_use]
+    pub fn of(e: EulerZyx) -> Self {
+        Self {
+            roll: math::sin_cos(e.roll_rad * 0.5),
+            pitch: math::sin_cos(e.pitch_rad * 0.5),
+            yaw: math::sin_cos(e.yaw_rad * 0.5),
+        }
+    }
+}
+
 /// Intrinsic z-y-x Euler angles of a frame relative to another (body relative to navigation), rad.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EulerZyx {
@@ -137,9 +160,13 @@ impl<From: Frame, To: Frame> Rotation<From, To> {
     /// library call (`math::sin_cos`).
     #[must_use]
     pub fn from_euler(e: EulerZyx) -> Self {
-        let (sr, cr) = math::sin_cos(e.roll_rad * 0.5);
-        let (sp, cp) = math::sin_cos(e.pitch_rad * 0.5);
-        let (sy, cy) = math::sin_cos(e.yaw_rad * 0.5);
+        Self::from_half_angle_trig(&HalfAngleTrig::of(e))
+    }
+    /// [`Self::from_euler`] from the sines and cosines of the half angles, taken elsewhere (by
+    /// [`crate::kinematics::euler::EulerTrig::of_each`], many at once).
+    #[must_use]
+    pub fn from_half_angle_trig(half: &HalfAngleTrig) -> Self {
+        let ((sr, cr), (sp, cp), (sy, cy)) = (half.roll, half.pitch, half.yaw);
         Self::assume_from_quaternion(UnitQuaternion::new_unchecked(Quaternion::new(
             cr * cp * cy + sr * sp * sy,
             sr * cp * cy - cr * sp * sy,

@@ -1,6 +1,7 @@
 //! Formula trajectories are evaluated by the compiled program (`motion::compiled`): on every
-//! example and built-in scenario whose trajectory is formulas, its derivatives equal the
-//! formulas' evaluation over dual numbers bit for bit (a zero's sign aside), and so does the
+//! example and built-in scenario whose trajectory is formulas, its derivatives are the formulas'
+//! evaluation over dual numbers to within `DUAL_NUMBERS_BOUND` (the program takes its sines and
+//! cosines from `imu_core::trig`'s vector kernels, num-dual from the C library), and so is the
 //! truth built from them.
 use std::path::Path;
 
@@ -10,6 +11,7 @@ use imukit::motion::Trajectory;
 use imukit::motion::analytic::{
     AnalyticOptions, Motion, MotionPoint, dual_derivatives, truth_from_motion,
 };
+use imukit::motion::compiled::DUAL_NUMBERS_BOUND;
 use imukit::scenario::builtin;
 use imukit::{Scenario, ScenarioSpec};
 
@@ -59,43 +61,48 @@ fn a_number_whose_sine_positions_and_angles_both_take_gets_one_sin_cos() {
     assert_eq!(motion.compiled().unwrap().sin_cos_per_sample(), 4);
 }
 
-fn same(a: f64, b: f64) -> bool {
-    a == b || (a.is_nan() && b.is_nan())
+/// The largest `|a − b|` over pairs of series, in units of ε times the largest `|b|`.
+fn deviation(pairs: impl Iterator<Item = (f64, f64)> + Clone) -> f64 {
+    let scale = pairs.clone().map(|(_, b)| b.abs()).fold(0.0, f64::max);
+    let worst = pairs.map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    if worst == 0.0 {
+        0.0
+    } else {
+        worst / (f64::EPSILON * scale)
+    }
 }
 
-fn assert_same_points(name: &str, t: &[f64], a: &[MotionPoint], b: &[MotionPoint]) {
-    for (i, (p, q)) in a.iter().zip(b).enumerate() {
-        for axis in 0..3 {
-            for k in 0..4 {
+/// Every derivative of `a` within the bound of `b`'s, component by component over the run.
+fn assert_close_points(name: &str, a: &[MotionPoint], b: &[MotionPoint]) {
+    let pairs =
+        |f: &dyn Fn(&MotionPoint) -> f64| a.iter().map(f).zip(b.iter().map(f)).collect::<Vec<_>>();
+    for axis in 0..3 {
+        for k in 0..4 {
+            let d = deviation(pairs(&|p: &MotionPoint| p.position[axis][k]).into_iter());
+            assert!(
+                d <= DUAL_NUMBERS_BOUND,
+                "{name}: position axis {axis} derivative {k}: {d} ε"
+            );
+        }
+    }
+    assert_eq!(a[0].euler.is_some(), b[0].euler.is_some(), "{name}");
+    if a[0].euler.is_some() {
+        for angle in 0..3 {
+            for k in 0..3 {
+                let d = deviation(
+                    pairs(&|p: &MotionPoint| p.euler.expect("angles")[angle][k]).into_iter(),
+                );
                 assert!(
-                    same(p.position[axis][k], q.position[axis][k]),
-                    "{name}, t = {}: position axis {axis} derivative {k}: {} vs {}",
-                    t[i],
-                    p.position[axis][k],
-                    q.position[axis][k]
+                    d <= DUAL_NUMBERS_BOUND,
+                    "{name}: angle {angle} derivative {k}: {d} ε"
                 );
             }
-        }
-        match (p.euler, q.euler) {
-            (None, None) => {}
-            (Some(e), Some(f)) => {
-                for angle in 0..3 {
-                    for k in 0..3 {
-                        assert!(
-                            same(e[angle][k], f[angle][k]),
-                            "{name}, t = {}: angle {angle} derivative {k}",
-                            t[i]
-                        );
-                    }
-                }
-            }
-            _ => panic!("{name}: one has angles, the other not"),
         }
     }
 }
 
 #[test]
-fn compiled_formulas_give_the_dual_numbers_on_every_example_and_builtin() {
+fn compiled_formulas_give_the_dual_numbers_within_the_bound_on_every_example_and_builtin() {
     let scenarios = formula_scenarios();
     assert!(
         scenarios.len() >= 5,
@@ -111,7 +118,7 @@ fn compiled_formulas_give_the_dual_numbers_on_every_example_and_builtin() {
         motion.derivatives(&t, &mut compiled);
         dual_derivatives(motion, &t, &mut duals);
         assert_eq!(compiled.len(), t.len());
-        assert_same_points(name, &t, &compiled, &duals);
+        assert_close_points(name, &compiled, &duals);
     }
 }
 
@@ -127,8 +134,29 @@ impl Motion for OverDuals<'_> {
     }
 }
 
+/// A truth sample's numbers: position, velocity, acceleration, angles, quaternion, body rate
+/// and angular acceleration.
+fn numbers(s: &Truth<Enu>) -> Vec<f64> {
+    let mut v = Vec::with_capacity(22);
+    for x in [s.position_m, s.velocity_m_s, s.acceleration_m_s2] {
+        v.extend(x.to_array());
+    }
+    v.extend(s.euler.to_array());
+    v.extend(s.attitude.to_wxyz());
+    v.extend(s.omega_b_rad_s.to_array());
+    v.extend(s.alpha_b_rad_s2.to_array());
+    v
+}
+
+/// How far the truth built from compiled formulas may be from the truth built from the same
+/// formulas over dual numbers, in the units of [`DUAL_NUMBERS_BOUND`]: the derivatives' differences
+/// pass through the tangent attitude's quotients (rates and angular accelerations divide by the
+/// speed squared). The largest on the examples and built-ins is 15.9 ε: the angular acceleration
+/// of the tilted circle's tangent attitude (`examples/expression.toml`).
+const TRUTH_BOUND: f64 = 32.0;
+
 #[test]
-fn the_truth_of_compiled_formulas_is_the_truth_over_dual_numbers() {
+fn the_truth_of_compiled_formulas_is_the_truth_over_dual_numbers_within_the_bound() {
     for (name, s) in formula_scenarios() {
         let Trajectory::Expression(motion, _) = &s.trajectory else {
             unreachable!()
@@ -142,8 +170,13 @@ fn the_truth_of_compiled_formulas_is_the_truth_over_dual_numbers() {
         let fast = truth_from_motion(motion, &t, AnalyticOptions::default(), &mut a);
         let slow = truth_from_motion(&OverDuals(motion), &t, AnalyticOptions::default(), &mut b);
         assert_eq!(fast.is_ok(), slow.is_ok(), "{name}");
-        if let Some(i) = (0..t.len()).find(|&i| a[i] != b[i]) {
-            panic!("{name}: sample {i}: {:?} vs {:?}", a[i], b[i]);
+        let (a, b): (Vec<_>, Vec<_>) = (
+            a.iter().map(numbers).collect(),
+            b.iter().map(numbers).collect(),
+        );
+        for column in 0..a[0].len() {
+            let d = deviation(a.iter().map(|r| r[column]).zip(b.iter().map(|r| r[column])));
+            assert!(d <= TRUTH_BOUND, "{name}: truth number {column}: {d} ε");
         }
     }
 }

@@ -7,7 +7,8 @@
 //! navigation frame `ω_n = C_nb ω_b`, which equals `ω_b` only for rotation about one fixed axis.
 use crate::frame::Body;
 use crate::math;
-use crate::rotation::EulerZyx;
+use crate::rotation::{EulerZyx, HalfAngleTrig};
+use crate::trig;
 use crate::vector::Vec3;
 
 /// The sines and cosines of an attitude's pitch and roll: what the body rate and its derivative
@@ -66,6 +67,76 @@ impl PitchRollTrig {
             pdd * cr - pd * rd * sr + ydd * cp * sr - yd * pd * sp * sr + yd * rd * cp * cr,
             -pdd * sr - pd * rd * cr + ydd * cp * cr - yd * pd * sp * cr - yd * rd * cp * sr,
         )
+    }
+}
+
+/// Every sine and cosine an attitude from z-y-x Euler angles needs: the pitch's and roll's (body
+/// rate and angular acceleration, gimbal lock) and the half angles' (the quaternion).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EulerTrig {
+    /// Of the pitch and roll.
+    pub pitch_roll: PitchRollTrig,
+    /// Of half the yaw, pitch and roll.
+    pub half: HalfAngleTrig,
+}
+
+/// Attitudes whose sines and cosines [`EulerTrig::of_each`] takes in one pass of the kernels.
+const TRIG_BLOCK: usize = 16;
+
+impl EulerTrig {
+    /// The sines and cosines of `e`, from the library's `sin_cos` (see [`EulerTrig::of_each`]
+    /// for many attitudes at once).
+    #[must_use]
+    pub fn of(e: EulerZyx) -> Self {
+        Self {
+            pitch_roll: PitchRollTrig::of(e),
+            half: HalfAngleTrig::of(e),
+        }
+    }
+
+    /// The sines and cosines of each attitude of `euler` into `out` (the shorter of the two),
+    /// from the vector kernels of [`crate::trig`]: within [`trig::MAX_ULP`] of the correctly
+    /// rounded values, each attitude's independent of the others. A block of attitudes whose
+    /// rolls are all zero (the tangent attitude's) takes three kernel values per attitude instead
+    /// of five; a zero roll's sine and cosine are `(roll, 1)` exactly either way.
+    pub fn of_each(euler: &[EulerZyx], out: &mut [EulerTrig]) {
+        const MOST: usize = 5 * TRIG_BLOCK;
+        let (mut x, mut sin, mut cos) = ([0.0; MOST], [0.0; MOST], [0.0; MOST]);
+        for (euler, out) in euler.chunks(TRIG_BLOCK).zip(out.chunks_mut(TRIG_BLOCK)) {
+            let n = euler.len().min(out.len());
+            let rolls = euler.iter().any(|e| e.roll_rad != 0.0);
+            let per = if rolls { 5 } else { 3 };
+            for (k, e) in euler[..n].iter().enumerate() {
+                let a = &mut x[per * k..per * (k + 1)];
+                a[..3].copy_from_slice(&[e.pitch_rad, e.yaw_rad * 0.5, e.pitch_rad * 0.5]);
+                if rolls {
+                    a[3..].copy_from_slice(&[e.roll_rad, e.roll_rad * 0.5]);
+                }
+            }
+            trig::sin_cos_into(&x[..per * n], &mut sin[..per * n], &mut cos[..per * n]);
+            for (k, (e, o)) in euler[..n].iter().zip(out.iter_mut()).enumerate() {
+                let at = |j: usize| (sin[per * k + j], cos[per * k + j]);
+                let ((sin_roll, cos_roll), half_roll) = if rolls {
+                    (at(3), at(4))
+                } else {
+                    ((e.roll_rad, 1.0), (e.roll_rad * 0.5, 1.0))
+                };
+                let (sin_pitch, cos_pitch) = at(0);
+                *o = Self {
+                    pitch_roll: PitchRollTrig {
+                        sin_pitch,
+                        cos_pitch,
+                        sin_roll,
+                        cos_roll,
+                    },
+                    half: HalfAngleTrig {
+                        yaw: at(1),
+                        pitch: at(2),
+                        roll: half_roll,
+                    },
+                };
+            }
+        }
     }
 }
 

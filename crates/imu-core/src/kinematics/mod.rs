@@ -71,22 +71,22 @@ impl<N: NavFrame> Truth<N> {
     /// angular acceleration from the angles' first and second time derivatives `rate` (rad/s)
     /// and `accel` (rad/s²) (see [`euler::body_rate_and_acceleration`]).
     pub fn set_euler_motion(&mut self, euler: EulerZyx, rate: EulerZyx, accel: EulerZyx) {
-        self.set_euler_motion_with(euler, &euler::PitchRollTrig::of(euler), rate, accel);
+        self.set_euler_motion_with(euler, &euler::EulerTrig::of(euler), rate, accel);
     }
 
-    /// [`Self::set_euler_motion`] with the pitch's and roll's sines and cosines `trig` of
-    /// `euler` already taken (for a gimbal-lock check, say).
+    /// [`Self::set_euler_motion`] with the sines and cosines `trig` of `euler` already taken
+    /// (many at once, by [`euler::EulerTrig::of_each`]).
     pub fn set_euler_motion_with(
         &mut self,
         euler: EulerZyx,
-        trig: &euler::PitchRollTrig,
+        trig: &euler::EulerTrig,
         rate: EulerZyx,
         accel: EulerZyx,
     ) {
         self.euler = euler;
-        self.attitude = Rotation::from_euler(euler);
+        self.attitude = Rotation::from_half_angle_trig(&trig.half);
         (self.omega_b_rad_s, self.alpha_b_rad_s2) =
-            euler::body_rate_and_acceleration(trig, rate, accel);
+            euler::body_rate_and_acceleration(&trig.pitch_roll, rate, accel);
     }
 }
 

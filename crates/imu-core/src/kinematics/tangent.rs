@@ -9,6 +9,7 @@
 use crate::kinematics::KinematicsError;
 use crate::math;
 use crate::rotation::EulerZyx;
+use crate::trig;
 
 /// Speeds below this (m/s) count as standstill for the tangent attitude, unless set otherwise.
 pub const DEFAULT_MIN_SPEED_M_S: f64 = 1e-6;
@@ -31,11 +32,18 @@ pub struct TangentAngles {
 /// `θ̇ = (h a_z − v_z ḣ)/|v|²`; pitch = −θ. Second derivatives by the quotient rule.
 #[must_use]
 pub fn tangent_angles(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> TangentAngles {
-    tangent_angles_at(v, a, j, math::sqrt(v[0] * v[0] + v[1] * v[1]))
+    let h = math::sqrt(v[0] * v[0] + v[1] * v[1]);
+    tangent_angles_at(v, a, j, h, (math::atan2(v[1], v[0]), math::atan2(v[2], h)))
 }
 
 /// [`tangent_angles`] given the horizontal speed `h = √(v_x² + v_y²)` (m/s) already taken.
-fn tangent_angles_at(v: [f64; 3], a: [f64; 3], j: [f64; 3], h: f64) -> TangentAngles {
+fn tangent_angles_at(
+    v: [f64; 3],
+    a: [f64; 3],
+    j: [f64; 3],
+    h: f64,
+    (yaw, elevation): (f64, f64),
+) -> TangentAngles {
     let [vx, vy, vz] = v;
     let [ax, ay, az] = a;
     let [jx, jy, jz] = j;
@@ -56,7 +64,7 @@ fn tangent_angles_at(v: [f64; 3], a: [f64; 3], j: [f64; 3], h: f64) -> TangentAn
     let theta_rate = n2 / d2;
     let theta_acc = (n2_dot * d2 - n2 * d2_dot) / (d2 * d2);
     TangentAngles {
-        euler: EulerZyx::new(math::atan2(vy, vx), -math::atan2(vz, h), 0.0),
+        euler: EulerZyx::new(yaw, -elevation, 0.0),
         rate: EulerZyx::new(yaw_rate, -theta_rate, 0.0),
         accel: EulerZyx::new(yaw_acc, -theta_acc, 0.0),
     }
@@ -93,6 +101,36 @@ impl TangentTracker {
         a: [f64; 3],
         j: [f64; 3],
     ) -> Result<Option<TangentAngles>, KinematicsError> {
+        self.update_with(index, v, a, j, |h| {
+            (math::atan2(v[1], v[0]), math::atan2(v[2], h))
+        })
+    }
+
+    /// [`Self::update`] with the two arctangents taken elsewhere ([`arctangents_into`], many
+    /// samples at once): `arctangents` is `(yaw, elevation)`, `atan2(v_y, v_x)` and
+    /// `atan2(v_z, |v_h|)` with `|v_h| = sqrt(v_x² + v_y²)`.
+    ///
+    /// # Errors
+    /// As [`Self::update`].
+    pub fn update_given(
+        &mut self,
+        index: usize,
+        v: [f64; 3],
+        a: [f64; 3],
+        j: [f64; 3],
+        arctangents: (f64, f64),
+    ) -> Result<Option<TangentAngles>, KinematicsError> {
+        self.update_with(index, v, a, j, |_| arctangents)
+    }
+
+    fn update_with(
+        &mut self,
+        index: usize,
+        v: [f64; 3],
+        a: [f64; 3],
+        j: [f64; 3],
+        arctangents: impl FnOnce(f64) -> (f64, f64),
+    ) -> Result<Option<TangentAngles>, KinematicsError> {
         let speed = math::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if speed < self.min_speed_m_s {
             return Ok(self.last.map(|euler| TangentAngles {
@@ -104,12 +142,34 @@ impl TangentTracker {
         if horizontal < self.min_speed_m_s {
             return Err(KinematicsError::VerticalTangent { index });
         }
-        let mut angles = tangent_angles_at(v, a, j, horizontal);
+        let mut angles = tangent_angles_at(v, a, j, horizontal, arctangents(horizontal));
         if let Some(last) = self.last {
             angles.euler.yaw_rad = math::unwrap_near(angles.euler.yaw_rad, last.yaw_rad);
         }
         self.last = Some(angles.euler);
         Ok(Some(angles))
+    }
+}
+
+/// The tangent attitude's two arctangents at each velocity of `v` (m/s, navigation frame), from
+/// the vector kernels of [`crate::trig`]: `yaw[i] = atan2(v_y, v_x)` and `elevation[i] =
+/// atan2(v_z, |v_h|)` with `|v_h| = sqrt(v_x² + v_y²)`, as [`TangentTracker::update_given`]
+/// takes them (for the shortest of the three slices).
+pub fn arctangents_into(v: &[[f64; 3]], yaw: &mut [f64], elevation: &mut [f64]) {
+    const BLOCK: usize = 16;
+    let (mut vy, mut vx, mut vz, mut h) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+    for ((v, yaw), elevation) in v
+        .chunks(BLOCK)
+        .zip(yaw.chunks_mut(BLOCK))
+        .zip(elevation.chunks_mut(BLOCK))
+    {
+        let n = v.len().min(yaw.len()).min(elevation.len());
+        for (k, v) in v[..n].iter().enumerate() {
+            (vx[k], vy[k], vz[k]) = (v[0], v[1], v[2]);
+            h[k] = math::sqrt(v[0] * v[0] + v[1] * v[1]);
+        }
+        trig::atan2_into(&vy[..n], &vx[..n], yaw);
+        trig::atan2_into(&vz[..n], &h[..n], elevation);
     }
 }
 

@@ -33,9 +33,9 @@
 //! ```
 use num_dual::{Dual2, Dual3, DualNum};
 
-use imu_core::kinematics::euler::{PitchRollTrig, unwrap_near};
+use imu_core::kinematics::euler::{EulerTrig, unwrap_near};
 use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
-use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
+use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker, arctangents_into};
 use imu_core::kinematics::{KinematicsError, Truth, check_times};
 use imu_core::{EulerZyx, NavFrame, Rotation, Vec3};
 
@@ -131,6 +131,23 @@ pub struct AnalyticStepper<'m, M> {
     index: usize,
     last_yaw: Option<f64>,
     point: Vec<MotionPoint>,
+    block: Block,
+}
+
+/// What [`AnalyticStepper::step_block`] keeps of each sample of a block between its passes.
+#[derive(Debug, Default)]
+struct Block {
+    /// The tangent attitude's arctangents, `(yaw, elevation)`.
+    yaw: Vec<f64>,
+    elevation: Vec<f64>,
+    velocity: Vec<[f64; 3]>,
+    /// Angles, rates and angular accelerations (a standstill before any motion: zeros).
+    euler: Vec<EulerZyx>,
+    rate: Vec<EulerZyx>,
+    accel: Vec<EulerZyx>,
+    /// Whether the attitude is valid (false: a standstill before any motion).
+    valid: Vec<bool>,
+    trig: Vec<EulerTrig>,
 }
 
 impl<'m, M: Motion> AnalyticStepper<'m, M> {
@@ -143,6 +160,7 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
             index: 0,
             last_yaw: None,
             point: Vec::with_capacity(1),
+            block: Block::default(),
         }
     }
 
@@ -183,64 +201,161 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
         point: &MotionPoint,
         truth: &mut Truth<N>,
     ) -> Result<bool, KinematicsError> {
-        let index = self.index;
-        self.index += 1;
-        let part = |k: usize| -> [f64; 3] { point.position.map(|axis| axis[k]) };
-        let (pos, vel, acc, jerk) = (part(0), part(1), part(2), part(3));
-        if !pos.iter().chain(&vel).chain(&acc).all(|c| c.is_finite()) {
-            return Err(KinematicsError::NotFinite {
-                field: "position_m",
-                index,
-            });
-        }
-        truth.t_s = t_s;
-        truth.position_m = Vec3::from_array(pos);
-        truth.velocity_m_s = Vec3::from_array(vel);
-        truth.acceleration_m_s2 = Vec3::from_array(acc);
-        let (euler, trig, rate, accel) = match point.euler {
-            Some(e) => {
-                let ang = |k: usize| EulerZyx::new(e[0][k], e[1][k], e[2][k]);
-                let mut euler = ang(0);
-                if !euler.to_array().iter().all(|c| c.is_finite()) {
-                    return Err(KinematicsError::NotFinite {
-                        field: "euler_rad",
-                        index,
-                    });
-                }
-                // The pitch's cosine, taken once: the gimbal-lock check's and ω's and α's.
-                let trig = PitchRollTrig::of(euler);
-                if trig.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
-                    return Err(KinematicsError::GimbalLock {
-                        index,
-                        pitch_rad: euler.pitch_rad,
-                    });
-                }
-                if let Some(last) = self.last_yaw {
-                    euler.yaw_rad = unwrap_near(euler.yaw_rad, last);
-                }
-                self.last_yaw = Some(euler.yaw_rad);
-                (euler, trig, ang(1), ang(2))
+        let first = self.step_block(
+            &[t_s],
+            core::slice::from_ref(point),
+            core::slice::from_mut(truth),
+        )?;
+        Ok(first.is_some())
+    }
+
+    /// [`Self::step_into`] for the samples at the times `t_s` in order, with their derivatives
+    /// `points`, written into `out` (the shortest of the three): returns the first sample whose
+    /// attitude is valid (`None` while a tangent attitude has not yet moved; from that sample
+    /// on, every attitude is valid).
+    ///
+    /// The angles' sines and cosines and the tangent attitude's arctangents are taken for many
+    /// samples at once by the vector kernels of [`imu_core::trig`] (within
+    /// [`imu_core::trig::MAX_ULP`] of the correctly rounded values); the numbers are the same
+    /// however the samples are split into calls.
+    ///
+    /// # Errors
+    /// As [`Self::step`], for the first sample in order that fails.
+    pub fn step_block<N: NavFrame>(
+        &mut self,
+        t_s: &[f64],
+        points: &[MotionPoint],
+        out: &mut [Truth<N>],
+    ) -> Result<Option<usize>, KinematicsError> {
+        let n = t_s.len().min(points.len()).min(out.len());
+        let mut first_valid = None;
+        for start in (0..n).step_by(DERIVATIVE_CHUNK) {
+            let end = n.min(start + DERIVATIVE_CHUNK);
+            let first =
+                self.step_chunk(&t_s[start..end], &points[start..end], &mut out[start..end])?;
+            if first_valid.is_none() {
+                first_valid = first.map(|k| start + k);
             }
-            None => match self.tracker.update(index, vel, acc, jerk)? {
-                Some(a) => (a.euler, PitchRollTrig::of(a.euler), a.rate, a.accel),
-                None => {
-                    let zero = EulerZyx::default();
-                    truth.euler = zero;
-                    truth.attitude = Rotation::identity();
-                    truth.omega_b_rad_s = Vec3::zeros();
-                    truth.alpha_b_rad_s2 = Vec3::zeros();
-                    return Ok(false);
-                }
-            },
-        };
-        truth.set_euler_motion_with(euler, &trig, rate, accel);
-        if !truth.is_finite() {
-            return Err(KinematicsError::NotFinite {
-                field: "truth",
-                index,
-            });
         }
-        Ok(true)
+        Ok(first_valid)
+    }
+
+    /// [`Self::step_block`] for at most [`DERIVATIVE_CHUNK`] samples: the motion's values and
+    /// angles sample by sample (checks, tangent tracker, yaw unwrapping), then the sines and
+    /// cosines of every angle at once, then the attitudes, body rates and accelerations.
+    fn step_chunk<N: NavFrame>(
+        &mut self,
+        t_s: &[f64],
+        points: &[MotionPoint],
+        out: &mut [Truth<N>],
+    ) -> Result<Option<usize>, KinematicsError> {
+        let n = t_s.len();
+        let base = self.index;
+        self.index += n;
+        let b = &mut self.block;
+        let tangent = points.first().is_some_and(|p| p.euler.is_none());
+        b.euler.clear();
+        b.rate.clear();
+        b.accel.clear();
+        b.valid.clear();
+        if tangent {
+            b.velocity.clear();
+            b.velocity
+                .extend(points.iter().map(|p| p.position.map(|axis| axis[1])));
+            b.yaw.resize(n, 0.0);
+            b.elevation.resize(n, 0.0);
+            arctangents_into(&b.velocity, &mut b.yaw, &mut b.elevation);
+        }
+        // First pass: in order, up to the first sample that fails here.
+        let mut failed = None;
+        for (k, (point, truth)) in points.iter().zip(out.iter_mut()).enumerate() {
+            let index = base + k;
+            let part = |k: usize| -> [f64; 3] { point.position.map(|axis| axis[k]) };
+            let (pos, vel, acc, jerk) = (part(0), part(1), part(2), part(3));
+            if !pos.iter().chain(&vel).chain(&acc).all(|c| c.is_finite()) {
+                failed = Some(KinematicsError::NotFinite {
+                    field: "position_m",
+                    index,
+                });
+                break;
+            }
+            truth.t_s = t_s[k];
+            truth.position_m = Vec3::from_array(pos);
+            truth.velocity_m_s = Vec3::from_array(vel);
+            truth.acceleration_m_s2 = Vec3::from_array(acc);
+            let angles = match point.euler {
+                Some(e) => {
+                    let ang = |k: usize| EulerZyx::new(e[0][k], e[1][k], e[2][k]);
+                    let mut euler = ang(0);
+                    if !euler.to_array().iter().all(|c| c.is_finite()) {
+                        failed = Some(KinematicsError::NotFinite {
+                            field: "euler_rad",
+                            index,
+                        });
+                        break;
+                    }
+                    if let Some(last) = self.last_yaw {
+                        euler.yaw_rad = unwrap_near(euler.yaw_rad, last);
+                    }
+                    self.last_yaw = Some(euler.yaw_rad);
+                    Some((euler, ang(1), ang(2)))
+                }
+                None => {
+                    let arctangents = (b.yaw[k], b.elevation[k]);
+                    match self
+                        .tracker
+                        .update_given(index, vel, acc, jerk, arctangents)
+                    {
+                        Ok(a) => a.map(|a| (a.euler, a.rate, a.accel)),
+                        Err(e) => {
+                            failed = Some(e);
+                            break;
+                        }
+                    }
+                }
+            };
+            let (euler, rate, accel) = angles.unwrap_or_default();
+            b.euler.push(euler);
+            b.rate.push(rate);
+            b.accel.push(accel);
+            b.valid.push(angles.is_some());
+        }
+        // The sines and cosines of every angle, at once.
+        let done = b.euler.len();
+        b.trig.resize(done, EulerTrig::of(EulerZyx::default()));
+        EulerTrig::of_each(&b.euler, &mut b.trig);
+        let mut first_valid = None;
+        for (k, truth) in out[..done].iter_mut().enumerate() {
+            let index = base + k;
+            if !b.valid[k] {
+                truth.euler = EulerZyx::default();
+                truth.attitude = Rotation::identity();
+                truth.omega_b_rad_s = Vec3::zeros();
+                truth.alpha_b_rad_s2 = Vec3::zeros();
+                continue;
+            }
+            first_valid.get_or_insert(k);
+            let trig = &b.trig[k];
+            // Euler angles given by the motion may reach gimbal lock; the tangent attitude's
+            // pitch is an arctangent of a nonzero horizontal speed, never ±90°.
+            if !tangent && trig.pitch_roll.is_near_gimbal_lock(GIMBAL_LOCK_COS_TOL) {
+                return Err(KinematicsError::GimbalLock {
+                    index,
+                    pitch_rad: b.euler[k].pitch_rad,
+                });
+            }
+            truth.set_euler_motion_with(b.euler[k], trig, b.rate[k], b.accel[k]);
+            if !truth.is_finite() {
+                return Err(KinematicsError::NotFinite {
+                    field: "truth",
+                    index,
+                });
+            }
+        }
+        match failed {
+            Some(e) => Err(e),
+            None => Ok(first_valid),
+        }
     }
 }
 
@@ -271,10 +386,8 @@ pub fn truth_from_motion<M: Motion, N: NavFrame>(
         .enumerate()
     {
         motion.derivatives(times, &mut points);
-        for (k, ((&t, slot), point)) in times.iter().zip(slots).zip(&points).enumerate() {
-            if stepper.step_into(t, point, slot)? {
-                first_valid.get_or_insert(c * DERIVATIVE_CHUNK + k);
-            }
+        if let Some(k) = stepper.step_block(times, &points, slots)? {
+            first_valid.get_or_insert(c * DERIVATIVE_CHUNK + k);
         }
     }
     backfill_standstill(out, first_valid);

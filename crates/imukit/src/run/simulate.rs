@@ -449,7 +449,7 @@ pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
     emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
 ) -> Result<()> {
     let mut stepper = AnalyticStepper::new(motion, options);
-    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(chunk);
+    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(chunk + DERIVATIVE_CHUNK);
     let mut moving = false;
     let (mut times, mut points) = (
         Vec::with_capacity(DERIVATIVE_CHUNK),
@@ -459,21 +459,18 @@ pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
         times.clear();
         times.extend((start..t_s.len().min(start + DERIVATIVE_CHUNK)).map(|k| t_s.at(k)));
         motion.derivatives(&times, &mut points);
-        for (&t, point) in times.iter().zip(&points) {
-            buffer.push(Truth::default());
-            let slot = buffer.last_mut().expect("just pushed");
-            let valid = stepper
-                .step_into::<N>(t, point, slot)
-                .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
-            if valid && !moving {
-                moving = true;
-                let first = buffer.len() - 1;
-                backfill_standstill(&mut buffer, Some(first));
-            }
-            if moving && buffer.len() >= chunk {
-                emit(&buffer)?;
-                buffer.clear();
-            }
+        let base = buffer.len();
+        buffer.resize(base + times.len(), Truth::default());
+        let first = stepper
+            .step_block::<N>(&times, &points, &mut buffer[base..])
+            .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
+        if let (false, Some(k)) = (moving, first) {
+            moving = true;
+            backfill_standstill(&mut buffer, Some(base + k));
+        }
+        while moving && buffer.len() >= chunk {
+            emit(&buffer[..chunk])?;
+            buffer.drain(..chunk);
         }
     }
     if buffer.is_empty() {

@@ -1,0 +1,221 @@
+//! The vector kernels of `imu_core::trig` against correctly rounded references (CORE-MATH's
+//! functions, through the `pxfm` crate): within `MAX_ULP` on random arguments of every range they
+//! take, exact on signed zeros, the library's own answer outside their range, and a value's
+//! result independent of where it sits in the slice.
+use imu_core::trig::{MAX_ULP, SIN_COS_MAX_ARG, atan2_into, sin_cos_into};
+
+/// `|a − b|` in units in the last place of `b` (a correctly rounded, finite reference).
+fn ulps(a: f64, b: f64) -> f64 {
+    if a == b {
+        return 0.0;
+    }
+    let ulp = f64::from_bits(b.abs().to_bits() + 1) - b.abs();
+    (a - b).abs() / ulp
+}
+
+/// `n` uniform numbers in `[−r, r]` (xorshift64, fixed seed).
+fn uniform(n: usize, r: f64, mut seed: u64) -> Vec<f64> {
+    (0..n)
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * r
+        })
+        .collect()
+}
+
+const SAMPLES: usize = 100_000;
+
+#[test]
+fn sines_and_cosines_are_within_the_bound_of_the_correctly_rounded_values() {
+    for (k, range) in [
+        1e-6,
+        1.0,
+        std::f64::consts::PI,
+        100.0,
+        1e4,
+        1e6,
+        SIN_COS_MAX_ARG,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let x = uniform(SAMPLES, range, 0x9E37_79B9 + k as u64);
+        let (mut s, mut c) = (vec![0.0; SAMPLES], vec![0.0; SAMPLES]);
+        sin_cos_into(&x, &mut s, &mut c);
+        let (mut worst_s, mut worst_c) = (0.0_f64, 0.0_f64);
+        for i in 0..SAMPLES {
+            worst_s = worst_s.max(ulps(s[i], pxfm::f_sin(x[i])));
+            worst_c = worst_c.max(ulps(c[i], pxfm::f_cos(x[i])));
+        }
+        assert!(
+            worst_s <= f64::from(MAX_ULP) && worst_c <= f64::from(MAX_ULP),
+            "|x| ≤ {range:e}: sin off by {worst_s} ulp, cos by {worst_c}"
+        );
+    }
+}
+
+#[test]
+fn arctangents_are_within_the_bound_of_the_correctly_rounded_values() {
+    for (k, (ry, rx)) in [
+        (1.0, 1.0),
+        (1e-3, 1.0),
+        (1.0, 1e-3),
+        (1e3, 1e3),
+        (1e-200, 1e-200),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let y = uniform(SAMPLES, ry, 0x1234_5678 + k as u64);
+        let x = uniform(SAMPLES, rx, 0x8765_4321 + k as u64);
+        let mut a = vec![0.0; SAMPLES];
+        atan2_into(&y, &x, &mut a);
+        let worst = (0..SAMPLES)
+            .map(|i| ulps(a[i], pxfm::f_atan2(y[i], x[i])))
+            .fold(0.0_f64, f64::max);
+        assert!(
+            worst <= f64::from(MAX_ULP),
+            "|y| ≤ {ry:e}, |x| ≤ {rx:e}: off by {worst} ulp"
+        );
+    }
+}
+
+#[test]
+fn signed_zeros_are_exact() {
+    let (mut s, mut c) = ([1.0; 2], [0.0; 2]);
+    sin_cos_into(&[0.0, -0.0], &mut s, &mut c);
+    assert_eq!(
+        s.map(f64::to_bits),
+        [0.0_f64.to_bits(), (-0.0_f64).to_bits()]
+    );
+    assert_eq!(c, [1.0, 1.0]);
+    let mut a = [1.0; 4];
+    atan2_into(&[0.0, -0.0, 0.0, -0.0], &[0.0, 0.0, -0.0, -0.0], &mut a);
+    let pi = std::f64::consts::PI;
+    assert_eq!(
+        a.map(f64::to_bits),
+        [0.0, -0.0, pi, -pi].map(f64::to_bits),
+        "atan2 of signed zeros"
+    );
+}
+
+#[test]
+fn arguments_outside_the_kernels_range_get_the_library_answer() {
+    let x = [
+        SIN_COS_MAX_ARG,
+        -1e10,
+        1e300,
+        f64::INFINITY,
+        f64::NAN,
+        f64::MIN_POSITIVE,
+        5e-324,
+    ];
+    let (mut s, mut c) = ([0.0; 7], [0.0; 7]);
+    sin_cos_into(&x, &mut s, &mut c);
+    for (i, &xi) in x.iter().enumerate().take(5) {
+        let (rs, rc) = xi.sin_cos();
+        assert!(
+            s[i].to_bits() == rs.to_bits() || (s[i].is_nan() && rs.is_nan()),
+            "sin {xi}: {} vs {rs}",
+            s[i]
+        );
+        assert!(
+            c[i].to_bits() == rc.to_bits() || (c[i].is_nan() && rc.is_nan()),
+            "cos {xi}: {} vs {rc}",
+            c[i]
+        );
+    }
+    // Subnormal and tiny arguments: sin x = x, cos x = 1.
+    assert_eq!(
+        (s[5], c[5], s[6], c[6]),
+        (f64::MIN_POSITIVE, 1.0, 5e-324, 1.0)
+    );
+    let (y, xs) = (
+        [1.0, f64::INFINITY, f64::NAN, 2.0],
+        [f64::INFINITY, 1.0, 1.0, -f64::INFINITY],
+    );
+    let mut a = [0.0; 4];
+    atan2_into(&y, &xs, &mut a);
+    for i in 0..4 {
+        let r = y[i].atan2(xs[i]);
+        assert!(
+            a[i].to_bits() == r.to_bits() || (a[i].is_nan() && r.is_nan()),
+            "atan2({}, {})",
+            y[i],
+            xs[i]
+        );
+    }
+}
+
+#[test]
+fn a_value_gets_the_same_result_wherever_it_sits() {
+    let x = uniform(103, 50.0, 77);
+    let (mut s, mut c) = (vec![0.0; 103], vec![0.0; 103]);
+    sin_cos_into(&x, &mut s, &mut c);
+    let mut a = vec![0.0; 103];
+    atan2_into(&x, &s, &mut a);
+    for start in [1, 2, 3, 5, 50] {
+        for len in [1, 2, 3, 4, 7, 40] {
+            let end = (start + len).min(103);
+            let (mut s2, mut c2, mut a2) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+            sin_cos_into(&x[start..end], &mut s2, &mut c2);
+            atan2_into(&x[start..end], &s[start..end], &mut a2);
+            let n = end - start;
+            assert_eq!(s2[..n], s[start..end], "sines of {start}..{end}");
+            assert_eq!(c2[..n], c[start..end], "cosines of {start}..{end}");
+            assert_eq!(a2[..n], a[start..end], "arctangents of {start}..{end}");
+        }
+    }
+}
+
+/// `EulerTrig::of_each` (kernels, many attitudes) against `EulerTrig::of` (the C library, one):
+/// every sine and cosine within `MAX_ULP + 1` ulp of the library's (each is within `MAX_ULP`,
+/// resp. one, of the correctly rounded value), whatever the block; rolls all zero take the
+/// three-value path with exact `(±0, 1)`.
+#[test]
+fn many_attitudes_trig_is_one_attitudes_within_the_bound() {
+    use imu_core::EulerZyx;
+    use imu_core::kinematics::euler::EulerTrig;
+    let yaw = uniform(150, 10.0, 5);
+    let pitch = uniform(150, 1.5, 6);
+    let roll = uniform(150, 3.0, 7);
+    for zero_roll in [false, true] {
+        let euler: Vec<EulerZyx> = (0..150)
+            .map(|i| {
+                let r = if zero_roll { 0.0 * roll[i] } else { roll[i] };
+                EulerZyx::new(yaw[i], pitch[i], r)
+            })
+            .collect();
+        let mut many = vec![EulerTrig::of(EulerZyx::default()); 150];
+        EulerTrig::of_each(&euler, &mut many);
+        for (e, got) in euler.iter().zip(&many) {
+            let want = EulerTrig::of(*e);
+            let pairs = |t: &EulerTrig| {
+                let p = t.pitch_roll;
+                [
+                    (p.sin_pitch, p.cos_pitch),
+                    (p.sin_roll, p.cos_roll),
+                    t.half.yaw,
+                    t.half.pitch,
+                    t.half.roll,
+                ]
+            };
+            for ((gs, gc), (ws, wc)) in pairs(got).into_iter().zip(pairs(&want)) {
+                for (g, w) in [(gs, ws), (gc, wc)] {
+                    assert!(ulps(g, w) <= f64::from(MAX_ULP + 1), "{e:?}: {g} vs {w}");
+                }
+            }
+            if zero_roll {
+                assert_eq!(got.pitch_roll.sin_roll.to_bits(), e.roll_rad.to_bits());
+                assert_eq!((got.pitch_roll.cos_roll, got.half.roll.1), (1.0, 1.0));
+            }
+        }
+        // Split anywhere, the same numbers.
+        let mut split = many.clone();
+        EulerTrig::of_each(&euler[..37], &mut split[..37]);
+        EulerTrig::of_each(&euler[37..], &mut split[37..]);
+        assert_eq!(split, many);
+    }
+}
