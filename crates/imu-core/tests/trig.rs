@@ -219,3 +219,44 @@ fn many_attitudes_trig_is_one_attitudes_within_the_bound() {
         assert_eq!(split, many);
     }
 }
+
+/// `TangentSample::of_each` (kernels' arctangents, many samples) against `TangentSample::at`
+/// (the library's, one): speeds, rates and angular accelerations bit for bit, the angles within
+/// `MAX_ULP + 1` ulp; split anywhere, the same numbers.
+#[test]
+fn many_tangent_samples_are_one_samples_within_the_bound() {
+    use imu_core::kinematics::tangent::TangentSample;
+    let n = 77;
+    let axes = |scale: f64, seed: u64| -> Vec<[f64; 3]> {
+        let u = uniform(3 * n, scale, seed);
+        u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+    };
+    let (v, a, j) = (axes(20.0, 11), axes(5.0, 12), axes(2.0, 13));
+    let mut many = vec![TangentSample::default(); n];
+    TangentSample::of_each(&v, &a, &j, &mut many);
+    for i in 0..n {
+        let (got, want) = (many[i], TangentSample::at(v[i], a[i], j[i]));
+        assert_eq!(
+            (got.speed_m_s, got.horizontal_m_s),
+            (want.speed_m_s, want.horizontal_m_s)
+        );
+        assert_eq!(
+            (got.angles.rate, got.angles.accel),
+            (want.angles.rate, want.angles.accel)
+        );
+        for (g, w) in [
+            (got.angles.euler.yaw_rad, want.angles.euler.yaw_rad),
+            (got.angles.euler.pitch_rad, want.angles.euler.pitch_rad),
+        ] {
+            assert!(
+                ulps(g, w) <= f64::from(MAX_ULP + 1),
+                "sample {i}: {g} vs {w}"
+            );
+        }
+        assert_eq!(got.angles.euler.roll_rad, 0.0);
+    }
+    let mut split = vec![TangentSample::default(); n];
+    TangentSample::of_each(&v[..20], &a[..20], &j[..20], &mut split[..20]);
+    TangentSample::of_each(&v[20..], &a[20..], &j[20..], &mut split[20..]);
+    assert_eq!(split, many);
+}

@@ -32,11 +32,79 @@ pub struct TangentAngles {
 /// `θ̇ = (h a_z − v_z ḣ)/|v|²`; pitch = −θ. Second derivatives by the quotient rule.
 #[must_use]
 pub fn tangent_angles(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> TangentAngles {
-    let h = math::sqrt(v[0] * v[0] + v[1] * v[1]);
-    tangent_angles_at(v, a, j, h, (math::atan2(v[1], v[0]), math::atan2(v[2], h)))
+    TangentSample::at(v, a, j).angles
 }
 
-/// [`tangent_angles`] given the horizontal speed `h = √(v_x² + v_y²)` (m/s) already taken.
+/// One sample's tangent attitude before [`TangentTracker`]'s standstill hold and yaw unwrapping:
+/// the speeds its checks need and [`tangent_angles`] (yaw in `[−π, π]`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TangentSample {
+    /// `|v|`, m/s.
+    pub speed_m_s: f64,
+    /// `|v_h| = √(v_x² + v_y²)`, m/s.
+    pub horizontal_m_s: f64,
+    /// The angles and their derivatives (not finite where the horizontal speed is zero).
+    pub angles: TangentAngles,
+}
+
+impl TangentSample {
+    /// At velocity `v`, acceleration `a` and jerk `j` (navigation frame, SI), the arctangents
+    /// from the library's `atan2`.
+    #[must_use]
+    pub fn at(v: [f64; 3], a: [f64; 3], j: [f64; 3]) -> Self {
+        let (speed_m_s, h) = speeds(v);
+        let arctangents = (math::atan2(v[1], v[0]), math::atan2(v[2], h));
+        Self {
+            speed_m_s,
+            horizontal_m_s: h,
+            angles: tangent_angles_at(v, a, j, h, arctangents),
+        }
+    }
+
+    /// [`Self::at`] for each sample of the shortest of the four slices: the arctangents from
+    /// the vector kernels of [`crate::trig`] (within [`trig::MAX_ULP`] of the correctly rounded
+    /// values), the rest as [`Self::at`] computes it, in loops over the samples with no state
+    /// between them (so the quotients and roots of neighbouring samples overlap).
+    pub fn of_each(v: &[[f64; 3]], a: &[[f64; 3]], j: &[[f64; 3]], out: &mut [TangentSample]) {
+        const BLOCK: usize = 16;
+        let (mut vy, mut vx, mut vz) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        let (mut h, mut yaw, mut elevation) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        let n = v.len().min(a.len()).min(j.len()).min(out.len());
+        for start in (0..n).step_by(BLOCK) {
+            let m = BLOCK.min(n - start);
+            let block = start..start + m;
+            for (k, v) in v[block.clone()].iter().enumerate() {
+                (vx[k], vy[k], vz[k]) = (v[0], v[1], v[2]);
+                (out[start + k].speed_m_s, h[k]) = speeds(*v);
+            }
+            trig::atan2_into(&vy[..m], &vx[..m], &mut yaw[..m]);
+            trig::atan2_into(&vz[..m], &h[..m], &mut elevation[..m]);
+            for (k, ((v, a), j)) in v[block.clone()]
+                .iter()
+                .zip(&a[block.clone()])
+                .zip(&j[block])
+                .enumerate()
+            {
+                let o = &mut out[start + k];
+                o.horizontal_m_s = h[k];
+                o.angles = tangent_angles_at(*v, *a, *j, h[k], (yaw[k], elevation[k]));
+            }
+        }
+    }
+}
+
+/// `(|v|, |v_h|)`.
+#[inline]
+fn speeds(v: [f64; 3]) -> (f64, f64) {
+    (
+        math::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]),
+        math::sqrt(v[0] * v[0] + v[1] * v[1]),
+    )
+}
+
+/// [`tangent_angles`] given the horizontal speed `h = √(v_x² + v_y²)` (m/s) and the arctangents
+/// `atan2(v_y, v_x)` and `atan2(v_z, h)` already taken.
+#[inline]
 fn tangent_angles_at(
     v: [f64; 3],
     a: [f64; 3],
@@ -101,75 +169,34 @@ impl TangentTracker {
         a: [f64; 3],
         j: [f64; 3],
     ) -> Result<Option<TangentAngles>, KinematicsError> {
-        self.update_with(index, v, a, j, |h| {
-            (math::atan2(v[1], v[0]), math::atan2(v[2], h))
-        })
+        self.update_sample(index, &TangentSample::at(v, a, j))
     }
 
-    /// [`Self::update`] with the two arctangents taken elsewhere ([`arctangents_into`], many
-    /// samples at once): `arctangents` is `(yaw, elevation)`, `atan2(v_y, v_x)` and
-    /// `atan2(v_z, |v_h|)` with `|v_h| = sqrt(v_x² + v_y²)`.
+    /// [`Self::update`] from the sample's speeds and angles taken already ([`TangentSample`],
+    /// many samples at once by [`TangentSample::of_each`]).
     ///
     /// # Errors
     /// As [`Self::update`].
-    pub fn update_given(
+    pub fn update_sample(
         &mut self,
         index: usize,
-        v: [f64; 3],
-        a: [f64; 3],
-        j: [f64; 3],
-        arctangents: (f64, f64),
+        sample: &TangentSample,
     ) -> Result<Option<TangentAngles>, KinematicsError> {
-        self.update_with(index, v, a, j, |_| arctangents)
-    }
-
-    fn update_with(
-        &mut self,
-        index: usize,
-        v: [f64; 3],
-        a: [f64; 3],
-        j: [f64; 3],
-        arctangents: impl FnOnce(f64) -> (f64, f64),
-    ) -> Result<Option<TangentAngles>, KinematicsError> {
-        let speed = math::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        if speed < self.min_speed_m_s {
+        if sample.speed_m_s < self.min_speed_m_s {
             return Ok(self.last.map(|euler| TangentAngles {
                 euler,
                 ..TangentAngles::default()
             }));
         }
-        let horizontal = math::sqrt(v[0] * v[0] + v[1] * v[1]);
-        if horizontal < self.min_speed_m_s {
+        if sample.horizontal_m_s < self.min_speed_m_s {
             return Err(KinematicsError::VerticalTangent { index });
         }
-        let mut angles = tangent_angles_at(v, a, j, horizontal, arctangents(horizontal));
+        let mut angles = sample.angles;
         if let Some(last) = self.last {
             angles.euler.yaw_rad = math::unwrap_near(angles.euler.yaw_rad, last.yaw_rad);
         }
         self.last = Some(angles.euler);
         Ok(Some(angles))
-    }
-}
-
-/// The tangent attitude's two arctangents at each velocity of `v` (m/s, navigation frame), from
-/// the vector kernels of [`crate::trig`]: `yaw[i] = atan2(v_y, v_x)` and `elevation[i] =
-/// atan2(v_z, |v_h|)` with `|v_h| = sqrt(v_x² + v_y²)`, as [`TangentTracker::update_given`]
-/// takes them (for the shortest of the three slices).
-pub fn arctangents_into(v: &[[f64; 3]], yaw: &mut [f64], elevation: &mut [f64]) {
-    const BLOCK: usize = 16;
-    let (mut vy, mut vx, mut vz, mut h) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
-    for ((v, yaw), elevation) in v
-        .chunks(BLOCK)
-        .zip(yaw.chunks_mut(BLOCK))
-        .zip(elevation.chunks_mut(BLOCK))
-    {
-        let n = v.len().min(yaw.len()).min(elevation.len());
-        for (k, v) in v[..n].iter().enumerate() {
-            (vx[k], vy[k], vz[k]) = (v[0], v[1], v[2]);
-            h[k] = math::sqrt(v[0] * v[0] + v[1] * v[1]);
-        }
-        trig::atan2_into(&vy[..n], &vx[..n], yaw);
-        trig::atan2_into(&vz[..n], &h[..n], elevation);
     }
 }
 

@@ -35,7 +35,7 @@ use num_dual::{Dual2, Dual3, DualNum};
 
 use imu_core::kinematics::euler::{EulerTrig, unwrap_near};
 use imu_core::kinematics::sampled::{GIMBAL_LOCK_COS_TOL, backfill_standstill};
-use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker, arctangents_into};
+use imu_core::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentSample, TangentTracker};
 use imu_core::kinematics::{KinematicsError, Truth, check_times};
 use imu_core::{EulerZyx, NavFrame, Rotation, Vec3};
 
@@ -137,10 +137,9 @@ pub struct AnalyticStepper<'m, M> {
 /// What [`AnalyticStepper::step_block`] keeps of each sample of a block between its passes.
 #[derive(Debug, Default)]
 struct Block {
-    /// The tangent attitude's arctangents, `(yaw, elevation)`.
-    yaw: Vec<f64>,
-    elevation: Vec<f64>,
-    velocity: Vec<[f64; 3]>,
+    /// The tangent attitude's motion (velocity, acceleration, jerk) and its samples.
+    motion: [Vec<[f64; 3]>; 3],
+    tangent: Vec<TangentSample>,
     /// Angles, rates and angular accelerations (a standstill before any motion: zeros).
     euler: Vec<EulerZyx>,
     rate: Vec<EulerZyx>,
@@ -259,19 +258,20 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
         b.accel.clear();
         b.valid.clear();
         if tangent {
-            b.velocity.clear();
-            b.velocity
-                .extend(points.iter().map(|p| p.position.map(|axis| axis[1])));
-            b.yaw.resize(n, 0.0);
-            b.elevation.resize(n, 0.0);
-            arctangents_into(&b.velocity, &mut b.yaw, &mut b.elevation);
+            for (k, series) in b.motion.iter_mut().enumerate() {
+                series.clear();
+                series.extend(points.iter().map(|p| p.position.map(|axis| axis[k + 1])));
+            }
+            b.tangent.resize(n, TangentSample::default());
+            let [v, a, j] = &b.motion;
+            TangentSample::of_each(v, a, j, &mut b.tangent);
         }
         // First pass: in order, up to the first sample that fails here.
         let mut failed = None;
         for (k, (point, truth)) in points.iter().zip(out.iter_mut()).enumerate() {
             let index = base + k;
             let part = |k: usize| -> [f64; 3] { point.position.map(|axis| axis[k]) };
-            let (pos, vel, acc, jerk) = (part(0), part(1), part(2), part(3));
+            let (pos, vel, acc) = (part(0), part(1), part(2));
             if !pos.iter().chain(&vel).chain(&acc).all(|c| c.is_finite()) {
                 failed = Some(KinematicsError::NotFinite {
                     field: "position_m",
@@ -300,19 +300,13 @@ impl<'m, M: Motion> AnalyticStepper<'m, M> {
                     self.last_yaw = Some(euler.yaw_rad);
                     Some((euler, ang(1), ang(2)))
                 }
-                None => {
-                    let arctangents = (b.yaw[k], b.elevation[k]);
-                    match self
-                        .tracker
-                        .update_given(index, vel, acc, jerk, arctangents)
-                    {
-                        Ok(a) => a.map(|a| (a.euler, a.rate, a.accel)),
-                        Err(e) => {
-                            failed = Some(e);
-                            break;
-                        }
+                None => match self.tracker.update_sample(index, &b.tangent[k]) {
+                    Ok(a) => a.map(|a| (a.euler, a.rate, a.accel)),
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
                     }
-                }
+                },
             };
             let (euler, rate, accel) = angles.unwrap_or_default();
             b.euler.push(euler);
