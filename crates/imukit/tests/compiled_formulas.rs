@@ -180,3 +180,56 @@ fn the_truth_of_compiled_formulas_is_the_truth_over_dual_numbers_within_the_boun
         }
     }
 }
+
+/// The stepper's blocks change no number: a whole run stepped a block at a time equals the same
+/// run stepped sample by sample (each sample a block of one), bit for bit, with the tangent
+/// attitude and with formula angles.
+#[test]
+fn stepping_in_blocks_or_sample_by_sample_gives_the_same_truth() {
+    use imukit::motion::analytic::AnalyticStepper;
+    let mut seen = [false; 2];
+    for (name, s) in formula_scenarios() {
+        let Trajectory::Expression(motion, _) = &s.trajectory else {
+            unreachable!()
+        };
+        let t = s.t_s.to_vec();
+        let mut points = Vec::new();
+        motion.derivatives(&t, &mut points);
+        seen[usize::from(points[0].euler.is_some())] = true;
+        let mut whole = vec![Truth::<Enu>::default(); t.len()];
+        let mut one_by_one = whole.clone();
+        let mut a = AnalyticStepper::new(motion, AnalyticOptions::default());
+        let mut b = AnalyticStepper::new(motion, AnalyticOptions::default());
+        let first = a.step_block(&t, &points, &mut whole);
+        let mut first_b = None;
+        let mut failed = None;
+        for (k, ((&tk, p), slot)) in t.iter().zip(&points).zip(&mut one_by_one).enumerate() {
+            match b.step_into(tk, p, slot) {
+                Ok(valid) => {
+                    if valid {
+                        first_b.get_or_insert(k);
+                    }
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        match (first, failed) {
+            (Ok(first), None) => {
+                assert_eq!(first, first_b, "{name}: first valid sample");
+                if let Some(i) = (0..t.len()).find(|&i| whole[i] != one_by_one[i]) {
+                    panic!("{name}: sample {i}: {:?} vs {:?}", whole[i], one_by_one[i]);
+                }
+            }
+            (Err(e), Some(f)) => assert_eq!(e.to_string(), f.to_string(), "{name}"),
+            (a, b) => panic!("{name}: {a:?} vs {b:?}"),
+        }
+    }
+    assert_eq!(
+        seen,
+        [true, true],
+        "tangent and formula angles both covered"
+    );
+}
