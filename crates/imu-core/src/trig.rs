@@ -41,40 +41,17 @@ const LANES: usize = 4;
 /// slices.
 pub fn sin_cos_into(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     let n = x.len().min(sin.len()).min(cos.len());
-    let (x, sin, cos) = (&x[..n], &mut sin[..n], &mut cos[..n]);
-    let whole = n - n % LANES;
-    let lanes = x[..whole]
-        .chunks_exact(LANES)
-        .zip(sin[..whole].chunks_exact_mut(LANES))
-        .zip(cos[..whole].chunks_exact_mut(LANES));
-    for ((x, sin), cos) in lanes {
+    for start in (0..n).step_by(LANES) {
+        let end = n.min(start + LANES);
         let mut v = [0.0; LANES];
-        v.copy_from_slice(x);
-        sin_cos_lanes(v, sin, cos);
-    }
-    if whole < n {
-        let (mut v, mut s, mut c) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-        v[..n - whole].copy_from_slice(&x[whole..]);
-        sin_cos_lanes(v, &mut s, &mut c);
-        sin[whole..].copy_from_slice(&s[..n - whole]);
-        cos[whole..].copy_from_slice(&c[..n - whole]);
-    }
-}
-
-/// [`sin_cos_into`] of one vector's lanes, into the first [`LANES`] entries of `sin` and `cos`.
-#[inline]
-fn sin_cos_lanes(v: [f64; LANES], sin: &mut [f64], cos: &mut [f64]) {
-    let (s, c) = f64x4::from(v).sin_cos();
-    if v.iter().all(|x| math::abs(*x) < SIN_COS_MAX_ARG) {
-        sin[..LANES].copy_from_slice(&s.to_array());
-        cos[..LANES].copy_from_slice(&c.to_array());
-    } else {
+        v[..end - start].copy_from_slice(&x[start..end]);
+        let (s, c) = f64x4::from(v).sin_cos();
         let (s, c) = (s.to_array(), c.to_array());
-        for (k, &x) in v.iter().enumerate() {
-            (sin[k], cos[k]) = if math::abs(x) < SIN_COS_MAX_ARG {
+        for k in 0..end - start {
+            (sin[start + k], cos[start + k]) = if math::abs(v[k]) < SIN_COS_MAX_ARG {
                 (s[k], c[k])
             } else {
-                math::sin_cos(x)
+                math::sin_cos(v[k])
             };
         }
     }

@@ -630,11 +630,11 @@ fn run<A: Arithmetic>(
             for (((o, x), p), sc) in out
                 .iter_mut()
                 .zip(x)
-                .zip(pair.iter_mut())
-                .zip(sin.iter().zip(cos))
+                .zip(pair)
+                .zip(sin.into_iter().zip(cos))
             {
-                *p = (*sc.0, sc.1);
-                *o = from_pair::<A>(f, *x, *p);
+                *p = sc;
+                *o = from_pair::<A>(f, *x, sc);
             }
         }
         Op::FromPair(f, a, k) => {
