@@ -19,7 +19,8 @@
 //! where a slice starts or on its length, so a run gives the same numbers in one call, in chunks
 //! and on any number of threads. The kernels are plain IEEE arithmetic (no fused multiply-add on
 //! the x86-64 baseline), so unlike the C library's functions, which choose an FMA variant by CPU
-//! at run time, they give the same numbers on every x86-64 machine. Built for a CPU with FMA
+//! at run time, a build's results do not depend on the x86-64 CPU that runs it (by construction:
+//! nothing is chosen at run time). Built for a CPU with FMA
 //! (`-C target-cpu=native`) or for AArch64, `wide` fuses its multiply-adds and results can
 //! differ within the bound.
 use wide::f64x4;
