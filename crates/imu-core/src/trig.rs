@@ -42,19 +42,40 @@ const LANES: usize = 4;
 /// slices.
 pub fn sin_cos_into(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     let n = x.len().min(sin.len()).min(cos.len());
-    for start in (0..n).step_by(LANES) {
-        let end = n.min(start + LANES);
-        let mut v = [0.0; LANES];
-        v[..end - start].copy_from_slice(&x[start..end]);
-        let (s, c) = f64x4::from(v).sin_cos();
-        let (s, c) = (s.to_array(), c.to_array());
-        for k in 0..end - start {
-            (sin[start + k], cos[start + k]) = if math::abs(v[k]) < SIN_COS_MAX_ARG {
-                (s[k], c[k])
-            } else {
-                math::sin_cos(v[k])
-            };
-        }
+    let (x, sin, cos) = (&x[..n], &mut sin[..n], &mut cos[..n]);
+    let whole = n - n % LANES;
+    let lanes = x[..whole].chunks_exact(LANES);
+    let outs = sin[..whole]
+        .chunks_exact_mut(LANES)
+        .zip(cos[..whole].chunks_exact_mut(LANES));
+    for (v, (s, c)) in lanes.zip(outs) {
+        sin_cos_lanes(v, s, c);
+    }
+    if whole == n {
+        return;
+    }
+    // The last values padded with zeros to a whole vector (fixed-size copies above: a
+    // variable-length copy per vector was a `memcpy` call each).
+    let mut v = [0.0; LANES];
+    v[..n - whole].copy_from_slice(&x[whole..]);
+    let (mut s, mut c) = ([0.0; LANES], [0.0; LANES]);
+    sin_cos_lanes(&v, &mut s, &mut c);
+    sin[whole..].copy_from_slice(&s[..n - whole]);
+    cos[whole..].copy_from_slice(&c[..n - whole]);
+}
+
+/// [`sin_cos_into`] of one vector's worth of values (`x`, `sin`, `cos` of length [`LANES`]).
+#[inline(always)]
+fn sin_cos_lanes(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    let v: [f64; LANES] = core::array::from_fn(|k| x[k]);
+    let (s, c) = f64x4::from(v).sin_cos();
+    let (s, c) = (s.to_array(), c.to_array());
+    for k in 0..LANES {
+        (sin[k], cos[k]) = if math::abs(v[k]) < SIN_COS_MAX_ARG {
+            (s[k], c[k])
+        } else {
+            math::sin_cos(v[k])
+        };
     }
 }
 
@@ -62,18 +83,35 @@ pub fn sin_cos_into(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
 /// three slices.
 pub fn atan2_into(y: &[f64], x: &[f64], out: &mut [f64]) {
     let n = y.len().min(x.len()).min(out.len());
-    for start in (0..n).step_by(LANES) {
-        let end = n.min(start + LANES);
-        let (mut vy, mut vx) = ([0.0; LANES], [1.0; LANES]);
-        vy[..end - start].copy_from_slice(&y[start..end]);
-        vx[..end - start].copy_from_slice(&x[start..end]);
-        let a = f64x4::from(vy).atan2(f64x4::from(vx)).to_array();
-        for k in 0..end - start {
-            out[start + k] = if vy[k].is_finite() && vx[k].is_finite() {
-                a[k]
-            } else {
-                math::atan2(vy[k], vx[k])
-            };
-        }
+    let (y, x, out) = (&y[..n], &x[..n], &mut out[..n]);
+    let whole = n - n % LANES;
+    let ins = y[..whole]
+        .chunks_exact(LANES)
+        .zip(x[..whole].chunks_exact(LANES));
+    for ((vy, vx), o) in ins.zip(out[..whole].chunks_exact_mut(LANES)) {
+        atan2_lanes(vy, vx, o);
+    }
+    if whole == n {
+        return;
+    }
+    let (mut vy, mut vx, mut o) = ([0.0; LANES], [1.0; LANES], [0.0; LANES]);
+    vy[..n - whole].copy_from_slice(&y[whole..]);
+    vx[..n - whole].copy_from_slice(&x[whole..]);
+    atan2_lanes(&vy, &vx, &mut o);
+    out[whole..].copy_from_slice(&o[..n - whole]);
+}
+
+/// [`atan2_into`] of one vector's worth of values (`y`, `x`, `out` of length [`LANES`]).
+#[inline(always)]
+fn atan2_lanes(y: &[f64], x: &[f64], out: &mut [f64]) {
+    let vy: [f64; LANES] = core::array::from_fn(|k| y[k]);
+    let vx: [f64; LANES] = core::array::from_fn(|k| x[k]);
+    let a = f64x4::from(vy).atan2(f64x4::from(vx)).to_array();
+    for k in 0..LANES {
+        out[k] = if vy[k].is_finite() && vx[k].is_finite() {
+            a[k]
+        } else {
+            math::atan2(vy[k], vx[k])
+        };
     }
 }

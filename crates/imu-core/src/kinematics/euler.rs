@@ -156,6 +156,7 @@ pub fn body_angular_acceleration(e: EulerZyx, d: EulerZyx, dd: EulerZyx) -> Vec3
 /// [`body_rate`] and [`body_angular_acceleration`] together, from the sines and cosines `trig`
 /// of the angles' pitch and roll (taken once for both).
 #[must_use]
+#[inline]
 pub fn body_rate_and_acceleration(
     trig: &PitchRollTrig,
     d: EulerZyx,
@@ -167,6 +168,7 @@ pub fn body_rate_and_acceleration(
 /// `angle` plus the multiple of 2π that brings it closest to `reference` (rad): yaw unwrapping
 /// for callers that evaluate attitudes sample by sample.
 #[must_use]
+#[inline]
 pub fn unwrap_near(angle: f64, reference: f64) -> f64 {
     math::unwrap_near(angle, reference)
 }

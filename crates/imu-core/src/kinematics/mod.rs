@@ -57,6 +57,7 @@ impl<N: NavFrame> Default for Truth<N> {
 impl<N: NavFrame> Truth<N> {
     /// True when every field is finite.
     #[must_use]
+    #[inline]
     pub fn is_finite(&self) -> bool {
         self.t_s.is_finite()
             && self.position_m.is_finite()

@@ -177,6 +177,7 @@ impl TangentTracker {
     ///
     /// # Errors
     /// As [`Self::update`].
+    #[inline]
     pub fn update_sample(
         &mut self,
         index: usize,
