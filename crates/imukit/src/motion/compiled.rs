@@ -3,7 +3,9 @@
 //! [`Program::compile`] turns the parsed trees of several formulas (a motion's three positions
 //! and its angles) into one list of operations in evaluation order: every subexpression that
 //! occurs more than once — within a formula or across them — is computed once, subexpressions
-//! of constants are folded, and values are kept in as few registers as their lifetimes allow.
+//! of constants are folded, a sum, difference, product or quotient with a constant holds the
+//! constant in the operation (not in a register refilled every chunk), and values are kept in as
+//! few registers as their lifetimes allow.
 //! [`Program::eval`] runs the list over up to [`CHUNK`] samples at a time, each register
 //! holding a [`Jet`] per sample: the value and its first three time derivatives.
 //!
@@ -78,6 +80,28 @@ enum Op {
     SinCos(Func1, u32, u32),
     /// `sin` or `cos` from the pair an earlier [`Op::SinCos`] of the same value kept.
     FromPair(Func1, u32, u32),
+    /// `+`, `−`, `×` or `÷` of a value and a constant (on the side given): the same arithmetic
+    /// as the operation on the constant's jet `[c, 0, 0, 0]`, the constant held in the step
+    /// instead of a register filled with it every chunk.
+    WithConst(Arith, u32, f64, Side),
+}
+
+/// The four arithmetic operations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Arith {
+    Add,
+    Sub,
+    Mul,
+    Div,
+}
+
+/// Which operand of [`Op::WithConst`] the constant is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Side {
+    /// `value ∘ constant`.
+    Right,
+    /// `constant ∘ value`.
+    Left,
 }
 
 /// [`Op`] as a hash key (constants by their bits).
@@ -101,6 +125,7 @@ enum Key {
     Select(u32, u32, u32),
     SinCos(Func1, u32, u32),
     FromPair(Func1, u32, u32),
+    WithConst(Arith, u32, u64, Side),
 }
 
 impl Op {
@@ -124,6 +149,7 @@ impl Op {
             Self::Select(c, a, b) => Key::Select(c, a, b),
             Self::SinCos(f, a, k) => Key::SinCos(f, a, k),
             Self::FromPair(f, a, k) => Key::FromPair(f, a, k),
+            Self::WithConst(o, a, c, side) => Key::WithConst(o, a, c.to_bits(), side),
         }
     }
 
@@ -137,7 +163,8 @@ impl Op {
             | Self::F1(_, a)
             | Self::Not(a)
             | Self::SinCos(_, a, _)
-            | Self::FromPair(_, a, _) => (Some(a), None, None),
+            | Self::FromPair(_, a, _)
+            | Self::WithConst(_, a, ..) => (Some(a), None, None),
             Self::Add(a, b)
             | Self::Sub(a, b)
             | Self::Mul(a, b)
@@ -171,6 +198,7 @@ impl Op {
             Self::Select(c, a, b) => Self::Select(f(c), f(a), f(b)),
             Self::SinCos(g, a, k) => Self::SinCos(g, f(a), k),
             Self::FromPair(g, a, k) => Self::FromPair(g, f(a), k),
+            Self::WithConst(o, a, c, side) => Self::WithConst(o, f(a), c, side),
         }
     }
 }
@@ -336,6 +364,26 @@ impl Program {
         for (formulas, order) in groups {
             b.order = *order;
             values.extend(formulas.iter().map(|f| b.node(f.root())));
+        }
+        // An operation of a value and a constant holds the constant itself (the same numbers;
+        // a constant read by nothing else is then dropped below).
+        for i in 0..b.ops.len() {
+            let (arith, x, y) = match b.ops[i].1 {
+                Op::Add(x, y) => (Arith::Add, x, y),
+                Op::Sub(x, y) => (Arith::Sub, x, y),
+                Op::Mul(x, y) => (Arith::Mul, x, y),
+                Op::Div(x, y) => (Arith::Div, x, y),
+                _ => continue,
+            };
+            let constant = |v: u32| match b.ops[v as usize].1 {
+                Op::Const(c) => Some(c),
+                _ => None,
+            };
+            b.ops[i].1 = match (constant(x), constant(y)) {
+                (None, Some(c)) => Op::WithConst(arith, x, c, Side::Right),
+                (Some(c), None) => Op::WithConst(arith, y, c, Side::Left),
+                _ => continue,
+            };
         }
         // Keep only what the outputs need.
         let mut needed = vec![false; b.ops.len()];
@@ -529,6 +577,19 @@ fn apply<A: Arithmetic>(op: Op, args: &[Jet]) -> Jet {
             }
         }
         Op::SinCos(f, ..) | Op::FromPair(f, ..) => func1::<A>(f, arg(0)),
+        Op::WithConst(arith, _, c, side) => {
+            let k = [c, 0.0, 0.0, 0.0];
+            let (x, y) = match side {
+                Side::Right => (arg(0), k),
+                Side::Left => (k, arg(0)),
+            };
+            match arith {
+                Arith::Add => add(x, y),
+                Arith::Sub => sub(x, y),
+                Arith::Mul => A::mul(x, y),
+                Arith::Div => A::div(x, y),
+            }
+        }
     }
 }
 
@@ -641,6 +702,19 @@ fn run<A: Arithmetic>(
             let (x, pair) = (regs.get(a), &pairs[k as usize]);
             for ((o, x), p) in out.iter_mut().zip(x).zip(pair) {
                 *o = from_pair::<A>(f, *x, *p);
+            }
+        }
+        Op::WithConst(arith, a, c, side) => {
+            let (x, k) = (regs.get(a), [c, 0.0, 0.0, 0.0]);
+            match (arith, side) {
+                (Arith::Add, Side::Right) => map1(out, x, |x| add(x, k)),
+                (Arith::Add, Side::Left) => map1(out, x, |x| add(k, x)),
+                (Arith::Sub, Side::Right) => map1(out, x, |x| sub(x, k)),
+                (Arith::Sub, Side::Left) => map1(out, x, |x| sub(k, x)),
+                (Arith::Mul, Side::Right) => map1(out, x, |x| A::mul(x, k)),
+                (Arith::Mul, Side::Left) => map1(out, x, |x| A::mul(k, x)),
+                (Arith::Div, Side::Right) => map1(out, x, |x| A::div(x, k)),
+                (Arith::Div, Side::Left) => map1(out, x, |x| A::div(k, x)),
             }
         }
     }
@@ -939,7 +1013,7 @@ mod tests {
             "exp(0.1*t) + ln(t + 1) + log10(t + 2) + log2(t + 3) + sqrt(t + 1) + cbrt(t + 1) + abs(t - 2)",
             "atan2(t - 1, 2 - t) + atan2(1, t) + hypot(t, 2) + pow(t + 1, 0.5*t) + (t + 1)^(t/3)",
             "min(t, 2) + max(t^2, 3) + if(t < 1 && t >= 0.2 || t > 4, t^2, -t) + piecewise(t < 2, t, t > 3, 2*t, 5 - t)",
-            "2*pi*3 + t/(1 + t^2) - (t - 2)^4",
+            "2*pi*3 + t/(1 + t^2) - (t - 2)^4 + 3/(t + 1) + (t + 2)*0.5 - 1.5/t",
         ];
         let exprs: Vec<Expr> = formulas.iter().map(|f| parse(f)).collect();
         let refs: Vec<&Expr> = exprs.iter().collect();
@@ -1009,10 +1083,17 @@ mod tests {
         let both = Program::compile(&[&a, &b], Order::Third).unwrap();
         let alone = Program::compile(&[&a], Order::Third).unwrap().len()
             + Program::compile(&[&b], Order::Third).unwrap().len();
-        // The phase `0.16*t + 0.02*sin(0.5*t)` (t, 4 constants, 5 operations) is shared.
+        // The phase `0.16*t + 0.02*sin(0.5*t)` (t and 5 operations) is shared.
         assert!(both.len() + 5 <= alone, "{} vs {alone}", both.len());
+        // Constants are folded, and an operation holds its constant operand: t, then 6π·t.
         let folded = Program::compile(&[&parse("2*pi*3*t")], Order::Third).unwrap();
-        assert_eq!(folded.len(), 3, "{folded:?}"); // const 6π, t, product
+        assert_eq!(folded.len(), 2, "{folded:?}");
+        assert!(matches!(
+            folded.steps[1].1,
+            Op::WithConst(Arith::Mul, _, c, Side::Left) if c == 2.0 * std::f64::consts::PI * 3.0
+        ));
+        let constant_out = Program::compile(&[&parse("2*pi")], Order::Third).unwrap();
+        assert!(matches!(constant_out.steps[..], [(_, Op::Const(_), _)]));
     }
 
     #[test]
