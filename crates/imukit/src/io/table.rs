@@ -823,6 +823,56 @@ mod tests {
     }
 
     #[test]
+    fn rows_are_each_values_shortest_text_byte_for_byte() {
+        // Numbers of every text length (3 to 24 characters: integers, decimals, quantised
+        // readings, random bit patterns of every exponent) over several 64 KiB blocks, and every separator length
+        // the commands use, against the plain join of zmij's texts.
+        let mut z: u64 = 0x0123_4567_89AB_CDEF;
+        let mut next = || {
+            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut v = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            v = (v ^ (v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            v ^ (v >> 31)
+        };
+        let mut data = Vec::new();
+        for i in 0..40_000 {
+            let r = next();
+            data.push(match i % 5 {
+                0 => f64::from_bits(r & !(0x7FF << 52) | ((r % 2046 + 1) << 52)),
+                1 => 1e-6 * ((r % 20_000_000) as f64 - 1e7),
+                2 => (r % 1000) as f64,
+                3 => (r % 10_u64.pow(1 + i % 16)) as f64 / 10_f64.powi((i % 7) as i32),
+                _ => f64::from(i) / 100.0,
+            });
+        }
+        let mut lengths = std::collections::BTreeSet::new();
+        let mut buf = zmij::Buffer::new();
+        for separator in [b",".as_slice(), b" ", b", "] {
+            for width in [1, 10, 23] {
+                let mut out = Vec::new();
+                write_rows(&mut out, &data, width, separator).expect("written to memory");
+                let mut want = Vec::new();
+                for row in data.chunks(width) {
+                    for (k, v) in row.iter().enumerate() {
+                        if k > 0 {
+                            want.extend_from_slice(separator);
+                        }
+                        let text = buf.format(*v);
+                        lengths.insert(text.len());
+                        want.extend_from_slice(text.as_bytes());
+                    }
+                    want.push(b'\n');
+                }
+                assert!(out == want, "width {width}, separator {separator:?}");
+            }
+        }
+        assert!(
+            lengths.iter().copied().eq(3..=24),
+            "text lengths: {lengths:?}"
+        );
+    }
+
+    #[test]
     fn values_are_read_with_whitespace_trimmed_and_bad_ones_named_by_row_and_column() {
         let dir = std::env::temp_dir().join(format!("imukit-table-trim-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("a temporary folder");
