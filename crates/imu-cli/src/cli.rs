@@ -52,9 +52,10 @@ pub enum Command {
         #[arg(long)]
         runs: Option<u64>,
         /// Use at most this many threads (default: every core this process may use). A single
-        /// run uses up to two, the truth a chunk ahead of the sensors and the files (by default
-        /// from 1 537 samples, four chunks); with --runs, this many runs go at a time. The
-        /// numbers are the same however many.
+        /// run uses up to three (by default from 1 537 samples, four chunks): the truth, the
+        /// sensors and the files, each a chunk ahead of the next; on two, CSV is written on its
+        /// own thread, binary files beside the sensors. With --runs, this many runs go at a
+        /// time. The numbers are the same however many.
         #[arg(long, allow_negative_numbers = true)]
         threads: Option<i64>,
     },

@@ -999,10 +999,10 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
 }
 
 #[test]
-fn simulate_writes_the_same_bytes_on_one_thread_or_two_and_refuses_no_thread() {
+fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thread() {
     let dir = temp_dir("threads");
-    // Five streamed chunks of the figure-8, with sensor noise: the truth crosses to the second
-    // thread chunk by chunk while the noise is drawn on the first.
+    // Five streamed chunks of the figure-8, with sensor noise: the truth, the readings and the
+    // writing cross between threads chunk by chunk while the noise is drawn in order.
     std::fs::write(
         dir.join("s.toml"),
         "rate_hz = 2000.0\nduration_s = 10.0\n[trajectory]\ntype = \"builtin\"\n\
@@ -1011,26 +1011,71 @@ fn simulate_writes_the_same_bytes_on_one_thread_or_two_and_refuses_no_thread() {
     )
     .unwrap();
     let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
-    for (threads, tag) in [(None, "auto"), (Some("1"), "one"), (Some("2"), "two")] {
-        let (imu, truth) = (format!("imu_{tag}.npy"), format!("truth_{tag}.csv"));
-        let mut args = vec!["simulate", "s.toml", "--out", &imu, "--truth", &truth];
-        args.extend(threads.map(|n| ["--threads", n]).into_iter().flatten());
+    // Text among the outputs (written on its own thread when there are two), binary alone (the
+    // truth a chunk ahead instead), and both.
+    for (imu_ext, truth_ext) in [
+        ("npy", Some("csv")),
+        ("csv", None),
+        ("parquet", Some("npz")),
+    ] {
+        for (threads, tag) in [
+            (None, "auto"),
+            (Some("1"), "one"),
+            (Some("2"), "two"),
+            (Some("3"), "three"),
+        ] {
+            let imu = format!("imu_{tag}.{imu_ext}");
+            let truth = truth_ext.map(|e| format!("truth_{tag}.{e}"));
+            let mut args = vec!["simulate", "s.toml", "--out", &imu];
+            args.extend(truth.iter().flat_map(|t| ["--truth", t.as_str()]));
+            args.extend(threads.map(|n| ["--threads", n]).into_iter().flatten());
+            let (code, err) = run_in(&dir, &args);
+            assert_eq!(code, Some(0), "{tag}: {err}");
+        }
+        if imu_ext == "npy" {
+            // Every row: 20 001 samples of ten float64 columns after NumPy's header (< 1 KiB).
+            let header = read("imu_one.npy").len() - 20_001 * 10 * 8;
+            assert!((64..1024).contains(&header), "{header}");
+        }
+        for tag in ["auto", "two", "three"] {
+            let same = |name: &str, ext: &str| {
+                read(&format!("{name}_{tag}.{ext}")) == read(&format!("{name}_one.{ext}"))
+            };
+            assert!(same("imu", imu_ext), "{tag}: IMU .{imu_ext}");
+            if let Some(e) = truth_ext {
+                assert!(same("truth", e), "{tag}: truth .{e}");
+            }
+        }
+    }
+    // A run that breaks off after a few chunks: the same error on every split, and no file.
+    std::fs::write(
+        dir.join("breaks.toml"),
+        "rate_hz = 2000.0\nduration_s = 10.0\n[trajectory]\ntype = \"expression\"\n\
+         position_m = [\"t\", \"0\", \"sqrt(7 - t)\"]\nattitude = \"tangent\"\n",
+    )
+    .unwrap();
+    let mut errors = Vec::new();
+    for threads in ["1", "2", "3"] {
+        let args = [
+            "simulate",
+            "breaks.toml",
+            "--out",
+            "b.csv",
+            "--truth",
+            "bt.npy",
+            "--threads",
+            threads,
+        ];
         let (code, err) = run_in(&dir, &args);
-        assert_eq!(code, Some(0), "{tag}: {err}");
-    }
-    // Every row: 20 001 samples of ten float64 columns after NumPy's header (< 1 KiB here).
-    let header = read("imu_one.npy").len() - 20_001 * 10 * 8;
-    assert!((64..1024).contains(&header), "{header}");
-    for tag in ["auto", "two"] {
+        assert_eq!(code, Some(65), "{threads}: {err}");
         assert!(
-            read(&format!("imu_{tag}.npy")) == read("imu_one.npy"),
-            "{tag}: IMU"
+            !dir.join("b.csv").exists() && !dir.join("bt.npy").exists(),
+            "{threads}"
         );
-        assert!(
-            read(&format!("truth_{tag}.csv")) == read("truth_one.csv"),
-            "{tag}: truth"
-        );
+        errors.push(err);
     }
+    assert!(errors[0].contains("t = 7"), "{}", errors[0]);
+    assert!(errors.iter().all(|e| *e == errors[0]), "{errors:?}");
     // Monte Carlo runs at most --threads at a time, each run the same as with every core.
     for (threads, out) in [("1", "mc_one.csv"), ("8", "mc_many.csv")] {
         let args = [

@@ -1,12 +1,14 @@
-//! One run on two threads: the truth of the next chunk is made on a second thread while the
-//! caller's thread measures, tabulates and writes the previous one (a two-stage pipeline).
+//! One run on two or three threads: the truth of the next chunk is made on one thread while
+//! another measures and tabulates the previous one, and (for a run that writes files) a third
+//! writes the chunk before (a pipeline of stages).
 //!
 //! Each stage runs on one thread and keeps its order, so the numbers are those of a single
-//! thread bit for bit: the truth is the same function of the sample times, and the sensors draw
-//! their noise on the caller's thread in sample order, from the same stream. What changes is the
-//! wall-clock time, when a second core is free (see docs/design.md §1 for the figures).
+//! thread bit for bit: the truth is the same function of the sample times, the sensors draw
+//! their noise in sample order from the same stream, and the files get the same rows in the same
+//! order. What changes is the wall-clock time, when cores are free (see docs/design.md §1 and §8
+//! for the figures).
 //!
-//! Memory stays flat: at most two finished chunks wait between the stages, and their buffers go
+//! Memory stays flat: at most two finished chunks wait between two stages, and their buffers go
 //! back to the producer to be refilled.
 use std::num::NonZeroUsize;
 use std::sync::mpsc;
@@ -19,11 +21,17 @@ use crate::error::{Error, Result, invalid};
 pub enum RunThreads {
     /// Truth, sensors and outputs on the caller's thread.
     One,
-    /// The truth a chunk ahead on a second thread; sensors and outputs on the caller's.
+    /// Two stages. A run that writes files ([`crate::Scenario::stream_to_files`]) makes its truth
+    /// and readings on a second thread and writes them on the caller's (formatting CSV takes
+    /// about as long as the rest); any other run makes its truth a chunk ahead on a second
+    /// thread, its readings on the caller's.
     Two,
-    /// [`RunThreads::Two`] when this process may use more than one core
-    /// ([`std::thread::available_parallelism`]: affinity masks and cgroup quotas count) and the
-    /// run has at least [`AUTO_MIN_CHUNKS`] chunks, else [`RunThreads::One`].
+    /// Three stages: the truth a chunk ahead on one thread, the readings on a second and, for a
+    /// run that writes files, the files on the caller's; [`RunThreads::Two`] for any other run.
+    Three,
+    /// As many stages as this process may use cores ([`std::thread::available_parallelism`]:
+    /// affinity masks and cgroup quotas count), at most three, when the run has at least
+    /// [`AUTO_MIN_CHUNKS`] chunks; else [`RunThreads::One`].
     #[default]
     Auto,
 }
@@ -44,7 +52,8 @@ pub fn available_cores() -> usize {
 impl RunThreads {
     /// From the most threads a user lets one run use (as a command line or Python gives it),
     /// named `field` in the error: `None` is [`RunThreads::Auto`], 1 is [`RunThreads::One`], 2
-    /// or more [`RunThreads::Two`] (a run has two stages to share out).
+    /// [`RunThreads::Two`], 3 or more [`RunThreads::Three`] (a run has at most three stages to
+    /// share out).
     ///
     /// # Errors
     /// [`Error::Invalid`] on `field` for a count below 1.
@@ -52,19 +61,28 @@ impl RunThreads {
         match count {
             None => Ok(Self::Auto),
             Some(1) => Ok(Self::One),
-            Some(n) if n >= 2 => Ok(Self::Two),
+            Some(2) => Ok(Self::Two),
+            Some(n) if n >= 3 => Ok(Self::Three),
             Some(n) => Err(invalid(field, format!("must be ≥ 1 thread, got {n}"))),
         }
     }
 
-    /// Whether a run of `chunks` chunks is split over two threads.
+    /// The threads (1 to 3) a run of `chunks` chunks is split over.
+    #[must_use]
+    pub fn stages(self, chunks: usize) -> usize {
+        match self {
+            Self::One => 1,
+            Self::Two => 2,
+            Self::Three => 3,
+            Self::Auto if chunks < AUTO_MIN_CHUNKS => 1,
+            Self::Auto => available_cores().min(3),
+        }
+    }
+
+    /// Whether a run of `chunks` chunks is split over two threads or more.
     #[must_use]
     pub fn pipelined(self, chunks: usize) -> bool {
-        match self {
-            Self::One => false,
-            Self::Two => true,
-            Self::Auto => chunks >= AUTO_MIN_CHUNKS && available_cores() >= 2,
-        }
+        self.stages(chunks) >= 2
     }
 }
 
@@ -202,7 +220,8 @@ mod tests {
         assert_eq!(at_most(None), Some(RunThreads::Auto));
         assert_eq!(at_most(Some(1)), Some(RunThreads::One));
         assert_eq!(at_most(Some(2)), Some(RunThreads::Two));
-        assert_eq!(at_most(Some(64)), Some(RunThreads::Two));
+        assert_eq!(at_most(Some(3)), Some(RunThreads::Three));
+        assert_eq!(at_most(Some(64)), Some(RunThreads::Three));
         for n in [0, -3] {
             let err = RunThreads::at_most(Some(n), "--threads").expect_err("no thread");
             assert_eq!(
@@ -212,5 +231,7 @@ mod tests {
         }
         assert!(!RunThreads::One.pipelined(100) && RunThreads::Two.pipelined(1));
         assert!(!RunThreads::Auto.pipelined(AUTO_MIN_CHUNKS - 1));
+        let auto = RunThreads::Auto.stages(AUTO_MIN_CHUNKS);
+        assert_eq!(auto, available_cores().min(3));
     }
 }
