@@ -170,54 +170,80 @@ fn a_value_gets_the_same_result_wherever_it_sits() {
     }
 }
 
-/// `EulerTrig::of_each` (kernels, many attitudes) against `EulerTrig::of` (the C library, one):
-/// every sine and cosine within `MAX_ULP + 1` ulp of the library's (each is within `MAX_ULP`,
-/// resp. one, of the correctly rounded value), whatever the block; rolls all zero take the
-/// three-value path with exact `(±0, 1)`.
+/// `EulerTrig::of_each` (many attitudes) against the correctly rounded values: the half angles'
+/// within `MAX_ULP`, the pitch's and roll's sines within `DOUBLE_ANGLE_ULP` ulp and their
+/// cosines within `DOUBLE_ANGLE_ULP` ulp of 1 (the double-angle formulas); zero rolls on the
+/// two-value path with exact `(±0, 1)`; split anywhere, the same numbers.
 #[test]
-fn many_attitudes_trig_is_one_attitudes_within_the_bound() {
+fn many_attitudes_trig_is_within_the_bound_of_the_correctly_rounded_values() {
     use imu_core::EulerZyx;
-    use imu_core::kinematics::euler::EulerTrig;
-    let yaw = uniform(150, 10.0, 5);
-    let pitch = uniform(150, 1.5, 6);
-    let roll = uniform(150, 3.0, 7);
+    use imu_core::kinematics::euler::{DOUBLE_ANGLE_ULP, EulerTrig};
+    let n = 20_000;
+    let yaw = uniform(n, 10.0, 5);
+    // Pitch over its whole range, ±π/2 included (the cosine's absolute bound matters there).
+    let mut pitch = uniform(n, std::f64::consts::FRAC_PI_2, 6);
+    pitch[..4].copy_from_slice(&[
+        std::f64::consts::FRAC_PI_2,
+        -std::f64::consts::FRAC_PI_2,
+        0.0,
+        -0.0,
+    ]);
+    let roll = uniform(n, 3.0, 7);
+    let ulp_of_one = f64::EPSILON;
+    let (mut worst_sin, mut worst_cos) = (0.0_f64, 0.0_f64);
     for zero_roll in [false, true] {
-        let euler: Vec<EulerZyx> = (0..150)
+        let euler: Vec<EulerZyx> = (0..n)
             .map(|i| {
                 let r = if zero_roll { 0.0 * roll[i] } else { roll[i] };
                 EulerZyx::new(yaw[i], pitch[i], r)
             })
             .collect();
-        let mut many = vec![EulerTrig::of(EulerZyx::default()); 150];
+        let mut many = vec![EulerTrig::of(EulerZyx::default()); n];
         EulerTrig::of_each(&euler, &mut many);
         for (e, got) in euler.iter().zip(&many) {
-            let want = EulerTrig::of(*e);
-            let pairs = |t: &EulerTrig| {
-                let p = t.pitch_roll;
-                [
-                    (p.sin_pitch, p.cos_pitch),
-                    (p.sin_roll, p.cos_roll),
-                    t.half.yaw,
-                    t.half.pitch,
-                    t.half.roll,
-                ]
-            };
-            for ((gs, gc), (ws, wc)) in pairs(got).into_iter().zip(pairs(&want)) {
-                for (g, w) in [(gs, ws), (gc, wc)] {
-                    assert!(ulps(g, w) <= f64::from(MAX_ULP + 1), "{e:?}: {g} vs {w}");
-                }
+            let halves = [
+                (e.yaw_rad * 0.5, got.half.yaw),
+                (e.pitch_rad * 0.5, got.half.pitch),
+                (e.roll_rad * 0.5, got.half.roll),
+            ];
+            for (x, (s, c)) in halves {
+                assert!(
+                    ulps(s, pxfm::f_sin(x)) <= f64::from(MAX_ULP),
+                    "{e:?}: sin({x})"
+                );
+                assert!(
+                    ulps(c, pxfm::f_cos(x)) <= f64::from(MAX_ULP),
+                    "{e:?}: cos({x})"
+                );
+            }
+            let p = got.pitch_roll;
+            for (x, s, c) in [
+                (e.pitch_rad, p.sin_pitch, p.cos_pitch),
+                (e.roll_rad, p.sin_roll, p.cos_roll),
+            ] {
+                worst_sin = worst_sin.max(ulps(s, pxfm::f_sin(x)));
+                worst_cos = worst_cos.max((c - pxfm::f_cos(x)).abs() / ulp_of_one);
             }
             if zero_roll {
-                assert_eq!(got.pitch_roll.sin_roll.to_bits(), e.roll_rad.to_bits());
-                assert_eq!((got.pitch_roll.cos_roll, got.half.roll.1), (1.0, 1.0));
+                assert_eq!(p.sin_roll.to_bits(), e.roll_rad.to_bits());
+                assert_eq!((p.cos_roll, got.half.roll.1), (1.0, 1.0));
             }
         }
+        assert_eq!(many[2].pitch_roll.sin_pitch.to_bits(), 0.0_f64.to_bits());
+        assert_eq!(many[3].pitch_roll.sin_pitch.to_bits(), (-0.0_f64).to_bits());
+        assert_eq!(many[2].pitch_roll.cos_pitch, 1.0);
         // Split anywhere, the same numbers.
         let mut split = many.clone();
         EulerTrig::of_each(&euler[..37], &mut split[..37]);
         EulerTrig::of_each(&euler[37..], &mut split[37..]);
         assert_eq!(split, many);
     }
+    eprintln!("double angles: sin {worst_sin} ulp, cos {worst_cos} ulp of 1");
+    let bound = f64::from(DOUBLE_ANGLE_ULP);
+    assert!(
+        worst_sin <= bound && worst_cos <= bound,
+        "sin off by {worst_sin} ulp, cos by {worst_cos} ulp of 1"
+    );
 }
 
 /// `TangentSample::of_each` (kernels' arctangents, many samples) against `TangentSample::at`
