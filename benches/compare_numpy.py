@@ -29,7 +29,7 @@ time ratio at 10⁶ samples.
 
 Run (prints tables of time ratios; first one core — both sides single-threaded, imukit with
 ``threads=1`` / ``--threads 1`` — then the formula job with imukit on every core it may use, where
-one run makes its truth a chunk ahead on a second thread):
+one run makes its truth, readings and file a chunk apart on up to three threads, docs/design.md §1):
     python benches/compare_numpy.py                     # N = 10⁴ … 10⁶
     python benches/compare_numpy.py --sizes 1e4 1e5 1e6 1e7 --rust
 """
@@ -348,8 +348,9 @@ def main() -> None:
                              *(None if args.no_cli else cli_formula_time(n, prm, Path(tmp), ext, threads=None)
                                for ext in ("csv", "parquet", "npy")))
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    print(f"the formula job with imukit on every core it may use ({cores} here: one run puts its truth a chunk "
-          "ahead on a second thread, same numbers); NumPy as above, single-threaded")
+    print(f"the formula job with imukit on every core it may use ({cores} here: one run makes its truth, its "
+          "readings and its file a chunk apart on up to three threads, same numbers); NumPy as above, "
+          "single-threaded")
     print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
           f"{'formulas, CLI (.npy)':>20}")
     for n, (t_fnp, *ours) in every_core.items():
