@@ -126,12 +126,9 @@ impl EulerTrig {
                 } else {
                     (e.roll_rad * 0.5, 1.0)
                 };
+                // A zero roll's `(±0, 1)` halves give `(±0, 1)` exactly.
                 let (sin_pitch, cos_pitch) = double_angle(half_pitch);
-                let (sin_roll, cos_roll) = if rolls {
-                    double_angle(half_roll)
-                } else {
-                    (e.roll_rad, 1.0)
-                };
+                let (sin_roll, cos_roll) = double_angle(half_roll);
                 *o = Self {
                     pitch_roll: PitchRollTrig {
                         sin_pitch,

@@ -173,6 +173,11 @@ impl Scenario {
             open(outputs.odometer)?,
         );
         let tabulate = truth.is_some();
+        // Whether any file is CSV: it decides how two threads share the run (below).
+        let text = [&imu, &truth, &gnss, &baro, &odometer]
+            .into_iter()
+            .flatten()
+            .any(|s| s.format == TableFormat::Csv);
         let mut write = |chunks: &[Chunk]| -> Result<()> {
             for chunk in chunks {
                 for (sink, table) in [
@@ -195,16 +200,6 @@ impl Scenario {
         // other. Binary files take little writing: there, as for tables, the truth is made a
         // chunk ahead on the second thread (1.1–1.2× faster than the other split, measured).
         // Three threads do all three at once.
-        let text = [
-            outputs.imu,
-            outputs.truth,
-            outputs.gnss,
-            outputs.baro,
-            outputs.odometer,
-        ]
-        .into_iter()
-        .flatten()
-        .any(|p| TableFormat::of(p) == TableFormat::Csv);
         let (writer, maker) = match threads.stages(chunks) {
             1 => (RunThreads::One, RunThreads::One),
             2 if text => (RunThreads::Two, RunThreads::One),
@@ -431,6 +426,7 @@ impl Scenario {
 /// columns once, then the chunks' rows, each checked finite and named by its file row.
 struct TableSink {
     file: AtomicFile,
+    format: TableFormat,
     name: String,
     /// The next row's number in the file (a CSV file's header is row 1).
     next_row: usize,
@@ -440,10 +436,12 @@ struct TableSink {
 
 impl TableSink {
     fn create(path: &Path, metadata: &[(String, String)]) -> Result<Self> {
+        let format = TableFormat::of(path);
         Ok(Self {
             file: AtomicFile::create(path)?,
+            format,
             name: path.display().to_string(),
-            next_row: TableFormat::of(path).first_row(),
+            next_row: format.first_row(),
             metadata: metadata.to_vec(),
             started: false,
         })
