@@ -1,24 +1,25 @@
 //! The `imukit` binary as a user runs it.
-use std::path::PathBuf;
 use std::process::Command;
 
 fn imukit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_imukit"))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("imukit-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
 fn demo_writes_its_outputs_and_says_where() {
     let dir = temp_dir("demo");
+    let dir = dir.path();
     let out = imukit()
         .args(["demo", "--out-dir"])
-        .arg(&dir)
+        .arg(dir)
         .output()
         .unwrap();
     assert!(
@@ -46,6 +47,7 @@ fn demo_writes_its_outputs_and_says_where() {
 #[test]
 fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
     let dir = temp_dir("roundtrip");
+    let dir = dir.path();
     let list = imukit().arg("scenario").output().unwrap();
     let names = String::from_utf8(list.stdout).unwrap();
     assert_eq!(names.lines().count(), 6);
@@ -65,7 +67,7 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
         assert!(status.success(), "{name}");
         let direct = imukit::scenario::builtin::spec(name)
             .unwrap()
-            .resolve(&dir)
+            .resolve(dir)
             .unwrap()
             .simulate()
             .unwrap();
@@ -87,6 +89,7 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
 #[test]
 fn bad_input_exits_non_zero_with_a_located_message_and_no_output_file() {
     let dir = temp_dir("bad");
+    let dir = dir.path();
     let scenario = dir.join("bad.toml");
     std::fs::write(
         &scenario,
@@ -126,9 +129,10 @@ fn bad_input_exits_non_zero_with_a_located_message_and_no_output_file() {
 #[test]
 fn exercise_writes_the_datasets_trajectories_and_figure() {
     let dir = temp_dir("exercise");
+    let dir = dir.path();
     let out = imukit()
         .args(["exercise", "--out-dir"])
-        .arg(&dir)
+        .arg(dir)
         .output()
         .unwrap();
     assert!(
@@ -179,6 +183,7 @@ fn exercise_writes_the_datasets_trajectories_and_figure() {
 #[test]
 fn integrate_refuses_bad_input_with_its_line() {
     let dir = temp_dir("integrate");
+    let dir = dir.path();
     std::fs::write(dir.join("bad.dat"), "0 0 0 0\n0.1 0 0 0 9\n").unwrap();
     let out = imukit()
         .arg("integrate")
@@ -224,6 +229,7 @@ fn integrate_refuses_bad_input_with_its_line() {
 #[test]
 fn simulate_integrate_compare_closes_the_loop() {
     let dir = temp_dir("loop");
+    let dir = dir.path();
     std::fs::write(
         dir.join("helix.toml"),
         "rate_hz = 400.0\nduration_s = 10.0\nnav_frame = \"NED\"\n[trajectory]\ntype = \"expression\"\n\
@@ -232,7 +238,7 @@ fn simulate_integrate_compare_closes_the_loop() {
     )
     .unwrap();
     let run = |args: &[&str]| {
-        let out = imukit().current_dir(&dir).args(args).output().unwrap();
+        let out = imukit().current_dir(dir).args(args).output().unwrap();
         assert!(
             out.status.success(),
             "{args:?}: {}",
@@ -306,7 +312,7 @@ fn simulate_integrate_compare_closes_the_loop() {
     // Missing columns are named.
     std::fs::write(dir.join("few.csv"), "t_s,accel_x_m_s2\n0,0\n0.1,0\n").unwrap();
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["integrate", "few.csv", "--out", "n.csv"])
         .output()
         .unwrap();
@@ -321,6 +327,7 @@ fn simulate_integrate_compare_closes_the_loop() {
 #[test]
 fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
     let dir = temp_dir("orient");
+    let dir = dir.path();
     let header =
         "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s";
     let good = format!("{header}\n0.00,0,0,9.81,0,0,0\n0.01,0,0,9.81,0,0,0\n0.02,0,0,9.81,0,0,0\n");
@@ -387,6 +394,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
 #[test]
 fn gravity_flag_carries_its_unit_and_keeps_the_old_spelling() {
     let dir = temp_dir("gravity");
+    let dir = dir.path();
     let scenario = dir.join("static.toml");
     std::fs::write(
         &scenario,
@@ -452,6 +460,7 @@ fn gravity_flag_carries_its_unit_and_keeps_the_old_spelling() {
 #[test]
 fn a_duplicated_column_or_a_missing_position_is_refused_not_a_panic() {
     let dir = temp_dir("columns");
+    let dir = dir.path();
     let dup = dir.join("dup.csv");
     std::fs::write(
         &dup,
@@ -506,6 +515,7 @@ fn a_duplicated_column_or_a_missing_position_is_refused_not_a_panic() {
 #[test]
 fn a_deeply_nested_or_very_long_formula_is_refused_without_a_crash() {
     let dir = temp_dir("nesting");
+    let dir = dir.path();
     let nested = format!("{}t{}", "(".repeat(5000), ")".repeat(5000));
     let sum = vec!["t"; 40_000].join("+");
     for (formula, message) in [
@@ -539,7 +549,7 @@ fn a_deeply_nested_or_very_long_formula_is_refused_without_a_crash() {
         let err = String::from_utf8(out.stderr).unwrap();
         assert_eq!(out.status.code(), Some(65), "{err}");
         assert!(err.contains(message), "{err}");
-        let left: Vec<_> = std::fs::read_dir(&dir)
+        let left: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name())
             .collect();
@@ -560,12 +570,13 @@ fn run_in(dir: &std::path::Path, args: &[&str]) -> (Option<i32>, String) {
 #[test]
 fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special() {
     let dir = temp_dir("outputs");
+    let dir = dir.path();
     let scenario = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/expression.toml"),
     )
     .unwrap();
     std::fs::write(dir.join("s.toml"), &scenario).unwrap();
-    let (code, err) = run_in(&dir, &["simulate", "s.toml", "--out", "s.toml"]);
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "s.toml"]);
     assert_eq!(code, Some(65));
     assert!(
         err.contains("--out: s.toml is also the scenario file"),
@@ -576,23 +587,23 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
         scenario
     );
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["simulate", "s.toml", "--out", "i.csv", "--truth", "./i.csv"],
     );
     assert_eq!(code, Some(65));
     assert!(err.contains("--truth: ./i.csv is also the --out"), "{err}");
     std::fs::create_dir_all(dir.join("folder")).unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["simulate", "s.toml", "--out", "i.csv", "--truth", "folder"],
     );
     assert_eq!(code, Some(65));
     assert!(err.contains("folder is a folder"), "{err}");
-    let (code, err) = run_in(&dir, &["simulate", "s.toml", "--out", "-"]);
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "-"]);
     assert_eq!(code, Some(65));
     assert!(err.contains("/dev/stdout"), "{err}");
     // Nothing was written by the refused runs.
-    let mut left: Vec<String> = std::fs::read_dir(&dir)
+    let mut left: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
@@ -601,7 +612,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
 
     // The usual way to discard outputs: /dev/null is written, not replaced.
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "s.toml",
@@ -618,7 +629,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
     // A long legal name still gets a temporary name within the file-name limit.
     let long = format!("{}.csv", "x".repeat(250));
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["simulate", "s.toml", "--out", &long, "--truth", "t.csv"],
     );
     assert_eq!(code, Some(0), "{err}");
@@ -635,7 +646,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
         vec!["plot", "t.svg", "--out", "t.svg"],
     ] {
         let before = std::fs::read(dir.join(args.last().unwrap())).unwrap();
-        let (code, err) = run_in(&dir, &args);
+        let (code, err) = run_in(dir, &args);
         assert_eq!(code, Some(65), "{args:?}: {err}");
         assert!(
             err.contains("writing it would destroy the input"),
@@ -647,7 +658,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
         );
     }
     // A figure extension is checked before the table is written.
-    let (code, err) = run_in(&dir, &["allan", &long, "--out", "a.csv", "--plot", "a.txt"]);
+    let (code, err) = run_in(dir, &["allan", &long, "--out", "a.csv", "--plot", "a.txt"]);
     assert_eq!(code, Some(74));
     assert!(
         err.contains("a.txt: the figure file must end in .svg or .png"),
@@ -656,7 +667,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
     assert!(!dir.join("a.csv").exists());
     // An unknown built-in leaves no folder behind.
     let (code, _) = run_in(
-        &dir,
+        dir,
         &["demo", "--scenario", "nosuch", "--out-dir", "newdir"],
     );
     assert_eq!(code, Some(65));
@@ -666,6 +677,7 @@ fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special()
 #[test]
 fn an_allan_deviation_that_overflows_is_refused_and_nothing_is_written() {
     let dir = temp_dir("allan-overflow");
+    let dir = dir.path();
     let mut text = String::from("t_s,gyro_x_rad_s\n");
     for k in 0..200 {
         let v = if k == 5 { "1e200" } else { "0.001" };
@@ -673,7 +685,7 @@ fn an_allan_deviation_that_overflows_is_refused_and_nothing_is_written() {
     }
     std::fs::write(dir.join("imu.csv"), text).unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["allan", "imu.csv", "--out", "a.csv", "--plot", "a.png"],
     );
     assert_eq!(code, Some(65), "{err}");
@@ -687,6 +699,7 @@ fn an_allan_deviation_that_overflows_is_refused_and_nothing_is_written() {
 #[test]
 fn compare_refuses_truth_times_that_repeat_or_go_back_anywhere_in_the_file() {
     let dir = temp_dir("compare-times");
+    let dir = dir.path();
     let header = "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,q_w,q_x,q_y,q_z\n";
     let rows = |times: &[&str]| {
         let mut s = header.to_string();
@@ -698,14 +711,14 @@ fn compare_refuses_truth_times_that_repeat_or_go_back_anywhere_in_the_file() {
     std::fs::write(dir.join("zero.csv"), rows(&["0", "0", "0"])).unwrap();
     std::fs::write(dir.join("back.csv"), rows(&["0", "2", "1"])).unwrap();
     std::fs::write(dir.join("est.csv"), rows(&["0", "0.5", "1"])).unwrap();
-    let (code, err) = run_in(&dir, &["compare", "zero.csv", "zero.csv"]);
+    let (code, err) = run_in(dir, &["compare", "zero.csv", "zero.csv"]);
     assert_eq!(code, Some(65), "{err}");
     assert!(
         err.contains("zero.csv, row 3: truth time 0 s does not increase (previous 0 s)"),
         "{err}"
     );
     // The bad row lies past every estimate time: it is found all the same.
-    let (code, err) = run_in(&dir, &["compare", "back.csv", "est.csv", "--out", "e.csv"]);
+    let (code, err) = run_in(dir, &["compare", "back.csv", "est.csv", "--out", "e.csv"]);
     assert_eq!(code, Some(65), "{err}");
     assert!(
         err.contains("back.csv, row 4: truth time 1 s does not increase (previous 2 s)"),
@@ -717,6 +730,7 @@ fn compare_refuses_truth_times_that_repeat_or_go_back_anywhere_in_the_file() {
 #[test]
 fn samples_whose_times_go_back_are_named_by_row_not_by_a_sample_rate() {
     let dir = temp_dir("samples-back");
+    let dir = dir.path();
     let mut csv = String::from("t_s,pos_x_m,pos_y_m,pos_z_m\n");
     for (k, t) in [0.0, 0.2, 0.1, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8]
         .iter()
@@ -730,7 +744,7 @@ fn samples_whose_times_go_back_are_named_by_row_not_by_a_sample_rate() {
         "[trajectory]\ntype = \"samples\"\nfile = \"dec.csv\"\nattitude = \"tangent\"\n",
     )
     .unwrap();
-    let (code, err) = run_in(&dir, &["simulate", "dec.toml", "--out", "o.csv"]);
+    let (code, err) = run_in(dir, &["simulate", "dec.toml", "--out", "o.csv"]);
     assert_eq!(code, Some(65), "{err}");
     assert!(
         err.contains(
@@ -744,6 +758,7 @@ fn samples_whose_times_go_back_are_named_by_row_not_by_a_sample_rate() {
 #[test]
 fn a_filter_that_may_use_a_magnetometer_names_a_missing_mag_column() {
     let dir = temp_dir("orient-mag");
+    let dir = dir.path();
     let header = "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,mag_x_ut,mag_y_ut";
     let mut text = format!("{header}\n");
     for k in 0..10 {
@@ -751,7 +766,7 @@ fn a_filter_that_may_use_a_magnetometer_names_a_missing_mag_column() {
     }
     std::fs::write(dir.join("imu.csv"), text).unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "orient",
             "imu.csv",
@@ -769,6 +784,7 @@ fn a_filter_that_may_use_a_magnetometer_names_a_missing_mag_column() {
 #[test]
 fn a_matlab_parameter_file_with_unknown_keys_is_read_with_warnings() {
     let dir = temp_dir("matlab-vendor");
+    let dir = dir.path();
     std::fs::write(
         dir.join("p.json"),
         r#"{"Part": {"Vendor": "ACME", "Gyroscope": {"NoiseDensity": 0.001, "Colour": "blue"}}}"#,
@@ -779,7 +795,7 @@ fn a_matlab_parameter_file_with_unknown_keys_is_read_with_warnings() {
         "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n[imu]\nparams = \"p.json\"\n",
     )
     .unwrap();
-    let (code, err) = run_in(&dir, &["simulate", "s.toml", "--out", "o.csv"]);
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "o.csv"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
         err.contains("warning: ") && err.contains("Part: Vendor: not a sensor, skipped"),
@@ -795,10 +811,11 @@ fn a_matlab_parameter_file_with_unknown_keys_is_read_with_warnings() {
 #[test]
 fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
     let dir = temp_dir("bad-start");
+    let dir = dir.path();
     let scenario =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/expression.toml");
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             scenario.to_str().unwrap(),
@@ -810,7 +827,7 @@ fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
     );
     assert_eq!(code, Some(0), "{err}");
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "integrate",
             "imu.csv",
@@ -842,7 +859,7 @@ fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
     lines[1] = first.join(",");
     std::fs::write(dir.join("zero_q.csv"), lines.join("\n") + "\n").unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "integrate",
             "imu.csv",
@@ -864,6 +881,7 @@ fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
 #[test]
 fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
     let dir = temp_dir("orient-decimation");
+    let dir = dir.path();
     let header =
         "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s";
     let mut text = format!("{header}\n");
@@ -872,7 +890,7 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
     }
     std::fs::write(dir.join("imu.csv"), text).unwrap();
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["orient", "imu.csv", "--param", "DecimationFactor=3"])
         .args(["--out", "o.csv"])
         .output()
@@ -894,6 +912,7 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
 #[test]
 fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missing() {
     let dir = temp_dir("earth-integrate");
+    let dir = dir.path();
     std::fs::write(
         dir.join("flight.toml"),
         "rate_hz = 50.0\nduration_s = 120.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
@@ -904,7 +923,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "flight.toml",
@@ -926,7 +945,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
     let integrate = |extra: &[&str], out: &str| {
         let mut args = vec!["integrate", "imu.csv", "--nav-frame", "NED", "--out", out];
         args.extend(extra);
-        run_in(&dir, &args)
+        run_in(dir, &args)
     };
     let (code, err) = integrate(&["--init", "truth.csv", "--earth", "wgs84"], "nav.csv");
     assert_eq!(code, Some(0), "{err}");
@@ -938,7 +957,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
             .ends_with(",lat_rad,lon_rad,height_m")
     );
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["compare", "truth.csv", "nav.csv"])
         .output()
         .unwrap();
@@ -1001,6 +1020,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
 #[test]
 fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thread() {
     let dir = temp_dir("threads");
+    let dir = dir.path();
     // Five streamed chunks of the figure-8, with sensor noise: the truth, the readings and the
     // writing cross between threads chunk by chunk while the noise is drawn in order.
     std::fs::write(
@@ -1029,7 +1049,7 @@ fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thr
             let mut args = vec!["simulate", "s.toml", "--out", &imu];
             args.extend(truth.iter().flat_map(|t| ["--truth", t.as_str()]));
             args.extend(threads.map(|n| ["--threads", n]).into_iter().flatten());
-            let (code, err) = run_in(&dir, &args);
+            let (code, err) = run_in(dir, &args);
             assert_eq!(code, Some(0), "{tag}: {err}");
         }
         if imu_ext == "npy" {
@@ -1066,7 +1086,7 @@ fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thr
             "--threads",
             threads,
         ];
-        let (code, err) = run_in(&dir, &args);
+        let (code, err) = run_in(dir, &args);
         assert_eq!(code, Some(65), "{threads}: {err}");
         assert!(
             !dir.join("b.csv").exists() && !dir.join("bt.npy").exists(),
@@ -1088,14 +1108,14 @@ fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thr
             "--threads",
             threads,
         ];
-        assert_eq!(run_in(&dir, &args).0, Some(0), "{threads}");
+        assert_eq!(run_in(dir, &args).0, Some(0), "{threads}");
     }
     for r in ["0", "1"] {
         assert!(read(&format!("mc_one_run000{r}.csv")) == read(&format!("mc_many_run000{r}.csv")));
     }
     for bad in ["0", "-1"] {
         let (code, err) = run_in(
-            &dir,
+            dir,
             &["simulate", "s.toml", "--out", "bad.csv", "--threads", bad],
         );
         assert_eq!(code, Some(65), "{bad}: {err}");
@@ -1110,6 +1130,7 @@ fn simulate_writes_the_same_bytes_on_one_two_or_three_threads_and_refuses_no_thr
 #[test]
 fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     let dir = temp_dir("gnss-simulate");
+    let dir = dir.path();
     std::fs::write(
         dir.join("s.toml"),
         "rate_hz = 50.0\nduration_s = 10.0\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n\
@@ -1117,7 +1138,7 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate", "s.toml", "--out", "imu.csv", "--gnss", "gnss.csv", "--runs", "2",
         ],
@@ -1130,7 +1151,7 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
         assert!(text.starts_with("t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n"));
     }
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate", "s.toml", "--out", "imu.csv", "--gnss", "imu.csv",
         ],
@@ -1142,6 +1163,7 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
 #[test]
 fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
     let dir = temp_dir("fuse");
+    let dir = dir.path();
     std::fs::write(
         dir.join("s.toml"),
         "rate_hz = 100.0\nduration_s = 60.0\n[trajectory]\ntype = \"expression\"\n\
@@ -1151,7 +1173,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "s.toml",
@@ -1177,7 +1199,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
             out,
         ];
         args.extend(extra);
-        run_in(&dir, &args)
+        run_in(dir, &args)
     };
     let (code, err) = fuse_to("nav.csv", &[]);
     assert_eq!(code, Some(0), "{err}");
@@ -1194,7 +1216,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
         "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad,pos_x_sigma_m,"
     ));
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["compare", "truth.csv", "nav.csv"])
         .output()
         .unwrap();
@@ -1222,6 +1244,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
 #[test]
 fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
     let dir = temp_dir("baro-integrate");
+    let dir = dir.path();
     // At rest at 45° N for 20 minutes with a 1e-3 m/s² vertical accelerometer bias; a
     // barometer at 10 Hz with 0.5 m of noise.
     std::fs::write(
@@ -1233,7 +1256,7 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "s.toml",
@@ -1260,7 +1283,7 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
             out,
         ];
         args.extend(extra);
-        run_in(&dir, &args)
+        run_in(dir, &args)
     };
     let last_height = |file: &str| -> f64 {
         let text = std::fs::read_to_string(dir.join(file)).unwrap();
@@ -1303,6 +1326,7 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
 #[test]
 fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
     let dir = temp_dir("study");
+    let dir = dir.path();
     let scenario =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
     std::fs::write(
@@ -1314,7 +1338,7 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["study", "study.toml", "--out", "t.csv", "--plot", "t.png"],
     );
     assert_eq!(code, Some(0), "{err}");
@@ -1329,7 +1353,7 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
     assert!(std::fs::metadata(dir.join("t.png")).unwrap().len() > 1000);
     // A bad figure name is refused before any run; an output over the study file is refused.
     let (code, err) = run_in(
-        &dir,
+        dir,
         &["study", "study.toml", "--out", "u.csv", "--plot", "u.gif"],
     );
     assert_ne!(code, Some(0));
@@ -1337,7 +1361,7 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
         err.contains("u.gif") && !dir.join("u.csv").exists(),
         "{err}"
     );
-    let (code, err) = run_in(&dir, &["study", "study.toml", "--out", "study.toml"]);
+    let (code, err) = run_in(dir, &["study", "study.toml", "--out", "study.toml"]);
     assert_ne!(code, Some(0));
     assert!(err.contains("study.toml"), "{err}");
     assert!(
@@ -1350,6 +1374,7 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_diverged_filter() {
 #[test]
 fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_ones() {
     let dir = temp_dir("fuse-aids");
+    let dir = dir.path();
     let scenario = "rate_hz = 100.0\nduration_s = 30.0\n[trajectory]\ntype = \"expression\"\n\
          position_m = [\"60*sin(0.16*t)\", \"60*(1 - cos(0.16*t))\", \"0\"]\nattitude = \"tangent\"\n\
          [imu]\nkind = \"accel-gyro\"\npreset = \"stim300\"\n\
@@ -1362,7 +1387,7 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "s.toml",
@@ -1392,7 +1417,7 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
             "nav.csv",
         ];
         args.extend(extra);
-        run_in(&dir, &args)
+        run_in(dir, &args)
     };
     let (code, err) = fuse(
         "s.toml",
@@ -1446,11 +1471,12 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
 #[test]
 fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     let dir = temp_dir("fuse-align");
+    let dir = dir.path();
     let scenario =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
     let scenario = scenario.display().to_string();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             &scenario,
@@ -1474,7 +1500,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
             "nav.csv",
         ];
         args.extend(extra);
-        run_in(&dir, &args)
+        run_in(dir, &args)
     };
     let (code, err) = fuse(&["--align", "gnss"]);
     assert_eq!(code, Some(0), "{err}");
@@ -1492,7 +1518,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
         .unwrap();
     assert!(t0 > 20.5 && t0 < 25.0, "{t0}");
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["compare", "truth.csv", "nav.csv"])
         .output()
         .unwrap();
@@ -1535,6 +1561,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
 #[test]
 fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
     let dir = temp_dir("fuse-earth");
+    let dir = dir.path();
     std::fs::write(
         dir.join("s.toml"),
         "rate_hz = 100.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
@@ -1546,7 +1573,7 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "simulate",
             "s.toml",
@@ -1560,7 +1587,7 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
     );
     assert_eq!(code, Some(0), "{err}");
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "fuse",
             "imu.csv",
@@ -1585,7 +1612,7 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
         header.lines().next().unwrap()
     );
     let out = imukit()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["compare", "truth.csv", "nav.csv"])
         .output()
         .unwrap();
@@ -1604,7 +1631,7 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
     )
     .unwrap();
     let (code, err) = run_in(
-        &dir,
+        dir,
         &[
             "fuse",
             "imu.csv",

@@ -27,7 +27,9 @@ fn ok(out: &Output) {
 fn data() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("imukit-plot-{}", std::process::id()));
+        // Cargo's folder for integration tests' files, inside the target folder: one set of
+        // outputs, remade at every run, instead of a new folder per process in /tmp.
+        let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("plot");
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         ok(&imukit(&["demo", "--out-dir"], &[&d]));

@@ -567,8 +567,11 @@ fn samples_of_latitude_longitude_and_height_give_the_formulas_readings() {
     // longitude, height and local angles (no pos_* columns): the finite differences (sixth
     // order at 20 Hz) give the exact readings to their error, which here is the rounding of
     // positions carried from radians on a 6.4e6 m Earth (1e-9 m, amplified by 1/h²).
-    let dir = std::env::temp_dir().join(format!("imukit-earth-samples-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-earth-samples-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let head = "rate_hz = 20.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
         origin = { latitude_deg = 52.0, longitude_deg = 4.0, height_m = 0.0 }\n";
     let formulas = format!(
@@ -600,7 +603,7 @@ fn samples_of_latitude_longitude_and_height_give_the_formulas_readings() {
     );
     let sampled = ScenarioSpec::from_toml(&samples, "samples.toml")
         .unwrap()
-        .resolve(&dir)
+        .resolve(dir)
         .unwrap()
         .simulate()
         .unwrap();
@@ -625,7 +628,7 @@ fn samples_of_latitude_longitude_and_height_give_the_formulas_readings() {
     );
     let e = ScenarioSpec::from_toml(&flat, "samples.toml")
         .unwrap()
-        .resolve(&dir)
+        .resolve(dir)
         .unwrap_err()
         .to_string();
     assert!(e.contains("geodetic samples need earth = \"wgs84\""), "{e}");

@@ -4,15 +4,18 @@
 use imukit::Table;
 use imukit::io::parquet::{read_metadata, read_table};
 
-fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("imukit-formats-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-formats-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
 fn parquet_tables_round_trip_bit_for_bit_across_row_groups() {
     let d = dir("round-trip");
+    let d = d.path();
     let n = imukit::io::parquet::ROW_GROUP + 1234;
     let mut t = Table::new(&["t_s", "x", "y"]);
     for i in 0..n {
@@ -52,6 +55,7 @@ fn parquet_tables_round_trip_bit_for_bit_across_row_groups() {
 #[test]
 fn a_value_that_is_not_finite_is_refused_and_no_file_is_left() {
     let d = dir("finite");
+    let d = d.path();
     let mut t = Table::new(&["t_s", "x"]);
     t.push_row(&[0.0, 1.0]);
     t.push_row(&[0.1, f64::NAN]);
@@ -61,7 +65,7 @@ fn a_value_that_is_not_finite_is_refused_and_no_file_is_left() {
     assert!(e.contains("row 2") && e.contains("column x"), "{e}");
     assert!(!path.exists());
     assert!(
-        std::fs::read_dir(&d).unwrap().next().is_none(),
+        std::fs::read_dir(d).unwrap().next().is_none(),
         "a partial file was left"
     );
     // Not a Parquet file at all.
@@ -88,6 +92,7 @@ fn same_bits(a: &[f64], b: &[f64]) -> bool {
 #[test]
 fn npy_tables_round_trip_bit_for_bit_and_read_like_csv() {
     let d = dir("npy");
+    let d = d.path();
     let t = awkward_table(10_000);
     let path = d.join("t.npy");
     t.write(&path).unwrap();
@@ -121,6 +126,7 @@ fn npy_tables_round_trip_bit_for_bit_and_read_like_csv() {
 #[test]
 fn a_bad_npy_file_is_refused_saying_what_and_where() {
     let d = dir("npy-bad");
+    let d = d.path();
     let t = awkward_table(100);
     let good = d.join("good.npy");
     t.write(&good).unwrap();
@@ -177,6 +183,7 @@ fn a_bad_npy_file_is_refused_saying_what_and_where() {
 #[test]
 fn npz_archives_round_trip_bit_for_bit_across_blocks() {
     let d = dir("npz");
+    let d = d.path();
     // 40 columns × 60 000 rows: more than one block of rows goes through the temporary file.
     let names: Vec<String> = (0..40).map(|k| format!("c{k}")).collect();
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
@@ -199,13 +206,14 @@ fn npz_archives_round_trip_bit_for_bit_across_blocks() {
         &t.column("c39").unwrap()
     ));
     // Only the archive is left in the folder: the block file had no name.
-    let left: Vec<_> = std::fs::read_dir(&d).unwrap().collect();
+    let left: Vec<_> = std::fs::read_dir(d).unwrap().collect();
     assert_eq!(left.len(), 1, "{left:?}");
 }
 
 #[test]
 fn a_bad_npz_archive_is_refused_saying_what_and_where() {
     let d = dir("npz-bad");
+    let d = d.path();
     let mut t = Table::new(&["t_s", "x"]);
     for i in 0..50 {
         t.push_row(&[i as f64 * 0.1, (i as f64).sqrt()]);

@@ -124,8 +124,11 @@ fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
     let text = format!("{text}[gnss]\nrate_hz = 20.0\n[imu]\nseed = 7\n");
     let spec = ScenarioSpec::from_toml(&text, "g.toml").unwrap();
     let sc = spec.resolve(Path::new(".")).unwrap();
-    let dir = std::env::temp_dir().join(format!("imukit-gnss-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-gnss-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let (imu, gnss) = (dir.join("imu.csv"), dir.join("gnss.csv"));
     // 10 001 samples: the stream crosses chunk boundaries (4096).
     sc.stream_to_files(

@@ -23,10 +23,12 @@ fn examples_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("imukit-hostile-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-hostile-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Pieces formulas are made of, hostile numbers and broken syntax among them.
@@ -227,7 +229,8 @@ proptest! {
             let t = f64::from(k) * 0.01;
             text += &format!("{t},0.1,-0.2,9.81,0.01,0.02,{}\n", 0.3 * t.sin());
         }
-        let path = scratch("imu").join(format!("{case}.csv"));
+        let dir = scratch("imu");
+        let path = dir.path().join(format!("{case}.csv"));
         std::fs::write(&path, apply(&text, &edits)).unwrap();
         if let Ok(table) = read_table(&path) {
             assert_finite(&table, "the table read");
@@ -254,7 +257,8 @@ proptest! {
               bias_instability_flicker_tau_s = [1, 1000]\n[gyroscope]\nrandom_walk_rad_s_per_rt_s = 1e-5\n\
               measurement_range_rad_s = 8.7\n", "toml")
         };
-        let path = scratch("params").join(format!("{case}.{ext}"));
+        let dir = scratch("params");
+        let path = dir.path().join(format!("{case}.{ext}"));
         std::fs::write(&path, apply(text, &edits)).unwrap();
         if let Err(e) = read_param_file(&path, None, Profile::Default) {
             // The message names the file or the key it is about.

@@ -169,8 +169,11 @@ fn gaps_and_disorder_in_the_times_are_named() {
 fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
     use imukit::io::rows::GAP_WINDOW;
     use imukit::run::navigate::{NavScheme, integrate_csv};
-    let dir = std::env::temp_dir().join(format!("imukit-nav-stream-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-nav-stream-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     // 4001 rows: the gap check's look-ahead window and the rest.
     let rk4 = NavScheme::Rk4 { substeps: 2 };
     for (extra, frame, sign, scheme) in [
@@ -267,7 +270,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap_err();
     assert!(e.to_string().contains("between rows 3001 and 3002"), "{e}");
     assert!(!out.exists());
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// A state table on `times` with position `[t, 2t, 0] + offset`, velocity `[1, 2, 0]` and a yaw
@@ -296,8 +299,11 @@ fn linear_states(times: &[f64], offset: [f64; 3]) -> imukit::Table {
 #[test]
 fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
     use imukit::run::compare::compare_csv;
-    let dir = std::env::temp_dir().join(format!("imukit-compare-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-compare-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let truth_times: Vec<f64> = (0..200)
         .map(|k| 0.1 * k as f64 + 0.001 * (k % 3) as f64)
         .collect();
@@ -353,7 +359,7 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
         assert!(e.contains(needle), "{e}");
         assert!(!out.exists());
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]

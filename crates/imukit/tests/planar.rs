@@ -1,15 +1,17 @@
 //! The exercise's files and the built-in cart, dead-reckoned.
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
 use imukit::ScenarioSpec;
 use imukit::run::planar::{integrate, read_planar, samples_from_table, write_dat};
 use imukit::scenario::builtin;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("imukit-planar-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-planar-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn cart(rate_hz: Option<f64>) -> imukit::Simulation {
@@ -76,6 +78,7 @@ fn default_scheme_recovers_the_builtin_cart_track() {
 #[test]
 fn dat_files_round_trip_and_bad_lines_are_named() {
     let dir = temp_dir("dat");
+    let dir = dir.path();
     let samples = samples_from_table(&cart(None).imu).unwrap();
     let path = dir.join("inertial_data.dat");
     write_dat(&path, &samples).unwrap();

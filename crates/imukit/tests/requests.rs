@@ -158,8 +158,11 @@ fn a_refused_parameter_carries_the_cores_error_as_its_source() {
 
 #[test]
 fn a_bad_csv_cell_is_located_by_file_row_and_column() {
-    let dir = std::env::temp_dir().join(format!("imukit-requests-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-requests-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let path = dir.join("bad.csv");
     std::fs::write(&path, "t_s,gyro_z_rad_s\n0,0.1\n0.01,oops\n").unwrap();
     let e = imukit::io::table::read_table(&path).unwrap_err();
@@ -167,13 +170,16 @@ fn a_bad_csv_cell_is_located_by_file_row_and_column() {
     assert_eq!(at.file.as_deref(), Some(path.as_path()));
     assert_eq!(at.row, Some(3));
     assert_eq!(at.column.as_deref(), Some("gyro_z_rad_s"));
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
 fn a_column_named_twice_is_refused_with_both_places() {
-    let dir = std::env::temp_dir().join(format!("imukit-dup-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-dup-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let path = dir.join("dup.csv");
     std::fs::write(
         &path,
@@ -195,7 +201,7 @@ fn a_column_named_twice_is_refused_with_both_places() {
         );
         assert_eq!(e.location().file.as_deref(), Some(path.as_path()));
     }
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -282,8 +288,11 @@ fn a_result_that_is_not_finite_is_never_written() {
     .unwrap()
     .resolve(Path::new("."))
     .unwrap();
-    let dir = std::env::temp_dir().join(format!("imukit-notfinite-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-notfinite-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let out = dir.join("imu.csv");
     let e = scenario
         .stream_to_files(
@@ -299,7 +308,7 @@ fn a_result_that_is_not_finite_is_never_written() {
     assert_eq!(e.location().column.as_deref(), Some("accel_x_m_s2"));
     assert!(!out.exists());
     assert!(
-        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        std::fs::read_dir(dir).unwrap().next().is_none(),
         "no partial file"
     );
     let e = scenario.simulate().unwrap_err();
@@ -308,7 +317,7 @@ fn a_result_that_is_not_finite_is_never_written() {
             .starts_with("IMU readings, row 2, column accel_x_m_s2: the result is inf"),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]

@@ -1,14 +1,16 @@
 //! Scenario files end to end: parsing, built-ins, samples files, and the errors users meet.
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use imukit::io::table::{TRUTH_COLUMNS, read_columns};
 use imukit::scenario::builtin;
 use imukit::{Error, Scenario, ScenarioSpec, Table};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("imukit-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-test-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn run_toml(text: &str, dir: &Path) -> Result<imukit::Simulation, Error> {
@@ -128,9 +130,10 @@ fn rounded_rectangle_lap_returns_to_its_start() {
 #[test]
 fn csv_written_tables_read_back_bit_for_bit_and_feed_a_samples_scenario() {
     let dir = temp_dir("samples");
+    let dir = dir.path();
     let exact = builtin::spec("tilted-circle")
         .unwrap()
-        .resolve(&dir)
+        .resolve(dir)
         .unwrap()
         .simulate()
         .unwrap();
@@ -145,9 +148,9 @@ fn csv_written_tables_read_back_bit_for_bit_and_feed_a_samples_scenario() {
         );
     }
     // No partial file is left behind.
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+    assert_eq!(std::fs::read_dir(dir).unwrap().count(), 1);
     let scenario = "[trajectory]\ntype = \"samples\"\nfile = \"truth.csv\"\n";
-    let sampled = run_toml(scenario, &dir).unwrap();
+    let sampled = run_toml(scenario, dir).unwrap();
     for c in ["vel_x_m_s", "acc_z_m_s2", "omega_y_rad_s", "alpha_x_rad_s2"] {
         let (a, b) = (
             sampled.truth.column(c).unwrap(),
@@ -171,9 +174,10 @@ fn err_text(r: Result<impl std::fmt::Debug, Error>) -> String {
 #[test]
 fn errors_say_what_and_where() {
     let dir = temp_dir("errors");
+    let dir = dir.path();
     // Unknown function, with key and column.
     let bad = ISSUE_EXAMPLE.replace("0.8*sin(2*pi*f*t)", "0.8*sine(2*pi*f*t)");
-    let e = err_text(run_toml(&bad, &dir));
+    let e = err_text(run_toml(&bad, dir));
     assert!(
         e.contains("trajectory.position_m[1]")
             && e.contains("unknown function 'sine'")
@@ -182,7 +186,7 @@ fn errors_say_what_and_where() {
     );
     // Unknown variable.
     let bad = ISSUE_EXAMPLE.replace("0.3*cos(2*pi*f*t)", "0.3*cos(2*pi*g*t)");
-    let e = err_text(run_toml(&bad, &dir));
+    let e = err_text(run_toml(&bad, dir));
     assert!(
         e.contains("unknown variable 'g'") && e.contains("position_m[2]"),
         "{e}"
@@ -190,7 +194,7 @@ fn errors_say_what_and_where() {
     // Unknown key.
     let e = err_text(run_toml(
         &ISSUE_EXAMPLE.replace("gravity_m_s2", "gravity"),
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("test.toml") && e.contains("unknown field `gravity`"),
@@ -199,18 +203,18 @@ fn errors_say_what_and_where() {
     // Unknown built-in.
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"builtin\"\nname = \"figure9\"\n",
-        &dir,
+        dir,
     ));
     assert!(e.contains("figure9") && e.contains("figure8"), "{e}");
     // Gimbal lock in an Euler path, with the time.
     let lock = "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\nposition_m = [0, 0, 0]\npitch_rad = \"pi/2*t/0.5\"\n";
-    let e = err_text(run_toml(lock, &dir));
+    let e = err_text(run_toml(lock, dir));
     assert!(e.contains("gimbal lock") && e.contains("t = 0.5 s"), "{e}");
     // Missing columns in a samples file.
     std::fs::write(dir.join("nocols.csv"), "t_s,pos_x_m,pos_y_m\n0,0,0\n").unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"nocols.csv\"\n",
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("nocols.csv") && e.contains("pos_z_m") && e.contains("yaw_rad"),
@@ -229,7 +233,7 @@ fn errors_say_what_and_where() {
     std::fs::write(dir.join("nan.csv"), text).unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"nan.csv\"\nattitude = \"tangent\"\n",
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("nan.csv, row 6, column pos_z_m") && e.contains("not a finite number"),
@@ -244,7 +248,7 @@ fn errors_say_what_and_where() {
     std::fs::write(dir.join("rep.csv"), text).unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"rep.csv\"\nattitude = \"tangent\"\n",
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("rep.csv, row 11") && e.contains("does not increase"),
@@ -258,7 +262,7 @@ fn errors_say_what_and_where() {
     .unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"few.csv\"\nattitude = \"tangent\"\n",
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("too few samples") && e.contains("need at least 10"),
@@ -272,26 +276,26 @@ fn errors_say_what_and_where() {
     .unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"trunc.csv\"\nattitude = \"tangent\"\n",
-        &dir,
+        dir,
     ));
     assert!(e.contains("trunc.csv") && e.contains("row 3"), "{e}");
     // Missing file.
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"absent.csv\"\n",
-        &dir,
+        dir,
     ));
     assert!(e.contains("absent.csv"), "{e}");
     // Empty file.
     std::fs::write(dir.join("empty.csv"), "").unwrap();
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"samples\"\nfile = \"empty.csv\"\n",
-        &dir,
+        dir,
     ));
     assert!(e.contains("empty.csv") && e.contains("empty"), "{e}");
     // Missing rate for an expression.
     let e = err_text(run_toml(
         "[trajectory]\ntype = \"expression\"\nposition_m = [0, 0, 0]\n",
-        &dir,
+        dir,
     ));
     assert!(e.contains("rate_hz: missing"), "{e}");
 }
@@ -313,12 +317,13 @@ fn builtin_defaults_can_be_overridden_by_the_file() {
 #[test]
 fn body_rate_scenarios_reproduce_matlabs_platform_from_formulas_and_files() {
     let dir = temp_dir("bodyrates");
+    let dir = dir.path();
     let text = "rate_hz = 100.0\nduration_s = 5.99\nnav_frame = \"NED\"\n[trajectory]\ntype = \"body-rates\"\n\
                 angular_velocity_body_rad_s = [0, 0, \"piecewise(t < 3.995, pi/2, pi)\"]\n";
-    let formulas = run_toml(text, &dir).unwrap();
+    let formulas = run_toml(text, dir).unwrap();
     let builtin = builtin::spec("platform-turn")
         .unwrap()
-        .resolve(&dir)
+        .resolve(dir)
         .unwrap()
         .simulate()
         .unwrap();
@@ -349,7 +354,7 @@ fn body_rate_scenarios_reproduce_matlabs_platform_from_formulas_and_files() {
     std::fs::write(dir.join("rates.csv"), csv).unwrap();
     let file = run_toml(
         "nav_frame = \"NED\"\n[trajectory]\ntype = \"body-rates\"\nfile = \"rates.csv\"\n",
-        &dir,
+        dir,
     )
     .unwrap();
     let c = file.truth.column("yaw_rad").unwrap();
@@ -358,7 +363,7 @@ fn body_rate_scenarios_reproduce_matlabs_platform_from_formulas_and_files() {
     }
     let e = err_text(run_toml(
         "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"body-rates\"\nangular_velocity_body_rad_s = [0, 0, \"w*t\"]\n",
-        &dir,
+        dir,
     ));
     assert!(
         e.contains("angular_velocity_body_rad_s[2]") && e.contains("unknown variable 'w'"),

@@ -1,6 +1,6 @@
 //! Realistic sensors in scenarios: parameter files in both dialects, profiles, seeds,
 //! temperature profiles, MATLAB's documentation examples, and the errors users meet.
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use imu_core::sensor::NoiseType;
 use imukit::io::params::{ParamFile, Profile, parse_any_document, read_param_file, to_toml};
@@ -8,10 +8,12 @@ use imukit::io::presets;
 use imukit::sensor::{BiasInstabilityModel, SensorParams};
 use imukit::{ScenarioSpec, Simulation};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("imukit-sensors-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder under the system's temporary folder, removed with its files when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-sensors-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn run(text: &str, dir: &Path) -> Result<Simulation, imukit::Error> {
@@ -160,6 +162,7 @@ fn same_seed_same_numbers_other_seed_other_numbers_and_runs_differ() {
 #[test]
 fn temperature_profile_file_drives_temperature_bias() {
     let dir = temp_dir("temp");
+    let dir = dir.path();
     std::fs::write(
         dir.join("temps.csv"),
         "t_s,temperature_c,gyro_temperature_c\n0,25,25\n10,45,65\n",
@@ -168,7 +171,7 @@ fn temperature_profile_file_drives_temperature_bias() {
     let text = format!(
         "{STATIC_NED}[imu]\ntemperature_c = \"temps.csv\"\n[imu.accelerometer]\ntemperature_bias_m_s2_per_c = 0.01\n[imu.gyroscope]\ntemperature_bias_rad_s_per_c = 0.001\n"
     );
-    let sim = run(&text, &dir).unwrap();
+    let sim = run(&text, dir).unwrap();
     let (t, ax, gx) = (
         sim.imu.column("t_s").unwrap(),
         sim.imu.column("accel_x_m_s2").unwrap(),
@@ -230,6 +233,7 @@ fn parameter_files_round_trip_through_toml() {
 #[test]
 fn matlab_loadparams_json_is_read_as_matlab_reads_it() {
     let dir = temp_dir("loadparams");
+    let dir = dir.path();
     let json = r#"{
       "Part A": {
         "Accelerometer": {"MeasurementRange": "inf", "AxesMisalignment": [[100, 1, 2], [3, 100, 4], [5, 6, 100]],
@@ -266,7 +270,7 @@ fn matlab_loadparams_json_is_read_as_matlab_reads_it() {
     let text = format!(
         "{STATIC_NED}[imu]\nparams = \"params.json\"\npart = \"Part A\"\n[imu.gyroscope]\nConstantBias = 0.02\n"
     );
-    let sim = run(&text, &dir).unwrap();
+    let sim = run(&text, dir).unwrap();
     // Default profile: the g-sensitivity sees the body specific force, −9.81 on z (FRD, at rest).
     assert!(
         sim.imu
@@ -288,7 +292,7 @@ fn matlab_loadparams_json_is_read_as_matlab_reads_it() {
         "{\n  \"Part\": {\n    \"Gyroscope\": {\"ConstantBias\": 0.01,}\n  }\n}\n",
     )
     .unwrap();
-    let e = err(&format!("{STATIC_NED}[imu]\nparams = \"bad.json\"\n"), &dir);
+    let e = err(&format!("{STATIC_NED}[imu]\nparams = \"bad.json\"\n"), dir);
     assert!(e.contains("bad.json") && e.contains("line 3"), "{e}");
 }
 
@@ -579,6 +583,7 @@ fn matlabs_fractalcoef_500_from_a_parameter_file_drives_the_scenario() {
     // y = filter(1, den, B·n), and filtering y by the FIR `den` gives B·n back, white with σ = B,
     // only if all 501 coefficients act.
     let dir = temp_dir("fractal500");
+    let dir = dir.path();
     let den = fractal_denominator(500);
     let b = 0.01;
     let doc = serde_json::json!({"Gyroscope": {
@@ -588,7 +593,7 @@ fn matlabs_fractalcoef_500_from_a_parameter_file_drives_the_scenario() {
     std::fs::write(dir.join("fractal.json"), doc.to_string()).unwrap();
     let text = STATIC_NED.replace("duration_s = 9.99", "duration_s = 99.99")
         + "[imu]\nkind = \"accel-gyro\"\nseed = 4\nparams = \"fractal.json\"\n";
-    let sim = run(&text, &dir).unwrap();
+    let sim = run(&text, dir).unwrap();
     let y = sim.imu.column("gyro_x_rad_s").unwrap();
     let n = y.len();
     assert_eq!(n, 10_000);

@@ -88,8 +88,11 @@ fn a_run_is_the_same_whichever_order_runs_are_computed_in() {
 
 #[test]
 fn bad_study_files_are_refused_by_key() {
-    let dir = std::env::temp_dir().join(format!("imukit-study-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::Builder::new()
+        .prefix("imukit-study-")
+        .tempdir()
+        .unwrap();
+    let dir = dir.path();
     let scenario = examples().join("car_tunnel.toml");
     let write = |name: &str, text: String| {
         let p = dir.join(name);

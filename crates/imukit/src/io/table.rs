@@ -874,8 +874,11 @@ mod tests {
 
     #[test]
     fn values_are_read_with_whitespace_trimmed_and_bad_ones_named_by_row_and_column() {
-        let dir = std::env::temp_dir().join(format!("imukit-table-trim-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("a temporary folder");
+        let dir = tempfile::Builder::new()
+            .prefix("imukit-table-trim-")
+            .tempdir()
+            .unwrap();
+        let dir = dir.path();
         let path = dir.join("t.csv");
         // Spaces, a tab and no-break spaces (Unicode whitespace) around names and values.
         std::fs::write(&path, " t_s ,\tx\n 0.5 ,\u{a0}-2\u{a0}\n1,\t3e2 \n").expect("written");
@@ -902,6 +905,6 @@ mod tests {
             let err = read_columns(&path, &["t_s", "x"], "").expect_err("a bad value");
             assert!(err.to_string().ends_with(message), "{err}");
         }
-        let _ = std::fs::remove_dir_all(&dir);
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
