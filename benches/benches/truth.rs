@@ -1,5 +1,6 @@
 //! Truth + ideal IMU throughput (samples/s) on the figure-8: exact (formula strings, compiled)
-//! and sampled (finite differences, order 6, tangent attitude); and the exact truth alone.
+//! and sampled (finite differences, order 6, tangent attitude); and the exact truth alone. Also
+//! the vector kernels' `sin_cos` against `wide`'s own and the C library's (values/s).
 //!
 //! Run: `cargo bench -p imu-benches --bench truth`.
 #![allow(missing_docs)]
@@ -66,5 +67,36 @@ fn bench_truth(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_truth);
+fn bench_sin_cos(c: &mut Criterion) {
+    let x: Vec<f64> = (0..4096).map(|k| 0.37 * k as f64 - 700.0).collect();
+    let (mut s, mut co) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+    let mut group = c.benchmark_group("sin_cos/4096");
+    group.throughput(Throughput::Elements(x.len() as u64));
+    group.bench_function("kernel", |b| {
+        b.iter(|| imu_core::trig::sin_cos_into(&x, &mut s, &mut co));
+    });
+    group.bench_function("wide", |b| {
+        b.iter(|| {
+            for ((v, s), c) in x
+                .chunks_exact(4)
+                .zip(s.chunks_exact_mut(4))
+                .zip(co.chunks_exact_mut(4))
+            {
+                let (vs, vc) = wide::f64x4::from([v[0], v[1], v[2], v[3]]).sin_cos();
+                s.copy_from_slice(&vs.to_array());
+                c.copy_from_slice(&vc.to_array());
+            }
+        });
+    });
+    group.bench_function("libm", |b| {
+        b.iter(|| {
+            for ((v, s), c) in x.iter().zip(s.iter_mut()).zip(co.iter_mut()) {
+                (*s, *c) = v.sin_cos();
+            }
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_truth, bench_sin_cos);
 criterion_main!(benches);

@@ -423,6 +423,75 @@ fn a_run_split_into_chunks_equals_one_call() {
 }
 
 #[test]
+fn many_samples_at_once_are_each_samples_reading_bit_for_bit() {
+    use imu_core::sensor::{ImuReading, MEASURE_BLOCK};
+    let p = full_params();
+    // A moving truth, so that every reading differs, and a temperature that changes with time.
+    let truth: Vec<Truth<Ned>> = (0..3 * MEASURE_BLOCK + 5)
+        .map(|k| {
+            let t = 0.01 * k as f64;
+            let e = EulerZyx::new(0.3 * t, 0.1 * t.sin(), -0.2 * t);
+            Truth {
+                t_s: t,
+                attitude: Rotation::from_euler(e),
+                euler: e,
+                acceleration_m_s2: Vec3::new(t, -0.5 * t, 0.2),
+                omega_b_rad_s: Vec3::new(0.1, -0.2 * t, 0.3),
+                ..Truth::default()
+            }
+        })
+        .collect();
+    let temperatures = |s: &Truth<Ned>| Temperatures::uniform(20.0 + s.t_s);
+    for (gyroscope, magnetometer) in [(true, true), (true, false), (false, false)] {
+        let imu = ImuModel::<Ned>::new(
+            ImuMount::default(),
+            SensorSet {
+                gyroscope,
+                magnetometer,
+            },
+            GyroAccelerationInput::BodySpecificForce,
+            [&p, &p, &p],
+            100.0,
+        )
+        .unwrap();
+        // Lengths around a block, and an output shorter than the truth.
+        for (n, out_len) in [
+            (0, 0),
+            (1, 1),
+            (MEASURE_BLOCK, MEASURE_BLOCK),
+            (truth.len(), truth.len()),
+            (truth.len(), 11),
+        ] {
+            let (mut state_one, mut noise_one) = (ImuState::default(), SeededNormals::new(5));
+            let one_by_one: Vec<ImuReading> = truth[..out_len.min(n)]
+                .iter()
+                .map(|s| imu.measure(s, &temperatures(s), &mut state_one, &mut noise_one))
+                .collect();
+            let (mut state, mut noise) = (ImuState::default(), SeededNormals::new(5));
+            let mut many = vec![ImuReading::default(); out_len];
+            imu.measure_many(&truth[..n], temperatures, &mut state, &mut noise, &mut many);
+            let bits = |r: &[ImuReading]| {
+                r.iter()
+                    .flat_map(|r| [r.accel_m_s2, r.gyro_rad_s, r.mag_ut].concat())
+                    .map(f64::to_bits)
+                    .collect::<Vec<_>>()
+            };
+            let case = format!(
+                "gyroscope {gyroscope}, magnetometer {magnetometer}, {n} samples into {out_len}"
+            );
+            assert_eq!(bits(&many), bits(&one_by_one), "{case}");
+            // The same state and the same place in the stream afterwards.
+            assert_eq!(state, state_one, "{case}");
+            assert_eq!(
+                noise.standard_normal().to_bits(),
+                noise_one.standard_normal().to_bits(),
+                "{case}"
+            );
+        }
+    }
+}
+
+#[test]
 fn seeds_give_identical_streams_and_runs_differ() {
     let draw = |mut n: SeededNormals| (0..5).map(|_| n.standard_normal()).collect::<Vec<_>>();
     assert_eq!(draw(SeededNormals::new(1)), draw(SeededNormals::new(1)));

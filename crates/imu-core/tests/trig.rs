@@ -57,6 +57,60 @@ fn sines_and_cosines_are_within_the_bound_of_the_correctly_rounded_values() {
 }
 
 #[test]
+fn sines_and_cosines_are_wides_own_bit_for_bit() {
+    // The kernel reads the quadrant from the bits of |x|·2/π + 2⁵² instead of calling `wide`'s
+    // rounding and conversion; every result must still be `wide::f64x4::sin_cos`'s. Random
+    // arguments of every range, and the places where the quadrant changes: odd multiples of π/4
+    // (where |x|·2/π is a half and ties go to even) and their neighbours, signed zeros, tiny
+    // and subnormal numbers, and the largest arguments the kernel takes.
+    let mut x: Vec<f64> = [1e-300, 1e-6, 1.0, 10.0, 1e3, 1e5, 1e7, SIN_COS_MAX_ARG]
+        .into_iter()
+        .enumerate()
+        .flat_map(|(k, r)| uniform(20_000, r, 0x51_7CC1 + k as u64))
+        .collect();
+    for k in -2000_i32..=2000 {
+        let at = f64::from(k) * std::f64::consts::FRAC_PI_4;
+        let below = f64::from_bits(at.abs().to_bits().saturating_sub(1)).copysign(at);
+        let above = f64::from_bits(at.abs().to_bits() + 1).copysign(at);
+        x.extend([at, below, above]);
+    }
+    let largest = f64::from_bits(SIN_COS_MAX_ARG.to_bits() - 1);
+    x.extend([
+        0.0,
+        -0.0,
+        f64::MIN_POSITIVE,
+        -5e-324,
+        5e-324,
+        largest,
+        -largest,
+    ]);
+    x.truncate(x.len() - x.len() % 4);
+    let (mut s, mut c) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+    sin_cos_into(&x, &mut s, &mut c);
+    let mut checked = 0;
+    for (k, v) in x.chunks_exact(4).enumerate() {
+        let (ws, wc) = wide::f64x4::from([v[0], v[1], v[2], v[3]]).sin_cos();
+        let (ws, wc) = (ws.to_array(), wc.to_array());
+        for lane in 0..4 {
+            let i = 4 * k + lane;
+            assert_eq!(
+                (s[i].to_bits(), c[i].to_bits()),
+                (ws[lane].to_bits(), wc[lane].to_bits()),
+                "x = {:e} ({:#x}): ({}, {}) against wide's ({}, {})",
+                x[i],
+                x[i].to_bits(),
+                s[i],
+                c[i],
+                ws[lane],
+                wc[lane]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 170_000, "{checked}");
+}
+
+#[test]
 fn arctangents_are_within_the_bound_of_the_correctly_rounded_values() {
     for (k, (ry, rx)) in [
         (1.0, 1.0),

@@ -11,6 +11,9 @@ use crate::sensor::{
 };
 use crate::vector::Vec3;
 
+/// Samples whose normals [`ImuModel::measure_many`] draws before making their readings.
+pub const MEASURE_BLOCK: usize = 8;
+
 /// Which sensors besides the accelerometer the IMU has (MATLAB's `IMUType`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SensorSet {
@@ -254,19 +257,19 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
         state: &mut ImuState<B>,
         noise: &mut impl NoiseSource,
     ) -> ImuReading {
-        let accel_in = match self.mount.accel_sign {
-            AccelSign::SpecificForce => f_b,
-            AccelSign::Matlab => -f_b,
-        };
-        let g_input = match self.gyro_acceleration {
-            GyroAccelerationInput::BodySpecificForce => f_b.to_array(),
-            GyroAccelerationInput::NavAcceleration => acceleration_n.to_array(),
-        };
         // All of this sample's normals first, in the order the sensors consume them (accelerometer,
         // gyroscope, magnetometer; nine each): the generator runs in a tight loop instead of
         // interleaved with the model arithmetic. Plain loops, not closures: the compiler inlines
         // them in every crate measured (closure forms ran 1.3–1.7× slower where it did not).
         let mut normals = [[0.0; 9]; 3];
+        self.draw(&mut normals, noise);
+        self.finish_drawn(f_b, acceleration_n, w_b, m_b, temperatures, state, &normals)
+    }
+
+    /// One sample's standard normals, in the order the sensors consume them: nine for each enabled
+    /// sensor (accelerometer, gyroscope, magnetometer), none for a disabled one.
+    #[inline(always)]
+    fn draw(&self, normals: &mut [[f64; 9]; 3], noise: &mut impl NoiseSource) {
         let enabled = [true, self.sensors.gyroscope, self.sensors.magnetometer];
         for (drawn, on) in normals.iter_mut().zip(enabled) {
             if on {
@@ -275,6 +278,71 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
                 }
             }
         }
+    }
+
+    /// [`Self::measure`] of each sample of `truth` into `out` (as many as the shorter of the two
+    /// has), at the temperatures `temperatures` gives for each sample: the same readings and the
+    /// same state and noise stream afterwards as calling [`Self::measure`] sample by sample.
+    ///
+    /// The normals of [`MEASURE_BLOCK`] samples are drawn before the block's readings are made, in
+    /// the same order: the generator's loop and the model's then each run on their own, which
+    /// measured 8 % faster for a whole simulation than drawing sample by sample (design §1). The
+    /// block's normals live on the stack (1.7 KB).
+    pub fn measure_many(
+        &self,
+        truth: &[Truth<N>],
+        temperatures: impl Fn(&Truth<N>) -> Temperatures,
+        state: &mut ImuState<B>,
+        noise: &mut impl NoiseSource,
+        out: &mut [ImuReading],
+    ) {
+        let n = truth.len().min(out.len());
+        let (truth, out) = (&truth[..n], &mut out[..n]);
+        let mut normals = [[[0.0; 9]; 3]; MEASURE_BLOCK];
+        for (samples, readings) in truth
+            .chunks(MEASURE_BLOCK)
+            .zip(out.chunks_mut(MEASURE_BLOCK))
+        {
+            for n in normals.iter_mut().take(samples.len()) {
+                self.draw(n, noise);
+            }
+            for ((s, o), n) in samples.iter().zip(readings.iter_mut()).zip(&normals) {
+                let f_b = self.mount.specific_force(s);
+                *o = self.finish_drawn(
+                    f_b,
+                    s.acceleration_m_s2,
+                    s.omega_b_rad_s,
+                    || self.field_in_body(&s.attitude),
+                    &temperatures(s),
+                    state,
+                    n,
+                );
+            }
+        }
+    }
+
+    /// The reading of one sample from its ideal inputs (body frame; the acceleration in frame `N`
+    /// for MATLAB's gyroscope acceleration input) and its normals, drawn by [`Self::draw`].
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn finish_drawn(
+        &self,
+        f_b: Vec3<Body>,
+        acceleration_n: Vec3<N>,
+        w_b: Vec3<Body>,
+        m_b: impl FnOnce() -> Vec3<Body>,
+        temperatures: &Temperatures,
+        state: &mut ImuState<B>,
+        normals: &[[f64; 9]; 3],
+    ) -> ImuReading {
+        let accel_in = match self.mount.accel_sign {
+            AccelSign::SpecificForce => f_b,
+            AccelSign::Matlab => -f_b,
+        };
+        let g_input = match self.gyro_acceleration {
+            GyroAccelerationInput::BodySpecificForce => f_b.to_array(),
+            GyroAccelerationInput::NavAcceleration => acceleration_n.to_array(),
+        };
         let mut reading = ImuReading::default();
         let env = |t: f64, a: [f64; 3]| Environment {
             temperature_c: t,

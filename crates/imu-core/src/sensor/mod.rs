@@ -23,7 +23,8 @@ mod params;
 
 pub use error::ParamError;
 pub use imu::{
-    GyroAccelerationInput, ImuModel, ImuParamError, ImuReading, ImuState, SensorSet, Temperatures,
+    GyroAccelerationInput, ImuModel, ImuParamError, ImuReading, ImuState, MEASURE_BLOCK, SensorSet,
+    Temperatures,
 };
 pub use model::MAX_FLICKER_SECTIONS;
 pub use model::{Environment, SensorModel, SensorState};

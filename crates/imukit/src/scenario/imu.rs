@@ -201,10 +201,14 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     /// [`Self::measure`] into `readings` (cleared first; its memory kept).
     pub fn measure_into(&mut self, truth: &[Truth<N>], readings: &mut Vec<ImuReading>) {
         readings.clear();
-        readings.extend(truth.iter().map(|s| {
-            let temperatures = self.setup.sensors.temperature.at(s.t_s);
-            self.model
-                .measure(s, &temperatures, &mut self.state, &mut self.noise)
-        }));
+        readings.resize(truth.len(), ImuReading::default());
+        let temperature = &self.setup.sensors.temperature;
+        self.model.measure_many(
+            truth,
+            |s| temperature.at(s.t_s),
+            &mut self.state,
+            &mut self.noise,
+            readings,
+        );
     }
 }
