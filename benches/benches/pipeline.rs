@@ -46,6 +46,15 @@ fn bench_pipeline(c: &mut Criterion) {
                 });
             });
         }
+        // What `imukit.simulate(..., truth=False)` runs: the readings into one caller's array.
+        let columns = sc.gathered_shape().expect("a shape").imu_columns.len();
+        let mut readings = vec![0.0; n * columns];
+        group.bench_function(BenchmarkId::new(format!("into_array{name}"), "imu"), |b| {
+            b.iter(|| {
+                sc.simulate_streamed_into(None, threads, None, &mut readings)
+                    .expect("simulated")
+            });
+        });
         group.bench_function(
             BenchmarkId::new(format!("tables{name}"), "truth+imu"),
             |b| {

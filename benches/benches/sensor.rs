@@ -8,7 +8,7 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_core::sensor::{
     BiasInstabilityModel, GyroAccelerationInput, ImuModel, ImuReading, ImuState, InlineBuffer,
-    SeededNormals, SensorSet, Temperatures,
+    NoiseSource, SeededNormals, SensorSet, Temperatures,
 };
 
 /// The core's inline filter storage, named once for the struct literals below.
@@ -70,6 +70,13 @@ fn bench_sensor(c: &mut Criterion) {
                     }
                 });
             });
+            // The same readings with each block's normals drawn first, as a simulation makes them.
+            let many = vec![truth; n];
+            group.bench_function(BenchmarkId::new(format!("{label}/many"), n), |b| {
+                let mut state = ImuState::default();
+                let mut noise = SeededNormals::new(1);
+                b.iter(|| model.measure_many(&many, |_| temps, &mut state, &mut noise, &mut out));
+            });
             group.bench_function(BenchmarkId::new(format!("{label}/no_noise"), n), |b| {
                 let mut state = ImuState::default();
                 b.iter(|| {
@@ -85,6 +92,21 @@ fn bench_sensor(c: &mut Criterion) {
             });
         }
     }
+    // The 27 normals a sample alone, for the share of the generator in the readings' time.
+    let n = 100_000;
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function(BenchmarkId::new("27_normals", n), |b| {
+        let mut noise = SeededNormals::new(1);
+        let mut drawn = [0.0; 27];
+        b.iter(|| {
+            for _ in 0..n {
+                for d in &mut drawn {
+                    *d = noise.standard_normal();
+                }
+                std::hint::black_box(&drawn);
+            }
+        });
+    });
     group.finish();
 }
 

@@ -9,7 +9,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::frame::{Body, NavFrame};
-use crate::kinematics::finite_diff::{check_order, derivatives_at};
+use crate::kinematics::finite_diff::{Stencils, check_order};
 use crate::kinematics::{KinematicsError, Truth, check_times};
 use crate::math;
 use crate::rotation::Rotation;
@@ -95,12 +95,17 @@ pub fn truth_from_body_rates<N: NavFrame>(
         *start.attitude.quaternion(),
     );
     let mut last_yaw: Option<f64> = None;
+    let mut stencils = Stencils::new();
     for k in 0..n {
         let attitude = Rotation::<Body, N>::assume_from_quaternion(q);
         let a_n = q * Vector3::from(accel_body_m_s2[k]);
         let alpha = match alpha_body_rad_s2 {
             Some(a) => a[k],
-            None if n >= 3 => derivatives_at(t_s, k, order, |j| omega_body_rad_s[j]).0,
+            None if n >= 3 => {
+                stencils
+                    .derivatives_at(t_s, k, order, |j| omega_body_rad_s[j])
+                    .0
+            }
             None => [0.0; 3],
         };
         let mut euler = attitude.to_euler();

