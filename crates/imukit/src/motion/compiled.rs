@@ -515,9 +515,8 @@ impl Program {
     /// [`Self::eval`] in the registers of `scratch`, grown once and kept for the next call (a
     /// caller that evaluates chunk after chunk allocates nothing after the first).
     pub fn eval_in(&self, t_s: &[f64], out: &mut Vec<Jet>, scratch: &mut Scratch) {
-        let m = self.outputs.len();
         out.clear();
-        out.resize(t_s.len() * m, [0.0; 4]);
+        out.reserve(t_s.len() * self.outputs.len());
         // Every register and pair slot is written before it is read (the program is in
         // order), so what an earlier call left there is never seen.
         if scratch.registers.len() < self.registers {
@@ -528,7 +527,7 @@ impl Program {
         }
         let regs = &mut scratch.registers[..self.registers];
         let pairs = &mut scratch.pairs[..self.pairs];
-        for (c, times) in t_s.chunks(CHUNK).enumerate() {
+        for times in t_s.chunks(CHUNK) {
             let n = times.len();
             for &(order, op, r) in &self.steps {
                 let (out, regs) = split(regs, r as usize);
@@ -538,13 +537,10 @@ impl Program {
                     Order::Third => run::<Third>(op, out, &regs, pairs, times),
                 }
             }
-            for (i, row) in out[c * CHUNK * m..(c * CHUNK + n) * m]
-                .chunks_exact_mut(m)
-                .enumerate()
-            {
-                for (k, &r) in self.outputs.iter().enumerate() {
-                    row[k] = regs[r as usize][i];
-                }
+            // Appended row by row, not written over a zeroed vector: zeroing it first was 2 %
+            // of a simulation.
+            for i in 0..n {
+                out.extend(self.outputs.iter().map(|&r| regs[r as usize][i]));
             }
         }
     }
