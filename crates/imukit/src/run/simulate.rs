@@ -476,7 +476,11 @@ pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
     emit: &mut dyn FnMut(&[Truth<N>]) -> Result<()>,
 ) -> Result<()> {
     let mut stepper = AnalyticStepper::new(motion, options);
-    let mut buffer: Vec<Truth<N>> = Vec::with_capacity(chunk + DERIVATIVE_CHUNK);
+    // The truth of the samples not yet emitted is `buffer[..filled]`: each block is written over
+    // what earlier chunks left instead of over defaults written first, and the buffer grows only
+    // while a tangent attitude waits for the body to move.
+    let mut buffer: Vec<Truth<N>> = vec![Truth::default(); chunk + DERIVATIVE_CHUNK];
+    let mut filled = 0;
     let mut moving = false;
     let (mut times, mut points) = (
         Vec::with_capacity(DERIVATIVE_CHUNK),
@@ -486,23 +490,27 @@ pub(crate) fn motion_chunks<M: Motion, N: NavFrame>(
         times.clear();
         times.extend((start..t_s.len().min(start + DERIVATIVE_CHUNK)).map(|k| t_s.at(k)));
         motion.derivatives(&times, &mut points);
-        let base = buffer.len();
-        buffer.resize(base + times.len(), Truth::default());
+        let base = filled;
+        filled += times.len();
+        if buffer.len() < filled {
+            buffer.resize(filled, Truth::default());
+        }
         let first = stepper
-            .step_block::<N>(&times, &points, &mut buffer[base..])
+            .step_block::<N>(&times, &points, &mut buffer[base..filled])
             .map_err(|e| with_time(&t_s.to_vec(), e, what))?;
         if let (false, Some(k)) = (moving, first) {
             moving = true;
-            backfill_standstill(&mut buffer, Some(base + k));
+            backfill_standstill(&mut buffer[..filled], Some(base + k));
         }
-        while moving && buffer.len() >= chunk {
+        while moving && filled >= chunk {
             emit(&buffer[..chunk])?;
-            buffer.drain(..chunk);
+            buffer.copy_within(chunk..filled, 0);
+            filled -= chunk;
         }
     }
-    if buffer.is_empty() {
+    if filled == 0 {
         Ok(())
     } else {
-        emit(&buffer)
+        emit(&buffer[..filled])
     }
 }
