@@ -539,6 +539,10 @@ impl Program {
             }
             // Appended row by row, not written over a zeroed vector: zeroing it first was 2 %
             // of a simulation.
+            #[allow(
+                clippy::needless_range_loop,
+                reason = "sample i of each output's register"
+            )]
             for i in 0..n {
                 out.extend(self.outputs.iter().map(|&r| regs[r as usize][i]));
             }
