@@ -274,18 +274,19 @@ def imukit_binary() -> str:
         Path(__file__).resolve().parents[1] / "target" / "release" / "imukit")
 
 
-def cli_formula_time(n, prm, work: Path, ext: str = "csv", threads: Optional[int] = 1) -> float:
+def cli_formula_time(n, prm, work: Path, ext: str = "csv", threads: Optional[int] = 1, repeat: int = 1) -> float:
     """`imukit simulate` of the formula scenario, readings to a file of format ``ext`` (process
-    start and writing included), on ``threads`` (None: every core it may use)."""
+    start and writing included), on ``threads`` (None: every core it may use); the best of
+    ``repeat`` fresh processes."""
     spec = work / "formulas.json"
     spec.write_text(json.dumps(formula_scenario(n, prm)))
     out = work / f"formula_imu.{ext}"
     cap = [] if threads is None else ["--threads", str(threads)]
     return best_of(lambda: subprocess.run([imukit_binary(), "simulate", str(spec), "--out", str(out), *cap],
-                                          check=True, capture_output=True), 1)
+                                          check=True, capture_output=True), repeat)
 
 
-def cli_time(t, pos, euler, prm, work: Path) -> float:
+def cli_time(t, pos, euler, prm, work: Path, repeat: int = 1) -> float:
     """`imukit simulate` on the same samples, from CSV in to CSV out (parsing and writing included)."""
     binary = imukit_binary()
     samples = work / "samples.csv"
@@ -301,7 +302,7 @@ def cli_time(t, pos, euler, prm, work: Path) -> float:
     spec.write_text(json.dumps(scenario))
     out = work / "imu.csv"
     return best_of(lambda: subprocess.run([binary, "simulate", str(spec), "--out", str(out), "--threads", "1"],
-                                          check=True, capture_output=True), 1)
+                                          check=True, capture_output=True), repeat)
 
 
 def main() -> None:
@@ -323,17 +324,20 @@ def main() -> None:
         for size in args.sizes:
             n = int(size)
             t, pos, euler = trajectory(n)
-            repeat = 3 if n <= 1_000_000 else 1
+            # Best of seven below 10⁶ samples, where a call or a process start takes milliseconds
+            # (with three, one run put Python at 3.3× NumPy at 10⁴ where seven calls gave 4.4×),
+            # of three at 10⁶; every side, NumPy's included, gets the same number of tries.
+            repeat = 7 if n < 1_000_000 else 3 if n == 1_000_000 else 1
             t_fnp = best_of(lambda: numpy_formula_pipeline(n, prm,
                                                            np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_fpy = best_of(lambda: imukit_formula_pipeline(n, prm), repeat)
-            fcli = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp)):>20.2f}"
-            fpq = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'parquet'):>24.2f}"
-            fnpy = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'npy'):>20.2f}"
+            fcli = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), repeat=repeat):>20.2f}"
+            fpq = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'parquet', repeat=repeat):>24.2f}"
+            fnpy = "" if args.no_cli else f"{t_fnp / cli_formula_time(n, prm, Path(tmp), 'npy', repeat=repeat):>20.2f}"
             t_np = best_of(lambda: numpy_pipeline(t, pos, euler, prm,
                                                   np.random.default_rng(1).standard_normal((n, 27))), repeat)
             t_py = best_of(lambda: imukit_pipeline(t, pos, euler, prm), repeat)
-            cli = "" if args.no_cli else f"{t_np / cli_time(t, pos, euler, prm, Path(tmp)):>26.2f}"
+            cli = "" if args.no_cli else f"{t_np / cli_time(t, pos, euler, prm, Path(tmp), repeat):>26.2f}"
             ours_in, ref_in = model_inputs(t, pos, euler)
             imu = imukit.ImuSensor("accel-gyro-mag", reference_frame="NED", sample_rate=FS,
                                    temperature=TEMPERATURE, seed=1, magnetic_field=MAG_NED, **prm)
@@ -345,7 +349,8 @@ def main() -> None:
             print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {fcli:>20} {fpq:>24} {fnpy:>20} {t_np / t_py:>16.2f} {cli:>26} "
                   f"{t_model_np / t_model_py:>20.2f}")
             every_core[n] = (t_fnp, best_of(lambda: imukit_formula_pipeline(n, prm, threads=None), repeat),
-                             *(None if args.no_cli else cli_formula_time(n, prm, Path(tmp), ext, threads=None)
+                             *(None if args.no_cli else cli_formula_time(n, prm, Path(tmp), ext, threads=None,
+                                                                         repeat=repeat)
                                for ext in ("csv", "parquet", "npy")))
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     print(f"the formula job with imukit on every core it may use ({cores} here: one run makes its truth, its "
