@@ -198,9 +198,9 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         readings
     }
 
-    /// [`Self::measure`] into `readings` (cleared first; its memory kept).
+    /// [`Self::measure`] into `readings`, resized to the samples (its memory kept; what an
+    /// earlier chunk left is written over, not cleared first).
     pub fn measure_into(&mut self, truth: &[Truth<N>], readings: &mut Vec<ImuReading>) {
-        readings.clear();
         readings.resize(truth.len(), ImuReading::default());
         let temperature = &self.setup.sensors.temperature;
         self.model.measure_many(
