@@ -55,6 +55,18 @@ fn bench_pipeline(c: &mut Criterion) {
                     .expect("simulated")
             });
         });
+        if threads == RunThreads::One {
+            // The same with the AVX2 copies forbidden (`imu_core::cpu`): the baseline build's
+            // speed on this CPU, same numbers.
+            imu_core::cpu::allow_avx2(false);
+            group.bench_function(BenchmarkId::new("into_array_baseline", "imu"), |b| {
+                b.iter(|| {
+                    sc.simulate_streamed_into(None, threads, None, &mut readings)
+                        .expect("simulated")
+                });
+            });
+            imu_core::cpu::allow_avx2(true);
+        }
         group.bench_function(
             BenchmarkId::new(format!("tables{name}"), "truth+imu"),
             |b| {

@@ -1,6 +1,7 @@
 //! Truth + ideal IMU throughput (samples/s) on the figure-8: exact (formula strings, compiled)
 //! and sampled (finite differences, order 6, tangent attitude); and the exact truth alone. Also
-//! the vector kernels' `sin_cos` against `wide`'s own and the C library's (values/s).
+//! the vector kernels' `sin_cos` (as this CPU runs it, and its baseline copy) against `wide`'s own
+//! and the C library's (values/s).
 //!
 //! Run: `cargo bench -p imu-benches --bench truth`.
 #![allow(missing_docs)]
@@ -72,9 +73,15 @@ fn bench_sin_cos(c: &mut Criterion) {
     let (mut s, mut co) = (vec![0.0; x.len()], vec![0.0; x.len()]);
     let mut group = c.benchmark_group("sin_cos/4096");
     group.throughput(Throughput::Elements(x.len() as u64));
+    // The kernel as this CPU runs it (AVX2 where it has it), then its baseline copy.
     group.bench_function("kernel", |b| {
         b.iter(|| imu_core::trig::sin_cos_into(&x, &mut s, &mut co));
     });
+    imu_core::cpu::allow_avx2(false);
+    group.bench_function("kernel_baseline", |b| {
+        b.iter(|| imu_core::trig::sin_cos_into(&x, &mut s, &mut co));
+    });
+    imu_core::cpu::allow_avx2(true);
     group.bench_function("wide", |b| {
         b.iter(|| {
             for ((v, s), c) in x

@@ -3,6 +3,7 @@
 //! `main.rs` parses ([`cli`]), dispatches ([`commands`], one file per subcommand) and prints the
 //! error chain with an exit code ([`CliError`]). The work is done by the `imukit` library and the
 //! figures by `imu-plot`; this crate turns flags into their calls.
+#![forbid(unsafe_code)]
 #[doc(hidden)]
 pub mod cli;
 #[doc(hidden)]

@@ -1,4 +1,5 @@
 //! `imukit`: IMU simulation and navigation from the command line.
+#![forbid(unsafe_code)]
 use imu_cli::{cli, commands};
 
 use std::process::ExitCode;

@@ -19,13 +19,14 @@
 //! math comes from `std` (default feature) or `libm`. Exact analytic trajectories over dual
 //! numbers, which need the standard library, are in `imukit::motion::analytic`.
 #![no_std]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("imu-core needs float math: enable the `std` or the `libm` feature");
 
 pub mod aiding;
 pub mod allan;
+pub mod cpu;
 pub mod earth;
 pub mod frame;
 pub mod fusion;

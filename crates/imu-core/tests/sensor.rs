@@ -491,6 +491,69 @@ fn many_samples_at_once_are_each_samples_reading_bit_for_bit() {
     }
 }
 
+// The only test in this file that switches the AVX2 copy (`imu_core::cpu`): the others may run
+// meanwhile and see either copy, which give the same numbers (that is what this checks).
+#[test]
+fn the_models_avx2_copy_gives_the_baselines_readings_bit_for_bit() {
+    use imu_core::sensor::ImuReading;
+    let p = full_params();
+    let truth: Vec<Truth<Ned>> = (0..2000)
+        .map(|k| {
+            let t = 0.01 * k as f64;
+            let e = EulerZyx::new(0.3 * t, 0.4 * (3.0 * t).sin(), -0.2 * t.cos());
+            Truth {
+                t_s: t,
+                attitude: Rotation::from_euler(e),
+                euler: e,
+                acceleration_m_s2: Vec3::new((7.0 * t).sin(), -0.5 * t, 0.2),
+                omega_b_rad_s: Vec3::new(0.1 * t.cos(), -0.2 * t, 0.3),
+                alpha_b_rad_s2: Vec3::new(0.01, (2.0 * t).sin(), -0.02),
+                ..Truth::default()
+            }
+        })
+        .collect();
+    let imu = ImuModel::<Ned>::new(
+        ImuMount {
+            lever_arm_m: Vec3::new(0.1, -0.05, 0.02),
+            ..ImuMount::default()
+        },
+        SensorSet {
+            gyroscope: true,
+            magnetometer: true,
+        },
+        GyroAccelerationInput::BodySpecificForce,
+        [&p, &p, &p],
+        100.0,
+    )
+    .unwrap();
+    let run = |avx2: bool| {
+        imu_core::cpu::allow_avx2(avx2);
+        let (mut state, mut noise) = (ImuState::default(), SeededNormals::new(9));
+        let mut readings = vec![ImuReading::default(); truth.len()];
+        imu.measure_many(
+            &truth,
+            |s| Temperatures::uniform(15.0 + s.t_s),
+            &mut state,
+            &mut noise,
+            &mut readings,
+        );
+        let bits: Vec<u64> = readings
+            .iter()
+            .flat_map(|r| [r.accel_m_s2, r.gyro_rad_s, r.mag_ut].concat())
+            .map(f64::to_bits)
+            .collect();
+        (bits, state, noise.standard_normal().to_bits())
+    };
+    let (baseline, avx2) = (run(false), run(true));
+    if !imu_core::cpu::avx2_in_use() {
+        eprintln!("this CPU runs no AVX2 copy: both runs were the baseline's");
+    }
+    assert_eq!(avx2.0.len(), 2000 * 9);
+    assert!(avx2.0 == baseline.0, "the readings differ");
+    assert_eq!(avx2.1, baseline.1, "the states afterwards differ");
+    assert_eq!(avx2.2, baseline.2, "the streams' places afterwards differ");
+}
+
 #[test]
 fn seeds_give_identical_streams_and_runs_differ() {
     let draw = |mut n: SeededNormals| (0..5).map(|_| n.standard_normal()).collect::<Vec<_>>();

@@ -56,13 +56,11 @@ fn sines_and_cosines_are_within_the_bound_of_the_correctly_rounded_values() {
     }
 }
 
-#[test]
-fn sines_and_cosines_are_wides_own_bit_for_bit() {
-    // The kernel reads the quadrant from the bits of |x|·2/π + 2⁵² instead of calling `wide`'s
-    // rounding and conversion; every result must still be `wide::f64x4::sin_cos`'s. Random
-    // arguments of every range, and the places where the quadrant changes: odd multiples of π/4
-    // (where |x|·2/π is a half and ties go to even) and their neighbours, signed zeros, tiny
-    // and subnormal numbers, and the largest arguments the kernel takes.
+/// Random arguments of every range the kernel takes, and the places where the quadrant changes:
+/// odd multiples of π/4 (where |x|·2/π is a half and ties go to even) and their neighbours,
+/// signed zeros, tiny and subnormal numbers, and the largest arguments the kernel takes (a whole
+/// number of vectors).
+fn quadrant_edges_and_every_range() -> Vec<f64> {
     let mut x: Vec<f64> = [1e-300, 1e-6, 1.0, 10.0, 1e3, 1e5, 1e7, SIN_COS_MAX_ARG]
         .into_iter()
         .enumerate()
@@ -85,6 +83,20 @@ fn sines_and_cosines_are_wides_own_bit_for_bit() {
         -largest,
     ]);
     x.truncate(x.len() - x.len() % 4);
+    x
+}
+
+// `wide` fuses its multiply-adds where the build has FMA (and on AArch64); the kernel never
+// does, so there the two differ within the bound.
+#[test]
+#[cfg_attr(
+    any(target_feature = "fma", target_arch = "aarch64"),
+    ignore = "wide fuses its multiply-adds in this build"
+)]
+fn sines_and_cosines_are_wides_own_bit_for_bit() {
+    // The kernel reads the quadrant from the bits of |x|·2/π + 2⁵² instead of calling `wide`'s
+    // rounding and conversion; every result must still be `wide::f64x4::sin_cos`'s.
+    let x = quadrant_edges_and_every_range();
     let (mut s, mut c) = (vec![0.0; x.len()], vec![0.0; x.len()]);
     sin_cos_into(&x, &mut s, &mut c);
     let mut checked = 0;
@@ -108,6 +120,34 @@ fn sines_and_cosines_are_wides_own_bit_for_bit() {
         }
     }
     assert!(checked > 170_000, "{checked}");
+}
+
+// The only test in this file that switches the AVX2 copy: the others may run meanwhile and see
+// either copy, which give the same numbers (that is what this checks).
+#[test]
+fn the_avx2_kernel_gives_the_baselines_numbers_bit_for_bit() {
+    let x = quadrant_edges_and_every_range();
+    let run = |avx2: bool| {
+        imu_core::cpu::allow_avx2(avx2);
+        let (mut s, mut c) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        sin_cos_into(&x, &mut s, &mut c);
+        (s, c)
+    };
+    let (baseline, avx2) = (run(false), run(true));
+    if !imu_core::cpu::avx2_in_use() {
+        eprintln!("this CPU runs no AVX2 copy: both runs were the baseline's");
+    }
+    for (i, &v) in x.iter().enumerate() {
+        assert_eq!(
+            (avx2.0[i].to_bits(), avx2.1[i].to_bits()),
+            (baseline.0[i].to_bits(), baseline.1[i].to_bits()),
+            "x = {v:e}: AVX2 ({}, {}), baseline ({}, {})",
+            avx2.0[i],
+            avx2.1[i],
+            baseline.0[i],
+            baseline.1[i]
+        );
+    }
 }
 
 #[test]

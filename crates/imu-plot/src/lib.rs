@@ -19,6 +19,7 @@
 //! imu_plot::plot_files(&[PathBuf::from("truth.csv")], Path::new("truth.png"), false)?;
 //! # Ok::<(), imu_plot::PlotError>(())
 //! ```
+#![forbid(unsafe_code)]
 mod allan;
 pub mod animate;
 mod draw;

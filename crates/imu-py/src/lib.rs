@@ -2,6 +2,7 @@
 //! convert the Python arguments ([`convert`]), release the GIL, call the `imukit` library (or
 //! `imu-plot` for figure specs), convert back; refusals become `imukit.ImuError` with the field,
 //! file, row and column they name ([`errors`]). No numerics here.
+#![forbid(unsafe_code)]
 mod convert;
 mod errors;
 mod figures;

@@ -88,6 +88,7 @@
 //! # std::fs::remove_file(&path).ok();
 //! # Ok::<(), imukit::Error>(())
 //! ```
+#![forbid(unsafe_code)]
 pub mod error;
 pub mod io;
 pub mod motion;

@@ -122,6 +122,37 @@ fn compiled_formulas_give_the_dual_numbers_within_the_bound_on_every_example_and
     }
 }
 
+// The only test in this file that switches the AVX2 copy (`imu_core::cpu`): the others may run
+// meanwhile and see either copy, which give the same numbers (that is what this checks).
+#[test]
+fn the_avx2_copy_of_compiled_formulas_gives_the_baselines_numbers_bit_for_bit() {
+    let bits = |points: &[MotionPoint]| -> Vec<u64> {
+        points
+            .iter()
+            .flat_map(|p| {
+                let euler = p.euler.map_or_else(Vec::new, |e| e.concat());
+                [p.position.concat(), euler].concat()
+            })
+            .map(f64::to_bits)
+            .collect()
+    };
+    for (name, s) in formula_scenarios() {
+        let Trajectory::Expression(motion, _) = &s.trajectory else {
+            unreachable!()
+        };
+        let t = s.t_s.to_vec();
+        let run = |avx2: bool| {
+            imu_core::cpu::allow_avx2(avx2);
+            let mut points = Vec::new();
+            motion.derivatives(&t, &mut points);
+            bits(&points)
+        };
+        let (baseline, avx2) = (run(false), run(true));
+        assert!(baseline.len() >= 12 * t.len(), "{name}");
+        assert!(avx2 == baseline, "{name}: the two copies' numbers differ");
+    }
+}
+
 /// The motion's formulas evaluated only over dual numbers (the path before compilation).
 struct OverDuals<'a>(&'a ExpressionMotion);
 

@@ -297,6 +297,26 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
         noise: &mut impl NoiseSource,
         out: &mut [ImuReading],
     ) {
+        crate::cpu::with_avx2(Block {
+            model: self,
+            truth,
+            temperatures,
+            state,
+            noise,
+            out,
+        });
+    }
+
+    /// [`Self::measure_many`] as compiled where it is inlined.
+    #[inline(always)]
+    fn measure_many_here(
+        &self,
+        truth: &[Truth<N>],
+        temperatures: impl Fn(&Truth<N>) -> Temperatures,
+        state: &mut ImuState<B>,
+        noise: &mut impl NoiseSource,
+        out: &mut [ImuReading],
+    ) {
         let n = truth.len().min(out.len());
         let (truth, out) = (&truth[..n], &mut out[..n]);
         let mut normals = [[[0.0; 9]; 3]; MEASURE_BLOCK];
@@ -372,5 +392,31 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
             );
         }
         reading
+    }
+}
+
+/// The arguments of [`ImuModel::measure_many`], run by [`crate::cpu::with_avx2`].
+struct Block<'a, N: NavFrame, B: FilterBuffer, T, S> {
+    model: &'a ImuModel<N, B>,
+    truth: &'a [Truth<N>],
+    temperatures: T,
+    state: &'a mut ImuState<B>,
+    noise: &'a mut S,
+    out: &'a mut [ImuReading],
+}
+
+impl<N: NavFrame, B: FilterBuffer, T: Fn(&Truth<N>) -> Temperatures, S: NoiseSource>
+    crate::cpu::Work for Block<'_, N, B, T, S>
+{
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        self.model.measure_many_here(
+            self.truth,
+            self.temperatures,
+            self.state,
+            self.noise,
+            self.out,
+        );
     }
 }
