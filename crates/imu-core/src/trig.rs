@@ -4,10 +4,10 @@
 //! arguments, and the tangent attitude two arctangents: one C-library call each was most of its
 //! time (10 ns a call on our machines). These kernels evaluate four values together with the
 //! `wide` crate's polynomial `sin_cos` and `atan2` (Agner Fog's vector class library, after
-//! Cephes). The sine and cosine take 3.5 ns a value on x86-64's SSE2 baseline, against 5.4 ns for
-//! `wide`'s own `sin_cos` (same results bit for bit, see `sin_cos_reduced`) and 9.9 ns for glibc's
-//! `sincos` (`cargo bench -p imu-benches --bench truth -- sin_cos`); `atan2` about 4.8 ns
-//! against glibc's 10.3 ns.
+//! Cephes). The sine and cosine take 3.3–3.5 ns a value on x86-64's SSE2 baseline and 2.0 ns
+//! with AVX2, against 5.1–5.4 ns for `wide`'s own `sin_cos` (same results bit for bit, see
+//! `sin_cos_reduced!`) and 9.7–9.9 ns for glibc's `sincos` (`cargo bench -p imu-benches --bench
+//! truth -- sin_cos`); `atan2` about 4.8 ns against glibc's 10.3 ns.
 //!
 //! **Accuracy.** Each result is within [`MAX_ULP`] units in the last place of the correctly
 //! rounded value (the library's own functions are within one). `tests/trig.rs` checks this
@@ -19,12 +19,14 @@
 //!
 //! **Reproducibility.** A value's result depends on that value alone, not on its neighbours, on
 //! where a slice starts or on its length, so a run gives the same numbers in one call, in chunks
-//! and on any number of threads. The kernels are plain IEEE arithmetic (no fused multiply-add on
-//! the x86-64 baseline), so unlike the C library's functions, which choose an FMA variant by CPU
-//! at run time, a build's results do not depend on the x86-64 CPU that runs it (by construction:
-//! nothing is chosen at run time). Built for a CPU with FMA
-//! (`-C target-cpu=native`) or for AArch64, `wide` fuses its multiply-adds and results can
-//! differ within the bound.
+//! and on any number of threads. The kernels are plain IEEE arithmetic (no fused multiply-add),
+//! so unlike the C library's functions, which choose an FMA variant by CPU at run time, a
+//! build's results do not depend on the x86-64 CPU that runs it. The sine and cosine kernel has
+//! a second copy in AVX2's instructions, which runs where the CPU has AVX2 ([`crate::cpu`]): the
+//! same operations in the same order, so the same results bit for bit (`tests/trig.rs` runs both
+//! copies). It never fuses a multiply-add, on any target; `wide`'s arctangent does where the
+//! build has FMA (`-C target-cpu=native`) or on AArch64, and its results can then differ within
+//! the bound.
 use wide::f64x4;
 
 use crate::math;

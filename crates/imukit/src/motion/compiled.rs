@@ -514,21 +514,7 @@ impl Program {
 
     /// [`Self::eval`] in the registers of `scratch`, grown once and kept for the next call (a
     /// caller that evaluates chunk after chunk allocates nothing after the first).
-    ///
-    /// On an x86-64 CPU with AVX2 this runs a copy compiled for it, with the same numbers
-    /// ([`imu_core::cpu`]).
     pub fn eval_in(&self, t_s: &[f64], out: &mut Vec<Jet>, scratch: &mut Scratch) {
-        imu_core::cpu::with_avx2(EvalIn {
-            program: self,
-            t_s,
-            out,
-            scratch,
-        });
-    }
-
-    /// [`Self::eval_in`] as compiled where it is inlined.
-    #[inline(always)]
-    fn eval_in_here(&self, t_s: &[f64], out: &mut Vec<Jet>, scratch: &mut Scratch) {
         out.clear();
         out.reserve(t_s.len() * self.outputs.len());
         // Every register and pair slot is written before it is read (the program is in
@@ -561,22 +547,6 @@ impl Program {
                 out.extend(self.outputs.iter().map(|&r| regs[r as usize][i]));
             }
         }
-    }
-}
-
-/// The arguments of [`Program::eval_in`], run by [`imu_core::cpu::with_avx2`].
-struct EvalIn<'a> {
-    program: &'a Program,
-    t_s: &'a [f64],
-    out: &'a mut Vec<Jet>,
-    scratch: &'a mut Scratch,
-}
-
-impl imu_core::cpu::Work for EvalIn<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn run(self) {
-        self.program.eval_in_here(self.t_s, self.out, self.scratch);
     }
 }
 
