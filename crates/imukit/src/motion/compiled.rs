@@ -517,6 +517,16 @@ impl Program {
     pub fn eval_in(&self, t_s: &[f64], out: &mut Vec<Jet>, scratch: &mut Scratch) {
         out.clear();
         out.reserve(t_s.len() * self.outputs.len());
+        self.eval_rows(t_s, scratch, |row| {
+            out.extend((0..self.outputs.len()).map(|k| row.jet(k)));
+        });
+    }
+
+    /// The formulas at each time of `t_s` in order, handed to `each` sample by sample as a
+    /// [`Row`], whose jets are read straight from the registers: a caller that builds its own
+    /// rows from them copies nothing in between.
+    #[inline]
+    pub fn eval_rows(&self, t_s: &[f64], scratch: &mut Scratch, mut each: impl FnMut(&Row<'_>)) {
         // Every register and pair slot is written before it is read (the program is in
         // order), so what an earlier call left there is never seen.
         if scratch.registers.len() < self.registers {
@@ -537,16 +547,30 @@ impl Program {
                     Order::Third => run::<Third>(op, out, &regs, pairs, times),
                 }
             }
-            // Appended row by row, not written over a zeroed vector: zeroing it first was 2 %
-            // of a simulation.
-            #[allow(
-                clippy::needless_range_loop,
-                reason = "sample i of each output's register"
-            )]
             for i in 0..n {
-                out.extend(self.outputs.iter().map(|&r| regs[r as usize][i]));
+                each(&Row {
+                    registers: regs,
+                    outputs: &self.outputs,
+                    sample: i,
+                });
             }
         }
+    }
+}
+
+/// One time's outputs of a [`Program`], as [`Program::eval_rows`] hands them out.
+pub struct Row<'a> {
+    registers: &'a [[Jet; CHUNK]],
+    outputs: &'a [u32],
+    sample: usize,
+}
+
+impl Row<'_> {
+    /// The jet of output `k` (in the order the program's formulas were given).
+    #[inline(always)]
+    #[must_use]
+    pub fn jet(&self, k: usize) -> Jet {
+        self.registers[self.outputs[k] as usize][self.sample]
     }
 }
 

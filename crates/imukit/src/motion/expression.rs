@@ -13,7 +13,7 @@ use std::cell::RefCell;
 use std::sync::OnceLock;
 
 use crate::motion::analytic::{Motion, MotionPoint, Scalar, atan2, dual_derivatives};
-use crate::motion::compiled::{Jet, Order, Program, Scratch};
+use crate::motion::compiled::{Order, Program, Row, Scratch};
 use crate::motion::expr::Expr;
 use crate::scenario::NavFrameName;
 
@@ -66,16 +66,10 @@ impl GeodeticPlane {
     }
 }
 
-/// What [`ExpressionMotion::derivatives`] evaluates in, kept per thread between calls: the
-/// program's registers and its jets.
-#[derive(Default)]
-struct EvalScratch {
-    registers: Scratch,
-    jets: Vec<Jet>,
-}
-
 thread_local! {
-    static EVAL_SCRATCH: RefCell<EvalScratch> = RefCell::new(EvalScratch::default());
+    /// What [`ExpressionMotion::derivatives`] evaluates in, kept per thread between calls: the
+    /// program's registers.
+    static EVAL_SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
 /// A motion given by formulas of time.
@@ -134,20 +128,21 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
-    /// The program's jets, `width` per time (the three positions, then the three angles when
-    /// given), into [`MotionPoint`]s.
-    fn points(&self, jets: &[Jet], width: usize, out: &mut Vec<MotionPoint>) {
-        out.clear();
-        out.extend(jets.chunks_exact(width).map(|j| MotionPoint {
-            position: [j[0], j[1], j[2]],
+    /// One time's outputs of the program, `j(k)` the jet of output `k` (the three positions,
+    /// then the three angles when given), as a [`MotionPoint`].
+    #[inline(always)]
+    fn point(&self, row: &Row<'_>) -> MotionPoint {
+        MotionPoint {
+            position: [row.jet(0), row.jet(1), row.jet(2)],
             euler: match &self.attitude {
                 ExpressionAttitude::Tangent => None,
                 ExpressionAttitude::Level => Some([[0.0; 3]; 3]),
-                ExpressionAttitude::Euler(_) => {
-                    Some([3, 4, 5].map(|k| [j[k][0], j[k][1], j[k][2]]))
-                }
+                ExpressionAttitude::Euler(_) => Some([3, 4, 5].map(|k| {
+                    let a = row.jet(k);
+                    [a[0], a[1], a[2]]
+                })),
             },
-        }));
+        }
     }
 
     /// A motion of these formulas.
@@ -243,10 +238,10 @@ impl Motion for ExpressionMotion {
         let Some(program) = self.compiled() else {
             return dual_derivatives(self, t_s, out);
         };
-        EVAL_SCRATCH.with_borrow_mut(|s| {
-            let EvalScratch { registers, jets } = s;
-            program.eval_in(t_s, jets, registers);
-            self.points(jets, program.outputs(), out);
+        EVAL_SCRATCH.with_borrow_mut(|registers| {
+            out.clear();
+            out.reserve(t_s.len());
+            program.eval_rows(t_s, registers, |row| out.push(self.point(row)));
         });
     }
 
