@@ -372,6 +372,21 @@ fn higher_order_filters_match_a_direct_recursion() {
     }
 }
 
+/// Accelerometer, gyroscope and magnetometer, each with `p`, at 100 Hz.
+fn all_three<N: NavFrame>(mount: ImuMount<N>, p: &SensorParams) -> ImuModel<N> {
+    ImuModel::<N>::new(
+        mount,
+        SensorSet {
+            gyroscope: true,
+            magnetometer: true,
+        },
+        GyroAccelerationInput::BodySpecificForce,
+        [p, p, p],
+        100.0,
+    )
+    .unwrap()
+}
+
 fn full_params() -> SensorParams {
     SensorParams {
         measurement_range: 50.0,
@@ -391,17 +406,7 @@ fn full_params() -> SensorParams {
 #[test]
 fn a_run_split_into_chunks_equals_one_call() {
     let p = full_params();
-    let imu = ImuModel::<Enu>::new(
-        ImuMount::default(),
-        SensorSet {
-            gyroscope: true,
-            magnetometer: true,
-        },
-        GyroAccelerationInput::BodySpecificForce,
-        [&p, &p, &p],
-        100.0,
-    )
-    .unwrap();
+    let imu = all_three::<Enu>(ImuMount::default(), &p);
     let truth = Truth::<Enu>::default();
     let temps = Temperatures::uniform(30.0);
     let run = |chunks: &[usize]| {
@@ -512,20 +517,13 @@ fn the_models_avx2_copy_gives_the_baselines_readings_bit_for_bit() {
             }
         })
         .collect();
-    let imu = ImuModel::<Ned>::new(
+    let imu = all_three::<Ned>(
         ImuMount {
             lever_arm_m: Vec3::new(0.1, -0.05, 0.02),
             ..ImuMount::default()
         },
-        SensorSet {
-            gyroscope: true,
-            magnetometer: true,
-        },
-        GyroAccelerationInput::BodySpecificForce,
-        [&p, &p, &p],
-        100.0,
-    )
-    .unwrap();
+        &p,
+    );
     let run = |avx2: bool| {
         imu_core::cpu::allow_avx2(avx2);
         let (mut state, mut noise) = (ImuState::default(), SeededNormals::new(9));

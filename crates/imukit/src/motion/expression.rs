@@ -128,8 +128,8 @@ fn ned_to_ecef<D: Scalar>(lat: D, lon: D) -> [[D; 3]; 3] {
 }
 
 impl ExpressionMotion {
-    /// One time's outputs of the program, `j(k)` the jet of output `k` (the three positions,
-    /// then the three angles when given), as a [`MotionPoint`].
+    /// One time's outputs of the program, `row.jet(k)` the jet of output `k` (the three
+    /// positions, then the three angles when given), as a [`MotionPoint`].
     #[inline(always)]
     fn point(&self, row: &Row<'_>) -> MotionPoint {
         MotionPoint {
