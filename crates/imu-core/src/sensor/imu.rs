@@ -308,41 +308,6 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
         });
     }
 
-    /// [`Self::measure_many`] as compiled where it is inlined.
-    #[inline(always)]
-    fn measure_many_here(
-        &self,
-        truth: &[Truth<N>],
-        temperatures: impl Fn(&Truth<N>) -> Temperatures,
-        state: &mut ImuState<B>,
-        noise: &mut impl NoiseSource,
-        out: &mut [ImuReading],
-    ) {
-        let n = truth.len().min(out.len());
-        let (truth, out) = (&truth[..n], &mut out[..n]);
-        let mut normals = [[[0.0; 9]; 3]; MEASURE_BLOCK];
-        for (samples, readings) in truth
-            .chunks(MEASURE_BLOCK)
-            .zip(out.chunks_mut(MEASURE_BLOCK))
-        {
-            for n in normals.iter_mut().take(samples.len()) {
-                self.draw(n, noise);
-            }
-            for ((s, o), n) in samples.iter().zip(readings.iter_mut()).zip(&normals) {
-                let f_b = self.mount.specific_force(s);
-                *o = self.finish_drawn(
-                    f_b,
-                    s.acceleration_m_s2,
-                    s.omega_b_rad_s,
-                    || self.field_in_body(&s.attitude),
-                    &temperatures(s),
-                    state,
-                    n,
-                );
-            }
-        }
-    }
-
     /// The reading of one sample from its ideal inputs (body frame; the acceleration in frame `N`
     /// for MATLAB's gyroscope acceleration input) and its normals, drawn by [`Self::draw`].
     #[allow(clippy::too_many_arguments)]
@@ -410,14 +375,39 @@ impl<N: NavFrame, B: FilterBuffer, T: Fn(&Truth<N>) -> Temperatures, S: NoiseSou
     crate::cpu::Work for Block<'_, N, B, T, S>
 {
     type Output = ();
+    /// The loop of [`ImuModel::measure_many`], compiled where it is inlined.
     #[inline(always)]
     fn run(self) {
-        self.model.measure_many_here(
-            self.truth,
-            self.temperatures,
-            self.state,
-            self.noise,
-            self.out,
-        );
+        let Self {
+            model,
+            truth,
+            temperatures,
+            state,
+            noise,
+            out,
+        } = self;
+        let n = truth.len().min(out.len());
+        let (truth, out) = (&truth[..n], &mut out[..n]);
+        let mut normals = [[[0.0; 9]; 3]; MEASURE_BLOCK];
+        for (samples, readings) in truth
+            .chunks(MEASURE_BLOCK)
+            .zip(out.chunks_mut(MEASURE_BLOCK))
+        {
+            for n in normals.iter_mut().take(samples.len()) {
+                model.draw(n, noise);
+            }
+            for ((s, o), n) in samples.iter().zip(readings.iter_mut()).zip(&normals) {
+                let f_b = model.mount.specific_force(s);
+                *o = model.finish_drawn(
+                    f_b,
+                    s.acceleration_m_s2,
+                    s.omega_b_rad_s,
+                    || model.field_in_body(&s.attitude),
+                    &temperatures(s),
+                    state,
+                    n,
+                );
+            }
+        }
     }
 }
