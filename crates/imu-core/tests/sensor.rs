@@ -566,6 +566,26 @@ fn seeds_give_identical_streams_and_runs_differ() {
     );
 }
 
+#[test]
+fn filling_a_slice_gives_the_numbers_of_as_many_single_draws_and_the_same_place_after() {
+    // Lengths around the block's 216, and 20 000 numbers, which take in draws from the
+    // ziggurat's rare slow path.
+    for len in [0, 1, 9, 27, 215, 216, 20_000] {
+        let mut one = SeededNormals::for_run(5, 3);
+        let mut filled = one.clone();
+        let singles: Vec<u64> = (0..len).map(|_| one.standard_normal().to_bits()).collect();
+        let mut out = vec![f64::NAN; len];
+        filled.fill_standard_normal(&mut out);
+        let out: Vec<u64> = out.iter().map(|v| v.to_bits()).collect();
+        assert!(out == singles, "length {len}: the numbers differ");
+        assert_eq!(
+            filled.standard_normal().to_bits(),
+            one.standard_normal().to_bits(),
+            "length {len}: the streams' places afterwards differ"
+        );
+    }
+}
+
 fn profiles_case<N: NavFrame>() {
     // A static IMU, yawed and tilted, noise off: MATLAB call shape and truth path agree with the
     // formulas in both accelerometer signs and both g-sensitivity inputs.

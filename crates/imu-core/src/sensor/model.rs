@@ -372,7 +372,8 @@ impl<B: FilterBuffer> SensorModel<B> {
         state: &mut SensorState<B>,
         noise: &mut impl NoiseSource,
     ) -> [f64; 3] {
-        let normals: [f64; 9] = core::array::from_fn(|_| noise.standard_normal());
+        let mut normals = [0.0; 9];
+        noise.fill_standard_normal(&mut normals);
         self.measure_drawn(u, env, state, &normals)
     }
 

@@ -7,6 +7,14 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 pub trait NoiseSource {
     /// The next N(0, 1) number.
     fn standard_normal(&mut self) -> f64;
+
+    /// The next `out.len()` numbers, in order: the same numbers as as many calls of
+    /// [`Self::standard_normal`].
+    fn fill_standard_normal(&mut self, out: &mut [f64]) {
+        for o in out {
+            *o = self.standard_normal();
+        }
+    }
 }
 
 /// Seeded, portable normals: xoshiro256++ with `rand_distr`'s ziggurat `StandardNormal`.
@@ -59,6 +67,17 @@ impl NoiseSource for SeededNormals {
     #[inline(always)]
     fn standard_normal(&mut self) -> f64 {
         StandardNormal.sample(&mut self.rng)
+    }
+
+    // The generator's state is copied into a local for the loop, so that it lives in registers
+    // instead of being stored back through `self` after every number.
+    #[inline(always)]
+    fn fill_standard_normal(&mut self, out: &mut [f64]) {
+        let mut rng = self.rng.clone();
+        for o in out {
+            *o = StandardNormal.sample(&mut rng);
+        }
+        self.rng = rng;
     }
 }
 
