@@ -41,7 +41,7 @@ use crate::sensor::{BiasInstabilityModel, FilterCoefficients, SensorParams};
 /// JSON `"inf"`), a string, a list (vectors, 3×3 matrices, filter coefficients) or a table of
 /// named values. Typed all the way from the file or the Python object: no value passes through
 /// JSON text (which has no infinity).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum ParamValue {
     /// `true`/`false`.
@@ -77,6 +77,89 @@ impl ParamValue {
             Self::Text(s) => Some(s),
             _ => None,
         }
+    }
+}
+
+/// Read by the value's own kind (`deserialize_any`), as `serde_json::Value` is: an untagged enum
+/// would buffer each value and try the variants in turn, formatting an error message for each
+/// that fails, which was a third of the time a Python call spent reading its scenario.
+impl<'de> Deserialize<'de> for ParamValue {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        deserializer.deserialize_any(ParamValueVisitor)
+    }
+}
+
+struct ParamValueVisitor;
+
+impl<'de> serde::de::Visitor<'de> for ParamValueVisitor {
+    type Value = ParamValue;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a boolean, number, string, list, table or null")
+    }
+
+    fn visit_bool<E>(self, v: bool) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Bool(v))
+    }
+
+    fn visit_i64<E>(self, v: i64) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Integer(v))
+    }
+
+    /// An integer beyond `i64` is kept as the nearest number.
+    fn visit_u64<E>(self, v: u64) -> std::result::Result<ParamValue, E> {
+        Ok(i64::try_from(v).map_or(ParamValue::Number(v as f64), ParamValue::Integer))
+    }
+
+    fn visit_f64<E>(self, v: f64) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Number(v))
+    }
+
+    fn visit_str<E>(self, v: &str) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Text(v.to_owned()))
+    }
+
+    fn visit_string<E>(self, v: String) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Text(v))
+    }
+
+    fn visit_unit<E>(self) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Null)
+    }
+
+    fn visit_none<E>(self) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Null)
+    }
+
+    fn visit_some<D: serde::Deserializer<'de>>(
+        self,
+        deserializer: D,
+    ) -> std::result::Result<ParamValue, D::Error> {
+        ParamValue::deserialize(deserializer)
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(
+        self,
+        mut seq: A,
+    ) -> std::result::Result<ParamValue, A::Error> {
+        let mut items = Vec::new();
+        while let Some(item) = seq.next_element()? {
+            items.push(item);
+        }
+        Ok(ParamValue::List(items))
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<ParamValue, A::Error> {
+        let mut table = BTreeMap::new();
+        while let Some((key, value)) = map.next_entry::<String, ParamValue>()? {
+            table.insert(key, value);
+        }
+        Ok(ParamValue::Table(table))
     }
 }
 
