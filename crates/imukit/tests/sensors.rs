@@ -634,3 +634,41 @@ fn matlabs_fractalcoef_500_from_a_parameter_file_drives_the_scenario() {
         "{e}"
     );
 }
+
+/// Every kind of value a scenario or parameter file holds is read as that kind, from JSON and
+/// from TOML: integers stay integers (beyond `i64`, the nearest number), numbers stay numbers,
+/// `null` is `Null`, and lists and tables nest.
+#[test]
+fn param_values_are_read_as_their_own_kind() {
+    use imukit::io::params::ParamValue as V;
+    let json = r#"{"b": true, "i": -7, "big": 18446744073709551615, "x": 0.25, "s": "inf",
+                   "n": null, "l": [1, 2.5, [false]], "t": {"a": "x"}}"#;
+    let from_json: V = serde_json::from_str(json).unwrap();
+    let want = |null: bool| {
+        let mut t = std::collections::BTreeMap::new();
+        t.insert("b".to_string(), V::Bool(true));
+        t.insert("i".to_string(), V::Integer(-7));
+        t.insert("big".to_string(), V::Number(18_446_744_073_709_551_615.0));
+        t.insert("x".to_string(), V::Number(0.25));
+        t.insert("s".to_string(), V::Text("inf".into()));
+        if null {
+            t.insert("n".to_string(), V::Null);
+        }
+        let list = vec![V::Integer(1), V::Number(2.5), V::List(vec![V::Bool(false)])];
+        t.insert("l".to_string(), V::List(list));
+        let inner = std::iter::once(("a".to_string(), V::Text("x".into()))).collect();
+        t.insert("t".to_string(), V::Table(inner));
+        V::Table(t)
+    };
+    assert_eq!(from_json, want(true));
+    // TOML has no null, and its integers end at i64.
+    let toml_text = "b = true\ni = -7\nbig = 18446744073709551615.0\nx = 0.25\ns = \"inf\"\n\
+                     l = [1, 2.5, [false]]\nt = { a = \"x\" }\n";
+    let from_toml: V = toml::from_str(toml_text).unwrap();
+    assert_eq!(from_toml, want(false));
+    // A value of no kind (TOML's dates are tables to serde) still reads.
+    assert!(matches!(
+        toml::from_str::<V>("d = 1979-05-27").unwrap(),
+        V::Table(_)
+    ));
+}
