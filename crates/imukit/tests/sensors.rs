@@ -666,7 +666,7 @@ fn param_values_are_read_as_their_own_kind() {
                      l = [1, 2.5, [false]]\nt = { a = \"x\" }\n";
     let from_toml: V = toml::from_str(toml_text).unwrap();
     assert_eq!(from_toml, want(false));
-    // A value of no kind (TOML's dates are tables to serde) still reads.
+    // TOML's dates reach serde as one-entry tables, and read as such.
     assert!(matches!(
         toml::from_str::<V>("d = 1979-05-27").unwrap(),
         V::Table(_)

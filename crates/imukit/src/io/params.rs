@@ -82,7 +82,8 @@ impl ParamValue {
 
 /// Read by the value's own kind (`deserialize_any`), as `serde_json::Value` is: an untagged enum
 /// would buffer each value and try the variants in turn, formatting an error message for each
-/// that fails, which was a third of the time a Python call spent reading its scenario.
+/// that fails: more than half of the time a Python call spent reading its scenario dict, a third
+/// of a short call's time in Rust (the formula job at 10 samples, in a profile).
 impl<'de> Deserialize<'de> for ParamValue {
     fn deserialize<D: serde::Deserializer<'de>>(
         deserializer: D,
