@@ -107,6 +107,18 @@ fn bench_sensor(c: &mut Criterion) {
             }
         });
     });
+    // The same 27 drawn by one fill, as a simulation's block draws them (its generator state in
+    // a local).
+    group.bench_function(BenchmarkId::new("27_normals_fill", n), |b| {
+        let mut noise = SeededNormals::new(1);
+        let mut drawn = [0.0; 27];
+        b.iter(|| {
+            for _ in 0..n {
+                noise.fill_standard_normal(&mut drawn);
+                std::hint::black_box(&drawn);
+            }
+        });
+    });
     group.finish();
 }
 
