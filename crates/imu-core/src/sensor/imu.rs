@@ -394,7 +394,8 @@ impl<N: NavFrame, B: FilterBuffer, T: Fn(&Truth<N>) -> Temperatures, S: NoiseSou
             .zip(out.chunks_mut(MEASURE_BLOCK))
         {
             if model.sensors.gyroscope && model.sensors.magnetometer {
-                // Every sensor draws: the block's normals are one run of the stream, in order.
+                // Every sensor draws: the block's normals are one run of the stream, in order,
+                // drawn in one fill (a fill of nine a sensor, as `draw` does, ran 4 % slower).
                 let drawn = normals[..samples.len()].as_flattened_mut();
                 noise.fill_standard_normal(drawn.as_flattened_mut());
             } else {
