@@ -203,7 +203,8 @@ impl Op {
     }
 }
 
-/// The registers a [`Program`] works in, kept between calls of [`Program::eval_rows`] (and [`Program::eval_in`]).
+/// The registers a [`Program`] works in, kept between calls of [`Program::eval_rows`] (and
+/// [`Program::eval_in`]).
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     registers: Vec<[Jet; CHUNK]>,
