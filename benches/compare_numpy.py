@@ -27,6 +27,13 @@ numbers that the formula path then was. The formula job is the first column now.
 ``--rust`` also runs the criterion bench of the same call in Rust and prints the Python/Rust
 time ratio at 10⁶ samples.
 
+The formula job's two Python sides are each timed in fresh processes (the median of three, each
+the best of its calls), as the goal they are measured against asks, so that neither inherits the
+other's warm caches or the allocator state earlier work left; the commands run in fresh
+processes anyway. A "warm" column times both Python sides in this process after the agreement
+check too: there NumPy is faster at small N, because the check freed large arrays and glibc then
+keeps the memory of NumPy's temporaries instead of returning it and faulting it in again.
+
 Run (prints tables of time ratios; first one core — both sides single-threaded, imukit with
 ``threads=1`` / ``--threads 1`` — then the formula job with imukit on every core it may use, where
 one run makes its truth, readings and file a chunk apart on up to three threads, docs/design.md §1):
