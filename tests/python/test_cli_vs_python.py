@@ -95,6 +95,30 @@ def test_cli_and_python_are_bit_identical(tmp_path, name):
         assert np.array_equal(values.view(np.uint64), table.values.view(np.uint64)), path.name
 
 
+def test_a_64_bit_seed_from_a_dict_gives_the_clis_numbers(tmp_path):
+    """Any u64 seed (e.g. `secrets.randbits(64)`) works from a Python dict as from the file, bit
+    for bit; one a u64 cannot hold is refused naming `imu.seed`."""
+    import json
+    import tomllib
+
+    scenario = tomllib.loads(SCENARIOS["noisy.toml"])
+    scenario["duration_s"] = 2.0
+    scenario["imu"]["seed"] = 2**64 - 1
+    path = tmp_path / "seeded.json"
+    path.write_text(json.dumps(scenario))
+    out = tmp_path / "imu.csv"
+    subprocess.run([imukit_bin(), "simulate", str(path), "--out", str(out)], check=True, capture_output=True)
+    header, values = read_csv(out)
+    sim = imukit.simulate(scenario)
+    assert header == list(sim.imu.columns)
+    assert np.array_equal(values.view(np.uint64), sim.imu.values.view(np.uint64))
+    other = imukit.simulate({**scenario, "imu": {**scenario["imu"], "seed": 2**63 + 5}})
+    assert not np.array_equal(other.imu.values, sim.imu.values)
+    with pytest.raises(imukit.ImuError, match=r"imu\.seed: .*expected u64") as e:
+        imukit.simulate({**scenario, "imu": {**scenario["imu"], "seed": 2**64}})
+    assert e.value.field == "imu.seed"
+
+
 def test_cli_demo_runs_with_no_arguments(tmp_path):
     result = subprocess.run([imukit_bin(), "demo"], cwd=tmp_path, check=True, capture_output=True, text=True)
     assert "imukit-demo" in result.stdout

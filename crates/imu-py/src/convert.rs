@@ -164,7 +164,8 @@ pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamVa
         return Ok(ParamValue::Bool(obj.extract()?));
     }
     if obj.is_instance_of::<PyInt>() {
-        if let Ok(i) = obj.extract::<i64>() {
+        // Exact up to 128 bits (every seed, any `u64`, fits); beyond, the nearest number.
+        if let Ok(i) = obj.extract::<i128>() {
             return Ok(ParamValue::Integer(i));
         }
         return Ok(ParamValue::Number(obj.extract()?));

@@ -29,6 +29,16 @@ pub enum Error {
         /// The parser's message (it names the key and, for files, the line).
         message: String,
     },
+    /// An in-memory scenario (a Python dict) whose value at `field` does not fit its key.
+    #[error("{origin}: {field}: {message}")]
+    ScenarioKey {
+        /// What the scenario is, e.g. "scenario dict".
+        origin: String,
+        /// Dotted key path, e.g. `imu.seed`; empty for the whole scenario.
+        field: String,
+        /// What does not fit.
+        message: String,
+    },
     /// A scenario key with an invalid value.
     #[error("{field}: {message}")]
     Invalid {
@@ -193,6 +203,7 @@ impl Error {
             Self::Io { path, .. } => file(path),
             Self::Scenario { .. } => Location::default(),
             Self::Invalid { field: f, .. }
+            | Self::ScenarioKey { field: f, .. }
             | Self::Expression { field: f, .. }
             | Self::BadQuaternion { field: f }
             | Self::Diverged { context: f, .. } => field(f),

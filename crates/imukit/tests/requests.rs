@@ -385,3 +385,88 @@ fn an_error_inside_the_trajectory_table_names_the_key() {
         "{e}"
     );
 }
+
+/// A scenario handed over as a tree of values (what a Python dict becomes) reads as the same
+/// scenario its file does: every example, and the specs in `examples/study`.
+#[test]
+fn every_example_reads_the_same_from_its_file_and_as_a_tree() {
+    use imukit::io::params::ParamValue;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut read = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let name = path.display().to_string();
+        let from_file = ScenarioSpec::from_toml(&text, &name).unwrap();
+        let tree: ParamValue = toml::from_str(&text).unwrap();
+        assert_eq!(
+            ScenarioSpec::from_tree(&tree, "scenario dict").unwrap(),
+            from_file,
+            "{name}"
+        );
+        read += 1;
+    }
+    assert!(read >= 10, "{read} examples read");
+}
+
+/// Any `u64` seed reads from a tree as from JSON text (a seed of 2⁶³ or more once failed: the
+/// tree went through TOML, whose integers end at `i64`); a seed a `u64` cannot hold is refused,
+/// naming the key.
+#[test]
+fn a_tree_keeps_every_u64_seed_and_names_the_key_of_a_bad_one() {
+    use imukit::io::params::ParamValue;
+    let json = |seed: &str| {
+        format!(
+            r#"{{"rate_hz": 10.0, "trajectory": {{"type": "builtin", "name": "static"}},
+                 "imu": {{"seed": {seed}, "accelerometer": {{"MeasurementRange": "inf"}}}}}}"#
+        )
+    };
+    for seed in [0, 1 << 63, u64::MAX] {
+        let text = json(&seed.to_string());
+        let tree: ParamValue = serde_json::from_str(&text).unwrap();
+        let spec = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap();
+        assert_eq!(spec.imu.seed, Some(seed));
+        assert_eq!(spec, ScenarioSpec::from_json(&text, "s.json").unwrap());
+    }
+    for (seed, why) in [
+        ("18446744073709551616", "expected u64"),
+        ("-1", "invalid value: integer `-1`, expected u64"),
+        ("2.5", "invalid type: floating point `2.5`, expected u64"),
+        ("\"7\"", "invalid type: string \"7\", expected u64"),
+    ] {
+        let tree: ParamValue = serde_json::from_str(&json(seed)).unwrap();
+        let e = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap_err();
+        assert_eq!(e.location().field.as_deref(), Some("imu.seed"), "{seed}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("scenario dict: imu.seed: ") && text.contains(why),
+            "{seed}: {text}"
+        );
+    }
+    // Inside the trajectory (read by its type first) and in a list, the path goes to the item.
+    let tree: ParamValue =
+        serde_json::from_str(r#"{"trajectory": {"type": "expression", "position_m": ["t", "0"]}}"#)
+            .unwrap();
+    let e = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap_err();
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("trajectory.position_m"),
+        "{e}"
+    );
+    assert!(
+        e.to_string()
+            .ends_with("invalid length 2, expected an array of length 3"),
+        "{e}"
+    );
+    let tree: ParamValue =
+        serde_json::from_str(r#"{"imu": {"lever_arm_m": [0.1, "x", 0.3]}}"#).unwrap();
+    let e = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap_err();
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("imu.lever_arm_m[1]"),
+        "{e}"
+    );
+}

@@ -636,7 +636,7 @@ fn matlabs_fractalcoef_500_from_a_parameter_file_drives_the_scenario() {
 }
 
 /// Every kind of value a scenario or parameter file holds is read as that kind, from JSON and
-/// from TOML: integers stay integers (beyond `i64`, the nearest number), numbers stay numbers,
+/// from TOML: integers stay integers (exactly, any `u64` too), numbers stay numbers,
 /// `null` is `Null`, and lists and tables nest.
 #[test]
 fn param_values_are_read_as_their_own_kind() {
@@ -644,11 +644,11 @@ fn param_values_are_read_as_their_own_kind() {
     let json = r#"{"b": true, "i": -7, "big": 18446744073709551615, "x": 0.25, "s": "inf",
                    "n": null, "l": [1, 2.5, [false]], "t": {"a": "x"}}"#;
     let from_json: V = serde_json::from_str(json).unwrap();
-    let want = |null: bool| {
+    let want = |null: bool, big: V| {
         let mut t = std::collections::BTreeMap::new();
         t.insert("b".to_string(), V::Bool(true));
         t.insert("i".to_string(), V::Integer(-7));
-        t.insert("big".to_string(), V::Number(18_446_744_073_709_551_615.0));
+        t.insert("big".to_string(), big);
         t.insert("x".to_string(), V::Number(0.25));
         t.insert("s".to_string(), V::Text("inf".into()));
         if null {
@@ -660,12 +660,15 @@ fn param_values_are_read_as_their_own_kind() {
         t.insert("t".to_string(), V::Table(inner));
         V::Table(t)
     };
-    assert_eq!(from_json, want(true));
-    // TOML has no null, and its integers end at i64.
+    assert_eq!(from_json, want(true, V::Integer(u64::MAX.into())));
+    // TOML has no null, and its integers end at i64 (the big one is written as a number there).
     let toml_text = "b = true\ni = -7\nbig = 18446744073709551615.0\nx = 0.25\ns = \"inf\"\n\
                      l = [1, 2.5, [false]]\nt = { a = \"x\" }\n";
     let from_toml: V = toml::from_str(toml_text).unwrap();
-    assert_eq!(from_toml, want(false));
+    assert_eq!(
+        from_toml,
+        want(false, V::Number(18_446_744_073_709_551_615.0))
+    );
     // TOML's dates reach serde as one-entry tables, and read as such.
     assert!(matches!(
         toml::from_str::<V>("d = 1979-05-27").unwrap(),

@@ -1,8 +1,9 @@
 //! Files in and out: tables and CSV ([`table`]), tables as Parquet ([`parquet`]) and as NumPy
 //! `.npy` and `.npz` ([`npy`], [`npz`]), each chosen by its path's extension ([`TableFormat`]), parameter
 //! files ([`params`]), the built-in
-//! presets of real parts ([`presets`]), datasheet units ([`units`]) and the time-checked row
-//! reader of IMU files ([`rows`]).
+//! presets of real parts ([`presets`]), datasheet units ([`units`]), the time-checked row
+//! reader of IMU files ([`rows`]) and typed values read from a tree of them ([`value_tree`]:
+//! a Python dict's way in).
 pub mod npy;
 pub mod npz;
 pub mod output;
@@ -12,6 +13,7 @@ pub mod presets;
 pub mod rows;
 pub mod table;
 pub mod units;
+pub mod value_tree;
 
 use std::path::Path;
 

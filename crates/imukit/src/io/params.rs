@@ -46,8 +46,9 @@ use crate::sensor::{BiasInstabilityModel, FilterCoefficients, SensorParams};
 pub enum ParamValue {
     /// `true`/`false`.
     Bool(bool),
-    /// An integer (a seed, a count); also a number where one is expected.
-    Integer(i64),
+    /// An integer (a seed, a count), exactly, of up to 128 bits: every `i64` and `u64` a file or
+    /// Python holds (a seed may be any `u64`); also a number where one is expected.
+    Integer(i128),
     /// A number.
     Number(f64),
     /// A string (`"inf"`, `"single-sided"`).
@@ -106,12 +107,20 @@ impl<'de> serde::de::Visitor<'de> for ParamValueVisitor {
     }
 
     fn visit_i64<E>(self, v: i64) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Integer(v.into()))
+    }
+
+    fn visit_u64<E>(self, v: u64) -> std::result::Result<ParamValue, E> {
+        Ok(ParamValue::Integer(v.into()))
+    }
+
+    fn visit_i128<E>(self, v: i128) -> std::result::Result<ParamValue, E> {
         Ok(ParamValue::Integer(v))
     }
 
-    /// An integer beyond `i64` is kept as the nearest number.
-    fn visit_u64<E>(self, v: u64) -> std::result::Result<ParamValue, E> {
-        Ok(i64::try_from(v).map_or(ParamValue::Number(v as f64), ParamValue::Integer))
+    /// An integer beyond `i128` is kept as the nearest number.
+    fn visit_u128<E>(self, v: u128) -> std::result::Result<ParamValue, E> {
+        Ok(i128::try_from(v).map_or(ParamValue::Number(v as f64), ParamValue::Integer))
     }
 
     fn visit_f64<E>(self, v: f64) -> std::result::Result<ParamValue, E> {

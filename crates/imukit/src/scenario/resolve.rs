@@ -60,19 +60,29 @@ impl ScenarioSpec {
     }
 
     /// From a tree of values (what a Python dict becomes), keys as in a file; `origin` names it
-    /// in messages. Integers stay integers and infinities stay infinite.
+    /// in messages. Read as the tree's own values ([`crate::io::value_tree`]): integers stay
+    /// exact (a seed may be any `u64`) and infinities stay infinite.
     ///
     /// # Errors
-    /// [`Error::Scenario`] with the key that does not fit.
+    /// [`Error::ScenarioKey`] naming the key that does not fit.
     pub fn from_tree(tree: &ParamValue, origin: &str) -> Result<Self> {
-        let fail = |message: String| Error::Scenario {
-            origin: origin.into(),
-            message,
-        };
-        let value = toml::Value::try_from(tree).map_err(|e| fail(e.to_string()))?;
-        value
-            .try_into()
-            .map_err(|e: toml::de::Error| fail(e.to_string()))
+        crate::io::value_tree::read(tree).map_err(|e| {
+            // The trajectory's keys are read by TOML's deserializer (its `type` first), whose
+            // message ends with the key inside the table: ".. \nin `position_m`\n".
+            let message = e.message.trim_end();
+            let (message, field) = match message.rsplit_once("\nin `") {
+                Some((text, key)) if key.ends_with('`') && !e.path.is_empty() => (
+                    text.trim_end(),
+                    format!("{}.{}", e.path, key.trim_end_matches('`')),
+                ),
+                _ => (message, e.path.clone()),
+            };
+            Error::ScenarioKey {
+                origin: origin.into(),
+                field,
+                message: message.into(),
+            }
+        })
     }
 
     /// The files this scenario reads, with what each is, relative paths taken from `base_dir`
