@@ -11,6 +11,68 @@ pub const MAX_FLICKER_SECTIONS: usize = 16;
 /// (longer filters keep theirs in the [`FilterBuffer`]).
 const INLINE_STATE: usize = 2 * MAX_FLICKER_SECTIONS;
 
+/// A triad's three axis values in four lanes, the fourth a spare that parameters and state keep
+/// at zero. The model's arithmetic is written lane by lane over it, so that one vector
+/// instruction does an operation on all three axes: the same IEEE operations, in the same order,
+/// on each axis as a per-axis loop, so the same numbers bit for bit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(32))]
+struct Axes([f64; 4]);
+
+impl Axes {
+    #[inline(always)]
+    fn of(v: [f64; 3]) -> Self {
+        Self([v[0], v[1], v[2], 0.0])
+    }
+    #[inline(always)]
+    fn xyz(self) -> [f64; 3] {
+        [self.0[0], self.0[1], self.0[2]]
+    }
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        Self([v; 4])
+    }
+}
+
+macro_rules! lanewise {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl core::ops::$trait for Axes {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, o: Self) -> Self {
+                let (a, b) = (self.0, o.0);
+                Self([a[0] $op b[0], a[1] $op b[1], a[2] $op b[2], a[3] $op b[3]])
+            }
+        }
+        impl core::ops::$trait<f64> for Axes {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, k: f64) -> Self {
+                self.$method(Axes::splat(k))
+            }
+        }
+    };
+}
+lanewise!(Add, add, +);
+lanewise!(Sub, sub, -);
+lanewise!(Mul, mul, *);
+lanewise!(Div, div, /);
+
+/// [`math::round`] on each lane.
+#[inline(always)]
+fn round_lanes(x: Axes) -> Axes {
+    Axes(x.0.map(math::round))
+}
+
+/// `y` limited to `±range` (NaN passes), on each lane.
+#[inline(always)]
+fn saturate_lanes(y: Axes, range: f64) -> Axes {
+    Axes(y.0.map(|v| {
+        let v = if v < -range { -range } else { v };
+        if v > range { range } else { v }
+    }))
+}
+
 /// The bias-instability generator, ready to step.
 #[derive(Clone, Debug, PartialEq)]
 #[allow(
@@ -93,18 +155,16 @@ impl<B: FilterBuffer> BiasFilter<B> {
         }
     }
 
-    /// One step of the filter on the three axes, each with its own memory.
+    /// One step of the filter on the three axes, each with its own memory: `first_order`'s for
+    /// the first-order filter, `z`'s for the others.
     #[inline(always)]
-    fn step3(&self, x: [f64; 3], z: &mut [FilterMemory<B>; 3]) -> [f64; 3] {
+    fn step3(&self, x: Axes, first_order: &mut Axes, z: &mut [FilterMemory<B>; 3]) -> Axes {
         match *self {
-            // The general recursion unrolled for order 1, the same operations in the same order.
+            // The general recursion unrolled for order 1, the same operations in the same order:
+            // `y = b₀x + z`, `z = b₁x + 0 − a₁y`, the three axes at once.
             Self::FirstOrder { b0, b1, a1 } => {
-                let mut y = [0.0; 3];
-                for i in 0..3 {
-                    let z0 = &mut z[i].inline[0];
-                    y[i] = b0 * x[i] + *z0;
-                    *z0 = b1 * x[i] + 0.0 - a1 * y[i];
-                }
+                let y = x * b0 + *first_order;
+                *first_order = x * b1 + 0.0 - y * a1;
                 y
             }
             Self::Cascade {
@@ -113,9 +173,15 @@ impl<B: FilterBuffer> BiasFilter<B> {
                 sections,
                 gain,
             } => {
-                [0, 1, 2].map(|i| cascade_step(zero, pole, sections, x[i], &mut z[i].inline) * gain)
+                let x = x.xyz();
+                Axes::of(
+                    [0, 1, 2]
+                        .map(|i| cascade_step(zero, pole, sections, x[i], &mut z[i].inline) * gain),
+                )
             }
-            Self::Iir { ref b, ref a } => iir_step3(b.as_slice(), a.as_slice(), x, z),
+            Self::Iir { ref b, ref a } => {
+                Axes::of(iir_step3(b.as_slice(), a.as_slice(), x.xyz(), z))
+            }
         }
     }
 }
@@ -261,17 +327,21 @@ impl Default for Environment {
 /// What drifts over time: the bias-instability filter state and the random-walk value, per axis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SensorState<B: FilterBuffer = InlineBuffer> {
+    /// The general filters' and the flicker cascade's memory, per axis.
     filter: [FilterMemory<B>; 3],
-    random_walk: [f64; 3],
-    quantization_residual: [f64; 3],
+    /// The first-order filter's memory (its one value per axis).
+    first_order: Axes,
+    random_walk: Axes,
+    quantization_residual: Axes,
 }
 
 impl<B: FilterBuffer> Default for SensorState<B> {
     fn default() -> Self {
         Self {
             filter: Default::default(),
-            random_walk: [0.0; 3],
-            quantization_residual: [0.0; 3],
+            first_order: Axes::default(),
+            random_walk: Axes::default(),
+            quantization_residual: Axes::default(),
         }
     }
 }
@@ -280,22 +350,23 @@ impl<B: FilterBuffer> SensorState<B> {
     /// The current random-walk value per axis.
     #[must_use]
     pub fn random_walk(&self) -> [f64; 3] {
-        self.random_walk
+        self.random_walk.xyz()
     }
 }
 
 /// A validated error model of one triad at a fixed sample rate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SensorModel<B: FilterBuffer = InlineBuffer> {
-    misalignment: [[f64; 3]; 3],
-    bias: [f64; 3],
-    white_sigma: [f64; 3],
-    bias_instability: [f64; 3],
+    /// The misalignment matrix's columns (`misalignment_columns[j].0[i]` is row `i`, column `j`).
+    misalignment_columns: [Axes; 3],
+    bias: Axes,
+    white_sigma: Axes,
+    bias_instability: Axes,
     bias_filter: BiasFilter<B>,
-    random_walk_sigma: [f64; 3],
-    temperature_bias: [f64; 3],
-    temperature_scale: [f64; 3],
-    acceleration_bias: [f64; 3],
+    random_walk_sigma: Axes,
+    temperature_bias: Axes,
+    temperature_scale: Axes,
+    acceleration_bias: Axes,
     range: f64,
     resolution: f64,
     quantization_carry: bool,
@@ -319,18 +390,19 @@ impl<B: FilterBuffer> SensorModel<B> {
             NoiseType::DoubleSided => sample_rate_hz / 2.0,
         };
         let root = math::sqrt(bandwidth);
+        let misalignment = params
+            .axes_misalignment_pct
+            .map(|row| row.map(|m| m / 100.0));
         let model = Self {
-            misalignment: params
-                .axes_misalignment_pct
-                .map(|row| row.map(|m| m / 100.0)),
-            bias: params.constant_bias,
-            white_sigma: params.noise_density.map(|n| n * root),
-            bias_instability: params.bias_instability,
+            misalignment_columns: [0, 1, 2].map(|j| Axes::of(misalignment.map(|row| row[j]))),
+            bias: Axes::of(params.constant_bias),
+            white_sigma: Axes::of(params.noise_density.map(|n| n * root)),
+            bias_instability: Axes::of(params.bias_instability),
             bias_filter: BiasFilter::new(&params.bias_instability_model, sample_rate_hz),
-            random_walk_sigma: params.random_walk.map(|k| k / root),
-            temperature_bias: params.temperature_bias,
-            temperature_scale: params.temperature_scale_factor_pct.map(|s| s / 100.0),
-            acceleration_bias: params.acceleration_bias,
+            random_walk_sigma: Axes::of(params.random_walk.map(|k| k / root)),
+            temperature_bias: Axes::of(params.temperature_bias),
+            temperature_scale: Axes::of(params.temperature_scale_factor_pct.map(|s| s / 100.0)),
+            acceleration_bias: Axes::of(params.acceleration_bias),
             range: params.measurement_range,
             resolution: params.resolution,
             quantization_carry: params.quantization_carry,
@@ -342,8 +414,8 @@ impl<B: FilterBuffer> SensorModel<B> {
                 .position(|v| !v.is_finite())
                 .map(|index| ParamError::Overflow { field, index })
         };
-        if let Some(e) = overflow("noise_density", &model.white_sigma)
-            .or_else(|| overflow("random_walk", &model.random_walk_sigma))
+        if let Some(e) = overflow("noise_density", &model.white_sigma.xyz())
+            .or_else(|| overflow("random_walk", &model.random_walk_sigma.xyz()))
         {
             return Err(e);
         }
@@ -391,54 +463,36 @@ impl<B: FilterBuffer> SensorModel<B> {
         state: &mut SensorState<B>,
         normals: &[f64; 9],
     ) -> [f64; 3] {
-        let n_bi = [normals[0], normals[1], normals[2]];
-        let n_white = [normals[3], normals[4], normals[5]];
-        let n_rw = [normals[6], normals[7], normals[8]];
+        let n_bi = Axes([normals[0], normals[1], normals[2], 0.0]);
+        let n_white = Axes([normals[3], normals[4], normals[5], 0.0]);
+        let n_rw = Axes([normals[6], normals[7], normals[8], 0.0]);
         let dt_c = env.temperature_c - 25.0;
-        let mut y = [0.0; 3];
-        for i in 0..3 {
-            let m = &self.misalignment[i];
-            y[i] = m[0] * u[0] + m[1] * u[1] + m[2] * u[2] + self.bias[i];
-        }
+        // `M u + b`, each row's sum in the order `m₀u₀ + m₁u₁ + m₂u₂ + b`.
+        let [c0, c1, c2] = self.misalignment_columns;
+        let y = c0 * u[0] + c1 * u[1] + c2 * u[2] + self.bias;
         let instability = self.bias_filter.step3(
-            [0, 1, 2].map(|i| self.bias_instability[i] * n_bi[i]),
+            self.bias_instability * n_bi,
+            &mut state.first_order,
             &mut state.filter,
         );
-        for i in 0..3 {
-            state.random_walk[i] += self.random_walk_sigma[i] * n_rw[i];
-            let drift = instability[i] + self.white_sigma[i] * n_white[i] + state.random_walk[i];
-            let environment = dt_c * self.temperature_bias[i]
-                + self.acceleration_bias[i] * env.acceleration_m_s2[i];
-            y[i] = self
-                .saturate((1.0 + dt_c * self.temperature_scale[i]) * (y[i] + drift + environment));
-        }
-        if self.quantization_carry && self.resolution > 0.0 {
-            for i in 0..3 {
-                let carried = y[i] + state.quantization_residual[i];
-                y[i] = self.quantise(carried);
-                state.quantization_residual[i] = carried - y[i];
+        state.random_walk = state.random_walk + self.random_walk_sigma * n_rw;
+        let drift = instability + self.white_sigma * n_white + state.random_walk;
+        let environment =
+            self.temperature_bias * dt_c + self.acceleration_bias * Axes::of(env.acceleration_m_s2);
+        let scale = self.temperature_scale * dt_c + 1.0;
+        let y = saturate_lanes(scale * (y + drift + environment), self.range);
+        if self.resolution > 0.0 {
+            let r = self.resolution;
+            if self.quantization_carry {
+                let carried = y + state.quantization_residual;
+                let q = round_lanes(carried / r) * r;
+                state.quantization_residual = carried - q;
+                q.xyz()
+            } else {
+                (round_lanes(y / r) * r).xyz()
             }
         } else {
-            y = y.map(|v| self.quantise(v));
-        }
-        y
-    }
-
-    fn saturate(&self, y: f64) -> f64 {
-        if y > self.range {
-            self.range
-        } else if y < -self.range {
-            -self.range
-        } else {
-            y
-        }
-    }
-
-    fn quantise(&self, y: f64) -> f64 {
-        if self.resolution > 0.0 {
-            self.resolution * math::round(y / self.resolution)
-        } else {
-            y
+            y.xyz()
         }
     }
 }
