@@ -160,6 +160,29 @@ pub(crate) fn matrices_out(
 /// library's typed value tree: integers stay integers, `inf` stays infinite. Dict entries whose
 /// value is `None` are left out (not given); `path` names the value in messages.
 pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamValue> {
+    tree_at(obj, &At::Root(path))
+}
+
+/// Where a value sits in the object handed over (`scenario.imu.lever_arm_m[1]`), written out
+/// only for a message: most calls need none, and formatting every key's path was a tenth of a
+/// short simulation's call.
+enum At<'a> {
+    Root(&'a str),
+    Key(&'a At<'a>, &'a str),
+    Item(&'a At<'a>, usize),
+}
+
+impl std::fmt::Display for At<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Root(name) => f.write_str(name),
+            Self::Key(parent, key) => write!(f, "{parent}.{key}"),
+            Self::Item(parent, k) => write!(f, "{parent}[{k}]"),
+        }
+    }
+}
+
+fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>) -> PyResult<ParamValue> {
     if obj.is_instance_of::<PyBool>() {
         return Ok(ParamValue::Bool(obj.extract()?));
     }
@@ -184,11 +207,11 @@ pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamVa
         for (k, v) in d.iter() {
             let key: String = k
                 .extract()
-                .map_err(|_| PyTypeError::new_err(format!("{path}: keys must be strings")))?;
+                .map_err(|_| PyTypeError::new_err(format!("{at}: keys must be strings")))?;
             if v.is_none() {
                 continue;
             }
-            let inner = value_tree(&v, &format!("{path}.{key}"))?;
+            let inner = tree_at(&v, &At::Key(at, &key))?;
             table.insert(key, inner);
         }
         return Ok(ParamValue::Table(table));
@@ -197,16 +220,16 @@ pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamVa
         let items = obj
             .try_iter()?
             .enumerate()
-            .map(|(k, v)| value_tree(&v?, &format!("{path}[{k}]")))
+            .map(|(k, v)| tree_at(&v?, &At::Item(at, k)))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(ParamValue::List(items));
     }
     // NumPy arrays and scalars: their Python equivalents.
     if obj.hasattr("tolist")? {
-        return value_tree(&obj.call_method0("tolist")?, path);
+        return tree_at(&obj.call_method0("tolist")?, at);
     }
     Err(PyTypeError::new_err(format!(
-        "{path}: expected a number, string, bool, list or dict, got {}",
+        "{at}: expected a number, string, bool, list or dict, got {}",
         obj.get_type().name()?
     )))
 }
