@@ -163,6 +163,18 @@ def test_a_run_too_long_for_memory_raises_before_allocating():
     assert e.value.field == "duration_s"
 
 
+def test_a_dict_value_of_no_scenario_type_is_refused_naming_its_place():
+    static = {"trajectory": {"type": "builtin", "name": "static"}}
+    with pytest.raises(TypeError, match=r"^scenario\.imu\.lever_arm_m\[1\]: expected a number, .* got object$"):
+        imukit.simulate({**static, "imu": {"lever_arm_m": [0.1, object(), 0.3]}})
+    with pytest.raises(TypeError, match=r"^scenario\.imu: keys must be strings$"):
+        imukit.simulate({**static, "imu": {1: 2}})
+    # A value of the wrong kind for its key: the library names the key as the error's field.
+    with pytest.raises(ImuError, match=r"imu\.lever_arm_m\[1\]: invalid type: string \"x\", expected f64") as e:
+        imukit.simulate({**static, "imu": {"lever_arm_m": [0.1, "x", 0.3]}})
+    assert e.value.field == "imu.lever_arm_m[1]"
+
+
 def test_negative_counts_and_seeds_are_refused_by_name():
     for call, field in [
         (lambda: imukit.simulate({"trajectory": {"type": "builtin", "name": "static"}}, run=-1), "run"),
