@@ -1,7 +1,7 @@
 //! NumPy and Python objects in, library types out, and back: shapes are checked here, once, with
 //! the argument named. Nothing here computes.
 use imukit::Table;
-use imukit::io::params::{ParamValue, SensorTable};
+use imukit::io::params::{MAX_DEPTH, ParamValue, SensorTable};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
@@ -158,9 +158,10 @@ pub(crate) fn matrices_out(
 
 /// A Python value (dict, list, tuple, NumPy array or scalar, number, string, bool) as the
 /// library's typed value tree: integers stay integers, `inf` stays infinite. Dict entries whose
-/// value is `None` are left out (not given); `path` names the value in messages.
+/// value is `None` are left out (not given); `path` names the value in messages. Nested deeper
+/// than [`MAX_DEPTH`] is refused, naming where, before going further.
 pub(crate) fn value_tree(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<ParamValue> {
-    tree_at(obj, &At::Root(path))
+    tree_at(obj, &At::Root(path), 0)
 }
 
 /// Where a value sits in the object handed over (`scenario.imu.lever_arm_m[1]`), written out
@@ -182,7 +183,13 @@ impl std::fmt::Display for At<'_> {
     }
 }
 
-fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>) -> PyResult<ParamValue> {
+fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>, depth: usize) -> PyResult<ParamValue> {
+    if depth > MAX_DEPTH {
+        return Err(crate::errors::refused(imukit::Error::Invalid {
+            field: at.to_string(),
+            message: format!("nested deeper than {MAX_DEPTH} levels"),
+        }));
+    }
     if obj.is_instance_of::<PyBool>() {
         return Ok(ParamValue::Bool(obj.extract()?));
     }
@@ -211,7 +218,7 @@ fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>) -> PyResult<ParamValue> {
             if v.is_none() {
                 continue;
             }
-            let inner = tree_at(&v, &At::Key(at, &key))?;
+            let inner = tree_at(&v, &At::Key(at, &key), depth + 1)?;
             table.insert(key, inner);
         }
         return Ok(ParamValue::Table(table));
@@ -220,13 +227,13 @@ fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>) -> PyResult<ParamValue> {
         let items = obj
             .try_iter()?
             .enumerate()
-            .map(|(k, v)| tree_at(&v?, &At::Item(at, k)))
+            .map(|(k, v)| tree_at(&v?, &At::Item(at, k), depth + 1))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(ParamValue::List(items));
     }
     // NumPy arrays and scalars: their Python equivalents.
     if obj.hasattr("tolist")? {
-        return tree_at(&obj.call_method0("tolist")?, at);
+        return tree_at(&obj.call_method0("tolist")?, at, depth);
     }
     Err(PyTypeError::new_err(format!(
         "{at}: expected a number, string, bool, list or dict, got {}",

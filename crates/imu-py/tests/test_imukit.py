@@ -175,6 +175,23 @@ def test_a_dict_value_of_no_scenario_type_is_refused_naming_its_place():
     assert e.value.field == "imu.lever_arm_m[1]"
 
 
+def test_a_dict_nested_too_deep_is_refused_without_overflowing_the_stack():
+    # 200 000 levels once overflowed the converter's stack and killed the interpreter.
+    static = {"trajectory": {"type": "builtin", "name": "static"}}
+    for wrap, inner in ((lambda d: {"a": d}, ".a"), (lambda d: [d], "[0]")):
+        deep = 1.0
+        for _ in range(200_000):
+            deep = wrap(deep)
+        with pytest.raises(ImuError, match="nested deeper than 64 levels") as e:
+            imukit.simulate({**static, "imu": {"accelerometer": deep}})
+        assert e.value.field == "scenario.imu.accelerometer" + inner * 63
+    # The deepest a scenario needs reads as before.
+    coefficients = {"Numerator": [1.0], "Denominator": [1.0, -0.5]}
+    sim = imukit.simulate({**static, "duration_s": 0.1, "imu": {"accelerometer": {
+        "BiasInstability": 0.01, "BiasInstabilityCoefficients": coefficients}}})
+    assert sim.imu.values.shape[0] == 11
+
+
 def test_negative_counts_and_seeds_are_refused_by_name():
     for call, field in [
         (lambda: imukit.simulate({"trajectory": {"type": "builtin", "name": "static"}}, run=-1), "run"),

@@ -61,6 +61,13 @@ pub enum ParamValue {
     Null,
 }
 
+/// The deepest a tree of values may nest, lists and tables counted: a scenario needs six levels
+/// (scenario, `imu`, a sensor, `BiasInstabilityCoefficients`, `Numerator`, a number). Front
+/// ends that build trees from their own objects refuse deeper ones before reading on (a tree is
+/// read, and dropped, by recursion: ten thousand levels overflowed the stack); the file parsers
+/// have limits of their own (JSON 128 levels, TOML fewer).
+pub const MAX_DEPTH: usize = 64;
+
 /// One sensor's parameters by name (imukit's unit-suffixed keys or MATLAB's property names).
 pub type SensorTable = BTreeMap<String, ParamValue>;
 
