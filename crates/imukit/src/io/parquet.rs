@@ -127,17 +127,38 @@ impl ParquetSink {
         if self.columns.first().is_none_or(Vec::is_empty) {
             return Ok(());
         }
-        let arrays: Vec<ArrayRef> = self
+        // Each column's buffer becomes its Arrow array without a copy, and comes back once the
+        // group is written, emptied for the next: the system allocator gave each group's fresh
+        // buffers back to the system and faulted them in again (29 600 page faults for 10⁶
+        // rows of ten columns, against 700 for `.npy`).
+        let arrays: Vec<Float64Array> = self
             .columns
             .iter_mut()
-            .map(|c| Arc::new(Float64Array::from(std::mem::take(c))) as ArrayRef)
+            .map(|c| Float64Array::from(std::mem::take(c)))
             .collect();
-        let batch = RecordBatch::try_new(Arc::clone(&self.schema), arrays)
-            .map_err(|e| format_error(&self.path, e))?;
-        self.writer
+        let batch = RecordBatch::try_new(
+            Arc::clone(&self.schema),
+            arrays
+                .iter()
+                .map(|a| Arc::new(a.clone()) as ArrayRef)
+                .collect(),
+        )
+        .map_err(|e| format_error(&self.path, e))?;
+        let written = self
+            .writer
             .write(&batch)
             .and_then(|()| self.writer.flush())
-            .map_err(|e| format_error(&self.path, e))
+            .map_err(|e| format_error(&self.path, e));
+        drop(batch);
+        for (column, array) in self.columns.iter_mut().zip(arrays) {
+            // The writer keeps no reference to the values once they are encoded; were one kept,
+            // the column would simply grow a new buffer.
+            if let Ok(mut buffer) = array.into_parts().1.into_inner().into_vec::<f64>() {
+                buffer.clear();
+                *column = buffer;
+            }
+        }
+        written
     }
 
     /// Writes what is buffered and the footer, and gives the writer back.
