@@ -21,8 +21,8 @@ use pyo3::prelude::*;
 /// its megabyte or two of chunk buffers back to the system and faulted them in again: 20 % of a
 /// call of 4 096 samples in the kernel, 1.83 ms a call against 1.18 ms with mimalloc (10⁴
 /// samples: 3.30 → 2.80 ms; 10⁵ and more unchanged). NumPy's arrays keep NumPy's allocator. The
-/// command line keeps the system's: one run a process, its buffers reused from chunk to chunk,
-/// it measured no different.
+/// command line keeps the system's: one run a process, its buffers reused from chunk to chunk;
+/// mimalloc there doubled the streaming commands' peak memory (docs/design.md §7).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
