@@ -175,6 +175,21 @@ def test_a_dict_value_of_no_scenario_type_is_refused_naming_its_place():
     assert e.value.field == "imu.lever_arm_m[1]"
 
 
+def test_a_bad_trajectory_key_is_named_from_a_dict_and_from_a_json_file(tmp_path):
+    # The trajectory's keys are read after its type, whatever their order: the key path goes
+    # into the trajectory's lists, and a JSON file's message gives the line.
+    bad = {"trajectory": {"position_m": ["t", "0", [1]], "yaw_rad": "0", "pitch_rad": "0",
+                          "roll_rad": "0", "type": "expression"}}
+    with pytest.raises(ImuError, match=r"position_m\[2\]: invalid type: sequence, expected a formula string of t, or a number$") as e:
+        imukit.simulate(bad)
+    assert e.value.field == "trajectory.position_m[2]"
+    path = tmp_path / "bad.json"
+    path.write_text('{"trajectory": {"type": "expression",\n "position_m": ["t", "0"]}}')
+    with pytest.raises(ImuError, match=r"invalid length 2, expected an array of length 3 at line 2") as e:
+        imukit.simulate(path)
+    assert e.value.field == "trajectory.position_m"
+
+
 def test_a_dict_nested_too_deep_is_refused_without_overflowing_the_stack():
     # 200 000 levels once overflowed the converter's stack and killed the interpreter.
     static = {"trajectory": {"type": "builtin", "name": "static"}}

@@ -29,7 +29,7 @@ pub enum Error {
         /// The parser's message (it names the key and, for files, the line).
         message: String,
     },
-    /// An in-memory scenario (a Python dict) whose value at `field` does not fit its key.
+    /// A scenario (a Python dict, a JSON file) whose value at `field` does not fit its key.
     #[error("{origin}: {field}: {message}")]
     ScenarioKey {
         /// What the scenario is, e.g. "scenario dict".

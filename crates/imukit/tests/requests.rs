@@ -461,6 +461,18 @@ fn a_tree_keeps_every_u64_seed_and_names_the_key_of_a_bad_one() {
             .ends_with("invalid length 2, expected an array of length 3"),
         "{e}"
     );
+    // A tree offers the trajectory's `type` first whatever its keys' order, so the path goes on
+    // into the trajectory's lists too.
+    let tree: ParamValue = serde_json::from_str(
+        r#"{"trajectory": {"position_m": ["t", "0", [1]], "type": "expression"}}"#,
+    )
+    .unwrap();
+    let e = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap_err();
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("trajectory.position_m[2]"),
+        "{e}"
+    );
     let tree: ParamValue =
         serde_json::from_str(r#"{"imu": {"lever_arm_m": [0.1, "x", 0.3]}}"#).unwrap();
     let e = ScenarioSpec::from_tree(&tree, "scenario dict").unwrap_err();
@@ -469,4 +481,52 @@ fn a_tree_keeps_every_u64_seed_and_names_the_key_of_a_bad_one() {
         Some("imu.lever_arm_m[1]"),
         "{e}"
     );
+}
+
+/// A JSON scenario's error names the key path whose value does not fit, and the line and column
+/// where the parser stopped in the value (the end of a list too short); a trajectory whose `type`
+/// comes after other keys is still read, its error naming the key in the message.
+#[test]
+fn a_json_scenario_error_names_the_key_path_and_the_values_place() {
+    let at = |text: &str| {
+        let e = ScenarioSpec::from_json(text, "s.json").unwrap_err();
+        (e.location().field, e.to_string())
+    };
+    let (field, text) =
+        at("{\"trajectory\": {\"type\": \"expression\",\n  \"position_m\": [\"t\", \"0\"]}}");
+    assert_eq!(field.as_deref(), Some("trajectory.position_m"), "{text}");
+    assert!(
+        text.starts_with("s.json: trajectory.position_m: invalid length 2")
+            && text.ends_with("at line 2 column 26"),
+        "{text}"
+    );
+    let (field, text) = at(r#"{"imu": {"seed": -1}}"#);
+    assert_eq!(field.as_deref(), Some("imu.seed"), "{text}");
+    assert!(text.contains("expected u64 at line 1 column 19"), "{text}");
+    let (field, text) = at(r#"{"trajectory": {"type": 3}}"#);
+    assert_eq!(field.as_deref(), Some("trajectory.type"), "{text}");
+    // `type` after another key: the keys are held until it comes, the table is named.
+    let (field, text) = at(r#"{"trajectory": {"position_m": ["t"], "type": "expression"}}"#);
+    assert_eq!(field.as_deref(), Some("trajectory"), "{text}");
+    assert!(
+        text.contains("invalid length 1, expected an array of length 3")
+            && text.contains("position_m"),
+        "{text}"
+    );
+    let late = r#"{"trajectory": {"name": "static", "type": "builtin"}}"#;
+    let early = r#"{"trajectory": {"type": "builtin", "name": "static"}}"#;
+    assert_eq!(
+        ScenarioSpec::from_json(late, "late.json").unwrap(),
+        ScenarioSpec::from_json(early, "early.json").unwrap()
+    );
+    // Text after the scenario, or no scenario at all, is the parser's message alone.
+    let (field, text) = at(&format!("{early} x"));
+    assert_eq!(field, None, "{text}");
+    assert!(
+        text.contains("trailing characters at line 1 column"),
+        "{text}"
+    );
+    let (field, text) = at("{");
+    assert_eq!(field, None, "{text}");
+    assert!(text.contains("EOF while parsing"), "{text}");
 }

@@ -50,32 +50,33 @@ pub struct TreeMismatch {
 /// # Errors
 /// [`TreeMismatch`] naming the key whose value does not fit, and why.
 pub fn read<T: for<'de> Deserialize<'de>>(tree: &ParamValue) -> Result<T, TreeMismatch> {
-    serde_path_to_error::deserialize(tree).map_err(|e| {
-        // Segments after a buffered enum are unknown to the tracker ("?"): the path is cut
-        // there, so that it names the key that holds the value.
-        let path = e
-            .path()
-            .iter()
-            .take_while(|s| !matches!(s, serde_path_to_error::Segment::Unknown))
-            .fold(String::new(), |mut path, s| {
-                use serde_path_to_error::Segment;
-                match s {
-                    Segment::Seq { index } => path.push_str(&format!("[{index}]")),
-                    Segment::Map { key } | Segment::Enum { variant: key } => {
-                        if !path.is_empty() {
-                            path.push('.');
-                        }
-                        path.push_str(key);
-                    }
-                    Segment::Unknown => {}
-                }
-                path
-            });
-        TreeMismatch {
-            path,
-            message: e.into_inner().0,
-        }
+    serde_path_to_error::deserialize(tree).map_err(|e| TreeMismatch {
+        path: key_path(e.path()),
+        message: e.into_inner().0,
     })
+}
+
+/// `path` as a dotted key path, list items as `[k]` (`trajectory.position_m[1]`), cut at the
+/// first segment the tracker could not follow ("?", after a buffered enum), so that it names the
+/// key that holds the value.
+#[must_use]
+pub fn key_path(path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    path.iter()
+        .take_while(|s| !matches!(s, Segment::Unknown))
+        .fold(String::new(), |mut path, s| {
+            match s {
+                Segment::Seq { index } => path.push_str(&format!("[{index}]")),
+                Segment::Map { key } | Segment::Enum { variant: key } => {
+                    if !path.is_empty() {
+                        path.push('.');
+                    }
+                    path.push_str(key);
+                }
+                Segment::Unknown => {}
+            }
+            path
+        })
 }
 
 impl<'de> IntoDeserializer<'de, TreeError> for &'de ParamValue {
@@ -158,9 +159,29 @@ impl<'de> de::Deserializer<'de> for &'de ParamValue {
         }
     }
 
+    /// A table's keys that are among `fields` first, in the order of `fields`, then the others
+    /// (which the type may refuse), so that a type that must read one key before the rest (a
+    /// trajectory's `type`) reads it first from a tree, whose tables keep their keys sorted.
+    fn deserialize_struct<V: Visitor<'de>>(
+        self,
+        _name: &'static str,
+        fields: &'static [&'static str],
+        visitor: V,
+    ) -> Result<V::Value, TreeError> {
+        let ParamValue::Table(table) = self else {
+            return self.deserialize_any(visitor);
+        };
+        let named = fields.iter().filter_map(|f| table.get_key_value(*f));
+        let others = table.iter().filter(|(k, _)| !fields.contains(&k.as_str()));
+        let mut map = MapDeserializer::new(named.chain(others).map(|(k, v)| (k.as_str(), v)));
+        let value = visitor.visit_map(&mut map)?;
+        map.end()?;
+        Ok(value)
+    }
+
     serde::forward_to_deserialize_any! {
         bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf
-        unit unit_struct seq tuple tuple_struct map struct identifier ignored_any
+        unit unit_struct seq tuple tuple_struct map identifier ignored_any
     }
 }
 

@@ -48,15 +48,36 @@ impl ScenarioSpec {
         })
     }
 
-    /// Parses JSON text with the same keys (what the Python dicts become).
+    /// Parses JSON text with the same keys.
     ///
     /// # Errors
-    /// [`Error::Scenario`] with the parser's message.
+    /// [`Error::ScenarioKey`] naming the key whose value does not fit (`trajectory.position_m`),
+    /// with the parser's message and line; [`Error::Scenario`] for text that is not JSON before
+    /// any key.
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
-        serde_json::from_str(text).map_err(|e| Error::Scenario {
+        let mut json = serde_json::Deserializer::from_str(text);
+        let spec = serde_path_to_error::deserialize(&mut json).map_err(|e| {
+            let field = crate::io::value_tree::key_path(e.path());
+            let message = e.into_inner().to_string();
+            if field.is_empty() {
+                Error::Scenario {
+                    origin: origin.into(),
+                    message,
+                }
+            } else {
+                Error::ScenarioKey {
+                    origin: origin.into(),
+                    field,
+                    message,
+                }
+            }
+        })?;
+        // Nothing but white space may follow the scenario.
+        json.end().map_err(|e| Error::Scenario {
             origin: origin.into(),
             message: e.to_string(),
-        })
+        })?;
+        Ok(spec)
     }
 
     /// From a tree of values (what a Python dict becomes), keys as in a file; `origin` names it
@@ -66,22 +87,10 @@ impl ScenarioSpec {
     /// # Errors
     /// [`Error::ScenarioKey`] naming the key that does not fit.
     pub fn from_tree(tree: &ParamValue, origin: &str) -> Result<Self> {
-        crate::io::value_tree::read(tree).map_err(|e| {
-            // The trajectory's keys are read by TOML's deserializer (its `type` first), whose
-            // message ends with the key inside the table: ".. \nin `position_m`\n".
-            let message = e.message.trim_end();
-            let (message, field) = match message.rsplit_once("\nin `") {
-                Some((text, key)) if key.ends_with('`') && !e.path.is_empty() => (
-                    text.trim_end(),
-                    format!("{}.{}", e.path, key.trim_end_matches('`')),
-                ),
-                _ => (message, e.path.clone()),
-            };
-            Error::ScenarioKey {
-                origin: origin.into(),
-                field,
-                message: message.into(),
-            }
+        crate::io::value_tree::read(tree).map_err(|e| Error::ScenarioKey {
+            origin: origin.into(),
+            field: e.path,
+            message: e.message,
         })
     }
 

@@ -62,13 +62,56 @@ impl From<AccelSignName> for AccelSign {
 }
 
 /// A formula, or a plain number where a formula is expected.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Formula {
     /// A formula string of `t`.
     Text(String),
     /// A constant.
     Number(f64),
+}
+
+impl<'de> Deserialize<'de> for Formula {
+    /// Text or a number, read as what it is (serde's untagged enums buffer the value and say
+    /// only that it "did not match any variant").
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(FormulaVisitor)
+    }
+}
+
+/// Reads a [`Formula`]: a string, or any number.
+struct FormulaVisitor;
+
+impl serde::de::Visitor<'_> for FormulaVisitor {
+    type Value = Formula;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a formula string of t, or a number")
+    }
+
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<Formula, E> {
+        Ok(Formula::Text(v.to_owned()))
+    }
+
+    fn visit_string<E: serde::de::Error>(self, v: String) -> std::result::Result<Formula, E> {
+        Ok(Formula::Text(v))
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<Formula, E> {
+        Ok(Formula::Number(v))
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<Formula, E> {
+        Ok(Formula::Number(v as f64))
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Formula, E> {
+        Ok(Formula::Number(v as f64))
+    }
+
+    fn visit_i128<E: serde::de::Error>(self, v: i128) -> std::result::Result<Formula, E> {
+        Ok(Formula::Number(v as f64))
+    }
 }
 
 impl Formula {
@@ -188,25 +231,58 @@ const TRAJECTORY_TYPES: [&str; 6] = [
 
 impl<'de> Deserialize<'de> for TrajectorySpec {
     /// Reads `type` first, then the keys of that type, so that an error names the key inside the
-    /// table (`position_m: invalid length 2, expected an array of length 3`) rather than only the
-    /// table (what serde's internally tagged enums do: they buffer the table and lose the path).
+    /// table (`trajectory.position_m: invalid length 2, expected an array of length 3`) rather
+    /// than only the table (serde's internally tagged enums buffer the table and lose the path).
+    ///
+    /// When `type` is the table's first key — a dict read as a value tree always offers it first
+    /// (it is asked for as the struct's first field), files most often write it first — the
+    /// other keys are read straight from the file's or the tree's own map, so that its path and
+    /// position stay known. When it comes later, the keys before it are held as TOML values
+    /// until it is found, and an error names the key in its message.
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_struct("TrajectorySpec", &["type"], TrajectoryVisitor)
+    }
+}
+
+/// Reads a `[trajectory]` table, its `type` first ([`TrajectorySpec`]'s `Deserialize`).
+struct TrajectoryVisitor;
+
+impl<'de> serde::de::Visitor<'de> for TrajectoryVisitor {
+    type Value = TrajectorySpec;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a table with a type key")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<TrajectorySpec, A::Error> {
         use serde::de::Error as _;
-        let value = toml::Value::deserialize(d)?;
-        let toml::Value::Table(mut table) = value else {
-            return Err(D::Error::custom("expected a table with a type key"));
+        use serde::de::value::MapAccessDeserializer;
+        let Some(first) = map.next_key::<String>()? else {
+            return Err(A::Error::missing_field("type"));
         };
+        if first == "type" {
+            let kind: String = map.next_value()?;
+            return TrajectorySpec::of_type(&kind, MapAccessDeserializer::new(map));
+        }
+        let mut table = toml::Table::new();
+        table.insert(first, map.next_value()?);
+        while let Some((key, value)) = map.next_entry::<String, toml::Value>()? {
+            table.insert(key, value);
+        }
         let kind = match table.remove("type") {
             Some(toml::Value::String(s)) => s,
             Some(other) => {
-                return Err(D::Error::custom(format!(
+                return Err(A::Error::custom(format!(
                     "type: expected a string, got {other}"
                 )));
             }
-            None => return Err(D::Error::missing_field("type")),
+            None => return Err(A::Error::missing_field("type")),
         };
         // Deserialized from the table itself, toml names the key of an error.
-        TrajectorySpec::of_type(&kind, toml::Value::Table(table)).map_err(D::Error::custom)
+        TrajectorySpec::of_type(&kind, toml::Value::Table(table)).map_err(A::Error::custom)
     }
 }
 
