@@ -7,6 +7,8 @@ use imukit::io::table::ImuKind;
 use imukit::run::navigate::{DEFAULT_RK4_SUBSTEPS, NavRequest, NavScheme};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest};
 use imukit::scenario::parse_name;
+use imukit::scenario::sensors::TemperatureSpec;
+use imukit::scenario::spec::{Formula, TrajectorySpec};
 use imukit::{Error, ScenarioSpec};
 
 #[test]
@@ -529,4 +531,66 @@ fn a_json_scenario_error_names_the_key_path_and_the_values_place() {
     let (field, text) = at("{");
     assert_eq!(field, None, "{text}");
     assert!(text.contains("EOF while parsing"), "{text}");
+}
+
+/// A value that is neither of a key's two kinds is refused saying what the key takes; each kind
+/// reads as itself (an integer temperature or formula is a number).
+#[test]
+fn a_formula_or_a_temperature_of_the_wrong_kind_says_what_it_takes() {
+    let scenario = |trajectory: &str, imu: &str| {
+        format!(
+            r#"{{"trajectory": {{"type": "expression", "position_m": {trajectory}, "yaw_rad": "0", "pitch_rad": "0", "roll_rad": "0"}}, "imu": {imu}}}"#
+        )
+    };
+    let e = ScenarioSpec::from_json(&scenario(r#"["t", 2, true]"#, "{}"), "s.json").unwrap_err();
+    assert_eq!(
+        e.location().field.as_deref(),
+        Some("trajectory.position_m[2]")
+    );
+    assert!(
+        e.to_string()
+            .contains("invalid type: boolean `true`, expected a formula string of t, or a number"),
+        "{e}"
+    );
+    let e = ScenarioSpec::from_json(
+        &scenario(r#"["t", 2, 3]"#, r#"{"temperature_c": [1]}"#),
+        "s.json",
+    )
+    .unwrap_err();
+    assert_eq!(e.location().field.as_deref(), Some("imu.temperature_c"));
+    assert!(
+        e.to_string().contains(
+            "invalid type: sequence, expected a temperature in °C, or the path of a CSV file"
+        ),
+        "{e}"
+    );
+    let spec = ScenarioSpec::from_json(
+        &scenario(r#"["t", 2, -3.5]"#, r#"{"temperature_c": 25}"#),
+        "s.json",
+    )
+    .unwrap();
+    let TrajectorySpec::Expression(x) = &spec.trajectory else {
+        panic!("an expression trajectory")
+    };
+    assert_eq!(
+        x.position_m,
+        Some([
+            Formula::Text("t".into()),
+            Formula::Number(2.0),
+            Formula::Number(-3.5)
+        ])
+    );
+    assert_eq!(
+        spec.imu.temperature_c,
+        Some(TemperatureSpec::Constant(25.0))
+    );
+    let spec = ScenarioSpec::from_json(
+        &scenario(r#"["t", 2, 3]"#, r#"{"temperature_c": "profile.csv"}"#),
+        "s.json",
+    )
+    .unwrap();
+    assert_eq!(
+        spec.imu.temperature_c,
+        Some(TemperatureSpec::File("profile.csv".into()))
+    );
 }

@@ -30,7 +30,7 @@ use crate::scenario::resolve::check_temperature;
 use crate::scenario::spec::ImuSpec;
 
 /// `temperature_c`: a constant, or a CSV file of a temperature profile.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum TemperatureSpec {
     /// The same temperature throughout, °C.
@@ -38,6 +38,45 @@ pub enum TemperatureSpec {
     /// A CSV file with `t_s` and `temperature_c`, or per sensor `accel_temperature_c`,
     /// `gyro_temperature_c`, `mag_temperature_c` (missing ones fall back to `temperature_c`).
     File(PathBuf),
+}
+
+impl<'de> Deserialize<'de> for TemperatureSpec {
+    /// A number or a path, read as what it is (serde's untagged enums buffer the value and say
+    /// only that it "did not match any variant").
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(TemperatureVisitor)
+    }
+}
+
+/// Reads a [`TemperatureSpec`]: a number of °C, or a file's path.
+struct TemperatureVisitor;
+
+impl serde::de::Visitor<'_> for TemperatureVisitor {
+    type Value = TemperatureSpec;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a temperature in °C, or the path of a CSV file of temperatures")
+    }
+
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<Self::Value, E> {
+        Ok(TemperatureSpec::File(v.into()))
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<Self::Value, E> {
+        Ok(TemperatureSpec::Constant(v))
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<Self::Value, E> {
+        Ok(TemperatureSpec::Constant(v as f64))
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Self::Value, E> {
+        Ok(TemperatureSpec::Constant(v as f64))
+    }
+
+    fn visit_i128<E: serde::de::Error>(self, v: i128) -> std::result::Result<Self::Value, E> {
+        Ok(TemperatureSpec::Constant(v as f64))
+    }
 }
 
 /// Sensor temperatures over time.
