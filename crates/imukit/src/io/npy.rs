@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use npyz::{DType, NpyHeader, NpyWriter, TypeStr, WriterBuilder};
 
 use crate::error::{Error, Result};
+use crate::io::output::OutputFile;
 
 /// NumPy's own limit on a header's length (`max_header_size` of `numpy.load`), bytes: a longer
 /// header is refused before it is read.
@@ -75,7 +76,7 @@ impl npyz::Serialize for Record {
 
 /// A `.npy` table being written record by record.
 pub struct NpySink {
-    writer: NpyWriter<Record, BufWriter<File>>,
+    writer: NpyWriter<Record, BufWriter<OutputFile>>,
     record: Record,
     path: PathBuf,
 }
@@ -111,7 +112,9 @@ impl NpySink {
         );
         let writer = npyz::WriteOptions::new()
             .dtype(dtype)
-            .writer(BufWriter::new(file.try_clone().map_err(io)?))
+            .writer(BufWriter::new(OutputFile::new(
+                file.try_clone().map_err(io)?,
+            )))
             .begin_1d()
             .map_err(io)?;
         Ok(Self {

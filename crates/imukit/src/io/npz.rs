@@ -20,6 +20,7 @@ use zip::write::SimpleFileOptions;
 
 use crate::error::{Error, Result};
 use crate::io::npy::{MAX_HEADER_BYTES, float64};
+use crate::io::output::OutputFile;
 use crate::io::table::Table;
 
 /// Bytes of rows a writer keeps in memory before moving them to its temporary file.
@@ -127,7 +128,7 @@ impl NpzSink {
     ///
     /// # Errors
     /// The file system's or the archive writer's refusal, naming the file.
-    pub fn finish(mut self, out: BufWriter<File>) -> Result<BufWriter<File>> {
+    pub fn finish(mut self, out: BufWriter<OutputFile>) -> Result<BufWriter<OutputFile>> {
         self.move_block()?;
         let rows: usize = self.blocks.iter().sum();
         let mut spill = self.spill.into_inner().map_err(|e| Error::Io {

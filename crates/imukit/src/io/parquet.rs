@@ -18,6 +18,7 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
 use crate::error::{Error, Result};
+use crate::io::output::OutputFile;
 use crate::io::table::Table;
 
 /// Metadata key of the scenario a file was simulated from (its text as given).
@@ -38,7 +39,7 @@ fn format_error(path: &Path, e: impl std::fmt::Display) -> Error {
 /// A Parquet table being written row group by row group (the rows buffered column by column
 /// until a group is full).
 pub struct ParquetSink {
-    writer: ArrowWriter<BufWriter<File>>,
+    writer: ArrowWriter<BufWriter<OutputFile>>,
     schema: Arc<Schema>,
     columns: Vec<Vec<f64>>,
     path: std::path::PathBuf,
@@ -60,7 +61,7 @@ impl ParquetSink {
     /// # Errors
     /// The Parquet writer's refusal, naming the file.
     pub fn create(
-        writer: BufWriter<File>,
+        writer: BufWriter<OutputFile>,
         path: &Path,
         columns: &[String],
         metadata: &[(String, String)],
@@ -165,7 +166,7 @@ impl ParquetSink {
     ///
     /// # Errors
     /// The Parquet writer's refusal, naming the file.
-    pub fn finish(mut self) -> Result<BufWriter<File>> {
+    pub fn finish(mut self) -> Result<BufWriter<OutputFile>> {
         self.flush()?;
         self.writer
             .into_inner()
