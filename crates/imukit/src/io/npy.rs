@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use npyz::{DType, NpyHeader, NpyWriter, TypeStr, WriterBuilder};
 
 use crate::error::{Error, Result};
-use crate::io::output::OutputFile;
+use crate::io::output::{OutputFile, WRITE_BLOCK};
 
 /// NumPy's own limit on a header's length (`max_header_size` of `numpy.load`), bytes: a longer
 /// header is refused before it is read.
@@ -112,9 +112,10 @@ impl NpySink {
         );
         let writer = npyz::WriteOptions::new()
             .dtype(dtype)
-            .writer(BufWriter::new(OutputFile::new(
-                file.try_clone().map_err(io)?,
-            )))
+            .writer(BufWriter::with_capacity(
+                WRITE_BLOCK,
+                OutputFile::new(file.try_clone().map_err(io)?),
+            ))
             .begin_1d()
             .map_err(io)?;
         Ok(Self {

@@ -20,6 +20,15 @@ const NAME_MAX: usize = 255;
 /// The suffix of a file being written.
 const PARTIAL: &str = ".imukit-partial";
 
+/// What an output gathers before it hands it to the system in one write, bytes: the block CSV
+/// rows are formatted into (at most; a chunk of rows is written when formatted) and the buffer
+/// `.npy` records go through. `imukit simulate` of 10⁶ readings (the comparison's formula job,
+/// one thread, best of five processes, three rounds): CSV 0.37 → 0.35 s with blocks of up to a
+/// mebibyte instead of 60 KiB, `.npy` 0.22 → 0.19 s with this buffer instead of 8 KiB (fewer
+/// calls, and the kernel copies larger pieces into its cache). Parquet's pages (about 50 KB)
+/// gathered the same way showed no change, so they are written as they come.
+pub const WRITE_BLOCK: usize = 1 << 20;
+
 /// How much an output file is written before its new part is handed to the disk, bytes.
 const WRITEBACK_STEP: u64 = 8 << 20;
 

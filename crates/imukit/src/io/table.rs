@@ -439,9 +439,9 @@ pub fn write_rows(
     separator: &[u8],
 ) -> std::io::Result<()> {
     // Rows are formatted into one local buffer (zmij straight into it) and handed to the writer
-    // a block at a time: no call into the writer per field.
+    // a block at a time: no call into the writer per field, and few calls into the system.
     let mut buf = zmij::Buffer::new();
-    let mut text: Vec<u8> = Vec::with_capacity(64 * 1024);
+    let mut text: Vec<u8> = Vec::with_capacity(crate::io::output::WRITE_BLOCK + 4096);
     for row in data.chunks(width.max(1)) {
         for (k, v) in row.iter().enumerate() {
             if k > 0 {
@@ -450,7 +450,7 @@ pub fn write_rows(
             text.extend_from_slice(buf.format(*v).as_bytes());
         }
         text.push(b'\n');
-        if text.len() >= 60 * 1024 {
+        if text.len() >= crate::io::output::WRITE_BLOCK {
             w.write_all(&text)?;
             text.clear();
         }
