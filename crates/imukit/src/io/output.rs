@@ -30,7 +30,7 @@ const PARTIAL: &str = ".imukit-partial";
 pub const WRITE_BLOCK: usize = 1 << 20;
 
 /// How much an output file is written before its new part is handed to the disk, bytes.
-const WRITEBACK_STEP: u64 = 8 << 20;
+pub const WRITEBACK_STEP: u64 = 8 << 20;
 
 /// An output file whose written part is handed to the disk as it grows, every
 /// [`WRITEBACK_STEP`] bytes, while the command goes on working, instead of all at once when it
@@ -38,7 +38,7 @@ const WRITEBACK_STEP: u64 = 8 << 20;
 /// then waits for the last step only. On Linux the kernel is asked to start writing the new
 /// part back (`posix_fadvise`'s `DONTNEED`, which starts the write-back of dirty pages without
 /// waiting for it); elsewhere, and where the file system declines, the file is written as any
-/// other. Reads, seeks and the file's contents are those of the file itself.
+/// other. Seeks and the file's contents are those of the file itself.
 #[derive(Debug)]
 pub struct OutputFile {
     file: File,

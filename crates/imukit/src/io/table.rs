@@ -196,7 +196,7 @@ pub fn check_finite_from<S: AsRef<str>>(
     }
 }
 
-/// The index of the first value of `data` that is not finite. Blocks of [`FINITE_BLOCK`] values
+/// The index of the first value of `data` that is not finite. Blocks of 32 values
 /// are tested whole, without stopping at the first failure, so that the test is a few vector
 /// operations a block; only a block that fails is searched.
 #[must_use]

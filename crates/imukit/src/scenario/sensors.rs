@@ -27,7 +27,7 @@ use crate::io::presets;
 use crate::io::table::read_columns;
 use crate::scenario::perturb::Perturbation;
 use crate::scenario::resolve::check_temperature;
-use crate::scenario::spec::ImuSpec;
+use crate::scenario::spec::{ImuSpec, NumberOrText, number_or_text};
 
 /// `temperature_c`: a constant, or a CSV file of a temperature profile.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -41,41 +41,12 @@ pub enum TemperatureSpec {
 }
 
 impl<'de> Deserialize<'de> for TemperatureSpec {
-    /// A number or a path, read as what it is (serde's untagged enums buffer the value and say
-    /// only that it "did not match any variant").
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        d.deserialize_any(TemperatureVisitor)
-    }
-}
-
-/// Reads a [`TemperatureSpec`]: a number of °C, or a file's path.
-struct TemperatureVisitor;
-
-impl serde::de::Visitor<'_> for TemperatureVisitor {
-    type Value = TemperatureSpec;
-
-    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("a temperature in °C, or the path of a CSV file of temperatures")
-    }
-
-    fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<Self::Value, E> {
-        Ok(TemperatureSpec::File(v.into()))
-    }
-
-    fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<Self::Value, E> {
-        Ok(TemperatureSpec::Constant(v))
-    }
-
-    fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<Self::Value, E> {
-        Ok(TemperatureSpec::Constant(v as f64))
-    }
-
-    fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Self::Value, E> {
-        Ok(TemperatureSpec::Constant(v as f64))
-    }
-
-    fn visit_i128<E: serde::de::Error>(self, v: i128) -> std::result::Result<Self::Value, E> {
-        Ok(TemperatureSpec::Constant(v as f64))
+        let expecting = "a temperature in °C, or the path of a CSV file of temperatures";
+        Ok(match number_or_text(d, expecting)? {
+            NumberOrText::Number(v) => Self::Constant(v),
+            NumberOrText::Text(s) => Self::File(s.into()),
+        })
     }
 }
 

@@ -72,45 +72,69 @@ pub enum Formula {
 }
 
 impl<'de> Deserialize<'de> for Formula {
-    /// Text or a number, read as what it is (serde's untagged enums buffer the value and say
-    /// only that it "did not match any variant").
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        d.deserialize_any(FormulaVisitor)
+        Ok(
+            match number_or_text(d, "a formula string of t, or a number")? {
+                NumberOrText::Number(v) => Self::Number(v),
+                NumberOrText::Text(s) => Self::Text(s),
+            },
+        )
     }
 }
 
-/// Reads a [`Formula`]: a string, or any number.
-struct FormulaVisitor;
+/// A scenario value that is a number or text (a formula or a constant; a temperature or a
+/// file), as [`number_or_text`] reads it.
+pub(crate) enum NumberOrText {
+    /// Any number, as `f64`.
+    Number(f64),
+    /// Text.
+    Text(String),
+}
 
-impl serde::de::Visitor<'_> for FormulaVisitor {
-    type Value = Formula;
+/// Reads a number or text as what it is, refusing anything else as not `expecting` (serde's
+/// untagged enums buffer the value and say only that it "did not match any variant").
+///
+/// # Errors
+/// The format's error for a value of another kind.
+pub(crate) fn number_or_text<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    expecting: &'static str,
+) -> std::result::Result<NumberOrText, D::Error> {
+    d.deserialize_any(NumberOrTextVisitor(expecting))
+}
+
+/// Reads a [`NumberOrText`]; holds what the key expects, for messages.
+struct NumberOrTextVisitor(&'static str);
+
+impl serde::de::Visitor<'_> for NumberOrTextVisitor {
+    type Value = NumberOrText;
 
     fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("a formula string of t, or a number")
+        f.write_str(self.0)
     }
 
-    fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<Formula, E> {
-        Ok(Formula::Text(v.to_owned()))
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Text(v.to_owned()))
     }
 
-    fn visit_string<E: serde::de::Error>(self, v: String) -> std::result::Result<Formula, E> {
-        Ok(Formula::Text(v))
+    fn visit_string<E: serde::de::Error>(self, v: String) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Text(v))
     }
 
-    fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<Formula, E> {
-        Ok(Formula::Number(v))
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Number(v))
     }
 
-    fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<Formula, E> {
-        Ok(Formula::Number(v as f64))
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Number(v as f64))
     }
 
-    fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Formula, E> {
-        Ok(Formula::Number(v as f64))
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Number(v as f64))
     }
 
-    fn visit_i128<E: serde::de::Error>(self, v: i128) -> std::result::Result<Formula, E> {
-        Ok(Formula::Number(v as f64))
+    fn visit_i128<E: serde::de::Error>(self, v: i128) -> std::result::Result<NumberOrText, E> {
+        Ok(NumberOrText::Number(v as f64))
     }
 }
 
