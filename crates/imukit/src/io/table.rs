@@ -835,8 +835,9 @@ mod tests {
 
     #[test]
     fn rows_of_any_width_read_back_as_the_numbers_written() {
-        // Rows wider than the 60 KiB blocks handed to the writer, and numbers from one to 24
-        // characters of text (all finite: nothing else reaches a file).
+        // Rows wider than the blocks handed to the writer (`WRITE_BLOCK`, a mebibyte: 80 000
+        // values of 3 to 24 characters), and numbers from one to 24 characters of text (all
+        // finite: nothing else reaches a file).
         let values = [
             0.0,
             -1.0,
@@ -846,7 +847,7 @@ mod tests {
             1.797_693_134_862_315_7e300,
             1e16,
         ];
-        for width in [1, 7, 5000] {
+        for width in [1, 7, 80_000] {
             let data: Vec<f64> = (0..3 * width)
                 .map(|i| values[i % values.len()] * (1.0 + i as f64))
                 .collect();
@@ -854,6 +855,10 @@ mod tests {
             write_rows(&mut out, &data, width, b", ").expect("written to memory");
             let text = String::from_utf8(out).expect("text");
             assert_eq!(text.lines().count(), 3);
+            if width == 80_000 {
+                let row = text.lines().next().map_or(0, str::len);
+                assert!(row > crate::io::output::WRITE_BLOCK, "a row of {row} bytes");
+            }
             let back: Vec<f64> = text
                 .lines()
                 .flat_map(|l| l.split(", ").map(|v| v.parse::<f64>().expect("a number")))
@@ -868,7 +873,8 @@ mod tests {
     #[test]
     fn rows_are_each_values_shortest_text_byte_for_byte() {
         // Numbers of every text length (3 to 24 characters: integers, decimals, quantised
-        // readings, random bit patterns of every exponent) over several 64 KiB blocks, and every separator length
+        // readings, random bit patterns of every exponent) over several of the blocks handed to the
+        // writer (`WRITE_BLOCK`: 200 000 values, about 2.4 MB of text), and every separator length
         // the commands use, against the plain join of zmij's texts.
         let mut z: u64 = 0x0123_4567_89AB_CDEF;
         let mut next = || {
@@ -878,7 +884,7 @@ mod tests {
             v ^ (v >> 31)
         };
         let mut data = Vec::new();
-        for i in 0..40_000 {
+        for i in 0..200_000 {
             let r = next();
             data.push(match i % 5 {
                 0 => f64::from_bits(r & !(0x7FF << 52) | ((r % 2046 + 1) << 52)),
@@ -907,6 +913,11 @@ mod tests {
                     want.push(b'\n');
                 }
                 assert!(out == want, "width {width}, separator {separator:?}");
+                assert!(
+                    out.len() > 2 * crate::io::output::WRITE_BLOCK,
+                    "{} bytes",
+                    out.len()
+                );
             }
         }
         assert!(
