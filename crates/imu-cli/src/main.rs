@@ -1,6 +1,7 @@
 //! `imukit`: IMU simulation and navigation from the command line.
 #![forbid(unsafe_code)]
-use imu_cli::{cli, commands};
+use imu_cli::{CliError, cli, commands, interrupt};
+use imukit::io::output::OutputGroup;
 
 use std::process::ExitCode;
 
@@ -8,7 +9,10 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     let args = cli::Cli::parse();
-    match commands::run(args) {
+    interrupt::clean_up_on_signals();
+    // Every output of the command is put in place at its end, all or none.
+    let outputs = OutputGroup::begin();
+    match commands::run(args).and_then(|()| outputs.commit().map_err(CliError::from)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imukit: {e}");

@@ -85,11 +85,23 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
             message: "give at least one CSV file".into(),
         });
     }
+    let tables = paths
+        .iter()
+        .map(|p| Ok((p.clone(), imukit::io::table::read_table(p)?)))
+        .collect::<Result<Vec<_>, PlotError>>()?;
+    plot_tables(&tables, out, ned)
+}
+
+/// Draws the default figure for tables (all of one kind, each with the file it is named by)
+/// into `out`, as [`plot_files`] does for the files themselves.
+///
+/// # Errors
+/// Unknown kinds of table, tables of different kinds, drawing errors.
+pub fn plot_tables(tables: &[(PathBuf, Table)], out: &Path, ned: bool) -> Result<(), PlotError> {
     let mut files = Vec::new();
     let mut traces: Vec<Trace> = Vec::new();
     let mut kind: Option<TableKind> = None;
-    for p in paths {
-        let t = imukit::io::table::read_table(p)?;
+    for (p, t) in tables {
         let k = TableKind::of(&t.columns, &p.display().to_string())?;
         if let Some(first) = kind.filter(|first| !first.overlays(k)) {
             return Err(PlotError::Invalid {
@@ -104,7 +116,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
         }
         kind.get_or_insert(k);
         if k.has_trajectory() {
-            let trace = Trace::from_table(&stem(p), &t, ned).map_err(|e| match e {
+            let trace = Trace::from_table(&stem(p), t, ned).map_err(|e| match e {
                 PlotError::Invalid { message, .. } => PlotError::Invalid {
                     field: p.display().to_string(),
                     message,
@@ -113,7 +125,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
             })?;
             traces.push(trace);
         }
-        files.push((stem(p), t));
+        files.push((stem(p), t.clone()));
     }
     let kind = kind.unwrap_or(TableKind::Imu);
     if kind == TableKind::Allan {

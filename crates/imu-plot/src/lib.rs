@@ -31,7 +31,7 @@ mod study;
 
 pub use allan::allan_figure;
 pub use draw::{COLORS, FigureFormat, check_figure_path, rasterise, write_figure};
-pub use figures::plot_files;
+pub use figures::{plot_files, plot_tables};
 pub use panels::{Trace, trajectories_figure};
 pub use spec::{FramePlan, PanelSpec, TableKind};
 pub use study::study_figure;

@@ -7,8 +7,10 @@ use imukit::scenario::builtin;
 
 use super::CliError;
 use imu_plot::animate::{AnimateOptions, animate};
-use imu_plot::plot_files;
+use imu_plot::plot_tables;
+use imukit::io::output::write_atomically;
 use imukit::scenario::NavFrameName;
+use std::io::Write as _;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let io = |source| CliError::Io {
@@ -24,19 +26,22 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
         "the scenario, editable: imukit simulate scenario.toml --out imu.csv",
     )];
     let toml_path = out_dir.join(files[0].0);
-    std::fs::write(&toml_path, builtin::toml(name)?).map_err(|source| CliError::Io {
-        path: toml_path.display().to_string(),
-        source,
-    })?;
+    let toml = builtin::toml(name)?;
+    write_atomically(&toml_path, |w| w.write_all(toml.as_bytes()))?;
     sim.truth.write_csv(&out_dir.join("truth.csv"))?;
     sim.imu.write_csv(&out_dir.join("imu.csv"))?;
     let ned = spec.nav_frame == Some(NavFrameName::NED);
-    plot_files(
-        &[out_dir.join("truth.csv")],
+    // Drawn from the tables in memory: the files are put in place when the command ends.
+    plot_tables(
+        &[(out_dir.join("truth.csv"), sim.truth.clone())],
         &out_dir.join("truth.png"),
         ned,
     )?;
-    plot_files(&[out_dir.join("imu.csv")], &out_dir.join("imu.png"), ned)?;
+    plot_tables(
+        &[(out_dir.join("imu.csv"), sim.imu.clone())],
+        &out_dir.join("imu.png"),
+        ned,
+    )?;
     let lever_arm_m = spec.imu.lever_arm_m.unwrap_or([0.0; 3]);
     let opts = AnimateOptions {
         lever_arm_m,
@@ -51,10 +56,7 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     )?;
     let summary = summary(name, &sim);
     let summary_path = out_dir.join("summary.txt");
-    std::fs::write(&summary_path, &summary).map_err(|source| CliError::Io {
-        path: summary_path.display().to_string(),
-        source,
-    })?;
+    write_atomically(&summary_path, |w| w.write_all(summary.as_bytes()))?;
     print!("{summary}");
     println!(
         "\nWrote scenario.toml, truth.csv, imu.csv, summary.txt, the figures truth.png and imu.png \

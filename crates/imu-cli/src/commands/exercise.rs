@@ -88,7 +88,9 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
         "Planar cart exercise: dead reckoning of the cart",
         &traces,
     )?;
-    std::fs::write(out_dir.join("summary.txt"), &summary).map_err(io)?;
+    imukit::io::output::write_atomically(&out_dir.join("summary.txt"), |w| {
+        std::io::Write::write_all(w, summary.as_bytes())
+    })?;
     print!("{summary}");
     println!(
         "\nWrote inertial_data.dat, inertial_data_errors.dat, truth.csv, the four trajectories (CSV), \

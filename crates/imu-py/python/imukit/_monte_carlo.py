@@ -87,7 +87,8 @@ def monte_carlo(
     Returns a :class:`MonteCarlo` (the IMU readings of every run in one array, which the runs
     write into in place on this machine's cores, and the truth), or,
     with ``out="dir/imu.csv"``, writes each run where it ran as ``dir/imu_run0007.csv`` (the
-    CLI's names) and returns the paths.
+    CLI's names) and returns the paths. Interrupted (Ctrl-C), it lets the runs under way finish
+    their files, starts no other and raises ``KeyboardInterrupt``: no file is left partial.
 
     >>> mc = monte_carlo({"trajectory": {"type": "builtin", "name": "static"}, "duration_s": 0.1,
     ...                   "imu": {"preset": "mpu-6050", "seed": 1}}, runs=3)
@@ -114,8 +115,13 @@ def monte_carlo(
         gathered = np.empty((runs, rows, len(imu_columns)))
         slots = list(gathered)
     if client is None:
-        with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
+        pool = ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1)
+        try:
             results = list(pool.map(_run, [spec] * runs, ids, [target] * runs, [total] * runs, with_truth, slots))
+        finally:
+            # On Ctrl-C (KeyboardInterrupt) the runs not started are dropped and those under way
+            # finish: each file is whole or absent, never partial.
+            pool.shutdown(wait=True, cancel_futures=True)
     else:
         futures = client.map(_run, [spec] * runs, ids, [target] * runs, [total] * runs, with_truth, pure=False)
         results = client.gather(futures)

@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
@@ -117,8 +118,8 @@ impl Seek for OutputFile {
     }
 }
 
-/// Writes a file through `fill` into a temporary name beside it, renamed into place only when
-/// complete (no half-written file left looking complete); the temporary file is removed on error.
+/// Writes a file through `fill` into a temporary file beside it, put in place only when
+/// complete ([`AtomicFile`]); nothing is left on error.
 ///
 /// # Errors
 /// [`Error::Io`] naming the file.
@@ -131,17 +132,219 @@ pub fn write_atomically(
     file.commit()
 }
 
-/// A file written under a temporary name beside its path and renamed into place by
+/// Where an output's bytes go until it is committed.
+#[derive(Debug)]
+enum Staged {
+    /// A special file (`/dev/null`, a FIFO), written directly.
+    Direct,
+    /// A file with no name in the output's folder (Linux's `O_TMPFILE`): however the process
+    /// ends, nothing is left; it is given a name only when committed.
+    Unnamed { folder: PathBuf },
+    /// A file under a fresh random name beside the output (created exclusively, so never through
+    /// a link planted there), removed on error or on a signal ([`abandon_outputs`]).
+    Named(PathBuf),
+}
+
+/// The outputs of this process not yet in place: the temporary names that exist, and the
+/// outputs of an open [`OutputGroup`] waiting for its commit. One lock guards both, so a
+/// signal's clean-up ([`abandon_outputs`]) never runs in the middle of a commit.
+struct Staging {
+    named: Vec<PathBuf>,
+    group: Option<Vec<Parked>>,
+}
+
+/// A complete output waiting under its temporary name for its group's commit.
+struct Parked {
+    temp: PathBuf,
+    path: PathBuf,
+}
+
+static STAGING: Mutex<Staging> = Mutex::new(Staging {
+    named: Vec::new(),
+    group: None,
+});
+
+fn staging() -> MutexGuard<'static, Staging> {
+    STAGING.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+impl Staging {
+    fn forget(&mut self, temp: &Path) {
+        self.named.retain(|n| n != temp);
+    }
+
+    /// Removes a temporary name and forgets it.
+    fn discard(&mut self, temp: &Path) {
+        let _ = std::fs::remove_file(temp);
+        self.forget(temp);
+    }
+
+    /// Puts the complete file `temp` in place at `path`, or parks it while a group is open.
+    fn publish(&mut self, temp: PathBuf, path: &Path) -> std::io::Result<()> {
+        if let Some(group) = self.group.as_mut() {
+            group.push(Parked {
+                temp,
+                path: path.to_path_buf(),
+            });
+            return Ok(());
+        }
+        let renamed = std::fs::rename(&temp, path);
+        if renamed.is_err() {
+            let _ = std::fs::remove_file(&temp);
+        }
+        self.forget(&temp);
+        renamed?;
+        sync_folder(&folder_of(path));
+        Ok(())
+    }
+}
+
+/// The outputs of one command, put in place together: while a group is open, every output
+/// committed ([`AtomicFile::commit`]) waits, complete and synced, under its temporary name;
+/// [`OutputGroup::commit`] renames them all into place, or none (a file it replaced is
+/// restored if a later rename fails); dropped uncommitted (an error on the way), the group
+/// removes them. One group is open at a time in a process (the command line opens it around a
+/// command); a second [`OutputGroup::begin`] while one is open joins it.
+#[derive(Debug)]
+#[must_use = "an output group's files are put in place by its commit"]
+pub struct OutputGroup {
+    /// False for a group begun while another was open: the outer one commits.
+    owner: bool,
+}
+
+impl OutputGroup {
+    /// Opens the group (or joins the one open).
+    pub fn begin() -> Self {
+        let mut s = staging();
+        let owner = s.group.is_none();
+        if owner {
+            s.group = Some(Vec::new());
+        }
+        Self { owner }
+    }
+
+    /// Puts every output of the group in place, all or none.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the output that could not be put in place (the others are then
+    /// removed, and files they replaced restored).
+    pub fn commit(mut self) -> Result<()> {
+        if !self.owner {
+            return Ok(());
+        }
+        self.owner = false;
+        let mut s = staging();
+        let parked = s.group.take().unwrap_or_default();
+        let mut done: Vec<(PathBuf, Option<PathBuf>)> = Vec::new();
+        let mut failed = None;
+        for (k, p) in parked.iter().enumerate() {
+            // A file already there is kept under a second name until every rename has worked.
+            let backup = if std::fs::symlink_metadata(&p.path).is_ok() {
+                let linked = with_temporary_name(&p.path, |t| {
+                    t.make_in(folder_of(&p.path), |b| std::fs::hard_link(&p.path, b))
+                });
+                match linked.and_then(|t| t.into_temp_path().keep().map_err(|e| e.error)) {
+                    Ok(b) => {
+                        s.named.push(b.clone());
+                        Some(b)
+                    }
+                    Err(e) => {
+                        failed = Some((k, e));
+                        break;
+                    }
+                }
+            } else {
+                None
+            };
+            if let Err(e) = std::fs::rename(&p.temp, &p.path) {
+                if let Some(b) = backup {
+                    s.discard(&b);
+                }
+                failed = Some((k, e));
+                break;
+            }
+            s.forget(&p.temp);
+            done.push((p.path.clone(), backup));
+        }
+        if let Some((k, source)) = failed {
+            for (path, backup) in done.into_iter().rev() {
+                match backup {
+                    Some(b) => {
+                        let _ = std::fs::rename(&b, &path);
+                        s.forget(&b);
+                    }
+                    None => {
+                        let _ = std::fs::remove_file(&path);
+                    }
+                }
+            }
+            for p in &parked[k..] {
+                s.discard(&p.temp);
+            }
+            return Err(Error::Io {
+                path: parked[k].path.clone(),
+                source,
+            });
+        }
+        let mut folders: Vec<PathBuf> = Vec::new();
+        for (path, backup) in done {
+            if let Some(b) = backup {
+                s.discard(&b);
+            }
+            let folder = folder_of(&path);
+            if !folders.contains(&folder) {
+                folders.push(folder);
+            }
+        }
+        for f in &folders {
+            sync_folder(f);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for OutputGroup {
+    fn drop(&mut self) {
+        if !self.owner {
+            return;
+        }
+        let mut s = staging();
+        for p in s.group.take().unwrap_or_default() {
+            s.discard(&p.temp);
+        }
+    }
+}
+
+/// Removes every output of this process not yet in place and keeps any other from being put in
+/// place until the process ends: what a signal's handler does before exiting. The returned
+/// guard holds the lock a commit takes, so the handler waits for a commit under way (its outputs
+/// are then all in place) and no commit starts after; exit while holding it.
+#[must_use = "hold the guard until the process exits"]
+pub fn abandon_outputs() -> impl Sized {
+    let mut s = staging();
+    for p in s.group.take().unwrap_or_default() {
+        let _ = std::fs::remove_file(&p.temp);
+    }
+    for n in std::mem::take(&mut s.named) {
+        let _ = std::fs::remove_file(&n);
+    }
+    s
+}
+
+/// A file written under a temporary name beside its path and put in place by
 /// [`AtomicFile::commit`]; dropped uncommitted (an error on the way), the temporary file is
-/// removed, so no half-written file is ever left looking complete.
+/// removed, so no half-written file is ever left looking complete. The temporary file can
+/// neither collide with another run's nor be redirected by a link planted beside the output:
+/// on Linux it has no name at all until the commit (`O_TMPFILE`), elsewhere a fresh random one
+/// created exclusively. Two runs writing one name each put a whole file in place; the last
+/// rename wins.
 #[derive(Debug)]
 pub struct AtomicFile {
     path: PathBuf,
     /// The header's columns and the rows written, to name a refused value.
     columns: Vec<String>,
     rows: usize,
-    /// The temporary name; `None` for a special file written directly.
-    tmp: Option<PathBuf>,
+    staged: Staged,
     writer: Option<BufWriter<OutputFile>>,
     /// A Parquet table being written (it holds the writer until the commit).
     parquet: Option<ParquetSink>,
@@ -167,37 +370,44 @@ impl AtomicFile {
                 "is a folder, not a file",
             )));
         }
-        if is_special(path) {
+        if path.file_name().is_none() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "names no file",
+            )));
+        }
+        let (file, staged) = if is_special(path) {
             // A device or FIFO: written as it is, never renamed over.
             let file = std::fs::OpenOptions::new()
                 .write(true)
                 .open(path)
                 .map_err(io)?;
-            return Ok(Self {
-                path: path.to_path_buf(),
-                columns: Vec::new(),
-                rows: 0,
-                tmp: None,
-                writer: Some(BufWriter::new(OutputFile::new(file))),
-                parquet: None,
-                npy: None,
-                npz: None,
-            });
-        }
-        let tmp = temporary_path(path);
-        let file = File::create(&tmp).map_err(io)?;
+            (file, Staged::Direct)
+        } else {
+            let folder = folder_of(path);
+            match unnamed_in(&folder) {
+                Some(file) => (file, Staged::Unnamed { folder }),
+                None => {
+                    let mut s = staging();
+                    let (file, temp) = with_temporary_name(path, |t| t.tempfile_in(&folder))
+                        .and_then(|t| t.keep().map_err(|e| e.error))
+                        .map_err(io)?;
+                    s.named.push(temp.clone());
+                    (file, Staged::Named(temp))
+                }
+            }
+        };
         Ok(Self {
             path: path.to_path_buf(),
             columns: Vec::new(),
             rows: 0,
-            tmp: Some(tmp),
+            staged,
             writer: Some(BufWriter::new(OutputFile::new(file))),
             parquet: None,
             npy: None,
             npz: None,
         })
     }
-
     /// The file's path (its final name).
     #[must_use]
     pub fn path(&self) -> &Path {
@@ -331,49 +541,134 @@ impl AtomicFile {
             let writer = self.writer.take().expect("the writer lives until commit");
             self.writer = Some(n.finish(writer)?);
         }
-        let result = (|| -> std::io::Result<()> {
-            let file = match self.writer.take() {
-                Some(w) => Some(
-                    w.into_inner()
-                        .map_err(std::io::IntoInnerError::into_error)?,
-                ),
-                None => None,
-            };
-            match &self.tmp {
-                Some(tmp) => {
-                    if let Some(f) = file {
-                        f.get_ref().sync_all()?;
+        let file = match self.writer.take() {
+            Some(w) => w
+                .into_inner()
+                .map_err(|e| self.error(e.into_error()))?
+                .into_inner(),
+            None => return Ok(()),
+        };
+        let staged = std::mem::replace(&mut self.staged, Staged::Direct);
+        let put = |s: &mut Staging, temp: PathBuf| s.publish(temp, &self.path);
+        let result = match staged {
+            Staged::Direct => Ok(()),
+            Staged::Named(temp) => {
+                let synced = file.sync_all();
+                drop(file);
+                let mut s = staging();
+                match synced {
+                    Ok(()) => put(&mut s, temp),
+                    Err(e) => {
+                        s.discard(&temp);
+                        Err(e)
                     }
-                    std::fs::rename(tmp, &self.path)
                 }
-                None => Ok(()),
             }
-        })();
+            Staged::Unnamed { folder } => file.sync_all().and_then(|()| {
+                let mut s = staging();
+                let temp = name_unnamed(&file, &folder, &self.path)?;
+                s.named.push(temp.clone());
+                drop(file);
+                put(&mut s, temp)
+            }),
+        };
         result.map_err(|source| self.error(source))
     }
 }
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        // Committed files were renamed away; anything left is incomplete.
-        if let Some(tmp) = &self.tmp {
-            let _ = std::fs::remove_file(tmp);
+        // A committed file was put in place (or handed to its group); anything else is
+        // incomplete. An unnamed file goes with its handle.
+        if let Staged::Named(temp) = &self.staged {
+            staging().discard(temp);
         }
     }
 }
 
-/// The temporary name beside `path`: its file name with [`PARTIAL`] appended, the name cut (at a
-/// character boundary) so that the whole stays within the file-name limit.
-fn temporary_path(path: &Path) -> PathBuf {
+/// The folder of `path` (`.` for a bare file name).
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Makes the names given in `folder` durable (best effort: a folder that cannot be opened or
+/// synced changes nothing the user can see).
+fn sync_folder(folder: &Path) {
+    if let Ok(f) = File::open(folder) {
+        let _ = f.sync_all();
+    }
+}
+
+/// Runs `make` with a builder of temporary names beside `path`:
+/// `.<name>.<random>.imukit-partial`, the name cut (at a character boundary) so that the whole
+/// stays within the file-name limit, readable and writable as a new file would be (the
+/// process's umask applies).
+fn with_temporary_name<R>(path: &Path, make: impl FnOnce(&tempfile::Builder) -> R) -> R {
+    const RANDOM: usize = 8;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut keep = name.len().min(NAME_MAX - PARTIAL.len());
+    let mut keep = name.len().min(NAME_MAX - PARTIAL.len() - RANDOM - 2);
     while !name.is_char_boundary(keep) {
         keep -= 1;
     }
-    path.with_file_name(format!("{}{PARTIAL}", &name[..keep]))
+    let prefix = format!(".{}.", &name[..keep]);
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(PARTIAL).rand_bytes(RANDOM);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    make(&b)
+}
+
+/// A new file without a name in `folder` (`O_TMPFILE`), where the system has them and can name
+/// them later (`/proc/self/fd`); `None` elsewhere.
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn unnamed_in(folder: &Path) -> Option<File> {
+    use rustix::fs::{CWD, Mode, OFlags};
+    static NAMEABLE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    if !*NAMEABLE.get_or_init(|| Path::new("/proc/self/fd").is_dir()) {
+        return None;
+    }
+    let fd = rustix::fs::openat(
+        CWD,
+        folder,
+        OFlags::TMPFILE | OFlags::RDWR | OFlags::CLOEXEC,
+        Mode::from_raw_mode(0o666),
+    )
+    .ok()?;
+    Some(File::from(fd))
+}
+
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn unnamed_in(_folder: &Path) -> Option<File> {
+    None
+}
+
+/// Gives the unnamed `file` a fresh temporary name in `folder` (beside `path`).
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn name_unnamed(file: &File, folder: &Path, path: &Path) -> std::io::Result<PathBuf> {
+    use rustix::fs::{AtFlags, CWD};
+    use std::os::fd::AsRawFd;
+    let fd = format!("/proc/self/fd/{}", file.as_raw_fd());
+    with_temporary_name(path, |t| {
+        t.make_in(folder, |temp| {
+            rustix::fs::linkat(CWD, fd.as_str(), CWD, temp, AtFlags::SYMLINK_FOLLOW)
+                .map_err(std::io::Error::from)
+        })
+    })
+    .and_then(|t| t.into_temp_path().keep().map_err(|e| e.error))
+}
+
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn name_unnamed(_file: &File, _folder: &Path, _path: &Path) -> std::io::Result<PathBuf> {
+    Err(std::io::Error::other("no unnamed files here"))
 }
 
 /// True for an existing path that is neither a regular file nor a folder: a device such as

@@ -1,0 +1,236 @@
+//! Outputs under faults, as a user meets them: a real process interrupted by a real signal, two
+//! real processes writing one name, links planted beside an output, and a command whose last
+//! output fails. Never a partial file, a mixed file, a write through a link, or half of a
+//! command's outputs.
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn imukit() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_imukit"))
+}
+
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("imukit-outputs-{name}-"))
+        .tempdir()
+        .unwrap()
+}
+
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut n: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    n.sort();
+    n
+}
+
+/// A scenario of `seconds` at 1 kHz: long enough to be interrupted while it writes.
+fn scenario(dir: &Path, name: &str, seconds: f64, builtin: &str) -> String {
+    std::fs::write(
+        dir.join(name),
+        format!(
+            "rate_hz = 1000.0\nduration_s = {seconds}\n[trajectory]\ntype = \"builtin\"\nname = \"{builtin}\"\n"
+        ),
+    )
+    .unwrap();
+    name.to_string()
+}
+
+/// Sends `signal` (a name `kill` takes) to the process.
+fn send(signal: &str, pid: u32) {
+    let status = Command::new("kill")
+        .args([format!("-{signal}"), pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{signal} {pid}");
+}
+
+#[test]
+fn a_signal_removes_every_output_begun_and_exits_with_the_conventional_status() {
+    let dir = temp_dir("signals");
+    let dir = dir.path();
+    let long = scenario(dir, "long.toml", 3000.0, "figure8");
+    for (signal, status) in [("INT", 130), ("TERM", 143), ("HUP", 129)] {
+        for outputs in [
+            vec!["--out", "o.csv", "--truth", "t.parquet"],
+            vec!["--out", "o.npy", "--truth", "t.npz"],
+            vec!["--out", "o.parquet", "--runs", "3"],
+        ] {
+            let mut child = imukit()
+                .current_dir(dir)
+                .arg("simulate")
+                .arg(&long)
+                .args(&outputs)
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .unwrap();
+            // Interrupted once it has written for a while (the files grow meanwhile).
+            std::thread::sleep(Duration::from_millis(700));
+            send(signal, child.id());
+            let waited = Instant::now();
+            let code = child.wait().unwrap().code();
+            assert_eq!(code, Some(status), "{signal} {outputs:?}");
+            assert!(waited.elapsed() < Duration::from_secs(10));
+            assert_eq!(names(dir), ["long.toml"], "{signal} {outputs:?}");
+        }
+    }
+}
+
+#[test]
+fn two_processes_writing_one_name_leave_one_whole_file_of_one_of_them() {
+    let dir = temp_dir("two-writers");
+    let dir = dir.path();
+    let a = scenario(dir, "a.toml", 20.0, "figure8");
+    let b = scenario(dir, "b.toml", 30.0, "tilted-circle");
+    for (s, out) in [
+        (&a, "a.csv"),
+        (&b, "b.csv"),
+        (&a, "a.parquet"),
+        (&b, "b.parquet"),
+    ] {
+        let ok = imukit()
+            .current_dir(dir)
+            .args(["simulate", s, "--out", out])
+            .output()
+            .unwrap();
+        assert!(ok.status.success());
+    }
+    let whole = |ext: &str| {
+        (
+            std::fs::read(dir.join(format!("a.{ext}"))).unwrap(),
+            std::fs::read(dir.join(format!("b.{ext}"))).unwrap(),
+        )
+    };
+    let mut winners = [0, 0];
+    for k in 0..20 {
+        let ext = if k % 2 == 0 { "csv" } else { "parquet" };
+        let same = format!("same.{ext}");
+        let spawn = |s: &str| {
+            imukit()
+                .current_dir(dir)
+                .args(["simulate", s, "--out", &same])
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        };
+        let (first, second) = (spawn(&a), spawn(&b));
+        for child in [first, second] {
+            let out = child.wait_with_output().unwrap();
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        let got = std::fs::read(dir.join(&same)).unwrap();
+        let (wa, wb) = whole(ext);
+        if got == wa {
+            winners[0] += 1;
+        } else if got == wb {
+            winners[1] += 1;
+        } else {
+            panic!(
+                "try {k}: {same} is neither run's file ({} bytes)",
+                got.len()
+            );
+        }
+        assert!(!names(dir).iter().any(|n| n.contains("imukit-partial")));
+    }
+    assert_eq!(winners[0] + winners[1], 20);
+}
+
+#[cfg(unix)]
+#[test]
+fn links_planted_beside_an_output_are_never_written_through() {
+    let dir = temp_dir("links");
+    let dir = dir.path();
+    let s = scenario(dir, "s.toml", 1.0, "figure8");
+    std::fs::write(dir.join("victim.txt"), "keep me").unwrap();
+    // At the name the temporary file once had, and at the output itself.
+    std::os::unix::fs::symlink("victim.txt", dir.join("o.csv.imukit-partial")).unwrap();
+    std::os::unix::fs::symlink("s.toml", dir.join("t.csv.imukit-partial")).unwrap();
+    std::os::unix::fs::symlink("victim.txt", dir.join("p.csv")).unwrap();
+    let before = std::fs::read(dir.join("s.toml")).unwrap();
+    for out in ["o.csv", "p.csv"] {
+        let run = imukit()
+            .current_dir(dir)
+            .args(["simulate", &s, "--out", out, "--truth", "t.csv"])
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let meta = std::fs::symlink_metadata(dir.join(out)).unwrap();
+        assert!(meta.file_type().is_file(), "{out} is a file, not a link");
+        assert!(
+            std::fs::read_to_string(dir.join(out))
+                .unwrap()
+                .starts_with("t_s,")
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("victim.txt")).unwrap(),
+        "keep me"
+    );
+    assert_eq!(std::fs::read(dir.join("s.toml")).unwrap(), before);
+}
+
+#[test]
+fn a_command_whose_last_output_fails_puts_none_of_them_in_place() {
+    let dir = temp_dir("all-or-none");
+    let dir = dir.path();
+    let s = scenario(dir, "s.toml", 1.0, "figure8");
+    std::fs::write(dir.join("o.csv"), "an older file").unwrap();
+    // The truth's folder does not exist: the readings must not be written either, and the
+    // older file stays as it was.
+    let run = imukit()
+        .current_dir(dir)
+        .args(["simulate", &s, "--out", "o.csv", "--truth", "nope/t.csv"])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(74));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("nope/t.csv"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("o.csv")).unwrap(),
+        "an older file"
+    );
+    assert_eq!(names(dir), ["o.csv", "s.toml"]);
+    // A study whose figure cannot be written leaves no table.
+    let study = dir.join("st.toml");
+    let tunnel = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "scenario = {:?}\npresets = [\"ideal\"]\nruns = 2\n",
+            tunnel.display().to_string()
+        ),
+    )
+    .unwrap();
+    let run = imukit()
+        .current_dir(dir)
+        .args([
+            "study",
+            "st.toml",
+            "--out",
+            "st.csv",
+            "--plot",
+            "nope/st.png",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        run.status.code(),
+        Some(74),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(names(dir), ["o.csv", "s.toml", "st.toml"]);
+}
