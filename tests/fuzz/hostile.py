@@ -13,14 +13,24 @@ says no cleanly.
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
 long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
 (extreme origins, geodetic formulas, dates, vertical channels); mutated and truncated Parquet,
-``.npy`` and ``.npz`` tables fed to the commands that read tables; output paths that collide with
-inputs, special files and folders; Python calls with NaN, inf, huge and misshapen arguments. Prints one line per
-class and a closing ``N passed, M failed`` line; exits 1 on any failure.
+``.npy`` and ``.npz`` tables fed to the commands that read tables; crafted binary tables (archives whose members
+lie about their sizes, repeat, fail their CRC or expand like bombs, ``.npy`` headers against their files, Parquet
+footers damaged field by field, a column twice); barometer and odometer files fed to ``integrate`` and ``fuse``;
+output paths that collide with inputs, special files and folders; real signals (SIGINT, SIGTERM, SIGHUP) sent to
+a command at a random moment of its run; two processes writing one output name at once; Python calls with NaN,
+inf, huge and misshapen arguments, empty tables, and tables written under hostile column names. Prints one line
+per class and a closing ``N passed, M failed`` line; exits 1 on any failure.
 """
 from __future__ import annotations
 
 import argparse
 import hashlib
+import io
+import signal
+import struct
+import time
+import zipfile
+import zlib
 import json
 import os
 import random
@@ -33,6 +43,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 TIME_LIMIT_S = 30.0
 ALLOWED_EXITS = {0, 2, 65, 74}
+SIGNAL_EXITS = {signal.SIGINT: 130, signal.SIGTERM: 143, signal.SIGHUP: 129}
 
 SCENARIO = """rate_hz = 100.0
 duration_s = 0.5
@@ -103,15 +114,124 @@ def run_cli(run: Run, work: Path, args: list, inputs: list, case: str) -> None:
             problems.append(f"input {p} changed")
     if code == 0:
         for p in work.iterdir():
-            if p.suffix == ".csv" and p.name not in inputs and p.is_file():
+            if p.name in inputs or not p.is_file():
+                continue
+            if p.suffix == ".csv":
                 text = p.read_text(errors="replace").lower()
                 if "nan" in text.replace("nan_", "") or "inf" in text:
                     problems.append(f"non-finite value written to {p.name}")
+                p.unlink()
+            elif p.suffix in (".npy", ".npz", ".parquet") and p.name.startswith("o"):
+                bad = non_finite_binary(p)
+                if bad:
+                    problems.append(f"{bad} written to {p.name}")
                 p.unlink()
     if problems:
         run.fail(case, "; ".join(problems) + f" [{' '.join(args)}]")
     else:
         run.passed += 1
+
+
+def non_finite_binary(path: Path) -> str:
+    """'' when every value of a binary table imukit wrote is finite (or the readers are absent)."""
+    try:
+        import numpy as np
+    except ImportError:
+        return ""
+    try:
+        if path.suffix == ".npy":
+            a = np.load(path)
+            arrays = [a[n] for n in a.dtype.names or []]
+        elif path.suffix == ".npz":
+            with np.load(path) as z:
+                arrays = [z[k] for k in z.files]
+        else:
+            try:
+                import pyarrow.parquet as pq
+            except ImportError:
+                return ""
+            arrays = [c.to_numpy() for c in pq.read_table(path).columns]
+    except Exception as e:  # noqa: BLE001 - a file imukit wrote that NumPy cannot read
+        return f"an unreadable table ({type(e).__name__}: {e})"
+    return "a non-finite value" if any(not np.all(np.isfinite(a)) for a in arrays) else ""
+
+
+def npy_bytes(values, shape=None, descr="'<f8'") -> bytes:
+    """An .npy file of float64 `values` whose header may say another `shape` or `descr`."""
+    shape = (len(values),) if shape is None else shape
+    text = f"{{'descr': {descr}, 'fortran_order': False, 'shape': {shape!r}, }}".encode()
+    text += b" " * (-(10 + len(text) + 1) % 64) + b"\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(text)) + text + struct.pack(f"<{len(values)}d", *values)
+
+
+def zip_bytes(members, sizes=None, crcs=None, method=zipfile.ZIP_STORED) -> bytes:
+    """A zip archive of `members` (name, bytes) whose directory may lie: `sizes[k]` and
+    `crcs[k]` replace member k's declared size (zip64 when large) and CRC-32."""
+    out, central = io.BytesIO(), io.BytesIO()
+    for k, (name, data) in enumerate(members):
+        stored = data
+        if method == zipfile.ZIP_DEFLATED:
+            c = zlib.compressobj(9, zlib.DEFLATED, -15)
+            stored = c.compress(data) + c.flush()
+        size = (sizes or {}).get(k, len(data))
+        crc = (crcs or {}).get(k, zlib.crc32(data))
+        wide = size >= 0xFFFFFFFF or len(stored) >= 0xFFFFFFFF
+        extra = struct.pack("<HHQQ", 1, 16, size, len(stored)) if wide else b""
+        short, cshort = (0xFFFFFFFF, 0xFFFFFFFF) if wide else (size, len(stored))
+        offset = out.tell()
+        out.write(struct.pack("<IHHHHHIIIHH", 0x04034B50, 45, 0, method, 0, 0, crc, cshort, short, len(name), len(extra)))
+        out.write(name.encode() + extra + stored)
+        central.write(struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 45, 45, 0, method, 0, 0, crc, cshort, short,
+                                  len(name), len(extra), 0, 0, 0, 0, offset))
+        central.write(name.encode() + extra)
+    start, body = out.tell(), central.getvalue()
+    out.write(body)
+    out.write(struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, len(members), len(members), len(body), start, 0))
+    return out.getvalue()
+
+
+def crafted_table(rng: random.Random, fmt: str, good: bytes) -> bytes:
+    """A binary table crafted to lie in one of the ways a reader must catch."""
+    n = rng.choice([0, 1, 5, 100])
+    t = [k / 100 for k in range(n)]
+    x = [rng.uniform(-5, 5) for _ in range(n)]
+    if fmt == "npy":
+        kind = rng.randrange(4)
+        rec = "[('t_s', '<f8'), ('accel_x_m_s2', '<f8')]"
+        values = [v for pair in zip(t, x) for v in pair]
+        if kind == 0:  # a shape that the file does not hold
+            return npy_bytes(values, shape=(rng.choice([2**62, 2**31, n + 1, 0]),), descr=rec)
+        if kind == 1:  # a shape of two dimensions, or another type
+            return npy_bytes(values, shape=rng.choice([(n, 2), (2, n)]), descr=rng.choice([rec, "'<f4'", "'|O'"]))
+        if kind == 2:  # a header length beyond what NumPy reads
+            return b"\x93NUMPY\x02\x00" + struct.pack("<I", rng.choice([2**32 - 1, 10_001, 70_000])) + b"{" * 64
+        return npy_bytes(values, descr="[" + ", ".join(["('t_s', '<f8')"] * 2) + "]")  # a field twice
+    if fmt == "npz":
+        members = [("t_s.npy", npy_bytes(t)), ("accel_x_m_s2.npy", npy_bytes(x))]
+        kind = rng.randrange(6)
+        if kind == 0:
+            return zip_bytes(members, sizes={1: rng.choice([2**62, 2**40, 2**32 + 5])})
+        if kind == 1:
+            return zip_bytes(members + [("t_s.npy", npy_bytes(x))])
+        if kind == 2:
+            return zip_bytes(members, crcs={rng.randrange(2): rng.randrange(2**32)})
+        if kind == 3:  # a bomb: zeros deflated
+            big = npy_bytes([0.0] * rng.choice([1 << 20, 10 << 20]))
+            return zip_bytes([("t_s.npy", big), ("accel_x_m_s2.npy", big)], method=zipfile.ZIP_DEFLATED)
+        if kind == 4:  # columns of different lengths, or a member that is not an array
+            return zip_bytes([("t_s.npy", npy_bytes(t + [1.0])), rng.choice(members[1:] + [("x.txt", b"x")])])
+        return zip_bytes(members, sizes={0: max(0, len(members[0][1]) - rng.randrange(1, 64))})
+    # Parquet: the footer's bytes damaged (the metadata a reader trusts), or its length.
+    data = bytearray(good)
+    footer = struct.unpack("<I", data[-8:-4])[0]
+    start = max(4, len(data) - 8 - footer)
+    if rng.random() < 0.2:
+        struct.pack_into("<I", data, len(data) - 8, rng.choice([0, 1, footer + 1, 2**31, 2**32 - 1]))
+    else:
+        for _ in range(rng.randint(1, 4)):
+            i = rng.randrange(start, len(data) - 8)
+            data[i] = rng.choice([0, 0xFF, 0x7F, 0x80, data[i] ^ (1 << rng.randrange(8)), rng.randrange(256)])
+    return bytes(data)
 
 
 def mutate(rng: random.Random, data: bytes) -> bytes:
@@ -331,6 +451,122 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                 (work / n).unlink(missing_ok=True)
             runs.append(r)
 
+        for fmt in ("parquet", "npy", "npz"):
+            r = Run(f"{fmt} files, crafted to lie")
+            (work / "cr.toml").write_text('rate_hz = 50.0\nduration_s = 2.0\n[trajectory]\ntype = "builtin"\n'
+                                          'name = "figure8"\n[imu]\nkind = "accel-gyro"\n')
+            run_cli(r, work, ["simulate", "cr.toml", "--out", f"ci.{fmt}", "--truth", f"ct.{fmt}"], ["cr.toml"],
+                    f"{fmt} seed files")
+            good = (work / f"ci.{fmt}").read_bytes() if (work / f"ci.{fmt}").exists() else b""
+            for k in range(per if good else 0):
+                m = f"c.{fmt}"
+                (work / m).write_bytes(crafted_table(rng, fmt, good))
+                args = rng.choice([
+                    ["allan", m, "--out", "co.csv"],
+                    ["integrate", m, "--init", f"ct.{fmt}", "--out", f"o.{fmt}"],
+                    ["compare", f"ct.{fmt}", m, "--out", "co.csv"],
+                    ["orient", m, "--filter", "madgwick", "--out", f"o.{fmt}"],
+                    ["plot", m, "--out", "co.png"],
+                ])
+                run_cli(r, work, args, [m, f"ci.{fmt}", f"ct.{fmt}"], f"case {k} ({fmt})")
+                for leftover in (m, "co.csv", "co.png", f"o.{fmt}"):
+                    (work / leftover).unlink(missing_ok=True)
+            for n in ("cr.toml", f"ci.{fmt}", f"ct.{fmt}"):
+                (work / n).unlink(missing_ok=True)
+            runs.append(r)
+
+        r = Run("barometer and odometer files")
+        (work / "ae.toml").write_text(
+            'rate_hz = 20.0\nduration_s = 30.0\nnav_frame = "NED"\nearth = "wgs84"\n'
+            'origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }\n'
+            '[trajectory]\ntype = "expression"\nposition_m = ["10*t", "0", "0"]\nattitude = "tangent"\n'
+            '[imu]\nkind = "accel-gyro"\n[gnss]\nrate_hz = 5.0\n[baro]\nrate_hz = 5.0\n[odometer]\nrate_hz = 10.0\n')
+        subprocess.run([imukit_bin(), "simulate", "ae.toml", "--out", "ai.csv", "--truth", "at.csv", "--gnss", "ag.csv",
+                        "--baro", "ab.csv", "--odometer", "ao.csv"], cwd=work, check=True, capture_output=True)
+        aids = {n: (work / n).read_bytes() for n in ("ab.csv", "ao.csv") if (work / n).exists()}
+        for k in range(per if len(aids) == 2 else 0):
+            name = rng.choice(sorted(aids))
+            data = aids[name]
+            if rng.random() < 0.5:
+                data = mutate(rng, data)
+            else:  # times shifted, stretched or reversed
+                lines = data.decode().splitlines()
+                shift = rng.choice(["1e4", "-1e4", "1e308", "0"])
+                body = [f"{float(l.split(',')[0]) * rng.choice([1, -1, 1e6]) + float(shift)},{l.split(',', 1)[1]}"
+                        for l in lines[1:]]
+                data = ("\n".join([lines[0], *rng.choice([body, body[::-1]])]) + "\n").encode()
+            (work / "ax.csv").write_bytes(data)
+            args = rng.choice([
+                ["integrate", "ai.csv", "--init", "at.csv", "--nav-frame", "NED", "--earth", "wgs84",
+                 "--vertical", "baro", "--baro", "ax.csv", "--out", "an.csv"],
+                ["fuse", "ai.csv", "ag.csv", "--init", "at.csv", "--scenario", "ae.toml", "--baro", "ax.csv",
+                 "--out", "an.csv"],
+                ["fuse", "ai.csv", "ag.csv", "--init", "at.csv", "--scenario", "ae.toml", "--odometer", "ax.csv",
+                 "--nhc", "--out", "an.csv"],
+            ])
+            run_cli(r, work, args, ["ax.csv", "ai.csv", "at.csv", "ag.csv", "ae.toml"], f"case {k} ({name})")
+        for n in ("ae.toml", "ai.csv", "at.csv", "ag.csv", "ab.csv", "ao.csv", "ax.csv", "an.csv"):
+            (work / n).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("signals at a random moment")
+        (work / "long.toml").write_text('rate_hz = 1000.0\nduration_s = 6000.0\n[trajectory]\ntype = "builtin"\n'
+                                        'name = "figure8"\n[imu]\npreset = "mpu-6050"\n')
+        for k in range(max(1, per // 4)):
+            ext = rng.choice(["csv", "parquet", "npy", "npz"])
+            sig = rng.choice(list(SIGNAL_EXITS))
+            args = ["simulate", "long.toml", "--out", f"s.{ext}", *rng.choice([[], ["--truth", f"st.{ext}"],
+                                                                               ["--runs", "2"]])]
+            proc = subprocess.Popen([imukit_bin(), *args], cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+            time.sleep(rng.uniform(0.0, 1.0))
+            proc.send_signal(sig)
+            try:
+                _, err = proc.communicate(timeout=TIME_LIMIT_S)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                r.fail(f"case {k}", f"no end within {TIME_LIMIT_S} s of {sig.name}")
+                continue
+            left = sorted(p.name for p in work.iterdir()
+                          if (p.name.startswith("s") or "imukit-partial" in p.name) and p.name != "s.toml")
+            # Before its handler is set up (the first milliseconds) the process ends by the signal
+            # itself, which a shell reports as the same status; a run that ended before the signal
+            # has put all its outputs in place.
+            expected = {"--truth": 2, "--runs": 2}.get(args[-2], 1)
+            finished = proc.returncode == 0 and len(left) == expected and not any("partial" in n for n in left)
+            if not finished and (proc.returncode not in (SIGNAL_EXITS[sig], -sig) or left) or b"panicked" in err:
+                r.fail(f"case {k}", f"{sig.name}: exit {proc.returncode}, left {left} [{' '.join(args)}]")
+            else:
+                r.passed += 1
+            for p in work.iterdir():
+                if p.name.startswith(("s.", "st.", "s_run", ".s")):
+                    p.unlink()
+        runs.append(r)
+
+        r = Run("two processes writing one name")
+        (work / "w1.toml").write_text('rate_hz = 200.0\nduration_s = 20.0\n[trajectory]\ntype = "builtin"\n'
+                                      'name = "figure8"\n')
+        (work / "w2.toml").write_text('rate_hz = 100.0\nduration_s = 30.0\n[trajectory]\ntype = "builtin"\n'
+                                      'name = "tilted-circle"\n')
+        for k in range(max(1, per // 4)):
+            ext = rng.choice(["csv", "parquet", "npy", "npz"])
+            whole = {}
+            for w in ("w1", "w2"):
+                subprocess.run([imukit_bin(), "simulate", f"{w}.toml", "--out", f"{w}.{ext}"], cwd=work,
+                               capture_output=True, check=True)
+                whole[w] = (work / f"{w}.{ext}").read_bytes()
+            procs = [subprocess.Popen([imukit_bin(), "simulate", f"{w}.toml", "--out", f"same.{ext}"], cwd=work,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for w in ("w1", "w2")]
+            codes = [p.wait(timeout=TIME_LIMIT_S) for p in procs]
+            got = (work / f"same.{ext}").read_bytes() if (work / f"same.{ext}").exists() else b""
+            left = [p.name for p in work.iterdir() if "imukit-partial" in p.name]
+            if codes != [0, 0] or got not in whole.values() or left:
+                r.fail(f"case {k}", f"exits {codes}, {len(got)} bytes matching neither run, left {left} ({ext})")
+            else:
+                r.passed += 1
+            for p in (f"same.{ext}", f"w1.{ext}", f"w2.{ext}"):
+                (work / p).unlink(missing_ok=True)
+        runs.append(r)
+
         r = Run("colliding and special output paths")
         (work / "folder").mkdir(exist_ok=True)
         long = "x" * 250 + ".csv"
@@ -356,13 +592,26 @@ def cli_cases(rng: random.Random, cases: int) -> list:
 
 
 PY_CASES = r"""
-import random, sys, numpy as np, imukit
+import os, random, shutil, sys, tempfile, numpy as np, imukit
 rng = random.Random(int(sys.argv[1]))
 cases = int(sys.argv[2])
 X = [np.nan, np.inf, -np.inf, 1e308, -1e308, 0.0, -1.0, 1e9, 1e-320]
 def arr(shape):
     a = np.array([[rng.choice(X + [rng.uniform(-5, 5)] * 6) for _ in range(shape[1])] for _ in range(shape[0])])
     return a
+OUT = tempfile.mkdtemp(prefix="imukit-hostile-py-")
+FUSE_SCENARIO = {"rate_hz": 10.0, "duration_s": 10.0, "imu": {"kind": "accel-gyro"}, "gnss": {"rate_hz": 1.0},
+                 "trajectory": {"type": "expression", "position_m": ["5*t", "0", "0"], "attitude": "tangent"}}
+BASE = imukit.simulate(FUSE_SCENARIO)
+NAMES = ["x" * rng.choice([255, 256, 100_000]), "a,b", "t_s", "", " x", "#x", "a\nb", "it's", "a/b", "ok_name", "é"]
+def rows(table, n):
+    return imukit.Table(list(table.columns), np.array(table.values)[:n])
+def imu_table(n):
+    return rows(BASE.imu, n)
+def gnss_table(n):
+    return rows(BASE.gnss, n)
+def truth_table(n):
+    return rows(BASE.truth, n)
 passed = failed = 0
 for k in range(cases):
     n = rng.choice([0, 1, 2, 5, 50])
@@ -383,6 +632,12 @@ for k in range(cases):
         lambda: imukit.planar_dead_reckon(np.arange(n, dtype=float), arr((n, 1))[:, 0] if n else np.zeros(0),
                                           np.zeros(n), np.zeros(n), heading0_rad=rng.choice(X)),
         lambda: imukit.ImuFilter(sample_rate=rng.choice(X + [100.0]))(arr((n, 3)), arr((n, 3))),
+        lambda: imukit.fuse(imu_table(n), gnss_table(rng.choice([0, 1, 3])), initial=truth_table(max(n, 1)),
+                            scenario=FUSE_SCENARIO),
+        lambda: imukit.strapdown(imu_table(n), truth_table(max(n, 1))),
+        lambda: imukit.compare(truth_table(n), truth_table(rng.choice([0, 1, n]))),
+        lambda: imukit.Table(["t_s", rng.choice(NAMES)], np.ones((max(n, 1), 2))).write(
+            os.path.join(OUT, "o." + rng.choice(["csv", "parquet", "npy", "npz"]))),
     ]
     call = rng.choice(calls)
     try:
@@ -401,6 +656,11 @@ for k in range(cases):
     except Exception as e:  # anything else is a failure of the binding
         failed += 1
         print(f"case {k}: {type(e).__name__}: {e}")
+left = [f for f in os.listdir(OUT) if "imukit-partial" in f]
+if left:
+    failed += 1
+    print(f"partial files left: {left}")
+shutil.rmtree(OUT, ignore_errors=True)
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)
 """

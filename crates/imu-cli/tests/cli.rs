@@ -1319,8 +1319,28 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
     std::fs::write(dir.join("bad.csv"), "t_s,baro_height_m\n0,300\n0,301\n").unwrap();
     let (code, err) = integrate(&["--vertical", "baro", "--baro", "bad.csv"], "y.csv");
     assert_eq!(code, Some(65), "{err}");
-    assert!(err.contains("bad.csv: row 3: times must increase"), "{err}");
-    assert!(!dir.join("x.csv").exists() && !dir.join("y.csv").exists());
+    assert!(
+        err.contains("bad.csv: row 3: times must be finite and increase"),
+        "{err}"
+    );
+    // Readings 10⁴ s after the IMU's last sample: refused as the fusion refuses them.
+    std::fs::write(
+        dir.join("late.csv"),
+        "t_s,baro_height_m
+0,300
+10000,301
+",
+    )
+    .unwrap();
+    let (code, err) = integrate(&["--vertical", "baro", "--baro", "late.csv"], "z.csv");
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("late.csv: row 3: time 10000 s is outside the IMU's span"),
+        "{err}"
+    );
+    assert!(
+        !dir.join("x.csv").exists() && !dir.join("y.csv").exists() && !dir.join("z.csv").exists()
+    );
 }
 
 #[test]

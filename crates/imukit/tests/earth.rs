@@ -243,7 +243,34 @@ fn a_bad_origin_or_a_trip_over_the_pole_is_refused_by_name() {
         ),
         (
             base.replace("longitude_deg = 7.0", "longitude_deg = nan"),
-            "origin.longitude_deg: must be a finite number",
+            "origin.longitude_deg: must be within ±180°, got NaN",
+        ),
+        (
+            base.replace("longitude_deg = 7.0", "longitude_deg = 187.0"),
+            "origin.longitude_deg: must be within ±180°, got 187",
+        ),
+        // The height is needed (gravity and the radii depend on it): no silent 0.
+        (
+            base.replace(", height_m = 250.0", ""),
+            "missing field `height_m`",
+        ),
+        // A latitude formula beyond the pole was wrapped over it (2 rad was placed at 65.4° N,
+        // −174.3°), while the same number as an origin is refused.
+        (
+            base.replace(
+                "[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+                "[trajectory]\ntype = \"expression\"\nlatitude_rad = \"2\"\n\
+                 longitude_rad = \"0.1\"\nheight_m = \"0\"\n",
+            ),
+            "trajectory.latitude_rad: at t = 0 s the latitude is 2 rad (114.5916°)",
+        ),
+        (
+            base.replace(
+                "[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+                "[trajectory]\ntype = \"expression\"\nlatitude_rad = \"1.5 + 0.1*t\"\n\
+                 longitude_rad = \"0.1\"\nheight_m = \"0\"\n",
+            ),
+            "at t = 0.7 s the latitude is 1.57 rad",
         ),
         (
             base.replace("earth = \"wgs84\"", "earth = \"round\""),
@@ -260,7 +287,7 @@ fn a_bad_origin_or_a_trip_over_the_pole_is_refused_by_name() {
     }
     // North at 300 m/s from 89.8°: the 89.9° line is 11 km on, crossed after about 37 s.
     let polar = "rate_hz = 1.0\nduration_s = 60.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
-        origin = { latitude_deg = 89.8, longitude_deg = 0.0 }\n[trajectory]\ntype = \"expression\"\n\
+        origin = { latitude_deg = 89.8, longitude_deg = 0.0, height_m = 0.0 }\n[trajectory]\ntype = \"expression\"\n\
         position_m = [\"300*t\", \"0\", \"0\"]\n";
     let e = run(polar).unwrap_err().to_string();
     assert!(e.contains("beyond ±89.9°") && e.contains("at t = 3"), "{e}");
@@ -314,14 +341,14 @@ fn the_world_magnetic_model_gives_the_field_at_each_position_and_date() {
 #[test]
 fn a_magnetic_model_needs_the_earth_a_date_in_its_validity_and_no_constant_field() {
     let base = "rate_hz = 1.0\nduration_s = 2.0\nearth = \"wgs84\"\n\
-        origin = { latitude_deg = 45.0, longitude_deg = 7.0 }\n\
+        origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 0.0 }\n\
         magnetic_model = \"wmm2025\"\ndate = \"2026-06-01\"\n\
         [trajectory]\ntype = \"builtin\"\nname = \"static\"\n";
     assert!(run(base).is_ok());
     let cases = [
         (
             base.replace("earth = \"wgs84\"\n", "").replace(
-                "origin = { latitude_deg = 45.0, longitude_deg = 7.0 }\n",
+                "origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 0.0 }\n",
                 "",
             ),
             "magnetic_model: needs positions on the Earth",

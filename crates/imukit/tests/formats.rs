@@ -136,10 +136,20 @@ fn a_bad_npy_file_is_refused_saying_what_and_where() {
         std::fs::write(&p, content).unwrap();
         imukit::io::table::read_table(&p).unwrap_err().to_string()
     };
-    // Cut short: the row where it ends, of how many.
+    // Cut short, or longer than its header says: what the header gives against what the file
+    // holds, before a row is read.
     let e = err("short.npy", &bytes[..bytes.len() - 12]);
     assert!(
-        e.contains("short.npy") && e.contains("row 101 of the 101") && e.contains("truncated"),
+        e.contains("short.npy")
+            && e.contains("header gives 101 rows")
+            && e.contains("(100 whole rows): truncated"),
+        "{e}"
+    );
+    let mut long = bytes.clone();
+    long.extend_from_slice(&[0; 8]);
+    let e = err("long.npy", &long);
+    assert!(
+        e.contains("header gives 101 rows") && !e.contains("truncated"),
         "{e}"
     );
     // Not a NumPy file.

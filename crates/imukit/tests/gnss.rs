@@ -188,6 +188,15 @@ fn bad_gnss_keys_are_refused_by_name() {
             "gnss.outages[0]: needs a finite start_s and a duration_s > 0",
         ),
         ("rate = 1.0", "unknown field `rate`"),
+        // No fix inside the run: the GNSS file would hold only its header.
+        (
+            "latency_s = 1e308",
+            "gnss: no fix falls within the run (it ends at",
+        ),
+        (
+            "outages = [{ start_s = -1.0, duration_s = 1e9 }]",
+            "outages included",
+        ),
     ];
     for (keys, want) in cases {
         let e = run(&format!("{FIGURE8}[gnss]\n{keys}\n"))

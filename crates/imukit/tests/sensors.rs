@@ -266,6 +266,17 @@ fn matlab_loadparams_json_is_read_as_matlab_reads_it() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("no part \"Part C\""), "{e}");
+    // A key MATLAB's coefficients do not have was ignored: now named.
+    let misspelt = json.replace("\"Denominator\"", "\"Denominater\"");
+    std::fs::write(&path, misspelt).unwrap();
+    let e = read_param_file(&path, Some("Part A"), Profile::Default)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("BiasInstabilityCoefficients.Denominater: unknown key"),
+        "{e}"
+    );
+    std::fs::write(&path, json).unwrap();
     // In a scenario: params + part, and an inline table overriding one key.
     let text = format!(
         "{STATIC_NED}[imu]\nparams = \"params.json\"\npart = \"Part A\"\n[imu.gyroscope]\nConstantBias = 0.02\n"

@@ -15,7 +15,39 @@ pub mod table;
 pub mod units;
 pub mod value_tree;
 
+use std::cell::Cell;
 use std::path::Path;
+use std::sync::Once;
+
+thread_local! {
+    /// True while this thread runs a reader under [`contained`].
+    static CONTAINING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `read`, a panic inside it returned as its message instead of unwinding further, and
+/// printed by no panic hook: for third-party readers that may still panic on a damaged file
+/// where imukit's own checks did not foresee it. A last line of defence, not a way of reading.
+pub(crate) fn contained<T>(read: impl FnOnce() -> T) -> std::result::Result<T, String> {
+    static QUIET: Once = Once::new();
+    QUIET.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !CONTAINING.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let was = CONTAINING.with(|c| c.replace(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
+    CONTAINING.with(|c| c.set(was));
+    result.map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic".to_string())
+    })
+}
 
 /// The format of a table file, by its path's extension (any case): `.parquet`, `.npy`, `.npz`,
 /// else CSV.
@@ -55,5 +87,25 @@ impl TableFormat {
             Self::Csv => 2,
             Self::Parquet | Self::Npy | Self::Npz => 1,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::contained;
+
+    #[test]
+    fn a_panic_in_a_contained_reader_is_its_message_and_the_thread_goes_on() {
+        assert_eq!(contained(|| 7), Ok(7));
+        let index = 5;
+        let caught = contained(|| [1, 2, 3][index]);
+        assert_eq!(
+            caught,
+            Err("index out of bounds: the len is 3 but the index is 5".to_string())
+        );
+        let text = contained(|| -> u8 { panic!("{} pages", 3) });
+        assert_eq!(text, Err("3 pages".to_string()));
+        // Outside it, panics are what they were (caught here by the test harness's own means).
+        assert!(std::panic::catch_unwind(|| panic!("plain")).is_err());
     }
 }

@@ -11,7 +11,7 @@
 //! a structured array of float64 fields (a plain 2-D array has no column names) is refused
 //! saying what it holds.
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, BufWriter, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use npyz::{DType, NpyHeader, NpyWriter, TypeStr, WriterBuilder};
@@ -110,6 +110,26 @@ impl NpySink {
                 })
                 .collect(),
         );
+        // The header this table gets, made alone first: one NumPy (and imukit) would refuse to
+        // read is not written.
+        let mut alone = std::io::Cursor::new(Vec::new());
+        npyz::WriteOptions::<Record>::new()
+            .dtype(dtype.clone())
+            .writer(&mut alone)
+            .begin_1d()
+            .and_then(|w| w.finish())
+            .map_err(io)?;
+        if check_header_length(path, &mut alone.get_ref().as_slice()).is_err() {
+            return Err(format_error(
+                path,
+                format!(
+                    "{} columns make a header of {} bytes, more than NumPy reads \
+                     ({MAX_HEADER_BYTES}): write this table as .parquet, .npz or .csv",
+                    columns.len(),
+                    alone.get_ref().len()
+                ),
+            ));
+        }
         let writer = npyz::WriteOptions::new()
             .dtype(dtype)
             .writer(BufWriter::with_capacity(
@@ -215,7 +235,37 @@ fn open(path: &Path) -> Result<(Vec<String>, u64, BufReader<File>)> {
     if let Some(twice) = names.iter().find(|n| !seen.insert(n.as_str())) {
         return Err(format_error(path, format!("field {twice} appears twice")));
     }
-    Ok((names, header.shape()[0], reader))
+    // The records the header gives must be what the file holds after it.
+    let rows = header.shape()[0];
+    let io = |source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    let start = reader.stream_position().map_err(io)?;
+    let held = reader
+        .get_ref()
+        .metadata()
+        .map_err(io)?
+        .len()
+        .saturating_sub(start);
+    let record = 8 * names.len() as u64;
+    if rows.checked_mul(record) != Some(held) {
+        return Err(format_error(
+            path,
+            format!(
+                "its header gives {rows} rows of {} float64 fields, but {held} bytes follow it \
+                 ({} whole rows){}",
+                names.len(),
+                held / record,
+                if held < rows.saturating_mul(record) {
+                    ": truncated"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok((names, rows, reader))
 }
 
 /// Refuses a header longer than NumPy reads (before `npyz` allocates room for it): the magic

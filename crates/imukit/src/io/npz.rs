@@ -171,23 +171,97 @@ impl NpzSink {
     }
 }
 
+/// The most an archive's members may expand, all together, once they hold more than
+/// [`RATIO_FREE_BYTES`]: float64 measurements deflate by a few times, a constant column by up to
+/// deflate's 1032; a whole table a hundred times smaller than its values is a decompression bomb.
+const MAX_ARCHIVE_RATIO: u64 = 100;
+
+/// Archives up to this size of values (64 MiB) are read whatever their ratio.
+const RATIO_FREE_BYTES: u64 = 64 << 20;
+
 /// Every column of a `.npz` archive as a table, the members' order the columns' order.
 ///
+/// Before a value is read, the archive's directory is checked: no member named twice, each
+/// member's stored size within the file, its declared size within what its compression can
+/// give (stored: its stored size; deflate: 1032 times it), the members together within the
+/// memory limit of in-memory work ([`crate::scenario::times::max_memory_bytes`]) and, beyond 64
+/// MiB, within [`MAX_ARCHIVE_RATIO`] times what they store. Each member's values go straight to
+/// their place in the table (one copy in memory), and its CRC-32 is checked when it ends.
+///
 /// # Errors
-/// An unreadable archive; a member that is not a one-dimensional float64 array, or that
-/// declares more than the archive can hold; columns of different lengths; no rows; a value that
-/// is not finite (row and column named).
+/// An unreadable archive; a member that is not a one-dimensional float64 array, that declares
+/// more than the archive can hold, holds more or less than its header says, or fails its CRC;
+/// a member twice; columns of different lengths; no rows; a table beyond the limits above;
+/// a value that is not finite (row and column named).
 pub fn read_table(path: &Path) -> Result<Table> {
     let file = File::open(path).map_err(|source| Error::Io {
         path: path.into(),
         source,
     })?;
+    let file_bytes = file
+        .metadata()
+        .map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?
+        .len();
     let mut archive =
         zip::ZipArchive::new(BufReader::new(file)).map_err(|e| format_error(path, e))?;
-    let mut names = Vec::with_capacity(archive.len());
-    let mut columns: Vec<Vec<f64>> = Vec::with_capacity(archive.len());
-    for i in 0..archive.len() {
-        let mut member = archive.by_index(i).map_err(|e| format_error(path, e))?;
+    if archive.has_duplicate_names() {
+        return Err(format_error(
+            path,
+            "a member appears twice (NumPy refuses such an archive; which one is meant?)",
+        ));
+    }
+    let width = archive.len();
+    let (mut total, mut stored_total) = (0u64, 0u64);
+    for i in 0..width {
+        let member = archive.by_index_raw(i).map_err(|e| format_error(path, e))?;
+        let name = String::from_utf8_lossy(member.name_raw()).into_owned();
+        let (declared, stored) = (member.size(), member.compressed_size());
+        let limit = match member.compression() {
+            CompressionMethod::Stored => stored,
+            _ => stored.saturating_mul(MAX_DEFLATE_RATIO),
+        };
+        if stored > file_bytes || declared > limit {
+            return Err(format_error(
+                path,
+                format!(
+                    "member {name} declares {declared} bytes from {stored} stored in a file of \
+                     {file_bytes} (not a valid archive)"
+                ),
+            ));
+        }
+        total = total.saturating_add(declared);
+        stored_total = stored_total.saturating_add(stored);
+    }
+    let limit = crate::scenario::times::max_memory_bytes();
+    #[allow(clippy::cast_precision_loss)]
+    if total as f64 > limit {
+        return Err(format_error(
+            path,
+            format!(
+                "its members hold {total} bytes, more than the memory limit of {:.1} GB (a .npz \
+                 table is read whole: write a larger one as .parquet or .npy, read row by row, \
+                 or raise the limit with IMUKIT_MAX_MEMORY_GB)",
+                limit / 1e9
+            ),
+        ));
+    }
+    if total > RATIO_FREE_BYTES && total / stored_total.max(1) > MAX_ARCHIVE_RATIO {
+        return Err(format_error(
+            path,
+            format!(
+                "its members expand {stored_total} stored bytes into {total}, more than \
+                 {MAX_ARCHIVE_RATIO} times: not a table of measurements (a decompression bomb?)"
+            ),
+        ));
+    }
+    let mut names: Vec<String> = Vec::with_capacity(width);
+    let mut table = Table::new(&[]);
+    let mut rows = 0usize;
+    for k in 0..width {
+        let mut member = archive.by_index(k).map_err(|e| format_error(path, e))?;
         let member_name = member
             .name()
             .map_err(|e| format_error(path, e))?
@@ -199,18 +273,11 @@ pub fn read_table(path: &Path) -> Result<Table> {
             ));
         };
         let bad = |what: String| format_error(path, format!("member {member_name}: {what}"));
-        let declared = member.size();
-        let limit = match member.compression() {
-            CompressionMethod::Stored => member.compressed_size(),
-            _ => member.compressed_size().saturating_mul(MAX_DEFLATE_RATIO),
-        };
-        if declared > limit {
-            return Err(bad(format!(
-                "declares {declared} bytes from {} stored (not a valid archive)",
-                member.compressed_size()
-            )));
+        if names.iter().any(|n| n == name) {
+            return Err(bad(format!("column {name} appears twice")));
         }
-        let mut reader = BufReader::new((&mut member).take(declared));
+        let declared = member.size();
+        let mut reader = BufReader::new(&mut member);
         crate::io::npy::check_header_length(path, &mut reader)?;
         let header = NpyHeader::from_reader(&mut reader).map_err(|e| bad(e.to_string()))?;
         if header.dtype() != float64() || header.shape().len() != 1 {
@@ -226,39 +293,45 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 "its header gives {n} values, more than its {declared} bytes hold"
             )));
         }
-        let mut bytes = vec![0u8; 8 * n as usize];
-        reader
-            .read_exact(&mut bytes)
-            .map_err(|e| bad(format!("ends before its {n} values (truncated: {e})")))?;
-        let values: Vec<f64> = bytes
-            .chunks_exact(8)
-            .map(|b| f64::from_le_bytes(b.try_into().expect("eight bytes")))
-            .collect();
-        if let Some(first) = columns.first()
-            && first.len() != values.len()
-        {
+        // Within the checked total, so the table's room can be made.
+        let n = usize::try_from(n).map_err(|_| bad(format!("{n} values")))?;
+        if k == 0 {
+            rows = n;
+            table.data = vec![0.0; rows * width];
+        } else if n != rows {
             return Err(bad(format!(
-                "{} values, but column {} has {}: the columns of a table are equally long",
-                values.len(),
-                names[0],
-                first.len()
+                "{n} values, but column {} has {rows}: the columns of a table are equally long",
+                names[0]
             )));
         }
-        if names.iter().any(|n| n == name) {
-            return Err(bad(format!("column {name} appears twice")));
+        // The values, a block at a time, each to its place in its row.
+        let mut block = vec![0u8; 8 * 8192];
+        let mut row = 0;
+        while row < rows {
+            let take = (rows - row).min(8192);
+            let bytes = &mut block[..8 * take];
+            reader
+                .read_exact(bytes)
+                .map_err(|e| bad(format!("ends before its {rows} values ({e})")))?;
+            for (j, b) in bytes.chunks_exact(8).enumerate() {
+                let v = f64::from_le_bytes(b.try_into().expect("eight bytes"));
+                table.data[(row + j) * width + k] = v;
+            }
+            row += take;
+        }
+        // To the member's end: nothing may follow the values, and the end checks the CRC-32.
+        let mut rest = [0u8; 64];
+        match reader.read(&mut rest) {
+            Ok(0) => {}
+            Ok(_) => return Err(bad(format!("more bytes than its {rows} values"))),
+            Err(e) => return Err(bad(format!("damaged ({e})"))),
         }
         names.push(name.to_string());
-        columns.push(values);
     }
-    let rows = columns.first().map_or(0, Vec::len);
     if rows == 0 {
         return Err(format_error(path, "no rows (or no columns)"));
     }
-    let names_ref: Vec<&str> = names.iter().map(String::as_str).collect();
-    let mut table = Table::new(&names_ref);
-    table.data = (0..rows)
-        .flat_map(|i| columns.iter().map(move |c| c[i]))
-        .collect();
+    table.columns = names;
     crate::io::table::check_finite_from(
         &table.columns,
         &table.data,

@@ -13,7 +13,7 @@ use crate::io::TableFormat;
 use crate::io::npy::NpySink;
 use crate::io::npz::NpzSink;
 use crate::io::parquet::ParquetSink;
-use crate::io::table::{check_finite, write_rows};
+use crate::io::table::{check_column_names, check_finite, write_rows};
 
 /// The longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
@@ -421,6 +421,7 @@ impl AtomicFile {
     /// # Errors
     /// [`Error::Io`] naming the file; the Parquet writer's refusal.
     pub fn begin_table(&mut self, columns: &[String], metadata: &[(String, String)]) -> Result<()> {
+        check_column_names(columns, &self.path)?;
         self.columns = columns.to_vec();
         match TableFormat::of(&self.path) {
             TableFormat::Parquet => {

@@ -493,6 +493,15 @@ fn parse_sensor_keys(
                 let ParamValue::Table(t) = v else {
                     return Err(invalid(field, "needs Numerator and Denominator"));
                 };
+                if let Some(other) = t
+                    .keys()
+                    .find(|k| !matches!(k.as_str(), "Numerator" | "Denominator"))
+                {
+                    return Err(invalid(
+                        format!("{field}.{other}"),
+                        "unknown key (BiasInstabilityCoefficients has Numerator and Denominator)",
+                    ));
+                }
                 let get = |name: &str| {
                     t.get(name)
                         .map(|x| list(x, &format!("{field}.{name}")))

@@ -13,8 +13,8 @@ use arrow_array::{Array, ArrayRef, Float64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema};
 use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use parquet::basic::Compression;
-use parquet::file::metadata::KeyValue;
+use parquet::basic::{Compression, Encoding};
+use parquet::file::metadata::{KeyValue, ParquetMetaData};
 use parquet::file::properties::WriterProperties;
 
 use crate::error::{Error, Result};
@@ -202,12 +202,127 @@ pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>> {
         .unwrap_or_default())
 }
 
+/// A reader of the file at `path`, its metadata checked ([`check_metadata`]); a panic of the
+/// Parquet crate on a damaged file is an error naming it ([`contain`]).
 fn builder(path: &Path) -> Result<ParquetRecordBatchReaderBuilder<File>> {
     let file = File::open(path).map_err(|source| Error::Io {
         path: path.into(),
         source,
     })?;
-    ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format_error(path, e))
+    let file_bytes = file
+        .metadata()
+        .map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?
+        .len();
+    contain(path, || {
+        let builder =
+            ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format_error(path, e))?;
+        check_metadata(path, builder.metadata(), file_bytes)?;
+        Ok(builder)
+    })
+}
+
+/// The encodings imukit's float64 columns may have: plain values, split bytes, and a dictionary
+/// (with its indices' run-length encoding) as other writers make them, and the old bit-packed
+/// levels some writers still list.
+#[allow(deprecated)]
+const ENCODINGS: [Encoding; 6] = [
+    Encoding::PLAIN,
+    Encoding::BYTE_STREAM_SPLIT,
+    Encoding::RLE,
+    Encoding::RLE_DICTIONARY,
+    Encoding::PLAIN_DICTIONARY,
+    Encoding::BIT_PACKED,
+];
+
+/// Checks a file's metadata before any page is read: every column chunk's offsets and length
+/// within the file, counts not negative and within the row group's, a codec this build reads
+/// (uncompressed or Snappy), known encodings, and each column named once.
+fn check_metadata(path: &Path, metadata: &ParquetMetaData, file_bytes: u64) -> Result<()> {
+    let bad = |what: String| format_error(path, format!("damaged metadata: {what}"));
+    let schema = metadata.file_metadata().schema_descr();
+    let mut seen = std::collections::HashSet::new();
+    for c in schema.columns() {
+        if !seen.insert(c.name()) {
+            return Err(format_error(
+                path,
+                format!("column {} appears twice", c.name()),
+            ));
+        }
+    }
+    for (g, group) in metadata.row_groups().iter().enumerate() {
+        let rows = group.num_rows();
+        if rows < 0 {
+            return Err(bad(format!("row group {g} has {rows} rows")));
+        }
+        for chunk in group.columns() {
+            let name = chunk.column_descr().name();
+            let here = |what: String| bad(format!("row group {g}, column {name}: {what}"));
+            let start = chunk
+                .dictionary_page_offset()
+                .unwrap_or_else(|| chunk.data_page_offset());
+            let length = chunk.compressed_size();
+            let inside = u64::try_from(start).ok().zip(u64::try_from(length).ok());
+            if inside.is_none_or(|(s, l)| s.saturating_add(l) > file_bytes)
+                || chunk.data_page_offset() < 0
+            {
+                return Err(here(format!(
+                    "{length} bytes from byte {start}, outside the file's {file_bytes}"
+                )));
+            }
+            // A flat column has a value (or a null) in every row.
+            let flat = chunk.column_descr().max_rep_level() == 0;
+            if chunk.num_values() < 0 || (flat && chunk.num_values() != rows) {
+                return Err(here(format!(
+                    "{} values in {rows} rows",
+                    chunk.num_values()
+                )));
+            }
+            if chunk.uncompressed_size() < 0 {
+                return Err(here(format!(
+                    "{} bytes uncompressed",
+                    chunk.uncompressed_size()
+                )));
+            }
+            if !matches!(
+                chunk.compression(),
+                Compression::UNCOMPRESSED | Compression::SNAPPY
+            ) {
+                return Err(here(format!(
+                    "compressed with {} (imukit reads uncompressed and Snappy Parquet)",
+                    chunk.compression()
+                )));
+            }
+            // Pages stored as they are take the room their values do.
+            if chunk.compression() == Compression::UNCOMPRESSED
+                && chunk.compressed_size() != chunk.uncompressed_size()
+            {
+                return Err(here(format!(
+                    "said to be uncompressed, but {} bytes hold {} of pages",
+                    chunk.compressed_size(),
+                    chunk.uncompressed_size()
+                )));
+            }
+            if let Some(e) = chunk.encodings().find(|e| !ENCODINGS.contains(e)) {
+                return Err(here(format!("encoding {e} (not one of a float64 column)")));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Runs `read` on the file at `path`, a panic inside the Parquet crate (a damaged file it does
+/// not refuse cleanly) turned into an error naming the file: the last line behind
+/// [`check_metadata`], so that no file can end the process.
+fn contain<T>(path: &Path, read: impl FnOnce() -> Result<T>) -> Result<T> {
+    crate::io::contained(read).unwrap_or_else(|message| {
+        Err(format_error(
+            path,
+            format!("damaged file (the Parquet reader failed: {message})"),
+        ))
+    })
 }
 
 /// Every column of a Parquet table: float64 columns without nulls, finite values (a column of
@@ -218,6 +333,14 @@ fn builder(path: &Path) -> Result<ParquetRecordBatchReaderBuilder<File>> {
 pub fn read_table(path: &Path) -> Result<Table> {
     let builder = builder(path)?;
     let names = float64_names(path, builder.schema())?;
+    contain(path, || read_batches(path, builder, names))
+}
+
+fn read_batches(
+    path: &Path,
+    builder: ParquetRecordBatchReaderBuilder<File>,
+    names: Vec<String>,
+) -> Result<Table> {
     let reader = builder.build().map_err(|e| format_error(path, e))?;
     let names_ref: Vec<&str> = names.iter().map(String::as_str).collect();
     let mut table = Table::new(&names_ref);
@@ -324,7 +447,7 @@ impl ParquetRows {
     pub fn open(path: &Path) -> Result<(Vec<String>, Self)> {
         let builder = builder(path)?;
         let names = float64_names(path, builder.schema())?;
-        let reader = builder.build().map_err(|e| format_error(path, e))?;
+        let reader = contain(path, || builder.build().map_err(|e| format_error(path, e)))?;
         Ok((
             names,
             Self {
@@ -348,7 +471,8 @@ impl ParquetRows {
         out: &mut [f64],
     ) -> Result<Option<usize>> {
         while self.batch.first().is_none_or(|c| self.next >= c.len()) {
-            let Some(batch) = self.reader.next() else {
+            let (reader, path) = (&mut self.reader, &self.path);
+            let Some(batch) = contain(path, || Ok(reader.next()))? else {
                 return Ok(None);
             };
             let batch = batch.map_err(|e| format_error(&self.path, e))?;

@@ -196,6 +196,62 @@ pub fn check_finite_from<S: AsRef<str>>(
     }
 }
 
+/// The longest column name a table file takes, bytes.
+pub const MAX_COLUMN_NAME_BYTES: usize = 255;
+
+/// Refuses column names that a table file could not carry back, before anything is written:
+/// one rule for every format, so that a table written as one reads back as any other. A name
+/// is 1 to [`MAX_COLUMN_NAME_BYTES`] bytes of text with no control character, no `,` `"` `'`
+/// `\` `/` (CSV's separator and quotes, the quotes and escapes of a `.npy` header, a `.npz`
+/// member's folder), no space at either end (CSV trims it) and no `#` first (a CSV comment);
+/// no name twice.
+///
+/// # Errors
+/// [`Error::CsvFormat`] naming `path`, the column's place and what is wrong with it.
+pub fn check_column_names<S: AsRef<str>>(columns: &[S], path: &Path) -> Result<()> {
+    let refuse = |k: usize, name: &str, why: String| {
+        let shown: String = name.chars().take(40).collect();
+        let cut = if shown.len() < name.len() { "…" } else { "" };
+        Err(Error::CsvFormat {
+            file: path.into(),
+            message: format!("column {} ({shown:?}{cut}) cannot be written: {why}", k + 1),
+        })
+    };
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(columns.len());
+    for (k, name) in columns.iter().enumerate() {
+        let name = name.as_ref();
+        if name.is_empty() {
+            return refuse(k, name, "a column needs a name".into());
+        }
+        if name.len() > MAX_COLUMN_NAME_BYTES {
+            return refuse(
+                k,
+                name,
+                format!(
+                    "a name of {} bytes (at most {MAX_COLUMN_NAME_BYTES})",
+                    name.len()
+                ),
+            );
+        }
+        if let Some(c) = name
+            .chars()
+            .find(|c| c.is_control() || matches!(c, ',' | '"' | '\'' | '\\' | '/'))
+        {
+            return refuse(k, name, format!("it holds {c:?}"));
+        }
+        if name.trim() != name {
+            return refuse(k, name, "a space at its start or end".into());
+        }
+        if name.starts_with('#') {
+            return refuse(k, name, "a name starting with # (a comment in CSV)".into());
+        }
+        if let Some(first) = seen.insert(name, k) {
+            return refuse(k, name, format!("the name of column {} too", first + 1));
+        }
+    }
+    Ok(())
+}
+
 /// The index of the first value of `data` that is not finite. Blocks of 32 values
 /// are tested whole, without stopping at the first failure, so that the test is a few vector
 /// operations a block; only a block that fails is searched.
@@ -391,6 +447,7 @@ impl Table {
     /// # Errors
     /// A value that is not finite; the writer's or the file system's refusal, naming the file.
     pub(crate) fn write_binary(&self, path: &Path, metadata: &[(String, String)]) -> Result<()> {
+        check_column_names(&self.columns, path)?;
         check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
         let mut file = crate::io::output::AtomicFile::create(path)?;
         file.begin_table(&self.columns, metadata)?;
@@ -403,6 +460,7 @@ impl Table {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
+        check_column_names(&self.columns, path)?;
         self.check_finite(&path.display().to_string())?;
         write_atomically(path, |w| {
             self.write_header(w)?;

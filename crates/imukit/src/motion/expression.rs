@@ -220,6 +220,33 @@ impl ExpressionMotion {
         [atan2(across, along), pitch, D::from(0.0)]
     }
 
+    /// Refuses geodetic formulas whose latitude leaves ±89.9° at one of the times `t_s` (the
+    /// first such time named): a latitude is an angle of the meridian, not one to wrap over
+    /// the pole. Longitudes wrap as they should (a flight round the Earth crosses ±180°).
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] for `trajectory.latitude_rad`.
+    pub fn check_latitudes(&self, t_s: impl IntoIterator<Item = f64>) -> crate::Result<()> {
+        if self.geodetic.is_none() {
+            return Ok(());
+        }
+        let limit = imu_core::earth::MAX_LATITUDE_RAD;
+        for t in t_s {
+            let lat: f64 = self.position[0].eval(t);
+            if !(lat.is_finite() && lat.abs() <= limit) {
+                return Err(crate::error::invalid(
+                    "trajectory.latitude_rad",
+                    format!(
+                        "at t = {t} s the latitude is {lat} rad ({:.4}°): a latitude lies within \
+                         ±{limit} rad (±89.9°, where the local NED frame is used)",
+                        lat.to_degrees()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The formulas at `t`: `[x, y, z]`, or `[φ, λ, h]` for geodetic ones.
     fn formulas<D: Scalar>(&self, t: D) -> [D; 3] {
         [

@@ -274,31 +274,20 @@ pub(crate) fn integrate_earth_csv(
 /// (the first reading before the first one).
 ///
 /// # Errors
-/// Missing columns, times that do not increase, values that are not finite, an empty file.
+/// Missing columns, times that do not increase or fall outside the IMU's span, values that are
+/// not finite, an empty file.
 pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
-    let (Some(tb), Some(hb)) = (baro.column("t_s"), baro.column(BARO_COLUMN)) else {
-        return Err(invalid(
-            "barometer data",
-            format!("needs columns t_s and {BARO_COLUMN}"),
-        ));
-    };
-    if tb.is_empty() {
-        return Err(invalid("barometer data", "has no readings"));
-    }
-    for k in 0..tb.len() {
-        if !(tb[k].is_finite() && hb[k].is_finite()) || (k > 0 && tb[k] <= tb[k - 1]) {
-            return Err(invalid(
-                "barometer data",
-                format!(
-                    "row {}: times must increase and values be finite numbers",
-                    k + 2
-                ),
-            ));
-        }
-    }
     let t = imu
         .column("t_s")
         .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else {
+        return Err(invalid("IMU data", "has no rows"));
+    };
+    // The same rule as the fusion's aids: finite, increasing, within the IMU's span.
+    let (tb, hb) = crate::run::fuse_aids::aid_series(baro, "barometer", BARO_COLUMN, (t0, t1))?;
+    if tb.is_empty() {
+        return Err(invalid("barometer data", "has no readings"));
+    }
     let mut columns: Vec<&str> = imu.columns.iter().map(String::as_str).collect();
     if columns.contains(&BARO_COLUMN) {
         return Err(invalid(

@@ -467,6 +467,12 @@ impl FusionInputs {
                 "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
             ));
         };
+        if t.len() < 2 {
+            return Err(invalid(
+                "IMU data",
+                format!("{} rows: fusion needs at least two samples", t.len()),
+            ));
+        }
         let missing: Vec<&str> = columns
             .iter()
             .copied()

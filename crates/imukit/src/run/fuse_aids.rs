@@ -104,7 +104,7 @@ impl<const S: usize> AidUpdates for EarthEskf<S> {
 }
 
 /// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
-fn aid_series(
+pub(crate) fn aid_series(
     table: &Table,
     what: &str,
     value: &str,

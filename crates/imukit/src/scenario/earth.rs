@@ -121,8 +121,12 @@ impl TangentPlane {
                 ),
             ));
         }
-        if !origin.longitude_rad.is_finite() {
-            return Err(invalid("origin.longitude_deg", "must be a finite number"));
+        let lon = origin.longitude_rad.to_degrees();
+        if !(lon.is_finite() && lon.abs() <= 180.0) {
+            return Err(invalid(
+                "origin.longitude_deg",
+                format!("must be within ±180°, got {lon}"),
+            ));
         }
         if !(origin.height_m.is_finite() && origin.height_m.abs() <= 1e6) {
             return Err(invalid(

@@ -178,6 +178,45 @@ impl GnssSpec {
     }
 }
 
+impl GnssSetup {
+    /// Whether a fix stamped `stamp` is written in a run ending at `end_s`: not after the end,
+    /// not in an outage.
+    fn writes(&self, stamp: f64, end_s: f64) -> bool {
+        stamp <= end_s && !self.outages.iter().any(|&(a, b)| (a..b).contains(&stamp))
+    }
+
+    /// Refuses a receiver that would write no fix over the run's times `t_s` (a latency longer
+    /// than the run, outages over all of it): a GNSS file of only a header is a slip, not data.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] for `gnss`, saying why.
+    pub fn check_writes_a_fix(&self, t_s: &crate::scenario::times::SampleTimes) -> Result<()> {
+        let n = t_s.len();
+        let Some(end_s) = n.checked_sub(1).map(|k| t_s.at(k)) else {
+            return Ok(());
+        };
+        if (0..n)
+            .step_by(self.every)
+            .any(|k| self.writes(t_s.at(k) + self.latency_s, end_s))
+        {
+            return Ok(());
+        }
+        Err(invalid(
+            "gnss",
+            format!(
+                "no fix falls within the run (it ends at {end_s} s; latency_s = {} s{}): the GNSS \
+                 file would hold only its header",
+                self.latency_s,
+                if self.outages.is_empty() {
+                    ""
+                } else {
+                    ", outages included"
+                }
+            ),
+        ))
+    }
+}
+
 /// The receiver running over a scenario's samples: which sample comes next, the error state,
 /// the seeded noise.
 #[derive(Debug)]
@@ -220,12 +259,7 @@ impl<'a> GnssStream<'a> {
     }
 
     fn written(&self, stamp: f64) -> bool {
-        stamp <= self.end_s
-            && !self
-                .setup
-                .outages
-                .iter()
-                .any(|&(a, b)| (a..b).contains(&stamp))
+        self.setup.writes(stamp, self.end_s)
     }
 
     /// Fixes from the next flat-Earth truth samples (frame `N`), as rows of [`GNSS_COLUMNS`].

@@ -217,6 +217,7 @@ impl ScenarioSpec {
                         &plane.origin,
                         spec.nav_frame.unwrap_or_default(),
                     ));
+                    motion.check_latitudes((0..t.len()).map(|k| t.at(k)))?;
                 }
                 (
                     Trajectory::Expression(motion, AnalyticOptions { min_speed_m_s }),
@@ -301,6 +302,9 @@ impl ScenarioSpec {
             .as_ref()
             .map(|g| g.resolve(sample_rate_hz, imu.sensors.seed))
             .transpose()?;
+        if let Some(g) = &gnss {
+            g.check_writes_a_fix(&t_s)?;
+        }
         let baro = spec
             .baro
             .as_ref()

@@ -219,8 +219,8 @@ pub struct OriginSpec {
     pub latitude_deg: f64,
     /// Longitude, degrees east.
     pub longitude_deg: f64,
-    /// Height above the ellipsoid, m (default 0).
-    #[serde(default)]
+    /// Height above the ellipsoid, m (required: gravity and the radii depend on it, and a
+    /// silent 0 is a plausible slip).
     pub height_m: f64,
 }
 
