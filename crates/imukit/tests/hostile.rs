@@ -285,4 +285,46 @@ proptest! {
             prop_assert!(tau.iter().all(|v| *v > 0.0));
         }
     }
+
+    #[test]
+    fn damaged_binary_tables_read_finite_or_are_refused_naming_the_file(
+        format in 0..3usize,
+        flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6),
+        cut in prop::option::of(any::<prop::sample::Index>()),
+        case in any::<u32>(),
+    ) {
+        // A valid table of each binary format, then bytes changed (most in the part a reader
+        // trusts most: Parquet's footer, the .npy header, the archive's directory) and
+        // perhaps cut short. The reader gives finite values or an error naming the file.
+        let ext = ["parquet", "npy", "npz"][format];
+        let dir = scratch("binary");
+        let good = dir.path().join(format!("good.{ext}"));
+        let mut t = Table::new(&["t_s", "accel_x_m_s2", "gyro_z_rad_s"]);
+        for k in 0..300 {
+            let x = f64::from(k);
+            t.push_row(&[x / 100.0, (x * 0.3).sin(), 1e-3 * x]);
+        }
+        t.write(&good).unwrap();
+        let mut bytes = std::fs::read(&good).unwrap();
+        let tail = bytes.len().min(400);
+        let n = bytes.len();
+        for (i, value) in &flips {
+            // Half the changes fall in the first or last 400 bytes.
+            let at = match value % 3 {
+                0 => i.index(tail),
+                1 => n - tail + i.index(tail),
+                _ => i.index(n),
+            };
+            bytes[at] = *value;
+        }
+        if let Some(c) = cut {
+            bytes.truncate(c.index(n));
+        }
+        let bad = dir.path().join(format!("{case}.{ext}"));
+        std::fs::write(&bad, &bytes).unwrap();
+        match read_table(&bad) {
+            Ok(table) => assert_finite(&table, "a damaged table read back"),
+            Err(e) => prop_assert!(e.to_string().contains(&format!("{case}.{ext}")), "{e}"),
+        }
+    }
 }

@@ -19,6 +19,21 @@ use std::cell::Cell;
 use std::path::Path;
 use std::sync::Once;
 
+/// Opens the file at `path` to read it, with its length in bytes (what a binary reader checks
+/// declared sizes against before it allocates).
+///
+/// # Errors
+/// [`crate::Error::Io`] naming the file.
+pub(crate) fn open_with_length(path: &Path) -> crate::Result<(std::fs::File, u64)> {
+    let io = |source| crate::Error::Io {
+        path: path.into(),
+        source,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let length = file.metadata().map_err(io)?.len();
+    Ok((file, length))
+}
+
 thread_local! {
     /// True while this thread runs a reader under [`contained`].
     static CONTAINING: Cell<bool> = const { Cell::new(false) };

@@ -194,17 +194,7 @@ const RATIO_FREE_BYTES: u64 = 64 << 20;
 /// a member twice; columns of different lengths; no rows; a table beyond the limits above;
 /// a value that is not finite (row and column named).
 pub fn read_table(path: &Path) -> Result<Table> {
-    let file = File::open(path).map_err(|source| Error::Io {
-        path: path.into(),
-        source,
-    })?;
-    let file_bytes = file
-        .metadata()
-        .map_err(|source| Error::Io {
-            path: path.into(),
-            source,
-        })?
-        .len();
+    let (file, file_bytes) = crate::io::open_with_length(path)?;
     let mut archive =
         zip::ZipArchive::new(BufReader::new(file)).map_err(|e| format_error(path, e))?;
     if archive.has_duplicate_names() {

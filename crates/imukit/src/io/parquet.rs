@@ -205,17 +205,7 @@ pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>> {
 /// A reader of the file at `path`, its metadata checked ([`check_metadata`]); a panic of the
 /// Parquet crate on a damaged file is an error naming it ([`contain`]).
 fn builder(path: &Path) -> Result<ParquetRecordBatchReaderBuilder<File>> {
-    let file = File::open(path).map_err(|source| Error::Io {
-        path: path.into(),
-        source,
-    })?;
-    let file_bytes = file
-        .metadata()
-        .map_err(|source| Error::Io {
-            path: path.into(),
-            source,
-        })?
-        .len();
+    let (file, file_bytes) = crate::io::open_with_length(path)?;
     contain(path, || {
         let builder =
             ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format_error(path, e))?;
