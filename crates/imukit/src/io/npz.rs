@@ -174,10 +174,10 @@ impl NpzSink {
 /// The most an archive's members may expand, all together, once they hold more than
 /// [`RATIO_FREE_BYTES`]: float64 measurements deflate by a few times, a constant column by up to
 /// deflate's 1032; a whole table a hundred times smaller than its values is a decompression bomb.
-const MAX_ARCHIVE_RATIO: u64 = 100;
+pub const MAX_ARCHIVE_RATIO: u64 = 100;
 
 /// Archives up to this size of values (64 MiB) are read whatever their ratio.
-const RATIO_FREE_BYTES: u64 = 64 << 20;
+pub const RATIO_FREE_BYTES: u64 = 64 << 20;
 
 /// Every column of a `.npz` archive as a table, the members' order the columns' order.
 ///
