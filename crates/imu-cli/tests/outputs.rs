@@ -81,6 +81,43 @@ fn a_signal_removes_every_output_begun_and_exits_with_the_conventional_status() 
 }
 
 #[test]
+fn an_interrupted_navigation_leaves_no_output_and_its_inputs_as_they_were() {
+    let dir = temp_dir("signals-integrate");
+    let dir = dir.path();
+    let s = scenario(dir, "s.toml", 200.0, "figure8");
+    let made = imukit()
+        .current_dir(dir)
+        .args(["simulate", &s, "--out", "imu.csv", "--truth", "truth.csv"])
+        .output()
+        .unwrap();
+    assert!(made.status.success());
+    let before = std::fs::read(dir.join("imu.csv")).unwrap();
+    let mut child = imukit()
+        .current_dir(dir)
+        .args([
+            "integrate",
+            "imu.csv",
+            "--init",
+            "truth.csv",
+            "--scheme",
+            "rk4",
+            "--substeps",
+            "1000",
+            "--out",
+            "nav.parquet",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    send("INT", child.id());
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    assert_eq!(names(dir), ["imu.csv", "s.toml", "truth.csv"]);
+    assert_eq!(std::fs::read(dir.join("imu.csv")).unwrap(), before);
+}
+
+#[test]
 fn two_processes_writing_one_name_leave_one_whole_file_of_one_of_them() {
     let dir = temp_dir("two-writers");
     let dir = dir.path();

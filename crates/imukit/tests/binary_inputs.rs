@@ -351,6 +351,45 @@ fn damaged_parquet_metadata_is_refused_naming_the_file_never_a_panic() {
 }
 
 #[test]
+fn a_page_whose_header_says_dictionary_without_a_dictionary_is_an_error_not_a_panic() {
+    // The metadata is sound; the first data page's header says its values are dictionary
+    // indices (RLE_DICTIONARY) where they are split bytes. The parquet crate panics there
+    // ("Decoder for dict should have been set"): the reader's containment turns it into an
+    // error naming the file.
+    let d = scratch("dictionary");
+    let d = d.path();
+    let good = d.join("good.parquet");
+    small_table(1000).write(&good).unwrap();
+    let mut bytes = std::fs::read(&good).unwrap();
+    let metadata = parquet::file::metadata::ParquetMetaDataReader::new()
+        .parse_and_finish(&std::fs::File::open(&good).unwrap())
+        .unwrap();
+    let start = usize::try_from(metadata.row_group(0).column(0).data_page_offset()).unwrap();
+    // In the page header (Thrift compact): the data page header's field 2, an i32 (0x15), holding
+    // BYTE_STREAM_SPLIT (9, zigzag 0x12) becomes RLE_DICTIONARY (8, zigzag 0x10).
+    let at = bytes[start..start + 48]
+        .windows(2)
+        .position(|w| w == [0x15, 0x12])
+        .expect("the encoding in the page header")
+        + start;
+    bytes[at + 1] = 0x10;
+    let p = d.join("dictionary.parquet");
+    std::fs::write(&p, &bytes).unwrap();
+    let e = refused(&p);
+    assert!(
+        e.contains("dictionary.parquet") && e.contains("damaged file"),
+        "{e}"
+    );
+    let rows = imukit::io::table::CsvRows::open(&p, &["t_s"], "").and_then(|mut r| {
+        let mut out = [0.0];
+        while r.next_row(&mut out)?.is_some() {}
+        Ok(())
+    });
+    let e = rows.unwrap_err().to_string();
+    assert!(e.contains("dictionary.parquet"), "{e}");
+}
+
+#[test]
 fn a_column_named_twice_is_refused_in_every_format_read() {
     let d = scratch("twice");
     let d = d.path();
