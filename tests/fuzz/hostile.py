@@ -9,6 +9,7 @@ says no cleanly.
 
     python tests/fuzz/hostile.py                     # the short seeded run CI does (~400 cases)
     python tests/fuzz/hostile.py --cases 5000 --seed 7   # a long run; any seed reproduces itself
+    python tests/fuzz/hostile.py --cases 10 --process-cases 2000   # signals and two writers, long
 
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
 long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
@@ -276,7 +277,7 @@ def formula(rng: random.Random, depth: int = 0, limit: int = 0) -> str:
     return f"if(t < {rng.choice(EXTREMES[3:])}, {inner}, {rng.choice(['t', '0', '1e308'])})"
 
 
-def cli_cases(rng: random.Random, cases: int) -> list:
+def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
     runs = []
     work = Path(tempfile.mkdtemp(prefix="imukit-hostile-"))
     try:
@@ -287,6 +288,8 @@ def cli_cases(rng: random.Random, cases: int) -> list:
         (work / "p.json").write_text(PARAMS)
         valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv")}
         per = max(1, cases // 7)
+        # The classes that run a process for a second or so: a quarter of the others' cases.
+        slow = process_cases or max(1, per // 4)
 
         r = Run("byte mutations of valid files")
         for k in range(per):
@@ -512,7 +515,7 @@ def cli_cases(rng: random.Random, cases: int) -> list:
         r = Run("signals at a random moment")
         (work / "long.toml").write_text('rate_hz = 1000.0\nduration_s = 6000.0\n[trajectory]\ntype = "builtin"\n'
                                         'name = "figure8"\n[imu]\npreset = "mpu-6050"\n')
-        for k in range(max(1, per // 4)):
+        for k in range(slow):
             ext = rng.choice(["csv", "parquet", "npy", "npz"])
             sig = rng.choice(list(SIGNAL_EXITS))
             args = ["simulate", "long.toml", "--out", f"s.{ext}", *rng.choice([[], ["--truth", f"st.{ext}"],
@@ -547,7 +550,7 @@ def cli_cases(rng: random.Random, cases: int) -> list:
                                       'name = "figure8"\n')
         (work / "w2.toml").write_text('rate_hz = 100.0\nduration_s = 30.0\n[trajectory]\ntype = "builtin"\n'
                                       'name = "tilted-circle"\n')
-        for k in range(max(1, per // 4)):
+        for k in range(slow):
             ext = rng.choice(["csv", "parquet", "npy", "npz"])
             whole = {}
             for w in ("w1", "w2"):
@@ -695,9 +698,11 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=400, help="cases in all (CLI classes share 4/5)")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--process-cases", type=int, default=0,
+                    help="cases of each class that signals or races real processes (default: a quarter of the others')")
     a = ap.parse_args()
     rng = random.Random(a.seed)
-    runs = cli_cases(rng, a.cases * 4 // 5)
+    runs = cli_cases(rng, a.cases * 4 // 5, a.process_cases)
     runs.append(python_cases(a.seed, max(1, a.cases // 5)))
     total_pass = sum(r.passed for r in runs)
     total_fail = sum(len(r.failures) for r in runs)

@@ -192,8 +192,11 @@ fn links_planted_beside_an_output_are_never_written_through() {
     std::os::unix::fs::symlink("victim.txt", dir.join("o.csv.imukit-partial")).unwrap();
     std::os::unix::fs::symlink("s.toml", dir.join("t.csv.imukit-partial")).unwrap();
     std::os::unix::fs::symlink("victim.txt", dir.join("p.csv")).unwrap();
+    // A link to a device is replaced too (only the system's own, /dev/stdout, are written
+    // through): run as root, a link to a disk would otherwise be a write to the disk.
+    std::os::unix::fs::symlink("/dev/null", dir.join("q.csv")).unwrap();
     let before = std::fs::read(dir.join("s.toml")).unwrap();
-    for out in ["o.csv", "p.csv"] {
+    for out in ["o.csv", "p.csv", "q.csv"] {
         let run = imukit()
             .current_dir(dir)
             .args(["simulate", &s, "--out", out, "--truth", "t.csv"])
@@ -216,6 +219,15 @@ fn links_planted_beside_an_output_are_never_written_through() {
         std::fs::read_to_string(dir.join("victim.txt")).unwrap(),
         "keep me"
     );
+    assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+    // The system's own links are written through: the table goes to standard output.
+    let out = imukit()
+        .current_dir(dir)
+        .args(["simulate", &s, "--out", "/dev/stdout"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("t_s,accel_x_m_s2,"));
     assert_eq!(std::fs::read(dir.join("s.toml")).unwrap(), before);
 }
 

@@ -673,9 +673,22 @@ fn name_unnamed(_file: &File, _folder: &Path, _path: &Path) -> std::io::Result<P
 }
 
 /// True for an existing path that is neither a regular file nor a folder: a device such as
-/// `/dev/null`, a FIFO or a socket. Such outputs are written directly.
+/// `/dev/null`, a FIFO or a socket. Such outputs are written directly. A symbolic link is
+/// written through only where the system keeps its own (`/dev/stdout`, `/dev/fd/1`,
+/// `/proc/self/fd/1`): a link planted anywhere else is replaced by the output, never followed,
+/// whatever it points to.
 fn is_special(path: &Path) -> bool {
-    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+    let Ok(itself) = std::fs::symlink_metadata(path) else {
+        return false;
+    };
+    let special = |m: &std::fs::Metadata| !m.is_file() && !m.is_dir();
+    if !itself.file_type().is_symlink() {
+        return special(&itself);
+    }
+    let system = folder_of(path)
+        .canonicalize()
+        .is_ok_and(|f| f.starts_with("/dev") || f.starts_with("/proc"));
+    system && std::fs::metadata(path).is_ok_and(|m| special(&m))
 }
 
 /// The identity of a path for comparison: the canonical path of the file, or of its folder
