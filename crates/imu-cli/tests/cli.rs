@@ -1424,6 +1424,14 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
         ],
     );
     assert_eq!(code, Some(0), "{err}");
+    // Every file written is named.
+    assert!(
+        err.contains(
+            "IMU readings in imu.csv, truth in truth.csv, GNSS fixes in gnss.csv, barometer \
+             readings in baro.csv, odometer readings in odo.csv"
+        ),
+        "{err}"
+    );
     let fuse = |scenario: &str, extra: &[&str]| {
         let mut args = vec![
             "fuse",

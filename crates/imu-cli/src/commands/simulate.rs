@@ -75,16 +75,18 @@ pub fn run(
         };
         sc.stream_to_files(None, run_threads, &outputs)
             .map_err(threads_by_flag)?;
-        eprintln!(
-            "imukit: {} samples; IMU readings in {}{}{}",
-            sc.t_s.len(),
-            out.display(),
-            truth
-                .map(|t| format!(", truth in {}", t.display()))
-                .unwrap_or_default(),
-            gnss.map(|g| format!(", GNSS fixes in {}", g.display()))
-                .unwrap_or_default()
-        );
+        let mut written = format!("IMU readings in {}", out.display());
+        for (what, path) in [
+            ("truth", truth),
+            ("GNSS fixes", gnss),
+            ("barometer readings", baro),
+            ("odometer readings", odometer),
+        ] {
+            if let Some(p) = path {
+                written += &format!(", {what} in {}", p.display());
+            }
+        }
+        eprintln!("imukit: {} samples; {written}", sc.t_s.len());
         return Ok(());
     };
     if runs == 0 {

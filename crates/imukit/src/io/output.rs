@@ -1,7 +1,11 @@
-//! Output files: written under a temporary name and renamed into place when complete, so a
-//! failed command leaves no partial file; special files (`/dev/null`, `/dev/stdout`, FIFOs) are
-//! written directly, never replaced; and a job's outputs are checked against its inputs and
-//! against each other before work starts ([`check_outputs`]), so no input is overwritten.
+//! Output files: written to a temporary file no one else can reach (unnamed where the system
+//! allows, else a fresh random name created exclusively) and renamed into place when complete, so
+//! a failed or interrupted command leaves no partial file and two runs on one name leave one
+//! whole file; a command's outputs put in place together ([`OutputGroup`]), all or none, and
+//! removed on a signal ([`abandon_outputs`]); special files (`/dev/null`, `/dev/stdout`, FIFOs)
+//! written directly, never replaced, while a link planted elsewhere is replaced, never followed;
+//! and a job's outputs checked against its inputs and against each other before work starts
+//! ([`check_outputs`]), so no input is overwritten.
 use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::num::NonZeroU64;
