@@ -220,3 +220,12 @@ def test_cli_orient_equals_the_python_filters(tmp_path, filter_name):
     np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m))
     report = run("compare", str(truth_csv), str(out)).stdout
     assert "attitude" in report and "position" not in report
+
+
+def test_one_version_for_the_package_the_command_and_the_workspace():
+    import tomllib
+
+    workspace = tomllib.loads((ROOT / "Cargo.toml").read_text())["workspace"]["package"]["version"]
+    printed = subprocess.run([imukit_bin(), "--version"], capture_output=True, text=True, check=True).stdout
+    assert imukit.__version__ == workspace
+    assert printed.split() == ["imukit", workspace]

@@ -29,6 +29,8 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 /// The compiled core of the `imukit` package.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // One version for every package of the workspace (`imukit --version` prints the same).
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     errors::register(m)?;
     truth::register(m)?;
     rotations::register(m)?;

@@ -21,7 +21,7 @@ The package is split by area as the compiled core is: ``_truth`` (scenarios and 
 """
 from __future__ import annotations
 
-from ._core import ImuError
+from ._core import ImuError, __version__
 from ._table import Simulation, Table
 from ._truth import (
     builtin_scenario_toml,
@@ -69,6 +69,7 @@ from ._orientation import (
 )
 
 __all__ = [
+    "__version__",
     "ImuError",
     "Table",
     "Simulation",

@@ -8,7 +8,10 @@ _Table = tuple[list[str], npt.NDArray[np.float64]]
 #: A run's tables: truth (None when not kept), IMU, and the GNSS, barometer and odometer ones.
 _Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]
 
+__version__: str
+
 __all__ = [
+    "__version__",
     "ImuError",
     "study_plan",
     "study_run",
