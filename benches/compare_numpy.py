@@ -334,6 +334,32 @@ def cli_time(t, pos, euler, prm, work: Path, repeat: int = 1) -> float:
                                           check=True, capture_output=True), repeat)
 
 
+def write_readme(path: Path, lines: list) -> None:
+    """The benchmark page: the tables this run printed, and what made them (the one current table;
+    history is git's)."""
+    import platform
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next((l.split(":", 1)[1].strip() for l in f if l.startswith("model name")), cpu)
+    except OSError:
+        pass
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    command = "python benches/compare_numpy.py " + " ".join(sys.argv[1:])
+    text = (
+        "# Benchmarks\n\n"
+        "Written by `benches/compare_numpy.py --write-readme benches/README.md`; rerun it to replace this page.\n\n"
+        f"- machine: {cpu}, {cores} cores, {platform.system()} {platform.release()}, Python {platform.python_version()}\n"
+        f"- date: {time.strftime('%Y-%m-%d', time.gmtime())}\n"
+        f"- command: `{command}`\n\n"
+        "Time ratios NumPy / imukit (> 1: imukit is faster). The criterion benches "
+        "(`cargo bench -p imu-benches`) print their own figures.\n\n"
+        "```text\n" + "\n".join(lines) + "\n```\n"
+    )
+    path.write_text(text)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
@@ -343,20 +369,28 @@ def main() -> None:
     parser.add_argument("--time-one", nargs=3, metavar=("JOB", "N", "REPEAT"),
                         help="(used by the script itself) time one side of the formula job in this process "
                              "and print the best of REPEAT runs in seconds")
+    parser.add_argument("--write-readme", metavar="PATH",
+                        help="also write the tables to PATH (benches/README.md), with the machine, date and command")
     args = parser.parse_args()
     if args.time_one:
         job, n, repeat = args.time_one[0], int(args.time_one[1]), int(args.time_one[2])
         prm = params(noise=True)
         print(best_of(lambda: FRESH_JOBS[job](n, prm), repeat))
         return
+    lines: list = []
+
+    def say(line: str) -> None:
+        print(line)
+        lines.append(line)
+
     check_agreement(20_000)
-    print("agreement: noise-free outputs equal to rounding; drift variances match theory in both")
+    say("agreement: noise-free outputs equal to rounding; drift variances match theory in both")
     prm = params(noise=True)
-    print("time ratios, NumPy / imukit (> 1: imukit is faster); one core on both sides. The formula job: each "
+    say("time ratios, NumPy / imukit (> 1: imukit is faster); one core on both sides. The formula job: each "
           "side in fresh processes (Python: the median of three processes' best times; the CLI: the best of "
           "its processes); 'warm' times both sides in this process, after the agreement check, where NumPy "
           "runs faster at small N (its temporaries' memory is kept, not returned and faulted in again)")
-    print(f"{'N':>10} {'formulas, Python':>17} {'(warm)':>7} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
+    say(f"{'N':>10} {'formulas, Python':>17} {'(warm)':>7} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
           f"{'formulas, CLI (.npy)':>20} {'samples, Python':>16} {'samples, CLI (CSV in+out)':>26} {'error model, Python':>20}")
     python_model_s, numpy_model_s = {}, {}
     every_core = {}  # N → (NumPy time, imukit times on every core: Python, CSV, Parquet, .npy)
@@ -390,26 +424,26 @@ def main() -> None:
             t_model_np = best_of(lambda: numpy_model(*ref_in, prm), repeat)
             t_model_py = best_of(lambda: imu(*ours_in, out=out), repeat)
             python_model_s[n], numpy_model_s[n] = t_model_py, t_model_np
-            print(f"{n:>10} {t_fnp / t_fpy:>17.2f} {warm_np / warm_py:>7.2f} {fcli:>20} {fpq:>24} {fnpy:>20} {t_np / t_py:>16.2f} {cli:>26} "
+            say(f"{n:>10} {t_fnp / t_fpy:>17.2f} {warm_np / warm_py:>7.2f} {fcli:>20} {fpq:>24} {fnpy:>20} {t_np / t_py:>16.2f} {cli:>26} "
                   f"{t_model_np / t_model_py:>20.2f}")
             every_core[n] = (t_fnp, fresh_time("imukit-every-core", n, repeat, processes),
                              *(None if args.no_cli else cli_formula_time(n, prm, Path(tmp), ext, threads=None,
                                                                          repeat=repeat)
                                for ext in ("csv", "parquet", "npy")))
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    print(f"the formula job with imukit on every core it may use ({cores} here: one run makes its truth, its "
+    say(f"the formula job with imukit on every core it may use ({cores} here: one run makes its truth, its "
           "readings and its file a chunk apart on up to three threads, same numbers); NumPy as above, "
           "single-threaded")
-    print(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
+    say(f"{'N':>10} {'formulas, Python':>17} {'formulas, CLI (CSV)':>20} {'formulas, CLI (Parquet)':>24} "
           f"{'formulas, CLI (.npy)':>20}")
     for n, (t_fnp, *ours) in every_core.items():
         cells = ["" if t is None else f"{t_fnp / t:.2f}" for t in ours]
-        print(f"{n:>10} {cells[0]:>17} {cells[1]:>20} {cells[2]:>24} {cells[3]:>20}")
+        say(f"{n:>10} {cells[0]:>17} {cells[1]:>20} {cells[2]:>24} {cells[3]:>20}")
     if args.rust:
         rust = rust_matlab_call_ns_per_sample()
         n = 1_000_000
         if rust is None:
-            print("Rust comparison left out: cargo not found")
+            say("Rust comparison left out: cargo not found")
         else:
             if n not in python_model_s:
                 t, pos, euler = trajectory(n)
@@ -422,9 +456,11 @@ def main() -> None:
                 numpy_model_s[n] = best_of(lambda: numpy_model(*ref_in, prm), 3)
             py_ns = python_model_s[n] / n * 1e9
             np_ns = numpy_model_s[n] / n * 1e9
-            print(f"error model at 10⁶ samples: Python call / Rust (criterion matlab_call) = "
+            say(f"error model at 10⁶ samples: Python call / Rust (criterion matlab_call) = "
                   f"{py_ns / rust:.2f} (target ≤ 1.20); NumPy / Rust = {np_ns / rust:.2f} (target ≥ 5)")
 
+    if args.write_readme:
+        write_readme(Path(args.write_readme), lines)
 
 if __name__ == "__main__":
     main()
