@@ -29,13 +29,9 @@ fn refused(path: &Path) -> String {
     read_table(path).unwrap_err().to_string()
 }
 
-/// One `.npy` member (a float64 column) as NumPy writes it.
-fn npy_column(values: &[f64]) -> Vec<u8> {
-    let dict = format!(
-        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({},), }}",
-        values.len()
-    );
-    let mut header = dict.into_bytes();
+/// A version 1 `.npy` file: the header `dict` padded as NumPy pads it, then `data`.
+fn npy_file(dict: &str, data: &[u8]) -> Vec<u8> {
+    let mut header = dict.as_bytes().to_vec();
     while !(10 + header.len() + 1).is_multiple_of(64) {
         header.push(b' ');
     }
@@ -43,10 +39,18 @@ fn npy_column(values: &[f64]) -> Vec<u8> {
     let mut out = b"\x93NUMPY\x01\x00".to_vec();
     out.extend_from_slice(&u16::try_from(header.len()).unwrap().to_le_bytes());
     out.extend_from_slice(&header);
-    for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    out.extend_from_slice(data);
     out
+}
+
+/// One `.npy` member (a float64 column) as NumPy writes it.
+fn npy_column(values: &[f64]) -> Vec<u8> {
+    let dict = format!(
+        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({},), }}",
+        values.len()
+    );
+    let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    npy_file(&dict, &data)
 }
 
 /// A stored zip archive of `members` written by hand, so that its directory can say what a
@@ -241,15 +245,7 @@ fn an_npy_header_that_disagrees_with_the_file_is_refused_before_rows_are_read() 
     // A header giving 2⁶⁰ rows over two rows of data.
     let dict = "{'descr': [('t_s', '<f8'), ('x', '<f8')], 'fortran_order': False, \
                 'shape': (1152921504606846976,), }";
-    let mut header = dict.as_bytes().to_vec();
-    while !(10 + header.len() + 1).is_multiple_of(64) {
-        header.push(b' ');
-    }
-    header.push(b'\n');
-    let mut changed = b"\x93NUMPY\x01\x00".to_vec();
-    changed.extend_from_slice(&u16::try_from(header.len()).unwrap().to_le_bytes());
-    changed.extend_from_slice(&header);
-    changed.extend_from_slice(&[0; 32]);
+    let changed = npy_file(dict, &[0; 32]);
     let p = d.join("huge.npy");
     std::fs::write(&p, &changed).unwrap();
     let e = refused(&p);

@@ -263,9 +263,6 @@ pub fn read_table(path: &Path) -> Result<Table> {
             ));
         };
         let bad = |what: String| format_error(path, format!("member {member_name}: {what}"));
-        if names.iter().any(|n| n == name) {
-            return Err(bad(format!("column {name} appears twice")));
-        }
         let declared = member.size();
         let mut reader = BufReader::new(&mut member);
         crate::io::npy::check_header_length(path, &mut reader)?;

@@ -447,7 +447,6 @@ impl Table {
     /// # Errors
     /// A value that is not finite; the writer's or the file system's refusal, naming the file.
     pub(crate) fn write_binary(&self, path: &Path, metadata: &[(String, String)]) -> Result<()> {
-        check_column_names(&self.columns, path)?;
         check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
         let mut file = crate::io::output::AtomicFile::create(path)?;
         file.begin_table(&self.columns, metadata)?;
