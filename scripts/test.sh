@@ -1,24 +1,28 @@
 #!/usr/bin/env bash
-# Runs every test of imukit, Rust and Python, from a fresh clone: sets up what it needs
-# (a Python virtual environment in .venv with maturin, numpy, pytest, sympy, mypy; the release CLI;
-# the Python extension), checks formatting, lints and the heap-free core, runs the examples.
+# Runs every test of imukit, Rust and Python, from a fresh clone: sets up what it needs, checks
+# formatting, lints and the heap-free core, runs the Rust tests, builds the wheel (manylinux2014,
+# abi3, the `imukit` command inside) and the source distribution, installs the wheel into a fresh
+# virtual environment with no Rust on PATH, and runs the Python tests, the hostile-input run and
+# the examples against what that wheel installed.
+#   .venv        build tools (maturin, ziglang); kept between runs
+#   .venv-wheel  made anew each run from dist/imukit-*.whl with its [test] extra
 set -euo pipefail
 cd "$(dirname "$0")/.."
+section() { echo "== $1 (${SECONDS}s)"; }
 
-echo "== Python environment (.venv)"
+section "Build environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
   "${PYTHON:-python3}" -m venv .venv
 fi
-# shellcheck disable=SC1091
-. .venv/bin/activate
-python -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "sympy>=1.9" "mypy>=1.8" "matplotlib>=3.5" "dask[distributed]>=2023.1" "scipy>=1.7" "pandas>=2" "polars>=0.20" "pyarrow>=14"
+.venv/bin/python -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" "ziglang>=0.13" "check-jsonschema>=0.28"
 
-echo "== Format and lints"
+section "Format and lints"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
+.venv/bin/check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imukit -p imu-plot -p imu-cli   # doc links resolve
 
-echo "== Heap-free core: builds without std, never names alloc or std, no std-only dependency"
+section "Heap-free core: builds without std, never names alloc or std, no std-only dependency"
 cargo build --quiet -p imu-core --no-default-features --features libm
 # A bare-metal target has no std and no allocator: the core must build there.
 if rustup target add thumbv7em-none-eabihf >/dev/null 2>&1; then
@@ -35,49 +39,71 @@ if grep -rnE '(^|[^A-Za-z0-9_])alloc::|extern crate (alloc|std)|\bstd::' crates/
   exit 1
 fi
 
-echo "== Rust tests"
+section "Rust tests"
 cargo test --workspace --exclude imu-py
 
-echo "== Python extension and CLI (release)"
-cargo build --quiet --release -p imu-cli
-maturin develop --quiet --release -m crates/imu-py/Cargo.toml
+section "Wheel (manylinux2014, abi3, with the imukit command) and source distribution"
+rm -rf dist
+# --zig links against glibc 2.17 whatever this machine has, so the wheel is manylinux2014.
+.venv/bin/maturin build --quiet --release --zig --compatibility manylinux2014 -m crates/imu-py/Cargo.toml --out dist
+.venv/bin/maturin sdist --quiet -m crates/imu-py/Cargo.toml --out dist
+python3 scripts/check_dist.py dist
 
-echo "== Python stubs match the built module"
+section "A fresh environment from the wheel, no Rust on PATH"
+rm -rf .venv-wheel
+"${PYTHON:-python3}" -m venv .venv-wheel
+wheel=$(ls dist/imukit-*.whl)
+.venv-wheel/bin/python -m pip install --quiet --disable-pip-version-check "${wheel}[test]"
+# From here on only the wheel's environment and the system's programs are on PATH.
+PATH="$PWD/.venv-wheel/bin:$(printf '%s' "$PATH" | tr ':' '\n' | grep -vE '(cargo|rustup|\.venv)(/|$)' | paste -sd: -)"
+export PATH
+unset VIRTUAL_ENV
+if command -v cargo >/dev/null || command -v rustc >/dev/null; then
+  echo "a Rust toolchain is still on PATH" >&2
+  exit 1
+fi
+(cd "$(mktemp -d)" && imukit demo >/dev/null && test -s imukit-demo/imu.csv && test -s imukit-demo/truth.png \
+  && python -c "import imukit; s = imukit.simulate(imukit.builtin_scenario_toml('figure8')); assert s.imu.values.shape[0] == 2001" \
+  && test "$(imukit --version)" = "imukit $(python -c 'import imukit; print(imukit.__version__)')")
+export IMUKIT_BIN="$PWD/.venv-wheel/bin/imukit"
+
+section "Python stubs match the installed module"
 python -m mypy.stubtest imukit._core
 
-echo "== Python tests"
-IMUKIT_BIN="$PWD/target/release/imukit" python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md --doctest-modules crates/imu-py/python/imukit/plot.py crates/imu-py/python/imukit/_monte_carlo.py crates/imu-py/python/imukit/_orientation.py crates/imu-py/python/imukit/_sensor.py crates/imu-py/python/imukit/_truth.py
+section "Python tests (the installed wheel)"
+python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md
+python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth
 
-echo "== Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"
-IMUKIT_BIN="$PWD/target/release/imukit" python tests/fuzz/hostile.py --cases 400 --seed 1
+section "Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"
+python tests/fuzz/hostile.py --cases 400 --seed 1
 
-echo "== Examples"
+section "Examples"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for f in examples/*.toml; do
   name=$(basename "$f" .toml)
-  target/release/imukit simulate "$f" --out "$out/${name}_imu.csv" --truth "$out/${name}_truth.csv"
-  target/release/imukit plot "$out/${name}_truth.csv" --out "$out/${name}_truth.png"
-  target/release/imukit plot "$out/${name}_imu.csv" --out "$out/${name}_imu.png"
+  imukit simulate "$f" --out "$out/${name}_imu.csv" --truth "$out/${name}_truth.csv"
+  imukit plot "$out/${name}_truth.csv" --out "$out/${name}_truth.png"
+  imukit plot "$out/${name}_imu.csv" --out "$out/${name}_imu.png"
 done
 for f in differentiation_error_study matlab_imusensor matlab_orientation allan_study navigation_round_trip; do
   python "examples/$f.py" --figures "$out/figures"
 done
 python examples/gyrocompass.py
-target/release/imukit integrate "$out/schuler_imu.csv" --init "$out/schuler_truth.csv" --nav-frame NED \
+imukit integrate "$out/schuler_imu.csv" --init "$out/schuler_truth.csv" --nav-frame NED \
   --earth wgs84 --vertical hold --out "$out/schuler_nav.csv"
-target/release/imukit compare "$out/schuler_truth.csv" "$out/schuler_nav.csv" --out "$out/schuler_err.csv"
-target/release/imukit plot "$out/schuler_err.csv" --out "$out/schuler.png"
+imukit compare "$out/schuler_truth.csv" "$out/schuler_nav.csv" --out "$out/schuler_err.csv"
+imukit plot "$out/schuler_err.csv" --out "$out/schuler.png"
 for f in imufilter ahrsfilter ecompass madgwick mahony complementary; do
-  target/release/imukit orient "$out/matlab_orientation_imu.csv" --filter "$f" --nav-frame NED --accel-sign matlab \
+  imukit orient "$out/matlab_orientation_imu.csv" --filter "$f" --nav-frame NED --accel-sign matlab \
     --out "$out/orient_$f.csv"
-  target/release/imukit compare "$out/matlab_orientation_truth.csv" "$out/orient_$f.csv" --out "$out/orient_err_$f.csv"
+  imukit compare "$out/matlab_orientation_truth.csv" "$out/orient_$f.csv" --out "$out/orient_err_$f.csv"
 done
-target/release/imukit plot "$out/orient_err_ahrsfilter.csv" --out "$out/orient_err.png"
-target/release/imukit exercise --out-dir "$out/exercise"
-target/release/imukit study examples/study/tunnel.toml --out "$out/tunnel.csv" --plot "$out/tunnel.png"
-target/release/imukit study examples/study/tunnel_wheels.toml --out "$out/wheels.csv" --plot "$out/wheels.png"
+imukit plot "$out/orient_err_ahrsfilter.csv" --out "$out/orient_err.png"
+imukit exercise --out-dir "$out/exercise"
+imukit study examples/study/tunnel.toml --out "$out/tunnel.csv" --plot "$out/tunnel.png"
+imukit study examples/study/tunnel_wheels.toml --out "$out/wheels.csv" --plot "$out/wheels.png"
 
-echo "== NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"
-IMUKIT_BIN="$PWD/target/release/imukit" python benches/compare_numpy.py --sizes 1e4
-echo "== All tests passed"
+section "NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"
+python benches/compare_numpy.py --sizes 1e4
+section "All tests passed"

@@ -3,21 +3,39 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-/// A fast, exact and reproducible IMU simulator.
+/// A fast, exact and reproducible IMU simulator and inertial-navigation toolkit.
 #[derive(Debug, Parser)]
 #[command(
     name = "imukit",
     version,
-    about,
     long_about = None,
     after_help = "Tables (readings, truth, estimates, errors) are CSV unless a file's extension \
                   says otherwise, when written and when read: .parquet (Apache Parquet), .npy (a \
                   NumPy structured array), .npz (a NumPy archive, one array per column)."
 )]
 pub struct Cli {
+    /// No notes and no progress on standard error (warnings and errors still print).
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+}
+
+/// The shells `imukit completions` writes a script for.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum Shell {
+    /// Bash: `source <(imukit completions bash)`, or save it in
+    /// `~/.local/share/bash-completion/completions/imukit`.
+    Bash,
+    /// Zsh: save it as `_imukit` in a folder of `$fpath`.
+    Zsh,
+    /// Fish: save it in `~/.config/fish/completions/imukit.fish`.
+    Fish,
+    /// PowerShell: `imukit completions powershell | Out-String | Invoke-Expression`.
+    Powershell,
+    /// Elvish.
+    Elvish,
 }
 
 /// Subcommands.
@@ -27,7 +45,8 @@ pub struct Cli {
     reason = "parsed once per process; boxing the options would only obscure them"
 )]
 pub enum Command {
-    /// Truth kinematics and ideal IMU readings of a scenario file (TOML or JSON).
+    /// Truth kinematics and IMU readings of a scenario file (TOML or JSON): ideal, or through the
+    /// scenario's sensor error model (`[imu]`: noise, biases, scale factors, presets).
     Simulate {
         /// The scenario file.
         scenario: PathBuf,
@@ -218,9 +237,9 @@ pub enum Command {
         /// sample; default 0.05).
         #[arg(long)]
         covariance_interval_s: Option<f64>,
-        /// Also estimate the IMU's scale-factor and misalignment matrices (33 error states
-        /// instead of 15; their one-sigma at the start from the part's `axes_misalignment_pct`);
-        /// the estimate gains their columns.
+        /// Also estimate the IMU's scale-factor, misalignment and g-sensitivity errors (36 error
+        /// states instead of 15; their one-sigma at the start from the part's
+        /// `axes_misalignment_pct` and `acceleration_bias`); the estimate gains their columns.
         #[arg(long)]
         sensor_errors: bool,
         /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
@@ -350,5 +369,18 @@ pub enum Command {
         /// Navigation frame of the truth (ENU or NED; NED is drawn turned so that up is up).
         #[arg(long, default_value = "ENU")]
         nav_frame: String,
+    },
+    /// Prints a shell's completion script for imukit to standard output.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: Shell,
+    },
+    /// Prints imukit's manual page (roff) to standard output, or with --out-dir writes one page
+    /// per command (imukit.1, imukit-simulate.1, …) into a folder: `imukit man | man -l -`.
+    Man {
+        /// The folder for the pages.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
 }

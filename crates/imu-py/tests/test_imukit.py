@@ -295,8 +295,9 @@ def test_tables_become_pandas_and_polars_frames_and_read_reads_by_extension(tmp_
     sim = imukit.simulate({"trajectory": {"type": "builtin", "name": "figure8"}})
     df = sim.truth.to_pandas()
     assert isinstance(df, pd.DataFrame) and list(df.columns) == list(sim.truth.columns)
-    # The same memory, no copy.
-    assert np.shares_memory(df.to_numpy(), sim.truth.values)
+    # A copy by default (writable); copy=False shares the table's memory.
+    assert not np.shares_memory(df.to_numpy(), sim.truth.values)
+    assert np.shares_memory(sim.truth.to_pandas(copy=False).to_numpy(), sim.truth.values)
     assert df["vel_x_m_s"].iloc[5] == sim.truth["vel_x_m_s"][5]
     frame = sim.imu.to_polars()
     assert isinstance(frame, pl.DataFrame) and frame.columns == list(sim.imu.columns)

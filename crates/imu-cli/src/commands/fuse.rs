@@ -132,7 +132,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             .and_then(|v| v.last().copied())
             .unwrap_or(f64::NAN)
     };
-    eprintln!(
+    crate::note!(
         "imukit: {} samples fused with {} updates ({} rejected by the gate); final one-sigma: \
          position {:.3} {:.3} {:.3} m; estimate in {}",
         nav.rows(),

@@ -170,7 +170,7 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         other => other,
     })?;
     let [x, y, z] = summary.end_position_m;
-    eprintln!(
+    crate::note!(
         "imukit: {} samples, strapdown ({}); end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
         summary.rows,
         summary.scheme.describe(),
@@ -190,7 +190,7 @@ fn report(nav: &Table, what: &str, out: &Path) {
     } else {
         String::new()
     };
-    eprintln!(
+    crate::note!(
         "imukit: {} samples, {what}; end position ({:.3}, {:.3}{z}) m; trajectory in {}",
         nav.rows(),
         last("pos_x_m"),

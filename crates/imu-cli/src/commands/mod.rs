@@ -5,6 +5,7 @@ mod demo;
 mod exercise;
 mod fuse;
 mod integrate;
+mod manual;
 mod orient;
 mod plot;
 mod presets;
@@ -17,7 +18,10 @@ use crate::cli::{Cli, Command};
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
+    crate::report::set_quiet(cli.quiet);
     match cli.command {
+        Command::Completions { shell } => manual::completions(shell),
+        Command::Man { out_dir } => manual::man(out_dir.as_deref()),
         Command::Simulate {
             scenario,
             out,

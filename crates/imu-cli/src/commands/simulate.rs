@@ -7,7 +7,6 @@ use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::CliError;
@@ -50,7 +49,7 @@ pub fn run(
     check_outputs(&inputs, &outputs)?;
     let sc = spec.resolve(base)?;
     for w in &sc.imu.sensors.warnings {
-        eprintln!("imukit: warning: {w}");
+        crate::report::warn(&w.to_string());
     }
     // What made the files, for formats that carry it (Parquet).
     let metadata = vec![
@@ -86,7 +85,7 @@ pub fn run(
                 written += &format!(", {what} in {}", p.display());
             }
         }
-        eprintln!("imukit: {} samples; {written}", sc.t_s.len());
+        crate::note!("imukit: {} samples; {written}", sc.t_s.len());
         return Ok(());
     };
     if runs == 0 {
@@ -96,11 +95,7 @@ pub fn run(
         }
         .into());
     }
-    let progress = ProgressBar::new(runs);
-    progress.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {eta} left")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let progress = crate::report::Progress::start(runs, "runs");
     let done = AtomicU64::new(0);
     // Runs at a time: every core, or at most --threads of them; each run on one thread.
     let cores = available_cores();
@@ -134,12 +129,12 @@ pub fn run(
                     },
                 )?;
                 done.fetch_add(1, Ordering::Relaxed);
-                progress.inc(1);
+                progress.inc();
                 Ok(())
             })
     })?;
-    progress.finish_and_clear();
-    eprintln!(
+    progress.finish();
+    crate::note!(
         "imukit: {} runs of {} samples; IMU readings in {} … {}",
         done.load(Ordering::Relaxed),
         sc.t_s.len(),

@@ -4,7 +4,6 @@ use std::path::Path;
 
 use imukit::io::output::check_outputs;
 use imukit::run::study::Study;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::CliError;
@@ -22,20 +21,16 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
     let presets = s.presets().count();
     let runs = s.runs();
     let total = presets as u64 * runs;
-    let progress = ProgressBar::new(total);
-    progress.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {eta} left")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let progress = crate::report::Progress::start(total, "runs");
     let flat = (0..total)
         .into_par_iter()
         .map(|k| {
             let r = s.run_one((k / runs) as usize, k % runs);
-            progress.inc(1);
+            progress.inc();
             r
         })
         .collect::<Result<Vec<_>, _>>()?;
-    progress.finish_and_clear();
+    progress.finish();
     let mut per_preset = Vec::with_capacity(presets);
     let mut it = flat.into_iter();
     for _ in 0..presets {
@@ -48,7 +43,7 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
     }
     let (start, end) = s.outage_s();
     let into = summaries.first().map_or(0.0, |m| m.outage_s);
-    eprintln!(
+    crate::note!(
         "imukit: {runs} runs per preset through the GNSS outage at {start}–{end} s; horizontal \
          position error {into:.2} s into it (RMS over runs) and the filter's own one-sigma:"
     );
@@ -62,15 +57,15 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
         };
         match (m.rms_error_m, m.sigma_m) {
             (Some(e), Some(s)) => {
-                eprintln!(
+                crate::note!(
                     "  {:<14} {e:>10.3} m   (filter: {s:.3} m){diverged}",
                     m.preset
                 );
             }
-            _ => eprintln!("  {:<14} not reported{diverged}", m.preset),
+            _ => crate::note!("  {:<14} not reported{diverged}", m.preset),
         }
     }
-    eprintln!(
+    crate::note!(
         "imukit: table in {}{}",
         out.display(),
         plot.map(|p| format!(", figure in {}", p.display()))

@@ -22,7 +22,7 @@ The package is split by area as the compiled core is: ``_truth`` (scenarios and 
 from __future__ import annotations
 
 from ._core import ImuError, __version__
-from ._table import Simulation, Table
+from ._table import Simulation, Table, TableLike
 from ._truth import (
     builtin_scenario_toml,
     builtin_scenarios,
@@ -55,7 +55,7 @@ from ._sensor import (
     preset_params,
     presets,
 )
-from ._navigation import compare, fuse, planar_dead_reckon, read_planar, strapdown
+from ._navigation import Comparison, compare, fuse, planar_dead_reckon, read_planar, strapdown
 from ._monte_carlo import MonteCarlo, monte_carlo
 from ._study import PresetSummary, StudyResult, study
 from ._orientation import (
@@ -72,7 +72,9 @@ __all__ = [
     "__version__",
     "ImuError",
     "Table",
+    "TableLike",
     "Simulation",
+    "Comparison",
     "simulate",
     "monte_carlo",
     "study",

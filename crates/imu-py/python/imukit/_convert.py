@@ -7,7 +7,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._table import Table
+from ._table import Table, TableLike
 
 
 def _times(t_s) -> np.ndarray:
@@ -37,11 +37,10 @@ def _out(out: Optional[np.ndarray]) -> Optional[np.ndarray]:
     return out
 
 
-def _table_args(name: str, t) -> tuple:
-    """``(columns, values)`` of an :class:`imukit.Table`."""
-    if not isinstance(t, Table):
-        raise TypeError(f"{name} must be an imukit.Table, got {type(t).__name__}")
-    return list(t.columns), np.ascontiguousarray(t.values)
+def _table_args(name: str, t: TableLike) -> tuple:
+    """``(columns, values)`` of anything :data:`imukit.TableLike` (a Table, a DataFrame, …)."""
+    table = Table.of(t, name)
+    return list(table.columns), np.ascontiguousarray(table.values)
 
 
 def _flag(name: str, v) -> bool:

@@ -11,7 +11,7 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, List, Mapping, Optional, Tuple, Union
+from typing import Any, List, Mapping, Optional, Tuple, Union, overload
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from . import _core
 from ._core import ImuError
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class MonteCarlo:
     """Gathered Monte Carlo results: ``imu[k]`` is run ``runs[k]`` with columns ``columns``
     (shape (runs, samples, columns)); ``truth`` is common to every run."""
@@ -28,6 +28,28 @@ class MonteCarlo:
     columns: tuple
     imu: np.ndarray
     truth: Any  # imukit.Table
+
+    def run(self, k: int) -> Any:
+        """Run ``runs[k]``'s readings as an :class:`imukit.Table`."""
+        from ._table import Table
+
+        return Table(self.columns, self.imu[k])
+
+    def __repr__(self) -> str:
+        n, samples, columns = self.imu.shape
+        ids = f"{self.runs[0]}" if n == 1 else f"{self.runs[0]}…{self.runs[-1]}"
+        return (f"MonteCarlo({n} runs ({ids}) × {samples} samples × {columns} columns; "
+                f"truth={self.truth!r})")
+
+
+@overload
+def monte_carlo(scenario: Union[str, os.PathLike, Mapping[str, Any]], runs: int, *, client: Any = None,
+                out: None = None, first_run: int = 0, threads: Optional[int] = None) -> MonteCarlo: ...
+
+
+@overload
+def monte_carlo(scenario: Union[str, os.PathLike, Mapping[str, Any]], runs: int, *, client: Any = None,
+                out: Union[str, os.PathLike], first_run: int = 0, threads: Optional[int] = None) -> List[str]: ...
 
 
 def _scenario_text(scenario: Union[str, os.PathLike, Mapping]) -> Tuple[Any, str, str, str]:
@@ -68,7 +90,7 @@ def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: in
 
 
 def monte_carlo(
-    scenario: Union[str, os.PathLike, Mapping],
+    scenario: Union[str, os.PathLike, Mapping[str, Any]],
     runs: int,
     *,
     client: Any = None,

@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Mapping, NamedTuple, Optional, Sequence, Union
+
+import numpy as np
 
 from . import _core
 from ._core import ImuError
 from ._convert import _f64, _table_args, _times
-from ._table import Table, _table
+from ._table import Table, TableLike, _table
 from ._truth import DEFAULT_GRAVITY_M_S2
 
 
@@ -42,9 +44,9 @@ def read_planar(path: Union[str, os.PathLike]) -> Table:
     return _table(_core.read_planar(str(path)))
 
 def strapdown(
-    imu: Table,
+    imu: TableLike,
     *,
-    initial: Optional[Union[Table, Mapping]] = None,
+    initial: Optional[Union[TableLike, Mapping[str, Any]]] = None,
     nav_frame: str = "ENU",
     gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
     coning: bool = True,
@@ -56,7 +58,7 @@ def strapdown(
     vertical: str = "free",
     baro_time_constant_s: float = 100.0,
     earth_gravity: str = "normal",
-    baro: Optional[Table] = None,
+    baro: Optional[TableLike] = None,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
     increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
@@ -82,7 +84,7 @@ def strapdown(
     ``lat_rad, lon_rad, height_m``; ``pos_*`` stay in the tangent plane of the truth's origin.
     """
     start: dict = {}
-    if isinstance(initial, Table):
+    if isinstance(initial, (Table, np.ndarray)) or hasattr(initial, "to_numpy"):  # a truth table or frame
         start["initial_columns"], start["initial_values"] = _table_args("initial", initial)
     elif isinstance(initial, Mapping):
         keys = {"position_m": "position0_m", "velocity_m_s": "velocity0_m_s", "quaternion": "quaternion0",
@@ -102,8 +104,21 @@ def strapdown(
         baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity,
         **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro))))))
 
-def compare(truth: Table, estimate: Table):
-    """Errors of an estimate against truth on the estimate's times: returns ``(errors, summary)``.
+class Comparison(NamedTuple):
+    """What :func:`compare` returns: the errors over time and their summary. It unpacks as
+    ``errors, summary = imukit.compare(truth, estimate)``."""
+
+    errors: Table
+    summary: Dict[str, float]
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{k}={v:.4g}" for k, v in self.summary.items())
+        return f"Comparison(errors={self.errors!r}, summary={{{shown}}})"
+
+
+def compare(truth: TableLike, estimate: TableLike) -> Comparison:
+    """Errors of an estimate against truth on the estimate's times: a :class:`Comparison`
+    ``(errors, summary)``.
 
     A navigation estimate (``t_s, pos_*, vel_*, q_*``) gives the Table ``t_s, pos_err_*_m,
     pos_err_m, vel_err_*_m_s, att_err_rad``; an orientation estimate (``t_s, q_w, q_x, q_y, q_z``,
@@ -112,12 +127,13 @@ def compare(truth: Table, estimate: Table):
     ``position_max_m``, ``position_final_m``, …, ``attitude_final_rad``; attitude only for
     orientation estimates)."""
     table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate))
-    return _table(table), dict(summary)
+    return Comparison(_table(table), {str(k): float(v) for k, v in dict(summary).items()})
 
 
-def fuse(imu: Table, gnss: Table, *, scenario, initial: Optional[Table] = None, align: Optional[str] = None,
+def fuse(imu: TableLike, gnss: TableLike, *, scenario: Union[str, os.PathLike, Mapping[str, Any]],
+         initial: Optional[TableLike] = None, align: Optional[str] = None,
          gate: bool = True,
-         odometer: Optional[Table] = None, baro: Optional[Table] = None,
+         odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
          sensor_errors: bool = False, rest_s: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and

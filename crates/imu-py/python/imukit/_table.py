@@ -2,9 +2,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterator, Optional, Sequence
+from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
 import numpy as np
+
+#: What every function that takes a table accepts: an :class:`imukit.Table`, a pandas or polars
+#: ``DataFrame``, a NumPy structured array, or any mapping of column names to 1-D arrays of one
+#: length (``{"t_s": t, "gyro_x_rad_s": gx, …}``). Columns are named as imukit's CSV names them.
+TableLike = Union["Table", Mapping[str, Any], Any]
+
+_SHOWN_COLUMNS = 6
 
 
 class Table:
@@ -53,13 +60,76 @@ class Table:
         from . import _core
         _core.write_table_file(str(path), list(self.columns), self.values)
 
-    def to_pandas(self):
-        """A pandas ``DataFrame`` of the columns over the table's own memory (no copy; like the
-        table it is read-only until pandas copies on a write). Needs pandas."""
+    @classmethod
+    def of(cls, data: TableLike, name: str = "table") -> "Table":
+        """A table from anything :data:`TableLike`: a Table as it is; a pandas or polars
+        ``DataFrame`` (its index is not a column; put time in a ``t_s`` column); a NumPy
+        structured array; a mapping of names to 1-D arrays. Every column must hold numbers
+        (converted to float64); ``name`` names the argument in errors.
+
+        >>> import numpy as np
+        >>> Table.of({"t_s": np.arange(3.0), "gyro_z_rad_s": [0.1, 0.2, 0.3]})
+        Table(3 rows × 2 columns: t_s, gyro_z_rad_s)
+        """
+        if isinstance(data, Table):
+            return data
+        if isinstance(data, np.ndarray):
+            if data.dtype.names is None:
+                raise TypeError(f"{name}: a plain array has no column names; pass a structured array, "
+                                "a DataFrame, a mapping of names to columns or an imukit.Table")
+            return cls._from_columns(name, {n: data[n] for n in data.dtype.names})
+        columns = getattr(data, "columns", None)
+        to_numpy = getattr(data, "to_numpy", None)
+        if columns is not None and callable(to_numpy):  # pandas, polars and alike
+            names = [c for c in columns]
+            return cls._from_columns(name, {c: data[c] for c in names})
+        if isinstance(data, Mapping):
+            return cls._from_columns(name, data)
+        raise TypeError(f"{name} must be an imukit.Table, a pandas or polars DataFrame, a NumPy structured "
+                        f"array or a mapping of column names to arrays, got {type(data).__name__}")
+
+    @classmethod
+    def _from_columns(cls, name: str, columns: Mapping[Any, Any]) -> "Table":
+        names = list(columns)
+        for c in names:
+            if not isinstance(c, str):
+                raise TypeError(f"{name}: column names must be strings, got {c!r}")
+        arrays = []
+        rows = None
+        for c in names:
+            column = columns[c]
+            to_numpy = getattr(column, "to_numpy", None)
+            raw = to_numpy() if callable(to_numpy) else column
+            try:
+                a = np.asarray(raw, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(f"{name}: column {c!r} does not hold numbers") from None
+            if a.ndim != 1:
+                raise ValueError(f"{name}: column {c!r} must be 1-D, got shape {a.shape}")
+            if rows is None:
+                rows = a.shape[0]
+            elif a.shape[0] != rows:
+                raise ValueError(f"{name}: column {c!r} has {a.shape[0]} rows, column {names[0]!r} has {rows}")
+            arrays.append(a)
+        values = np.column_stack(arrays) if arrays else np.zeros((0, 0))
+        return cls(names, values)
+
+    def to_pandas(self, *, copy: bool = True):
+        """A pandas ``DataFrame`` of the columns. By default a copy you can change; with
+        ``copy=False`` a read-only view of the table's own memory (no copy; a write raises).
+        Needs pandas (``pip install "imukit[pandas]"``).
+
+        >>> df = Table(["t_s", "x"], [[0.0, 1.0], [1.0, 2.0]]).to_pandas()
+        >>> df.loc[0, "x"] = 5.0
+        >>> float(df["x"].sum())
+        7.0
+        """
         try:
             import pandas as pd
         except ImportError:
             raise ImportError("Table.to_pandas needs pandas (pip install pandas)") from None
+        if copy:
+            return pd.DataFrame(np.array(self.values), columns=list(self.columns))
         return pd.DataFrame(self.values, columns=list(self.columns), copy=False)
 
     def to_polars(self):
@@ -72,7 +142,10 @@ class Table:
         return pl.DataFrame({c: self.values[:, k] for k, c in enumerate(self.columns)})
 
     def __repr__(self) -> str:
-        return f"Table({len(self)} rows: {', '.join(self.columns)})"
+        names = list(self.columns)
+        if len(names) > _SHOWN_COLUMNS:
+            names = names[: _SHOWN_COLUMNS - 1] + ["…", names[-1]]
+        return f"Table({len(self)} rows × {len(self.columns)} columns: {', '.join(names)})"
 
 @dataclass(frozen=True)
 class Simulation:
@@ -85,6 +158,11 @@ class Simulation:
     gnss: Optional[Table] = None
     baro: Optional[Table] = None
     odometer: Optional[Table] = None
+
+    def __repr__(self) -> str:
+        parts = [f"{k}={v!r}" for k, v in (("imu", self.imu), ("truth", self.truth), ("gnss", self.gnss),
+                                          ("baro", self.baro), ("odometer", self.odometer)) if v is not None]
+        return f"Simulation({', '.join(parts)})"
 
 def _table(out) -> Table:
     columns, values = out

@@ -30,10 +30,12 @@ from typing import Any, Mapping, Optional, Sequence, Union
 import numpy as np
 
 from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_csv
+from ._table import TableLike
 
 __all__ = ["figure", "trajectory", "allan", "animate", "kind"]
 
-TableLike = Union[Table, str, os.PathLike, Mapping[str, Any]]
+#: A table (anything :data:`imukit.TableLike`) or the path of a CSV file.
+TableOrPath = Union[TableLike, str, os.PathLike]
 # Line styles of the first, second, … overlaid table (as `imukit plot` draws them).
 _STYLES = ("-", "--", ":", "-.")
 
@@ -48,27 +50,17 @@ def _pyplot() -> Any:
     return plt
 
 
-def _load(items: Sequence[TableLike], labels: Optional[Sequence[str]]) -> list:
+def _load(items: Sequence[TableOrPath], labels: Optional[Sequence[str]]) -> list:
     if not items:
         raise ValueError("give at least one table or CSV file")
     if labels is not None and len(labels) != len(items):
         raise ValueError(f"{len(labels)} labels for {len(items)} tables")
     out = []
     for i, item in enumerate(items):
-        if isinstance(item, Table):
-            name, table = f"table {i + 1}", item
-        elif isinstance(item, (str, os.PathLike)):
+        if isinstance(item, (str, os.PathLike)):
             name, table = Path(item).stem, read_csv(item)
-        elif isinstance(item, Mapping):  # plain arrays by column name
-            columns = list(item)
-            try:
-                values = np.column_stack([np.asarray(item[c], dtype=np.float64) for c in columns])
-            except ValueError as e:
-                raise ValueError(f"item {i}: the arrays must be 1-D and of one length ({e})") from None
-            name, table = f"table {i + 1}", Table(columns, values)
-        else:
-            raise TypeError(f"item {i}: expected an imukit.Table, a CSV path or a dict of arrays, "
-                            f"got {type(item).__name__}")
+        else:  # a Table, a DataFrame, a structured array or a mapping of arrays
+            name, table = f"table {i + 1}", Table.of(item, f"item {i}")
         out.append((labels[i] if labels is not None else name, table))
     return out
 
@@ -105,7 +97,7 @@ def _points(t: Table, nav_frame: str = "ENU") -> np.ndarray:
     return _core.points_enu(p, nav_frame)
 
 
-def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: Any = None,
+def trajectory(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, ax: Any = None,
                nav_frame: str = "ENU") -> Any:
     """Paths of truth or navigation tables (``pos_*_m``): seen from above with equal scales when
     they stay in a plane, in 3D otherwise; start ● and end ✕ marked; ``nav_frame="NED"`` paths
@@ -138,7 +130,7 @@ def trajectory(*tables: TableLike, labels: Optional[Sequence[str]] = None, ax: A
     return ax.figure
 
 
-def allan(tau_s: Union[Table, TableLike, np.ndarray], adev: Optional[np.ndarray] = None, *,
+def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = None, *,
           labels: Optional[Sequence[str]] = None, ax: Any = None) -> Any:
     """Allan deviation on log axes with the lines fitted by :func:`imukit.identify_noise` dashed.
 
@@ -177,7 +169,7 @@ def allan(tau_s: Union[Table, TableLike, np.ndarray], adev: Optional[np.ndarray]
     return ax.figure
 
 
-def figure(*tables: TableLike, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU") -> Any:
+def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU") -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
     dashed, dotted, …; ``nav_frame="NED"`` paths are drawn east, north, up. Returns the figure."""

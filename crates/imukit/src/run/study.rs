@@ -41,8 +41,8 @@ pub struct StudySpec {
     pub baro: bool,
     /// The non-holonomic constraints of a ground vehicle, one-sigma m/s (off when absent).
     pub nhc_sigma_m_s: Option<f64>,
-    /// The filter also estimates each IMU's scale-factor and misalignment matrices (33 states;
-    /// see [`FuseSetup::estimate_sensor_errors`]).
+    /// The filter also estimates each IMU's scale-factor, misalignment and g-sensitivity errors
+    /// (36 states; see [`FuseSetup::estimate_sensor_errors`]).
     #[serde(default)]
     pub sensor_errors: bool,
     /// The vehicle stands still for the first this many seconds, and the filter is told so
