@@ -71,7 +71,7 @@ section "Python stubs match the installed module"
 python -m mypy.stubtest imukit._core
 
 section "Python tests (the installed wheel)"
-python -m pytest -q crates/imu-py/tests tests/python --doctest-glob=README.md README.md
+python -m pytest -q crates/imu-py/tests tests/python --doctest-glob='*.md' README.md docs
 python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth
 
 section "Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass
-from typing import Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -111,9 +111,9 @@ class ImuSensor:
         sample_rate: float = 100.0,
         temperature: float = 25.0,
         magnetic_field: Optional[Sequence[float]] = None,
-        accelerometer: Optional[Mapping] = None,
-        gyroscope: Optional[Mapping] = None,
-        magnetometer: Optional[Mapping] = None,
+        accelerometer: Optional[Union[Mapping[str, Any], "AccelParams"]] = None,
+        gyroscope: Optional[Union[Mapping[str, Any], "GyroParams"]] = None,
+        magnetometer: Optional[Union[Mapping[str, Any], "MagParams"]] = None,
         preset: Optional[str] = None,
         seed: int = 0,
         profile: str = "matlab",
