@@ -118,7 +118,7 @@ fn long_monte_carlo(dir: &std::path::Path) -> std::path::PathBuf {
     let scenario = dir.join("mc.toml");
     std::fs::write(
         &scenario,
-        "rate_hz = 1000.0\nduration_s = 2.0\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n\
+        "rate_hz = 1000.0\nduration_s = 2.0\n[trajectory]\ntype = \"builtin\"\nname = \"platform-turn\"\n\
          [imu]\npreset = \"mpu-6050\"\nseed = 3\n",
     )
     .unwrap();

@@ -25,13 +25,14 @@ use crate::convert::{
 use crate::errors::{refused, shape_error};
 
 /// Truth (unless left out), IMU and (when the scenario has them) GNSS, barometer and odometer
-/// tables of one run.
+/// tables of one run, and the warnings the user should see (the scenario's, the run's).
 type SimulationOut<'py> = (
     Option<TableOut<'py>>,
     TableOut<'py>,
     Option<TableOut<'py>>,
     Option<TableOut<'py>>,
     Option<TableOut<'py>>,
+    Vec<String>,
 );
 
 /// A scenario spec from TOML or JSON text.
@@ -90,6 +91,8 @@ fn run_spec<'py>(
         }
         None => PyArray2::<f64>::zeros(py, imu_shape, false),
     };
+    let mut warnings = scenario.warnings.clone();
+    let sample_rate_hz = scenario.sample_rate_hz;
     let aids = {
         let mut truth_rw = truth.as_ref().map(|t| t.readwrite());
         let mut imu_rw = imu.readwrite();
@@ -103,6 +106,7 @@ fn run_spec<'py>(
         py.detach(move || scenario.simulate_streamed_into(run, threads, truth_values, imu_values))
             .map_err(refused)?
     };
+    warnings.extend(aids.report.warnings(sample_rate_hz));
     let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect();
     let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();
     Ok((
@@ -111,6 +115,7 @@ fn run_spec<'py>(
         optional(aids.gnss)?,
         optional(aids.baro)?,
         optional(aids.odometer)?,
+        warnings,
     ))
 }
 

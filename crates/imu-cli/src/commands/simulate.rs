@@ -7,6 +7,7 @@ use imukit::io::output::check_outputs;
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
+use imukit::scenario::report::RunReport;
 use rayon::prelude::*;
 
 use super::CliError;
@@ -48,8 +49,8 @@ pub fn run(
     outputs.extend(odometer_files.iter().map(|p| ("--odometer", p.as_path())));
     check_outputs(&inputs, &outputs)?;
     let sc = spec.resolve(base)?;
-    for w in &sc.imu.sensors.warnings {
-        crate::report::warn(&w.to_string());
+    for w in &sc.warnings {
+        crate::report::warn(w);
     }
     // What made the files, for formats that carry it (Parquet).
     let metadata = vec![
@@ -72,8 +73,12 @@ pub fn run(
             odometer,
             metadata: &metadata,
         };
-        sc.stream_to_files(None, run_threads, &outputs)
+        let report = sc
+            .stream_to_files(None, run_threads, &outputs)
             .map_err(threads_by_flag)?;
+        for w in report.warnings(sc.sample_rate_hz) {
+            crate::report::warn(&w);
+        }
         let mut written = format!("IMU readings in {}", out.display());
         for (what, path) in [
             ("truth", truth),
@@ -109,6 +114,7 @@ pub fn run(
             field: "--threads".into(),
             message: format!("could not start {pool_threads} threads: {e}"),
         })?;
+    let merged = std::sync::Mutex::new(RunReport::default());
     pool.install(|| {
         (0..runs)
             .into_par_iter()
@@ -116,7 +122,7 @@ pub fn run(
                 let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
                 let (imu_file, gnss_file, baro_file, odometer_file) =
                     (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
-                sc.stream_to_files(
+                let report = sc.stream_to_files(
                     Some(r),
                     RunThreads::One,
                     &StreamOutputs {
@@ -128,12 +134,20 @@ pub fn run(
                         metadata: &metadata,
                     },
                 )?;
+                if let Ok(mut m) = merged.lock() {
+                    m.merge(&report);
+                }
                 done.fetch_add(1, Ordering::Relaxed);
                 progress.inc();
                 Ok(())
             })
     })?;
     progress.finish();
+    if let Ok(m) = merged.into_inner() {
+        for w in m.warnings(sc.sample_rate_hz) {
+            crate::report::warn(&format!("over the {runs} runs, {w}"));
+        }
+    }
     crate::note!(
         "imukit: {} runs of {} samples; IMU readings in {} … {}",
         done.load(Ordering::Relaxed),

@@ -22,6 +22,7 @@ The package is split by area as the compiled core is: ``_truth`` (scenarios and 
 from __future__ import annotations
 
 from ._core import ImuError, __version__
+from ._warning import ImuWarning
 from ._table import Simulation, Table, TableLike
 from ._truth import (
     builtin_scenario_toml,
@@ -71,6 +72,7 @@ from ._orientation import (
 __all__ = [
     "__version__",
     "ImuError",
+    "ImuWarning",
     "Table",
     "TableLike",
     "Simulation",

@@ -6,7 +6,7 @@ import numpy.typing as npt
 
 _Table = tuple[list[str], npt.NDArray[np.float64]]
 #: A run's tables: truth (None when not kept), IMU, and the GNSS, barometer and odometer ones.
-_Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table]]
+_Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table], list[str]]
 
 __version__: str
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from . import _core
 from ._core import ImuError
+from ._warning import _emit
 
 
 @dataclass(frozen=True, repr=False)
@@ -75,13 +76,15 @@ def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: in
     # The truth is the same in every run: it is tabulated for the one that returns it.
     keep = with_truth and out is None
     if fmt == "dict":
-        truth, imu, *_ = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1,
-                                             truth=keep, imu_out=imu_out)
+        truth, imu, *_, notes = _core.simulate_dict(text, origin=origin, base_dir=base_dir, run=run, threads=1,
+                                                    truth=keep, imu_out=imu_out)
     else:
-        truth, imu, *_ = _core.simulate_text(
+        truth, imu, *_, notes = _core.simulate_text(
             text, format=fmt, origin=origin, base_dir=base_dir, run=run, threads=1, truth=keep,
             imu_out=imu_out,
         )
+    if with_truth:  # the first run speaks for all (warnings are about the scenario and the part)
+        _emit(notes, stacklevel=2)
     if out is None:
         return imu, truth
     path = _core.run_path(out, run, runs)

@@ -10,6 +10,7 @@ from . import _core
 from ._convert import _f64, _flag, _table_args, _times, _whole
 from ._core import ImuError
 from ._table import Simulation, Table, _table
+from ._warning import _emit
 
 DEFAULT_GRAVITY_M_S2: float = _core.DEFAULT_GRAVITY_M_S2  # m/s², MATLAB imuSensor's value
 
@@ -55,7 +56,8 @@ def simulate(
             text, format=fmt, origin=str(path), base_dir=str(path.parent), run=run, threads=threads,
             truth=keep_truth,
         )
-    truth_out, imu, gnss, baro, odometer = out
+    truth_out, imu, gnss, baro, odometer, notes = out
+    _emit(notes)
     optional = lambda t: None if t is None else _table(t)  # noqa: E731
     return Simulation(truth=optional(truth_out), imu=_table(imu), gnss=optional(gnss),
                       baro=optional(baro), odometer=optional(odometer))

@@ -22,6 +22,7 @@ use crate::io::output::AtomicFile;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
+use crate::scenario::report::RunReport;
 use crate::scenario::{NavFrameName, SampleTimes, Scenario};
 
 /// Samples per streamed chunk, at most.
@@ -52,6 +53,9 @@ pub struct Chunk {
     pub baro: Option<Table>,
     /// Odometer readings in this chunk, when the scenario has one.
     pub odometer: Option<Table>,
+    /// What this chunk's readings and motion say the user should know (clipped readings, the
+    /// largest turn between two samples).
+    pub report: RunReport,
 }
 
 /// The rows and columns of the truth and IMU tables a whole run gathers
@@ -75,6 +79,9 @@ pub struct AidTables {
     pub baro: Option<Table>,
     /// Odometer readings.
     pub odometer: Option<Table>,
+    /// The run's report: readings clipped at the sensors' ranges, the largest turn between two
+    /// samples ([`RunReport::warnings`]).
+    pub report: RunReport,
 }
 
 /// Where [`Scenario::stream_to_files`] writes: the IMU readings, and the truth and the aids'
@@ -129,6 +136,8 @@ impl Scenario {
     /// Streams run `run` on `threads` into the files of `outputs` (CSV, Parquet, `.npy` or `.npz`
     /// by extension); each file appears only when complete.
     ///
+    /// Returns the run's report ([`RunReport::warnings`] says what the user should know).
+    ///
     /// # Errors
     /// As [`Scenario::stream`], an aid's file without that aid in the scenario, and I/O errors
     /// naming the file.
@@ -137,7 +146,7 @@ impl Scenario {
         run: Option<u64>,
         threads: RunThreads,
         outputs: &StreamOutputs<'_>,
-    ) -> Result<()> {
+    ) -> Result<RunReport> {
         for (path, present, field, what) in [
             (
                 outputs.gnss,
@@ -178,8 +187,10 @@ impl Scenario {
             .into_iter()
             .flatten()
             .any(|s| s.format == TableFormat::Csv);
+        let mut report = RunReport::default();
         let mut write = |chunks: &[Chunk]| -> Result<()> {
             for chunk in chunks {
+                report.merge(&chunk.report);
                 for (sink, table) in [
                     (&mut imu, Some(&chunk.imu)),
                     (&mut truth, Some(&chunk.truth)),
@@ -213,7 +224,7 @@ impl Scenario {
         for sink in [imu, truth, gnss, baro, odometer].into_iter().flatten() {
             sink.commit()?;
         }
-        Ok(())
+        Ok(report)
     }
 
     /// The streamed simulation of run `run` (or the plain seed) on `threads`, gathered into whole
@@ -321,6 +332,7 @@ impl Scenario {
             append(&mut aids.gnss, chunk.gnss.as_ref());
             append(&mut aids.baro, chunk.baro.as_ref());
             append(&mut aids.odometer, chunk.odometer.as_ref());
+            aids.report.merge(&chunk.report);
             rows += n;
             Ok(())
         })?;
@@ -359,11 +371,18 @@ impl Scenario {
         let mut stretch = crate::scenario::Stretch::default();
         let mut chunk = Chunk::default();
         let mut t: Vec<f64> = Vec::new();
+        let blank_report = sensors.report();
+        let mut turn_rates: Vec<f64> = Vec::new();
         let mut emit = |truth: &[Truth<N>]| -> Result<()> {
             self.on_earth(truth, &mut sensors, &mut aids, truth_table, &mut stretch)?;
             let readings = &stretch.readings;
             t.clear();
             t.extend(truth.iter().map(|s| s.t_s));
+            chunk.report.clone_from(&blank_report);
+            chunk.report.add_readings(readings);
+            turn_rates.clear();
+            turn_rates.extend(truth.iter().map(|s| s.omega_b_rad_s.norm()));
+            chunk.report.add_turns(&t, &turn_rates);
             match output {
                 ImuOutput::Rates => chunk.imu.refill_readings(&t, readings, kind),
                 ImuOutput::Increments => {

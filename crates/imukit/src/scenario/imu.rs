@@ -2,6 +2,8 @@
 
 use crate::sensor::{ImuModel, ImuState};
 use imu_core::sensor::{ImuReading, SeededNormals, SensorSet};
+
+use crate::scenario::report::RunReport;
 use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 
 use crate::error::{Error, Result};
@@ -117,6 +119,7 @@ impl ImuSetup {
             params = drawn_part(&params, seed, run)?;
         }
         Ok(ReadingStream {
+            report: RunReport::for_sensors(&params),
             model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
@@ -144,6 +147,8 @@ impl ImuSetup {
 /// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
 #[derive(Debug)]
 pub struct ReadingStream<'a, N: NavFrame> {
+    /// A report for these sensors (their ranges), nothing counted yet.
+    report: RunReport,
     model: ImuModel<N>,
     noise: SeededNormals,
     state: ImuState,
@@ -151,6 +156,12 @@ pub struct ReadingStream<'a, N: NavFrame> {
 }
 
 impl<N: NavFrame> ReadingStream<'_, N> {
+    /// A blank report for these sensors: their measurement ranges, nothing counted yet.
+    #[must_use]
+    pub fn report(&self) -> RunReport {
+        self.report.clone()
+    }
+
     /// The readings of the next samples on the WGS-84 Earth: `earth` the samples, `local` the
     /// same in frame `N` (for the time and MATLAB's gyroscope acceleration input). The field is
     /// the magnetic model's at each position and time, or the IMU's constant field.

@@ -23,6 +23,7 @@ pub mod earth;
 pub mod gnss;
 pub mod imu;
 pub mod perturb;
+pub mod report;
 pub mod resolve;
 pub mod sensors;
 pub mod spec;
@@ -52,6 +53,9 @@ const IN_MEMORY_BYTES_PER_SAMPLE: usize = 8 * (23 + 9 + 23 + 10 + 1);
 /// A resolved, runnable scenario.
 #[derive(Clone, Debug)]
 pub struct Scenario {
+    /// What the user should be told before the run: skipped keys of a parameter file, figures
+    /// implausible for their unit, angles that look like degrees ([`report`]).
+    pub warnings: Vec<String>,
     /// Sample times.
     pub t_s: SampleTimes,
     /// Sample rate of the sensor error model, Hz (`rate_hz`, or the mean rate of a samples file).

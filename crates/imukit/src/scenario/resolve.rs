@@ -16,6 +16,7 @@ use crate::motion::track::{SpeedProfile, Track};
 use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
+use crate::scenario::report;
 
 use crate::scenario::earth::MagneticEnvironment;
 use crate::scenario::earth::{EarthSetup, TangentPlane};
@@ -315,7 +316,11 @@ impl ScenarioSpec {
             .as_ref()
             .map(|o| o.resolve(sample_rate_hz, imu.sensors.seed))
             .transpose()?;
+        let mut warnings = imu.sensors.warnings.clone();
+        warnings.extend(report::implausible_figures(&imu.sensors.params));
+        warnings.extend(angle_warnings(&spec.trajectory));
         Ok(Scenario {
+            warnings,
             t_s,
             sample_rate_hz,
             nav_frame: spec.nav_frame.unwrap_or_default(),
@@ -639,4 +644,33 @@ pub fn finite_vec<const K: usize>(field: &str, v: [f64; K]) -> Result<[f64; K]> 
     } else {
         Err(invalid(field, format!("must be finite, got {v:?}")))
     }
+}
+
+/// Angles given as numbers beyond a full turn (likely degrees), named by their key.
+fn angle_warnings(trajectory: &TrajectorySpec) -> Vec<String> {
+    let mut out = Vec::new();
+    match trajectory {
+        TrajectorySpec::BodyRates(b) => {
+            out.extend(report::angles_beyond_a_turn(
+                "trajectory.euler0_rad",
+                &b.euler0_rad,
+            ));
+        }
+        TrajectorySpec::Waypoints(w) => {
+            for (k, row) in w.euler_rad.iter().flatten().enumerate() {
+                out.extend(report::angles_beyond_a_turn(
+                    &format!("trajectory.euler_rad[{k}]"),
+                    row,
+                ));
+            }
+        }
+        TrajectorySpec::Track(t) => {
+            out.extend(report::angles_beyond_a_turn(
+                "trajectory.heading_rad",
+                &[t.heading_rad],
+            ));
+        }
+        _ => {}
+    }
+    out
 }
