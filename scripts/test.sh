@@ -14,12 +14,14 @@ section "Build environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
   "${PYTHON:-python3}" -m venv .venv
 fi
-.venv/bin/python -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" "ziglang>=0.13" "check-jsonschema>=0.28"
+# shellcheck disable=SC1091
+. .venv/bin/activate   # maturin finds zig as `python -m ziglang` of the active environment
+python -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" "ziglang>=0.13" "check-jsonschema>=0.28"
 
 section "Format and lints"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
-.venv/bin/check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
+check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imukit -p imu-plot -p imu-cli   # doc links resolve
 
 section "Heap-free core: builds without std, never names alloc or std, no std-only dependency"
@@ -45,11 +47,12 @@ cargo test --workspace --exclude imu-py
 section "Wheel (manylinux2014, abi3, with the imukit command) and source distribution"
 rm -rf dist
 # --zig links against glibc 2.17 whatever this machine has, so the wheel is manylinux2014.
-.venv/bin/maturin build --quiet --release --zig --compatibility manylinux2014 -m crates/imu-py/Cargo.toml --out dist
-.venv/bin/maturin sdist --quiet -m crates/imu-py/Cargo.toml --out dist
+maturin build --quiet --release --zig --compatibility manylinux2014 -m crates/imu-py/Cargo.toml --out dist
+maturin sdist --quiet -m crates/imu-py/Cargo.toml --out dist
 python3 scripts/check_dist.py dist
 
 section "A fresh environment from the wheel, no Rust on PATH"
+deactivate
 rm -rf .venv-wheel
 "${PYTHON:-python3}" -m venv .venv-wheel
 wheel=$(ls dist/imukit-*.whl)
