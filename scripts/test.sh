@@ -48,7 +48,7 @@ section "Wheel (manylinux2014, abi3, with the imukit command) and source distrib
 rm -rf dist
 # --zig links against glibc 2.17 whatever this machine has, so the wheel is manylinux2014.
 maturin build --quiet --release --zig --compatibility manylinux2014 -m crates/imu-py/Cargo.toml --out dist
-maturin sdist --quiet -m crates/imu-py/Cargo.toml --out dist
+maturin sdist -m crates/imu-py/Cargo.toml --out dist
 python3 scripts/check_dist.py dist
 
 section "A fresh environment from the wheel, no Rust on PATH"

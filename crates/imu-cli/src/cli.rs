@@ -22,6 +22,17 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// A figure's size and resolution (`plot`, `allan --plot`, `study --plot`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct FigureArgs {
+    /// The figure's width and height, inches (default: a size for its panels).
+    #[arg(long, num_args = 2, value_names = ["WIDTH_IN", "HEIGHT_IN"])]
+    pub size: Option<Vec<f64>>,
+    /// A PNG's resolution, pixels per inch (default 100; an SVG has none).
+    #[arg(long)]
+    pub dpi: Option<f64>,
+}
+
 /// The shells `imukit completions` writes a script for.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum Shell {
@@ -314,6 +325,9 @@ pub enum Command {
         /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// The figure's size and resolution.
+        #[command(flatten)]
+        figure: FigureArgs,
     },
     /// Runs a built-in scenario (default: the figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
@@ -344,6 +358,9 @@ pub enum Command {
         /// Navigation frame of the positions (ENU or NED; NED paths are drawn east, north, up).
         #[arg(long, default_value = "ENU")]
         nav_frame: String,
+        /// Size and resolution.
+        #[command(flatten)]
+        figure: FigureArgs,
     },
     /// Animates the body moving along its path from a truth CSV: a box turned by the attitude,
     /// the reference point and the IMU point at the lever arm marked, the trail drawn.

@@ -76,8 +76,8 @@ fn png_size(path: &Path) -> (u32, u32) {
     (be(16), be(20))
 }
 
-/// The SVG's size and its number of series: legend keys, one per series, are the polylines of
-/// exactly two points 18 px apart horizontally.
+/// The SVG's size and its number of series: the legends' labels, the texts drawn from their
+/// left end (every other text is centred or ends at its point), less the "● start ✕ end" note.
 fn svg_series(path: &Path) -> ((u32, u32), usize) {
     let s = std::fs::read_to_string(path).unwrap();
     let attr = |name: &str| -> u32 {
@@ -85,21 +85,24 @@ fn svg_series(path: &Path) -> ((u32, u32), usize) {
         s[i..].split('"').next().unwrap().parse().unwrap()
     };
     let series = s
-        .split("<polyline")
+        .split("<text")
         .skip(1)
-        .filter(|p| {
-            let i = p.find("points=\"").unwrap() + 8;
-            let pts: Vec<Vec<f64>> = p[i..]
-                .split('"')
-                .next()
-                .unwrap()
-                .split_whitespace()
-                .map(|xy| xy.split(',').map(|v| v.parse().unwrap()).collect())
-                .collect();
-            pts.len() == 2 && pts[1][0] - pts[0][0] == 18.0 && pts[1][1] == pts[0][1]
-        })
+        .filter(|t| t.contains("text-anchor=\"start\"") && !t.contains("✕ end"))
         .count();
     ((attr("width"), attr("height")), series)
+}
+
+/// The texts of an SVG figure.
+fn svg_texts(path: &Path) -> Vec<String> {
+    let s = std::fs::read_to_string(path).unwrap();
+    s.split("<text")
+        .skip(1)
+        .filter_map(|t| t.split_once('>').map(|(_, rest)| rest))
+        .filter_map(|t| {
+            t.split_once("</text>")
+                .map(|(text, _)| text.trim().to_string())
+        })
+        .collect()
 }
 
 /// Plots `files` into `name`.svg and `name`.png; returns the SVG's size and series count.
@@ -127,7 +130,10 @@ fn plot(files: &[&str], name: &str) -> ((u32, u32), usize) {
 fn truth_has_the_trajectory_and_six_panels_of_three() {
     // 7 cells (trajectory + position, velocity, acceleration, attitude, rate, angular
     // acceleration) in 2 columns of 560 × 320 px.
-    assert_eq!(plot(&["truth.csv"], "truth"), ((1120, 1280), 1 + 6 * 3));
+    assert_eq!(
+        plot(&["truth.csv"], "truth"),
+        ((1120, 40 + 1280), 1 + 6 * 3)
+    );
 }
 
 #[test]
@@ -135,27 +141,31 @@ fn truth_and_navigation_overlay_every_series() {
     // Navigation output has position, velocity and attitude: those panels get both files,
     // acceleration, rate and angular acceleration only the truth's.
     let ((w, h), n) = plot(&["truth.csv", "nav.csv"], "overlay");
-    assert_eq!((w, h), (1120, 1280));
+    assert_eq!((w, h), (1120, 40 + 1280));
     assert_eq!(n, 2 + 3 * 3 * 2 + 3 * 3);
 }
 
 #[test]
 fn imu_readings_have_accelerometer_gyroscope_and_magnetometer() {
-    assert_eq!(plot(&["imu.csv"], "imu"), ((560, 960), 3 * 3));
+    assert_eq!(plot(&["imu.csv"], "imu"), ((560, 40 + 960), 3 * 3));
 }
 
 #[test]
 fn errors_have_position_velocity_and_attitude_panels() {
-    assert_eq!(plot(&["errors.csv"], "errors"), ((560, 960), 4 + 3 + 1));
+    assert_eq!(
+        plot(&["errors.csv"], "errors"),
+        ((560, 40 + 960), 4 + 3 + 1)
+    );
 }
 
 #[test]
 fn errors_of_a_fused_estimate_are_drawn_against_plus_minus_three_sigma() {
-    // The same three panels; position and velocity each add a ±3σ envelope per axis (one
-    // legend key for its pair of dotted lines).
+    // The same three panels; position and velocity each add a ±3σ envelope per axis, the
+    // attitude angle one of the root sum of squares of its axes' (one legend key for each pair
+    // of dotted lines).
     assert_eq!(
         plot(&["fused_errors.csv"], "fused_errors"),
-        ((560, 960), 4 + 3 + 1 + 3 + 3)
+        ((560, 40 + 960), 4 + 3 + 1 + 3 + 3 + 1)
     );
     let errors = std::fs::read_to_string(data().join("fused_errors.csv")).unwrap();
     let nav = std::fs::read_to_string(data().join("car_nav.csv")).unwrap();
@@ -174,15 +184,27 @@ fn errors_of_a_fused_estimate_are_drawn_against_plus_minus_three_sigma() {
     for c in ["pos_x_sigma_m", "vel_z_sigma_m_s", "att_z_sigma_rad"] {
         assert_eq!(column(&errors, c), column(&nav, c), "{c}");
     }
+    let number = |v: &str| v.parse::<f64>().unwrap();
+    let rss = column(&errors, "att_sigma_rad");
+    for (k, total) in rss.iter().enumerate() {
+        let axes: f64 = ["att_x_sigma_rad", "att_y_sigma_rad", "att_z_sigma_rad"]
+            .iter()
+            .map(|c| number(&column(&nav, c)[k]).powi(2))
+            .sum();
+        assert!(
+            (number(total) - axes.sqrt()).abs() <= 1e-15 * number(total),
+            "row {k}"
+        );
+    }
 }
 
 #[test]
 fn orientation_output_and_its_errors_have_their_panels() {
     // Euler angles and the quaternion; then the attitude error and the three Euler errors.
-    assert_eq!(plot(&["orient.csv"], "orient"), ((560, 640), 3 + 4));
+    assert_eq!(plot(&["orient.csv"], "orient"), ((560, 40 + 640), 3 + 4));
     assert_eq!(
         plot(&["orient_errors.csv"], "orient_errors"),
-        ((560, 640), 1 + 3)
+        ((560, 40 + 640), 1 + 3)
     );
 }
 
@@ -197,7 +219,15 @@ fn allan_table_has_one_curve_per_column() {
         .filter(|c| c.starts_with("adev_"))
         .count();
     assert_eq!(curves, 6);
-    assert_eq!(plot(&["allan.csv"], "allan"), ((900, 600), curves));
+    // One panel per unit: the gyroscopes' rad/s above the accelerometers' m/s².
+    assert_eq!(
+        plot(&["allan.csv"], "allan"),
+        ((900, 120 + 2 * 480), curves)
+    );
+    let texts = svg_texts(&data().join("allan.svg"));
+    for label in ["σ(τ) (rad/s)", "σ(τ) (m/s²)", "Allan deviation — allan.csv"] {
+        assert!(texts.iter().any(|t| t == label), "{label} missing");
+    }
 }
 
 #[test]
@@ -441,4 +471,81 @@ fn allan_tables_spanning_the_whole_float_range_and_extreme_truth_values_are_draw
         &[&big, Path::new("--out"), &png],
     ));
     assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+}
+
+#[test]
+fn figures_are_titled_with_their_files_and_frame_and_take_a_size_and_resolution() {
+    let d = data();
+    let out = d.join("sized.png");
+    let o = imukit(
+        &[
+            "plot",
+            "--size",
+            "8",
+            "5",
+            "--dpi",
+            "150",
+            "--nav-frame",
+            "NED",
+        ],
+        &[&d.join("errors.csv"), Path::new("--out"), &out],
+    );
+    ok(&o);
+    assert_eq!(png_size(&out), (1200, 750));
+    let svg = d.join("titled.svg");
+    ok(&imukit(
+        &["plot", "--nav-frame", "NED"],
+        &[
+            &d.join("truth.csv"),
+            &d.join("nav.csv"),
+            Path::new("--out"),
+            &svg,
+        ],
+    ));
+    let texts = svg_texts(&svg);
+    assert!(
+        texts
+            .iter()
+            .any(|t| t == "truth.csv, nav.csv (truth) — NED"),
+        "{texts:?}"
+    );
+    // No tick reads -0 or carries a needless exponent.
+    for t in &texts {
+        assert!(
+            t != "-0" && !t.starts_with("-0.0") && !t.contains("e-0") && !t.contains(".0e"),
+            "{t}"
+        );
+    }
+    for (args, message) in [
+        (
+            vec!["--size", "0.5", "4"],
+            "--size: 0.5 × 4 inches: each side must be from 1 to 100 inches",
+        ),
+        (
+            vec!["--dpi", "5000"],
+            "--dpi: 5000: the resolution must be from 10 to 1200 pixels per inch",
+        ),
+        (
+            vec!["--size", "100", "100", "--dpi", "300"],
+            "--dpi: 300 pixels per inch make a side of 30000 pixels",
+        ),
+    ] {
+        let mut all = vec!["plot"];
+        all.extend(args);
+        let o = imukit(
+            &all,
+            &[
+                &d.join("errors.csv"),
+                Path::new("--out"),
+                &d.join("refused.png"),
+            ],
+        );
+        assert_eq!(o.status.code(), Some(65));
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(message),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!d.join("refused.png").exists());
+    }
 }

@@ -5,7 +5,7 @@ use imukit::run::allan::AllanResult;
 use plotters::prelude::*;
 
 use crate::PlotError;
-use crate::draw::{COLORS, draw_legend, err, key, write_figure};
+use crate::draw::{COLORS, FigureSize, draw_legend, err, key, tick};
 
 /// Most decades a log axis spans: plotters counts an axis's decades through `hi / lo`, which
 /// must stay finite (beyond about 308 decades it is infinite and the tick loop never ends).
@@ -21,82 +21,140 @@ pub(crate) fn log_range(lo: f64, hi: f64) -> std::ops::Range<f64> {
     if hi > lo { lo..hi } else { lo..lo * 10.0 }
 }
 
-/// Draws `result` (one curve per column) into `path` (SVG or PNG).
-pub fn allan_figure(path: &Path, result: &AllanResult) -> Result<(), PlotError> {
+/// The unit of an Allan column (`adev_gyro_x_rad_s` → `rad/s`), for the axis it is drawn on.
+fn unit_of(column: &str) -> &'static str {
+    // An overlay's label names its file after the column: `adev_gyro_x_rad_s (imu)`.
+    let column = column.split(" (").next().unwrap_or(column);
+    if column.ends_with("_rad_s") {
+        "rad/s"
+    } else if column.ends_with("_m_s2") {
+        "m/s²"
+    } else if column.ends_with("_ut") {
+        "µT"
+    } else if column.ends_with("_rad") {
+        "rad"
+    } else if column.ends_with("_m_s") {
+        "m/s"
+    } else {
+        "unit of the column"
+    }
+}
+
+/// Draws `result` (one curve per column) into `path` (SVG or PNG) at `size`: one panel per
+/// unit (the gyroscopes' rad/s apart from the accelerometers' m/s²), the fitted lines dashed,
+/// titled with `source` (the data's file).
+///
+/// # Errors
+/// Nothing positive to draw, or the figure's own failure.
+pub fn allan_figure(
+    path: &Path,
+    result: &AllanResult,
+    source: &str,
+    size: FigureSize,
+) -> Result<(), PlotError> {
     let table = &result.table;
     let tau = table.column("tau_s").unwrap_or_default();
-    let curves: Vec<(String, Vec<f64>)> = table
+    let curves: Vec<(String, &'static str, Vec<f64>)> = table
         .columns
         .iter()
         .skip(1)
         .map(|c| {
             (
                 c.trim_start_matches("adev_").to_string(),
+                unit_of(c),
                 table.column(c).unwrap_or_default(),
             )
         })
         .collect();
     let positive = curves
         .iter()
-        .flat_map(|(_, v)| v.iter().copied())
+        .flat_map(|(_, _, v)| v.iter().copied())
         .filter(|v| *v > 0.0);
-    let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, _) = positive.fold((f64::INFINITY, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
     if tau.is_empty() || !lo.is_finite() {
         return Err(PlotError::Draw {
             path: path.display().to_string(),
             message: "nothing to plot: the Allan deviation is empty or zero".into(),
         });
     }
-    write_figure(path, 900, 600, |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption("Allan deviation", ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(80)
-            .build_cartesian_2d(
-                log_range(tau[0] * 0.8, tau[tau.len() - 1] * 1.25).log_scale(),
-                log_range(lo * 0.5, hi * 2.0).log_scale(),
-            )
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("τ (s)")
-            .y_desc("σ(τ) (unit of the column)")
-            .y_label_formatter(&|v| format!("{v:.1e}"))
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(err)?;
-        for (k, ((name, adev), (_, id))) in curves.iter().zip(&result.noise).enumerate() {
-            let color = COLORS[k % COLORS.len()];
-            let points: Vec<(f64, f64)> = tau
-                .iter()
-                .copied()
-                .zip(adev.iter().copied())
-                .filter(|(_, a)| *a > 0.0)
-                .collect();
-            chart
-                .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
-                .map_err(err)?
-                .label(name.clone())
-                .legend(key(color));
-            chart
-                .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))
-                .map_err(err)?;
-            for line in [id.white_line, id.bias_line, id.random_walk_line]
-                .into_iter()
-                .flatten()
-            {
-                let ends = [tau[0], tau[tau.len() - 1]].map(|t| (t, line.at(t)));
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        ends,
-                        6,
-                        4,
-                        color.mix(0.6).stroke_width(1),
-                    ))
-                    .map_err(err)?;
-            }
+    let mut units: Vec<&'static str> = Vec::new();
+    for (_, unit, _) in &curves {
+        if !units.contains(unit) {
+            units.push(unit);
         }
-        draw_legend(&mut chart)
+    }
+    let rows = u32::try_from(units.len()).unwrap_or(1).max(1);
+    let title = format!("Allan deviation — {source}");
+    size.write(path, 900, 120 + 480 * rows, |root| {
+        let root = root.titled(&title, ("sans-serif", 22)).map_err(err)?;
+        let areas = root.split_evenly((units.len().max(1), 1));
+        for (unit, area) in units.iter().zip(&areas) {
+            let members: Vec<usize> = (0..curves.len())
+                .filter(|&k| curves[k].1 == *unit)
+                .collect();
+            let values = members
+                .iter()
+                .flat_map(|&k| curves[k].2.iter().copied())
+                .filter(|v| *v > 0.0);
+            let (lo, hi) = values.fold((f64::INFINITY, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
+            if !lo.is_finite() {
+                continue;
+            }
+            let mut chart = ChartBuilder::on(area)
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(
+                    log_range(tau[0] * 0.8, tau[tau.len() - 1] * 1.25).log_scale(),
+                    log_range(lo * 0.5, hi * 2.0).log_scale(),
+                )
+                .map_err(err)?;
+            let y_desc = format!("σ(τ) ({unit})");
+            chart
+                .configure_mesh()
+                .x_desc("τ (s)")
+                .y_desc(y_desc.as_str())
+                .y_label_formatter(&|v| tick(*v))
+                .x_label_formatter(&|v| tick(*v))
+                .draw()
+                .map_err(err)?;
+            for &k in &members {
+                let (name, _, adev) = &curves[k];
+                let color = COLORS[k % COLORS.len()];
+                let points: Vec<(f64, f64)> = tau
+                    .iter()
+                    .copied()
+                    .zip(adev.iter().copied())
+                    .filter(|(_, a)| *a > 0.0)
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(name.clone())
+                    .legend(key(color, 0));
+                chart
+                    .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))
+                    .map_err(err)?;
+                let Some((_, id)) = result.noise.get(k) else {
+                    continue;
+                };
+                for line in [id.white_line, id.bias_line, id.random_walk_line]
+                    .into_iter()
+                    .flatten()
+                {
+                    let ends = [tau[0], tau[tau.len() - 1]].map(|t| (t, line.at(t)));
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            ends,
+                            6,
+                            4,
+                            color.mix(0.6).stroke_width(1),
+                        ))
+                        .map_err(err)?;
+                }
+            }
+            draw_legend(&mut chart)?;
+        }
+        Ok(())
     })
 }

@@ -9,7 +9,7 @@ use imukit::run::allan::AllanResult;
 use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, is_3d};
 use crate::PlotError;
 use crate::allan::allan_figure;
-use crate::draw::write_figure;
+use crate::draw::{FigureSize, err};
 
 fn stem(p: &Path) -> String {
     p.file_stem().map_or_else(
@@ -78,7 +78,12 @@ fn panel(files: &[(String, Table)], spec: &PanelSpec) -> Option<Panel> {
 ///
 /// # Errors
 /// Unreadable or empty files, unknown kinds of CSV, files of different kinds, drawing errors.
-pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotError> {
+pub fn plot_files(
+    paths: &[PathBuf],
+    out: &Path,
+    ned: bool,
+    size: FigureSize,
+) -> Result<(), PlotError> {
     if paths.is_empty() {
         return Err(PlotError::Invalid {
             field: "plot".into(),
@@ -89,7 +94,7 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
         .iter()
         .map(|p| Ok((p.clone(), imukit::io::table::read_table(p)?)))
         .collect::<Result<Vec<_>, PlotError>>()?;
-    plot_tables(&tables, out, ned)
+    plot_tables(&tables, out, ned, size)
 }
 
 /// Draws the default figure for tables (all of one kind, each with the file it is named by)
@@ -97,7 +102,12 @@ pub fn plot_files(paths: &[PathBuf], out: &Path, ned: bool) -> Result<(), PlotEr
 ///
 /// # Errors
 /// Unknown kinds of table, tables of different kinds, drawing errors.
-pub fn plot_tables(tables: &[(PathBuf, Table)], out: &Path, ned: bool) -> Result<(), PlotError> {
+pub fn plot_tables(
+    tables: &[(PathBuf, Table)],
+    out: &Path,
+    ned: bool,
+    size: FigureSize,
+) -> Result<(), PlotError> {
     let mut files = Vec::new();
     let mut traces: Vec<Trace> = Vec::new();
     let mut kind: Option<TableKind> = None;
@@ -128,8 +138,17 @@ pub fn plot_tables(tables: &[(PathBuf, Table)], out: &Path, ned: bool) -> Result
         files.push((stem(p), t.clone()));
     }
     let kind = kind.unwrap_or(TableKind::Imu);
+    let names: Vec<String> = tables
+        .iter()
+        .map(|(p, _)| {
+            p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        })
+        .collect();
     if kind == TableKind::Allan {
-        return allan_from_tables(out, &files);
+        return allan_from_tables(out, &files, &names.join(", "), size);
     }
     let panels: Vec<Panel> = kind
         .panels()
@@ -143,8 +162,16 @@ pub fn plot_tables(tables: &[(PathBuf, Table)], out: &Path, ned: bool) -> Result
     let cells = panels.len() + usize::from(!traces.is_empty());
     let cols = if cells > 3 { 2 } else { 1 };
     let rows = cells.div_ceil(cols);
-    let (w, h) = (560 * cols as u32, 320 * rows as u32);
-    write_figure(out, w, h, |root| {
+    let (w, h) = (560 * cols as u32, 40 + 320 * rows as u32);
+    // The files drawn, their kind and, where positions or attitudes are drawn, their frame.
+    let frame = if kind.has_frame() {
+        format!(" — {}", if ned { "NED" } else { "ENU" })
+    } else {
+        String::new()
+    };
+    let title = format!("{} ({}){frame}", names.join(", "), kind.name());
+    size.write(out, w, h, |root| {
+        let root = root.titled(&title, ("sans-serif", 18)).map_err(err)?;
         let areas = root.split_evenly((rows, cols));
         let mut next = areas.iter();
         if !traces.is_empty() {
@@ -163,7 +190,12 @@ pub fn plot_tables(tables: &[(PathBuf, Table)], out: &Path, ned: bool) -> Result
 }
 
 /// Allan tables: the curves with the noise lines identified from each curve.
-fn allan_from_tables(out: &Path, files: &[(String, Table)]) -> Result<(), PlotError> {
+fn allan_from_tables(
+    out: &Path,
+    files: &[(String, Table)],
+    source: &str,
+    size: FigureSize,
+) -> Result<(), PlotError> {
     let mut columns = vec!["tau_s".to_string()];
     let mut noise = Vec::new();
     let first = &files[0].1;
@@ -199,5 +231,7 @@ fn allan_from_tables(out: &Path, files: &[(String, Table)]) -> Result<(), PlotEr
             table: Table { columns, data },
             noise,
         },
+        source,
+        size,
     )
 }

@@ -16,7 +16,9 @@
 //!
 //! ```no_run
 //! use std::path::{Path, PathBuf};
-//! imu_plot::plot_files(&[PathBuf::from("truth.csv")], Path::new("truth.png"), false)?;
+//! use imu_plot::FigureSize;
+//! let size = FigureSize::new(Some((8.0, 6.0)), Some(150.0))?; // inches, pixels per inch
+//! imu_plot::plot_files(&[PathBuf::from("truth.csv")], Path::new("truth.png"), false, size)?;
 //! # Ok::<(), imu_plot::PlotError>(())
 //! ```
 #![forbid(unsafe_code)]
@@ -30,7 +32,7 @@ pub mod spec;
 mod study;
 
 pub use allan::allan_figure;
-pub use draw::{COLORS, FigureFormat, check_figure_path, rasterise, write_figure};
+pub use draw::{COLORS, FigureFormat, FigureSize, check_figure_path, rasterise, write_figure};
 pub use figures::{plot_files, plot_tables};
 pub use panels::{Trace, trajectories_figure};
 pub use spec::{FramePlan, PanelSpec, TableKind};

@@ -5,7 +5,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::PlotError;
-use crate::draw::{COLORS, draw_legend, err, every, key, stride_for, write_figure};
+use crate::draw::{
+    COLORS, dashes, draw_legend, err, every, key, stride_for, tick_on, write_figure,
+};
 
 /// One line of a time-series panel.
 pub struct Series {
@@ -98,21 +100,21 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         .x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
         .label_style(("sans-serif", 11))
+        .x_label_formatter(&|v| tick_on(*v, x1 - x0))
+        .y_label_formatter(&|v| tick_on(*v, y1 - y0))
         .draw()
         .map_err(err)?;
     for s in &panel.series {
         let color = COLORS[s.color % COLORS.len()];
         let pts = thin(finite(&s.points));
         let stroke = color.stroke_width(2);
-        let drawn = match s.style % 4 {
-            0 => chart.draw_series(LineSeries::new(pts, stroke)),
-            1 => chart.draw_series(DashedLineSeries::new(pts, 6, 4, stroke)),
-            2 => chart.draw_series(DashedLineSeries::new(pts, 2, 3, stroke)),
-            _ => chart.draw_series(DashedLineSeries::new(pts, 12, 4, stroke)),
+        let drawn = match dashes(s.style) {
+            None => chart.draw_series(LineSeries::new(pts, stroke)),
+            Some((on, off)) => chart.draw_series(DashedLineSeries::new(pts, on, off, stroke)),
         };
         let drawn = drawn.map_err(err)?;
         if !s.label.is_empty() {
-            drawn.label(s.label.clone()).legend(key(color));
+            drawn.label(s.label.clone()).legend(key(color, s.style));
         }
     }
     draw_legend(&mut chart)
@@ -187,16 +189,22 @@ pub fn draw_plan_view(
         .x_desc("x (m)")
         .y_desc("y (m)")
         .label_style(("sans-serif", 11))
+        .x_label_formatter(&|v| tick_on(*v, 2.0 * half_x))
+        .y_label_formatter(&|v| tick_on(*v, 2.0 * half_y))
         .draw()
         .map_err(err)?;
     for (k, t) in traces.iter().enumerate() {
+        // The second trace (an estimate over the truth) dashed, the third dotted, as in the panels.
         let color = COLORS[k % COLORS.len()];
         let p = pts(t);
-        chart
-            .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(t.name.clone())
-            .legend(key(color));
+        let stroke = color.stroke_width(2);
+        match dashes(k) {
+            None => chart.draw_series(LineSeries::new(p.clone(), stroke)),
+            Some((on, off)) => chart.draw_series(DashedLineSeries::new(p.clone(), on, off, stroke)),
+        }
+        .map_err(err)?
+        .label(t.name.clone())
+        .legend(key(color, k));
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])
@@ -236,9 +244,13 @@ pub fn draw_3d(
         p.scale = 0.8;
         p.into_matrix()
     });
+    let (sx, sy, sz) = (x1 - x0, y1 - y0, z1 - z0);
     chart
         .configure_axes()
         .label_style(("sans-serif", 10))
+        .x_formatter(&|v| tick_on(*v, sx))
+        .y_formatter(&|v| tick_on(*v, sz))
+        .z_formatter(&|v| tick_on(*v, sy))
         .draw()
         .map_err(err)?;
     for (k, t) in traces.iter().enumerate() {
@@ -250,11 +262,14 @@ pub fn draw_3d(
                 .map(|p| (p.0, p.2, p.1))
                 .collect(),
         );
-        chart
-            .draw_series(LineSeries::new(p.clone(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(t.name.clone())
-            .legend(key(color));
+        let stroke = color.stroke_width(2);
+        match dashes(k) {
+            None => chart.draw_series(LineSeries::new(p.clone(), stroke)),
+            Some((on, off)) => chart.draw_series(DashedLineSeries::new(p.clone(), on, off, stroke)),
+        }
+        .map_err(err)?
+        .label(t.name.clone())
+        .legend(key(color, k));
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])

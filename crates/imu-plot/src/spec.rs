@@ -143,6 +143,13 @@ impl TableKind {
         matches!(self, Self::Truth | Self::Navigation)
     }
 
+    /// Whether the kind's numbers depend on the navigation frame (positions, velocities,
+    /// attitudes, readings in the body frame it implies), so that its figure names the frame.
+    #[must_use]
+    pub fn has_frame(self) -> bool {
+        !matches!(self, Self::Allan)
+    }
+
     /// The time-series panels of the kind's figure (none for Allan tables, drawn on log axes).
     #[must_use]
     pub fn panels(self) -> Vec<PanelSpec> {
@@ -211,7 +218,8 @@ impl TableKind {
                         "angle (deg)",
                         DEG,
                         &[own(("att_err_rad", "angle"))],
-                    ),
+                    )
+                    .with_envelopes(&["att_sigma_rad".to_string()]),
                     p(
                         "Euler angle errors",
                         "error (deg)",

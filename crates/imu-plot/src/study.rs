@@ -7,16 +7,7 @@ use plotters::prelude::*;
 
 use crate::PlotError;
 use crate::allan::log_range;
-use crate::draw::{COLORS, draw_legend, err, key, write_figure};
-
-/// `v` with three significant digits, without an exponent between 1 mm and 1000 km.
-fn significant(v: f64) -> String {
-    if !(1e-3..1e6).contains(&v.abs()) {
-        return format!("{v:.2e}");
-    }
-    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    format!("{v:.decimals$}")
-}
+use crate::draw::{COLORS, draw_legend, err, key, tick, write_figure};
 
 /// Draws a study table (`t_s`, then per preset `<preset>_rms_error_m` and `<preset>_sigma_m`,
 /// as `imukit::run::study` writes it) into `path` (SVG or PNG).
@@ -73,7 +64,7 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
             .configure_mesh()
             .x_desc("time since the outage began (s)")
             .y_desc("m (solid: RMS over runs; dashed: filter's 1σ)")
-            .y_label_formatter(&|v| significant(*v))
+            .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(err)?;
         for (k, (name, error, sigma)) in curves.iter().enumerate() {
@@ -89,7 +80,7 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
                 .draw_series(LineSeries::new(line(error), color.stroke_width(2)))
                 .map_err(err)?
                 .label((*name).to_string())
-                .legend(key(color));
+                .legend(key(color, 0));
             chart
                 .draw_series(DashedLineSeries::new(
                     line(sigma),

@@ -12,6 +12,7 @@ pub fn run(
     columns: &[String],
     out: &Path,
     plot: Option<&Path>,
+    size: imu_plot::FigureSize,
 ) -> Result<(), CliError> {
     if let Some(p) = plot {
         imu_plot::check_figure_path(p)?;
@@ -58,7 +59,11 @@ pub fn run(
     })?;
     result.table.write(out)?;
     if let Some(p) = plot {
-        imu_plot::allan_figure(p, &result)?;
+        let source = input.file_name().map_or_else(
+            || input.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        imu_plot::allan_figure(p, &result, &source, size)?;
     }
     println!(
         "{:<16} {:>14} {:>14} {:>14}",

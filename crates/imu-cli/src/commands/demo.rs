@@ -7,7 +7,7 @@ use imukit::scenario::builtin;
 
 use super::CliError;
 use imu_plot::animate::{AnimateOptions, animate};
-use imu_plot::plot_tables;
+use imu_plot::{FigureSize, plot_tables};
 use imukit::io::output::write_atomically;
 use imukit::scenario::NavFrameName;
 use std::io::Write as _;
@@ -36,11 +36,13 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
         &[(out_dir.join("truth.csv"), sim.truth.clone())],
         &out_dir.join("truth.png"),
         ned,
+        FigureSize::default(),
     )?;
     plot_tables(
         &[(out_dir.join("imu.csv"), sim.imu.clone())],
         &out_dir.join("imu.png"),
         ned,
+        FigureSize::default(),
     )?;
     let lever_arm_m = spec.imu.lever_arm_m.unwrap_or([0.0; 3]);
     let opts = AnimateOptions {

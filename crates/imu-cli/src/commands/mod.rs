@@ -152,12 +152,20 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             columns,
             out,
             plot,
-        } => allan::run(&input, &columns, &out, plot.as_deref()),
+            figure,
+        } => allan::run(
+            &input,
+            &columns,
+            &out,
+            plot.as_deref(),
+            plot::figure_size(&figure)?,
+        ),
         Command::Plot {
             files,
             out,
             nav_frame,
-        } => plot::plot(&files, &out, &nav_frame),
+            figure,
+        } => plot::plot(&files, &out, &nav_frame, plot::figure_size(&figure)?),
         Command::Animate {
             truth,
             out,

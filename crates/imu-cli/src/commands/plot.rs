@@ -2,21 +2,39 @@
 use std::path::{Path, PathBuf};
 
 use imu_plot::animate::{self as anim, AnimateOptions};
-use imu_plot::plot_files;
+use imu_plot::{FigureSize, plot_files};
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
 
 use imukit::scenario::{NavFrameName, parse_name};
 
 use super::CliError;
+use crate::cli::FigureArgs;
+use crate::plot_by_flag;
 
-pub fn plot(files: &[PathBuf], out: &Path, nav_frame: &str) -> Result<(), CliError> {
+pub fn plot(
+    files: &[PathBuf],
+    out: &Path,
+    nav_frame: &str,
+    size: FigureSize,
+) -> Result<(), CliError> {
     imu_plot::check_figure_path(out)?;
     let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
     check_outputs(&inputs, &[("--out", out)])?;
-    plot_files(files, out, is_ned(nav_frame)?)?;
+    plot_files(files, out, is_ned(nav_frame)?, size)?;
     println!("Wrote {}", out.display());
     Ok(())
+}
+
+/// The figure size and resolution of `--size` and `--dpi`, checked; refusals name the flag.
+pub fn figure_size(args: &FigureArgs) -> Result<FigureSize, CliError> {
+    let size_in = args
+        .size
+        .as_deref()
+        .map(|s| (s[0], s.get(1).copied().unwrap_or(s[0])));
+    FigureSize::new(size_in, args.dpi)
+        .map_err(plot_by_flag)
+        .map_err(CliError::from)
 }
 
 /// Whether `--nav-frame` names NED (else ENU).

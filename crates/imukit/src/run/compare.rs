@@ -155,13 +155,27 @@ fn has_sigmas(names: &[String], kind: EstimateKind) -> bool {
     kind == EstimateKind::Navigation && SIGMA_COLUMNS.iter().all(|c| names.iter().any(|n| n == c))
 }
 
-/// The error columns of `kind`, with [`SIGMA_COLUMNS`] when `sigmas`.
+/// The one-sigma of the attitude error's angle: the root sum of squares of the three axes'
+/// one-sigma, what the angle `att_err_rad` is drawn against (±3σ).
+pub const ATTITUDE_SIGMA_COLUMN: &str = "att_sigma_rad";
+
+/// The error columns of `kind`, with [`SIGMA_COLUMNS`] and [`ATTITUDE_SIGMA_COLUMN`] when
+/// `sigmas`.
 fn output_columns(kind: EstimateKind, sigmas: bool) -> Vec<&'static str> {
     let mut columns = kind.error_columns().to_vec();
     if sigmas {
         columns.extend(SIGMA_COLUMNS);
+        columns.push(ATTITUDE_SIGMA_COLUMN);
     }
     columns
+}
+
+/// Appends an estimate row's one-sigma ([`SIGMA_COLUMNS`]) and the attitude angle's
+/// ([`ATTITUDE_SIGMA_COLUMN`]) to an error row.
+fn push_sigmas(row: &mut Vec<f64>, sigmas: &[f64; SIGMA_COLUMNS.len()]) {
+    row.extend_from_slice(sigmas);
+    let [x, y, z] = [sigmas[6], sigmas[7], sigmas[8]];
+    row.push((x * x + y * y + z * z).sqrt());
 }
 
 /// Compares an estimate table with a truth table (see the module docs).
@@ -193,7 +207,13 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
             let k = table.rows();
             out.clear();
             out.extend_from_slice(e);
-            out.extend(sigmas.iter().map(|s| s[k]));
+            if !sigmas.is_empty() {
+                let mut row = [0.0; SIGMA_COLUMNS.len()];
+                for (r, s) in row.iter_mut().zip(&sigmas) {
+                    *r = s[k];
+                }
+                push_sigmas(&mut out, &row);
+            }
             table.push_row(&out);
             Ok(())
         },
@@ -299,7 +319,7 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
             Some(f) if sigmas => {
                 out_row.clear();
                 out_row.extend_from_slice(e);
-                out_row.extend(row_sigmas.get());
+                push_sigmas(&mut out_row, &row_sigmas.get());
                 f.write_row(&out_row)
             }
             Some(f) => f.write_row(e),
