@@ -50,6 +50,35 @@ pub fn dashes(style: usize) -> Option<(u32, u32)> {
     }
 }
 
+/// Draws `points` as one line in `color` with the dash pattern of `style` ([`dashes`]) and
+/// labels it `label` with a key of the same pattern (no legend entry for an empty label).
+///
+/// # Errors
+/// The chart's drawing error, as text.
+pub fn draw_line<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    points: Vec<CT::From>,
+    color: RGBColor,
+    style: usize,
+    label: &str,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+    CT::From: Clone + 'static,
+{
+    let stroke = color.stroke_width(2);
+    let drawn = match dashes(style) {
+        None => chart.draw_series(LineSeries::new(points, stroke)),
+        Some((on, off)) => chart.draw_series(DashedLineSeries::new(points, on, off, stroke)),
+    }
+    .map_err(err)?;
+    if !label.is_empty() {
+        drawn.label(label).legend(key(color, style));
+    }
+    Ok(())
+}
+
 /// A series' legend key: a short line in its colour and with its dash pattern (`style`, as
 /// [`dashes`]).
 pub fn key(

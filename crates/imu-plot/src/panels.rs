@@ -5,9 +5,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::PlotError;
-use crate::draw::{
-    COLORS, dashes, draw_legend, err, every, key, stride_for, tick_on, write_figure,
-};
+use crate::draw::{COLORS, draw_legend, draw_line, err, every, stride_for, tick_on, write_figure};
 
 /// One line of a time-series panel.
 pub struct Series {
@@ -106,16 +104,13 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         .map_err(err)?;
     for s in &panel.series {
         let color = COLORS[s.color % COLORS.len()];
-        let pts = thin(finite(&s.points));
-        let stroke = color.stroke_width(2);
-        let drawn = match dashes(s.style) {
-            None => chart.draw_series(LineSeries::new(pts, stroke)),
-            Some((on, off)) => chart.draw_series(DashedLineSeries::new(pts, on, off, stroke)),
-        };
-        let drawn = drawn.map_err(err)?;
-        if !s.label.is_empty() {
-            drawn.label(s.label.clone()).legend(key(color, s.style));
-        }
+        draw_line(
+            &mut chart,
+            thin(finite(&s.points)),
+            color,
+            s.style,
+            &s.label,
+        )?;
     }
     draw_legend(&mut chart)
 }
@@ -197,14 +192,7 @@ pub fn draw_plan_view(
         // The second trace (an estimate over the truth) dashed, the third dotted, as in the panels.
         let color = COLORS[k % COLORS.len()];
         let p = pts(t);
-        let stroke = color.stroke_width(2);
-        match dashes(k) {
-            None => chart.draw_series(LineSeries::new(p.clone(), stroke)),
-            Some((on, off)) => chart.draw_series(DashedLineSeries::new(p.clone(), on, off, stroke)),
-        }
-        .map_err(err)?
-        .label(t.name.clone())
-        .legend(key(color, k));
+        draw_line(&mut chart, p.clone(), color, k, &t.name)?;
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])
@@ -262,14 +250,7 @@ pub fn draw_3d(
                 .map(|p| (p.0, p.2, p.1))
                 .collect(),
         );
-        let stroke = color.stroke_width(2);
-        match dashes(k) {
-            None => chart.draw_series(LineSeries::new(p.clone(), stroke)),
-            Some((on, off)) => chart.draw_series(DashedLineSeries::new(p.clone(), on, off, stroke)),
-        }
-        .map_err(err)?
-        .label(t.name.clone())
-        .legend(key(color, k));
+        draw_line(&mut chart, p.clone(), color, k, &t.name)?;
         if let (Some(first), Some(last)) = (p.first(), p.last()) {
             chart
                 .draw_series([Circle::new(*first, 6, color.filled())])
