@@ -173,3 +173,10 @@ def test_orientation_outputs_and_their_errors_have_their_panels():
     fig = imukit.plot.figure(errors)
     assert [len(ax.get_lines()) for ax in fig.axes] == [1, 3]   # quaternion distance; Euler errors
     np.testing.assert_allclose(fig.axes[1].get_lines()[0].get_ydata(), np.degrees(0.01), atol=1e-9)
+
+
+def test_a_figure_takes_a_size_and_resolution_and_is_titled_with_its_tables_and_frame(sim):
+    fig = ip.figure(sim.truth, size_in=(8.0, 5.0), dpi=150, nav_frame="NED", labels=["truth"])
+    assert tuple(fig.get_size_inches()) == (8.0, 5.0)
+    assert fig.dpi == 150
+    assert fig._suptitle.get_text() == "truth (truth) — NED"

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -169,10 +169,13 @@ def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = No
     return ax.figure
 
 
-def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU") -> Any:
+def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU",
+           size_in: Optional[Tuple[float, float]] = None, dpi: Optional[float] = None) -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
-    dashed, dotted, …; ``nav_frame="NED"`` paths are drawn east, north, up. Returns the figure."""
+    dashed, dotted, …; ``nav_frame="NED"`` paths are drawn east, north, up. ``size_in`` (width,
+    height in inches) and ``dpi`` as ``imukit plot --size --dpi``; the title names the tables,
+    their kind and the frame. Returns the figure."""
     loaded = _load(tables, labels)
     k = _kinds(loaded)
     if k == "allan":
@@ -186,7 +189,8 @@ def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_fra
     ncols = 2 if cells > 3 else 1
     nrows = -(-cells // ncols)
     plt = _pyplot()
-    fig = plt.figure(figsize=(5.6 * ncols, 3.2 * nrows), layout="constrained")
+    fig = plt.figure(figsize=size_in or (5.6 * ncols, 3.2 * nrows), dpi=dpi, layout="constrained")
+    fig.suptitle(f"{', '.join(n for n, _ in loaded)} ({k}) — {nav_frame}")
     index = 1
     if with_path:
         points = np.vstack([_points(t, nav_frame) for _, t in loaded])
