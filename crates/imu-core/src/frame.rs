@@ -47,7 +47,7 @@ pub trait NavFrame: Frame {
     fn from_ned() -> Rotation<Ned, Self>;
 }
 
-/// East-North-Up navigation frame (the default, as in the German seed). Body frame is FLU.
+/// East-North-Up navigation frame (the default). Body frame is FLU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Enu;
 
