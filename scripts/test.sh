@@ -66,7 +66,7 @@ if command -v cargo >/dev/null || command -v rustc >/dev/null; then
   exit 1
 fi
 (cd "$(mktemp -d)" && imukit demo >/dev/null && test -s imukit-demo/imu.csv && test -s imukit-demo/truth.png \
-  && python -c "import imukit; s = imukit.simulate(imukit.builtin_scenario_toml('figure8')); assert s.imu.values.shape[0] == 2001" \
+  && python -c "import imukit; s = imukit.simulate({'trajectory': {'type': 'builtin', 'name': 'figure8'}}); assert s.imu.values.shape[0] == 2001" \
   && test "$(imukit --version)" = "imukit $(python -c 'import imukit; print(imukit.__version__)')")
 export IMUKIT_BIN="$PWD/.venv-wheel/bin/imukit"
 
