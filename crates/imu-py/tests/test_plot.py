@@ -83,12 +83,15 @@ def test_errors_of_a_fused_estimate_are_drawn_against_three_sigma():
     nav = imukit.fuse(car.imu, car.gnss, initial=car.truth, scenario=scenario)
     errors, _ = imukit.compare(car.truth, nav)
     np.testing.assert_array_equal(errors["pos_x_sigma_m"], nav["pos_x_sigma_m"])
-    # Position and velocity gain a dotted pair at ±3σ per axis, as imukit plot draws them.
+    # Position and velocity gain a dotted pair at ±3σ per axis, the attitude angle one at ±3σ of
+    # the root sum of squares of its axes' one-sigma, as imukit plot draws them.
     fig = ip.figure(errors)
-    assert lines(fig) == [4 + 6, 3 + 6, 1]
+    assert lines(fig) == [4 + 6, 3 + 6, 1 + 2]
     pos = fig.axes[0].get_lines()
     np.testing.assert_allclose(pos[4].get_ydata(), 3 * nav["pos_x_sigma_m"])
     np.testing.assert_allclose(pos[5].get_ydata(), -3 * nav["pos_x_sigma_m"])
+    rss = np.sqrt(sum(nav[f"att_{a}_sigma_rad"] ** 2 for a in "xyz"))
+    np.testing.assert_allclose(fig.axes[2].get_lines()[1].get_ydata(), 3 * np.degrees(rss))
 
 
 def test_plain_arrays_by_column_name_plot_like_tables(sim):

@@ -878,8 +878,9 @@ impl FuseSetup {
     }
 }
 
-/// The Allan floor of flicker noise per unit bias instability, `√(2 ln 2/π)` (IEEE 952).
-const FLICKER_FLOOR: f64 = 0.664_282_47;
+/// The Allan floor of flicker noise per unit bias instability, `√(2 ln 2/π)` (IEEE 952): the
+/// one constant of the core's Allan analysis.
+const FLICKER_FLOOR: f64 = imu_core::allan::BIAS_INSTABILITY_FACTOR;
 
 /// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
 pub const MAX_REJECTED_IN_A_ROW: usize = 10;
