@@ -75,7 +75,7 @@ python -m mypy.stubtest imukit._core
 
 section "Python tests (the installed wheel)"
 python -m pytest -q crates/imu-py/tests tests/python --doctest-glob='*.md' README.md docs
-python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth
+python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth imukit._table
 
 section "Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"
 python tests/fuzz/hostile.py --cases 400 --seed 1
