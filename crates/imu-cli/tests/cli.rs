@@ -1313,7 +1313,7 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
     let (code, err) = integrate(&["--baro", "baro.csv"], "x.csv");
     assert_eq!(code, Some(65), "{err}");
     assert!(
-        err.contains("--baro: feeds the baro-damped vertical channel"),
+        err.contains("--baro: barometer readings feed the baro-damped vertical channel"),
         "{err}"
     );
     std::fs::write(dir.join("bad.csv"), "t_s,baro_height_m\n0,300\n0,301\n").unwrap();

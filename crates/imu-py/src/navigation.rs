@@ -124,6 +124,7 @@ fn strapdown<'py>(
         vertical,
         baro_time_constant_s,
         earth_gravity,
+        barometer: baro_columns.is_some(),
     }
     .setup()
     .map_err(refused)?;

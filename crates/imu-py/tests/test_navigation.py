@@ -296,3 +296,16 @@ def test_barometer_readings_damp_the_vertical_channel_of_earth_navigation():
     with pytest.raises(ImuError, match="needs t_s and baro_height_m"):
         imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED", earth="wgs84", vertical="baro",
                          baro=sim.truth)
+
+
+def test_barometer_readings_without_the_baro_channel_are_refused_as_by_the_command_line():
+    scenario = {"rate_hz": 10.0, "duration_s": 5.0, "earth": "wgs84",
+                "origin": {"latitude_deg": 45.0, "longitude_deg": 7.0, "height_m": 300.0},
+                "trajectory": {"type": "builtin", "name": "static"}, "baro": {"noise_m": 0.1}}
+    sim = imukit.simulate(scenario)
+    for vertical in ("free", "hold"):
+        with pytest.raises(ImuError, match="barometer readings feed the baro-damped vertical channel") as e:
+            imukit.strapdown(sim.imu, initial=sim.truth, earth="wgs84", vertical=vertical, baro=sim.baro)
+        assert e.value.field == "baro"
+    nav = imukit.strapdown(sim.imu, initial=sim.truth, earth="wgs84", vertical="baro", baro=sim.baro)
+    assert len(nav) == len(sim.imu)

@@ -84,6 +84,24 @@ fn a_nav_request_is_checked_field_by_field() {
         ..d
     };
     assert_eq!(rk4.setup().unwrap().scheme, NavScheme::Rk4 { substeps: 7 });
+    // Barometer readings feed the baro vertical channel only: with another they are refused,
+    // one rule for the command line and Python.
+    for vertical in ["free", "hold"] {
+        let r = NavRequest {
+            earth: "wgs84",
+            vertical,
+            barometer: true,
+            ..d
+        };
+        assert_eq!(field(r).as_deref(), Some("baro"), "{vertical}");
+    }
+    let baro = NavRequest {
+        earth: "wgs84",
+        vertical: "baro",
+        barometer: true,
+        ..d
+    };
+    assert!(baro.setup().is_ok());
 }
 
 #[test]

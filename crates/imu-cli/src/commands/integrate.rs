@@ -91,21 +91,13 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
         vertical: o.vertical,
         baro_time_constant_s: o.baro_time_constant_s,
         earth_gravity: o.earth_gravity,
+        barometer: o.baro.is_some(),
     }
     .setup()
     .map_err(by_flag)?;
     let mut inputs = vec![("input", c.input)];
     inputs.extend(o.init.map(|p| ("--init file", p)));
     inputs.extend(o.baro.map(|p| ("--baro file", p)));
-    if o.baro.is_some() && o.vertical != "baro" {
-        return Err(Error::Invalid {
-            field: "--baro".into(),
-            message:
-                "feeds the baro-damped vertical channel: use it with --earth wgs84 --vertical baro"
-                    .into(),
-        }
-        .into());
-    }
     check_outputs(&inputs, &[("--out", c.out)])?;
     let mut initial = match o.init {
         Some(p) => InitialState::from_csv(p)?,

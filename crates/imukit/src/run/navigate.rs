@@ -416,6 +416,11 @@ pub struct NavRequest<'a> {
     /// On the WGS-84 Earth: `"normal"` (WGS-84 normal gravity) or `"constant"`
     /// (`gravity_m_s2`).
     pub earth_gravity: &'a str,
+    /// Barometer readings come with the IMU data (the command line's `--baro` file, Python's
+    /// `baro=`). They feed the baro-damped vertical channel only, so they need
+    /// `vertical = "baro"`: given with another channel they are refused (field `baro`), the same
+    /// from every front end.
+    pub barometer: bool,
 }
 
 /// The baro loop's time constant unless told otherwise, s.
@@ -433,6 +438,7 @@ impl Default for NavRequest<'_> {
             sculling: true,
             earth: "flat",
             vertical: "free",
+            barometer: false,
             baro_time_constant_s: DEFAULT_BARO_TIME_CONSTANT_S,
             earth_gravity: "normal",
         }
@@ -445,6 +451,13 @@ impl NavRequest<'_> {
     /// # Errors
     /// [`crate::Error::Invalid`] naming the field.
     pub fn setup(&self) -> Result<NavSetup> {
+        if self.barometer && self.vertical != "baro" {
+            return Err(invalid(
+                "baro",
+                "barometer readings feed the baro-damped vertical channel: use them with the \
+                 WGS-84 Earth and the baro vertical channel",
+            ));
+        }
         let scheme = self
             .scheme
             .parse::<NavScheme>()
