@@ -33,22 +33,6 @@ pub struct FigureArgs {
     pub dpi: Option<f64>,
 }
 
-/// The shells `imukit completions` writes a script for.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum Shell {
-    /// Bash: `source <(imukit completions bash)`, or save it in
-    /// `~/.local/share/bash-completion/completions/imukit`.
-    Bash,
-    /// Zsh: save it as `_imukit` in a folder of `$fpath`.
-    Zsh,
-    /// Fish: save it in `~/.config/fish/completions/imukit.fish`.
-    Fish,
-    /// PowerShell: `imukit completions powershell | Out-String | Invoke-Expression`.
-    Powershell,
-    /// Elvish.
-    Elvish,
-}
-
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 #[allow(
@@ -389,9 +373,10 @@ pub enum Command {
     },
     /// Prints a shell's completion script for imukit to standard output.
     Completions {
-        /// The shell.
+        /// The shell (bash: `source <(imukit completions bash)`; zsh: save it as `_imukit` in a
+        /// folder of `$fpath`; fish: `~/.config/fish/completions/imukit.fish`).
         #[arg(value_enum)]
-        shell: Shell,
+        shell: clap_complete::Shell,
     },
     /// Prints imukit's manual page (roff) to standard output, or with --out-dir writes one page
     /// per command (imukit.1, imukit-simulate.1, …) into a folder: `imukit man | man -l -`.

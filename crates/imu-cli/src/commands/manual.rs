@@ -8,35 +8,12 @@ use clap::CommandFactory;
 use imukit::io::output::write_atomically;
 
 use super::CliError;
-use crate::cli::{Cli, Shell};
+use crate::cli::Cli;
 
 /// Writes the completion script of `shell` to standard output.
-pub fn completions(shell: Shell) -> Result<(), CliError> {
-    let mut command = Cli::command();
+pub fn completions(shell: clap_complete::Shell) -> Result<(), CliError> {
     let mut out = Vec::new();
-    match shell {
-        Shell::Bash => {
-            clap_complete::generate(clap_complete::Shell::Bash, &mut command, "imukit", &mut out)
-        }
-        Shell::Zsh => {
-            clap_complete::generate(clap_complete::Shell::Zsh, &mut command, "imukit", &mut out)
-        }
-        Shell::Fish => {
-            clap_complete::generate(clap_complete::Shell::Fish, &mut command, "imukit", &mut out)
-        }
-        Shell::Powershell => clap_complete::generate(
-            clap_complete::Shell::PowerShell,
-            &mut command,
-            "imukit",
-            &mut out,
-        ),
-        Shell::Elvish => clap_complete::generate(
-            clap_complete::Shell::Elvish,
-            &mut command,
-            "imukit",
-            &mut out,
-        ),
-    }
+    clap_complete::generate(shell, &mut Cli::command(), "imukit", &mut out);
     to_stdout(&out)
 }
 
