@@ -7,7 +7,6 @@ use imu_core::sensor::ImuReading;
 
 use crate::io::params::ImuParams;
 use crate::io::units::convert;
-use crate::sensor::SensorParams;
 
 /// Above this turn between two samples (rad) the sampling is too coarse for the motion: the
 /// body's rotation is no longer resolved, and navigation from the readings loses accuracy
@@ -22,6 +21,8 @@ struct Plausible {
     high: f64,
     /// The units a pasted figure was likely written in, as `imukit convert` names them.
     likely: &'static [&'static str],
+    /// The figure's three axes in the parameters.
+    of: fn(&ImuParams) -> [f64; 3],
 }
 
 const PLAUSIBLE: [Plausible; 6] = [
@@ -31,6 +32,7 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "rad/s/√Hz",
         high: 0.01,
         likely: &["°/√h", "mdps/√Hz"],
+        of: |p| p.gyroscope.noise_density,
     },
     Plausible {
         key: "bias_instability",
@@ -38,6 +40,7 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "rad/s",
         high: 0.01,
         likely: &["°/h", "°/s"],
+        of: |p| p.gyroscope.bias_instability,
     },
     Plausible {
         key: "constant_bias",
@@ -45,6 +48,7 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "rad/s",
         high: 1.0,
         likely: &["°/h", "°/s"],
+        of: |p| p.gyroscope.constant_bias,
     },
     Plausible {
         key: "noise_density",
@@ -52,6 +56,7 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "m/s²/√Hz",
         high: 0.05,
         likely: &["µg/√Hz"],
+        of: |p| p.accelerometer.noise_density,
     },
     Plausible {
         key: "bias_instability",
@@ -59,6 +64,7 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "m/s²",
         high: 0.5,
         likely: &["µg", "mg"],
+        of: |p| p.accelerometer.bias_instability,
     },
     Plausible {
         key: "constant_bias",
@@ -66,16 +72,9 @@ const PLAUSIBLE: [Plausible; 6] = [
         unit: "m/s²",
         high: 5.0,
         likely: &["mg", "µg"],
+        of: |p| p.accelerometer.constant_bias,
     },
 ];
-
-fn figure(params: &SensorParams, key: &str) -> [f64; 3] {
-    match key {
-        "noise_density" => params.noise_density,
-        "bias_instability" => params.bias_instability,
-        _ => params.constant_bias,
-    }
-}
 
 /// Warnings for sensor figures no part of any grade has, each naming the likely unit slip and
 /// what the figure would be in SI if it was one.
@@ -83,11 +82,7 @@ fn figure(params: &SensorParams, key: &str) -> [f64; 3] {
 pub fn implausible_figures(params: &ImuParams) -> Vec<String> {
     let mut out = Vec::new();
     for p in &PLAUSIBLE {
-        let sensor = match p.sensor {
-            "gyroscope" => &params.gyroscope,
-            _ => &params.accelerometer,
-        };
-        let values = figure(sensor, p.key);
+        let values = (p.of)(params);
         let Some(worst) = values
             .iter()
             .copied()
