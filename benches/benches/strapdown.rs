@@ -7,16 +7,15 @@
 #![allow(missing_docs)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use imu_core::Enu;
-use imu_core::earth::Geodetic;
-use imu_core::strapdown::earth::{
-    EarthNavState, EarthOptions, strapdown_increments_earth, strapdown_rates_earth,
-};
+use imu_core::earth::{FlatEarth, Geodetic, Wgs84};
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
-use imu_core::strapdown::rk4::strapdown_rates_rk4;
-use imu_core::strapdown::step::{
-    NavState, StrapdownOptions, strapdown_increments, strapdown_rates,
+use imu_core::strapdown::{
+    NavState, StrapdownOptions, strapdown_increments, strapdown_rates, strapdown_rates_rk4,
 };
+use imu_core::{Enu, Ned};
+
+type FlatNavState = NavState<FlatEarth<Enu>>;
+type EarthNavState = NavState<Wgs84<Ned>>;
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("strapdown");
@@ -27,11 +26,13 @@ fn bench(c: &mut Criterion) {
             .map(|s| [0.3 * s.sin(), 0.2, -0.1 * s.cos()])
             .collect();
         let accel: Vec<[f64; 3]> = t.iter().map(|s| [0.5 * s.cos(), 0.1, 9.81]).collect();
-        let mut out = vec![NavState::<Enu>::default(); n];
+        let flat = FlatEarth::<Enu>::new(9.81);
+        let mut out = vec![FlatNavState::default(); n];
         group.throughput(Throughput::Elements(n as u64));
         group.bench_function(BenchmarkId::new("3d_rates", n), |b| {
             b.iter(|| {
                 strapdown_rates(
+                    flat,
                     &t,
                     &gyro,
                     &accel,
@@ -48,9 +49,11 @@ fn bench(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("3d_increments_flat", n), |b| {
             b.iter(|| {
                 strapdown_increments(
+                    flat,
                     &t,
                     &dth,
                     &dv,
+                    None,
                     NavState::default(),
                     StrapdownOptions::default(),
                     &mut out,
@@ -65,13 +68,14 @@ fn bench(c: &mut Criterion) {
         let mut eout = vec![EarthNavState::default(); n];
         group.bench_function(BenchmarkId::new("3d_increments_earth", n), |b| {
             b.iter(|| {
-                strapdown_increments_earth(
+                strapdown_increments(
+                    Wgs84::default(),
                     &t,
                     &dth,
                     &dv,
                     None,
-                    &start,
-                    EarthOptions::default(),
+                    start,
+                    StrapdownOptions::default(),
                     &mut eout,
                 )
                 .expect("valid")
@@ -80,19 +84,30 @@ fn bench(c: &mut Criterion) {
         if n >= 6 {
             group.bench_function(BenchmarkId::new("3d_rk4_flat", n), |b| {
                 b.iter(|| {
-                    strapdown_rates_rk4(&t, &gyro, &accel, NavState::default(), 9.81, 4, &mut out)
-                        .expect("valid")
-                });
-            });
-            group.bench_function(BenchmarkId::new("3d_rk4_earth", n), |b| {
-                b.iter(|| {
-                    strapdown_rates_earth(
+                    strapdown_rates_rk4(
+                        flat,
                         &t,
                         &gyro,
                         &accel,
                         None,
-                        &start,
-                        EarthOptions::default(),
+                        NavState::default(),
+                        StrapdownOptions::default(),
+                        4,
+                        &mut out,
+                    )
+                    .expect("valid")
+                });
+            });
+            group.bench_function(BenchmarkId::new("3d_rk4_earth", n), |b| {
+                b.iter(|| {
+                    strapdown_rates_rk4(
+                        Wgs84::default(),
+                        &t,
+                        &gyro,
+                        &accel,
+                        None,
+                        start,
+                        StrapdownOptions::default(),
                         4,
                         &mut eout,
                     )

@@ -45,6 +45,14 @@ pub trait NavFrame: Frame {
     /// The change of axes from NED to this frame (the identity for NED).
     #[must_use]
     fn from_ned() -> Rotation<Ned, Self>;
+
+    /// A NED vector re-resolved in this frame, by exchanging axes (exact; ENU `(y, x, −z)`).
+    #[must_use]
+    fn from_ned_axes(v: Vec3<Ned>) -> Vec3<Self>;
+
+    /// A vector of this frame re-resolved in NED (the inverse of [`Self::from_ned_axes`]).
+    #[must_use]
+    fn to_ned_axes(v: Vec3<Self>) -> Vec3<Ned>;
 }
 
 /// East-North-Up navigation frame (the default). Body frame is FLU.
@@ -86,6 +94,12 @@ impl NavFrame for Enu {
     fn from_ned() -> Rotation<Ned, Self> {
         Rotation::ned_to_enu()
     }
+    fn from_ned_axes(v: Vec3<Ned>) -> Vec3<Self> {
+        Vec3::new(v.y(), v.x(), -v.z())
+    }
+    fn to_ned_axes(v: Vec3<Self>) -> Vec3<Ned> {
+        Vec3::new(v.y(), v.x(), -v.z())
+    }
 }
 
 impl NavFrame for Ned {
@@ -95,5 +109,11 @@ impl NavFrame for Ned {
     }
     fn from_ned() -> Rotation<Ned, Self> {
         Rotation::identity()
+    }
+    fn from_ned_axes(v: Vec3<Ned>) -> Vec3<Self> {
+        v
+    }
+    fn to_ned_axes(v: Vec3<Self>) -> Vec3<Ned> {
+        v
     }
 }

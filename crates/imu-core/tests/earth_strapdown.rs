@@ -2,13 +2,16 @@
 //! is recovered from its ideal IMU, the increments scheme converges at second order, an
 //! accelerometer bias excites the 84-minute Schuler oscillation, the free vertical channel
 //! diverges with the e-folding time √(R/2g), and the baro loop holds it.
+use imu_core::earth::Wgs84;
 use imu_core::earth::ideal::EcefKinematics;
 use imu_core::earth::rates::MAX_LATITUDE_RAD;
 use imu_core::earth::{EarthMount, EarthTruth, Geodetic, normal_gravity_m_s2};
-use imu_core::strapdown::earth::{
-    EarthNavState, EarthOptions, VerticalChannel, strapdown_increments_earth, strapdown_rates_earth,
+use imu_core::strapdown::{
+    NavState, StrapdownError, StrapdownOptions, VerticalChannel, strapdown_increments,
+    strapdown_rates_rk4,
 };
-use imu_core::strapdown::step::StrapdownError;
+
+type EarthNavState = NavState<Wgs84<Ned>>;
 use imu_core::{Body, EulerZyx, Ned, Rotation, Vec3};
 
 /// A level body at rest at 45° N, 100 m up.
@@ -42,11 +45,22 @@ fn run_constant(
     let w = vec![gyro.to_array(); n];
     let f = vec![accel.to_array(); n];
     let mut out = vec![EarthNavState::default(); n];
-    let options = EarthOptions {
+    let options = StrapdownOptions {
         vertical,
-        ..EarthOptions::default()
+        ..StrapdownOptions::default()
     };
-    strapdown_rates_earth(&t, &w, &f, baro, start, options, 2, &mut out).unwrap();
+    strapdown_rates_rk4(
+        Wgs84::default(),
+        &t,
+        &w,
+        &f,
+        baro,
+        *start,
+        options,
+        2,
+        &mut out,
+    )
+    .unwrap();
     out
 }
 
@@ -266,13 +280,14 @@ fn a_30_minute_flight_is_recovered_from_its_ideal_imu_by_the_fourth_order_scheme
         .map(|s| mount.specific_force(s).to_array())
         .collect();
     let mut out = vec![EarthNavState::default(); n];
-    strapdown_rates_earth(
+    strapdown_rates_rk4(
+        Wgs84::default(),
         &t,
         &gyro,
         &accel,
         None,
-        &nav_state(&truth[0]),
-        EarthOptions::default(),
+        nav_state(&truth[0]),
+        StrapdownOptions::default(),
         4,
         &mut out,
     )
@@ -323,13 +338,14 @@ fn the_increments_scheme_converges_at_second_order() {
         let t: Vec<f64> = (0..n).map(|k| k as f64 / rate).collect();
         let (dth, dv) = increments(&t);
         let mut out = vec![EarthNavState::default(); n];
-        strapdown_increments_earth(
+        strapdown_increments(
+            Wgs84::default(),
             &t,
             &dth,
             &dv,
             None,
-            &nav_state(&flight(0.0)),
-            EarthOptions::default(),
+            nav_state(&flight(0.0)),
+            StrapdownOptions::default(),
             &mut out,
         )
         .unwrap();
@@ -348,13 +364,14 @@ fn the_increments_scheme_converges_at_second_order() {
 fn the_poles_are_refused_by_sample() {
     let mut start = nav_state(&rest_45());
     start.position.latitude_rad = 89.95f64.to_radians();
-    let err = strapdown_rates_earth(
+    let err = strapdown_rates_rk4(
+        Wgs84::default(),
         &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0],
         &[[0.0; 3]; 6],
         &[[0.0, 0.0, -9.8]; 6],
         None,
-        &start,
-        EarthOptions::default(),
+        start,
+        StrapdownOptions::default(),
         1,
         &mut [EarthNavState::default(); 6],
     )
@@ -368,15 +385,16 @@ fn the_poles_are_refused_by_sample() {
     let t: Vec<f64> = (0..n).map(f64::from).collect();
     let g = normal_gravity_m_s2(&start.position);
     let mut out = vec![EarthNavState::default(); n as usize];
-    let err = strapdown_rates_earth(
+    let err = strapdown_rates_rk4(
+        Wgs84::default(),
         &t,
         &vec![[0.0; 3]; n as usize],
         &vec![[0.0, 0.0, -g]; n as usize],
         None,
-        &start,
-        EarthOptions {
+        start,
+        StrapdownOptions {
             vertical: VerticalChannel::Hold,
-            ..EarthOptions::default()
+            ..StrapdownOptions::default()
         },
         1,
         &mut out,
@@ -388,17 +406,18 @@ fn the_poles_are_refused_by_sample() {
     assert!((35..=40).contains(&index), "{index}");
     assert!((MAX_LATITUDE_RAD.to_degrees() - 89.9).abs() < 1e-12);
     // A baro channel needs heights.
-    let err = strapdown_rates_earth(
+    let err = strapdown_rates_rk4(
+        Wgs84::default(),
         &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0],
         &[[0.0; 3]; 6],
         &[[0.0; 3]; 6],
         None,
-        &nav_state(&rest_45()),
-        EarthOptions {
+        nav_state(&rest_45()),
+        StrapdownOptions {
             vertical: VerticalChannel::Baro {
                 time_constant_s: 100.0,
             },
-            ..EarthOptions::default()
+            ..StrapdownOptions::default()
         },
         1,
         &mut [EarthNavState::default(); 6],

@@ -5,8 +5,8 @@ use imu_core::KinematicsError;
 use imu_core::allan::AllanError;
 use imu_core::orientation::OrientError;
 use imu_core::sensor::{ImuParamError, ParamError};
+use imu_core::strapdown::StrapdownError;
 use imu_core::strapdown::planar::PlanarError;
-use imu_core::strapdown::step::StrapdownError;
 
 use crate::motion::expr::ExprError;
 

@@ -1,7 +1,8 @@
 //! 3D strapdown: stationary, bias growth, classic coning (closed form), and round trips.
+use imu_core::earth::FlatEarth;
 use imu_core::kinematics::sampled::{SampledAttitude, SampledOptions, truth_from_samples};
-use imu_core::strapdown::step::{
-    NavState, RateStrapdown, StrapdownError, StrapdownOptions, strapdown_increments,
+use imu_core::strapdown::{
+    NavState, RateIncrements, StrapdownError, StrapdownOptions, strapdown_increments,
     strapdown_rates,
 };
 use imu_core::{Body, Enu, IdealReading, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
@@ -13,13 +14,18 @@ const G: f64 = 9.81;
 fn stationary_case<N: NavFrame>() {
     // Level, at rest: gyro 0, accelerometer −g_n (specific force), one hour at 100 Hz.
     let f = [0.0, 0.0, N::Z_UP * G];
-    let mut nav = RateStrapdown::<N>::new(NavState::default(), StrapdownOptions::default());
+    let mut nav = RateIncrements::new(
+        FlatEarth::<N>::new(G),
+        NavState::default(),
+        StrapdownOptions::default(),
+    )
+    .unwrap();
     let mut last = NavState::default();
     for k in 0..=360_000 {
         last = nav.step(k as f64 / 100.0, [0.0; 3], f).unwrap();
     }
     // h·(f₀ + f₁) with h = Δt/2 equals g·Δt bit for bit, so nothing accumulates at all.
-    assert_eq!(last.position_m.to_array(), [0.0; 3]);
+    assert_eq!(last.position.to_array(), [0.0; 3]);
     assert_eq!(last.velocity_m_s.to_array(), [0.0; 3]);
     assert_eq!(last.attitude.to_wxyz(), [1.0, 0.0, 0.0, 0.0]);
 }
@@ -37,18 +43,23 @@ fn stationary_ideal_input_keeps_the_initial_state_for_an_hour_ned() {
 #[test]
 fn accelerometer_bias_gives_half_b_t_squared() {
     let b = 0.01;
-    let mut nav = RateStrapdown::<Enu>::new(NavState::default(), StrapdownOptions::default());
+    let mut nav = RateIncrements::new(
+        FlatEarth::<Enu>::new(G),
+        NavState::default(),
+        StrapdownOptions::default(),
+    )
+    .unwrap();
     let mut s = NavState::default();
     for k in 0..=6000 {
         s = nav.step(k as f64 / 100.0, [0.0; 3], [b, 0.0, G]).unwrap();
     }
     let t: f64 = 60.0;
     assert!(
-        (s.position_m.x() - 0.5 * b * t * t).abs() < 1e-9,
+        (s.position.x() - 0.5 * b * t * t).abs() < 1e-9,
         "{}",
-        s.position_m.x()
+        s.position.x()
     );
-    assert!(s.position_m.y().abs() < 1e-12 && s.position_m.z().abs() < 1e-9);
+    assert!(s.position.y().abs() < 1e-12 && s.position.z().abs() < 1e-9);
 }
 
 #[test]
@@ -56,7 +67,12 @@ fn gyro_bias_gives_about_g_b_t_cubed_over_six() {
     // A bias about body x tilts the platform: the y error grows as g·b·t³/6 (small angles; the
     // exact value is g(t − sin(bt)/b)/b for a rotation at rate b).
     let b = 1e-4;
-    let mut nav = RateStrapdown::<Enu>::new(NavState::default(), StrapdownOptions::default());
+    let mut nav = RateIncrements::new(
+        FlatEarth::<Enu>::new(G),
+        NavState::default(),
+        StrapdownOptions::default(),
+    )
+    .unwrap();
     let mut s = NavState::default();
     for k in 0..=6000 {
         s = nav
@@ -67,9 +83,9 @@ fn gyro_bias_gives_about_g_b_t_cubed_over_six() {
     let approx = G * b * t.powi(3) / 6.0;
     // Tilting about x by bt turns the measured +g towards −y (nav): sign negative.
     assert!(
-        (s.position_m.y() + approx).abs() < 1e-3 * approx,
+        (s.position.y() + approx).abs() < 1e-3 * approx,
         "{} vs {}",
-        s.position_m.y(),
+        s.position.y(),
         -approx
     );
 }
@@ -143,17 +159,26 @@ fn coning_attitude_error(coning: bool) -> f64 {
         })
         .collect();
     let f = vec![[0.0; 3]; n + 1];
-    let initial = NavState::<Enu> {
+    let initial = NavState::<FlatEarth<Enu>> {
         attitude: Rotation::from_wxyz(cone_q(0.0)).unwrap(),
         ..NavState::default()
     };
-    let mut out = vec![NavState::<Enu>::default(); n + 1];
+    let mut out = vec![NavState::<FlatEarth<Enu>>::default(); n + 1];
     let opts = StrapdownOptions {
         coning,
-        gravity_m_s2: 0.0,
         ..StrapdownOptions::default()
     };
-    strapdown_increments(&t, &dth, &f, initial, opts, &mut out).unwrap();
+    strapdown_increments(
+        FlatEarth::new(0.0),
+        &t,
+        &dth,
+        &f,
+        None,
+        initial,
+        opts,
+        &mut out,
+    )
+    .unwrap();
     let truth = Rotation::<Body, Enu>::from_wxyz(cone_q(t[n])).unwrap();
     out[n].attitude.quaternion().angle_to(truth.quaternion())
 }
@@ -179,13 +204,22 @@ fn helix_error(rate: f64, seconds: f64) -> f64 {
         t_s: 0.0,
         attitude: truth[0].attitude,
         velocity_m_s: truth[0].velocity_m_s,
-        position_m: truth[0].position_m,
+        position: truth[0].position_m,
     };
-    let mut out = vec![NavState::<Enu>::default(); t.len()];
-    strapdown_rates(&t, &gyro, &acc, s0, StrapdownOptions::default(), &mut out).unwrap();
+    let mut out = vec![NavState::<FlatEarth<Enu>>::default(); t.len()];
+    strapdown_rates(
+        FlatEarth::new(G),
+        &t,
+        &gyro,
+        &acc,
+        s0,
+        StrapdownOptions::default(),
+        &mut out,
+    )
+    .unwrap();
     out.iter()
         .zip(&truth)
-        .map(|(a, b)| (a.position_m - b.position_m).norm())
+        .map(|(a, b)| (a.position - b.position_m).norm())
         .fold(0.0, f64::max)
 }
 
@@ -206,7 +240,12 @@ fn round_trip_on_a_rolling_helix_converges_at_second_order() {
 
 #[test]
 fn bad_strapdown_input_is_refused_with_its_index() {
-    let mut nav = RateStrapdown::<Enu>::new(NavState::default(), StrapdownOptions::default());
+    let mut nav = RateIncrements::new(
+        FlatEarth::<Enu>::new(G),
+        NavState::default(),
+        StrapdownOptions::default(),
+    )
+    .unwrap();
     nav.step(0.0, [0.0; 3], [0.0, 0.0, G]).unwrap();
     assert_eq!(
         nav.step(0.0, [0.0; 3], [0.0, 0.0, G]),
@@ -216,9 +255,10 @@ fn bad_strapdown_input_is_refused_with_its_index() {
         nav.step(0.01, [f64::NAN, 0.0, 0.0], [0.0, 0.0, G]),
         Err(StrapdownError::NotFinite { index: 1 })
     );
-    let mut out = vec![NavState::<Enu>::default(); 2];
+    let mut out = vec![NavState::<FlatEarth<Enu>>::default(); 2];
     assert!(matches!(
         strapdown_rates(
+            FlatEarth::new(G),
             &[0.0, 0.1],
             &[[0.0; 3]],
             &[[0.0; 3]; 2],
@@ -246,13 +286,24 @@ fn helix_error_rk4(rate: f64, seconds: f64, substeps: usize) -> f64 {
         t_s: 0.0,
         attitude: truth[0].attitude,
         velocity_m_s: truth[0].velocity_m_s,
-        position_m: truth[0].position_m,
+        position: truth[0].position_m,
     };
-    let mut out = vec![NavState::<Enu>::default(); t.len()];
-    strapdown_rates_rk4(&t, &gyro, &acc, s0, G, substeps, &mut out).unwrap();
+    let mut out = vec![NavState::<FlatEarth<Enu>>::default(); t.len()];
+    strapdown_rates_rk4(
+        FlatEarth::new(G),
+        &t,
+        &gyro,
+        &acc,
+        None,
+        s0,
+        StrapdownOptions::default(),
+        substeps,
+        &mut out,
+    )
+    .unwrap();
     out.iter()
         .zip(&truth)
-        .map(|(a, b)| (a.position_m - b.position_m).norm())
+        .map(|(a, b)| (a.position - b.position_m).norm())
         .fold(0.0, f64::max)
 }
 
@@ -271,14 +322,16 @@ fn rk4_round_trip_converges_at_fourth_order_and_meets_1e_6_m_after_60_s_at_1_khz
     let long = helix_error_rk4(1000.0, 60.0, 4);
     eprintln!("rolling helix, RK4 (4 substeps), 60 s at 1 kHz: {long:e} m");
     assert!(long <= 1e-6, "{long}");
-    let mut out = vec![NavState::<Enu>::default(); 5];
+    let mut out = vec![NavState::<FlatEarth<Enu>>::default(); 5];
     assert!(
         imu_core::strapdown::rk4::strapdown_rates_rk4(
+            FlatEarth::new(G),
             &[0.0, 1.0, 2.0, 3.0, 4.0],
             &[[0.0; 3]; 5],
             &[[0.0; 3]; 5],
+            None,
             NavState::default(),
-            G,
+            StrapdownOptions::default(),
             1,
             &mut out
         )

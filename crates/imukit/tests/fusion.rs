@@ -5,10 +5,12 @@
 //! heading is observable only when the vehicle accelerates horizontally.
 use std::path::Path;
 
+use imu_core::earth::FlatEarth;
 use imu_core::fusion::{
-    BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, InitialSigma, SensorErrorSigma,
+    BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma, SensorErrorSigma,
 };
 use imu_core::sensor::{NoiseSource, SeededNormals};
+use imu_core::strapdown::NavState;
 use imu_core::{Body, Enu, Rotation, Vec3};
 use imukit::run::fuse::{FuseSetup, fuse};
 use imukit::run::navigate::InitialState;
@@ -226,20 +228,22 @@ fn average_nees<const S: usize>(
         let c0 = Rotation::<Body, Enu>::from_wxyz(q_true[0]).unwrap();
         let start_q = *c0.quaternion();
         let start = EskfState {
-            t_s: t[0],
-            position_m: Vec3::<Enu>::from_array(p_true[0])
-                + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.position_m,
-            velocity_m_s: Vec3::<Enu>::from_array(v_true[0])
-                + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.velocity_m_s,
-            // Ĉ = (I − [φ×]) C_true: the estimate off by −φ.
-            attitude: Rotation::assume_from_quaternion(
-                nalgebra::UnitQuaternion::from_scaled_axis(-nalgebra::Vector3::from(tilt))
-                    * start_q,
-            ),
+            nav: NavState {
+                t_s: t[0],
+                position: Vec3::<Enu>::from_array(p_true[0])
+                    + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.position_m,
+                velocity_m_s: Vec3::<Enu>::from_array(v_true[0])
+                    + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.velocity_m_s,
+                // Ĉ = (I − [φ×]) C_true: the estimate off by −φ.
+                attitude: Rotation::assume_from_quaternion(
+                    nalgebra::UnitQuaternion::from_scaled_axis(-nalgebra::Vector3::from(tilt))
+                        * start_q,
+                ),
+            },
             accel_bias_m_s2: [0, 1, 2].map(|_| d(sigma0.accel_bias_m_s2)),
             gyro_bias_rad_s: [0, 1, 2].map(|_| d(sigma0.gyro_bias_rad_s)),
         };
-        let mut f = Eskf::<Enu, S>::new(&start, &sigma0, noise, 9.81)
+        let mut f = Eskf::<_, S>::new(FlatEarth::<Enu>::new(9.81), &start, &sigma0, noise)
             .unwrap()
             .with_covariance_interval(covariance_interval_s)
             .unwrap();
@@ -265,16 +269,15 @@ fn average_nees<const S: usize>(
         for i in 0..t.len() {
             f.propagate(t[i], w[i], a[i]).unwrap();
             while next < g_t.len() && g_t[next] <= t[i] {
-                let outcome = f
-                    .update_gnss(
-                        Vec3::from_array(g_p[next]),
-                        Some(Vec3::from_array(g_v[next])),
-                        Vec3::zeros(),
-                        [sigma_h * s2, sigma_h * s2, sigma_v * s2],
-                        [sigma_vel; 3],
-                        f64::INFINITY,
-                    )
-                    .unwrap();
+                let fix = GnssFix {
+                    position: Vec3::from_array(g_p[next]),
+                    velocity_m_s: Some(Vec3::from_array(g_v[next])),
+                    lever_arm_m: Vec3::zeros(),
+                    position_sigma_m: [sigma_h * s2, sigma_h * s2, sigma_v * s2],
+                    velocity_sigma_m_s: [sigma_vel; 3],
+                    age_s: 0.0,
+                };
+                let outcome = f.update_gnss(&fix, f64::INFINITY).unwrap();
                 nis_sum += outcome.nis;
                 fixes += 1;
                 next += 1;
@@ -290,12 +293,12 @@ fn average_nees<const S: usize>(
             }
             if (t[i] - check_s).abs() < 1e-9 {
                 let s = f.state();
-                let ep = nalgebra::Vector3::from(p_true[i]) - s.position_m.as_nalgebra();
-                let ev = nalgebra::Vector3::from(v_true[i]) - s.velocity_m_s.as_nalgebra();
+                let ep = nalgebra::Vector3::from(p_true[i]) - s.nav.position.as_nalgebra();
+                let ev = nalgebra::Vector3::from(v_true[i]) - s.nav.velocity_m_s.as_nalgebra();
                 let qt = *Rotation::<Body, Enu>::from_wxyz(q_true[i])
                     .unwrap()
                     .quaternion();
-                let ea = (qt * s.attitude.quaternion().inverse()).scaled_axis();
+                let ea = (qt * s.nav.attitude.quaternion().inverse()).scaled_axis();
                 for (k, e) in [ep, ev, ea].iter().enumerate() {
                     let block =
                         nalgebra::Matrix3::from_fn(|r, c| f.covariance(3 * k + r, 3 * k + c));

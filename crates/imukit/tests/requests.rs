@@ -37,7 +37,7 @@ fn imu_kind_names_round_trip_through_the_scenario_parser() {
 #[test]
 fn a_nav_request_is_checked_field_by_field() {
     let ok = NavRequest::default().setup().unwrap();
-    assert_eq!(ok.options.gravity_m_s2, imu_core::DEFAULT_GRAVITY_M_S2);
+    assert_eq!(ok.gravity_m_s2, imu_core::DEFAULT_GRAVITY_M_S2);
     let field = |r: NavRequest<'_>| r.setup().unwrap_err().location().field;
     let d = NavRequest::default();
     assert_eq!(

@@ -9,12 +9,14 @@
 //! sources.
 pub mod gravity;
 pub mod ideal;
+pub mod model;
 pub mod rates;
 pub mod wgs84;
 pub mod wmm;
 
 pub use gravity::{GravityModel, normal_gravity_m_s2};
 pub use ideal::{EarthMount, EarthTruth, EcefKinematics};
+pub use model::{EarthModel, EarthTerms, ErrorCouplings, FlatEarth, Wgs84};
 pub use rates::{MAX_LATITUDE_RAD, earth_rate_ned, transport_rate_ned};
 pub use wgs84::Geodetic;
 pub use wmm::{MagneticModel, WmmError};

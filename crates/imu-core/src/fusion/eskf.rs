@@ -1,33 +1,43 @@
-//! A loosely coupled error-state Kalman filter: 15 error states — position, velocity, attitude
-//! (a small rotation φ of the navigation frame, `C_true = (I + [φ×]) Ĉ`), accelerometer bias,
-//! gyroscope bias — around a strapdown nominal state on the flat Earth (frame `N`, constant
-//! gravity), with closed-loop correction after every update.
+//! A loosely coupled error-state Kalman filter on any [`EarthModel`]: 15 error states —
+//! position (metres of the navigation frame), velocity, attitude (a small rotation φ of the
+//! navigation frame, `C_true = (I + [φ×]) Ĉ`), accelerometer bias, gyroscope bias — or 36 with
+//! the sensors' scale-factor, misalignment and g-sensitivity errors of
+//! [`super::sensor_errors`], around the strapdown of [`crate::strapdown::increments`]
+//! (increments by the trapezoid of each interval's rate samples, coning and sculling, the
+//! Earth's terms), with closed-loop correction after every update. Fixed-size matrices, no
+//! heap.
 //!
-//! Propagation per IMU interval `Δt` (rates `ω_m`, `f_m`, biases removed, averaged over the
-//! interval): `q ← q ⊗ exp(ω̂ Δt)`, `v ← v + Ĉ_mid f̂ Δt + g Δt`, `p ← p + ½ (v₀ + v₁) Δt`.
-//! Error dynamics (Groves 2nd ed. §14.2, flat Earth):
-//! `δṗ = δv`, `δv̇ = −[f^n×] φ − Ĉ δb_a − Ĉ n_a`, `φ̇ = −Ĉ δb_g − Ĉ n_g`, `δḃ = n_b`
-//! (random-walk biases). `Φ = I + F Δt + (F Δt)²/2`; `Q_d = ½ (Φ G Q Gᵀ Φᵀ + G Q Gᵀ) Δt`.
+//! Error dynamics (Groves 2nd ed. §14.2, local-navigation frame, position error in metres):
+//! `δṗ = δv`; `δv̇ = −[f^n×]φ − Ĉ δb_a − Ĉ n_a + G δp − [(2ω_ie + ω_en)×] δv`;
+//! `φ̇ = −Ĉ δb_g − Ĉ n_g − [ω_in×]φ − (∂ω_in/∂p) δp − (∂ω_en/∂v) δv`; `δḃ = n_b` (random-walk
+//! biases). The Earth's couplings (`G`, the gravity gradient's vertical term; the frame rate's
+//! derivatives, which close the Schuler loop) come from [`EarthModel::couplings`] and vanish on
+//! the flat Earth. `Φ = I + A`, `A = FΔt + (FΔt)²/2`, kept as its non-zero 3 × 3 blocks (the
+//! rows below the attitude are zero); `Q_d = ½ (Φ G Q Gᵀ Φᵀ + G Q Gᵀ) Δt`.
+//!
 //! Updates: GNSS position and velocity at an antenna lever arm `l`
 //! (`p_a = p + Ĉ l`, `v_a = v + Ĉ (ω̂ × l)`), with `H` from
-//! `δp_a = δp − [(Ĉ l)×] φ` and `δv_a = δv − [(Ĉ(ω̂×l))×] φ + Ĉ [l×] δb_g`; Joseph form,
-//! symmetrised; a chi-square innovation gate (normalised innovation squared, NIS) rejects and
-//! counts outliers. Ground-vehicle aiding: body-frame velocity (odometer forward speed,
-//! non-holonomic zero lateral and vertical velocity) with `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`, and
-//! height (barometer) on the frame's up axis.
-use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
+//! `δp_a = δp − [(Ĉ l)×] φ` and `δv_a = δv − [(Ĉ(ω̂×l))×] φ + Ĉ [l×] δb_g`, the position
+//! innovation the Earth's [`EarthModel::displacement_m`]; Joseph form, symmetrised; a
+//! chi-square innovation gate (normalised innovation squared, NIS) rejects and counts
+//! outliers. Ground-vehicle aiding: body-frame velocity (odometer forward speed,
+//! non-holonomic zero lateral and vertical velocity) with `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`; height
+//! (barometer) on the frame's up axis; zero angular rate. Corrections are injected into the
+//! position through [`EarthModel::offset`].
+use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
+use crate::earth::EarthModel;
 use crate::frame::{Body, NavFrame};
 use crate::math;
 use crate::rotation::Rotation;
+use crate::strapdown::{Increments, NavState, StrapdownOptions};
 use crate::vector::Vec3;
 
 use super::sensor_errors::{
-    ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, GyroJacobian, SensorErrorEstimate,
-    SensorErrorSigma, SensorErrors, d_gyro, d_matrix,
+    ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, SensorErrorEstimate, SensorErrorSigma,
+    SensorErrors, d_gyro, d_matrix,
 };
 
-/// The error covariance of `S` states.
 pub(crate) type Cov<const S: usize> = SMatrix<f64, S, S>;
 /// An error-state vector of `S` states.
 pub(crate) type StateVec<const S: usize> = SVector<f64, S>;
@@ -62,15 +72,9 @@ pub struct InitialSigma {
 
 /// The filter's estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EskfState<N> {
-    /// Time, s.
-    pub t_s: f64,
-    /// Position, navigation frame, m.
-    pub position_m: Vec3<N>,
-    /// Velocity, navigation frame, m/s.
-    pub velocity_m_s: Vec3<N>,
-    /// Attitude `C_nb`.
-    pub attitude: Rotation<Body, N>,
+pub struct EskfState<E: EarthModel> {
+    /// Time, attitude `C_nb`, velocity and position.
+    pub nav: NavState<E>,
     /// Accelerometer bias, body frame, m/s².
     pub accel_bias_m_s2: [f64; 3],
     /// Gyroscope bias, body frame, rad/s.
@@ -86,16 +90,16 @@ pub struct UpdateOutcome {
     pub accepted: bool,
 }
 
-/// One GNSS fix as the filter takes it (see [`Eskf::update_gnss_fix`]).
+/// One GNSS fix as the filter takes it (see [`Eskf::update_gnss`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GnssFix<N> {
-    /// Antenna position, navigation frame, m.
-    pub position_m: Vec3<N>,
+pub struct GnssFix<E: EarthModel> {
+    /// Antenna position.
+    pub position: E::Position,
     /// Antenna velocity, navigation frame, m/s (`None`: position only).
-    pub velocity_m_s: Option<Vec3<N>>,
+    pub velocity_m_s: Option<Vec3<E::Frame>>,
     /// Antenna lever arm, body frame, m.
     pub lever_arm_m: Vec3<Body>,
-    /// Position one-sigma per axis, m.
+    /// Position one-sigma per navigation axis, m.
     pub position_sigma_m: [f64; 3],
     /// Velocity one-sigma per axis, m/s.
     pub velocity_sigma_m_s: [f64; 3],
@@ -156,133 +160,132 @@ pub(crate) fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
     nalgebra::Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// The non-zero blocks of `A = FΔt + (FΔt)²/2` (rows/columns in blocks of 3: δp, δv, φ, δb_a,
-/// δb_g, then the sensor errors δm_a (9) and δm_g (12), see [`super::sensor_errors`]):
-/// `F₀₁ = I`, `F₁₂ = −[f^n×]`, `F₁₃ = −Ĉ`, `F₂₄ = −Ĉ`, `F₁₅ = −Ĉ D_a`, `F₂₆ = −Ĉ D_g`, and `F²`
-/// adds `(0,2) = −[f^n×]`, `(0,3) = −Ĉ`, `(1,4) = [f^n×]Ĉ`, `(0,5) = −Ĉ D_a`,
-/// `(1,6) = [f^n×] Ĉ D_g`.
-struct Transition {
-    a01: nalgebra::Matrix3<f64>,
-    a02: nalgebra::Matrix3<f64>,
-    a03: nalgebra::Matrix3<f64>,
-    a12: nalgebra::Matrix3<f64>,
-    a13: nalgebra::Matrix3<f64>,
-    a14: nalgebra::Matrix3<f64>,
-    a24: nalgebra::Matrix3<f64>,
-    /// `(a05, a15, a16, a26)` with the sensor errors.
-    sensor: Option<SensorBlocks>,
+/// A 3 × `C` block of the transition.
+type Block<const C: usize> = SMatrix<f64, 3, C>;
+
+/// The non-zero 3 × 3 (and sensor-error) blocks of a matrix whose rows below the attitude
+/// are zero, as `F` and `A = FΔt + (FΔt)²/2` are: block rows δp, δv, φ; block columns δp, δv,
+/// φ, δb_a, δb_g, then the sensor errors δm_a (9 columns) and δm_g (12). `None` is a zero block,
+/// skipped in every product.
+#[derive(Clone, Copy, Debug, Default)]
+struct Blocks {
+    m: [[Option<Matrix3<f64>>; 5]; 3],
+    accel: [Option<Block<9>>; 3],
+    gyro: [Option<Block<12>>; 3],
 }
 
-/// The transition's sensor-error blocks `a05`, `a15` (3 × 9) and `a16`, `a26` (3 × 12).
-type SensorBlocks = (
-    SMatrix<f64, 3, 9>,
-    SMatrix<f64, 3, 9>,
-    GyroJacobian,
-    GyroJacobian,
-);
+/// `Σ` of the present terms, `None` when none is.
+fn sum_present<T: core::ops::Add<Output = T>>(terms: impl Iterator<Item = Option<T>>) -> Option<T> {
+    terms.flatten().reduce(|a, b| a + b)
+}
 
-impl Transition {
-    fn new(
-        fx: &nalgebra::Matrix3<f64>,
-        c: &nalgebra::Matrix3<f64>,
-        sensor: Option<(SMatrix<f64, 3, 9>, GyroJacobian)>,
-        dt: f64,
-    ) -> Self {
+impl Blocks {
+    /// `A = FΔt + F²Δt²/2` of `F = self`: `A_ij = F_ij Δt + (Σ_k F_ik F_kj) Δt²/2`, `k` over
+    /// the three non-zero block rows.
+    fn transition(&self, dt: f64) -> Blocks {
         let h = 0.5 * dt * dt;
-        Self {
-            a01: nalgebra::Matrix3::identity() * dt,
-            a02: -fx * h,
-            a03: -c * h,
-            a12: -fx * dt,
-            a13: -c * dt,
-            a14: fx * c * h,
-            a24: -c * dt,
-            sensor: sensor.map(|(cda, cdg)| (-cda * h, -cda * dt, fx * cdg * h, -cdg * dt)),
+        let f = &self.m;
+        let mut a = Blocks::default();
+        for i in 0..3 {
+            for j in 0..5 {
+                let second = sum_present((0..3).map(|k| f[i][k].zip(f[k][j]).map(|(x, y)| x * y)));
+                a.m[i][j] =
+                    sum_present([f[i][j].map(|x| x * dt), second.map(|s| s * h)].into_iter());
+            }
+            let accel = sum_present((0..3).map(|k| f[i][k].zip(self.accel[k]).map(|(x, y)| x * y)));
+            a.accel[i] =
+                sum_present([self.accel[i].map(|x| x * dt), accel.map(|s| s * h)].into_iter());
+            let gyro = sum_present((0..3).map(|k| f[i][k].zip(self.gyro[k]).map(|(x, y)| x * y)));
+            a.gyro[i] =
+                sum_present([self.gyro[i].map(|x| x * dt), gyro.map(|s| s * h)].into_iter());
         }
+        a
     }
 
-    /// `A · m`, block row by block row (rows 3–4 and the sensor rows of A are zero).
+    /// `self · m` (rows below the attitude zero).
     fn times<const S: usize>(&self, m: &Cov<S>) -> Cov<S> {
-        let row = |k: usize| m.fixed_view::<3, S>(3 * k, 0);
-        let mut r0 = self.a01 * row(1) + self.a02 * row(2) + self.a03 * row(3);
-        let mut r1 = self.a12 * row(2) + self.a13 * row(3) + self.a14 * row(4);
-        let mut r2 = self.a24 * row(4);
-        if let Some((a05, a15, a16, a26)) = &self.sensor {
-            let accel = m.fixed_view::<9, S>(ACCEL_MATRIX, 0);
-            let gyro = m.fixed_view::<12, S>(GYRO_ERRORS, 0);
-            r0 += a05 * accel;
-            r1 += a15 * accel + a16 * gyro;
-            r2 += a26 * gyro;
-        }
         let mut out = Cov::<S>::zeros();
-        out.fixed_view_mut::<3, S>(0, 0).copy_from(&r0);
-        out.fixed_view_mut::<3, S>(3, 0).copy_from(&r1);
-        out.fixed_view_mut::<3, S>(6, 0).copy_from(&r2);
+        for i in 0..3 {
+            let rows = sum_present(
+                (0..5).map(|j| self.m[i][j].map(|b| b * m.fixed_view::<3, S>(3 * j, 0))),
+            );
+            let sensor = sum_present(
+                [
+                    self.accel[i].map(|b| b * m.fixed_view::<9, S>(ACCEL_MATRIX, 0)),
+                    self.gyro[i].map(|b| b * m.fixed_view::<12, S>(GYRO_ERRORS, 0)),
+                ]
+                .into_iter(),
+            );
+            let row = match (rows, sensor) {
+                (Some(r), Some(s)) => r + s,
+                (r, s) => match r.or(s) {
+                    Some(x) => x,
+                    None => continue,
+                },
+            };
+            out.fixed_view_mut::<3, S>(3 * i, 0).copy_from(&row);
+        }
         out
     }
 }
 
-/// The error-state filter of `S` states: [`BASE_STATES`] (15, the default) or [`FULL_STATES`]
-/// (36, with the sensors' scale-factor, misalignment and g-sensitivity errors, see
-/// [`super::sensor_errors`]); any other `S` does not compile.
+/// The error-state filter of `S` states on the Earth `E`: [`BASE_STATES`] (15, the default) or
+/// [`FULL_STATES`] (36, with the sensors' scale-factor, misalignment and g-sensitivity errors,
+/// see [`super::sensor_errors`]); any other `S` does not compile.
 #[derive(Clone, Copy, Debug)]
-pub struct Eskf<N: NavFrame, const S: usize = BASE_STATES> {
-    t: f64,
-    p: Vector3<f64>,
-    v: Vector3<f64>,
-    q: UnitQuaternion<f64>,
+pub struct Eskf<E: EarthModel, const S: usize = BASE_STATES> {
+    mechanization: Increments<E>,
+    nav: NavState<E>,
     ba: Vector3<f64>,
     bg: Vector3<f64>,
     errors: SensorErrors,
     cov: Cov<S>,
     noise: EskfNoise,
-    g: Vector3<f64>,
     intake: Intake,
     updates: usize,
     rejected: usize,
-    frame: core::marker::PhantomData<N>,
 }
 
-impl<N: NavFrame, const S: usize> Eskf<N, S> {
-    /// A filter at `initial` (biases zero unless given) with `sigma` initial uncertainty (the
-    /// sensor errors of a 36-state filter start at zero, known exactly until
-    /// [`Self::with_sensor_error_sigma`]).
+impl<E: EarthModel, const S: usize> Eskf<E, S> {
+    /// A filter on `earth` at `initial` with `sigma` initial uncertainty (position in metres
+    /// on each navigation axis; the sensor errors of a 36-state filter start at zero, known
+    /// exactly until [`Self::with_sensor_error_sigma`]).
     ///
     /// # Errors
-    /// Non-finite state, negative or non-finite sigmas or noise.
+    /// Non-finite state, one outside the frame's domain (beyond ±89.9° on WGS-84), gravity
+    /// that is not finite or points up, sigmas or noise that are negative or not finite.
     pub fn new(
-        initial: &EskfState<N>,
+        earth: E,
+        initial: &EskfState<E>,
         sigma: &InitialSigma,
         noise: EskfNoise,
-        gravity_m_s2: f64,
     ) -> Result<Self, EskfError> {
         let cov = initial_covariance(sigma, &noise)?;
-        non_negative("gravity_m_s2", gravity_m_s2)?;
-        let finite = [initial.t_s]
+        let finite = initial
+            .accel_bias_m_s2
             .iter()
-            .chain(initial.position_m.as_nalgebra().iter())
-            .chain(initial.velocity_m_s.as_nalgebra().iter())
-            .chain(&initial.accel_bias_m_s2)
             .chain(&initial.gyro_bias_rad_s)
             .all(|v| v.is_finite());
+        let c = E::coordinates(&initial.nav.position);
+        let g = -<E::Frame as NavFrame>::Z_UP
+            * earth.terms(&c, &initial.nav.velocity_m_s).gravity_m_s2.z();
+        non_negative("gravity_m_s2", g)?;
+        let mechanization = Increments::new(earth, &initial.nav, StrapdownOptions::default())
+            .map_err(|_| EskfError::NotFinite { index: 0 })?;
         if !finite {
             return Err(EskfError::NotFinite { index: 0 });
         }
         Ok(Self {
-            t: initial.t_s,
-            p: *initial.position_m.as_nalgebra(),
-            v: *initial.velocity_m_s.as_nalgebra(),
-            q: *initial.attitude.quaternion(),
+            mechanization,
+            nav: initial.nav,
             ba: Vector3::from(initial.accel_bias_m_s2),
             bg: Vector3::from(initial.gyro_bias_rad_s),
             errors: SensorErrors::new(),
             cov,
             noise,
-            g: *N::gravity(gravity_m_s2).as_nalgebra(),
             intake: Intake::new(),
             updates: 0,
             rejected: 0,
-            frame: core::marker::PhantomData,
         })
     }
 
@@ -309,6 +312,12 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         Ok(self)
     }
 
+    /// The Earth the filter runs on.
+    #[must_use]
+    pub fn earth(&self) -> &E {
+        self.mechanization.earth()
+    }
+
     /// The estimated sensor errors (zero in a 15-state filter).
     #[must_use]
     pub fn sensor_errors(&self) -> SensorErrorEstimate {
@@ -317,20 +326,17 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
 
     /// The current estimate.
     #[must_use]
-    pub fn state(&self) -> EskfState<N> {
+    pub fn state(&self) -> EskfState<E> {
         EskfState {
-            t_s: self.t,
-            position_m: Vec3::from_nalgebra(self.p),
-            velocity_m_s: Vec3::from_nalgebra(self.v),
-            attitude: Rotation::assume_from_quaternion(self.q),
+            nav: self.nav,
             accel_bias_m_s2: self.ba.into(),
             gyro_bias_rad_s: self.bg.into(),
         }
     }
 
-    /// One-sigma of the error states: position (3), velocity (3), attitude (3, navigation
-    /// axes), accelerometer bias (3), gyroscope bias (3), and with 36 states the sensor
-    /// errors `M_a`, `M_g` (9 each, row-major) and `k` (3).
+    /// One-sigma of the error states: position (3, m on the navigation axes), velocity (3),
+    /// attitude (3, navigation axes), accelerometer bias (3), gyroscope bias (3), and with 36
+    /// states the sensor errors `M_a`, `M_g` (9 each, row-major) and `k` (3).
     #[must_use]
     pub fn sigmas(&self) -> [f64; S] {
         core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
@@ -348,31 +354,45 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         (self.updates, self.rejected)
     }
 
+    /// `Ĉ` as a matrix.
+    fn c_nb(&self) -> Matrix3<f64> {
+        self.nav
+            .attitude
+            .quaternion()
+            .to_rotation_matrix()
+            .into_inner()
+    }
+
     /// Takes IMU sample `(t_s, gyro, accel)` (body, rad/s and specific force m/s²): the first
-    /// sets the start time, each later one propagates over the interval.
+    /// sets the start time, each later one advances the mechanization over the interval with
+    /// the trapezoid of the two samples, biases removed.
     ///
     /// # Errors
-    /// Non-finite values or a time that does not increase.
+    /// Non-finite values, a time that does not increase, a position leaving the frame's domain.
     pub fn propagate(
         &mut self,
         t_s: f64,
         gyro_rad_s: [f64; 3],
         accel_m_s2: [f64; 3],
     ) -> Result<(), EskfError> {
-        let Some((dt, w, f)) = self.intake.take(self.t, t_s, gyro_rad_s, accel_m_s2)? else {
-            self.t = t_s;
-            return Ok(());
+        let index = self.intake.samples();
+        let Some((dt, w, f)) = self
+            .intake
+            .take(self.nav.t_s, t_s, gyro_rad_s, accel_m_s2)?
+        else {
+            self.nav.t_s = t_s;
+            return self
+                .mechanization
+                .reset(&self.nav)
+                .map_err(|_| EskfError::NotFinite { index });
         };
         let (w, f) = self.errors.correct::<S>(w - self.bg, f - self.ba);
-        // Nominal state.
-        let half = self.q * UnitQuaternion::from_scaled_axis(w * (0.5 * dt));
-        let q1 = self.q * UnitQuaternion::from_scaled_axis(w * dt);
-        let v0 = self.v;
-        self.v += (half * f + self.g) * dt;
-        self.p += 0.5 * (v0 + self.v) * dt;
-        let c = half.to_rotation_matrix().into_inner();
-        self.q = q1;
-        self.t = t_s;
+        let c0 = self.c_nb();
+        self.nav = self
+            .mechanization
+            .step(t_s, (w * dt).into(), (f * dt).into())
+            .map_err(|_| EskfError::NotFinite { index })?;
+        let c = (c0 + self.c_nb()) * 0.5;
         if S == FULL_STATES {
             self.errors.accumulate(dt, &c, &w, &f);
         }
@@ -382,15 +402,40 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         Ok(())
     }
 
-    /// One covariance step over the pending interval (nothing when none is pending): `Φ = I + A`,
-    /// `A = FΔt + (FΔt)²/2` with the interval's mean `Ĉf̂` and `Ĉ`, kept as its seven non-zero
-    /// 3 × 3 blocks; `Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ` (P symmetric).
+    /// One covariance step over the pending interval (nothing when none is pending), with the
+    /// interval's mean `Ĉf̂` and `Ĉ` and the Earth's couplings at the current state:
+    /// `Φ P Φᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ` (P symmetric).
     fn step_covariance(&mut self) {
         let Some((dt, cf, c)) = self.intake.take_pending() else {
             return;
         };
-        let sensor = (S == FULL_STATES).then(|| self.errors.take_pending(dt));
-        let a = Transition::new(&skew(&cf), &c, sensor, dt);
+        let mut f = Blocks::default();
+        f.m[0][1] = Some(Matrix3::identity());
+        f.m[1][2] = Some(-skew(&cf));
+        f.m[1][3] = Some(-c);
+        f.m[2][4] = Some(-c);
+        let earth = self.mechanization.earth();
+        let coords = E::coordinates(&self.nav.position);
+        let v = self.nav.velocity_m_s;
+        if let Some(k) = earth.couplings(&coords, &v) {
+            let t = earth.terms(&coords, &v);
+            let (w_ie, w_en) = (
+                *t.earth_rate_rad_s.as_nalgebra(),
+                *t.transport_rate_rad_s.as_nalgebra(),
+            );
+            let m = |a: [[f64; 3]; 3]| Matrix3::from_fn(|i, j| a[i][j]);
+            f.m[1][0] = Some(m(k.gravity_gradient));
+            f.m[1][1] = Some(-skew(&(2.0 * w_ie + w_en)));
+            f.m[2][0] = Some(-m(k.rate_by_position));
+            f.m[2][1] = Some(-m(k.rate_by_velocity));
+            f.m[2][2] = Some(-skew(&(w_ie + w_en)));
+        }
+        if S == FULL_STATES {
+            let (cda, cdg) = self.errors.take_pending(dt);
+            f.accel[1] = Some(-cda);
+            f.gyro[2] = Some(-cdg);
+        }
+        let a = f.transition(dt);
         let ap = a.times(&self.cov);
         // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases;
         // Q_d = ½ (Φ Q Φᵀ + Q) Δt.
@@ -401,77 +446,45 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
     }
 
-    /// A GNSS position (and, when given, velocity) fix at the current time: `position_m` of the
-    /// antenna at `lever_arm_m` (body) with one-sigma `position_sigma_m` per axis, and the
-    /// antenna velocity with `velocity_sigma_m_s`. Rejected (and counted) when its NIS exceeds
+    /// A GNSS position (and, when given, velocity) fix valid `fix.age_s = τ` before the
+    /// filter's time (latency compensation): the antenna is predicted back with the current
+    /// acceleration `a = Ĉf̂ + g`, `p_a = p + Ĉl − τ (v + Ĉ(ω̂×l)) + ½τ² a` and
+    /// `v_a = v + Ĉ(ω̂×l) − τ a`, so `δp_a = δp − τ δv − [(Ĉl)×] φ` and
+    /// `δv_a = δv − [(Ĉ(ω̂×l))×] φ + τ [(Ĉf̂)×] φ + τ Ĉ δb_a + Ĉ [l×] δb_g` (the change of the
+    /// lever-arm terms over `τ` is neglected). Rejected (and counted) when its NIS exceeds
     /// `gate` (a chi-square quantile for 3 or 6 degrees of freedom; `f64::INFINITY` turns the
     /// gate off).
     ///
     /// # Errors
-    /// Non-finite input, or a covariance that can no longer be inverted (divergence).
-    pub fn update_gnss(
-        &mut self,
-        position_m: Vec3<N>,
-        velocity_m_s: Option<Vec3<N>>,
-        lever_arm_m: Vec3<Body>,
-        position_sigma_m: [f64; 3],
-        velocity_sigma_m_s: [f64; 3],
-        gate: f64,
-    ) -> Result<UpdateOutcome, EskfError> {
-        let fix = GnssFix {
-            position_m,
-            velocity_m_s,
-            lever_arm_m,
-            position_sigma_m,
-            velocity_sigma_m_s,
-            age_s: 0.0,
-        };
-        self.update_gnss_fix(&fix, gate)
-    }
-
-    /// [`Self::update_gnss`] for a fix valid `fix.age_s = τ` before the filter's time (latency
-    /// compensation): the antenna is predicted back with the current acceleration
-    /// `a = Ĉf̂ + g`, `p_a = p + Ĉl − τ (v + Ĉ(ω̂×l)) + ½τ² a` and `v_a = v + Ĉ(ω̂×l) − τ a`, so
-    /// `δp_a = δp − τ δv − [(Ĉl)×] φ` and
-    /// `δv_a = δv − [(Ĉ(ω̂×l))×] φ + τ [(Ĉf̂)×] φ + τ Ĉ δb_a + Ĉ [l×] δb_g` (the change of the
-    /// lever-arm terms over `τ` is neglected).
-    ///
-    /// # Errors
-    /// As [`Self::update_gnss`]; an age that is negative or not finite.
-    pub fn update_gnss_fix(
-        &mut self,
-        fix: &GnssFix<N>,
-        gate: f64,
-    ) -> Result<UpdateOutcome, EskfError> {
-        let GnssFix {
-            position_m,
-            velocity_m_s,
-            lever_arm_m,
-            position_sigma_m,
-            velocity_sigma_m_s,
-            age_s,
-        } = *fix;
+    /// Non-finite input, sigmas that are not positive, an age that is negative or not finite,
+    /// or a covariance that can no longer be inverted (divergence).
+    pub fn update_gnss(&mut self, fix: &GnssFix<E>, gate: f64) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
-        if !(age_s.is_finite() && age_s >= 0.0) {
+        if !(fix.age_s.is_finite() && fix.age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
         }
         let (w_last, f_last) = self.intake.last();
         let (w_body, f_body) = self.errors.correct::<S>(w_last - self.bg, f_last - self.ba);
+        let earth = self.mechanization.earth();
+        let coords = E::coordinates(&self.nav.position);
+        let delta_p = earth.displacement_m(&coords, &E::coordinates(&fix.position));
         let lin = Linearisation {
-            c: self.q.to_rotation_matrix().into_inner(),
-            v: self.v,
+            c: self.c_nb(),
+            v: *self.nav.velocity_m_s.as_nalgebra(),
             w_body,
             f_body,
-            g: self.g,
+            g: *earth
+                .terms(&coords, &self.nav.velocity_m_s)
+                .gravity_m_s2
+                .as_nalgebra(),
         };
-        let delta_p = *position_m.as_nalgebra() - self.p;
         let (h, y, r) = gnss_model(
             &lin,
-            delta_p,
-            velocity_m_s.map(|v| *v.as_nalgebra()),
-            *lever_arm_m.as_nalgebra(),
-            [position_sigma_m, velocity_sigma_m_s],
-            age_s,
+            *delta_p.as_nalgebra(),
+            fix.velocity_m_s.map(|v| *v.as_nalgebra()),
+            *fix.lever_arm_m.as_nalgebra(),
+            [fix.position_sigma_m, fix.velocity_sigma_m_s],
+            fix.age_s,
             index,
         )?;
         self.correct(&h, &y, &r, gate, index)
@@ -480,7 +493,7 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
     /// A body-frame velocity measurement: `measured_m_s[i]`, when given, is the velocity of the
     /// reference point along body axis `i` with one-sigma `sigma_m_s[i]` — a wheel odometer's
     /// forward speed on x, and for a ground vehicle that neither slips sideways nor leaves the
-    /// road the non-holonomic constraints, 0 on y and z. With `v_b = Ĉᵀ v`,
+    /// road the non-holonomic constraints, 0 on the other two. With `v_b = Ĉᵀ v`,
     /// `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`. Gated like [`Self::update_gnss`] (`gate` for as many degrees
     /// of freedom as rows given).
     ///
@@ -494,13 +507,14 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         gate: f64,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
-        let c = self.q.to_rotation_matrix().into_inner();
-        let (h, y, r) = body_velocity_model(&c, &self.v, measured_m_s, sigma_m_s, index)?;
+        let v = *self.nav.velocity_m_s.as_nalgebra();
+        let (h, y, r) = body_velocity_model(&self.c_nb(), &v, measured_m_s, sigma_m_s, index)?;
         self.correct(&h, &y, &r, gate, index)
     }
 
-    /// A height measurement (a barometer): `height_m` of the reference point, up (`N::Z_UP`
-    /// times the frame's z), one-sigma `sigma_m`. Gated with `gate` (one degree of freedom).
+    /// A height measurement (a barometer): `height_m` of the reference point above the Earth's
+    /// reference surface (the frame's up axis on the flat Earth, the ellipsoid on WGS-84),
+    /// one-sigma `sigma_m`. Gated with `gate` (one degree of freedom).
     ///
     /// # Errors
     /// Non-finite input, a sigma that is not positive, or divergence.
@@ -514,22 +528,20 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
             return Err(EskfError::NotFinite { index });
         }
+        let coords = E::coordinates(&self.nav.position);
+        let (height_now, _) = self.mechanization.earth().height_m(&coords);
         let mut h = SMatrix::<f64, 1, S>::zeros();
-        h[(0, 2)] = N::Z_UP;
-        let y = SVector::<f64, 1>::new(height_m - N::Z_UP * self.p.z);
+        h[(0, 2)] = <E::Frame as NavFrame>::Z_UP;
+        let y = SVector::<f64, 1>::new(height_m - height_now);
         let r = SVector::<f64, 1>::new(sq(sigma_m));
         self.correct(&h, &y, &r, gate, index)
     }
 
-    /// The Kalman correction shared by every update: innovation `y` with model `H` and
-    /// measurement variances `r` (rows with `H = 0`, `y = 0`, `r = 1` are inert); NIS against
-    /// `gate` (rejected and counted above it); Joseph-form covariance, symmetrised; closed-loop
-    /// injection of `δx` into the nominal state, and reset.
-    /// A zero-angular-rate update (the vehicle stands still): the last gyroscope sample is
-    /// what the gyroscopes read of a body at rest on the flat Earth, `b_g` (and the
-    /// g-sensitivity's `k ∘ f`) plus noise of one-sigma `sigma_rad_s` per axis (one sample's
-    /// white noise): `y = ω_m − b̂_g − k̂ ∘ f̂`, `H = I` on the gyroscope bias (and `diag(f̂)` on
-    /// `k`). Gated with `gate` (three degrees of freedom).
+    /// A zero-angular-rate update (the vehicle stands still): the last gyroscope sample reads
+    /// the Earth's rate in body axes, `Ĉᵀ ω_ie` (nothing on the flat Earth), plus `b_g` (and the
+    /// g-sensitivity's `k ∘ f`) and noise of one-sigma `sigma_rad_s` per axis (one sample's
+    /// white noise): `y = ω_m − b̂_g − ((I + M̂_g) ω + k̂ ∘ f̂)`, `H = I` on the gyroscope bias
+    /// (and the sensor errors' Jacobian). Gated with `gate` (three degrees of freedom).
     ///
     /// # Errors
     /// A sigma that is not positive, no sample taken yet, or divergence.
@@ -539,18 +551,32 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
         gate: f64,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
+        let w_true = if E::ROTATING {
+            let coords = E::coordinates(&self.nav.position);
+            let t = self
+                .mechanization
+                .earth()
+                .terms(&coords, &self.nav.velocity_m_s);
+            self.c_nb().transpose() * t.earth_rate_rad_s.as_nalgebra()
+        } else {
+            Vector3::zeros()
+        };
         let (h, y, r) = zero_rate_model(
             self.intake.last_sample(),
             &self.bg,
             &self.ba,
             &self.errors,
-            &Vector3::zeros(),
+            &w_true,
             sigma_rad_s,
             index,
         )?;
         self.correct(&h, &y, &r, gate, index)
     }
 
+    /// The Kalman correction shared by every update: the pending covariance step, innovation
+    /// `y` with model `H` and measurement variances `r` (rows with `H = 0`, `y = 0`, `r = 1`
+    /// are inert); NIS against `gate` (rejected and counted above it); Joseph-form covariance,
+    /// symmetrised; closed-loop injection of `δx` into the nominal state, and reset.
     fn correct<const M: usize>(
         &mut self,
         h: &SMatrix<f64, M, S>,
@@ -568,21 +594,39 @@ impl<N: NavFrame, const S: usize> Eskf<N, S> {
                 accepted: false,
             });
         };
-        // Closed loop: inject and reset.
-        self.p += dx.fixed_rows::<3>(0);
-        self.v += dx.fixed_rows::<3>(3);
-        let phi: Vector3<f64> = dx.fixed_rows::<3>(6).into();
-        self.q = UnitQuaternion::from_scaled_axis(phi) * self.q;
-        self.ba += dx.fixed_rows::<3>(9);
-        self.bg += dx.fixed_rows::<3>(12);
-        if !self.errors.inject(&dx) {
-            return Err(EskfError::Diverged { index });
-        }
+        self.inject(&dx, index)?;
         self.updates += 1;
         Ok(UpdateOutcome {
             nis,
             accepted: true,
         })
+    }
+
+    /// Closed loop: the error estimate into the nominal state (the position through
+    /// [`EarthModel::offset`]), and the mechanization restarted from it (its coning and
+    /// sculling memory kept).
+    fn inject(&mut self, dx: &StateVec<S>, index: usize) -> Result<(), EskfError> {
+        let earth = self.mechanization.earth();
+        let coords = E::coordinates(&self.nav.position);
+        let position = E::position(earth.offset(&coords, &Vec3::new(dx[0], dx[1], dx[2])));
+        let phi = Vector3::new(dx[6], dx[7], dx[8]);
+        let q = UnitQuaternion::from_scaled_axis(phi) * *self.nav.attitude.quaternion();
+        self.nav = NavState {
+            t_s: self.nav.t_s,
+            attitude: Rotation::assume_from_quaternion(q),
+            velocity_m_s: Vec3::from_nalgebra(
+                *self.nav.velocity_m_s.as_nalgebra() + Vector3::new(dx[3], dx[4], dx[5]),
+            ),
+            position,
+        };
+        self.ba += Vector3::new(dx[9], dx[10], dx[11]);
+        self.bg += Vector3::new(dx[12], dx[13], dx[14]);
+        if !self.errors.inject(dx) {
+            return Err(EskfError::Diverged { index });
+        }
+        self.mechanization
+            .reset(&self.nav)
+            .map_err(|_| EskfError::Diverged { index })
     }
 }
 

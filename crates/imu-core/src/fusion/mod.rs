@@ -1,11 +1,8 @@
 //! Fusion of the IMU with aiding sensors: [`eskf`], a loosely coupled error-state Kalman filter
 //! (15 states, or 36 with the sensors' scale-factor, misalignment and g-sensitivity errors of
-//! [`sensor_errors`]; fixed-size matrices, no heap) on the flat-Earth mechanization, and
-//! [`earth`], the same filter on the WGS-84 Earth's mechanization.
-pub mod earth;
+//! [`sensor_errors`]; fixed-size matrices, no heap) on any [`crate::earth::EarthModel`].
 pub mod eskf;
 pub mod sensor_errors;
 
-pub use earth::{EarthEskf, EarthEskfState, EarthGnssFix};
 pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome};
 pub use sensor_errors::{BASE_STATES, FULL_STATES, SensorErrorEstimate, SensorErrorSigma};

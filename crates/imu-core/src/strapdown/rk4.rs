@@ -1,31 +1,15 @@
-//! A fourth-order strapdown for rate samples: classical Runge–Kutta on the navigation equations
-//! `q̇ = ½ q ⊗ (0, ω_b)`, `v̇ = C_nb f_b + g_n`, `ṗ = v` (flat Earth), with `substeps` RK4 steps
-//! per sample interval and the rates between samples taken from the quintic Lagrange polynomial
+//! A fourth-order strapdown for rate samples on any [`EarthModel`]: classical Runge–Kutta on
+//! the navigation equations (see the [module](super) page), with `substeps` RK4 steps per
+//! sample interval and the rates between samples taken from the quintic Lagrange polynomial
 //! through the six samples around the interval (one-sided near the ends, so the interpolation
 //! error, O(Δt⁶), stays below the integration error, O(Δt⁴/substeps⁴)). Errors fall as Δt⁴ on
-//! smooth motion, where the coning/sculling scheme of [`step`](super::step) falls as Δt². The
-//! quaternion is renormalised after every substep.
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+//! smooth motion, where the coning/sculling scheme of [`increments`](super::increments) falls
+//! as Δt². The quaternion is renormalised after every substep, and the specific force is
+//! turned by the normalised stage quaternion.
+use crate::earth::EarthModel;
 
-use crate::frame::NavFrame;
-use crate::rotation::Rotation;
-use crate::strapdown::step::{NavState, StrapdownError, check_lengths};
-use crate::vector::Vec3;
-
-type State = (Quaternion<f64>, Vector3<f64>, Vector3<f64>);
-
-fn derivative(
-    q: &Quaternion<f64>,
-    v: &Vector3<f64>,
-    w: [f64; 3],
-    f: [f64; 3],
-    g: &Vector3<f64>,
-) -> State {
-    let qdot = q * Quaternion::new(0.0, w[0], w[1], w[2]) * 0.5;
-    let unit = UnitQuaternion::from_quaternion(*q);
-    let vdot = unit * Vector3::from(f) + g;
-    (qdot, vdot, *v)
-}
+use super::equations::{State, check_initial, derivative, finish, start};
+use super::{NavState, StrapdownError, StrapdownOptions, check_baro, check_lengths};
 
 /// Interpolation nodes per interval: the six samples around it.
 pub const NODES: usize = 6;
@@ -63,33 +47,50 @@ pub struct RateWindow {
 /// each interval's six-sample window ([`window_start`]), so a stream needs to hold only six
 /// samples. [`strapdown_rates_rk4`] is this stepper over a whole series.
 #[derive(Clone, Copy, Debug)]
-pub struct Rk4Strapdown<N: NavFrame> {
-    q: Quaternion<f64>,
-    v: Vector3<f64>,
-    p: Vector3<f64>,
-    g: Vector3<f64>,
+pub struct Rk4<E: EarthModel> {
+    earth: E,
+    state: State,
+    options: StrapdownOptions,
     substeps: usize,
-    frame: core::marker::PhantomData<N>,
 }
 
-impl<N: NavFrame> Rk4Strapdown<N> {
-    /// Starts from `initial`, with `substeps` (≥ 1; 0 counts as 1) RK4 steps per interval.
-    #[must_use]
-    pub fn new(initial: NavState<N>, gravity_m_s2: f64, substeps: usize) -> Self {
-        Self {
-            q: *initial.attitude.quaternion().quaternion(),
-            v: *initial.velocity_m_s.as_nalgebra(),
-            p: *initial.position_m.as_nalgebra(),
-            g: *N::gravity(gravity_m_s2).as_nalgebra(),
+impl<E: EarthModel> Rk4<E> {
+    /// Starts from `initial` on `earth` with `substeps` (≥ 1; 0 counts as 1) RK4 steps per
+    /// interval (the coning and sculling options do not apply).
+    ///
+    /// # Errors
+    /// A non-finite initial state, one outside the frame's domain, a baro time constant ≤ 0.
+    pub fn new(
+        earth: E,
+        initial: &NavState<E>,
+        options: StrapdownOptions,
+        substeps: usize,
+    ) -> Result<Self, StrapdownError> {
+        check_initial(&earth, initial, &options)?;
+        Ok(Self {
+            earth,
+            state: start(initial, options.vertical),
+            options,
             substeps: substeps.max(1),
-            frame: core::marker::PhantomData,
-        }
+        })
     }
 
-    /// Integrates from `w.t_s[j]` to `w.t_s[j + 1]` (`j < 5`) and returns the state there. The
-    /// window's values must be finite and its times increasing (checked by the callers).
-    pub fn interval(&mut self, w: &RateWindow, j: usize) -> NavState<N> {
-        let (q, v, p, g) = (&mut self.q, &mut self.v, &mut self.p, &self.g);
+    /// Integrates from `w.t_s[j]` to `w.t_s[j + 1]` (`j < 5`; values finite, times increasing,
+    /// checked by the callers) with the barometric height `baro_height_m` (used by
+    /// [`super::VerticalChannel::Baro`] only), and returns the state there; `index` names the
+    /// sample in errors.
+    ///
+    /// # Errors
+    /// The position leaves the frame's domain ([`StrapdownError::NearPole`]) or the state
+    /// stops being finite.
+    pub fn interval(
+        &mut self,
+        w: &RateWindow,
+        j: usize,
+        baro_height_m: f64,
+        index: usize,
+    ) -> Result<NavState<E>, StrapdownError> {
+        let (earth, vertical) = (&self.earth, self.options.vertical);
         let m = self.substeps;
         let h = (w.t_s[j + 1] - w.t_s[j]) / m as f64;
         let at = |x: f64| -> ([f64; 3], [f64; 3]) {
@@ -99,6 +100,10 @@ impl<N: NavFrame> Rk4Strapdown<N> {
             };
             (sum(&w.gyro_rad_s), sum(&w.accel_m_s2))
         };
+        let rate = |s: &State, w: [f64; 3], f: [f64; 3]| {
+            derivative(earth, vertical, s, w, f, baro_height_m)
+        };
+        let mut s = self.state;
         for step in 0..m {
             let t0 = w.t_s[j] + step as f64 * h;
             let (w0, f0) = if step == 0 {
@@ -112,50 +117,48 @@ impl<N: NavFrame> Rk4Strapdown<N> {
             } else {
                 at(t0 + h)
             };
-            let k1 = derivative(q, v, w0, f0, g);
-            let k2 = derivative(
-                &(*q + k1.0 * (0.5 * h)),
-                &(*v + k1.1 * (0.5 * h)),
-                wm,
-                fm,
-                g,
-            );
-            let k3 = derivative(
-                &(*q + k2.0 * (0.5 * h)),
-                &(*v + k2.1 * (0.5 * h)),
-                wm,
-                fm,
-                g,
-            );
-            let k4 = derivative(&(*q + k3.0 * h), &(*v + k3.1 * h), w1, f1, g);
-            *q += (k1.0 + k2.0 * 2.0 + k3.0 * 2.0 + k4.0) * (h / 6.0);
-            *v += (k1.1 + k2.1 * 2.0 + k3.1 * 2.0 + k4.1) * (h / 6.0);
-            *p += (k1.2 + k2.2 * 2.0 + k3.2 * 2.0 + k4.2) * (h / 6.0);
-            *q = q.normalize();
+            let k1 = rate(&s, w0, f0);
+            let k2 = rate(&s.add(&k1, 0.5 * h), wm, fm);
+            let k3 = rate(&s.add(&k2, 0.5 * h), wm, fm);
+            let k4 = rate(&s.add(&k3, h), w1, f1);
+            s = State {
+                q: s.q + (k1.q + k2.q * 2.0 + k3.q * 2.0 + k4.q) * (h / 6.0),
+                v: s.v + (k1.v + k2.v * 2.0 + k3.v * 2.0 + k4.v) * (h / 6.0),
+                c: core::array::from_fn(|i| {
+                    s.c[i] + (k1.c[i] + 2.0 * k2.c[i] + 2.0 * k3.c[i] + k4.c[i]) * (h / 6.0)
+                }),
+                b: s.b + (k1.b + 2.0 * k2.b + 2.0 * k3.b + k4.b) * (h / 6.0),
+            };
+            s.q = s.q.normalize();
+            if !earth.in_domain(&s.c) {
+                return Err(StrapdownError::NearPole { index });
+            }
         }
-        NavState {
-            t_s: w.t_s[j + 1],
-            attitude: Rotation::assume_from_quaternion(UnitQuaternion::new_unchecked(*q)),
-            velocity_m_s: Vec3::from_nalgebra(*v),
-            position_m: Vec3::from_nalgebra(*p),
-        }
+        let out = finish(earth, &mut s, w.t_s[j + 1], index)?;
+        self.state = s;
+        Ok(out)
     }
 }
 
 /// Strapdown of rate samples by RK4 (`substeps` ≥ 1 per interval) with quintic interpolation,
-/// written into `out` (same length; `out[0]` is the initial state at `t_s[0]`). Needs at least
-/// 6 samples.
+/// written into `out` (same length; `out[0]` is `initial` at `t_s[0]`); `baro_height_m` gives
+/// the barometric height per sample for [`super::VerticalChannel::Baro`] (required then,
+/// ignored otherwise). Needs at least 6 samples.
 ///
 /// # Errors
-/// Mismatched lengths, fewer than 6 samples, non-finite values, times that do not increase.
-pub fn strapdown_rates_rk4<N: NavFrame>(
+/// Mismatched lengths, fewer than 6 samples, non-finite values, times that do not increase, a
+/// position outside the frame's domain, a baro channel without heights.
+#[allow(clippy::too_many_arguments)]
+pub fn strapdown_rates_rk4<E: EarthModel>(
+    earth: E,
     t_s: &[f64],
     gyro_rad_s: &[[f64; 3]],
     accel_m_s2: &[[f64; 3]],
-    initial: NavState<N>,
-    gravity_m_s2: f64,
+    baro_height_m: Option<&[f64]>,
+    initial: NavState<E>,
+    options: StrapdownOptions,
     substeps: usize,
-    out: &mut [NavState<N>],
+    out: &mut [NavState<E>],
 ) -> Result<(), StrapdownError> {
     let n = t_s.len();
     check_lengths(
@@ -166,6 +169,7 @@ pub fn strapdown_rates_rk4<N: NavFrame>(
             ("output", out.len()),
         ],
     )?;
+    let baro = check_baro(n, baro_height_m, &options)?;
     if n < NODES {
         return Err(StrapdownError::LengthMismatch {
             field: "samples (RK4 needs at least 6)",
@@ -174,23 +178,25 @@ pub fn strapdown_rates_rk4<N: NavFrame>(
         });
     }
     for i in 0..n {
-        if !(t_s[i].is_finite()
+        let finite = t_s[i].is_finite()
             && gyro_rad_s[i]
                 .iter()
                 .chain(&accel_m_s2[i])
-                .all(|c| c.is_finite()))
-        {
+                .all(|c| c.is_finite())
+            && baro.is_none_or(|b| b[i].is_finite());
+        if !finite {
             return Err(StrapdownError::NotFinite { index: i });
         }
         if i > 0 && t_s[i] <= t_s[i - 1] {
             return Err(StrapdownError::TimeNotIncreasing { index: i });
         }
     }
-    let mut nav = Rk4Strapdown::new(initial, gravity_m_s2, substeps);
-    out[0] = NavState {
+    let first = NavState {
         t_s: t_s[0],
         ..initial
     };
+    let mut nav = Rk4::new(earth, &first, options, substeps)?;
+    out[0] = first;
     for k in 0..n - 1 {
         let start = window_start(k, n);
         let window = RateWindow {
@@ -198,7 +204,8 @@ pub fn strapdown_rates_rk4<N: NavFrame>(
             gyro_rad_s: core::array::from_fn(|j| gyro_rad_s[start + j]),
             accel_m_s2: core::array::from_fn(|j| accel_m_s2[start + j]),
         };
-        out[k + 1] = nav.interval(&window, k - start);
+        let baro_k = baro.map_or(0.0, |b| b[k]);
+        out[k + 1] = nav.interval(&window, k - start, baro_k, k + 1)?;
     }
     Ok(())
 }

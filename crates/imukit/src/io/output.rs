@@ -389,6 +389,12 @@ impl AtomicFile {
             (file, Staged::Direct)
         } else {
             let folder = folder_of(path);
+            if !folder.is_dir() {
+                return Err(io(std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("its folder {} does not exist", folder.display()),
+                )));
+            }
             match unnamed_in(&folder) {
                 Some(file) => (file, Staged::Unnamed { folder }),
                 None => {
@@ -761,6 +767,20 @@ pub fn check_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Res
 mod tests {
     use super::*;
     use std::io::Read;
+
+    #[test]
+    fn an_output_in_a_missing_folder_is_refused_naming_the_file_and_its_folder() {
+        let dir = tempfile::tempdir().expect("a folder");
+        let path = dir.path().join("nosuch").join("out.csv");
+        let Err(e) = AtomicFile::create(&path) else {
+            panic!("a missing folder was accepted")
+        };
+        let message = e.to_string();
+        assert!(message.contains("out.csv"), "{message}");
+        assert!(message.contains("nosuch does not exist"), "{message}");
+        assert!(!message.contains(PARTIAL), "{message}");
+        assert!(!dir.path().join("nosuch").exists());
+    }
 
     #[test]
     fn an_output_file_holds_what_was_written_and_hands_each_step_to_the_disk() {

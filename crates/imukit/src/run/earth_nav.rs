@@ -1,17 +1,16 @@
 //! 3D strapdown on the WGS-84 Earth for the CLI and Python (`--earth wgs84`): the core's
-//! local-NED mechanization ([`imu_core::strapdown::earth`]) with Earth rate, transport rate,
+//! local-NED mechanization ([`imu_core::strapdown`] on [`imu_core::earth::Wgs84`]) with Earth rate, transport rate,
 //! Coriolis and normal gravity, fed from an IMU table and reported as the flat navigation is.
 //!
 //! Output: [`EARTH_NAV_COLUMNS`], the navigation columns of the flat integration (`pos_*` in
 //! the tangent plane at the origin of the starting truth, `vel_*` and the attitude in the
 //! local-level frame at each position, axes and body convention of the chosen frame) and
 //! `lat_rad, lon_rad, height_m`.
-use imu_core::earth::{Geodetic, GravityModel};
-use imu_core::strapdown::earth::{
-    Corrections, EarthNavState, EarthOptions, VerticalChannel, strapdown_increments_earth,
-    strapdown_rates_earth,
+use imu_core::earth::{Geodetic, GravityModel, Wgs84};
+use imu_core::strapdown::{
+    NavState, StrapdownOptions, VerticalChannel, strapdown_increments, strapdown_rates_rk4,
 };
-use imu_core::{Body, Ecef, NavFrame, Rotation, Vec3};
+use imu_core::{Body, Ecef, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
 use crate::io::table::{
@@ -21,6 +20,9 @@ use crate::run::navigate::{
     GEODETIC_COLUMNS, InitialState, NAV_COLUMNS, NavScheme, NavSetup, euler_unwrapped,
 };
 use crate::scenario::earth::frd_to_body;
+
+/// The navigation state on WGS-84 in local NED.
+pub(crate) type EarthNavState = NavState<Wgs84<Ned>>;
 
 /// Navigation output on the Earth: [`NAV_COLUMNS`] then the geodetic position.
 pub const EARTH_NAV_COLUMNS: [&str; 17] = concat_columns(NAV_COLUMNS, GEODETIC_COLUMNS);
@@ -98,11 +100,11 @@ pub(crate) fn integrate_earth_in<N: NavFrame>(
     earth: &EarthNav,
 ) -> Result<Table> {
     let (s0, origin) = start::<N>(initial, t.first().copied().unwrap_or(0.0))?;
-    let options = EarthOptions {
-        gravity: earth.gravity,
+    let options = StrapdownOptions {
         vertical: earth.vertical,
-        corrections: Corrections::from(&setup.options),
+        ..setup.options
     };
+    let model = Wgs84::new(earth.gravity);
     let baro = match earth.vertical {
         VerticalChannel::Baro { .. } => Some(imu.column(BARO_COLUMN).ok_or_else(|| {
             invalid(
@@ -130,13 +132,21 @@ pub(crate) fn integrate_earth_in<N: NavFrame>(
     {
         let (f, w) = (frd(f, sign), frd(w, 1.0));
         match setup.scheme.for_input(true, corrections) {
-            NavScheme::Rk4 { substeps } => {
-                strapdown_rates_earth(t, &w, &f, baro.as_deref(), &s0, options, substeps, &mut out)
-            }
+            NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
+                model,
+                t,
+                &w,
+                &f,
+                baro.as_deref(),
+                s0,
+                options,
+                substeps,
+                &mut out,
+            ),
             _ => {
                 // The trapezoid of rates as increments, as the flat scheme does.
                 let (dth, dv) = trapezoid(t, &w, &f);
-                strapdown_increments_earth(t, &dth, &dv, baro.as_deref(), &s0, options, &mut out)
+                strapdown_increments(model, t, &dth, &dv, baro.as_deref(), s0, options, &mut out)
             }
         }
     } else if let (Some(dv), Some(dth)) = (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS)) {
@@ -147,7 +157,7 @@ pub(crate) fn integrate_earth_in<N: NavFrame>(
             ));
         }
         let (dv, dth) = (frd(dv, sign), frd(dth, 1.0));
-        strapdown_increments_earth(t, &dth, &dv, baro.as_deref(), &s0, options, &mut out)
+        strapdown_increments(model, t, &dth, &dv, baro.as_deref(), s0, options, &mut out)
     } else {
         return Err(invalid(
             "IMU data",

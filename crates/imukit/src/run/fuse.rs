@@ -5,10 +5,12 @@
 //! velocity and attitude (navigation-frame axes), and the bias estimates — one row per IMU
 //! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
+use imu_core::earth::FlatEarth;
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
     SensorErrorEstimate, SensorErrorSigma,
 };
+use imu_core::strapdown::NavState;
 use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Error, Result, invalid};
@@ -607,16 +609,19 @@ fn fuse_in<N: NavFrame, const S: usize>(
         )
     })?;
     let start = EskfState {
-        t_s: t_first,
-        position_m: Vec3::from_array(initial.position_m),
-        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-        attitude,
+        nav: NavState {
+            t_s: t_first,
+            position: Vec3::from_array(initial.position_m),
+            velocity_m_s: Vec3::from_array(initial.velocity_m_s),
+            attitude,
+        },
         accel_bias_m_s2: [0.0; 3],
         gyro_bias_rad_s: [0.0; 3],
     };
     let filter_error =
         |context: &str, e: imu_core::fusion::EskfError| invalid(context, e.to_string());
-    let filter = Eskf::<N, S>::new(&start, &sigma, setup.noise, setup.gravity_m_s2)
+    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
+    let filter = Eskf::<_, S>::new(earth, &start, &sigma, setup.noise)
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
         .map_err(|_| covariance_interval_refusal(setup))?;
@@ -645,8 +650,8 @@ fn fuse_in<N: NavFrame, const S: usize>(
             .propagate(t[i], w[i], f[i].map(|x| sign * x))
             .map_err(|e| filter_error("IMU data", e))?;
         while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
-            let fix = GnssFix {
-                position_m: Vec3::from_array(g_p[next_fix]),
+            let fix = GnssFix::<FlatEarth<N>> {
+                position: Vec3::from_array(g_p[next_fix]),
                 velocity_m_s: setup
                     .gnss_velocity_sigma_m_s
                     .map(|_| Vec3::from_array(g_v[next_fix])),
@@ -657,7 +662,7 @@ fn fuse_in<N: NavFrame, const S: usize>(
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
             };
             count_fix(
-                filter.update_gnss_fix(&fix, setup.gate),
+                filter.update_gnss(&fix, setup.gate),
                 next_fix,
                 &mut rejected_in_a_row,
                 setup.gate,
@@ -667,11 +672,11 @@ fn fuse_in<N: NavFrame, const S: usize>(
         aid_streams.apply(&mut filter, t[i], i)?;
         let s = filter.state();
         let sig = filter.sigmas();
-        let e = euler_unwrapped(&s.attitude, &mut last_yaw);
+        let e = euler_unwrapped(&s.nav.attitude, &mut last_yaw);
         let (p, v, q) = (
-            s.position_m.to_array(),
-            s.velocity_m_s.to_array(),
-            s.attitude.to_wxyz(),
+            s.nav.position.to_array(),
+            s.nav.velocity_m_s.to_array(),
+            s.nav.attitude.to_wxyz(),
         );
         let mut row = vec![
             t[i],

@@ -2,8 +2,8 @@
 //! non-holonomic constraints and a rest at the start (zero velocity and zero angular rate) —
 //! read, checked and applied at their times, the same way for the flat filter and the Earth
 //! filter ([`AidUpdates`]).
-use imu_core::NavFrame;
-use imu_core::fusion::{EarthEskf, Eskf, EskfError, UpdateOutcome};
+use imu_core::earth::EarthModel;
+use imu_core::fusion::{Eskf, EskfError, UpdateOutcome};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
@@ -51,33 +51,7 @@ pub(crate) trait AidUpdates {
     ) -> std::result::Result<UpdateOutcome, EskfError>;
 }
 
-impl<N: NavFrame, const S: usize> AidUpdates for Eskf<N, S> {
-    fn body_velocity(
-        &mut self,
-        measured_m_s: [Option<f64>; 3],
-        sigma_m_s: [f64; 3],
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_body_velocity(measured_m_s, sigma_m_s, gate)
-    }
-    fn height(
-        &mut self,
-        height_m: f64,
-        sigma_m: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_height(height_m, sigma_m, gate)
-    }
-    fn zero_rate(
-        &mut self,
-        sigma_rad_s: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_zero_rate(sigma_rad_s, gate)
-    }
-}
-
-impl<const S: usize> AidUpdates for EarthEskf<S> {
+impl<E: EarthModel, const S: usize> AidUpdates for Eskf<E, S> {
     fn body_velocity(
         &mut self,
         measured_m_s: [Option<f64>; 3],

@@ -1,14 +1,17 @@
-//! Loosely coupled INS/GNSS fusion on the WGS-84 Earth: the core's Earth filter
-//! ([`imu_core::fusion::earth`]) over an IMU table (rates, frame `N`'s body convention) and a
+//! Loosely coupled INS/GNSS fusion on the WGS-84 Earth: the core's filter
+//! ([`imu_core::fusion::eskf`] on [`Wgs84`]) over an IMU table (rates, frame `N`'s body convention) and a
 //! GNSS table of geodetic fixes ([`GNSS_EARTH_COLUMNS`]), as [`super::fuse`] does on the flat
 //! Earth. Output: [`FUSE_EARTH_COLUMNS`] — the flat fusion's columns (positions in the tangent
 //! plane at the start's origin, velocity, attitude and one-sigmas on frame `N`'s axes, biases in
 //! its body convention) and `lat_rad, lon_rad, height_m`. Odometer, barometer (the ellipsoidal
 //! height) and the constraints aid it as on the flat Earth (the same code, `fuse_aids`).
 use imu_core::earth::wgs84::OMEGA_IE_RAD_S;
-use imu_core::earth::{Geodetic, GravityModel};
-use imu_core::fusion::{EarthEskf, EarthGnssFix, EskfError, FULL_STATES, InitialSigma};
-use imu_core::strapdown::earth::EarthNavState;
+use imu_core::earth::{Geodetic, GravityModel, Wgs84};
+use imu_core::fusion::{Eskf, EskfError, EskfState, FULL_STATES, GnssFix, InitialSigma};
+use imu_core::strapdown::NavState;
+
+/// The navigation state on WGS-84 in local NED.
+type EarthNavState = NavState<Wgs84<Ned>>;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
@@ -244,7 +247,12 @@ pub(crate) fn fuse_earth_in<N: NavFrame, const S: usize>(
     };
     aid_streams.start_at(t[first]);
     let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
-    let filter = EarthEskf::<S>::new(&s0, &sigma, setup.noise, gravity)
+    let start = EskfState {
+        nav: s0,
+        accel_bias_m_s2: [0.0; 3],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let filter = Eskf::<_, S>::new(Wgs84::<Ned>::new(gravity), &start, &sigma, setup.noise)
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
         .map_err(|_| covariance_interval_refusal(setup))?;
@@ -274,7 +282,7 @@ pub(crate) fn fuse_earth_in<N: NavFrame, const S: usize>(
             .map_err(|e| filter_error("IMU data", e))?;
         while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
             let [lat, lon, h] = g_p[next_fix];
-            let fix = EarthGnssFix {
+            let fix = GnssFix::<Wgs84<Ned>> {
                 position: geodetic(lat, lon, h),
                 velocity_m_s: setup
                     .gnss_velocity_sigma_m_s

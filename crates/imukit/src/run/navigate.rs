@@ -5,17 +5,14 @@
 //! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
 //! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
 //! yaw_rad, pitch_rad, roll_rad`.
-use imu_core::strapdown::rk4::{
-    NODES, RateWindow, Rk4Strapdown, strapdown_rates_rk4, window_start,
-};
+use imu_core::strapdown::rk4::{NODES, RateWindow, window_start};
 use std::collections::VecDeque;
 use std::path::Path;
 
-use imu_core::earth::{Geodetic, GravityModel};
-use imu_core::strapdown::earth::VerticalChannel;
-use imu_core::strapdown::step::{
-    NavState, RateStrapdown, Strapdown, StrapdownError, StrapdownOptions, strapdown_increments,
-    strapdown_rates,
+use imu_core::earth::{FlatEarth, Geodetic, GravityModel};
+use imu_core::strapdown::{
+    Increments, NavState, RateIncrements, Rk4, StrapdownError, StrapdownOptions, VerticalChannel,
+    strapdown_increments, strapdown_rates, strapdown_rates_rk4,
 };
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
@@ -323,8 +320,10 @@ impl NavScheme {
 pub struct NavSetup {
     /// Navigation frame.
     pub nav_frame: NavFrameName,
-    /// Algorithm options (gravity, coning, sculling).
+    /// Algorithm options (coning, sculling; the vertical channel on the Earth).
     pub options: StrapdownOptions,
+    /// Gravity magnitude on the flat Earth, m/s².
+    pub gravity_m_s2: f64,
     /// Sign of the accelerometer columns.
     pub accel_sign: AccelSign,
     /// Integration scheme.
@@ -338,6 +337,7 @@ impl Default for NavSetup {
         Self {
             nav_frame: NavFrameName::ENU,
             options: StrapdownOptions::default(),
+            gravity_m_s2: imu_core::DEFAULT_GRAVITY_M_S2,
             accel_sign: AccelSign::SpecificForce,
             scheme: NavScheme::ConingSculling,
             earth: None,
@@ -469,10 +469,11 @@ impl NavRequest<'_> {
             accel_sign: parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into(),
             scheme,
             options: StrapdownOptions {
-                gravity_m_s2: check_gravity("gravity_m_s2", self.gravity_m_s2)?,
                 coning: self.coning,
                 sculling: self.sculling,
+                vertical: VerticalChannel::Free,
             },
+            gravity_m_s2: check_gravity("gravity_m_s2", self.gravity_m_s2)?,
             earth: self.earth_nav()?,
         })
     }
@@ -574,31 +575,34 @@ fn integrate_in<N: NavFrame>(
             "the quaternion has zero norm or is not finite",
         )
     })?;
-    let s0 = NavState::<N> {
+    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
+    let s0 = NavState::<FlatEarth<N>> {
         t_s: t.first().copied().unwrap_or(0.0),
         attitude,
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-        position_m: Vec3::from_array(initial.position_m),
+        position: Vec3::from_array(initial.position_m),
     };
     let flip = |v: Vec<[f64; 3]>| match setup.accel_sign {
         AccelSign::SpecificForce => v,
         AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
     };
-    let mut out = vec![NavState::<N>::default(); t.len()];
+    let mut out = vec![NavState::<FlatEarth<N>>::default(); t.len()];
     let corrections = setup.options.coning || setup.options.sculling;
     let result = if let (Some(f), Some(w)) =
         (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
     {
         match setup.scheme.for_input(true, corrections) {
             NavScheme::ConingSculling => {
-                strapdown_rates(&t, &w, &flip(f), s0, setup.options, &mut out)
+                strapdown_rates(earth, &t, &w, &flip(f), s0, setup.options, &mut out)
             }
             NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
+                earth,
                 &t,
                 &w,
                 &flip(f),
+                None,
                 s0,
-                setup.options.gravity_m_s2,
+                setup.options,
                 substeps,
                 &mut out,
             ),
@@ -611,7 +615,16 @@ fn integrate_in<N: NavFrame>(
                 "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
             ));
         }
-        strapdown_increments(&t, &dth, &flip(dv), s0, setup.options, &mut out)
+        strapdown_increments(
+            earth,
+            &t,
+            &dth,
+            &flip(dv),
+            None,
+            s0,
+            setup.options,
+            &mut out,
+        )
     } else {
         return Err(invalid(
             "IMU data",
@@ -645,10 +658,10 @@ pub(crate) fn euler_unwrapped<N: NavFrame>(
 }
 
 /// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
-fn nav_row<N: NavFrame>(s: &NavState<N>, last_yaw: &mut Option<f64>) -> [f64; 14] {
+fn nav_row<N: NavFrame>(s: &NavState<FlatEarth<N>>, last_yaw: &mut Option<f64>) -> [f64; 14] {
     let [qw, qx, qy, qz] = s.attitude.to_wxyz();
     let e = euler_unwrapped(&s.attitude, last_yaw);
-    let [px, py, pz] = s.position_m.to_array();
+    let [px, py, pz] = s.position.to_array();
     let [vx, vy, vz] = s.velocity_m_s.to_array();
     [
         s.t_s,
@@ -703,17 +716,18 @@ pub fn integrate_csv(
 
 /// The per-sample integrator of a streamed file.
 enum Stepper<N: NavFrame> {
-    Rates(RateStrapdown<N>),
+    Rates(RateIncrements<FlatEarth<N>>),
     Increments {
-        nav: Strapdown<N>,
+        nav: Increments<FlatEarth<N>>,
+        initial: NavState<FlatEarth<N>>,
         started: bool,
     },
     /// RK4 holds the samples its next interval's quintic needs (six, from two before it) and
     /// emits each state once the three samples after the interval have been read (at the end
     /// of the file, the last intervals share the final six samples).
     Rk4 {
-        nav: Rk4Strapdown<N>,
-        initial: NavState<N>,
+        nav: Rk4<FlatEarth<N>>,
+        initial: NavState<FlatEarth<N>>,
         held: VecDeque<[f64; 7]>,
         first_held: usize,
         seen: usize,
@@ -721,7 +735,7 @@ enum Stepper<N: NavFrame> {
     },
 }
 
-type Emit<'a, N> = dyn FnMut(NavState<N>) -> Result<()> + 'a;
+type Emit<'a, N> = dyn FnMut(NavState<FlatEarth<N>>) -> Result<()> + 'a;
 
 impl<N: NavFrame> Stepper<N> {
     /// Takes the next row `[t, force, turn]` (force: accelerometer or Δv, physical sign; turn:
@@ -734,9 +748,11 @@ impl<N: NavFrame> Stepper<N> {
         };
         match self {
             Self::Rates(r) => emit(r.step(t, turn, force).map_err(failed)?),
-            Self::Increments { nav, started } if !*started => {
+            Self::Increments {
+                initial, started, ..
+            } if !*started => {
                 *started = true;
-                emit(*nav.state())
+                emit(*initial)
             }
             Self::Increments { nav, .. } => emit(nav.step(t, turn, force).map_err(failed)?),
             Self::Rk4 {
@@ -758,7 +774,10 @@ impl<N: NavFrame> Stepper<N> {
                 while *seen >= (*next_interval + 4).max(NODES) {
                     let k = *next_interval;
                     let start = k.saturating_sub(NODES / 2 - 1);
-                    emit(nav.interval(&window(held, start - *first_held), k - start))?;
+                    emit(
+                        nav.interval(&window(held, start - *first_held), k - start, 0.0, k + 1)
+                            .map_err(failed)?,
+                    )?;
                     *next_interval += 1;
                     while held.len() > NODES && *first_held + NODES / 2 - 1 < *next_interval {
                         held.pop_front();
@@ -792,7 +811,13 @@ impl<N: NavFrame> Stepper<N> {
         }
         for k in *next_interval..n - 1 {
             let start = window_start(k, n);
-            emit(nav.interval(&window(held, start - *first_held), k - start))?;
+            let state = nav
+                .interval(&window(held, start - *first_held), k - start, 0.0, k + 1)
+                .map_err(|source| crate::Error::Strapdown {
+                    context: "IMU data".into(),
+                    source,
+                })?;
+            emit(state)?;
         }
         *next_interval = n - 1;
         Ok(())
@@ -838,23 +863,31 @@ fn integrate_csv_in<N: NavFrame>(
             "the quaternion has zero norm or is not finite",
         )
     })?;
-    let s0 = NavState::<N> {
+    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
+    let s0 = NavState::<FlatEarth<N>> {
         t_s: rows.first_time(),
         attitude,
         velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-        position_m: Vec3::from_array(initial.position_m),
+        position: Vec3::from_array(initial.position_m),
+    };
+    let failed = |source: StrapdownError| crate::Error::Strapdown {
+        context: "initial state".into(),
+        source,
     };
     let scheme = setup
         .scheme
         .for_input(rates, setup.options.coning || setup.options.sculling);
     let mut stepper = match (scheme, rates) {
-        (NavScheme::ConingSculling, true) => Stepper::Rates(RateStrapdown::new(s0, setup.options)),
+        (NavScheme::ConingSculling, true) => {
+            Stepper::Rates(RateIncrements::new(earth, s0, setup.options).map_err(failed)?)
+        }
         (NavScheme::ConingSculling, false) => Stepper::Increments {
-            nav: Strapdown::new(s0, setup.options),
+            nav: Increments::new(earth, &s0, setup.options).map_err(failed)?,
+            initial: s0,
             started: false,
         },
         (NavScheme::Rk4 { substeps }, true) => Stepper::Rk4 {
-            nav: Rk4Strapdown::new(s0, setup.options.gravity_m_s2, substeps),
+            nav: Rk4::new(earth, &s0, setup.options, substeps).map_err(failed)?,
             initial: s0,
             held: VecDeque::with_capacity(NODES + 1),
             first_held: 0,
@@ -876,7 +909,7 @@ fn integrate_csv_in<N: NavFrame>(
     let mut file = AtomicFile::create(out)?;
     file.write_header(&NAV_COLUMNS)?;
     let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
-    let mut write = |state: NavState<N>, file: &mut AtomicFile| -> Result<()> {
+    let mut write = |state: NavState<FlatEarth<N>>, file: &mut AtomicFile| -> Result<()> {
         file.write_row(&nav_row(&state, &mut last_yaw))?;
         end = state;
         written += 1;
@@ -900,6 +933,6 @@ fn integrate_csv_in<N: NavFrame>(
     Ok(NavSummary {
         rows: written,
         scheme,
-        end_position_m: end.position_m.to_array(),
+        end_position_m: end.position.to_array(),
     })
 }
