@@ -18,6 +18,7 @@ pub const SOMIGLIANA_K: f64 = 0.001_931_852_652_41;
 pub const M_RATIO: f64 = OMEGA_IE_RAD_S * OMEGA_IE_RAD_S * A_M * A_M * B_M / GM_M3_S2;
 
 /// Normal gravity magnitude `γ(φ, h)`, m/s² (TR8350.2 eq. 4-1 and 4-3).
+#[inline]
 #[must_use]
 pub fn normal_gravity_m_s2(position: &Geodetic) -> f64 {
     let s2 = {
@@ -41,6 +42,7 @@ pub enum GravityModel {
 
 impl GravityModel {
     /// The gravity magnitude at `position`, m/s².
+    #[inline]
     #[must_use]
     pub fn magnitude_m_s2(&self, position: &Geodetic) -> f64 {
         match *self {

@@ -113,12 +113,15 @@ impl<N: NavFrame> EarthModel for FlatEarth<N> {
     type Position = Vec3<N>;
     const ROTATING: bool = false;
 
+    #[inline]
     fn coordinates(position: &Vec3<N>) -> [f64; 3] {
         position.to_array()
     }
+    #[inline]
     fn position(coordinates: [f64; 3]) -> Vec3<N> {
         Vec3::from_array(coordinates)
     }
+    #[inline]
     fn terms(&self, _c: &[f64; 3], _v: &Vec3<N>) -> EarthTerms<N> {
         EarthTerms {
             gravity_m_s2: N::gravity(self.gravity_m_s2),
@@ -126,24 +129,31 @@ impl<N: NavFrame> EarthModel for FlatEarth<N> {
             transport_rate_rad_s: Vec3::zeros(),
         }
     }
+    #[inline]
     fn position_rate(&self, _c: &[f64; 3], v: &Vec3<N>) -> [f64; 3] {
         v.to_array()
     }
+    #[inline]
     fn in_domain(&self, _c: &[f64; 3]) -> bool {
         true
     }
+    #[inline]
     fn height_m(&self, c: &[f64; 3]) -> (f64, f64) {
         (N::Z_UP * c[2], N::Z_UP)
     }
+    #[inline]
     fn radius_m(&self, _c: &[f64; 3]) -> f64 {
         f64::INFINITY
     }
+    #[inline]
     fn displacement_m(&self, from: &[f64; 3], to: &[f64; 3]) -> Vec3<N> {
         Vec3::from_array(*to) - Vec3::from_array(*from)
     }
+    #[inline]
     fn offset(&self, c: &[f64; 3], d: &Vec3<N>) -> [f64; 3] {
         (Vec3::<N>::from_array(*c) + *d).to_array()
     }
+    #[inline]
     fn couplings(&self, _c: &[f64; 3], _v: &Vec3<N>) -> Option<ErrorCouplings> {
         None
     }
@@ -172,11 +182,13 @@ impl<N: NavFrame> Wgs84<N> {
 }
 
 impl<N: NavFrame> Default for Wgs84<N> {
+    #[inline]
     fn default() -> Self {
         Self::new(GravityModel::Normal)
     }
 }
 
+#[inline]
 fn geodetic(c: &[f64; 3]) -> Geodetic {
     Geodetic {
         latitude_rad: c[0],
@@ -210,12 +222,15 @@ impl<N: NavFrame> EarthModel for Wgs84<N> {
     type Position = Geodetic;
     const ROTATING: bool = true;
 
+    #[inline]
     fn coordinates(p: &Geodetic) -> [f64; 3] {
         [p.latitude_rad, p.longitude_rad, p.height_m]
     }
+    #[inline]
     fn position(c: [f64; 3]) -> Geodetic {
         geodetic(&c)
     }
+    #[inline]
     fn terms(&self, c: &[f64; 3], v: &Vec3<N>) -> EarthTerms<N> {
         let p = geodetic(c);
         let v_ned = N::to_ned_axes(*v);
@@ -225,12 +240,15 @@ impl<N: NavFrame> EarthModel for Wgs84<N> {
             transport_rate_rad_s: N::from_ned_axes(transport_rate_ned(&p, v_ned)),
         }
     }
+    #[inline]
     fn position_rate(&self, c: &[f64; 3], v: &Vec3<N>) -> [f64; 3] {
         geodetic_rates(&geodetic(c), N::to_ned_axes(*v))
     }
+    #[inline]
     fn in_domain(&self, c: &[f64; 3]) -> bool {
         c[0].is_finite() && math::abs(c[0]) <= MAX_LATITUDE_RAD
     }
+    #[inline]
     fn wrap(&self, mut c: [f64; 3]) -> [f64; 3] {
         let pi = core::f64::consts::PI;
         if c[1] > pi || c[1] <= -pi {
@@ -238,13 +256,16 @@ impl<N: NavFrame> EarthModel for Wgs84<N> {
         }
         c
     }
+    #[inline]
     fn height_m(&self, c: &[f64; 3]) -> (f64, f64) {
         (c[2], 1.0)
     }
+    #[inline]
     fn radius_m(&self, c: &[f64; 3]) -> f64 {
         let (r_n, r_e) = geodetic(c).radii_m();
         math::sqrt(r_n * r_e)
     }
+    #[inline]
     fn displacement_m(&self, from: &[f64; 3], to: &[f64; 3]) -> Vec3<N> {
         let (r_n, r_e) = geodetic(from).radii_m();
         N::from_ned_axes(Vec3::new(
@@ -253,6 +274,7 @@ impl<N: NavFrame> EarthModel for Wgs84<N> {
             -(to[2] - from[2]),
         ))
     }
+    #[inline]
     fn offset(&self, c: &[f64; 3], d: &Vec3<N>) -> [f64; 3] {
         let d = N::to_ned_axes(*d);
         let (r_n, r_e) = geodetic(c).radii_m();
@@ -262,6 +284,7 @@ impl<N: NavFrame> EarthModel for Wgs84<N> {
             c[2] - d.z(),
         ]
     }
+    #[inline]
     fn couplings(&self, c: &[f64; 3], _v: &Vec3<N>) -> Option<ErrorCouplings> {
         let p = geodetic(c);
         let (r_n, r_e) = p.radii_m();

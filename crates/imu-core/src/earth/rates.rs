@@ -17,6 +17,7 @@ use crate::vector::Vec3;
 pub const MAX_LATITUDE_RAD: f64 = 89.9 * core::f64::consts::PI / 180.0;
 
 /// The Earth rate in local NED, rad/s.
+#[inline]
 #[must_use]
 pub fn earth_rate_ned(position: &Geodetic) -> Vec3<Ned> {
     let phi = position.latitude_rad;
@@ -28,6 +29,7 @@ pub fn earth_rate_ned(position: &Geodetic) -> Vec3<Ned> {
 }
 
 /// The transport rate `ω_en^n`, rad/s, for the ground velocity `v^n` (NED, m/s).
+#[inline]
 #[must_use]
 pub fn transport_rate_ned(position: &Geodetic, velocity_m_s: Vec3<Ned>) -> Vec3<Ned> {
     let (r_n, r_e) = position.radii_m();
@@ -42,6 +44,7 @@ pub fn transport_rate_ned(position: &Geodetic, velocity_m_s: Vec3<Ned>) -> Vec3<
 
 /// Rates of the geodetic coordinates for the ground velocity `v^n`:
 /// `(φ̇, λ̇, ḣ) = (v_N/(R_N + h), v_E/((R_E + h) cos φ), −v_D)`, rad/s, rad/s, m/s.
+#[inline]
 #[must_use]
 pub fn geodetic_rates(position: &Geodetic, velocity_m_s: Vec3<Ned>) -> [f64; 3] {
     let (r_n, r_e) = position.radii_m();

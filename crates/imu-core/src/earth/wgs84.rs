@@ -46,6 +46,7 @@ impl Geodetic {
 
     /// Meridian radius of curvature `R_N = a(1 − e²)/(1 − e² sin²φ)^{3/2}` and prime-vertical
     /// radius `R_E = a/√(1 − e² sin²φ)`, m.
+    #[inline]
     #[must_use]
     pub fn radii_m(&self) -> (f64, f64) {
         let s = math::sin(self.latitude_rad);

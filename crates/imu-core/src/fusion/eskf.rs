@@ -174,56 +174,95 @@ struct Blocks {
     gyro: [Option<Block<12>>; 3],
 }
 
-/// `Σ` of the present terms, `None` when none is.
-fn sum_present<T: core::ops::Add<Output = T>>(terms: impl Iterator<Item = Option<T>>) -> Option<T> {
-    terms.flatten().reduce(|a, b| a + b)
+/// `acc + term`, or `term` when nothing is accumulated yet (so that the sum of the present
+/// terms is formed in their order, with no zero added).
+#[inline(always)]
+fn accumulate<T: core::ops::Add<Output = T>>(acc: Option<T>, term: T) -> Option<T> {
+    Some(match acc {
+        Some(a) => a + term,
+        None => term,
+    })
+}
+
+/// `FΔt + (Σ F F) Δt²/2` of a block: `first` (`F_ij`, if present) and the present products.
+#[inline(always)]
+fn second_order<T>(first: Option<T>, products: Option<T>, dt: f64, h: f64) -> Option<T>
+where
+    T: core::ops::Add<Output = T> + core::ops::Mul<f64, Output = T>,
+{
+    match (first, products) {
+        (Some(f), Some(p)) => Some(f * dt + p * h),
+        (Some(f), None) => Some(f * dt),
+        (None, Some(p)) => Some(p * h),
+        (None, None) => None,
+    }
 }
 
 impl Blocks {
     /// `A = FΔt + F²Δt²/2` of `F = self`: `A_ij = F_ij Δt + (Σ_k F_ik F_kj) Δt²/2`, `k` over
-    /// the three non-zero block rows.
+    /// the three non-zero block rows. F's first block row is `δṗ = δv`, the identity at
+    /// `(0, 1)` and nothing else, so its products are taken without multiplying.
+    #[allow(clippy::needless_range_loop)] // the block indices index several arrays at once
     fn transition(&self, dt: f64) -> Blocks {
         let h = 0.5 * dt * dt;
         let f = &self.m;
         let mut a = Blocks::default();
         for i in 0..3 {
             for j in 0..5 {
-                let second = sum_present((0..3).map(|k| f[i][k].zip(f[k][j]).map(|(x, y)| x * y)));
-                a.m[i][j] =
-                    sum_present([f[i][j].map(|x| x * dt), second.map(|s| s * h)].into_iter());
+                let mut products = None;
+                for k in 0..3 {
+                    let term = match (i, k) {
+                        (0, 1) => f[1][j],
+                        (0, _) => None,
+                        (_, 0) if j == 1 => f[i][0],
+                        (_, 0) => None,
+                        _ => f[i][k].zip(f[k][j]).map(|(x, y)| x * y),
+                    };
+                    if let Some(t) = term {
+                        products = accumulate(products, t);
+                    }
+                }
+                a.m[i][j] = second_order(f[i][j], products, dt, h);
             }
-            let accel = sum_present((0..3).map(|k| f[i][k].zip(self.accel[k]).map(|(x, y)| x * y)));
-            a.accel[i] =
-                sum_present([self.accel[i].map(|x| x * dt), accel.map(|s| s * h)].into_iter());
-            let gyro = sum_present((0..3).map(|k| f[i][k].zip(self.gyro[k]).map(|(x, y)| x * y)));
-            a.gyro[i] =
-                sum_present([self.gyro[i].map(|x| x * dt), gyro.map(|s| s * h)].into_iter());
+            let (mut accel, mut gyro) = (None, None);
+            for k in 1..3 {
+                let through = if i == 0 {
+                    (k == 1).then(Matrix3::identity)
+                } else {
+                    f[i][k]
+                };
+                if let Some(x) = through {
+                    if let Some(y) = &self.accel[k] {
+                        accel = accumulate(accel, if i == 0 { *y } else { x * y });
+                    }
+                    if let Some(y) = &self.gyro[k] {
+                        gyro = accumulate(gyro, if i == 0 { *y } else { x * y });
+                    }
+                }
+            }
+            a.accel[i] = second_order(self.accel[i], accel, dt, h);
+            a.gyro[i] = second_order(self.gyro[i], gyro, dt, h);
         }
         a
     }
 
-    /// `self · m` (rows below the attitude zero).
+    /// `self · m` (rows below the attitude zero), each block row the sum of its present
+    /// blocks' products in column order.
     fn times<const S: usize>(&self, m: &Cov<S>) -> Cov<S> {
         let mut out = Cov::<S>::zeros();
         for i in 0..3 {
-            let rows = sum_present(
-                (0..5).map(|j| self.m[i][j].map(|b| b * m.fixed_view::<3, S>(3 * j, 0))),
-            );
-            let sensor = sum_present(
-                [
-                    self.accel[i].map(|b| b * m.fixed_view::<9, S>(ACCEL_MATRIX, 0)),
-                    self.gyro[i].map(|b| b * m.fixed_view::<12, S>(GYRO_ERRORS, 0)),
-                ]
-                .into_iter(),
-            );
-            let row = match (rows, sensor) {
-                (Some(r), Some(s)) => r + s,
-                (r, s) => match r.or(s) {
-                    Some(x) => x,
-                    None => continue,
-                },
-            };
-            out.fixed_view_mut::<3, S>(3 * i, 0).copy_from(&row);
+            let mut row = out.fixed_view_mut::<3, S>(3 * i, 0);
+            for j in 0..5 {
+                if let Some(b) = &self.m[i][j] {
+                    row += b * m.fixed_view::<3, S>(3 * j, 0);
+                }
+            }
+            if let Some(b) = &self.accel[i] {
+                row += b * m.fixed_view::<9, S>(ACCEL_MATRIX, 0);
+            }
+            if let Some(b) = &self.gyro[i] {
+                row += b * m.fixed_view::<12, S>(GYRO_ERRORS, 0);
+            }
         }
         out
     }
@@ -760,7 +799,7 @@ pub(crate) type Rows<const M: usize, const S: usize> =
 
 /// The GNSS measurement model shared by the flat and the Earth filters: `delta_p` is the fix's
 /// position minus the nominal position in local navigation-frame metres; the antenna at lever
-/// arm `l`, the fix valid `age_s` earlier (see [`Eskf::update_gnss_fix`]); `sigmas` are the
+/// arm `l`, the fix valid `age_s` earlier (see [`Eskf::update_gnss`]); `sigmas` are the
 /// position and velocity one-sigmas. Returns `(H, y, r)` with unused velocity rows inert. With
 /// the sensor errors the velocity rows also see them through the lever arm
 /// (`Ĉ [l×] D_g δm_g`) and the latency (`τ Ĉ D_a δm_a`).

@@ -22,6 +22,7 @@ pub(crate) struct State {
 }
 
 impl State {
+    #[inline(always)]
     pub(crate) fn add(&self, d: &State, h: f64) -> State {
         State {
             q: self.q + d.q * h,
@@ -42,6 +43,14 @@ impl State {
     }
 }
 
+/// Whether every value is finite: `x − x` is 0 for a finite `x` and NaN for an infinite or NaN
+/// one, so the sum is 0 exactly when all are finite (no branch per value).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` is the test itself
+pub(crate) fn all_finite(values: &[f64]) -> bool {
+    values.iter().map(|x| x - x).sum::<f64>() == 0.0
+}
+
 /// `−Z_UP`: +1 where the frame's z axis points down.
 fn down<E: EarthModel>() -> f64 {
     -<E::Frame as NavFrame>::Z_UP
@@ -49,6 +58,7 @@ fn down<E: EarthModel>() -> f64 {
 
 /// The Earth's terms of the velocity equation and the frame's rate at `s`:
 /// `(g^n − (2ω_ie + ω_en) × v, ω_in^n)`, the rate `None` when the frame does not turn.
+#[inline(always)]
 pub(crate) fn earth_terms<E: EarthModel>(
     earth: &E,
     s: &State,
@@ -78,6 +88,7 @@ pub(crate) fn baro_gains<E: EarthModel>(earth: &E, tau_s: f64, c: &[f64; 3]) -> 
 
 /// What the vertical channel adds to the rates at `s` (the baro loop) or holds (hold), given
 /// the barometric height `baro_m`: changes `v_dot`, `c_dot` and returns `ḃ`.
+#[inline(always)]
 pub(crate) fn vertical_rates<E: EarthModel>(
     earth: &E,
     vertical: VerticalChannel,
@@ -105,6 +116,7 @@ pub(crate) fn vertical_rates<E: EarthModel>(
 }
 
 /// The state's time derivative for body rate `w` and specific force `f`.
+#[inline(always)]
 pub(crate) fn derivative<E: EarthModel>(
     earth: &E,
     vertical: VerticalChannel,
@@ -139,8 +151,8 @@ fn in_domain<E: EarthModel>(earth: &E, c: &[f64; 3], index: usize) -> Result<(),
     }
 }
 
-/// The state after an interval (its quaternion normalised by the scheme): in the frame's
-/// domain, coordinates wrapped, finite; the navigation state at `t_s`.
+/// The state after an interval (its quaternion normalised and finite by the scheme): in the
+/// frame's domain, coordinates wrapped, finite; the navigation state at `t_s`.
 pub(crate) fn finish<E: EarthModel>(
     earth: &E,
     s: &mut State,
@@ -149,12 +161,9 @@ pub(crate) fn finish<E: EarthModel>(
 ) -> Result<NavState<E>, StrapdownError> {
     in_domain(earth, &s.c, index)?;
     s.c = earth.wrap(s.c);
-    let finite =
-        s.v.iter()
-            .chain(&s.c)
-            .chain(s.q.coords.iter())
-            .all(|v| v.is_finite());
-    if !finite {
+    // The attitude is a product of unit quaternions of finite angles (increments), or checked by
+    // the scheme (RK4): velocity and position are what finite inputs can overflow.
+    if !all_finite(&[s.v.x, s.v.y, s.v.z, s.c[0], s.c[1], s.c[2]]) {
         return Err(StrapdownError::NotFinite { index });
     }
     Ok(NavState {

@@ -21,13 +21,14 @@ use nalgebra::{UnitQuaternion, Vector3};
 use crate::earth::EarthModel;
 use crate::frame::NavFrame;
 
-use super::equations::{State, check_initial, earth_terms, finish, start};
+use super::equations::{State, all_finite, check_initial, earth_terms, finish, start};
 use super::{
     NavState, StrapdownError, StrapdownOptions, VerticalChannel, check_baro, check_lengths,
 };
 
+#[inline(always)]
 fn finite3(v: &[f64; 3]) -> bool {
-    v.iter().all(|c| c.is_finite())
+    all_finite(v)
 }
 
 /// Strapdown on Δθ/Δv increments.

@@ -8,7 +8,7 @@
 //! turned by the normalised stage quaternion.
 use crate::earth::EarthModel;
 
-use super::equations::{State, check_initial, derivative, finish, start};
+use super::equations::{State, all_finite, check_initial, derivative, finish, start};
 use super::{NavState, StrapdownError, StrapdownOptions, check_baro, check_lengths};
 
 /// Interpolation nodes per interval: the six samples around it.
@@ -133,6 +133,10 @@ impl<E: EarthModel> Rk4<E> {
             if !earth.in_domain(&s.c) {
                 return Err(StrapdownError::NearPole { index });
             }
+        }
+        let q = &s.q.coords;
+        if !all_finite(&[q.x, q.y, q.z, q.w]) {
+            return Err(StrapdownError::NotFinite { index });
         }
         let out = finish(earth, &mut s, w.t_s[j + 1], index)?;
         self.state = s;

@@ -1,9 +1,8 @@
 //! The aids of a fusion besides GNSS — odometer readings, barometer readings, the
 //! non-holonomic constraints and a rest at the start (zero velocity and zero angular rate) —
-//! read, checked and applied at their times, the same way for the flat filter and the Earth
-//! filter ([`AidUpdates`]).
+//! read, checked and applied at their times, the same way on every Earth.
 use imu_core::earth::EarthModel;
-use imu_core::fusion::{Eskf, EskfError, UpdateOutcome};
+use imu_core::fusion::Eskf;
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
@@ -25,57 +24,6 @@ const CHI2_99_9: [f64; 3] = [
     13.815_510_557_964_274,
     16.266_236_196_238_13,
 ];
-
-/// The updates aids make, on either filter.
-pub(crate) trait AidUpdates {
-    /// Body-frame velocity rows (x forward in both body conventions).
-    fn body_velocity(
-        &mut self,
-        measured_m_s: [Option<f64>; 3],
-        sigma_m_s: [f64; 3],
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError>;
-    /// A height: the frame's up coordinate on the flat Earth, the ellipsoidal height on WGS-84.
-    fn height(
-        &mut self,
-        height_m: f64,
-        sigma_m: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError>;
-    /// The body at rest turns only with the Earth (the last gyroscope sample, one-sigma
-    /// `sigma_rad_s`).
-    fn zero_rate(
-        &mut self,
-        sigma_rad_s: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError>;
-}
-
-impl<E: EarthModel, const S: usize> AidUpdates for Eskf<E, S> {
-    fn body_velocity(
-        &mut self,
-        measured_m_s: [Option<f64>; 3],
-        sigma_m_s: [f64; 3],
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_body_velocity(measured_m_s, sigma_m_s, gate)
-    }
-    fn height(
-        &mut self,
-        height_m: f64,
-        sigma_m: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_height(height_m, sigma_m, gate)
-    }
-    fn zero_rate(
-        &mut self,
-        sigma_rad_s: f64,
-        gate: f64,
-    ) -> std::result::Result<UpdateOutcome, EskfError> {
-        self.update_zero_rate(sigma_rad_s, gate)
-    }
-}
 
 /// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
 pub(crate) fn aid_series(
@@ -217,13 +165,18 @@ impl AidStreams {
     ///
     /// # Errors
     /// The filter's refusal, naming the aid and its row ([`filter_refusal`]).
-    pub(crate) fn apply(&mut self, filter: &mut impl AidUpdates, t_s: f64, i: usize) -> Result<()> {
+    pub(crate) fn apply<E: EarthModel, const S: usize>(
+        &mut self,
+        filter: &mut Eskf<E, S>,
+        t_s: f64,
+        i: usize,
+    ) -> Result<()> {
         if t_s < self.rest.0 {
             filter
-                .body_velocity([Some(0.0); 3], [REST_VELOCITY_SIGMA_M_S; 3], self.gate(3))
+                .update_body_velocity([Some(0.0); 3], [REST_VELOCITY_SIGMA_M_S; 3], self.gate(3))
                 .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;
             filter
-                .zero_rate(self.rest.1, self.gate(3))
+                .update_zero_rate(self.rest.1, self.gate(3))
                 .map_err(|e| filter_refusal("IMU (at rest, zero rate)", i, e))?;
         }
         let (odo_t, odo_v) = (&self.odometer.0, &self.odometer.1);
@@ -240,7 +193,7 @@ impl AidStreams {
                 None => ([Some(speed), None, None], [sigma, 1.0, 1.0], 1),
             };
             filter
-                .body_velocity(measured, sigmas, self.gate(dof))
+                .update_body_velocity(measured, sigmas, self.gate(dof))
                 .map_err(|e| filter_refusal("odometer", k, e))?;
             self.next.0 += 1;
         }
@@ -249,7 +202,7 @@ impl AidStreams {
             && t_s >= self.next_nhc_t
         {
             filter
-                .body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], self.gate(2))
+                .update_body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], self.gate(2))
                 .map_err(|e| filter_refusal("constraint", i, e))?;
             self.next_nhc_t = t_s + 1.0 / NHC_RATE_HZ;
         }
@@ -257,7 +210,7 @@ impl AidStreams {
         while self.next.1 < baro_t.len() && baro_t[self.next.1] <= t_s {
             let k = self.next.1;
             filter
-                .height(baro_h[k], self.baro_sigma_m, self.gate(1))
+                .update_height(baro_h[k], self.baro_sigma_m, self.gate(1))
                 .map_err(|e| filter_refusal("barometer", k, e))?;
             self.next.1 += 1;
         }

@@ -1,0 +1,268 @@
+//! The error-state filter, written once for every Earth, tested where it lives: consistency by
+//! Monte Carlo (average NEES of position, velocity and attitude inside the two-sided 95 %
+//! chi-square bounds) on the flat Earth and on WGS-84, a mistuned filter outside them, and a
+//! covariance still symmetric and positive definite after 10⁶ steps.
+use imu_core::earth::{EarthModel, EarthMount, EarthTruth, FlatEarth, Geodetic, Wgs84};
+use imu_core::fusion::{
+    BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma, SensorErrorSigma,
+};
+use imu_core::sensor::{NoiseSource, SeededNormals};
+use imu_core::strapdown::NavState;
+use imu_core::{Enu, NavFrame, Ned, Rotation, Vec3};
+
+const RATE_HZ: f64 = 100.0;
+const GNSS_EVERY: usize = 100;
+const POSITION_SIGMA_M: f64 = 1.0;
+const VELOCITY_SIGMA_M_S: f64 = 0.1;
+
+const NOISE: EskfNoise = EskfNoise {
+    accel_psd: 2e-3,
+    gyro_psd: 1e-4,
+    accel_bias_psd: 1e-5,
+    gyro_bias_psd: 1e-7,
+};
+
+const SIGMA: InitialSigma = InitialSigma {
+    position_m: 2.0,
+    velocity_m_s: 0.2,
+    attitude_rad: [0.01, 0.01, 0.05],
+    accel_bias_m_s2: 0.02,
+    gyro_bias_rad_s: 2e-4,
+};
+
+/// An Earth with a vehicle on it: where it is at `t_s`, how fast, and what an ideal IMU on it
+/// reads (level, its body axes on the navigation axes).
+trait Case: EarthModel {
+    fn earth() -> Self;
+    /// Truth at `t_s`: position and velocity (attitude level, yaw 0).
+    fn truth(t_s: f64) -> (Self::Position, Vec3<Self::Frame>);
+    /// The ideal gyroscope and accelerometer readings (constant along the motion).
+    fn ideal() -> ([f64; 3], [f64; 3]);
+}
+
+/// Driving north-east at a constant 11 m/s on the flat ENU Earth.
+impl Case for FlatEarth<Enu> {
+    fn earth() -> Self {
+        FlatEarth::new(9.81)
+    }
+    fn truth(t_s: f64) -> (Vec3<Enu>, Vec3<Enu>) {
+        let v = Vec3::new(10.0, 5.0, 0.0);
+        (Vec3::new(3.0, -2.0, 1.0) + v * t_s, v)
+    }
+    fn ideal() -> ([f64; 3], [f64; 3]) {
+        ([0.0; 3], [0.0, 0.0, 9.81])
+    }
+}
+
+/// Standing at 45° N on the rotating WGS-84 Earth (NED): the gyroscopes read the Earth's rate.
+impl Case for Wgs84<Ned> {
+    fn earth() -> Self {
+        Wgs84::default()
+    }
+    fn truth(_t_s: f64) -> (Geodetic, Vec3<Ned>) {
+        (Geodetic::from_degrees(45.0, 7.0, 300.0), Vec3::zeros())
+    }
+    fn ideal() -> ([f64; 3], [f64; 3]) {
+        let truth = EarthTruth {
+            position: Self::truth(0.0).0,
+            ..EarthTruth::default()
+        };
+        let r = EarthMount::default().read(&truth, Vec3::zeros());
+        (r.gyro_rad_s.to_array(), r.accel_m_s2.to_array())
+    }
+}
+
+fn chi2_quantile(k: f64, z: f64) -> f64 {
+    // Wilson–Hilferty.
+    let c = 2.0 / (9.0 * k);
+    k * (1.0 - c + z * c.sqrt()).powi(3)
+}
+
+fn draw3(n: &mut SeededNormals, sigma: [f64; 3]) -> [f64; 3] {
+    sigma.map(|s| s * n.standard_normal())
+}
+
+/// The filter's errors `(δp, δv, φ)` against the truth at `t_s` (navigation axes; position in
+/// metres), with `C_true = (I + [φ×]) Ĉ`.
+fn errors_of<E: Case>(earth: &E, nav: &NavState<E>, t_s: f64) -> [nalgebra::Vector3<f64>; 3] {
+    let (p, v) = E::truth(t_s);
+    let ep = earth.displacement_m(&E::coordinates(&nav.position), &E::coordinates(&p));
+    let ev = v - nav.velocity_m_s;
+    let ea = (Rotation::<imu_core::Body, E::Frame>::identity().quaternion()
+        * nav.attitude.quaternion().inverse())
+    .scaled_axis();
+    [*ep.as_nalgebra(), *ev.as_nalgebra(), ea]
+}
+
+/// One run of `seconds`: the truth's biases and the filter's start drawn from the initial
+/// one-sigmas times `draw_scale`, white noise on every reading, GNSS position and velocity at
+/// 1 Hz; returns the NEES of position, velocity and attitude at the end.
+fn run<E: Case>(seed: u64, run: u64, seconds: f64, draw_scale: f64) -> [f64; 3] {
+    let earth = E::earth();
+    let mut n = SeededNormals::for_run(seed, run);
+    let s = draw_scale;
+    let bias_a = draw3(&mut n, [SIGMA.accel_bias_m_s2 * s; 3]);
+    let bias_g = draw3(&mut n, [SIGMA.gyro_bias_rad_s * s; 3]);
+    let (p0, v0) = E::truth(0.0);
+    let dp = draw3(&mut n, [SIGMA.position_m * s; 3]);
+    let dv = draw3(&mut n, [SIGMA.velocity_m_s * s; 3]);
+    let tilt = draw3(&mut n, SIGMA.attitude_rad.map(|a| a * s));
+    let start = EskfState::<E> {
+        nav: NavState {
+            t_s: 0.0,
+            // The estimate off by −δx: Ĉ = exp(−[φ×]) C_true.
+            position: E::position(
+                earth.offset(&E::coordinates(&p0), &Vec3::from_array(dp.map(|x| -x))),
+            ),
+            velocity_m_s: v0 - Vec3::from_array(dv),
+            attitude: Rotation::assume_from_quaternion(nalgebra::UnitQuaternion::from_scaled_axis(
+                -nalgebra::Vector3::from(tilt),
+            )),
+        },
+        accel_bias_m_s2: [0.0; 3],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let mut f = Eskf::<E, BASE_STATES>::new(earth, &start, &SIGMA, NOISE).unwrap();
+    let (w_ideal, a_ideal) = E::ideal();
+    let (sigma_w, sigma_a) = (
+        NOISE.gyro_psd * RATE_HZ.sqrt(),
+        NOISE.accel_psd * RATE_HZ.sqrt(),
+    );
+    let samples = (seconds * RATE_HZ) as usize;
+    for k in 0..=samples {
+        let t = k as f64 / RATE_HZ;
+        let w = draw3(&mut n, [sigma_w; 3]);
+        let a = draw3(&mut n, [sigma_a; 3]);
+        f.propagate(
+            t,
+            std::array::from_fn(|i| w_ideal[i] + bias_g[i] + w[i]),
+            std::array::from_fn(|i| a_ideal[i] + bias_a[i] + a[i]),
+        )
+        .unwrap();
+        if k > 0 && k % GNSS_EVERY == 0 {
+            let (p, v) = E::truth(t);
+            let ep = draw3(&mut n, [POSITION_SIGMA_M; 3]);
+            let ev = draw3(&mut n, [VELOCITY_SIGMA_M_S; 3]);
+            let fix = GnssFix::<E> {
+                position: E::position(earth.offset(&E::coordinates(&p), &Vec3::from_array(ep))),
+                velocity_m_s: Some(v + Vec3::from_array(ev)),
+                lever_arm_m: Vec3::zeros(),
+                position_sigma_m: [POSITION_SIGMA_M; 3],
+                velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
+                age_s: 0.0,
+            };
+            f.update_gnss(&fix, f64::INFINITY).unwrap();
+        }
+    }
+    let t_end = samples as f64 / RATE_HZ;
+    let e = errors_of(f.earth(), &f.state().nav, t_end);
+    std::array::from_fn(|k| {
+        let block = nalgebra::Matrix3::from_fn(|r, c| f.covariance(3 * k + r, 3 * k + c));
+        (e[k].transpose() * block.try_inverse().unwrap() * e[k])[(0, 0)]
+    })
+}
+
+/// Average NEES over `runs` runs, and the 95 % bounds of an average of `runs` χ²(3) draws.
+fn average_nees<E: Case>(runs: u64, draw_scale: f64) -> ([f64; 3], (f64, f64)) {
+    let mut sums = [0.0; 3];
+    for r in 0..runs {
+        let nees = run::<E>(7, r, 60.0, draw_scale);
+        for k in 0..3 {
+            sums[k] += nees[k];
+        }
+    }
+    let dof = 3.0 * runs as f64;
+    let bounds = (
+        chi2_quantile(dof, -1.959_964) / runs as f64,
+        chi2_quantile(dof, 1.959_964) / runs as f64,
+    );
+    (sums.map(|s| s / runs as f64), bounds)
+}
+
+fn consistent<E: Case>(name: &str) {
+    let (nees, (lo, hi)) = average_nees::<E>(50, 1.0);
+    eprintln!("{name}: average NEES {nees:?}, 95 % bounds [{lo:.3}, {hi:.3}]");
+    for (what, v) in ["position", "velocity", "attitude"].iter().zip(nees) {
+        assert!(
+            lo <= v && v <= hi,
+            "{name} {what}: average NEES {v} outside [{lo}, {hi}]"
+        );
+    }
+    // A filter told a start three times better than it is: its attitude NEES leaves the bounds.
+    let (nees, _) = average_nees::<E>(50, 3.0);
+    eprintln!("{name}, start three times worse than told: average NEES {nees:?}");
+    assert!(nees[2] > hi, "{name}: a mistuned filter passed ({nees:?})");
+}
+
+#[test]
+fn the_filter_is_consistent_on_the_flat_earth_and_a_mistuned_one_is_not() {
+    consistent::<FlatEarth<Enu>>("flat ENU");
+}
+
+#[test]
+fn the_filter_is_consistent_on_wgs84_and_a_mistuned_one_is_not() {
+    consistent::<Wgs84<Ned>>("WGS-84 NED");
+}
+
+/// A million IMU steps with a fix every second, every step propagating the covariance: it
+/// stays exactly symmetric (Joseph form, symmetrised) and positive definite (its Cholesky
+/// factor exists, its smallest eigenvalue is positive).
+fn long_run<E: Case, const S: usize>(name: &str) {
+    let earth = E::earth();
+    let (p0, v0) = E::truth(0.0);
+    let start = EskfState::<E> {
+        nav: NavState {
+            t_s: 0.0,
+            position: p0,
+            velocity_m_s: v0,
+            attitude: Rotation::identity(),
+        },
+        accel_bias_m_s2: [0.0; 3],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let mut f = Eskf::<E, S>::new(earth, &start, &SIGMA, NOISE).unwrap();
+    if S == FULL_STATES {
+        f = f
+            .with_sensor_error_sigma(&SensorErrorSigma {
+                accel_scale_factor: 1e-3,
+                accel_misalignment: 1e-3,
+                gyro_scale_factor: 1e-3,
+                gyro_misalignment: 1e-3,
+                gyro_g_sensitivity: 1e-5,
+            })
+            .unwrap();
+    }
+    let (w, a) = E::ideal();
+    let mut n = SeededNormals::new(3);
+    for k in 0..=1_000_000usize {
+        let t = k as f64 / RATE_HZ;
+        f.propagate(t, w, a).unwrap();
+        if k > 0 && k % GNSS_EVERY == 0 {
+            let (p, v) = E::truth(t);
+            let ep = draw3(&mut n, [POSITION_SIGMA_M; 3]);
+            let fix = GnssFix::<E> {
+                position: E::position(earth.offset(&E::coordinates(&p), &Vec3::from_array(ep))),
+                velocity_m_s: Some(v),
+                lever_arm_m: Vec3::new(0.5, -0.2, 0.3),
+                position_sigma_m: [POSITION_SIGMA_M; 3],
+                velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
+                age_s: 0.0,
+            };
+            f.update_gnss(&fix, f64::INFINITY).unwrap();
+        }
+    }
+    let p = nalgebra::DMatrix::from_fn(S, S, |i, j| f.covariance(i, j));
+    assert_eq!(p, p.transpose(), "{name}: not symmetric");
+    let min = p.clone().symmetric_eigenvalues().min();
+    eprintln!("{name}: smallest eigenvalue after 10⁶ steps {min:e}");
+    assert!(min > 0.0, "{name}: smallest eigenvalue {min:e}");
+    assert!(p.cholesky().is_some(), "{name}: no Cholesky factor");
+    let _ = <E::Frame as NavFrame>::Z_UP;
+}
+
+#[test]
+fn the_covariance_stays_symmetric_and_positive_definite_for_a_million_steps() {
+    long_run::<FlatEarth<Enu>, BASE_STATES>("flat, 15 states");
+    long_run::<Wgs84<Ned>, BASE_STATES>("WGS-84, 15 states");
+    long_run::<FlatEarth<Enu>, FULL_STATES>("flat, 36 states");
+}
