@@ -51,6 +51,18 @@ pub(crate) fn all_finite(values: &[f64]) -> bool {
     values.iter().map(|x| x - x).sum::<f64>() == 0.0
 }
 
+/// Keeps `q` a unit quaternion: rescaled when its squared norm has drifted from 1 by more
+/// than 1e-12. A product of unit quaternions drifts by rounding only (about 1e-16 a step), so
+/// this rarely rescales, and the test, a predictable branch, stays off the recursion's
+/// critical path (a square root and four divisions every step would double its latency).
+#[inline(always)]
+pub(crate) fn keep_unit(q: &mut Quaternion<f64>) {
+    let n2 = q.norm_squared();
+    if (n2 - 1.0).abs() > 1e-12 {
+        *q /= crate::math::sqrt(n2);
+    }
+}
+
 /// `−Z_UP`: +1 where the frame's z axis points down.
 fn down<E: EarthModel>() -> f64 {
     -<E::Frame as NavFrame>::Z_UP

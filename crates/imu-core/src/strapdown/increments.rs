@@ -21,7 +21,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use crate::earth::EarthModel;
 use crate::frame::NavFrame;
 
-use super::equations::{State, all_finite, check_initial, earth_terms, finish, start};
+use super::equations::{State, all_finite, check_initial, earth_terms, finish, keep_unit, start};
 use super::{
     NavState, StrapdownError, StrapdownOptions, VerticalChannel, check_baro, check_lengths,
 };
@@ -145,7 +145,7 @@ impl<E: EarthModel> Increments<E> {
             // Predictor: the Earth's terms at the start; corrector: at the predicted midpoint.
             s1 = self.advance(&s0, &s0.midpoint(&s1), phi, dv_body, dt, baro_height_m);
         }
-        s1.q = s1.q.normalize();
+        keep_unit(&mut s1.q);
         let out = finish(&self.earth, &mut s1, t_s, index)?;
         self.state = s1;
         self.t_s = t_s;
