@@ -8,15 +8,12 @@
 use imu_core::earth::wgs84::OMEGA_IE_RAD_S;
 use imu_core::earth::{Geodetic, GravityModel, Wgs84};
 use imu_core::fusion::{Eskf, EskfError, EskfState, FULL_STATES, GnssFix, InitialSigma};
-use imu_core::strapdown::NavState;
 
-/// The navigation state on WGS-84 in local NED.
-type EarthNavState = NavState<Wgs84<Ned>>;
 use imu_core::{Body, EulerZyx, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
 use crate::io::table::{Table, concat_columns};
-use crate::run::earth_nav;
+use crate::run::earth_nav::{self, EarthNavState};
 use crate::run::fuse::{
     AidTables, FUSE_COLUMNS, FuseSetup, FuseSummary, FusionInputs, Start, align_from_gnss,
     count_fix, covariance_interval_refusal, fused_columns, push_sensor_errors,
