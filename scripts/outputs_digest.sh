@@ -5,9 +5,12 @@
 #   bash scripts/outputs_digest.sh > before.txt     # on the old commit
 #   bash scripts/outputs_digest.sh > after.txt      # on the new one
 #   diff before.txt after.txt
+# With a folder as argument, the outputs are also kept there (to compare the numbers of a file
+# whose digest differs).
 # Needs the release CLI (target/release/imukit) and the Python package in .venv (scripts/test.sh
 # builds both). Writes nothing outside a temporary folder.
 set -euo pipefail
+keep=${1:+$(realpath -m "$1")}
 cd "$(dirname "$0")/.."
 bin="$PWD/target/release/imukit"
 # shellcheck disable=SC1091
@@ -68,6 +71,32 @@ run orient_tuned "$bin" orient ex_matlab_orientation_imu.csv --nav-frame NED --a
 run allan "$bin" allan ex_matlab_stationary_imu.csv --column gyro_x_rad_s --column accel_z_m_s2 --out allan.csv --plot allan.png
 run plot_allan "$bin" plot allan.csv --out allan2.svg
 
+# Navigation and fusion on both Earths, in both frames: the tunnel road flat and on WGS-84
+# (ENU as written, and NED), with every start and aid, and the outage study in a few runs.
+# A navigation-grade part, and 70 s at rest before the car drives (the static alignment averages 60).
+sed -e 's/^preset = "stim300".*/preset = "hg1700"/' -e 's/^start_s = 120.0/start_s = 170.0/' \
+  -e 's/^time_s = .*/time_s = [70, 80, 90, 100, 110, 120, 130, 140, 150, 160, 170, 180, 190, 200, 210, 220]/' \
+  "$OLDPWD/examples/car_tunnel.toml" >road.toml
+printf '[baro]\nrate_hz = 10.0\nbias_m = 2.0\nnoise_m = 0.3\n' >>road.toml
+sed 's/^nav_frame = "ENU"/nav_frame = "ENU"\nearth = "wgs84"\norigin = { latitude_deg = 46.5, longitude_deg = 8.0, height_m = 500.0 }/' road.toml >road_enu.toml
+sed 's/^nav_frame = "ENU"/nav_frame = "NED"/' road_enu.toml >road_ned.toml
+for r in road road_enu road_ned; do
+  run "sim_$r" "$bin" simulate $r.toml --out $r.imu.csv --truth $r.truth.csv --gnss $r.gnss.csv --odometer $r.odo.csv --baro $r.baro.csv
+  frame=ENU; [ $r = road_ned ] && frame=NED
+  earth=flat; [ $r != road ] && earth=wgs84
+  run "nav_$r" "$bin" integrate $r.imu.csv --init $r.truth.csv --nav-frame $frame --earth $earth --out $r.nav.csv
+  run "nav_coning_$r" "$bin" integrate $r.imu.csv --init $r.truth.csv --nav-frame $frame --earth $earth --scheme coning --out $r.nav_coning.csv
+  run "fuse_$r" "$bin" fuse $r.imu.csv $r.gnss.csv --init $r.truth.csv --scenario $r.toml --out $r.fuse.csv
+  run "fuse_aids_$r" "$bin" fuse $r.imu.csv $r.gnss.csv --init $r.truth.csv --scenario $r.toml --odometer $r.odo.csv --nhc 0.05 --baro $r.baro.csv --out $r.fuse_aids.csv
+  run "fuse_gnss_$r" "$bin" fuse $r.imu.csv $r.gnss.csv --align gnss --scenario $r.toml --out $r.fuse_gnss.csv
+  run "fuse_static_$r" "$bin" fuse $r.imu.csv $r.gnss.csv --align static --scenario $r.toml --out $r.fuse_static.csv
+  run "fuse_full_$r" "$bin" fuse $r.imu.csv $r.gnss.csv --init $r.truth.csv --scenario $r.toml --rest-s 20 --sensor-errors --out $r.fuse_full.csv
+  run "compare_$r" "$bin" compare $r.truth.csv $r.fuse_full.csv --out $r.err.csv
+done
+run nav_baro "$bin" integrate road_ned.imu.csv --init road_ned.truth.csv --nav-frame NED --earth wgs84 --vertical baro --baro road_ned.baro.csv --out road_ned.nav_baro.csv
+sed -e 's#^scenario = .*#scenario = "road_enu.toml"#' -e 's/^runs = .*/runs = 3/' "$OLDPWD/examples/study/tunnel.toml" >study.toml
+run study "$bin" study study.toml --out study.csv
+
 # Refusals: the messages a user reads.
 printf 'rate_hz = 100.0\n[trajectory]\ntype = "expression"\nposition_m = ["sine(t)", "0", "0"]\n' >bad_formula.toml
 run bad_formula "$bin" simulate bad_formula.toml --out x.csv
@@ -89,3 +118,6 @@ if command -v python >/dev/null && python -c 'import imukit' 2>/dev/null; then
 fi
 
 find . -type f ! -name '*.imukit-partial' -print0 | sort -z | xargs -0 sha256sum
+if [ -n "$keep" ]; then
+  mkdir -p "$keep" && cp -r . "$keep"
+fi
