@@ -53,6 +53,17 @@ pub trait NavFrame: Frame {
     /// A vector of this frame re-resolved in NED (the inverse of [`Self::from_ned_axes`]).
     #[must_use]
     fn to_ned_axes(v: Vec3<Self>) -> Vec3<Ned>;
+
+    /// Body axes of this frame's convention from FRD: the identity under NED (FRD), a half turn
+    /// about x under ENU (FLU: `(x, −y, −z)`).
+    #[must_use]
+    fn frd_to_body() -> Rotation<Body, Body> {
+        if Self::Z_UP > 0.0 {
+            Rotation::from_wxyz([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()
+        } else {
+            Rotation::identity()
+        }
+    }
 }
 
 /// East-North-Up navigation frame (the default). Body frame is FLU.

@@ -30,6 +30,10 @@ pub(crate) fn sqrt(x: f64) -> f64 {
     Float::sqrt(x)
 }
 #[inline]
+pub(crate) fn hypot(x: f64, y: f64) -> f64 {
+    Float::hypot(x, y)
+}
+#[inline]
 pub(crate) fn abs(x: f64) -> f64 {
     Float::abs(x)
 }

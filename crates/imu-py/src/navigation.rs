@@ -130,7 +130,7 @@ fn strapdown<'py>(
     .map_err(refused)?;
     let mut imu = table_in("imu", columns, &values)?;
     if let (Some(c), Some(v)) = (baro_columns, &baro_values) {
-        imu = imukit::run::earth_nav::with_baro_column(&imu, &table_in("baro", c, v)?)
+        imu = imukit::run::navigate::with_baro_column(&imu, &table_in("baro", c, v)?)
             .map_err(refused)?;
     }
     let initial = match (initial_columns, &initial_values) {

@@ -129,10 +129,10 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
     }
     if let Some(baro) = o.baro {
         // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
-        let imu = imukit::run::earth_nav::read_whole(c.input)?;
+        let imu = imukit::run::navigate::read_whole(c.input)?;
         let readings = imukit::io::table::read_table(baro)?;
         let joined =
-            imukit::run::earth_nav::with_baro_column(&imu, &readings).map_err(|e| match e {
+            imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| match e {
                 Error::Invalid { field, message } if field == "barometer data" => Error::Invalid {
                     field: baro.display().to_string(),
                     message,

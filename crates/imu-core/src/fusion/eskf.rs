@@ -551,6 +551,63 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         self.correct(&h, &y, &r, gate, index)
     }
 
+    /// A wheel odometer's forward speed `speed_m_s` (body x) with one-sigma `sigma_m_s`, and
+    /// with `constraint_sigma_m_s` the non-holonomic constraints at the same time (no lateral
+    /// or vertical body velocity): [`Self::update_body_velocity`] with one or three rows.
+    ///
+    /// # Errors
+    /// As [`Self::update_body_velocity`].
+    pub fn update_odometer(
+        &mut self,
+        speed_m_s: f64,
+        sigma_m_s: f64,
+        constraint_sigma_m_s: Option<f64>,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        match constraint_sigma_m_s {
+            Some(c) => self.update_body_velocity(
+                [Some(speed_m_s), Some(0.0), Some(0.0)],
+                [sigma_m_s, c, c],
+                gate,
+            ),
+            None => self.update_body_velocity(
+                [Some(speed_m_s), None, None],
+                [sigma_m_s, 1.0, 1.0],
+                gate,
+            ),
+        }
+    }
+
+    /// The non-holonomic constraints alone: no lateral or vertical body velocity, within
+    /// `sigma_m_s` (two rows).
+    ///
+    /// # Errors
+    /// As [`Self::update_body_velocity`].
+    pub fn update_nonholonomic(
+        &mut self,
+        sigma_m_s: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        self.update_body_velocity(
+            [None, Some(0.0), Some(0.0)],
+            [1.0, sigma_m_s, sigma_m_s],
+            gate,
+        )
+    }
+
+    /// A zero-velocity update (the vehicle, or the foot, stands still): every body axis's
+    /// velocity 0 within `sigma_m_s` (three rows).
+    ///
+    /// # Errors
+    /// As [`Self::update_body_velocity`].
+    pub fn update_zero_velocity(
+        &mut self,
+        sigma_m_s: f64,
+        gate: f64,
+    ) -> Result<UpdateOutcome, EskfError> {
+        self.update_body_velocity([Some(0.0); 3], [sigma_m_s; 3], gate)
+    }
+
     /// A height measurement (a barometer): `height_m` of the reference point above the Earth's
     /// reference surface (the frame's up axis on the flat Earth, the ellipsoid on WGS-84),
     /// one-sigma `sigma_m`. Gated with `gate` (one degree of freedom).

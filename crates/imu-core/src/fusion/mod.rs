@@ -1,7 +1,10 @@
 //! Fusion of the IMU with aiding sensors: [`eskf`], a loosely coupled error-state Kalman filter
 //! (15 states, or 36 with the sensors' scale-factor, misalignment and g-sensitivity errors of
-//! [`sensor_errors`]; fixed-size matrices, no heap) on any [`crate::earth::EarthModel`].
+//! [`sensor_errors`]; fixed-size matrices, no heap) on any [`crate::earth::EarthModel`], and
+//! [`align`], where it starts without a reference attitude, and [`gate`], its innovation gate.
+pub mod align;
 pub mod eskf;
+pub mod gate;
 pub mod sensor_errors;
 
 pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome};

@@ -1,24 +1,26 @@
 //! Loosely coupled INS/GNSS fusion for the CLI and Python: the core's error-state filter
-//! ([`imu_core::fusion::eskf`]) over an IMU table (rates) and a GNSS table, flat Earth.
+//! ([`imu_core::fusion::eskf`]) over an IMU table (rates) and a GNSS table, on the flat Earth or
+//! WGS-84 (fixes then geodetic), in the data's own frame ([`nav_earth`](crate::run::nav_earth)).
+//! Odometer, barometer and the constraints aid it alike on both (`fuse_aids`).
 //!
 //! Output: [`FUSE_COLUMNS`] — the navigation columns of `integrate`, the one-sigma of position,
-//! velocity and attitude (navigation-frame axes), and the bias estimates — one row per IMU
-//! sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
+//! velocity and attitude (navigation-frame axes), and the bias estimates (body axes) — then on
+//! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
-use imu_core::earth::FlatEarth;
+use imu_core::fusion::align::{self, AlignError, PartFigures};
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
     SensorErrorEstimate, SensorErrorSigma,
 };
 use imu_core::strapdown::NavState;
-use imu_core::{AccelSign, Body, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
+use imu_core::{AccelSign, Body, Vec3};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
 use crate::run::fuse_aids::AidStreams;
-use crate::run::navigate::{InitialState, NAV_COLUMNS, euler_unwrapped};
+use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
+use crate::run::navigate::{InitialState, NAV_COLUMNS};
 use crate::scenario::NavFrameName;
-use crate::scenario::gnss::GNSS_COLUMNS;
 
 /// The one-sigma columns of a fused estimate: position, velocity and attitude error, axes of
 /// the navigation frame. `imukit compare` carries them into the errors, which `imukit plot`
@@ -96,18 +98,15 @@ pub(crate) fn fused_columns(base: &[&str], sensor_errors: bool) -> Vec<String> {
 }
 
 /// Appends the sensor errors' estimates and one-sigmas (`sigmas`: the 21 states in order) to
-/// `row`, on body axes that differ from the filter's by the signs `axis_sign` (a diagonal
-/// signed permutation: `M'ᵢⱼ = sᵢ sⱼ Mᵢⱼ`; `k'ᵢ = kᵢ`).
+/// `row`.
 pub(crate) fn push_sensor_errors(
     row: &mut Vec<f64>,
     estimate: &SensorErrorEstimate,
     sigmas: &[f64],
-    axis_sign: [f64; 3],
 ) {
     for m in [&estimate.accel, &estimate.gyro] {
-        for k in 0..9 {
-            let (r, c) = (k / 3, k % 3);
-            row.push(axis_sign[r] * axis_sign[c] * m[r][c]);
+        for r in m {
+            row.extend_from_slice(r);
         }
     }
     row.extend_from_slice(&estimate.gyro_g_sensitivity);
@@ -120,7 +119,7 @@ pub struct FuseSetup {
     /// Navigation frame of the tables.
     pub nav_frame: NavFrameName,
     /// `None`: the flat Earth; on the WGS-84 Earth its gravity model (the fixes are then
-    /// geodetic and the Earth filter runs, see [`crate::run::fuse_earth`]).
+    /// geodetic, see [`GNSS_EARTH_COLUMNS`](crate::scenario::gnss::GNSS_EARTH_COLUMNS)).
     pub earth: Option<imu_core::earth::GravityModel>,
     /// Sign of the accelerometer columns.
     pub accel_sign: AccelSign,
@@ -235,7 +234,7 @@ pub enum Start<'a> {
     /// Without truth: at the first GNSS fix whose horizontal speed is at least
     /// [`ALIGN_MIN_SPEED_M_S`], with position and velocity from the fix and the attitude of a
     /// vehicle moving nose first (heading and pitch along the fix's velocity, roll 0), each
-    /// with its stated one-sigma (see [`align_from_gnss`]); the estimate begins there.
+    /// with its stated one-sigma (see [`gnss_alignment_sigma`]); the estimate begins there.
     AlignGnss,
     /// Without truth, at rest, on the WGS-84 Earth: levelling from the mean specific force and
     /// gyrocompassing from the mean body rate (the Earth rate's horizontal part points north)
@@ -297,23 +296,15 @@ pub const ALIGN_MIN_SPEED_M_S: f64 = 3.0;
 /// (sideslip, angle of attack) and for its roll, rad.
 pub const ALIGN_ATTITUDE_ALLOWANCE_RAD: [f64; 2] = [0.02, 0.05];
 
-/// The initial state and one-sigma from GNSS fix `k` (position `p`, velocity `v`), taken at
-/// IMU time `t_imu` (the fix was valid `age_s` earlier): position `p + v·age`, velocity `v`,
-/// yaw `atan2(v_y, v_x)`, pitch `atan2(−v_z, |v_h|)` (the body's x axis along `v`, in either
-/// frame), roll 0. One-sigma: position the fix's plus the lever arm's length (the antenna's
-/// offset is not yet known in the navigation frame), velocity the fix's, heading and pitch
-/// `σ_v/|v_h|` and [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[0]` in quadrature, roll
-/// [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[1]`, biases as `setup` has them.
+/// The one-sigma of a start aligned from a GNSS fix of velocity `v` (attitude by
+/// [`imu_core::fusion::align::moving`]): position the fix's plus the lever arm's length (the
+/// antenna's offset is not yet known in the navigation frame), velocity the fix's, heading and
+/// pitch `σ_v/|v_h|` and [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[0]` in quadrature, roll
+/// [`ALIGN_ATTITUDE_ALLOWANCE_RAD`]`[1]` (roll about the heading and pitch across it, turned onto
+/// the frame's horizontal axes), biases as `setup` has them.
 #[must_use]
-pub fn align_from_gnss(
-    p: [f64; 3],
-    v: [f64; 3],
-    age_s: f64,
-    setup: &FuseSetup,
-) -> (InitialState, InitialSigma) {
+pub fn gnss_alignment_sigma(v: [f64; 3], setup: &FuseSetup) -> InitialSigma {
     let horizontal = v[0].hypot(v[1]);
-    let euler = EulerZyx::new(v[1].atan2(v[0]), (-v[2]).atan2(horizontal), 0.0);
-    let q = Rotation::<Body, Enu>::from_euler(euler).to_wxyz();
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     let lever = setup.lever_arm_m.iter().map(|l| l * l).sum::<f64>().sqrt();
     let pos_sigma = setup
@@ -323,20 +314,17 @@ pub fn align_from_gnss(
     let angle = (vel_sigma / horizontal)
         .atan()
         .hypot(ALIGN_ATTITUDE_ALLOWANCE_RAD[0]);
-    (
-        InitialState {
-            position_m: [0, 1, 2].map(|k| p[k] + v[k] * age_s),
-            velocity_m_s: v,
-            quaternion: q,
-            geodetic: None,
-        },
-        InitialSigma {
-            position_m: pos_sigma + lever,
-            velocity_m_s: vel_sigma,
-            attitude_rad: [ALIGN_ATTITUDE_ALLOWANCE_RAD[1], angle, angle],
-            ..setup.initial_sigma
-        },
-    )
+    // Roll is about the heading, pitch across it: on the frame's horizontal axes, the diagonal
+    // of σ_r² u uᵀ + σ_p² u⊥ u⊥ᵀ for the heading's unit vector u (the same in ENU and NED).
+    let roll = ALIGN_ATTITUDE_ALLOWANCE_RAD[1];
+    let (cos, sin) = (v[0] / horizontal, v[1] / horizontal);
+    let tilt = |along: f64, across: f64| (roll * along).hypot(angle * across);
+    InitialSigma {
+        position_m: pos_sigma + lever,
+        velocity_m_s: vel_sigma,
+        attitude_rad: [tilt(cos, sin), tilt(sin, cos), angle],
+        ..setup.initial_sigma
+    }
 }
 
 /// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`]) from `initial`.
@@ -373,19 +361,38 @@ pub fn fuse_with(
     start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    use crate::run::fuse_earth::fuse_earth_in;
-    use NavFrameName::{ENU, NED};
-    const B: usize = BASE_STATES;
-    const F: usize = FULL_STATES;
-    match (setup.nav_frame, setup.earth, setup.estimate_sensor_errors) {
-        (ENU, None, false) => fuse_in::<Enu, B>(imu, gnss, aids, start, setup),
-        (NED, None, false) => fuse_in::<Ned, B>(imu, gnss, aids, start, setup),
-        (ENU, None, true) => fuse_in::<Enu, F>(imu, gnss, aids, start, setup),
-        (NED, None, true) => fuse_in::<Ned, F>(imu, gnss, aids, start, setup),
-        (ENU, Some(g), false) => fuse_earth_in::<Enu, B>(imu, gnss, aids, start, setup, g),
-        (NED, Some(g), false) => fuse_earth_in::<Ned, B>(imu, gnss, aids, start, setup, g),
-        (ENU, Some(g), true) => fuse_earth_in::<Enu, F>(imu, gnss, aids, start, setup, g),
-        (NED, Some(g), true) => fuse_earth_in::<Ned, F>(imu, gnss, aids, start, setup, g),
+    on_earth(
+        setup.nav_frame,
+        setup.earth,
+        setup.gravity_m_s2,
+        Fuse {
+            imu,
+            gnss,
+            aids,
+            start,
+            setup,
+        },
+    )
+}
+
+/// [`fuse_with`] as an [`EarthJob`].
+struct Fuse<'a> {
+    imu: &'a Table,
+    gnss: &'a Table,
+    aids: AidTables<'a>,
+    start: Start<'a>,
+    setup: &'a FuseSetup,
+}
+
+impl EarthJob for Fuse<'_> {
+    type Output = Result<(Table, FuseSummary)>;
+
+    fn run<E: NavEarth>(self, earth: E) -> Self::Output {
+        if self.setup.estimate_sensor_errors {
+            fuse_on::<E, FULL_STATES>(earth, self)
+        } else {
+            fuse_on::<E, BASE_STATES>(earth, self)
+        }
     }
 }
 
@@ -563,14 +570,18 @@ pub(crate) fn count_fix(
     Ok(())
 }
 
-fn fuse_in<N: NavFrame, const S: usize>(
-    imu: &Table,
-    gnss: &Table,
-    aids: AidTables<'_>,
-    start: Start<'_>,
-    setup: &FuseSetup,
-) -> Result<(Table, FuseSummary)> {
-    let inputs = FusionInputs::read(imu, gnss, &GNSS_COLUMNS, "")?;
+/// The GNSS speed above which a vehicle is not at rest for the static alignment, m/s.
+const STATIC_SPEED_M_S: f64 = 0.5;
+
+fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Table, FuseSummary)> {
+    let Fuse {
+        imu,
+        gnss,
+        aids,
+        start,
+        setup,
+    } = job;
+    let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT)?;
     let FusionInputs {
         t,
         f,
@@ -581,10 +592,34 @@ fn fuse_in<N: NavFrame, const S: usize>(
     } = &inputs;
     let (t0, t1) = inputs.span();
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
-    // The first IMU sample, state and one-sigma; fixes up to `next_fix` are used up.
-    let (first, initial, sigma, mut next_fix) = match start {
-        Start::State(s) => (0, *s, setup.initial_sigma, 0),
-        Start::AlignStatic { .. } => {
+    let fixes = g_p
+        .iter()
+        .enumerate()
+        .map(|(k, &p)| {
+            E::fix_position(p).ok_or_else(|| {
+                invalid(
+                    "GNSS data",
+                    format!(
+                        "row {}: the latitude must be within ±89.9° and the longitude and height \
+                         finite",
+                        k + 2
+                    ),
+                )
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let fix_velocity: Vec<Vec3<E::Frame>> = g_v.iter().map(|&v| E::fix_velocity(v)).collect();
+    let sign = match setup.accel_sign {
+        AccelSign::SpecificForce => 1.0,
+        AccelSign::Matlab => -1.0,
+    };
+    // The first IMU sample, state, plane origin and one-sigma; fixes before `next_fix` used.
+    let (first, s0, origin, sigma, mut next_fix) = match start {
+        Start::State(initial) => {
+            let (s, origin) = nav_earth::start::<E>(initial, t0)?;
+            (0, s, origin, setup.initial_sigma, 0)
+        }
+        Start::AlignStatic { .. } if !E::ROTATING => {
             return Err(invalid(
                 "align",
                 "\"static\": on the flat Earth the gyroscopes cannot find north (the flat model \
@@ -592,36 +627,119 @@ fn fuse_in<N: NavFrame, const S: usize>(
                  use \"gnss\" (heading from the first fix at speed) or give the initial state",
             ));
         }
+        Start::AlignStatic { duration_s } => {
+            let i0 = t.partition_point(|&ti| ti < t0 + duration_s);
+            if i0 < 2 || i0 >= t.len() {
+                return Err(invalid(
+                    "align",
+                    format!(
+                        "\"static\" averages the first {duration_s} s at rest: the IMU data must \
+                         last longer"
+                    ),
+                ));
+            }
+            let used = g_t.partition_point(|&x| x <= t[i0]);
+            if used == 0 {
+                return Err(invalid(
+                    "GNSS data",
+                    format!(
+                        "no fix in the first {duration_s} s: the static alignment takes its \
+                         position from the fixes"
+                    ),
+                ));
+            }
+            if let Some(k) = (0..used).find(|&k| {
+                let v = g_v[k];
+                v[0].hypot(v[1]).hypot(v[2]) > STATIC_SPEED_M_S
+            }) {
+                return Err(invalid(
+                    "GNSS data",
+                    format!(
+                        "row {}: the vehicle moves ({:.2} m/s) during the static alignment's first \
+                         {duration_s} s",
+                        k + 2,
+                        g_v[k][0].hypot(g_v[k][1]).hypot(g_v[k][2])
+                    ),
+                ));
+            }
+            let mean = |v: &[[f64; 3]], s: f64| -> [f64; 3] {
+                let sum = v[..i0]
+                    .iter()
+                    .fold([0.0; 3], |a, x| [0, 1, 2].map(|j| a[j] + x[j]));
+                sum.map(|x| s * (x / i0 as f64))
+            };
+            let position = fixes[used - 1];
+            let part = PartFigures {
+                accel_bias_m_s2: setup.part_bias[0],
+                gyro_bias_rad_s: setup.part_bias[1],
+                accel_psd: setup.noise.accel_psd,
+                gyro_psd: setup.noise.gyro_psd,
+            };
+            let aligned = align::at_rest(
+                &earth,
+                &position,
+                mean(f, sign),
+                mean(w, 1.0),
+                t[i0] - t0,
+                &part,
+            )
+            .map_err(|e| {
+                let hint = match e {
+                    AlignError::NoNorth { .. } => "; use \"gnss\" or give the initial state",
+                    AlignError::NotAtRest { .. } => "",
+                };
+                invalid("align", format!("\"static\": {e}{hint}"))
+            })?;
+            let sigma = InitialSigma {
+                position_m: setup
+                    .gnss_position_sigma_m
+                    .iter()
+                    .fold(0.0_f64, |a, b| a.max(*b)),
+                velocity_m_s: 0.05,
+                attitude_rad: [
+                    aligned.tilt_sigma_rad,
+                    aligned.tilt_sigma_rad,
+                    aligned.heading_sigma_rad,
+                ],
+                // What the averages took for the attitude stays a bias the filter must learn.
+                accel_bias_m_s2: part.accel_bias_m_s2.max(1e-6),
+                gyro_bias_rad_s: part.gyro_bias_rad_s.max(1e-9),
+            };
+            let s = NavState {
+                t_s: t[i0],
+                attitude: aligned.attitude,
+                velocity_m_s: Vec3::zeros(),
+                position,
+            };
+            (i0, s, E::origin_at(&position), sigma, used)
+        }
         Start::AlignGnss => {
             let (k, i0, age) = inputs.first_fix_at_speed(setup.gnss_latency_s)?;
-            let (s, sigma) = align_from_gnss(g_p[k], g_v[k], age, setup);
-            (i0, s, sigma, k + 1)
+            let v = fix_velocity[k];
+            // The fix was valid `age` before sample i0: moved on by its velocity.
+            let position = E::position(earth.offset(&E::coordinates(&fixes[k]), &(v * age)));
+            let s = NavState {
+                t_s: t[i0],
+                attitude: align::moving(&v),
+                velocity_m_s: v,
+                position,
+            };
+            let sigma = gnss_alignment_sigma(v.to_array(), setup);
+            (i0, s, E::origin_at(&position), sigma, k + 1)
         }
     };
-    let t_first = t[first];
-    aid_streams.start_at(t_first);
-    // A quaternion in the ENU sense (the alignment builds it by geometry) is the same rotation
-    // in either frame's own axes.
-    let attitude = Rotation::<Body, N>::from_wxyz(initial.quaternion).ok_or_else(|| {
-        invalid(
-            "initial state",
-            "the quaternion has zero norm or is not finite",
-        )
-    })?;
+    let s0 = NavState {
+        t_s: t[first],
+        ..s0
+    };
+    aid_streams.start_at(t[first]);
+    let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
     let start = EskfState {
-        nav: NavState {
-            t_s: t_first,
-            position: Vec3::from_array(initial.position_m),
-            velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-            attitude,
-        },
+        nav: s0,
         accel_bias_m_s2: [0.0; 3],
         gyro_bias_rad_s: [0.0; 3],
     };
-    let filter_error =
-        |context: &str, e: imu_core::fusion::EskfError| invalid(context, e.to_string());
-    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
-    let filter = Eskf::<_, S>::new(earth, &start, &sigma, setup.noise)
+    let filter = Eskf::<E, S>::new(earth, &start, &sigma, setup.noise)
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
         .map_err(|_| covariance_interval_refusal(setup))?;
@@ -632,29 +750,28 @@ fn fuse_in<N: NavFrame, const S: usize>(
     } else {
         filter
     };
-    let sign = match setup.accel_sign {
-        AccelSign::SpecificForce => 1.0,
-        AccelSign::Matlab => -1.0,
-    };
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
-    let columns = fused_columns(&FUSE_COLUMNS, S == FULL_STATES);
+    let mut columns: Vec<&str> = FUSE_COLUMNS.to_vec();
+    columns.extend(E::POSITION_COLUMNS);
     let mut table = Table {
-        columns,
+        columns: fused_columns(&columns, S == FULL_STATES),
         data: Vec::new(),
     };
+    let (nav_width, base) = (nav_earth::nav_width::<E>(), NAV_COLUMNS.len());
     let mut rejected_in_a_row = 0;
     let mut last_yaw = None;
+    let mut row = Vec::with_capacity(table.columns.len());
     for i in first..t.len() {
         filter
             .propagate(t[i], w[i], f[i].map(|x| sign * x))
             .map_err(|e| filter_error("IMU data", e))?;
         while next_fix < g_t.len() && g_t[next_fix] <= t[i] {
-            let fix = GnssFix::<FlatEarth<N>> {
-                position: Vec3::from_array(g_p[next_fix]),
+            let fix = GnssFix::<E> {
+                position: fixes[next_fix],
                 velocity_m_s: setup
                     .gnss_velocity_sigma_m_s
-                    .map(|_| Vec3::from_array(g_v[next_fix])),
+                    .map(|_| fix_velocity[next_fix]),
                 lever_arm_m: lever,
                 position_sigma_m: setup.gnss_position_sigma_m,
                 velocity_sigma_m_s: [vel_sigma; 3],
@@ -672,34 +789,16 @@ fn fuse_in<N: NavFrame, const S: usize>(
         aid_streams.apply(&mut filter, t[i], i)?;
         let s = filter.state();
         let sig = filter.sigmas();
-        let e = euler_unwrapped(&s.nav.attitude, &mut last_yaw);
-        let (p, v, q) = (
-            s.nav.position.to_array(),
-            s.nav.velocity_m_s.to_array(),
-            s.nav.attitude.to_wxyz(),
-        );
-        let mut row = vec![
-            t[i],
-            p[0],
-            p[1],
-            p[2],
-            v[0],
-            v[1],
-            v[2],
-            q[0],
-            q[1],
-            q[2],
-            q[3],
-            e.yaw_rad,
-            e.pitch_rad,
-            e.roll_rad,
-        ];
+        let nav = nav_earth::nav_row(&s.nav, &origin, &mut last_yaw);
+        row.clear();
+        row.extend_from_slice(&nav[..base]);
         row.extend_from_slice(&sig[..9]);
         row.extend_from_slice(&s.accel_bias_m_s2);
         row.extend_from_slice(&s.gyro_bias_rad_s);
         row.extend_from_slice(&sig[9..15]);
+        row.extend_from_slice(&nav[base..nav_width]);
         if S == FULL_STATES {
-            push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..], [1.0; 3]);
+            push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..]);
         }
         table.push_row(&row);
     }
@@ -890,6 +989,6 @@ const FLICKER_FLOOR: f64 = imu_core::allan::BIAS_INSTABILITY_FACTOR;
 /// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
 pub const MAX_REJECTED_IN_A_ROW: usize = 10;
 
-/// The chi-square 99.9 % quantile with 6 degrees of freedom: the default innovation gate of a
-/// position-and-velocity fix (a good fix is rejected once in a thousand).
-pub const CHI2_99_9_6DOF: f64 = 22.457_744_484_825_3;
+/// The default innovation gate of a position-and-velocity fix: the chi-square 99.9 % quantile
+/// with 6 degrees of freedom (a good fix is rejected once in a thousand).
+pub const CHI2_99_9_6DOF: f64 = imu_core::fusion::gate::CHI2_99_9[5];

@@ -3,6 +3,7 @@
 //! read, checked and applied at their times, the same way on every Earth.
 use imu_core::earth::EarthModel;
 use imu_core::fusion::Eskf;
+use imu_core::fusion::gate::gate_99_9;
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
@@ -16,14 +17,6 @@ const MIN_SIGMA: f64 = 1e-3;
 
 /// The least one-sigma of a zero-rate update, rad/s (for noiseless gyroscopes).
 const MIN_RATE_SIGMA: f64 = 1e-9;
-
-/// One-degree-of-freedom and two- and three-degree chi-square 99.9 % quantiles: the gates of
-/// height, constraint and odometer-with-constraint updates.
-const CHI2_99_9: [f64; 3] = [
-    10.827_566_170_662_733,
-    13.815_510_557_964_274,
-    16.266_236_196_238_13,
-];
 
 /// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
 pub(crate) fn aid_series(
@@ -151,10 +144,10 @@ impl AidStreams {
         self.next_nhc_t = t_first;
     }
 
-    /// The χ² 99.9 % gate for `dof` rows (none when the fusion's gate is off).
-    fn gate(&self, dof: usize) -> f64 {
+    /// The χ² 99.9 % gate for `rows` rows (none when the fusion's gate is off).
+    fn gate(&self, rows: usize) -> f64 {
         if self.gate_on {
-            CHI2_99_9[dof - 1]
+            gate_99_9(rows)
         } else {
             f64::INFINITY
         }
@@ -173,7 +166,7 @@ impl AidStreams {
     ) -> Result<()> {
         if t_s < self.rest.0 {
             filter
-                .update_body_velocity([Some(0.0); 3], [REST_VELOCITY_SIGMA_M_S; 3], self.gate(3))
+                .update_zero_velocity(REST_VELOCITY_SIGMA_M_S, self.gate(3))
                 .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;
             filter
                 .update_zero_rate(self.rest.1, self.gate(3))
@@ -188,12 +181,9 @@ impl AidStreams {
                 .noise_m_s
                 .hypot(m.scale_factor_error * speed)
                 .max(MIN_SIGMA);
-            let (measured, sigmas, dof) = match self.nhc_sigma_m_s {
-                Some(c) => ([Some(speed), Some(0.0), Some(0.0)], [sigma, c, c], 3),
-                None => ([Some(speed), None, None], [sigma, 1.0, 1.0], 1),
-            };
+            let rows = if self.nhc_sigma_m_s.is_some() { 3 } else { 1 };
             filter
-                .update_body_velocity(measured, sigmas, self.gate(dof))
+                .update_odometer(speed, sigma, self.nhc_sigma_m_s, self.gate(rows))
                 .map_err(|e| filter_refusal("odometer", k, e))?;
             self.next.0 += 1;
         }
@@ -202,7 +192,7 @@ impl AidStreams {
             && t_s >= self.next_nhc_t
         {
             filter
-                .update_body_velocity([None, Some(0.0), Some(0.0)], [1.0, c, c], self.gate(2))
+                .update_nonholonomic(c, self.gate(2))
                 .map_err(|e| filter_refusal("constraint", i, e))?;
             self.next_nhc_t = t_s + 1.0 / NHC_RATE_HZ;
         }

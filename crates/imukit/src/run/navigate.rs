@@ -4,24 +4,26 @@
 //! increments (`dv_*_m_s`, `dtheta_*_rad`). The accelerometer columns must hold specific force
 //! (imukit's default sign); data in MATLAB's sign is flipped with `accel_sign = matlab`.
 //! Navigation output has the truth columns the integrator estimates: `t_s, pos_*, vel_*, q_*,
-//! yaw_rad, pitch_rad, roll_rad`.
+//! yaw_rad, pitch_rad, roll_rad`, and on the WGS-84 Earth `lat_rad, lon_rad, height_m` (`pos_*`
+//! then in the tangent plane at the origin of the starting truth, velocity and attitude in the
+//! local-level frame at each position). Both Earths run in the data's own frame through
+//! [`nav_earth`](crate::run::nav_earth).
 use imu_core::strapdown::rk4::{NODES, RateWindow, window_start};
 use std::collections::VecDeque;
 use std::path::Path;
 
-use imu_core::earth::{FlatEarth, Geodetic, GravityModel};
+use imu_core::earth::{EarthModel, Geodetic, GravityModel};
 use imu_core::strapdown::{
     Increments, NavState, RateIncrements, Rk4, StrapdownError, StrapdownOptions, VerticalChannel,
     strapdown_increments, strapdown_rates, strapdown_rates_rk4,
 };
-use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Ned, Rotation, Vec3};
-
-use crate::run::earth_nav::{EarthNav, integrate_earth_in};
+use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{TimedRows, check_gaps};
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
+use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
 use crate::scenario::resolve::{check_gravity, finite_vec};
 use crate::scenario::{AccelSignName, NavFrameName, parse_name};
 
@@ -536,111 +538,160 @@ impl NavRequest<'_> {
 /// Integrates an IMU table (rates or increments) from `initial`.
 ///
 /// # Errors
-/// Missing columns (both layouts named), invalid initial quaternion, non-finite values or
-/// non-increasing times (sample index named).
+/// Missing columns (both layouts named; `baro_height_m` for the baro channel), invalid initial
+/// quaternion, an initial state without a geodetic position on the WGS-84 Earth, non-finite
+/// values or non-increasing times (sample index named).
 pub fn integrate(imu: &Table, initial: &InitialState, setup: &NavSetup) -> Result<Table> {
-    let nav = match setup.nav_frame {
-        NavFrameName::ENU => integrate_in::<Enu>(imu, initial, setup),
-        NavFrameName::NED => integrate_in::<Ned>(imu, initial, setup),
-    }?;
+    let nav = with_earth(
+        setup,
+        Integrate {
+            imu,
+            initial,
+            setup,
+        },
+    )?;
     nav.check_finite("navigation")?;
     Ok(nav)
 }
 
-fn integrate_in<N: NavFrame>(
-    imu: &Table,
-    initial: &InitialState,
-    setup: &NavSetup,
-) -> Result<Table> {
-    let t = imu
-        .column("t_s")
-        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
-    if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1] || t[i].is_nan()) {
-        return Err(invalid(
-            "IMU data",
-            format!(
-                "time at row {} does not increase after row {}",
-                i + 2,
-                i + 1
-            ),
-        ));
+/// How the Earth mechanization runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthNav {
+    /// The vertical channel.
+    pub vertical: VerticalChannel,
+    /// Gravity.
+    pub gravity: GravityModel,
+}
+
+/// The barometric height column the baro-damped vertical channel reads from the IMU table.
+pub const BARO_COLUMN: &str = "baro_height_m";
+
+/// The strapdown options of `setup`, with the vertical channel of WGS-84.
+fn strapdown_options(setup: &NavSetup) -> StrapdownOptions {
+    StrapdownOptions {
+        vertical: setup
+            .earth
+            .map_or(VerticalChannel::Free, |earth| earth.vertical),
+        ..setup.options
     }
-    check_gaps(&t, "IMU data", 2)?;
-    if let Some(earth) = &setup.earth {
-        return integrate_earth_in::<N>(imu, &t, initial, setup, earth);
-    }
-    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
-        invalid(
-            "initial state",
-            "the quaternion has zero norm or is not finite",
-        )
-    })?;
-    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
-    let s0 = NavState::<FlatEarth<N>> {
-        t_s: t.first().copied().unwrap_or(0.0),
-        attitude,
-        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-        position: Vec3::from_array(initial.position_m),
-    };
-    let flip = |v: Vec<[f64; 3]>| match setup.accel_sign {
-        AccelSign::SpecificForce => v,
-        AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
-    };
-    let mut out = vec![NavState::<FlatEarth<N>>::default(); t.len()];
-    let corrections = setup.options.coning || setup.options.sculling;
-    let result = if let (Some(f), Some(w)) =
-        (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
-    {
-        match setup.scheme.for_input(true, corrections) {
-            NavScheme::ConingSculling => {
-                strapdown_rates(earth, &t, &w, &flip(f), s0, setup.options, &mut out)
-            }
-            NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
-                earth,
-                &t,
-                &w,
-                &flip(f),
-                None,
-                s0,
-                setup.options,
-                substeps,
-                &mut out,
-            ),
-            NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
-        }
-    } else if let (Some(dv), Some(dth)) = (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS)) {
-        if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
+}
+
+/// Runs `job` on the Earth and in the frame of `setup`.
+fn with_earth<J: EarthJob>(setup: &NavSetup, job: J) -> J::Output {
+    on_earth(
+        setup.nav_frame,
+        setup.earth.map(|e| e.gravity),
+        setup.gravity_m_s2,
+        job,
+    )
+}
+
+/// [`integrate`] as an [`EarthJob`].
+struct Integrate<'a> {
+    imu: &'a Table,
+    initial: &'a InitialState,
+    setup: &'a NavSetup,
+}
+
+impl EarthJob for Integrate<'_> {
+    type Output = Result<Table>;
+
+    fn run<E: NavEarth>(self, earth: E) -> Result<Table> {
+        let Self {
+            imu,
+            initial,
+            setup,
+        } = self;
+        let options = strapdown_options(setup);
+        let t = imu
+            .column("t_s")
+            .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+        if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1] || t[i].is_nan()) {
             return Err(invalid(
                 "IMU data",
-                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+                format!(
+                    "time at row {} does not increase after row {}",
+                    i + 2,
+                    i + 1
+                ),
             ));
         }
-        strapdown_increments(
-            earth,
-            &t,
-            &dth,
-            &flip(dv),
-            None,
-            s0,
-            setup.options,
-            &mut out,
-        )
-    } else {
-        return Err(invalid(
-            "IMU data",
-            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
-        ));
-    };
-    result.map_err(|source| crate::Error::Strapdown {
-        context: "IMU data".into(),
-        source,
-    })?;
-    let mut table = Table::new(&NAV_COLUMNS);
-    let mut last_yaw: Option<f64> = None;
-    for s in &out {
-        table.push_row(&nav_row(s, &mut last_yaw));
+        check_gaps(&t, "IMU data", 2)?;
+        let (s0, origin) = nav_earth::start::<E>(initial, t.first().copied().unwrap_or(0.0))?;
+        let baro = match options.vertical {
+            VerticalChannel::Baro { .. } => Some(imu.column(BARO_COLUMN).ok_or_else(|| {
+                invalid(
+                    "IMU data",
+                    format!("the baro vertical channel needs a {BARO_COLUMN} column"),
+                )
+            })?),
+            _ => None,
+        };
+        let baro = baro.as_deref();
+        let flip = |v: Vec<[f64; 3]>| match setup.accel_sign {
+            AccelSign::SpecificForce => v,
+            AccelSign::Matlab => v.into_iter().map(|a| a.map(|x| -x)).collect(),
+        };
+        let mut out = vec![NavState::<E>::default(); t.len()];
+        let corrections = options.coning || options.sculling;
+        let result = if let (Some(f), Some(w)) =
+            (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
+        {
+            let f = flip(f);
+            match setup.scheme.for_input(true, corrections) {
+                NavScheme::ConingSculling if baro.is_some() => {
+                    // The trapezoid of rates as increments, as `strapdown_rates` takes them.
+                    let (dth, dv) = trapezoid(&t, &w, &f);
+                    strapdown_increments(earth, &t, &dth, &dv, baro, s0, options, &mut out)
+                }
+                NavScheme::ConingSculling => {
+                    strapdown_rates(earth, &t, &w, &f, s0, options, &mut out)
+                }
+                NavScheme::Rk4 { substeps } => {
+                    strapdown_rates_rk4(earth, &t, &w, &f, baro, s0, options, substeps, &mut out)
+                }
+                NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
+            }
+        } else if let (Some(dv), Some(dth)) =
+            (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS))
+        {
+            if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
+                return Err(invalid(
+                    "IMU data",
+                    "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+                ));
+            }
+            strapdown_increments(earth, &t, &dth, &flip(dv), baro, s0, options, &mut out)
+        } else {
+            return Err(invalid(
+                "IMU data",
+                "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
+            ));
+        };
+        result.map_err(|source| crate::Error::Strapdown {
+            context: "IMU data".into(),
+            source,
+        })?;
+        let mut table = Table::new(&nav_earth::nav_columns::<E>());
+        let width = nav_earth::nav_width::<E>();
+        let mut last_yaw: Option<f64> = None;
+        for s in &out {
+            table.push_row(&nav_earth::nav_row(s, &origin, &mut last_yaw)[..width]);
+        }
+        Ok(table)
     }
-    Ok(table)
+}
+
+/// Increments from rate samples by the trapezoid (entry 0 unused).
+fn trapezoid(t: &[f64], w: &[[f64; 3]], f: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let mut dth = vec![[0.0; 3]; t.len()];
+    let mut dv = vec![[0.0; 3]; t.len()];
+    for k in 1..t.len() {
+        let h = 0.5 * (t[k] - t[k - 1]);
+        dth[k] = std::array::from_fn(|i| h * (w[k - 1][i] + w[k][i]));
+        dv[k] = std::array::from_fn(|i| h * (f[k - 1][i] + f[k][i]));
+    }
+    (dth, dv)
 }
 
 /// The z-y-x Euler angles of `r` with the yaw unwrapped against `last_yaw` (then updated).
@@ -657,30 +708,6 @@ pub(crate) fn euler_unwrapped<N: NavFrame>(
     e
 }
 
-/// One navigation output row in [`NAV_COLUMNS`] order; yaw is unwrapped against `last_yaw`.
-fn nav_row<N: NavFrame>(s: &NavState<FlatEarth<N>>, last_yaw: &mut Option<f64>) -> [f64; 14] {
-    let [qw, qx, qy, qz] = s.attitude.to_wxyz();
-    let e = euler_unwrapped(&s.attitude, last_yaw);
-    let [px, py, pz] = s.position.to_array();
-    let [vx, vy, vz] = s.velocity_m_s.to_array();
-    [
-        s.t_s,
-        px,
-        py,
-        pz,
-        vx,
-        vy,
-        vz,
-        qw,
-        qx,
-        qy,
-        qz,
-        e.yaw_rad,
-        e.pitch_rad,
-        e.roll_rad,
-    ]
-}
-
 /// What a streamed integration wrote.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavSummary {
@@ -688,14 +715,16 @@ pub struct NavSummary {
     pub rows: usize,
     /// The scheme used (what [`NavScheme::Auto`] chose).
     pub scheme: NavScheme,
-    /// The last position, m.
+    /// The last position in the plane, m.
     pub end_position_m: [f64; 3],
 }
 
-/// Integrates the IMU CSV file `input` into the navigation CSV `out` ([`NAV_COLUMNS`]), the
-/// same numbers as [`integrate`], streamed: memory does not grow with the file (the RK4 scheme
-/// holds the six samples around its current interval); gaps are judged against the median
-/// interval of the first [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows. `out` appears only when complete.
+/// Integrates the IMU CSV file `input` into the navigation CSV `out` (the columns of
+/// [`integrate`]), the same numbers as [`integrate`], streamed: memory does not grow with the
+/// file (the RK4 scheme holds the six samples around its current interval); gaps are judged
+/// against the median interval of the first [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows.
+/// The baro-damped vertical channel reads the file whole (within the memory budget of
+/// [`read_whole`]). `out` appears only when complete.
 ///
 /// # Errors
 /// As [`integrate`], CSV errors naming file, row and column, and I/O errors.
@@ -705,29 +734,113 @@ pub fn integrate_csv(
     setup: &NavSetup,
     out: &Path,
 ) -> Result<NavSummary> {
-    if setup.earth.is_some() {
-        return crate::run::earth_nav::integrate_earth_csv(input, initial, setup, out);
+    if let Some(EarthNav {
+        vertical: VerticalChannel::Baro { .. },
+        ..
+    }) = setup.earth
+    {
+        let imu = read_whole(input)?;
+        let nav = integrate(&imu, initial, setup)?;
+        let rates = ACCEL_COLUMNS
+            .iter()
+            .chain(&GYRO_COLUMNS)
+            .all(|c| imu.columns.iter().any(|h| h == c));
+        nav.write(out)?;
+        let last = |c: &str| nav.column(c).and_then(|v| v.last().copied()).unwrap_or(0.0);
+        return Ok(NavSummary {
+            rows: nav.rows(),
+            scheme: setup
+                .scheme
+                .for_input(rates, setup.options.coning || setup.options.sculling),
+            end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
+        });
     }
-    match setup.nav_frame {
-        NavFrameName::ENU => integrate_csv_in::<Enu>(input, initial, setup, out),
-        NavFrameName::NED => integrate_csv_in::<Ned>(input, initial, setup, out),
+    with_earth(
+        setup,
+        IntegrateCsv {
+            input,
+            initial,
+            setup,
+            out,
+        },
+    )
+}
+
+/// Reads an IMU CSV file whole, refused before reading when it could exceed the memory budget
+/// of [`check_in_memory`](crate::scenario::check_in_memory) with what the navigation keeps per
+/// sample.
+///
+/// # Errors
+/// The budget, and the reader's errors naming file, row and column.
+pub fn read_whole(input: &Path) -> Result<Table> {
+    let bytes = std::fs::metadata(input)
+        .map_err(|source| crate::Error::Io {
+            path: input.into(),
+            source,
+        })?
+        .len();
+    // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
+    // numbers per row come out (the states and the table).
+    let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
+    crate::scenario::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
+    crate::io::table::read_table(input)
+}
+
+/// `imu` with a [`BARO_COLUMN`] taken from barometer readings `baro` (`t_s, baro_height_m`,
+/// as `imukit simulate --baro` writes): each IMU sample gets the last reading at or before it
+/// (the first reading before the first one).
+///
+/// # Errors
+/// Missing columns, times that do not increase or fall outside the IMU's span, values that are
+/// not finite, an empty file.
+pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
+    let t = imu
+        .column("t_s")
+        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else {
+        return Err(invalid("IMU data", "has no rows"));
+    };
+    // The same rule as the fusion's aids: finite, increasing, within the IMU's span.
+    let (tb, hb) = crate::run::fuse_aids::aid_series(baro, "barometer", BARO_COLUMN, (t0, t1))?;
+    if tb.is_empty() {
+        return Err(invalid("barometer data", "has no readings"));
     }
+    let mut columns: Vec<&str> = imu.columns.iter().map(String::as_str).collect();
+    if columns.contains(&BARO_COLUMN) {
+        return Err(invalid(
+            "IMU data",
+            format!("already has a {BARO_COLUMN} column; give the barometer once"),
+        ));
+    }
+    columns.push(BARO_COLUMN);
+    let mut out = Table::new(&columns);
+    let width = imu.columns.len();
+    let mut k = 0;
+    for (i, ti) in t.iter().enumerate() {
+        while k + 1 < tb.len() && tb[k + 1] <= *ti {
+            k += 1;
+        }
+        let mut row = imu.data[i * width..(i + 1) * width].to_vec();
+        row.push(hb[k]);
+        out.push_row(&row);
+    }
+    Ok(out)
 }
 
 /// The per-sample integrator of a streamed file.
-enum Stepper<N: NavFrame> {
-    Rates(RateIncrements<FlatEarth<N>>),
+enum Stepper<E: EarthModel> {
+    Rates(RateIncrements<E>),
     Increments {
-        nav: Increments<FlatEarth<N>>,
-        initial: NavState<FlatEarth<N>>,
+        nav: Increments<E>,
+        initial: NavState<E>,
         started: bool,
     },
     /// RK4 holds the samples its next interval's quintic needs (six, from two before it) and
     /// emits each state once the three samples after the interval have been read (at the end
     /// of the file, the last intervals share the final six samples).
     Rk4 {
-        nav: Rk4<FlatEarth<N>>,
-        initial: NavState<FlatEarth<N>>,
+        nav: Rk4<E>,
+        initial: NavState<E>,
         held: VecDeque<[f64; 7]>,
         first_held: usize,
         seen: usize,
@@ -735,12 +848,12 @@ enum Stepper<N: NavFrame> {
     },
 }
 
-type Emit<'a, N> = dyn FnMut(NavState<FlatEarth<N>>) -> Result<()> + 'a;
+type Emit<'a, E> = dyn FnMut(NavState<E>) -> Result<()> + 'a;
 
-impl<N: NavFrame> Stepper<N> {
+impl<E: EarthModel> Stepper<E> {
     /// Takes the next row `[t, force, turn]` (force: accelerometer or Δv, physical sign; turn:
     /// gyroscope or Δθ) and emits the states it completes, in order.
-    fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, N>) -> Result<()> {
+    fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, E>) -> Result<()> {
         let (t, force, turn) = (row[0], [row[1], row[2], row[3]], [row[4], row[5], row[6]]);
         let failed = |source: StrapdownError| crate::Error::Strapdown {
             context: "IMU data".into(),
@@ -790,7 +903,7 @@ impl<N: NavFrame> Stepper<N> {
     }
 
     /// Emits the states still held once the file has ended.
-    fn finish(&mut self, emit: &mut Emit<'_, N>) -> Result<()> {
+    fn finish(&mut self, emit: &mut Emit<'_, E>) -> Result<()> {
         let Self::Rk4 {
             nav,
             held,
@@ -834,105 +947,108 @@ fn window(held: &VecDeque<[f64; 7]>, offset: usize) -> RateWindow {
     }
 }
 
-fn integrate_csv_in<N: NavFrame>(
-    input: &Path,
-    initial: &InitialState,
-    setup: &NavSetup,
-    out: &Path,
-) -> Result<NavSummary> {
-    let header = crate::io::table::read_header(input)?;
-    let has_all = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
-    let rates = has_all(&ACCEL_COLUMNS) && has_all(&GYRO_COLUMNS);
-    let (force, turn) = if rates {
-        (ACCEL_COLUMNS, GYRO_COLUMNS)
-    } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
-        (DV_COLUMNS, DTHETA_COLUMNS)
-    } else {
-        return Err(invalid(
-            "IMU data",
-            "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
-        ));
-    };
-    let mut columns = vec!["t_s"];
-    columns.extend(force);
-    columns.extend(turn);
-    let mut rows = TimedRows::open(input, &columns, "")?;
-    let attitude = Rotation::from_wxyz(initial.quaternion).ok_or_else(|| {
-        invalid(
-            "initial state",
-            "the quaternion has zero norm or is not finite",
-        )
-    })?;
-    let earth = FlatEarth::<N>::new(setup.gravity_m_s2);
-    let s0 = NavState::<FlatEarth<N>> {
-        t_s: rows.first_time(),
-        attitude,
-        velocity_m_s: Vec3::from_array(initial.velocity_m_s),
-        position: Vec3::from_array(initial.position_m),
-    };
-    let failed = |source: StrapdownError| crate::Error::Strapdown {
-        context: "initial state".into(),
-        source,
-    };
-    let scheme = setup
-        .scheme
-        .for_input(rates, setup.options.coning || setup.options.sculling);
-    let mut stepper = match (scheme, rates) {
-        (NavScheme::ConingSculling, true) => {
-            Stepper::Rates(RateIncrements::new(earth, s0, setup.options).map_err(failed)?)
-        }
-        (NavScheme::ConingSculling, false) => Stepper::Increments {
-            nav: Increments::new(earth, &s0, setup.options).map_err(failed)?,
-            initial: s0,
-            started: false,
-        },
-        (NavScheme::Rk4 { substeps }, true) => Stepper::Rk4 {
-            nav: Rk4::new(earth, &s0, setup.options, substeps).map_err(failed)?,
-            initial: s0,
-            held: VecDeque::with_capacity(NODES + 1),
-            first_held: 0,
-            seen: 0,
-            next_interval: 0,
-        },
-        (NavScheme::Rk4 { .. }, false) => {
+/// [`integrate_csv`] as an [`EarthJob`].
+struct IntegrateCsv<'a> {
+    input: &'a Path,
+    initial: &'a InitialState,
+    setup: &'a NavSetup,
+    out: &'a Path,
+}
+
+impl EarthJob for IntegrateCsv<'_> {
+    type Output = Result<NavSummary>;
+
+    fn run<E: NavEarth>(self, earth: E) -> Result<NavSummary> {
+        let Self {
+            input,
+            initial,
+            setup,
+            out,
+        } = self;
+        let options = strapdown_options(setup);
+        let header = crate::io::table::read_header(input)?;
+        let has_all = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+        let rates = has_all(&ACCEL_COLUMNS) && has_all(&GYRO_COLUMNS);
+        let (force, turn) = if rates {
+            (ACCEL_COLUMNS, GYRO_COLUMNS)
+        } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
+            (DV_COLUMNS, DTHETA_COLUMNS)
+        } else {
             return Err(invalid(
                 "IMU data",
-                "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+                "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
             ));
+        };
+        let mut columns = vec!["t_s"];
+        columns.extend(force);
+        columns.extend(turn);
+        let mut rows = TimedRows::open(input, &columns, "")?;
+        let (s0, origin) = nav_earth::start::<E>(initial, rows.first_time())?;
+        let failed = |source: StrapdownError| crate::Error::Strapdown {
+            context: "initial state".into(),
+            source,
+        };
+        let scheme = setup
+            .scheme
+            .for_input(rates, options.coning || options.sculling);
+        let mut stepper = match (scheme, rates) {
+            (NavScheme::ConingSculling, true) => {
+                Stepper::Rates(RateIncrements::new(earth, s0, options).map_err(failed)?)
+            }
+            (NavScheme::ConingSculling, false) => Stepper::Increments {
+                nav: Increments::new(earth, &s0, options).map_err(failed)?,
+                initial: s0,
+                started: false,
+            },
+            (NavScheme::Rk4 { substeps }, true) => Stepper::Rk4 {
+                nav: Rk4::new(earth, &s0, options, substeps).map_err(failed)?,
+                initial: s0,
+                held: VecDeque::with_capacity(NODES + 1),
+                first_held: 0,
+                seen: 0,
+                next_interval: 0,
+            },
+            (NavScheme::Rk4 { .. }, false) => {
+                return Err(invalid(
+                    "IMU data",
+                    "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+                ));
+            }
+            (NavScheme::Auto { .. }, _) => unreachable!("for_input chooses a concrete scheme"),
+        };
+        let sign = match setup.accel_sign {
+            AccelSign::SpecificForce => 1.0,
+            AccelSign::Matlab => -1.0,
+        };
+        let mut file = AtomicFile::create(out)?;
+        file.write_header(&nav_earth::nav_columns::<E>())?;
+        let width = nav_earth::nav_width::<E>();
+        let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
+        let mut write = |state: NavState<E>, file: &mut AtomicFile| -> Result<()> {
+            file.write_row(&nav_earth::nav_row(&state, &origin, &mut last_yaw)[..width])?;
+            end = state;
+            written += 1;
+            Ok(())
+        };
+        let mut r = [0.0; 7];
+        while rows.next_row(&mut r)? {
+            let row = [
+                r[0],
+                sign * r[1],
+                sign * r[2],
+                sign * r[3],
+                r[4],
+                r[5],
+                r[6],
+            ];
+            stepper.push(row, &mut |state| write(state, &mut file))?;
         }
-        (NavScheme::Auto { .. }, _) => unreachable!("for_input chooses a concrete scheme"),
-    };
-    let sign = match setup.accel_sign {
-        AccelSign::SpecificForce => 1.0,
-        AccelSign::Matlab => -1.0,
-    };
-    let mut file = AtomicFile::create(out)?;
-    file.write_header(&NAV_COLUMNS)?;
-    let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
-    let mut write = |state: NavState<FlatEarth<N>>, file: &mut AtomicFile| -> Result<()> {
-        file.write_row(&nav_row(&state, &mut last_yaw))?;
-        end = state;
-        written += 1;
-        Ok(())
-    };
-    let mut r = [0.0; 7];
-    while rows.next_row(&mut r)? {
-        let row = [
-            r[0],
-            sign * r[1],
-            sign * r[2],
-            sign * r[3],
-            r[4],
-            r[5],
-            r[6],
-        ];
-        stepper.push(row, &mut |state| write(state, &mut file))?;
+        stepper.finish(&mut |state| write(state, &mut file))?;
+        file.commit()?;
+        Ok(NavSummary {
+            rows: written,
+            scheme,
+            end_position_m: E::plane_m(&end.position, &origin),
+        })
     }
-    stepper.finish(&mut |state| write(state, &mut file))?;
-    file.commit()?;
-    Ok(NavSummary {
-        rows: written,
-        scheme,
-        end_position_m: end.position.to_array(),
-    })
 }

@@ -95,16 +95,6 @@ impl MagneticEnvironment {
     }
 }
 
-/// Body axes of the frame convention of `N` from FRD: the identity under NED (FRD), a half
-/// turn about x under ENU (FLU: `(x, −y, −z)`).
-pub(crate) fn frd_to_body<N: NavFrame>() -> Rotation<Body, Body> {
-    if N::Z_UP > 0.0 {
-        Rotation::from_wxyz([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()
-    } else {
-        Rotation::identity()
-    }
-}
-
 impl TangentPlane {
     /// Checks the origin: latitude within ±89.9° (the local NED frame is not used nearer the
     /// poles), every value finite, the height within 1000 km of the ellipsoid.
@@ -247,12 +237,12 @@ impl TangentPlane {
     /// its time.
     pub fn to_earth<N: NavFrame>(&self, s: &Truth<N>) -> Result<EarthTruth> {
         let c_et = self.plane_to_ecef::<N>();
-        let to_frd = frd_to_body::<N>().inverse();
+        let to_frd = N::frd_to_body().inverse();
         let k = EcefKinematics {
             position_m: self.origin.to_ecef() + c_et.apply(s.position_m),
             velocity_m_s: c_et.apply(s.velocity_m_s),
             acceleration_m_s2: c_et.apply(s.acceleration_m_s2),
-            attitude: frd_to_body::<N>().then(&s.attitude).then(&c_et),
+            attitude: N::frd_to_body().then(&s.attitude).then(&c_et),
             omega_eb_b_rad_s: to_frd.apply(s.omega_b_rad_s),
             alpha_eb_b_rad_s2: to_frd.apply(s.alpha_b_rad_s2),
         };
@@ -280,7 +270,7 @@ impl TangentPlane {
     #[must_use]
     pub fn local<N: NavFrame>(plane: &Truth<N>, earth: &EarthTruth) -> Truth<N> {
         let from_ned = N::from_ned();
-        let to_body = frd_to_body::<N>();
+        let to_body = N::frd_to_body();
         let attitude = to_body.inverse().then(&earth.attitude).then(&from_ned);
         Truth {
             t_s: earth.t_s,
@@ -319,7 +309,7 @@ impl TangentPlane {
         lever_arm_m: Vec3<Body>,
         field_ned: Vec3<Ned>,
     ) -> IdealReading {
-        let to_body = frd_to_body::<N>();
+        let to_body = N::frd_to_body();
         let mount = EarthMount {
             lever_arm_m: to_body.inverse().apply(lever_arm_m),
             accel_sign: imu_core::AccelSign::SpecificForce,

@@ -13,7 +13,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
-use crate::scenario::earth::frd_to_body;
 
 /// GNSS columns on the flat Earth.
 pub const GNSS_COLUMNS: [&str; 7] = [
@@ -294,7 +293,7 @@ impl<'a> GnssStream<'a> {
     /// convention of the lever arm), as rows of [`GNSS_EARTH_COLUMNS`].
     pub fn measure_earth<N: NavFrame>(&mut self, earth: &[EarthTruth]) -> Table {
         let mut t = Table::new(&GNSS_EARTH_COLUMNS);
-        let lever_frd = frd_to_body::<N>()
+        let lever_frd = N::frd_to_body()
             .inverse()
             .apply(Vec3::<Body>::from_array(self.setup.lever_arm_m));
         for e in earth {

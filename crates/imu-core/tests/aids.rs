@@ -1,0 +1,178 @@
+//! The filter's aiding updates besides GNSS, written once for every Earth and tested where they
+//! live: an odometer, the non-holonomic constraints and a zero-velocity update each move the
+//! estimate and shrink the covariance exactly as the scalar Kalman update does on the body axes
+//! they measure (and leave the others alone); the gate rejects what lies beyond its quantile,
+//! and the quantiles are the chi-square distribution's.
+use imu_core::earth::{EarthModel, FlatEarth, Geodetic, Wgs84};
+use imu_core::fusion::gate::{CHI2_99_9, gate_99_9};
+use imu_core::fusion::{BASE_STATES, Eskf, EskfNoise, EskfState, InitialSigma};
+use imu_core::strapdown::NavState;
+use imu_core::{Body, Enu, EulerZyx, Ned, Rotation, Vec3};
+
+/// The prior velocity one-sigma, m/s.
+const SIGMA_V: f64 = 0.3;
+
+fn filter<E: EarthModel>(earth: E, position: E::Position) -> Eskf<E, BASE_STATES> {
+    let start = EskfState {
+        nav: NavState {
+            t_s: 0.0,
+            // Pitched, rolled and turned: body and frame axes differ.
+            attitude: Rotation::<Body, E::Frame>::from_euler(EulerZyx::new(0.8, 0.2, -0.3)),
+            // At rest in the estimate: the attitude's error does not enter a body velocity.
+            velocity_m_s: Vec3::zeros(),
+            position,
+        },
+        accel_bias_m_s2: [0.0; 3],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let sigma = InitialSigma {
+        position_m: 1.0,
+        velocity_m_s: SIGMA_V,
+        attitude_rad: [0.01, 0.01, 0.05],
+        accel_bias_m_s2: 0.01,
+        gyro_bias_rad_s: 1e-4,
+    };
+    let noise = EskfNoise {
+        accel_psd: 1e-3,
+        gyro_psd: 1e-4,
+        accel_bias_psd: 1e-5,
+        gyro_bias_psd: 1e-7,
+    };
+    Eskf::new(earth, &start, &sigma, noise).unwrap()
+}
+
+/// The body axis `k` in the navigation frame.
+fn body_axis<E: EarthModel>(f: &Eskf<E, BASE_STATES>, k: usize) -> nalgebra::Vector3<f64> {
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    *f.state()
+        .nav
+        .attitude
+        .apply(Vec3::from_array(e))
+        .as_nalgebra()
+}
+
+/// The velocity estimate along body axis `k` and its variance.
+fn along<E: EarthModel>(f: &Eskf<E, BASE_STATES>, k: usize) -> (f64, f64) {
+    let u = body_axis(f, k);
+    let p = nalgebra::Matrix3::from_fn(|r, c| f.covariance(3 + r, 3 + c));
+    (
+        u.dot(f.state().nav.velocity_m_s.as_nalgebra()),
+        (u.transpose() * p * u)[(0, 0)],
+    )
+}
+
+/// The scalar Kalman update of a prior `N(0, σ₀²)` by a measurement `z` of variance `σ²`.
+fn scalar_update(z: f64, sigma: f64) -> (f64, f64) {
+    let (p, r) = (SIGMA_V * SIGMA_V, sigma * sigma);
+    (p / (p + r) * z, p * r / (p + r))
+}
+
+fn close(a: (f64, f64), b: (f64, f64), what: &str) {
+    assert!(
+        (a.0 - b.0).abs() < 1e-12 && (a.1 / b.1 - 1.0).abs() < 1e-9,
+        "{what}: {a:?} against {b:?}"
+    );
+}
+
+fn updates_are_scalar_kalman_updates<E: EarthModel + Copy>(earth: E, position: E::Position) {
+    // An odometer alone: forward only.
+    let mut f = filter(earth, position);
+    let outcome = f.update_odometer(0.5, 0.1, None, f64::INFINITY).unwrap();
+    assert!(outcome.accepted);
+    close(along(&f, 0), scalar_update(0.5, 0.1), "odometer, forward");
+    close(along(&f, 1), (0.0, SIGMA_V * SIGMA_V), "odometer, lateral");
+    close(along(&f, 2), (0.0, SIGMA_V * SIGMA_V), "odometer, vertical");
+    // With the constraints: forward as before, lateral and vertical held to 0 ± 0.05.
+    let mut f = filter(earth, position);
+    f.update_odometer(0.5, 0.1, Some(0.05), f64::INFINITY)
+        .unwrap();
+    close(
+        along(&f, 0),
+        scalar_update(0.5, 0.1),
+        "odometer + NHC, forward",
+    );
+    close(
+        along(&f, 1),
+        scalar_update(0.0, 0.05),
+        "odometer + NHC, lateral",
+    );
+    close(
+        along(&f, 2),
+        scalar_update(0.0, 0.05),
+        "odometer + NHC, vertical",
+    );
+    // The constraints alone leave the forward axis.
+    let mut f = filter(earth, position);
+    f.update_nonholonomic(0.05, f64::INFINITY).unwrap();
+    close(along(&f, 0), (0.0, SIGMA_V * SIGMA_V), "NHC, forward");
+    close(along(&f, 1), scalar_update(0.0, 0.05), "NHC, lateral");
+    // A zero-velocity update: every axis.
+    let mut f = filter(earth, position);
+    f.update_zero_velocity(0.01, f64::INFINITY).unwrap();
+    for k in 0..3 {
+        close(along(&f, k), scalar_update(0.0, 0.01), "zero velocity");
+    }
+    // The gate: NIS z²/(σ₀² + σ²) against the one-row quantile.
+    let limit = (gate_99_9(1) * (SIGMA_V * SIGMA_V + 0.01)).sqrt();
+    let mut f = filter(earth, position);
+    assert!(
+        f.update_odometer(0.99 * limit, 0.1, None, gate_99_9(1))
+            .unwrap()
+            .accepted
+    );
+    let mut f = filter(earth, position);
+    let outcome = f
+        .update_odometer(1.01 * limit, 0.1, None, gate_99_9(1))
+        .unwrap();
+    assert!(!outcome.accepted);
+    assert!((outcome.nis / (1.01 * 1.01 * gate_99_9(1)) - 1.0).abs() < 1e-9);
+    close(along(&f, 0), (0.0, SIGMA_V * SIGMA_V), "a rejected reading");
+}
+
+#[test]
+fn aiding_updates_are_the_scalar_kalman_update_on_the_body_axes_they_measure() {
+    updates_are_scalar_kalman_updates(FlatEarth::<Enu>::new(9.81), Vec3::new(1.0, 2.0, 3.0));
+    updates_are_scalar_kalman_updates(
+        Wgs84::<Ned>::default(),
+        Geodetic::from_degrees(48.0, 11.0, 520.0),
+    );
+    updates_are_scalar_kalman_updates(
+        Wgs84::<Enu>::default(),
+        Geodetic::from_degrees(-12.0, -77.0, 150.0),
+    );
+}
+
+/// The chi-square distribution function `P(k/2, x/2)` by its series,
+/// `e^{−y} Σ yᵃ⁺ⁿ / Γ(a + n + 1)`, with `Γ` of integers and half-integers exact.
+fn chi_square_cdf(x: f64, k: usize) -> f64 {
+    let a = k as f64 / 2.0;
+    let y = x / 2.0;
+    // Γ(a + 1) for a = k/2.
+    let mut gamma = if k.is_multiple_of(2) {
+        1.0
+    } else {
+        std::f64::consts::PI.sqrt() / 2.0
+    };
+    let mut s = if k.is_multiple_of(2) { 1.0 } else { 1.5 };
+    while s <= a {
+        gamma *= s;
+        s += 1.0;
+    }
+    let mut term = y.powf(a) / gamma;
+    let mut sum = 0.0;
+    for n in 1..400 {
+        sum += term;
+        term *= y / (a + n as f64);
+    }
+    (-y).exp() * sum
+}
+
+#[test]
+fn the_gates_are_the_chi_square_quantiles() {
+    for (k, q) in CHI2_99_9.iter().enumerate() {
+        let p = chi_square_cdf(*q, k + 1);
+        assert!((p - 0.999).abs() < 1e-13, "{} rows: P = {p}", k + 1);
+    }
+    assert_eq!(gate_99_9(7), f64::INFINITY);
+}
