@@ -1,6 +1,6 @@
 //! Loosely coupled INS/GNSS fusion for the CLI and Python: the core's error-state filter
 //! ([`imu_core::fusion::eskf`]) over an IMU table (rates) and a GNSS table, on the flat Earth or
-//! WGS-84 (fixes then geodetic), in the data's own frame ([`nav_earth`](crate::run::nav_earth)).
+//! WGS-84 (fixes then geodetic), in the data's own frame (`run::nav_earth`).
 //! Odometer, barometer and the constraints aid it alike on both (`fuse_aids`).
 //!
 //! Output: [`FUSE_COLUMNS`] — the navigation columns of `integrate`, the one-sigma of position,
@@ -327,7 +327,7 @@ pub fn gnss_alignment_sigma(v: [f64; 3], setup: &FuseSetup) -> InitialSigma {
     }
 }
 
-/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`]) from `initial`.
+/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::scenario::gnss::GNSS_COLUMNS)) from `initial`.
 ///
 /// # Errors
 /// Missing columns, GNSS times that do not increase or fall outside the IMU's span, the

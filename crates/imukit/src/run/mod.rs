@@ -1,5 +1,5 @@
 //! The jobs a user runs: simulate ([`simulate`], [`arrays`] for in-memory arrays), navigate
-//! ([`navigate`] and with GNSS [`fuse`] on either Earth through [`nav_earth`], [`planar`]), orient
+//! ([`navigate`] and with GNSS [`fuse`] on either Earth through `nav_earth`, [`planar`]), orient
 //! ([`orient`]), compare ([`compare`]), analyse ([`allan`]) and compare IMUs through a GNSS
 //! outage ([`study`]). A streamed run may use two threads ([`pipeline`]).
 pub mod allan;

@@ -7,7 +7,7 @@
 //! yaw_rad, pitch_rad, roll_rad`, and on the WGS-84 Earth `lat_rad, lon_rad, height_m` (`pos_*`
 //! then in the tangent plane at the origin of the starting truth, velocity and attitude in the
 //! local-level frame at each position). Both Earths run in the data's own frame through
-//! [`nav_earth`](crate::run::nav_earth).
+//! `run::nav_earth`.
 use imu_core::strapdown::rk4::{NODES, RateWindow, window_start};
 use std::collections::VecDeque;
 use std::path::Path;
