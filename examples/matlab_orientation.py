@@ -32,7 +32,7 @@ def stationary() -> None:
     imu = imukit.ImuSensor("accel-gyro-mag", sample_rate=100)
     n = 1000
     accel, gyro, mag = imu(np.zeros((n, 3)), np.zeros((n, 3)), np.tile([1.0, 0, 0, 0], (n, 1)))
-    q = imukit.ecompass(accel, mag)
+    q = imukit.ecompass(accel, mag, conventions="matlab")
     euler = np.degrees(imukit.quaternion_to_euler(q))
     print(f"stationary: ecompass yaw {euler[0, 0]:.3f}° (magnetic north is {math.degrees(DECLINATION):.3f}° "
           f"from true north), pitch {euler[0, 1]:.3f}°, roll {euler[0, 2]:.3f}°")
@@ -56,7 +56,7 @@ def platform(realistic: bool):
                               TemperatureBias=[0.8, 0.8, 2.4], NoiseDensity=[0.06, 0.06, 0.09]))
     imu = imukit.ImuSensor("accel-mag", sample_rate=fs, seed=67, **params)
     accel, mag = imu(np.zeros((n, 3)), ang_vel, q_true)
-    q = imukit.ecompass(accel, mag)
+    q = imukit.ecompass(accel, mag, conventions="matlab")
     # ecompass measures yaw from magnetic north: compare with the truth turned by the declination.
     q_magnetic = imukit.euler_to_quaternion(np.column_stack([yaw - DECLINATION, np.zeros(n), np.zeros(n)]))
     d = np.degrees(imukit.quaternion_distance(q, q_magnetic))
@@ -113,12 +113,12 @@ def imufilter_study(seed: int = 67) -> dict:
     out = {"t": t, "q_true": q_true}
     ideal = imukit.ImuSensor("accel-gyro", sample_rate=fs)
     a, g = ideal(acc, omega_n, q_true)
-    out["ideal"] = imukit.ImuFilter(sample_rate=fs)(a, g)
+    out["ideal"] = imukit.ImuFilter(sample_rate=fs, conventions="matlab")(a, g)
     real = imukit.ImuSensor("accel-gyro", sample_rate=fs, seed=seed, accelerometer=REALISTIC_ACCEL,
                             gyroscope=REALISTIC_GYRO)
     a, g = real(acc, omega_n, q_true)
-    out["default"] = imukit.ImuFilter(sample_rate=fs)(a, g)
-    out["tuned"] = imukit.ImuFilter(sample_rate=fs, **TUNED)(a, g)
+    out["default"] = imukit.ImuFilter(sample_rate=fs, conventions="matlab")(a, g)
+    out["tuned"] = imukit.ImuFilter(sample_rate=fs, **TUNED, conventions="matlab")(a, g)
     for k in ("ideal", "default", "tuned"):
         out[f"{k}_distance_deg"] = np.degrees(imukit.quaternion_distance(q_true, out[k]))
     return out

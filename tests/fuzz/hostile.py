@@ -634,7 +634,7 @@ for k in range(cases):
                                 truth=rng.choice([True, False, np.bool_(False), 0, None, "yes"])),
         lambda: imukit.planar_dead_reckon(np.arange(n, dtype=float), arr((n, 1))[:, 0] if n else np.zeros(0),
                                           np.zeros(n), np.zeros(n), heading0_rad=rng.choice(X)),
-        lambda: imukit.ImuFilter(sample_rate=rng.choice(X + [100.0]))(arr((n, 3)), arr((n, 3))),
+        lambda: imukit.ImuFilter(sample_rate=rng.choice(X + [100.0]), conventions="matlab")(arr((n, 3)), arr((n, 3))),
         lambda: imukit.fuse(imu_table(n), gnss_table(rng.choice([0, 1, 3])), initial=truth_table(max(n, 1)),
                             scenario=FUSE_SCENARIO),
         lambda: imukit.strapdown(imu_table(n), truth_table(max(n, 1))),

@@ -189,19 +189,21 @@ NoiseDensity = 0.06
 """
 
 PYTHON_FILTERS = {
-    "imufilter": lambda a, g, m: imukit.ImuFilter(100)(a, g),
-    "ahrsfilter": lambda a, g, m: imukit.AhrsFilter(100)(a, g, m),
-    "ecompass": lambda a, g, m: imukit.ecompass(a, m),
-    "madgwick": lambda a, g, m: imukit.MadgwickFilter(100, has_magnetometer=True)(a, g, m),
-    "mahony": lambda a, g, m: imukit.MahonyFilter(100, has_magnetometer=True)(a, g, m),
-    "complementary": lambda a, g, m: imukit.ComplementaryFilter(100)(a, g, m),
+    "imufilter": lambda a, g, m, **kw: imukit.ImuFilter(100, **kw)(a, g),
+    "ahrsfilter": lambda a, g, m, **kw: imukit.AhrsFilter(100, **kw)(a, g, m),
+    "ecompass": lambda a, g, m, **kw: imukit.ecompass(a, m, **kw),
+    "madgwick": lambda a, g, m, **kw: imukit.MadgwickFilter(100, has_magnetometer=True, **kw)(a, g, m),
+    "mahony": lambda a, g, m, **kw: imukit.MahonyFilter(100, has_magnetometer=True, **kw)(a, g, m),
+    "complementary": lambda a, g, m, **kw: imukit.ComplementaryFilter(100, **kw)(a, g, m),
 }
 
 
+@pytest.mark.parametrize("conventions", [None, "matlab"])
 @pytest.mark.parametrize("filter_name", sorted(PYTHON_FILTERS))
-def test_cli_orient_equals_the_python_filters(tmp_path, filter_name):
+def test_cli_orient_equals_the_python_filters(tmp_path, filter_name, conventions):
     """`imukit orient` on the turning platform (noisy, biased gyroscope) gives the Python filter's
-    numbers bit for bit, and `imukit compare` reads the orientation output back."""
+    numbers bit for bit, with the defaults of both (imukit's conventions) and with MATLAB's
+    asked for, and `imukit compare` reads the orientation output back."""
     scenario = tmp_path / "platform.toml"
     scenario.write_text(ORIENT_SCENARIO)
     imu_csv, truth_csv, out = tmp_path / "imu.csv", tmp_path / "truth.csv", tmp_path / "orient.csv"
@@ -210,14 +212,14 @@ def test_cli_orient_equals_the_python_filters(tmp_path, filter_name):
         return subprocess.run([imukit_bin(), *args], check=True, capture_output=True, text=True)
 
     run("simulate", str(scenario), "--out", str(imu_csv), "--truth", str(truth_csv))
-    run("orient", str(imu_csv), "--filter", filter_name, "--nav-frame", "NED", "--accel-sign", "matlab",
-        "--param", "SampleRate=100", "--out", str(out))
+    asked = [] if conventions is None else ["--conventions", conventions]
+    run("orient", str(imu_csv), "--filter", filter_name, *asked, "--param", "SampleRate=100", "--out", str(out))
     header, rows = read_csv(out)
     assert header == ["t_s", "q_w", "q_x", "q_y", "q_z", "yaw_rad", "pitch_rad", "roll_rad"]
     imu = imukit.read_csv(imu_csv)
     a, g, m = (np.column_stack([imu[f"{s}_{x}_{u}"] for x in "xyz"])
                for s, u in (("accel", "m_s2"), ("gyro", "rad_s"), ("mag", "ut")))
-    np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m))
+    np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m, conventions=conventions))
     report = run("compare", str(truth_csv), str(out)).stdout
     assert "attitude" in report and "position" not in report
 

@@ -175,12 +175,18 @@ pub enum Command {
         /// `MagnetometerGain` for complementary). The sample rate defaults to the data's.
         #[arg(long = "param", value_name = "KEY=VALUE")]
         params: Vec<String>,
-        /// Navigation frame of the estimate (ENU or NED).
-        #[arg(long, default_value = "ENU")]
-        nav_frame: String,
-        /// Sign of the accelerometer columns (`specific-force` or `matlab`).
-        #[arg(long, default_value = "specific-force")]
-        accel_sign: String,
+        /// Conventions: `imukit` (ENU and specific force, as every command; the default) or
+        /// `matlab` (NED and MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and
+        /// --accel-sign override either.
+        #[arg(long)]
+        conventions: Option<String>,
+        /// Navigation frame of the estimate (ENU or NED; default: the conventions').
+        #[arg(long)]
+        nav_frame: Option<String>,
+        /// Sign of the accelerometer columns (`specific-force` or `matlab`; default: the
+        /// conventions').
+        #[arg(long)]
+        accel_sign: Option<String>,
         /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,
         /// roll_rad`).
         #[arg(long)]

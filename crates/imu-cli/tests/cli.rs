@@ -369,6 +369,11 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         ),
         ("imu.csv", vec!["--filter", "ahrsfilter"], "missing"),
         (
+            "imu.csv",
+            vec!["--conventions", "nasa"],
+            "--conventions: unknown conventions \"nasa\" (imukit, matlab)",
+        ),
+        (
             "nan.csv",
             vec![],
             "nan.csv, row 3, column gyro_y_rad_s: not a finite number",
@@ -379,16 +384,49 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!out_file.exists(), "{args:?}");
     }
-    let (code, err) = orient("imu.csv", &["--nav-frame", "NED", "--accel-sign", "matlab"]);
+    // +g on z is level in imukit's conventions (ENU, specific force: the default) and in
+    // MATLAB's (NED, gravity minus acceleration), asked for at once or flag by flag.
+    for args in [
+        vec![],
+        vec!["--conventions", "matlab"],
+        vec!["--nav-frame", "NED", "--accel-sign", "matlab"],
+    ] {
+        let (code, err) = orient("imu.csv", &args);
+        assert_eq!(code, Some(0), "{args:?}: {err}");
+        let text = std::fs::read_to_string(&out_file).unwrap();
+        assert_eq!(text.lines().count(), 4);
+        assert!(text.starts_with("t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,"));
+        let q: Vec<f64> = text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .take(4)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!(
+            (q[0].abs() - 1.0).abs() < 1e-12 && q[1..].iter().all(|c| c.abs() < 1e-12),
+            "{args:?}: {text}"
+        );
+    }
+    // Down is up in the other frame: MATLAB's conventions on imukit's data turn it over.
+    let (code, err) = orient(
+        "imu.csv",
+        &["--conventions", "matlab", "--accel-sign", "specific-force"],
+    );
     assert_eq!(code, Some(0), "{err}");
     let text = std::fs::read_to_string(&out_file).unwrap();
-    assert_eq!(text.lines().count(), 4);
-    assert!(
-        text.starts_with(
-            "t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,1.0,0.0,0.0,0.0,0.0,"
-        ),
-        "{text}"
-    );
+    let roll: f64 = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((roll.abs() - std::f64::consts::PI).abs() < 1e-9, "{text}");
 }
 
 #[test]

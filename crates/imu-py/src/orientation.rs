@@ -1,21 +1,28 @@
 //! Orientation estimation for Python: the e-compass, every filter behind one class, and the
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
-use imu_core::{AccelSign, Enu, Ned};
+use imu_core::{Enu, Ned};
 use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows};
-use imukit::scenario::{AccelSignName, NavFrameName, parse_name};
+use imukit::scenario::NavFrameName;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::convert::{array2, flat_rows, nav_frame};
+use crate::convert::{array2, flat_rows};
 use crate::errors::refused;
-use imukit::run::orient::{ecompass_rows, quaternion_distances};
+use imukit::run::orient::{ecompass_rows, frame_and_sign, quaternion_distances};
 
-/// The accelerometer sign by name.
-fn sign(name: &str) -> PyResult<AccelSign> {
-    Ok(parse_name::<AccelSignName>("accel_sign", name)
-        .map_err(refused)?
-        .into())
+/// A refusal of the field `nav_frame` under the name the MATLAB-shaped classes give it,
+/// `reference_frame`.
+fn reference_frame_named(e: imukit::Error) -> imukit::Error {
+    match e {
+        imukit::Error::Invalid { field, message } if field == "nav_frame" => {
+            imukit::Error::Invalid {
+                field: "reference_frame".into(),
+                message,
+            }
+        }
+        other => other,
+    }
 }
 
 /// The nav-frame generic filter.
@@ -37,33 +44,30 @@ type Estimates<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 #[pymethods]
 impl PyOrientationFilter {
     #[new]
-    #[pyo3(signature = (kind, *, sample_rate, reference_frame = "NED", accel_sign = "matlab",
-                        magnetometer = false, settings = Vec::new(), initial_process_noise = None))]
+    #[pyo3(signature = (kind, *, sample_rate, conventions = None, reference_frame = None,
+                        accel_sign = None, magnetometer = false, settings = Vec::new(),
+                        initial_process_noise = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         kind: &str,
         sample_rate: f64,
-        reference_frame: &str,
-        accel_sign: &str,
+        conventions: Option<&str>,
+        reference_frame: Option<&str>,
+        accel_sign: Option<&str>,
         magnetometer: bool,
         settings: Vec<(String, f64)>,
         initial_process_noise: Option<Vec<f64>>,
     ) -> PyResult<Self> {
         let request = OrientRequest {
             filter: kind,
+            conventions,
             nav_frame: reference_frame,
             accel_sign,
             settings,
         };
-        let (mut spec, nav) = request.resolve().map_err(|e| match e {
-            // The MATLAB-shaped classes call the navigation frame reference_frame.
-            imukit::Error::Invalid { field, message } if field == "nav_frame" => {
-                refused(imukit::Error::Invalid {
-                    field: "reference_frame".into(),
-                    message,
-                })
-            }
-            other => refused(other),
-        })?;
+        let (mut spec, nav) = request
+            .resolve()
+            .map_err(|e| refused(reference_frame_named(e)))?;
         let kind = spec.kind;
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
         spec.initial_process_noise = initial_process_noise;
@@ -132,6 +136,15 @@ impl PyOrientationFilter {
     }
 
     /// The gyroscope offset estimate of a Kalman filter, rad/s (None for the others).
+    /// The navigation frame the filter estimates in, as resolved: `"ENU"` or `"NED"`.
+    #[getter]
+    fn reference_frame(&self) -> &'static str {
+        match self.filter {
+            Filter::Enu(_) => "ENU",
+            Filter::Ned(_) => "NED",
+        }
+    }
+
     #[getter]
     fn gyroscope_offset(&self) -> Option<[f64; 3]> {
         match &self.filter {
@@ -144,18 +157,19 @@ impl PyOrientationFilter {
 
 /// Orientation `q_nb` (N, 4) from accelerometer and magnetometer rows (N, 3).
 #[pyfunction]
-#[pyo3(signature = (accel, mag, *, reference_frame = "NED", accel_sign = "matlab"))]
+#[pyo3(signature = (accel, mag, *, conventions = None, reference_frame = None, accel_sign = None))]
 fn ecompass<'py>(
     py: Python<'py>,
     accel: PyReadonlyArray2<'py, f64>,
     mag: PyReadonlyArray2<'py, f64>,
-    reference_frame: &str,
-    accel_sign: &str,
+    conventions: Option<&str>,
+    reference_frame: Option<&str>,
+    accel_sign: Option<&str>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a = flat_rows::<3>("accel", &accel)?;
     let m = flat_rows::<3>("mag", &mag)?;
-    let s = sign(accel_sign)?;
-    let nav = nav_frame("reference_frame", reference_frame)?;
+    let (nav, s) = frame_and_sign(conventions, reference_frame, accel_sign)
+        .map_err(|e| refused(reference_frame_named(e)))?;
     let q = py.detach(|| ecompass_rows(a, m, s, nav)).map_err(refused)?;
     array2(py, a.len() / 3, 4, q)
 }

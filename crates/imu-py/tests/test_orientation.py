@@ -43,21 +43,21 @@ def test_ecompass_recovers_every_attitude_of_a_grid(frame, sign):
 
 def test_ecompass_refuses_degenerate_rows_by_index():
     with pytest.raises(ImuError, match=r"row 1: the magnetic field is parallel to gravity"):
-        imukit.ecompass([[0, 0, G], [0, 0, G]], [[20, 0, 40], [0, 0, 40]])
+        imukit.ecompass([[0, 0, G], [0, 0, G]], [[20, 0, 40], [0, 0, 40]], conventions="matlab")
     with pytest.raises(ImuError, match="row 0: accelerometer reading is not a finite number"):
-        imukit.ecompass([[np.nan, 0, G]], [[20, 0, 40]])
+        imukit.ecompass([[np.nan, 0, G]], [[20, 0, 40]], conventions="matlab")
     with pytest.raises(ValueError, match=r"mag has 1 rows, expected 2"):
-        imukit.ecompass(np.zeros((2, 3)), np.zeros((1, 3)))
+        imukit.ecompass(np.zeros((2, 3)), np.zeros((1, 3)), conventions="matlab")
 
 
 def filters(frame="NED"):
     kw = dict(reference_frame=frame)
     return {
-        "imufilter": (imukit.ImuFilter(100, **kw), False),
-        "ahrsfilter": (imukit.AhrsFilter(100, **kw), True),
-        "complementary": (imukit.ComplementaryFilter(100, **kw), True),
-        "madgwick": (imukit.MadgwickFilter(100, has_magnetometer=True, **kw), True),
-        "mahony": (imukit.MahonyFilter(100, **kw), False),
+        "imufilter": (imukit.ImuFilter(100, **kw, conventions="matlab"), False),
+        "ahrsfilter": (imukit.AhrsFilter(100, **kw, conventions="matlab"), True),
+        "complementary": (imukit.ComplementaryFilter(100, **kw, conventions="matlab"), True),
+        "madgwick": (imukit.MadgwickFilter(100, has_magnetometer=True, **kw, conventions="matlab"), True),
+        "mahony": (imukit.MahonyFilter(100, **kw, conventions="matlab"), False),
     }
 
 
@@ -102,10 +102,10 @@ def test_kalman_filters_estimate_a_constant_gyroscope_bias_within_5_percent_afte
     n = 6000
     accel, mag = readings(np.zeros((n, 3)))
     bias = np.array([0.02, -0.015, 0.01])
-    imu = imukit.ImuFilter(100)
+    imu = imukit.ImuFilter(100, conventions="matlab")
     imu(accel, np.tile([bias[0], bias[1], 0.0], (n, 1)))
     np.testing.assert_allclose(imu.gyroscope_offset[:2], bias[:2], rtol=0.05)
-    ahrs = imukit.AhrsFilter(100)
+    ahrs = imukit.AhrsFilter(100, conventions="matlab")
     q, w = ahrs(accel, np.tile(bias, (n, 1)), mag, return_angular_velocity=True)
     np.testing.assert_allclose(ahrs.gyroscope_offset, bias, rtol=0.05)
     np.testing.assert_allclose(w[-1], 0.0, atol=0.05 * np.abs(bias).max())
@@ -114,7 +114,7 @@ def test_kalman_filters_estimate_a_constant_gyroscope_bias_within_5_percent_afte
 def test_decimation_rotmat_and_tuned_initial_process_noise():
     accel, _ = readings(np.zeros((12, 3)))
     f = imukit.ImuFilter(100, decimation_factor=4, orientation_format="rotmat",
-                         initial_process_noise=imukit.ImuFilter.DEFAULT_INITIAL_PROCESS_NOISE * 10)
+                         initial_process_noise=imukit.ImuFilter.DEFAULT_INITIAL_PROCESS_NOISE * 10, conventions="matlab")
     r = f(accel, np.zeros((12, 3)))
     assert r.shape == (3, 3, 3)
     np.testing.assert_allclose(r, np.tile(np.eye(3), (3, 1, 1)), atol=1e-12)
@@ -122,16 +122,16 @@ def test_decimation_rotmat_and_tuned_initial_process_noise():
 
 def test_bad_input_is_named():
     with pytest.raises(ImuError, match="SampleRate = 0: must be finite and > 0"):
-        imukit.ImuFilter(0)
+        imukit.ImuFilter(0, conventions="matlab")
     with pytest.raises(ImuError, match="LinearAccelerationDecayFactor = 2: must be in"):
-        imukit.ImuFilter(linear_acceleration_decay_factor=2)
+        imukit.ImuFilter(linear_acceleration_decay_factor=2, conventions="matlab")
     with pytest.raises(ImuError, match="DecimationFactor"):
-        imukit.ImuFilter(decimation_factor=0)
+        imukit.ImuFilter(decimation_factor=0, conventions="matlab")
     with pytest.raises(ValueError, match=r"initial_process_noise must be \(9,\)"):
-        imukit.ImuFilter(initial_process_noise=np.ones(4))
+        imukit.ImuFilter(initial_process_noise=np.ones(4), conventions="matlab")
     with pytest.raises(ImuError, match="AccelerometerGain"):
-        imukit.ComplementaryFilter(accelerometer_gain=1.5)
-    f = imukit.AhrsFilter()
+        imukit.ComplementaryFilter(accelerometer_gain=1.5, conventions="matlab")
+    f = imukit.AhrsFilter(conventions="matlab")
     accel, mag = readings(np.zeros((4, 3)))
     gyro = np.zeros((4, 3))
     bad = gyro.copy()
@@ -139,11 +139,11 @@ def test_bad_input_is_named():
     with pytest.raises(ImuError, match="row 2: gyroscope reading is not a finite number"):
         f(accel, bad, mag)
     # The failed call left no trace: the same filter now gives a fresh filter's numbers.
-    np.testing.assert_array_equal(f(accel, gyro, mag), imukit.AhrsFilter()(accel, gyro, mag))
+    np.testing.assert_array_equal(f(accel, gyro, mag), imukit.AhrsFilter(conventions="matlab")(accel, gyro, mag))
     with pytest.raises(ValueError, match=r"gyro has 3 rows, expected 4"):
         f(accel, gyro[:3], mag)
     with pytest.raises(ValueError, match="has_magnetometer=False"):
-        imukit.MahonyFilter()(accel, gyro, mag)
+        imukit.MahonyFilter(conventions="matlab")(accel, gyro, mag)
 
 
 def test_quaternion_distance_and_compare_of_an_orientation_output():
@@ -168,18 +168,18 @@ def test_decimation_takes_whole_blocks_per_call_as_matlab_does():
     accel, mag = readings(np.zeros((24, 3)))
     accel += rng.normal(scale=0.05, size=accel.shape)
     gyro = rng.normal(scale=0.01, size=accel.shape)
-    whole = imukit.AhrsFilter(100, decimation_factor=4)(accel, gyro, mag)
-    f = imukit.AhrsFilter(100, decimation_factor=4)
+    whole = imukit.AhrsFilter(100, decimation_factor=4, conventions="matlab")(accel, gyro, mag)
+    f = imukit.AhrsFilter(100, decimation_factor=4, conventions="matlab")
     parts = [f(accel[i:j], gyro[i:j], mag[i:j]) for i, j in [(0, 4), (4, 16), (16, 24)]]
     assert [p.shape[0] for p in parts] == [1, 3, 2]
     np.testing.assert_array_equal(np.vstack(parts), whole)
     # MATLAB refuses a call whose row count is not a multiple of DecimationFactor; so does imukit,
     # and the refused call leaves the filter as it was.
-    g = imukit.ImuFilter(100, decimation_factor=3)
+    g = imukit.ImuFilter(100, decimation_factor=3, conventions="matlab")
     a50, g50 = readings(np.zeros((50, 3)))[0], np.zeros((50, 3))
     with pytest.raises(ImuError, match="50 rows is not a multiple of DecimationFactor = 3"):
         g(a50, g50)
-    np.testing.assert_array_equal(g(a50[:48], g50[:48]), imukit.ImuFilter(100, decimation_factor=3)(a50[:48], g50[:48]))
+    np.testing.assert_array_equal(g(a50[:48], g50[:48]), imukit.ImuFilter(100, decimation_factor=3, conventions="matlab")(a50[:48], g50[:48]))
 
 
 def test_ahrs_ignores_a_jammed_magnetometer_sample():
@@ -191,12 +191,12 @@ def test_ahrs_ignores_a_jammed_magnetometer_sample():
     jammed = mag.copy()
     jammed[150] = [500.0, 300.0, 0.0]
     gyro = np.zeros_like(accel)
-    clean = imukit.AhrsFilter(100)(accel, gyro, mag)
-    spiked = imukit.AhrsFilter(100)(accel, gyro, jammed)
+    clean = imukit.AhrsFilter(100, conventions="matlab")(accel, gyro, mag)
+    spiked = imukit.AhrsFilter(100, conventions="matlab")(accel, gyro, jammed)
     assert imukit.quaternion_distance(clean, spiked).max() < 1e-9
     # The same spike just under the jamming bound does move the estimate.
     jammed[150] = [60.0, 60.0, 0.0]
-    moved = imukit.AhrsFilter(100)(accel, gyro, jammed)
+    moved = imukit.AhrsFilter(100, conventions="matlab")(accel, gyro, jammed)
     assert imukit.quaternion_distance(clean, moved).max() > 1e-3
 
 
@@ -209,7 +209,7 @@ def test_kalman_filters_stay_well_conditioned_over_millions_of_updates():
     accel = np.repeat(accel, n, axis=0) + rng.normal(scale=0.02, size=(n, 3))
     mag = np.repeat(mag, n, axis=0) + rng.normal(scale=0.1, size=(n, 3))
     gyro = rng.normal(scale=1e-3, size=(n, 3))
-    for f, args in ((imukit.ImuFilter(100), (accel, gyro)), (imukit.AhrsFilter(100), (accel, gyro, mag))):
+    for f, args in ((imukit.ImuFilter(100, conventions="matlab"), (accel, gyro)), (imukit.AhrsFilter(100, conventions="matlab"), (accel, gyro, mag))):
         for _ in range(2):
             q = f(*args)
         assert np.all(np.isfinite(q)) and imukit.quaternion_distance(q[-1], [1.0, 0, 0, 0])[0] < 0.05

@@ -10,12 +10,14 @@ pub fn run(
     input: &Path,
     filter: &str,
     params: &[String],
-    nav_frame: &str,
-    accel_sign: &str,
+    conventions: Option<&str>,
+    nav_frame: Option<&str>,
+    accel_sign: Option<&str>,
     out: &Path,
 ) -> Result<(), CliError> {
     let (spec, nav) = OrientRequest {
         filter,
+        conventions,
         nav_frame,
         accel_sign,
         settings: FilterSpec::parse_settings(params)?,

@@ -304,8 +304,9 @@ class OrientationFilter:
         kind: str,
         *,
         sample_rate: float,
-        reference_frame: str = "NED",
-        accel_sign: str = "matlab",
+        conventions: Optional[str] = None,
+        reference_frame: Optional[str] = None,
+        accel_sign: Optional[str] = None,
         magnetometer: bool = False,
         settings: Sequence[tuple[str, float]] = ...,
         initial_process_noise: Optional[Sequence[float]] = None,
@@ -318,14 +319,17 @@ class OrientationFilter:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
     def reset(self) -> None: ...
     @property
+    def reference_frame(self) -> str: ...
+    @property
     def gyroscope_offset(self) -> Optional[list[float]]: ...
 
 def ecompass(
     accel: npt.NDArray[np.float64],
     mag: npt.NDArray[np.float64],
     *,
-    reference_frame: str = "NED",
-    accel_sign: str = "matlab",
+    conventions: Optional[str] = None,
+    reference_frame: Optional[str] = None,
+    accel_sign: Optional[str] = None,
 ) -> npt.NDArray[np.float64]: ...
 def quaternion_distance(q1: npt.NDArray[np.float64], q2: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def study_plan(path: str) -> tuple[list[str], int]: ...

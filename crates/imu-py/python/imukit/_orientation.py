@@ -3,8 +3,10 @@
 
 Orientations are quaternions ``[w, x, y, z]`` = imukit's ``q_nb`` = MATLAB's orientation
 quaternion, or with ``orientation_format="rotmat"`` MATLAB's rotation matrices (nav → body,
-``C_nbᵀ``). Accelerometer readings are taken in MATLAB's sign (gravity minus acceleration) by
-default, as these classes mirror MATLAB; pass ``accel_sign="specific-force"`` for imukit's.
+``C_nbᵀ``). Frame and accelerometer sign follow imukit's conventions unless told otherwise, as
+``imukit orient`` does: ENU (FLU body axes) and specific force (``+g`` up at rest). MATLAB's —
+NED and its accelerometer sign (gravity minus acceleration) — are one keyword away,
+``conventions="matlab"``; ``reference_frame`` and ``accel_sign`` override either.
 Filters keep their state between calls (a run in chunks equals the run whole); ``reset()``
 starts over. The equations are in the Rust docs of ``imu_core::orientation``.
 """
@@ -36,19 +38,22 @@ def _format(q: np.ndarray, orientation_format: str) -> np.ndarray:
     raise ValueError(f'orientation_format must be "quaternion" or "rotmat", got {orientation_format!r}')
 
 
-def ecompass(accel, mag, *, reference_frame: str = "NED", accel_sign: str = "matlab",
-             orientation_format: str = "quaternion") -> np.ndarray:
+def ecompass(accel, mag, *, conventions: Optional[str] = None, reference_frame: Optional[str] = None,
+             accel_sign: Optional[str] = None, orientation_format: str = "quaternion") -> np.ndarray:
     """Orientation from accelerometer and magnetometer readings (N, 3), one per row, yaw from
     magnetic north (MATLAB ``ecompass``).
 
     >>> import numpy as np
-    >>> q = ecompass([[0.0, 0.0, 9.81]], [[27.0, 0.0, 16.0]])   # level, facing magnetic north
+    >>> q = ecompass([[0.0, 0.0, 9.81]], [[0.0, 27.0, -16.0]])   # ENU: level, facing magnetic east
+    >>> float(quaternion_distance(q[0], [1.0, 0.0, 0.0, 0.0])[0]) < 1e-12
+    True
+    >>> q = ecompass([[0.0, 0.0, 9.81]], [[27.0, 0.0, 16.0]], conventions="matlab")   # NED: north
     >>> np.round(q, 12).tolist()
     [[1.0, 0.0, 0.0, 0.0]]
     """
     a = _rows("accel", accel)
     m = _rows("mag", mag, a.shape[0])
-    q = _core.ecompass(a, m, reference_frame=reference_frame, accel_sign=accel_sign)
+    q = _core.ecompass(a, m, conventions=conventions, reference_frame=reference_frame, accel_sign=accel_sign)
     return _format(q, orientation_format)
 
 
@@ -69,16 +74,17 @@ class _Filter:
 
     _kind = ""
 
-    def __init__(self, sample_rate: float, reference_frame: str, accel_sign: str, magnetometer: bool,
-                 settings: dict, orientation_format: str, initial_process_noise=None) -> None:
+    def __init__(self, sample_rate: float, conventions: Optional[str], reference_frame: Optional[str],
+                 accel_sign: Optional[str], magnetometer: bool, settings: dict, orientation_format: str,
+                 initial_process_noise=None) -> None:
         if orientation_format not in ("quaternion", "rotmat"):
             raise ValueError(f'orientation_format must be "quaternion" or "rotmat", got {orientation_format!r}')
         self.orientation_format = orientation_format
         self.sample_rate = float(sample_rate)
-        self.reference_frame = reference_frame
         self._magnetometer = magnetometer
         self._filter = _core.OrientationFilter(
-            self._kind, sample_rate=self.sample_rate, reference_frame=reference_frame, accel_sign=accel_sign,
+            self._kind, sample_rate=self.sample_rate, conventions=conventions, reference_frame=reference_frame,
+            accel_sign=accel_sign,
             magnetometer=magnetometer, settings=[(k, float(v)) for k, v in settings.items()],
             initial_process_noise=initial_process_noise)
 
@@ -93,6 +99,11 @@ class _Filter:
     def reset(self) -> None:
         """Back to the state before the first sample."""
         self._filter.reset()
+
+    @property
+    def reference_frame(self) -> str:
+        """The navigation frame of the orientations, ``"ENU"`` or ``"NED"``."""
+        return self._filter.reference_frame
 
 
 def _diagonal(ipn, states: int):
@@ -124,17 +135,18 @@ class ImuFilter(_Filter):
     _states = 9
     DEFAULT_INITIAL_PROCESS_NOISE = np.diag(_IPN_DIAG[:9])
 
-    def __init__(self, sample_rate: float = 100.0, *, reference_frame: str = "NED", decimation_factor: int = 1,
+    def __init__(self, sample_rate: float = 100.0, *, conventions: Optional[str] = None,
+                 reference_frame: Optional[str] = None, decimation_factor: int = 1,
                  accelerometer_noise: float = 0.00019247, gyroscope_noise: float = 9.1385e-5,
                  gyroscope_drift_noise: float = 3.0462e-13, linear_acceleration_noise: float = 0.0096236,
                  linear_acceleration_decay_factor: float = 0.5, initial_process_noise=None,
-                 orientation_format: str = "quaternion", accel_sign: str = "matlab", **magnetic) -> None:
+                 orientation_format: str = "quaternion", accel_sign: Optional[str] = None, **magnetic) -> None:
         settings = dict(DecimationFactor=decimation_factor, AccelerometerNoise=accelerometer_noise,
                         GyroscopeNoise=gyroscope_noise, GyroscopeDriftNoise=gyroscope_drift_noise,
                         LinearAccelerationNoise=linear_acceleration_noise,
                         LinearAccelerationDecayFactor=linear_acceleration_decay_factor, **magnetic)
-        super().__init__(sample_rate, reference_frame, accel_sign, self._kind == "ahrsfilter", settings,
-                         orientation_format, _diagonal(initial_process_noise, self._states))
+        super().__init__(sample_rate, conventions, reference_frame, accel_sign, self._kind == "ahrsfilter",
+                         settings, orientation_format, _diagonal(initial_process_noise, self._states))
         self.decimation_factor = int(decimation_factor)
 
     def __call__(self, accel, gyro, *, return_angular_velocity: bool = False):
@@ -186,9 +198,10 @@ class ComplementaryFilter(_SimpleFilter):
     _kind = "complementary"
 
     def __init__(self, sample_rate: float = 100.0, *, accelerometer_gain: float = 0.01,
-                 magnetometer_gain: float = 0.01, has_magnetometer: bool = True, reference_frame: str = "NED",
-                 orientation_format: str = "quaternion", accel_sign: str = "matlab") -> None:
-        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer,
+                 magnetometer_gain: float = 0.01, has_magnetometer: bool = True, conventions: Optional[str] = None,
+                 reference_frame: Optional[str] = None, orientation_format: str = "quaternion",
+                 accel_sign: Optional[str] = None) -> None:
+        super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer,
                          dict(AccelerometerGain=accelerometer_gain, MagnetometerGain=magnetometer_gain),
                          orientation_format)
 
@@ -200,10 +213,11 @@ class MadgwickFilter(_SimpleFilter):
     _kind = "madgwick"
 
     def __init__(self, sample_rate: float = 100.0, *, beta: Optional[float] = None, has_magnetometer: bool = False,
-                 reference_frame: str = "NED", orientation_format: str = "quaternion",
-                 accel_sign: str = "matlab") -> None:
+                 conventions: Optional[str] = None, reference_frame: Optional[str] = None,
+                 orientation_format: str = "quaternion", accel_sign: Optional[str] = None) -> None:
         settings = {} if beta is None else dict(Beta=beta)
-        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer, settings, orientation_format)
+        super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer, settings,
+                         orientation_format)
 
 
 class MahonyFilter(_SimpleFilter):
@@ -212,9 +226,10 @@ class MahonyFilter(_SimpleFilter):
     _kind = "mahony"
 
     def __init__(self, sample_rate: float = 100.0, *, kp: float = 1.0, ki: float = 0.3,
-                 has_magnetometer: bool = False, reference_frame: str = "NED",
-                 orientation_format: str = "quaternion", accel_sign: str = "matlab") -> None:
-        super().__init__(sample_rate, reference_frame, accel_sign, has_magnetometer, dict(Kp=kp, Ki=ki),
-                         orientation_format)
+                 has_magnetometer: bool = False, conventions: Optional[str] = None,
+                 reference_frame: Optional[str] = None, orientation_format: str = "quaternion",
+                 accel_sign: Optional[str] = None) -> None:
+        super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer,
+                         dict(Kp=kp, Ki=ki), orientation_format)
 
 

@@ -131,17 +131,91 @@ const MAGNETIC_SETTINGS: [&str; 4] = [
     "ExpectedMagneticFieldStrength",
 ];
 
-/// An orientation run as a front end states it (filter, frame and sign by name, settings by
-/// MATLAB's property names); checked once, in [`OrientRequest::resolve`]. Errors name the fields
-/// as written here (`filter`, `nav_frame`, `accel_sign`) or the setting.
-#[derive(Clone, Debug, PartialEq)]
+/// The conventions an orientation run follows where a front end names neither the frame nor
+/// the accelerometer sign: imukit's unless asked, from every front end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Conventions {
+    /// imukit's, as in every other command: ENU (FLU body axes), accelerometers reading
+    /// specific force (`+g` up at rest).
+    #[default]
+    Imukit,
+    /// MATLAB's Navigation Toolbox: NED (FRD body axes), accelerometers in MATLAB's sign
+    /// (gravity minus acceleration: `+g` down at rest).
+    Matlab,
+}
+
+impl Conventions {
+    /// `"imukit"` or `"matlab"`.
+    ///
+    /// # Errors
+    /// Any other name (field `conventions`).
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "imukit" => Ok(Self::Imukit),
+            "matlab" => Ok(Self::Matlab),
+            other => Err(invalid(
+                "conventions",
+                format!("unknown conventions \"{other}\" (imukit, matlab)"),
+            )),
+        }
+    }
+
+    /// The navigation frame.
+    #[must_use]
+    pub fn nav_frame(self) -> NavFrameName {
+        match self {
+            Self::Imukit => NavFrameName::ENU,
+            Self::Matlab => NavFrameName::NED,
+        }
+    }
+
+    /// The accelerometer sign.
+    #[must_use]
+    pub fn accel_sign(self) -> AccelSign {
+        match self {
+            Self::Imukit => AccelSign::SpecificForce,
+            Self::Matlab => AccelSign::Matlab,
+        }
+    }
+}
+
+/// The frame and accelerometer sign of an orientation run: each as named, else the named
+/// conventions' (imukit's when none are named). Errors name the fields `conventions`,
+/// `nav_frame`, `accel_sign`.
+///
+/// # Errors
+/// Unknown names.
+pub fn frame_and_sign(
+    conventions: Option<&str>,
+    nav_frame: Option<&str>,
+    accel_sign: Option<&str>,
+) -> Result<(NavFrameName, AccelSign)> {
+    let conventions = conventions.map_or(Ok(Conventions::default()), Conventions::parse)?;
+    let nav = match nav_frame {
+        Some(name) => parse_name("nav_frame", &name.to_ascii_uppercase())?,
+        None => conventions.nav_frame(),
+    };
+    let sign = match accel_sign {
+        Some(name) => parse_name::<AccelSignName>("accel_sign", name)?.into(),
+        None => conventions.accel_sign(),
+    };
+    Ok((nav, sign))
+}
+
+/// An orientation run as a front end states it (filter, conventions, frame and sign by name,
+/// settings by MATLAB's property names); checked once, in [`OrientRequest::resolve`]. Errors
+/// name the fields as written here (`filter`, `conventions`, `nav_frame`, `accel_sign`) or the
+/// setting.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct OrientRequest<'a> {
     /// The filter's name ([`FilterKind::ALL`]).
     pub filter: &'a str,
-    /// `"ENU"` or `"NED"` (any case).
-    pub nav_frame: &'a str,
-    /// `"specific-force"` or `"matlab"`.
-    pub accel_sign: &'a str,
+    /// `"imukit"` or `"matlab"` ([`Conventions`]; `None`: imukit's).
+    pub conventions: Option<&'a str>,
+    /// `"ENU"` or `"NED"` (any case; `None`: the conventions').
+    pub nav_frame: Option<&'a str>,
+    /// `"specific-force"` or `"matlab"` (`None`: the conventions').
+    pub accel_sign: Option<&'a str>,
     /// `(name, value)` settings.
     pub settings: Vec<(String, f64)>,
 }
@@ -152,8 +226,7 @@ impl OrientRequest<'_> {
     /// # Errors
     /// Unknown names, named by field.
     pub fn resolve(&self) -> Result<(FilterSpec, NavFrameName)> {
-        let nav = parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?;
-        let sign: AccelSign = parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into();
+        let (nav, sign) = frame_and_sign(self.conventions, self.nav_frame, self.accel_sign)?;
         let mut spec = FilterSpec::new(FilterKind::parse(self.filter)?, sign);
         spec.settings.clone_from(&self.settings);
         Ok((spec, nav))
