@@ -12,8 +12,9 @@ use core::fmt;
 
 use crate::math;
 
-/// `√(2 ln 2 / π)`: the Allan floor of bias instability B is this times B.
-pub const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_262_771_418_5;
+/// `√(2 ln 2 / π)` (IEEE Std 952, Annex C): the Allan floor of flicker noise of bias instability
+/// B is this times B.
+pub const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_470_267_960_1;
 
 /// Why an Allan deviation could not be computed.
 #[derive(Clone, Copy, Debug, PartialEq)]

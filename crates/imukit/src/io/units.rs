@@ -221,7 +221,7 @@ mod tests {
             "{e}"
         );
         assert!(close(
-            datasheet_bias_instability(0.664_282_262_771_418_5),
+            datasheet_bias_instability((2.0 * 2f64.ln() / std::f64::consts::PI).sqrt()),
             1.0
         ));
     }

@@ -8,6 +8,7 @@
 //! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
 //! samples in imukit's simulations, so exactly there).
 use imu_core::fusion::align::{self, AlignError, PartFigures};
+use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
     SensorErrorEstimate, SensorErrorSigma,
@@ -839,57 +840,9 @@ fn matrix_sigma(p: &crate::sensor::SensorParams) -> (f64, f64) {
     )
 }
 
-/// The filter's model of one sensor triad from its error parameters at `rate_hz`: the
-/// continuous PSD of the white noise and of the bias drift (worst axis), each from the discrete
-/// noise the simulator draws. White: `σ_d = N √β` per sample (`β = fs` single-sided, `fs/2`
-/// double-sided), so `√q = σ_d/√fs`; quantisation to a step `r` adds white noise of variance
-/// `r²/12` per sample (Widrow's model; for the ICM-42688-P's gyroscopes a fifth of the noise). Random walk `K/√β` per sample: `√q = K √(fs/β)`. Bias
-/// instability `B`: MATLAB's filter (short memory) joins the white noise with its low-frequency
-/// gain, `√q += B·|Σb/Σa|/√fs`; Gauss–Markov (time `T`) joins the drift as a random walk of the
-/// same variance growth, `q += 2B²/T`; flicker joins it as the random walk whose Allan deviation
-/// `√(qτ/3)` equals the floor `0.664·B` at the floor's geometric centre `√(τ_min τ_max)` (with
-/// `τ_max` instead, the filter was 25 % overconfident through a 30 s outage on the road of the
-/// outage study).
-fn triad_psd(p: &crate::sensor::SensorParams, rate_hz: f64) -> (f64, f64) {
-    use crate::sensor::BiasInstabilityModel;
-    use imu_core::sensor::NoiseType;
-    let beta = match p.noise_type {
-        NoiseType::SingleSided => rate_hz,
-        NoiseType::DoubleSided => rate_hz / 2.0,
-    };
-    let max = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-    let (n, k, b) = (
-        max(p.noise_density),
-        max(p.random_walk),
-        max(p.bias_instability),
-    );
-    let mut white =
-        (n * n * beta / rate_hz + p.resolution * p.resolution / (12.0 * rate_hz)).sqrt();
-    let mut drift_q = (k * (rate_hz / beta).sqrt()).powi(2);
-    match &p.bias_instability_model {
-        BiasInstabilityModel::Filter(c) => {
-            let gain = c.numerator().iter().sum::<f64>() / c.denominator().iter().sum::<f64>();
-            white = (white.powi(2) + (b * gain.abs()).powi(2) / rate_hz).sqrt();
-        }
-        BiasInstabilityModel::Flicker {
-            tau_min_s,
-            tau_max_s,
-        } => {
-            // A random walk's Allan deviation is √(qτ/3): equal to the flicker floor 0.664·B
-            // at the floor's geometric centre τ_c = √(τ_min τ_max).
-            let tau_c = (tau_min_s * tau_max_s).sqrt();
-            drift_q += 3.0 * (FLICKER_FLOOR * b).powi(2) / tau_c;
-        }
-        BiasInstabilityModel::GaussMarkov { correlation_time_s } => {
-            drift_q += 2.0 * b * b / correlation_time_s;
-        }
-    }
-    (white, drift_q.sqrt())
-}
-
 impl FuseSetup {
     /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
-    /// IMU's noise (white and drift PSDs, see `triad_psd`) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
+    /// IMU's noise (white and drift PSDs, `imu_core::fusion::process_noise`) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
     /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
     /// filter assumes uncorrelated fixes). Initial uncertainty: position as the fixes, 0.1 m/s,
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
@@ -912,10 +865,8 @@ impl FuseSetup {
             crate::scenario::EarthSetup::Flat => None,
             crate::scenario::EarthSetup::Wgs84(plane) => Some(plane.gravity),
         };
-        let rate = scenario.sample_rate_hz;
         let p = &scenario.imu.sensors.params;
-        let (accel_psd, accel_bias_psd) = triad_psd(&p.accelerometer, rate);
-        let (gyro_psd, gyro_bias_psd) = triad_psd(&p.gyroscope, rate);
+        let noise = eskf_noise(&p.accelerometer, &p.gyroscope, scenario.sample_rate_hz);
         let g = &gnss.params;
         let scale = match g.position_noise {
             PositionNoise::DecayFactor(k) => (2.0 / (1.0 + k)).sqrt(),
@@ -935,12 +886,7 @@ impl FuseSetup {
             earth,
             accel_sign: scenario.imu.accel_sign,
             gravity_m_s2: scenario.gravity_m_s2,
-            noise: EskfNoise {
-                accel_psd,
-                gyro_psd,
-                accel_bias_psd,
-                gyro_bias_psd,
-            },
+            noise,
             initial_sigma: InitialSigma {
                 position_m: h.max(v),
                 velocity_m_s: 0.1,
@@ -981,10 +927,6 @@ impl FuseSetup {
         })
     }
 }
-
-/// The Allan floor of flicker noise per unit bias instability, `√(2 ln 2/π)` (IEEE 952): the
-/// one constant of the core's Allan analysis.
-const FLICKER_FLOOR: f64 = imu_core::allan::BIAS_INSTABILITY_FACTOR;
 
 /// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
 pub const MAX_REJECTED_IN_A_ROW: usize = 10;
