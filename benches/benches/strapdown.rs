@@ -36,6 +36,7 @@ fn bench(c: &mut Criterion) {
                     &t,
                     &gyro,
                     &accel,
+                    None,
                     NavState::default(),
                     StrapdownOptions::default(),
                     &mut out,

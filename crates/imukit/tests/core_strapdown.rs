@@ -212,6 +212,7 @@ fn helix_error(rate: f64, seconds: f64) -> f64 {
         &t,
         &gyro,
         &acc,
+        None,
         s0,
         StrapdownOptions::default(),
         &mut out,
@@ -262,6 +263,7 @@ fn bad_strapdown_input_is_refused_with_its_index() {
             &[0.0, 0.1],
             &[[0.0; 3]],
             &[[0.0; 3]; 2],
+            None,
             NavState::default(),
             StrapdownOptions::default(),
             &mut out

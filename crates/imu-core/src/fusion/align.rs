@@ -91,15 +91,6 @@ impl core::fmt::Display for AlignError {
     }
 }
 
-/// A body vector of frame `N`'s convention on FRD axes (FLU `(x, y, z)` → `(x, −y, −z)`).
-fn to_frd<N: NavFrame>(v: [f64; 3]) -> [f64; 3] {
-    if N::Z_UP > 0.0 {
-        [v[0], -v[1], -v[2]]
-    } else {
-        v
-    }
-}
-
 /// The attitude of a vehicle at rest at `position` on `earth` from the mean specific force
 /// `specific_force_m_s2` and mean body rate `rate_rad_s` (body axes of the frame's convention)
 /// over `duration_s`: roll `atan2(−f_y, −f_z)` and pitch `atan2(f_x, √(f_y² + f_z²))` (FRD);
@@ -122,8 +113,9 @@ pub fn at_rest<E: EarthModel>(
     let gravity = E::Frame::to_ned_axes(terms.gravity_m_s2).z();
     let earth_rate = E::Frame::to_ned_axes(terms.earth_rate_rad_s);
     let horizontal = math::hypot(earth_rate.x(), earth_rate.y());
-    let f = to_frd::<E::Frame>(specific_force_m_s2);
-    let w = to_frd::<E::Frame>(rate_rad_s);
+    let to_frd = E::Frame::frd_to_body().inverse();
+    let f = to_frd.apply(Vec3::from_array(specific_force_m_s2)).to_array();
+    let w = to_frd.apply(Vec3::from_array(rate_rad_s)).to_array();
     let magnitude = math::sqrt(f.iter().map(|x| x * x).sum::<f64>());
     if math::abs(magnitude - gravity) > REST_TOLERANCE * gravity || magnitude.is_nan() {
         return Err(AlignError::NotAtRest {

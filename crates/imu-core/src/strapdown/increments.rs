@@ -258,6 +258,34 @@ impl<E: EarthModel> RateIncrements<E> {
         gyro_rad_s: [f64; 3],
         accel_m_s2: [f64; 3],
     ) -> Result<NavState<E>, StrapdownError> {
+        self.sample(t_s, gyro_rad_s, accel_m_s2, None)
+    }
+
+    /// [`Self::step`] with the barometric height `baro_height_m` the baro vertical channel damps
+    /// the interval ending at `t_s` towards (ignored by the other channels and by the first
+    /// sample).
+    ///
+    /// # Errors
+    /// As [`Self::step`] and [`Increments::step_with_baro`].
+    pub fn step_with_baro(
+        &mut self,
+        t_s: f64,
+        gyro_rad_s: [f64; 3],
+        accel_m_s2: [f64; 3],
+        baro_height_m: f64,
+    ) -> Result<NavState<E>, StrapdownError> {
+        self.sample(t_s, gyro_rad_s, accel_m_s2, Some(baro_height_m))
+    }
+
+    /// One sample: the trapezoid of the rates since the last one as increments.
+    #[inline]
+    fn sample(
+        &mut self,
+        t_s: f64,
+        gyro_rad_s: [f64; 3],
+        accel_m_s2: [f64; 3],
+        baro_height_m: Option<f64>,
+    ) -> Result<NavState<E>, StrapdownError> {
         let index = self.index;
         if !(t_s.is_finite() && finite3(&gyro_rad_s) && finite3(&accel_m_s2)) {
             return Err(StrapdownError::NotFinite { index });
@@ -278,7 +306,10 @@ impl<E: EarthModel> RateIncrements<E> {
                 let dth = core::array::from_fn(|i| h * (w0[i] + gyro_rad_s[i]));
                 let dv = core::array::from_fn(|i| h * (f0[i] + accel_m_s2[i]));
                 self.inner.index = index;
-                self.inner.step(t_s, dth, dv)
+                match baro_height_m {
+                    None => self.inner.step(t_s, dth, dv),
+                    Some(b) => self.inner.step_with_baro(t_s, dth, dv, b),
+                }
             }
         };
         self.last = Some((t_s, gyro_rad_s, accel_m_s2));
@@ -288,15 +319,19 @@ impl<E: EarthModel> RateIncrements<E> {
 }
 
 /// Strapdown over rate samples on slices, written into `out` (same length; `out[0]` is the
-/// initial state at `t_s[0]`).
+/// initial state at `t_s[0]`); `baro_height_m` gives the barometric height per sample for
+/// [`VerticalChannel::Baro`] (required then, ignored otherwise; the interval ending at
+/// `t_s[i]` uses entry `i − 1`, as [`strapdown_increments`]).
 ///
 /// # Errors
-/// As [`RateIncrements::step`]; mismatched lengths.
+/// As [`RateIncrements::step`]; mismatched lengths; a baro channel without heights.
+#[allow(clippy::too_many_arguments)]
 pub fn strapdown_rates<E: EarthModel>(
     earth: E,
     t_s: &[f64],
     gyro_rad_s: &[[f64; 3]],
     accel_m_s2: &[[f64; 3]],
+    baro_height_m: Option<&[f64]>,
     initial: NavState<E>,
     options: StrapdownOptions,
     out: &mut [NavState<E>],
@@ -310,9 +345,19 @@ pub fn strapdown_rates<E: EarthModel>(
             ("output", out.len()),
         ],
     )?;
+    let baro = check_baro(n, baro_height_m, &options)?;
     let mut nav = RateIncrements::new(earth, initial, options)?;
     for i in 0..n {
-        out[i] = nav.step(t_s[i], gyro_rad_s[i], accel_m_s2[i])?;
+        out[i] = match baro {
+            None => nav.step(t_s[i], gyro_rad_s[i], accel_m_s2[i])?,
+            Some(b) => {
+                let baro_i = if i == 0 { 0.0 } else { b[i - 1] };
+                if !baro_i.is_finite() {
+                    return Err(StrapdownError::NotFinite { index: i - 1 });
+                }
+                nav.step_with_baro(t_s[i], gyro_rad_s[i], accel_m_s2[i], baro_i)?
+            }
+        };
     }
     Ok(())
 }

@@ -5,8 +5,9 @@
 //!
 //! Output: [`FUSE_COLUMNS`] — the navigation columns of `integrate`, the one-sigma of position,
 //! velocity and attitude (navigation-frame axes), and the bias estimates (body axes) — then on
-//! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU sample at or after its stamp (fixes are taken at IMU
-//! samples in imukit's simulations, so exactly there).
+//! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU
+//! sample at or after its stamp (fixes are taken at IMU samples in imukit's simulations, so
+//! exactly there).
 use imu_core::fusion::align::{self, AlignError, PartFigures};
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::{
@@ -90,7 +91,7 @@ pub fn sensor_error_columns() -> Vec<String> {
 
 /// The column names of a fused estimate: `base` and, with the sensor matrices,
 /// [`sensor_error_columns`].
-pub(crate) fn fused_columns(base: &[&str], sensor_errors: bool) -> Vec<String> {
+fn fused_columns(base: &[&str], sensor_errors: bool) -> Vec<String> {
     let mut columns: Vec<String> = base.iter().map(|c| (*c).to_string()).collect();
     if sensor_errors {
         columns.extend(sensor_error_columns());
@@ -100,11 +101,7 @@ pub(crate) fn fused_columns(base: &[&str], sensor_errors: bool) -> Vec<String> {
 
 /// Appends the sensor errors' estimates and one-sigmas (`sigmas`: the 21 states in order) to
 /// `row`.
-pub(crate) fn push_sensor_errors(
-    row: &mut Vec<f64>,
-    estimate: &SensorErrorEstimate,
-    sigmas: &[f64],
-) {
+fn push_sensor_errors(row: &mut Vec<f64>, estimate: &SensorErrorEstimate, sigmas: &[f64]) {
     for m in [&estimate.accel, &estimate.gyro] {
         for r in m {
             row.extend_from_slice(r);
@@ -399,7 +396,7 @@ impl EarthJob for Fuse<'_> {
 
 /// GNSS stamps: finite, increasing, inside the IMU's span `[t0, t1]` (the row named), and not
 /// more frequent on average than the IMU's `samples` (fixes are applied at IMU samples).
-pub(crate) fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<()> {
+fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<()> {
     for (k, &tk) in g_t.iter().enumerate() {
         if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
             return Err(invalid(
@@ -449,15 +446,15 @@ pub(crate) fn filter_refusal(what: &str, index: usize, e: EskfError) -> Error {
     }
 }
 
-/// What both fusions read: IMU times and rates (frame `N`'s body convention, as in the table),
+/// What a fusion reads: IMU times and rates (the frame's body convention, as in the table),
 /// GNSS stamps, positions (three columns) and velocities, checked.
-pub(crate) struct FusionInputs {
-    pub(crate) t: Vec<f64>,
-    pub(crate) f: Vec<[f64; 3]>,
-    pub(crate) w: Vec<[f64; 3]>,
-    pub(crate) g_t: Vec<f64>,
-    pub(crate) g_p: Vec<[f64; 3]>,
-    pub(crate) g_v: Vec<[f64; 3]>,
+struct FusionInputs {
+    t: Vec<f64>,
+    f: Vec<[f64; 3]>,
+    w: Vec<[f64; 3]>,
+    g_t: Vec<f64>,
+    g_p: Vec<[f64; 3]>,
+    g_v: Vec<[f64; 3]>,
 }
 
 impl FusionInputs {
@@ -467,7 +464,7 @@ impl FusionInputs {
     ///
     /// # Errors
     /// Missing columns, named; the stamps' refusals.
-    pub(crate) fn read(imu: &Table, gnss: &Table, columns: &[&str; 7], hint: &str) -> Result<Self> {
+    fn read(imu: &Table, gnss: &Table, columns: &[&str; 7], hint: &str) -> Result<Self> {
         let t = imu
             .column("t_s")
             .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
@@ -513,7 +510,7 @@ impl FusionInputs {
     }
 
     /// The IMU's span `[t₀, t₁]`, s.
-    pub(crate) fn span(&self) -> (f64, f64) {
+    fn span(&self) -> (f64, f64) {
         (self.t[0], self.t[self.t.len() - 1])
     }
 
@@ -522,7 +519,7 @@ impl FusionInputs {
     ///
     /// # Errors
     /// No fix that fast.
-    pub(crate) fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
+    fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
         let k = self
             .g_v
             .iter()
@@ -548,7 +545,7 @@ impl FusionInputs {
 ///
 /// # Errors
 /// The filter's refusal ([`filter_refusal`]) or the divergence.
-pub(crate) fn count_fix(
+fn count_fix(
     outcome: std::result::Result<imu_core::fusion::UpdateOutcome, EskfError>,
     index: usize,
     in_a_row: &mut usize,
@@ -809,7 +806,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
 }
 
 /// The refusal of `setup`'s covariance interval.
-pub(crate) fn covariance_interval_refusal(setup: &FuseSetup) -> Error {
+fn covariance_interval_refusal(setup: &FuseSetup) -> Error {
     invalid(
         "covariance_interval_s",
         format!(

@@ -67,9 +67,9 @@ impl<N: NavFrame> NavEarth for Wgs84<N> {
     const POSITION_COLUMNS: &'static [&'static str] = &GEODETIC_COLUMNS;
     const GNSS_COLUMNS: &'static [&'static str; 7] = &GNSS_EARTH_COLUMNS;
     const GNSS_HINT: &'static str = " (fixes on the WGS-84 Earth are geodetic)";
-    type Origin = Geodetic;
+    type Origin = Plane<N>;
 
-    fn start_position(initial: &InitialState) -> Result<(Geodetic, Geodetic)> {
+    fn start_position(initial: &InitialState) -> Result<(Geodetic, Plane<N>)> {
         let position = initial.geodetic.ok_or_else(|| {
             invalid(
                 "initial state",
@@ -78,14 +78,19 @@ impl<N: NavFrame> NavEarth for Wgs84<N> {
                  lat0_deg, lon0_deg, height0_m",
             )
         })?;
-        Ok((position, plane_origin::<N>(initial.position_m, &position)))
+        Ok((
+            position,
+            Plane::at(&plane_origin::<N>(initial.position_m, &position)),
+        ))
     }
-    fn origin_at(position: &Geodetic) -> Geodetic {
-        *position
+    fn origin_at(position: &Geodetic) -> Plane<N> {
+        Plane::at(position)
     }
-    fn plane_m(position: &Geodetic, origin: &Geodetic) -> [f64; 3] {
-        let c_te: Rotation<Ecef, N> = origin.ned_to_ecef().inverse().then(&N::from_ned());
-        c_te.apply(position.to_ecef() - origin.to_ecef()).to_array()
+    fn plane_m(position: &Geodetic, plane: &Plane<N>) -> [f64; 3] {
+        plane
+            .c_te
+            .apply(position.to_ecef() - plane.origin_ecef_m)
+            .to_array()
     }
     fn fix_position([lat, lon, h]: [f64; 3]) -> Option<Geodetic> {
         (lat.abs() <= MAX_LATITUDE_RAD && lon.is_finite() && h.is_finite()).then_some(Geodetic {
@@ -124,7 +129,25 @@ pub(crate) fn on_earth<J: EarthJob>(
     }
 }
 
-/// The tangent plane whose coordinates are the `pos_*` columns: the origin `o` with
+/// The tangent plane of the `pos_*` columns on WGS-84, with what each row's coordinates need
+/// worked out once: the origin in ECEF and the turn from ECEF to the plane's axes (frame `N`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Plane<N> {
+    origin_ecef_m: Vec3<Ecef>,
+    c_te: Rotation<Ecef, N>,
+}
+
+impl<N: NavFrame> Plane<N> {
+    /// The plane tangent at `origin`.
+    fn at(origin: &Geodetic) -> Self {
+        Self {
+            origin_ecef_m: origin.to_ecef(),
+            c_te: origin.ned_to_ecef().inverse().then(&N::from_ned()),
+        }
+    }
+}
+
+/// The origin of the tangent plane whose coordinates are the `pos_*` columns: the origin `o` with
 /// `r(o) + C_et(o) p = r₁` for the first sample's plane coordinates `p` and position `r₁`
 /// (solved by fixed-point iteration; the plane's axes turn by |p|/R between iterates).
 fn plane_origin<N: NavFrame>(position_m: [f64; 3], at: &Geodetic) -> Geodetic {

@@ -639,13 +639,8 @@ impl EarthJob for Integrate<'_> {
         {
             let f = flip(f);
             match setup.scheme.for_input(true, corrections) {
-                NavScheme::ConingSculling if baro.is_some() => {
-                    // The trapezoid of rates as increments, as `strapdown_rates` takes them.
-                    let (dth, dv) = trapezoid(&t, &w, &f);
-                    strapdown_increments(earth, &t, &dth, &dv, baro, s0, options, &mut out)
-                }
                 NavScheme::ConingSculling => {
-                    strapdown_rates(earth, &t, &w, &f, s0, options, &mut out)
+                    strapdown_rates(earth, &t, &w, &f, baro, s0, options, &mut out)
                 }
                 NavScheme::Rk4 { substeps } => {
                     strapdown_rates_rk4(earth, &t, &w, &f, baro, s0, options, substeps, &mut out)
@@ -680,18 +675,6 @@ impl EarthJob for Integrate<'_> {
         }
         Ok(table)
     }
-}
-
-/// Increments from rate samples by the trapezoid (entry 0 unused).
-fn trapezoid(t: &[f64], w: &[[f64; 3]], f: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-    let mut dth = vec![[0.0; 3]; t.len()];
-    let mut dv = vec![[0.0; 3]; t.len()];
-    for k in 1..t.len() {
-        let h = 0.5 * (t[k] - t[k - 1]);
-        dth[k] = std::array::from_fn(|i| h * (w[k - 1][i] + w[k][i]));
-        dv[k] = std::array::from_fn(|i| h * (f[k - 1][i] + f[k][i]));
-    }
-    (dth, dv)
 }
 
 /// The z-y-x Euler angles of `r` with the yaw unwrapped against `last_yaw` (then updated).
