@@ -114,7 +114,9 @@ pub fn at_rest<E: EarthModel>(
     let earth_rate = E::Frame::to_ned_axes(terms.earth_rate_rad_s);
     let horizontal = math::hypot(earth_rate.x(), earth_rate.y());
     let to_frd = E::Frame::frd_to_body().inverse();
-    let f = to_frd.apply(Vec3::from_array(specific_force_m_s2)).to_array();
+    let f = to_frd
+        .apply(Vec3::from_array(specific_force_m_s2))
+        .to_array();
     let w = to_frd.apply(Vec3::from_array(rate_rad_s)).to_array();
     let magnitude = math::sqrt(f.iter().map(|x| x * x).sum::<f64>());
     if math::abs(magnitude - gravity) > REST_TOLERANCE * gravity || magnitude.is_nan() {
