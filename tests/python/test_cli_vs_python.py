@@ -231,3 +231,39 @@ def test_one_version_for_the_package_the_command_and_the_workspace():
     printed = subprocess.run([imukit_bin(), "--version"], capture_output=True, text=True, check=True).stdout
     assert imukit.__version__ == workspace
     assert printed.split() == ["imukit", workspace]
+
+
+def cli_defaults(command: str) -> dict:
+    """The `[default: …]` of each flag in `imukit COMMAND --help`."""
+    import re
+
+    text = subprocess.run([imukit_bin(), command, "--help"], capture_output=True, text=True, check=True).stdout
+    blocks = re.split(r"\n\s+(?=--[a-z])", text)
+    out = {}
+    for b in blocks:
+        flag = re.match(r"--([a-z0-9-]+)", b)
+        default = re.search(r"\[default: ([^\]]+)\]", b)
+        if flag and default:
+            out[flag.group(1).replace("-", "_")] = default.group(1)
+    return out
+
+
+def test_python_and_the_command_line_start_from_the_same_defaults():
+    import inspect
+
+    cli = cli_defaults("integrate")
+    py = inspect.signature(imukit.strapdown).parameters
+    shared = ["nav_frame", "accel_sign", "earth", "vertical", "earth_gravity", "substeps",
+              "baro_time_constant_s", "gravity_m_s2"]
+    for name in shared:
+        want = py[name].default
+        got = cli[name]
+        assert (float(got) == want) if isinstance(want, (int, float)) else (got == want), (name, got, want)
+    # The scheme: one default for 3D (`auto`), one for planar (`trapezoid`), named by the library.
+    assert py["scheme"].default == imukit._core.DEFAULTS["scheme"] == "auto"
+    assert inspect.signature(imukit.planar_dead_reckon).parameters["scheme"].default == "trapezoid"
+    orient = cli_defaults("orient")
+    assert orient["conventions"] == imukit._core.DEFAULTS["conventions"] == "imukit"
+    assert orient["filter"] == imukit._core.DEFAULTS["filter"]
+    # The orientation filters' frame and sign, unless told, are the conventions': ENU.
+    assert imukit.ImuFilter(100.0).reference_frame == cli["nav_frame"] == "ENU"

@@ -1,7 +1,20 @@
 //! Command-line arguments.
 use std::path::PathBuf;
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
+use imukit::choice::Choice;
+use imukit::run::fuse::AlignName;
+use imukit::run::navigate::{EarthGravityName, VerticalName};
+use imukit::run::orient::{Conventions, FilterKind};
+use imukit::scenario::{AccelSignName, EarthName, NavFrameName};
+
+/// A flag that takes one of a library choice's names (any case): the names for help and
+/// completion, the library's value.
+fn choice<T: Choice>() -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(T::NAMES.iter().map(|(n, _)| PossibleValue::new(*n)))
+        .map(|s| T::parse("", &s).unwrap_or_default())
+}
 
 /// A fast, exact and reproducible IMU simulator and inertial-navigation toolkit.
 #[derive(Debug, Parser)]
@@ -83,15 +96,15 @@ pub enum Command {
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
         init: Option<PathBuf>,
-        /// 3D: navigation frame of the data (ENU or NED).
-        #[arg(long, default_value = "ENU")]
-        nav_frame: String,
+        /// 3D: navigation frame of the data.
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
+        nav_frame: NavFrameName,
         /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling).
         #[arg(long, alias = "gravity", default_value_t = imu_core::DEFAULT_GRAVITY_M_S2)]
         gravity_m_s2: f64,
-        /// 3D: sign of the accelerometer columns (`specific-force` or `matlab`).
-        #[arg(long, default_value = "specific-force")]
-        accel_sign: String,
+        /// 3D: sign of the accelerometer columns.
+        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true, default_value_t)]
+        accel_sign: AccelSignName,
         /// 3D: switch off the coning and sculling corrections (for comparison).
         #[arg(long)]
         no_corrections: bool,
@@ -123,25 +136,25 @@ pub enum Command {
         /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
         #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_negative_numbers = true)]
         velocity0: Option<Vec<f64>>,
-        /// 3D: the Earth: `flat` (default; non-rotating, constant gravity) or `wgs84` (the
+        /// 3D: the Earth: `flat` (non-rotating, constant gravity) or `wgs84` (the
         /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
         /// needs a geodetic position, from an --init truth file of a `wgs84` scenario or
         /// --lat0-deg/--lon0-deg/--height0-m). Writes lat_rad, lon_rad, height_m beside the
         /// local columns.
-        #[arg(long, default_value = "flat")]
-        earth: String,
+        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true, default_value_t)]
+        earth: EarthName,
         /// 3D, `--earth wgs84`: the vertical channel: `free` (unstable, as physics says),
         /// `hold` (height and vertical velocity held) or `baro` (a third-order loop on the IMU
         /// file's `baro_height_m` column).
-        #[arg(long, default_value = "free")]
-        vertical: String,
+        #[arg(long, value_parser = choice::<VerticalName>(), ignore_case = true, default_value_t)]
+        vertical: VerticalName,
         /// 3D, `--vertical baro`: the loop's time constant, s.
         #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
         baro_time_constant_s: f64,
         /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
         /// (--gravity-m-s2).
-        #[arg(long, default_value = "normal")]
-        earth_gravity: String,
+        #[arg(long, value_parser = choice::<EarthGravityName>(), ignore_case = true, default_value_t)]
+        earth_gravity: EarthGravityName,
         /// 3D, `--vertical baro`: barometer readings (`t_s, baro_height_m`, as `imukit simulate
         /// --baro` writes) instead of a `baro_height_m` column in the IMU file.
         #[arg(long)]
@@ -167,26 +180,25 @@ pub enum Command {
         /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
         input: PathBuf,
         /// The filter.
-        #[arg(long, default_value = "imufilter")]
-        filter: String,
+        #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
+        filter: FilterKind,
         /// A filter setting, `KEY=VALUE`, repeatable: MATLAB's property names
         /// (`GyroscopeNoise=7.6154e-7`, `DecimationFactor=2`, `InitialProcessNoiseScale=10`,
         /// `SampleRate=100`; `Beta` for madgwick, `Kp`/`Ki` for mahony, `AccelerometerGain`/
         /// `MagnetometerGain` for complementary). The sample rate defaults to the data's.
         #[arg(long = "param", value_name = "KEY=VALUE")]
         params: Vec<String>,
-        /// Conventions: `imukit` (ENU and specific force, as every command; the default) or
-        /// `matlab` (NED and MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and
-        /// --accel-sign override either.
-        #[arg(long)]
-        conventions: Option<String>,
-        /// Navigation frame of the estimate (ENU or NED; default: the conventions').
-        #[arg(long)]
-        nav_frame: Option<String>,
-        /// Sign of the accelerometer columns (`specific-force` or `matlab`; default: the
-        /// conventions').
-        #[arg(long)]
-        accel_sign: Option<String>,
+        /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
+        /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
+        /// override either.
+        #[arg(long, value_parser = choice::<Conventions>(), ignore_case = true, default_value_t)]
+        conventions: Conventions,
+        /// Navigation frame of the estimate (default: the conventions').
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+        nav_frame: Option<NavFrameName>,
+        /// Sign of the accelerometer columns (default: the conventions').
+        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
+        accel_sign: Option<AccelSignName>,
         /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,
         /// roll_rad`).
         #[arg(long)]
@@ -208,16 +220,16 @@ pub enum Command {
         /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); `static` (WGS-84
         /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s. The
         /// estimate begins there.
-        #[arg(long)]
-        align: Option<String>,
+        #[arg(long, value_parser = choice::<AlignName>(), ignore_case = true)]
+        align: Option<AlignName>,
         /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.
         #[arg(long)]
         scenario: PathBuf,
         /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
         /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
         /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.
-        #[arg(long)]
-        earth: Option<String>,
+        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
+        earth: Option<EarthName>,
         /// Apply every fix (no chi-square innovation gate).
         #[arg(long)]
         no_gate: bool,
@@ -345,9 +357,9 @@ pub enum Command {
         /// The figure file (`.svg` or `.png`).
         #[arg(long)]
         out: PathBuf,
-        /// Navigation frame of the positions (ENU or NED; NED paths are drawn east, north, up).
-        #[arg(long, default_value = "ENU")]
-        nav_frame: String,
+        /// Navigation frame of the positions (NED paths are drawn east, north, up).
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
+        nav_frame: NavFrameName,
         /// Size and resolution.
         #[command(flatten)]
         figure: FigureArgs,
@@ -373,9 +385,9 @@ pub enum Command {
         /// Seconds of motion per second of animation (default: the animation lasts 4 to 12 s).
         #[arg(long)]
         speed: Option<f64>,
-        /// Navigation frame of the truth (ENU or NED; NED is drawn turned so that up is up).
-        #[arg(long, default_value = "ENU")]
-        nav_frame: String,
+        /// Navigation frame of the truth (NED is drawn turned so that up is up).
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
+        nav_frame: NavFrameName,
     },
     /// Prints a shell's completion script for imukit to standard output.
     Completions {

@@ -33,10 +33,21 @@ impl CliError {
     }
 }
 
-/// The flag that sets a library field: `gravity_m_s2` → `--gravity-m-s2`.
+/// The request fields whose flag is not the field's name with `-` for `_`.
+const FLAGS: [(&str, &str); 3] = [
+    ("initial", "--init"),
+    ("nhc_sigma_m_s", "--nhc"),
+    ("gate", "--no-gate"),
+];
+
+/// The flag that sets a library request field: the table `FLAGS`, else the field's name with `-` for
+/// `_` (`gravity_m_s2` → `--gravity-m-s2`). Python's keywords are the fields' own names.
 #[must_use]
 pub fn flag(field: &str) -> String {
-    format!("--{}", field.replace('_', "-"))
+    FLAGS.iter().find(|(f, _)| *f == field).map_or_else(
+        || format!("--{}", field.replace('_', "-")),
+        |(_, flag)| (*flag).to_string(),
+    )
 }
 
 /// A library refusal of a request field, named by its flag.
@@ -46,6 +57,17 @@ pub fn by_flag(e: imukit::Error) -> imukit::Error {
         imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
             field: flag(&field),
             message,
+        },
+        imukit::Error::UnknownChoice {
+            field,
+            what,
+            value,
+            choices,
+        } => imukit::Error::UnknownChoice {
+            field: flag(&field),
+            what,
+            value,
+            choices,
         },
         other => other,
     }

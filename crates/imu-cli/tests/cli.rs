@@ -350,7 +350,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         (
             "imu.csv",
             vec!["--filter", "kalman"],
-            "unknown filter \"kalman\"; known: imufilter, ahrsfilter",
+            "invalid value 'kalman' for '--filter <FILTER>'\n  [possible values: imufilter, ahrsfilter, ecompass, madgwick, mahony, complementary]",
         ),
         (
             "imu.csv",
@@ -371,7 +371,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         (
             "imu.csv",
             vec!["--conventions", "nasa"],
-            "--conventions: unknown conventions \"nasa\" (imukit, matlab)",
+            "invalid value 'nasa' for '--conventions <CONVENTIONS>'\n  [possible values: imukit, matlab]",
         ),
         (
             "nan.csv",
@@ -380,7 +380,8 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         ),
     ] {
         let (code, err) = orient(input, &args);
-        assert_eq!(code, Some(65), "{args:?}: {err}");
+        let usage = needle.starts_with("invalid value");
+        assert_eq!(code, Some(if usage { 2 } else { 65 }), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!out_file.exists(), "{args:?}");
     }
@@ -1026,7 +1027,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
                 "--init",
                 "truth.csv",
             ],
-            "--vertical: unknown vertical channel \"sideways\"",
+            "invalid value 'sideways' for '--vertical <VERTICAL>'\n  [possible values: free, hold, baro]",
         ),
         (
             vec!["--earth", "wgs84", "--lat0-deg", "45"],
@@ -1034,7 +1035,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
         ),
         (
             vec!["--earth", "globe"],
-            "--earth: unknown Earth model \"globe\"",
+            "invalid value 'globe' for '--earth <EARTH>'\n  [possible values: flat, wgs84]",
         ),
         (
             vec![
@@ -1049,7 +1050,9 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
         ),
     ] {
         let (code, err) = integrate(&extra, "bad.csv");
-        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        // An unknown name is a usage error (2), listing the names; bad data is 65.
+        let usage = needle.starts_with("invalid value");
+        assert_eq!(code, Some(if usage { 2 } else { 65 }), "{extra:?}: {err}");
         assert!(err.contains(needle), "{extra:?}: {err}");
         assert!(!dir.join("bad.csv").exists());
     }
@@ -1596,11 +1599,17 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     std::fs::remove_file(dir.join("nav.csv")).unwrap();
     for (extra, needles) in [
         (vec!["--align", "static"], vec!["--align", "north", "gnss"]),
-        (vec!["--align", "sideways"], vec!["--align", "sideways"]),
+        (
+            vec!["--align", "sideways"],
+            vec![
+                "invalid value 'sideways' for '--align <ALIGN>'",
+                "gnss, static",
+            ],
+        ),
         (vec![], vec!["--init", "\"gnss\""]),
         (
             vec!["--init", "truth.csv", "--align", "gnss"],
-            vec!["--align", "not both"],
+            vec!["--init", "not both"],
         ),
         (
             vec!["--init", "truth.csv", "--rest-s=-1"],
@@ -1608,7 +1617,8 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
         ),
     ] {
         let (code, err) = fuse(&extra);
-        assert_eq!(code, Some(65), "{extra:?}: {err}");
+        let usage = needles[0].starts_with("invalid value");
+        assert_eq!(code, Some(if usage { 2 } else { 65 }), "{extra:?}: {err}");
         for n in needles {
             assert!(err.contains(n), "{extra:?}: {err}");
         }

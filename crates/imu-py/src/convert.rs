@@ -255,9 +255,17 @@ pub(crate) fn sensor_table(
     }
 }
 
-/// A navigation frame given by name (any case) for the argument `field`.
-pub(crate) fn nav_frame(field: &str, name: &str) -> PyResult<imukit::scenario::NavFrameName> {
-    imukit::scenario::parse_name(field, &name.to_ascii_uppercase()).map_err(crate::errors::refused)
+/// A library choice given by name (any case) for the keyword `field`.
+pub(crate) fn choice<T: imukit::choice::Choice>(field: &str, name: &str) -> PyResult<T> {
+    T::parse(field, name).map_err(crate::errors::refused)
+}
+
+/// An optional library choice given by name for the keyword `field`.
+pub(crate) fn choice_opt<T: imukit::choice::Choice>(
+    field: &str,
+    name: Option<&str>,
+) -> PyResult<Option<T>> {
+    name.map(|n| choice(field, n)).transpose()
 }
 
 /// A count or seed given as a Python int: refused by name when negative (instead of Python's

@@ -6,7 +6,7 @@ use imu_plot::spec::{self, TableKind};
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::convert::{check_len, fixed, nav_frame, rows, rows_out};
+use crate::convert::{check_len, choice, fixed, rows, rows_out};
 use crate::errors::{refused, refused_figure, shape_error};
 use imukit::scenario::NavFrameName;
 
@@ -98,7 +98,7 @@ fn points_enu<'py>(
     points: PyReadonlyArray2<'py, f64>,
     nav_frame: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let ned = self::nav_frame("nav_frame", nav_frame)? == NavFrameName::NED;
+    let ned = choice::<NavFrameName>("nav_frame", nav_frame)? == NavFrameName::NED;
     let p = rows::<3>("points", &points)?;
     rows_out(py, p.into_iter().map(|x| point_enu(x, ned)).collect())
 }
@@ -112,7 +112,7 @@ fn poses_enu<'py>(
     quaternion: PyReadonlyArray2<'py, f64>,
     nav_frame: &str,
 ) -> PyResult<PosesOut<'py>> {
-    let ned = self::nav_frame("nav_frame", nav_frame)? == NavFrameName::NED;
+    let ned = choice::<NavFrameName>("nav_frame", nav_frame)? == NavFrameName::NED;
     let p = rows::<3>("position_m", &position_m)?;
     let q = rows::<4>("quaternion", &quaternion)?;
     check_len("quaternion", q.len(), p.len())?;

@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 mod cli;
 mod convert;
+mod defaults;
 mod errors;
 mod figures;
 mod io;
@@ -33,6 +34,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // One version for every package of the workspace (`imukit --version` prints the same).
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     errors::register(m)?;
+    defaults::register(m)?;
     truth::register(m)?;
     rotations::register(m)?;
     sensor::register(m)?;

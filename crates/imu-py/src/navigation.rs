@@ -1,22 +1,28 @@
 //! Navigation: planar dead reckoning, 3D strapdown, and errors against truth.
 use std::path::Path;
 
-use imu_core::strapdown::planar::PlanarSample;
+use imu_core::strapdown::planar::{PlanarSample, PlanarScheme};
 use imukit::Table;
+use imukit::choice::Choice;
 use imukit::run::compare as comparison;
-use imukit::run::navigate::{InitialState, NavRequest, integrate};
+use imukit::run::navigate::{
+    EarthGravityName, InitialState, NavRequest, SchemeName, VerticalName, integrate,
+};
 use imukit::run::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
+use imukit::scenario::{AccelSignName, EarthName, NavFrameName};
 use numpy::PyReadonlyArray1;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{TableOut, check_len, fixed, fixed_opt, non_negative, table_in, table_out};
+use crate::convert::{
+    TableOut, check_len, choice, choice_opt, fixed, fixed_opt, non_negative, table_in, table_out,
+};
 use crate::errors::refused;
 
 /// Planar dead reckoning of (t, a_x, a_y, ω_z) into a navigation table.
 #[pyfunction]
-#[pyo3(signature = (t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s, *, scheme = "trapezoid",
+#[pyo3(signature = (t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s, *, scheme = PlanarScheme::default_name(),
                     position0_m = EXERCISE_POSITION0_M.to_vec(), heading0_rad = 0.0, velocity0_m_s = vec![0.0, 0.0]))]
 #[allow(clippy::too_many_arguments)]
 fn planar_dead_reckon<'py>(
@@ -54,7 +60,7 @@ fn planar_dead_reckon<'py>(
         })
         .collect();
     let request = PlanarRequest {
-        scheme,
+        scheme: choice("scheme", scheme)?,
         position0_m,
         heading0_rad,
         velocity0_m_s,
@@ -75,13 +81,14 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 /// a truth table (`initial_columns`, `initial_values`) or its parts.
 #[pyfunction]
 #[pyo3(signature = (columns, values, *, initial_columns = None, initial_values = None, position0_m = None,
-                    velocity0_m_s = None, quaternion0 = None, euler0_rad = None, nav_frame = "ENU",
+                    velocity0_m_s = None, quaternion0 = None, euler0_rad = None,
+                    nav_frame = NavFrameName::default_name(),
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
-                    accel_sign = "specific-force", scheme = "auto",
-                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64, earth = "flat",
-                    vertical = "free",
+                    accel_sign = AccelSignName::default_name(), scheme = SchemeName::default_name(),
+                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64,
+                    earth = EarthName::default_name(), vertical = VerticalName::default_name(),
                     baro_time_constant_s = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
-                    earth_gravity = "normal", lat0_deg = None, lon0_deg = None, height0_m = None,
+                    earth_gravity = EarthGravityName::default_name(), lat0_deg = None, lon0_deg = None, height0_m = None,
                     baro_columns = None, baro_values = None))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
@@ -113,17 +120,17 @@ fn strapdown<'py>(
 ) -> PyResult<TableOut<'py>> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
     let setup = NavRequest {
-        nav_frame,
-        accel_sign,
-        scheme,
+        nav_frame: choice("nav_frame", nav_frame)?,
+        accel_sign: choice("accel_sign", accel_sign)?,
+        scheme: choice("scheme", scheme)?,
         substeps,
         gravity_m_s2,
         coning,
         sculling,
-        earth,
-        vertical,
+        earth: choice("earth", earth)?,
+        vertical: choice("vertical", vertical)?,
         baro_time_constant_s,
-        earth_gravity,
+        earth_gravity: choice("earth_gravity", earth_gravity)?,
         barometer: baro_columns.is_some(),
     }
     .setup()
@@ -204,7 +211,7 @@ fn fuse<'py>(
     rest_s: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
+    use imukit::run::fuse::{AidTables, FuseRequest, fuse_with};
     let spec = match format {
         "dict" => ScenarioSpec::from_tree(
             &crate::convert::value_tree(scenario, "scenario")?,
@@ -227,7 +234,7 @@ fn fuse<'py>(
         }
         _ => None,
     };
-    Start::choose(initial.as_ref(), align.as_deref()).map_err(refused)?;
+    let align = choice_opt("align", align.as_deref())?;
     let optional =
         |name: &str, columns: Option<Vec<String>>, values: &Option<PyReadonlyArray2<'py, f64>>| {
             match (columns, values) {
@@ -241,23 +248,21 @@ fn fuse<'py>(
     let (table, summary) = py
         .detach(move || {
             let sc = spec.resolve(Path::new(&base))?;
-            let mut setup = FuseSetup::from_scenario(&sc)?;
-            if !gate {
-                setup.gate = f64::INFINITY;
+            let (setup, start) = FuseRequest {
+                initial: initial.as_ref(),
+                align,
+                earth: None,
+                gate,
+                nhc_sigma_m_s,
+                covariance_interval_s,
+                sensor_errors,
+                rest_s,
             }
-            setup.aiding.nhc_sigma_m_s = nhc_sigma_m_s;
-            if let Some(s) = covariance_interval_s {
-                setup.covariance_interval_s = s;
-            }
-            setup.estimate_sensor_errors = sensor_errors;
-            if let Some(s) = rest_s {
-                setup.rest_s = s;
-            }
+            .setup(&sc)?;
             let aids = AidTables {
                 odometer: odometer.as_ref(),
                 baro: baro.as_ref(),
             };
-            let start = Start::choose(initial.as_ref(), align.as_deref())?;
             fuse_with(&imu, &gnss, aids, start, &setup)
         })
         .map_err(refused)?;

@@ -7,23 +7,9 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::convert::{array2, flat_rows};
+use crate::convert::{array2, choice, choice_opt, flat_rows};
 use crate::errors::refused;
 use imukit::run::orient::{ecompass_rows, frame_and_sign, quaternion_distances};
-
-/// A refusal of the field `nav_frame` under the name the MATLAB-shaped classes give it,
-/// `reference_frame`.
-fn reference_frame_named(e: imukit::Error) -> imukit::Error {
-    match e {
-        imukit::Error::Invalid { field, message } if field == "nav_frame" => {
-            imukit::Error::Invalid {
-                field: "reference_frame".into(),
-                message,
-            }
-        }
-        other => other,
-    }
-}
 
 /// The nav-frame generic filter.
 enum Filter {
@@ -59,15 +45,13 @@ impl PyOrientationFilter {
         initial_process_noise: Option<Vec<f64>>,
     ) -> PyResult<Self> {
         let request = OrientRequest {
-            filter: kind,
-            conventions,
-            nav_frame: reference_frame,
-            accel_sign,
+            filter: choice("kind", kind)?,
+            conventions: choice_opt("conventions", conventions)?.unwrap_or_default(),
+            nav_frame: choice_opt("reference_frame", reference_frame)?,
+            accel_sign: choice_opt("accel_sign", accel_sign)?,
             settings,
         };
-        let (mut spec, nav) = request
-            .resolve()
-            .map_err(|e| refused(reference_frame_named(e)))?;
+        let (mut spec, nav) = request.resolve();
         let kind = spec.kind;
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
         spec.initial_process_noise = initial_process_noise;
@@ -168,8 +152,11 @@ fn ecompass<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a = flat_rows::<3>("accel", &accel)?;
     let m = flat_rows::<3>("mag", &mag)?;
-    let (nav, s) = frame_and_sign(conventions, reference_frame, accel_sign)
-        .map_err(|e| refused(reference_frame_named(e)))?;
+    let (nav, s) = frame_and_sign(
+        choice_opt("conventions", conventions)?.unwrap_or_default(),
+        choice_opt("reference_frame", reference_frame)?,
+        choice_opt("accel_sign", accel_sign)?,
+    );
     let q = py.detach(|| ecompass_rows(a, m, s, nav)).map_err(refused)?;
     array2(py, a.len() / 3, 4, q)
 }

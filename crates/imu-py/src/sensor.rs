@@ -17,7 +17,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    check_len, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table, vector,
+    check_len, choice, choice_opt, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table,
+    vector,
 };
 use crate::errors::{refused, shape_error};
 
@@ -47,13 +48,13 @@ impl PyImuSensor {
         accel_sign: Option<&str>,
     ) -> PyResult<Self> {
         let request = ImuSensorRequest {
-            imu_type,
-            reference_frame,
+            imu_type: choice("imu_type", imu_type)?,
+            reference_frame: choice("reference_frame", reference_frame)?,
             sample_rate_hz: sample_rate,
             temperature_c: temperature,
             magnetic_field_ut: fixed_opt::<3>("magnetic_field", magnetic_field)?,
-            profile,
-            accel_sign,
+            profile: choice("profile", profile)?,
+            accel_sign: choice_opt("accel_sign", accel_sign)?,
             params: ImuSpec {
                 preset,
                 seed: Some(non_negative("seed", seed)?),
@@ -133,7 +134,7 @@ impl PyImuSensor {
     /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
     #[getter]
     fn imu_type(&self) -> &'static str {
-        self.0.kind().name()
+        imukit::choice::Choice::name(self.0.kind())
     }
 
     /// Temperature of all sensors, °C.

@@ -8,18 +8,20 @@ use imu_core::EulerZyx;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 use imukit::ScenarioSpec;
+use imukit::choice::Choice;
+use imukit::io::table::ImuKind;
 use imukit::io::table::TRUTH_COLUMNS;
 use imukit::motion::waypoints::Waypoints;
 use imukit::motion::{BodyRatesData, SampledAttitudeData};
 use imukit::run::arrays::{self, IdealRequest};
 use imukit::run::pipeline::RunThreads;
-use imukit::scenario::{ExpressionSpec, Formula, builtin};
+use imukit::scenario::{AccelSignName, ExpressionSpec, Formula, NavFrameName, builtin};
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::convert::{
-    TableOut, check_len, fixed, fixed_opt, nav_frame, non_negative, rows, rows_out, table_in,
+    TableOut, check_len, choice, fixed, fixed_opt, non_negative, rows, rows_out, table_in,
     table_out, value_tree, vector,
 };
 use crate::errors::{refused, shape_error};
@@ -188,7 +190,7 @@ fn simulation_shape(
 /// Exact truth from formula strings at the times `t_s`.
 #[pyfunction]
 #[pyo3(signature = (t_s, position_m, *, attitude = None, yaw_rad = None, pitch_rad = None, roll_rad = None,
-                    constants = None, nav_frame = "ENU", min_speed_m_s = None))]
+                    constants = None, nav_frame = NavFrameName::default_name(), min_speed_m_s = None))]
 #[allow(clippy::too_many_arguments)]
 fn truth_from_expressions<'py>(
     py: Python<'py>,
@@ -215,7 +217,7 @@ fn truth_from_expressions<'py>(
         roll_rad: roll_rad.map(Formula::Text),
         min_speed_m_s,
     };
-    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let nav = choice::<NavFrameName>("nav_frame", nav_frame)?;
     let out = PyArray2::<f64>::zeros(py, [t.len(), TRUTH_COLUMNS.len()], false);
     {
         let mut guard = out.readwrite();
@@ -267,7 +269,7 @@ fn sampled_attitude(
 /// Truth from sampled positions and attitude by finite differences.
 #[pyfunction]
 #[pyo3(signature = (t_s, position_m, *, euler_rad = None, quaternion = None, attitude = None, order = 6,
-                    nav_frame = "ENU", min_speed_m_s = None))]
+                    nav_frame = NavFrameName::default_name(), min_speed_m_s = None))]
 #[allow(clippy::too_many_arguments)]
 fn truth_from_samples<'py>(
     py: Python<'py>,
@@ -289,7 +291,7 @@ fn truth_from_samples<'py>(
         order,
         min_speed_m_s: min_speed_m_s.unwrap_or(DEFAULT_MIN_SPEED_M_S),
     };
-    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let nav = choice::<NavFrameName>("nav_frame", nav_frame)?;
     let out = PyArray2::<f64>::zeros(py, [t.len(), TRUTH_COLUMNS.len()], false);
     {
         let mut guard = out.readwrite();
@@ -305,9 +307,9 @@ fn truth_from_samples<'py>(
 
 /// Ideal IMU readings from a truth table (its column names and values).
 #[pyfunction]
-#[pyo3(signature = (columns, values, *, lever_arm_m = vec![0.0, 0.0, 0.0], accel_sign = "specific-force",
+#[pyo3(signature = (columns, values, *, lever_arm_m = vec![0.0, 0.0, 0.0], accel_sign = AccelSignName::default_name(),
                     gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, magnetic_field_ut = None,
-                    nav_frame = "ENU", kind = "accel-gyro-mag"))]
+                    nav_frame = NavFrameName::default_name(), kind = ImuKind::default_name()))]
 #[allow(clippy::too_many_arguments)]
 fn ideal_imu<'py>(
     py: Python<'py>,
@@ -322,12 +324,12 @@ fn ideal_imu<'py>(
 ) -> PyResult<TableOut<'py>> {
     let truth = table_in("truth", columns, &values)?;
     let request = IdealRequest {
-        kind,
+        kind: choice("kind", kind)?,
         lever_arm_m: fixed::<3>("lever_arm_m", &lever_arm_m)?,
-        accel_sign,
+        accel_sign: choice("accel_sign", accel_sign)?,
         gravity_m_s2,
         magnetic_field_ut: fixed_opt::<3>("magnetic_field_ut", magnetic_field_ut)?,
-        nav_frame,
+        nav_frame: choice("nav_frame", nav_frame)?,
     };
     let out = py.detach(|| request.run(&truth)).map_err(refused)?;
     table_out(py, out)
@@ -390,7 +392,7 @@ fn at_lever_arm<'py>(
 /// Truth from body-frame acceleration and angular velocity (MATLAB kinematicTrajectory).
 #[pyfunction]
 #[pyo3(signature = (t_s, accel_body_m_s2, omega_body_rad_s, *, position0_m = vec![0.0; 3],
-                    velocity0_m_s = vec![0.0; 3], euler0_rad = vec![0.0; 3], nav_frame = "ENU"))]
+                    velocity0_m_s = vec![0.0; 3], euler0_rad = vec![0.0; 3], nav_frame = NavFrameName::default_name()))]
 #[allow(clippy::too_many_arguments)]
 fn truth_from_body_rates<'py>(
     py: Python<'py>,
@@ -418,7 +420,7 @@ fn truth_from_body_rates<'py>(
         velocity0_m_s,
         euler0_rad,
     };
-    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let nav = choice::<NavFrameName>("nav_frame", nav_frame)?;
     let table = py
         .detach(move || arrays::truth_from_body_rates(&t, data, nav))
         .map_err(refused)?;
@@ -427,7 +429,7 @@ fn truth_from_body_rates<'py>(
 
 /// Exact truth at `t_s` of a waypoint trajectory (cubic spline through the waypoints).
 #[pyfunction]
-#[pyo3(signature = (t_s, time_s, position_m, *, velocity_m_s = None, euler_rad = None, nav_frame = "ENU"))]
+#[pyo3(signature = (t_s, time_s, position_m, *, velocity_m_s = None, euler_rad = None, nav_frame = NavFrameName::default_name()))]
 fn truth_from_waypoints<'py>(
     py: Python<'py>,
     t_s: PyReadonlyArray1<'py, f64>,
@@ -449,7 +451,7 @@ fn truth_from_waypoints<'py>(
         .map(|e| rows::<3>("euler_rad", e))
         .transpose()?;
     let w = Waypoints::new(&knots, &p, v.as_deref(), e.as_deref()).map_err(refused)?;
-    let nav = self::nav_frame("nav_frame", nav_frame)?;
+    let nav = choice::<NavFrameName>("nav_frame", nav_frame)?;
     let table = py
         .detach(move || arrays::truth_from_waypoints(&t, w, nav))
         .map_err(refused)?;

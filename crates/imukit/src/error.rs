@@ -47,6 +47,18 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An option given a name it does not take (see [`crate::choice::Choice`]).
+    #[error("{field}: unknown {what} \"{value}\" ({})", choices.join(", "))]
+    UnknownChoice {
+        /// The request field, e.g. `nav_frame`.
+        field: String,
+        /// What is chosen, e.g. "navigation frame".
+        what: &'static str,
+        /// The name given.
+        value: String,
+        /// The names it takes.
+        choices: Vec<&'static str>,
+    },
     /// A Kalman filter that lost its measurements (its covariance no longer positive definite,
     /// or fixes rejected one after another): the estimate is not written.
     #[error("{context}: {message}")]
@@ -204,6 +216,7 @@ impl Error {
             Self::Scenario { .. } => Location::default(),
             Self::Invalid { field: f, .. }
             | Self::ScenarioKey { field: f, .. }
+            | Self::UnknownChoice { field: f, .. }
             | Self::Expression { field: f, .. }
             | Self::BadQuaternion { field: f }
             | Self::Diverged { context: f, .. } => field(f),

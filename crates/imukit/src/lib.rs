@@ -20,6 +20,7 @@
 //! | [`io`] | [`Table`] and CSV files (readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
 //! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
 //! | [`sensor`] | the core's sensor types with bias-instability filters on the heap (any length, as MATLAB) |
+//! | [`choice`] | options chosen by name ([`choice::Choice`]): the names, the default, the refusal |
 //! | [`error`] | [`Error`]: what went wrong and where |
 //!
 //! ## Simulate a scenario
@@ -89,6 +90,7 @@
 //! # Ok::<(), imukit::Error>(())
 //! ```
 #![forbid(unsafe_code)]
+pub mod choice;
 pub mod error;
 pub mod io;
 pub mod motion;

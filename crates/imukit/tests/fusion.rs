@@ -909,7 +909,7 @@ fn a_navigation_grade_imu_at_rest_finds_north_and_then_holds_it_through_the_outa
     for run in 0..runs {
         let sim = sc.simulate_run(run).unwrap();
         let gnss = sim.gnss.as_ref().unwrap();
-        let start = Start::alignment("static").unwrap();
+        let start = Start::from(imukit::run::fuse::AlignName::Static);
         let (nav, _) = fuse_with(&sim.imu, gnss, AidTables::default(), start, &setup).unwrap();
         let yaw_error = col(&nav, "yaw_rad")[0] - col(&sim.truth, "yaw_rad")[0];
         let yaw_sigma = col(&nav, "att_z_sigma_rad")[0];

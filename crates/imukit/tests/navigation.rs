@@ -365,7 +365,7 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
 #[test]
 fn the_default_scheme_is_the_best_for_rate_samples_on_a_coning_motion() {
     use imu_core::{Body, Enu, Rotation, Vec3};
-    use imukit::run::navigate::{NavRequest, NavScheme};
+    use imukit::run::navigate::{NavRequest, NavScheme, SchemeName};
     // Classic coning (docs/design.md §6): a 5° cone at 2 Hz, 200 Hz rate samples, 30 s, at rest.
     let (a, w) = (5f64.to_radians(), 2.0 * std::f64::consts::TAU);
     let attitude = |t: f64| {
@@ -398,7 +398,7 @@ fn the_default_scheme_is_the_best_for_rate_samples_on_a_coning_motion() {
         quaternion: attitude(0.0).to_wxyz(),
         ..InitialState::default()
     };
-    let end = |scheme: &str| {
+    let end = |scheme: SchemeName| {
         let setup = NavRequest {
             scheme,
             gravity_m_s2: 9.81,
@@ -415,8 +415,8 @@ fn the_default_scheme_is_the_best_for_rate_samples_on_a_coning_motion() {
             setup.scheme,
         )
     };
-    let (auto, scheme) = end("auto");
-    let (coning, _) = end("coning");
+    let (auto, scheme) = end(SchemeName::Auto);
+    let (coning, _) = end(SchemeName::Coning);
     eprintln!("coning motion, 30 s: {auto:e} m (auto), {coning:e} m (coning)");
     assert_eq!(scheme.for_input(true, true), NavScheme::Rk4 { substeps: 4 });
     assert!(auto < 1e-5, "{auto}");

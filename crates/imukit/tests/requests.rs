@@ -3,34 +3,57 @@
 use std::path::Path;
 
 use imu_core::strapdown::planar::PlanarScheme;
+use imukit::choice::Choice;
 use imukit::io::table::ImuKind;
-use imukit::run::navigate::{DEFAULT_RK4_SUBSTEPS, NavRequest, NavScheme};
+use imukit::run::navigate::{
+    DEFAULT_RK4_SUBSTEPS, EarthGravityName, NavRequest, NavScheme, SchemeName, VerticalName,
+};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest};
-use imukit::scenario::parse_name;
 use imukit::scenario::sensors::TemperatureSpec;
 use imukit::scenario::spec::{Formula, TrajectorySpec};
+use imukit::scenario::{AccelSignName, EarthName, NavFrameName, parse_name};
 use imukit::{Error, ScenarioSpec};
 
 #[test]
 fn scheme_names_parse_and_unknown_ones_are_listed() {
-    assert_eq!("coning".parse(), Ok(NavScheme::ConingSculling));
     assert_eq!(
-        "rk4".parse(),
-        Ok(NavScheme::Rk4 {
-            substeps: DEFAULT_RK4_SUBSTEPS
-        })
+        SchemeName::parse("scheme", "coning").unwrap(),
+        SchemeName::Coning
     );
-    let e = "euler".parse::<NavScheme>().unwrap_err();
-    assert!(e.contains("\"euler\"") && e.contains("coning, rk4"), "{e}");
-    assert_eq!("exercise".parse(), Ok(PlanarScheme::Exercise));
-    assert_eq!("trapezoid".parse(), Ok(PlanarScheme::Trapezoid));
-    assert!("rk4".parse::<PlanarScheme>().is_err());
+    assert_eq!(SchemeName::parse("scheme", "RK4").unwrap(), SchemeName::Rk4);
+    let e = SchemeName::parse("scheme", "euler").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scheme: unknown scheme \"euler\" (auto, coning, rk4)"
+    );
+    assert_eq!(e.location().field.as_deref(), Some("scheme"));
+    assert_eq!(
+        PlanarScheme::parse("scheme", "exercise").unwrap(),
+        PlanarScheme::Exercise
+    );
+    assert_eq!(
+        PlanarScheme::parse("scheme", "euler")
+            .unwrap_err()
+            .to_string(),
+        "scheme: unknown scheme \"euler\" (trapezoid, exercise)"
+    );
+    assert!(PlanarScheme::parse("scheme", "rk4").is_err());
 }
 
 #[test]
-fn imu_kind_names_round_trip_through_the_scenario_parser() {
+fn choice_names_round_trip_and_agree_with_the_scenario_parser() {
     for kind in [ImuKind::AccelGyro, ImuKind::AccelMag, ImuKind::AccelGyroMag] {
         assert_eq!(parse_name::<ImuKind>("kind", kind.name()).unwrap(), kind);
+        assert_eq!(ImuKind::parse("kind", kind.name()).unwrap(), kind);
+    }
+    for (name, frame) in NavFrameName::NAMES {
+        assert_eq!(parse_name::<NavFrameName>("f", name).unwrap(), *frame);
+    }
+    for (name, sign) in AccelSignName::NAMES {
+        assert_eq!(parse_name::<AccelSignName>("f", name).unwrap(), *sign);
+    }
+    for (name, earth) in EarthName::NAMES {
+        assert_eq!(parse_name::<EarthName>("f", name).unwrap(), *earth);
     }
 }
 
@@ -38,34 +61,18 @@ fn imu_kind_names_round_trip_through_the_scenario_parser() {
 fn a_nav_request_is_checked_field_by_field() {
     let ok = NavRequest::default().setup().unwrap();
     assert_eq!(ok.gravity_m_s2, imu_core::DEFAULT_GRAVITY_M_S2);
-    let field = |r: NavRequest<'_>| r.setup().unwrap_err().location().field;
+    assert_eq!(ok.nav_frame, NavFrameName::ENU);
+    assert_eq!(
+        ok.scheme,
+        NavScheme::Auto {
+            substeps: DEFAULT_RK4_SUBSTEPS
+        }
+    );
+    assert!(ok.earth.is_none());
+    let field = |r: NavRequest| r.setup().unwrap_err().location().field;
     let d = NavRequest::default();
-    assert_eq!(
-        field(NavRequest {
-            nav_frame: "XYZ",
-            ..d
-        })
-        .as_deref(),
-        Some("nav_frame")
-    );
-    assert_eq!(
-        field(NavRequest {
-            accel_sign: "up",
-            ..d
-        })
-        .as_deref(),
-        Some("accel_sign")
-    );
-    assert_eq!(
-        field(NavRequest {
-            scheme: "euler",
-            ..d
-        })
-        .as_deref(),
-        Some("scheme")
-    );
     let zero_substeps = NavRequest {
-        scheme: "rk4",
+        scheme: SchemeName::Rk4,
         substeps: 0,
         ..d
     };
@@ -79,16 +86,40 @@ fn a_nav_request_is_checked_field_by_field() {
     }
     // The coning scheme ignores sub-steps; RK4 takes them.
     let rk4 = NavRequest {
-        scheme: "rk4",
+        scheme: SchemeName::Rk4,
         substeps: 7,
         ..d
     };
     assert_eq!(rk4.setup().unwrap().scheme, NavScheme::Rk4 { substeps: 7 });
+    let coning = NavRequest {
+        scheme: SchemeName::Coning,
+        substeps: 0,
+        ..d
+    };
+    assert_eq!(coning.setup().unwrap().scheme, NavScheme::ConingSculling);
+    // The vertical channel and the Earth's gravity model belong to the WGS-84 Earth.
+    let flat_hold = NavRequest {
+        vertical: VerticalName::Hold,
+        ..d
+    };
+    assert_eq!(field(flat_hold).as_deref(), Some("vertical"));
+    let flat_constant = NavRequest {
+        earth_gravity: EarthGravityName::Constant,
+        ..d
+    };
+    assert_eq!(field(flat_constant).as_deref(), Some("earth_gravity"));
+    let bad_tau = NavRequest {
+        earth: EarthName::Wgs84,
+        vertical: VerticalName::Baro,
+        baro_time_constant_s: 0.0,
+        ..d
+    };
+    assert_eq!(field(bad_tau).as_deref(), Some("baro_time_constant_s"));
     // Barometer readings feed the baro vertical channel only: with another they are refused,
     // one rule for the command line and Python.
-    for vertical in ["free", "hold"] {
+    for vertical in [VerticalName::Free, VerticalName::Hold] {
         let r = NavRequest {
-            earth: "wgs84",
+            earth: EarthName::Wgs84,
             vertical,
             barometer: true,
             ..d
@@ -96,8 +127,8 @@ fn a_nav_request_is_checked_field_by_field() {
         assert_eq!(field(r).as_deref(), Some("baro"), "{vertical}");
     }
     let baro = NavRequest {
-        earth: "wgs84",
-        vertical: "baro",
+        earth: EarthName::Wgs84,
+        vertical: VerticalName::Baro,
         barometer: true,
         ..d
     };
@@ -123,14 +154,6 @@ fn a_planar_request_turns_the_start_velocity_into_the_body_frame() {
     };
     let e = bad.initial_state(0.0).unwrap_err();
     assert_eq!(e.location().field.as_deref(), Some("heading0_rad"));
-    let unknown = PlanarRequest {
-        scheme: "euler",
-        ..PlanarRequest::default()
-    };
-    assert_eq!(
-        unknown.scheme().unwrap_err().to_string(),
-        "scheme: unknown scheme \"euler\" (trapezoid, exercise)"
-    );
 }
 
 #[test]
@@ -255,7 +278,7 @@ fn runs_too_long_for_memory_are_refused_before_anything_is_allocated() {
 #[test]
 fn rk4_substeps_are_bounded() {
     let r = NavRequest {
-        scheme: "rk4",
+        scheme: SchemeName::Rk4,
         substeps: 1_000_000_000,
         ..NavRequest::default()
     };
@@ -611,4 +634,62 @@ fn a_formula_or_a_temperature_of_the_wrong_kind_says_what_it_takes() {
         spec.imu.temperature_c,
         Some(TemperatureSpec::File("profile.csv".into()))
     );
+}
+
+#[test]
+fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
+    use imukit::run::fuse::{AlignName, DEFAULT_COVARIANCE_INTERVAL_S, FuseRequest, Start};
+    use imukit::run::navigate::InitialState;
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let scenario = ScenarioSpec::from_file(&examples.join("car_tunnel.toml"))
+        .unwrap()
+        .resolve(&examples)
+        .unwrap();
+    let initial = InitialState::default();
+    let d = FuseRequest::default();
+    let field = |r: FuseRequest<'_>| r.setup(&scenario).unwrap_err().location().field;
+    // A start: the truth row or an alignment, exactly one.
+    assert_eq!(field(d).as_deref(), Some("initial"));
+    let both = FuseRequest {
+        initial: Some(&initial),
+        align: Some(AlignName::Gnss),
+        ..d
+    };
+    assert_eq!(field(both).as_deref(), Some("initial"));
+    // The scenario decides the Earth.
+    let wgs84 = FuseRequest {
+        align: Some(AlignName::Gnss),
+        earth: Some(EarthName::Wgs84),
+        ..d
+    };
+    assert_eq!(field(wgs84).as_deref(), Some("earth"));
+    let (setup, start) = FuseRequest {
+        align: Some(AlignName::Static),
+        earth: Some(EarthName::Flat),
+        ..d
+    }
+    .setup(&scenario)
+    .unwrap();
+    assert!(matches!(start, Start::AlignStatic { .. }));
+    assert!(setup.gate.is_finite());
+    assert_eq!(setup.covariance_interval_s, DEFAULT_COVARIANCE_INTERVAL_S);
+    assert!(!setup.estimate_sensor_errors);
+    assert_eq!(setup.aiding.nhc_sigma_m_s, None);
+    let (setup, start) = FuseRequest {
+        initial: Some(&initial),
+        gate: false,
+        nhc_sigma_m_s: Some(0.2),
+        covariance_interval_s: Some(0.0),
+        sensor_errors: true,
+        rest_s: Some(5.0),
+        ..d
+    }
+    .setup(&scenario)
+    .unwrap();
+    assert_eq!(start, Start::State(&initial));
+    assert_eq!(setup.gate, f64::INFINITY);
+    assert_eq!(setup.aiding.nhc_sigma_m_s, Some(0.2));
+    assert_eq!(setup.covariance_interval_s, 0.0);
+    assert!(setup.estimate_sensor_errors);
+    assert_eq!(setup.rest_s, 5.0);
 }

@@ -4,20 +4,22 @@ use std::path::Path;
 
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
-use imukit::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
+use imukit::run::fuse::{AidTables, AlignName, FuseRequest, fuse_with};
 use imukit::run::navigate::InitialState;
+use imukit::scenario::EarthName;
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
+use crate::error::{by_flag, flag};
 
 /// The command's arguments.
 pub struct Args<'a> {
     pub imu: &'a Path,
     pub gnss: &'a Path,
     pub init: Option<&'a Path>,
-    pub align: Option<&'a str>,
+    pub align: Option<AlignName>,
     pub scenario: &'a Path,
-    pub earth: Option<&'a str>,
+    pub earth: Option<EarthName>,
     pub no_gate: bool,
     pub odometer: Option<&'a Path>,
     pub baro: Option<&'a Path>,
@@ -40,37 +42,6 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     check_outputs(&inputs, &[("--out", a.out)])?;
     let base = a.scenario.parent().unwrap_or_else(|| Path::new("."));
     let scenario = ScenarioSpec::from_file(a.scenario)?.resolve(base)?;
-    let mut setup = FuseSetup::from_scenario(&scenario)?;
-    // The scenario says which Earth; --earth, when given, must agree.
-    let earth = if setup.earth.is_some() {
-        "wgs84"
-    } else {
-        "flat"
-    };
-    if let Some(e) = a.earth
-        && e != earth
-    {
-        return Err(Error::Invalid {
-            field: "--earth".into(),
-            message: format!(
-                "\"{e}\": the scenario {} is on the {earth} Earth, and the filter takes its model \
-                 from it",
-                a.scenario.display()
-            ),
-        }
-        .into());
-    }
-    if a.no_gate {
-        setup.gate = f64::INFINITY;
-    }
-    setup.aiding.nhc_sigma_m_s = a.nhc;
-    if let Some(s) = a.covariance_interval_s {
-        setup.covariance_interval_s = s;
-    }
-    setup.estimate_sensor_errors = a.sensor_errors;
-    if let Some(s) = a.rest_s {
-        setup.rest_s = s;
-    }
     let initial = match a.init {
         Some(init) => {
             let s = InitialState::from_csv(init)?;
@@ -79,17 +50,24 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         None => None,
     };
-    // Where the filter starts: a truth row, or an alignment from the fixes.
-    let start = Start::choose(initial.as_ref(), a.align).map_err(|e| match e {
-        Error::Invalid { field, message } => Error::Invalid {
-            field: if field == "initial" && a.align.is_none() {
-                "--init".into()
-            } else {
-                "--align".into()
-            },
-            message,
+    let (setup, start) = FuseRequest {
+        initial: initial.as_ref(),
+        align: a.align,
+        earth: a.earth,
+        gate: !a.no_gate,
+        nhc_sigma_m_s: a.nhc,
+        covariance_interval_s: a.covariance_interval_s,
+        sensor_errors: a.sensor_errors,
+        rest_s: a.rest_s,
+    }
+    .setup(&scenario)
+    .map_err(|e| match e {
+        // The scenario decides the Earth: say which file.
+        Error::Invalid { field, message } if field == "earth" => Error::Invalid {
+            field: flag(&field),
+            message: format!("{message} ({})", a.scenario.display()),
         },
-        other => other,
+        other => by_flag(other),
     })?;
     let imu = read_table(a.imu)?;
     let gnss = read_table(a.gnss)?;
@@ -105,14 +83,11 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         "GNSS data" => Some(a.gnss),
         "odometer data" => a.odometer,
         "barometer data" => a.baro,
-        "nhc_sigma_m_s" => Some(Path::new("--nhc")),
-        "align" => Some(Path::new("--align")),
-        "covariance_interval_s" => Some(Path::new("--covariance-interval-s")),
-        "rest_s" => Some(Path::new("--rest-s")),
         _ => None,
     };
     let rename = |context: String| match file_of(&context) {
         Some(p) => p.display().to_string(),
+        None if FuseRequest::FIELDS.contains(&context.as_str()) => flag(&context),
         None => context,
     };
     let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| match e {

@@ -3,6 +3,8 @@
 use std::path::Path;
 
 use imu_core::EulerZyx;
+use imukit::choice::Choice;
+use imukit::core::strapdown::planar::PlanarScheme;
 use imukit::io::output::check_outputs;
 use imukit::run::navigate::{InitialState, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
@@ -18,20 +20,10 @@ pub struct Common<'a> {
     pub velocity0: Option<&'a [f64]>,
 }
 
-/// 3D options.
+/// 3D options besides the library's request.
 pub struct Options3d<'a> {
     pub init: Option<&'a Path>,
-    pub nav_frame: &'a str,
-    pub gravity_m_s2: f64,
-    pub accel_sign: &'a str,
-    pub corrections: bool,
     pub euler0: Option<&'a [f64]>,
-    pub scheme: &'a str,
-    pub substeps: usize,
-    pub earth: &'a str,
-    pub vertical: &'a str,
-    pub baro_time_constant_s: f64,
-    pub earth_gravity: &'a str,
     /// `--baro FILE`.
     pub baro: Option<&'a Path>,
     /// `--lat0-deg`, `--lon0-deg`, `--height0-m`.
@@ -57,41 +49,34 @@ fn vector<const K: usize>(
     }
 }
 
-pub fn planar(c: &Common<'_>, scheme: &str, heading0_rad: f64) -> Result<(), CliError> {
+pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result<(), CliError> {
+    let scheme = scheme
+        .map(|s| PlanarScheme::parse("--scheme", s))
+        .transpose()?
+        .unwrap_or_default();
     let request = PlanarRequest {
         scheme,
         position0_m: vector("--position0-m", c.position0, EXERCISE_POSITION0_M)?,
         heading0_rad,
         velocity0_m_s: vector("--velocity0-m-s", c.velocity0, [0.0, 0.0])?,
     };
-    let scheme_rules = request.scheme().map_err(by_flag)?;
     check_outputs(&[("input", c.input)], &[("--out", c.out)])?;
     let samples = read_planar(c.input)?;
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
     let initial = request.initial_state(t0).map_err(by_flag)?;
-    let nav = integrate(&samples, scheme_rules, initial).map_err(|e| Error::Invalid {
+    let nav = integrate(&samples, scheme, initial).map_err(|e| Error::Invalid {
         field: c.input.display().to_string(),
         message: e.to_string(),
     })?;
     nav.write(c.out)?;
-    report(&nav, &format!("{scheme} scheme"), c.out);
+    report(&nav, &format!("{} scheme", scheme.name()), c.out);
     Ok(())
 }
 
-pub fn three_d(c: &Common<'_>, o: &Options3d<'_>) -> Result<(), CliError> {
+pub fn three_d(c: &Common<'_>, o: &Options3d<'_>, request: &NavRequest) -> Result<(), CliError> {
     let setup = NavRequest {
-        nav_frame: o.nav_frame,
-        accel_sign: o.accel_sign,
-        scheme: o.scheme,
-        substeps: o.substeps,
-        gravity_m_s2: o.gravity_m_s2,
-        coning: o.corrections,
-        sculling: o.corrections,
-        earth: o.earth,
-        vertical: o.vertical,
-        baro_time_constant_s: o.baro_time_constant_s,
-        earth_gravity: o.earth_gravity,
         barometer: o.baro.is_some(),
+        ..*request
     }
     .setup()
     .map_err(by_flag)?;

@@ -13,6 +13,9 @@ mod scenario;
 mod simulate;
 mod study;
 
+use imukit::choice::Choice;
+use imukit::run::navigate::{NavRequest, SchemeName};
+
 use crate::CliError;
 use crate::cli::{Cli, Command};
 
@@ -75,25 +78,33 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 velocity0: velocity0.as_deref(),
             };
             if planar {
-                integrate::planar(&common, scheme.as_deref().unwrap_or("trapezoid"), heading0)
+                integrate::planar(&common, scheme.as_deref(), heading0)
             } else {
+                let scheme = scheme
+                    .map(|s| SchemeName::parse("--scheme", &s))
+                    .transpose()?
+                    .unwrap_or_default();
+                let request = NavRequest {
+                    nav_frame,
+                    accel_sign,
+                    scheme,
+                    substeps,
+                    gravity_m_s2,
+                    coning: !no_corrections,
+                    sculling: !no_corrections,
+                    earth,
+                    vertical,
+                    baro_time_constant_s,
+                    earth_gravity,
+                    barometer: false,
+                };
                 let opts = integrate::Options3d {
                     init: init.as_deref(),
-                    nav_frame: &nav_frame,
-                    gravity_m_s2,
-                    accel_sign: &accel_sign,
-                    corrections: !no_corrections,
                     euler0: euler0.as_deref(),
-                    scheme: scheme.as_deref().unwrap_or("auto"),
-                    substeps,
-                    earth: &earth,
-                    vertical: &vertical,
-                    baro_time_constant_s,
-                    earth_gravity: &earth_gravity,
                     baro: baro.as_deref(),
                     geodetic0: (lat0_deg, lon0_deg, height0_m),
                 };
-                integrate::three_d(&common, &opts)
+                integrate::three_d(&common, &opts, &request)
             }
         }
         Command::Fuse {
@@ -115,9 +126,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             imu: &imu,
             gnss: &gnss,
             init: init.as_deref(),
-            align: align.as_deref(),
+            align,
             scenario: &scenario,
-            earth: earth.as_deref(),
+            earth,
             no_gate,
             odometer: odometer.as_deref(),
             baro: baro.as_deref(),
@@ -138,11 +149,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => orient::run(
             &input,
-            &filter,
+            filter,
             &params,
-            conventions.as_deref(),
-            nav_frame.as_deref(),
-            accel_sign.as_deref(),
+            conventions,
+            nav_frame,
+            accel_sign,
             &out,
         ),
         Command::Compare {
@@ -174,7 +185,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             nav_frame,
             figure,
-        } => plot::plot(&files, &out, &nav_frame, plot::figure_size(&figure)?),
+        } => plot::plot(&files, &out, nav_frame, plot::figure_size(&figure)?),
         Command::Animate {
             truth,
             out,
@@ -184,13 +195,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             speed,
             nav_frame,
         } => {
-            let opts = plot::options(
-                body.as_deref(),
-                lever_arm.as_deref(),
-                fps,
-                speed,
-                &nav_frame,
-            )?;
+            let opts = plot::options(body.as_deref(), lever_arm.as_deref(), fps, speed, nav_frame);
             plot::animate(&truth, &out, &opts)
         }
     }

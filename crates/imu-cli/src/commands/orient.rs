@@ -2,17 +2,18 @@
 use std::path::Path;
 
 use imukit::io::output::check_outputs;
-use imukit::run::orient::{FilterSpec, OrientRequest, orient_csv};
+use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
+use imukit::scenario::{AccelSignName, NavFrameName};
 
-use crate::{CliError, by_flag};
+use crate::CliError;
 
 pub fn run(
     input: &Path,
-    filter: &str,
+    filter: FilterKind,
     params: &[String],
-    conventions: Option<&str>,
-    nav_frame: Option<&str>,
-    accel_sign: Option<&str>,
+    conventions: Conventions,
+    nav_frame: Option<NavFrameName>,
+    accel_sign: Option<AccelSignName>,
     out: &Path,
 ) -> Result<(), CliError> {
     let (spec, nav) = OrientRequest {
@@ -22,8 +23,7 @@ pub fn run(
         accel_sign,
         settings: FilterSpec::parse_settings(params)?,
     }
-    .resolve()
-    .map_err(by_flag)?;
+    .resolve();
     check_outputs(&[("input", input)], &[("--out", out)])?;
     let s = orient_csv(input, &spec, nav, out)?;
     println!(

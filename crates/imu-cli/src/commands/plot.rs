@@ -6,7 +6,7 @@ use imu_plot::{FigureSize, plot_files};
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
 
-use imukit::scenario::{NavFrameName, parse_name};
+use imukit::scenario::NavFrameName;
 
 use super::CliError;
 use crate::cli::FigureArgs;
@@ -15,13 +15,13 @@ use crate::plot_by_flag;
 pub fn plot(
     files: &[PathBuf],
     out: &Path,
-    nav_frame: &str,
+    nav_frame: NavFrameName,
     size: FigureSize,
 ) -> Result<(), CliError> {
     imu_plot::check_figure_path(out)?;
     let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
     check_outputs(&inputs, &[("--out", out)])?;
-    plot_files(files, out, is_ned(nav_frame)?, size)?;
+    plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
     println!("Wrote {}", out.display());
     Ok(())
 }
@@ -37,29 +37,23 @@ pub fn figure_size(args: &FigureArgs) -> Result<FigureSize, CliError> {
         .map_err(CliError::from)
 }
 
-/// Whether `--nav-frame` names NED (else ENU).
-fn is_ned(nav_frame: &str) -> Result<bool, CliError> {
-    let frame: NavFrameName = parse_name("--nav-frame", &nav_frame.to_ascii_uppercase())?;
-    Ok(frame == NavFrameName::NED)
-}
-
 /// The animation options from the command line.
 pub fn options(
     body: Option<&[f64]>,
     lever_arm: Option<&[f64]>,
     fps: f64,
     speed: Option<f64>,
-    nav_frame: &str,
-) -> Result<AnimateOptions, CliError> {
+    nav_frame: NavFrameName,
+) -> AnimateOptions {
     let three = |v: &[f64]| [v[0], v[1], v[2]];
-    Ok(AnimateOptions {
+    AnimateOptions {
         body_m: body.map(three),
         lever_arm_m: lever_arm.map_or([0.0; 3], three),
         fps,
         speed,
-        ned: is_ned(nav_frame)?,
+        ned: nav_frame == NavFrameName::NED,
         ..AnimateOptions::default()
-    })
+    }
 }
 
 pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), CliError> {

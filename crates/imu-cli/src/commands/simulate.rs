@@ -60,7 +60,7 @@ pub fn run(
         ),
         (
             imukit::io::parquet::NAV_FRAME_KEY.to_string(),
-            sc.nav_frame.name().to_string(),
+            imukit::choice::Choice::name(sc.nav_frame).to_string(),
         ),
     ];
     let Some(runs) = runs else {

@@ -25,36 +25,6 @@ pub enum PlanarScheme {
     Exercise,
 }
 
-impl PlanarScheme {
-    /// The names `FromStr` accepts, in the order of the variants.
-    pub const NAMES: &'static str = "trapezoid, exercise";
-}
-
-/// A scheme name that is not one of [`PlanarScheme::NAMES`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct UnknownPlanarScheme;
-
-impl core::fmt::Display for UnknownPlanarScheme {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "unknown scheme ({})", PlanarScheme::NAMES)
-    }
-}
-
-impl core::error::Error for UnknownPlanarScheme {}
-
-impl core::str::FromStr for PlanarScheme {
-    type Err = UnknownPlanarScheme;
-
-    /// `"trapezoid"` or `"exercise"`.
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "trapezoid" => Ok(Self::Trapezoid),
-            "exercise" => Ok(Self::Exercise),
-            _ => Err(UnknownPlanarScheme),
-        }
-    }
-}
-
 /// One planar IMU sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PlanarSample {

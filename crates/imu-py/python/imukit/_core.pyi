@@ -9,10 +9,12 @@ _Table = tuple[list[str], npt.NDArray[np.float64]]
 _Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table], list[str]]
 
 __version__: str
+DEFAULTS: dict[str, str | int | float | bool]
 
 __all__ = [
     "cli_main",
     "__version__",
+    "DEFAULTS",
     "ImuError",
     "study_plan",
     "study_run",
@@ -108,7 +110,7 @@ def truth_from_expressions(
     pitch_rad: Optional[str] = None,
     roll_rad: Optional[str] = None,
     constants: Optional[dict[str, float]] = None,
-    nav_frame: str = "ENU",
+    nav_frame: str = ...,
     min_speed_m_s: Optional[float] = None,
 ) -> _Table: ...
 def truth_from_samples(
@@ -119,7 +121,7 @@ def truth_from_samples(
     quaternion: Optional[npt.NDArray[np.float64]] = None,
     attitude: Optional[str] = None,
     order: int = 6,
-    nav_frame: str = "ENU",
+    nav_frame: str = ...,
     min_speed_m_s: Optional[float] = None,
 ) -> _Table: ...
 def ideal_imu(
@@ -127,11 +129,11 @@ def ideal_imu(
     values: npt.NDArray[np.float64],
     *,
     lever_arm_m: Sequence[float] = ...,
-    accel_sign: str = "specific-force",
+    accel_sign: str = ...,
     gravity_m_s2: float = ...,
     magnetic_field_ut: Optional[Sequence[float]] = None,
-    nav_frame: str = "ENU",
-    kind: str = "accel-gyro-mag",
+    nav_frame: str = ...,
+    kind: str = ...,
 ) -> _Table: ...
 def tangent_euler(velocity_m_s: npt.NDArray[np.float64], *, min_speed_m_s: float = ...) -> npt.NDArray[np.float64]: ...
 def nav_to_body(euler_rad: npt.NDArray[np.float64], v_n: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
@@ -199,7 +201,7 @@ def planar_dead_reckon(
     accel_y_m_s2: npt.NDArray[np.float64],
     gyro_z_rad_s: npt.NDArray[np.float64],
     *,
-    scheme: str = "trapezoid",
+    scheme: str = ...,
     position0_m: Sequence[float] = ...,
     heading0_rad: float = 0.0,
     velocity0_m_s: Sequence[float] = ...,
@@ -215,17 +217,17 @@ def strapdown(
     velocity0_m_s: Optional[Sequence[float]] = None,
     quaternion0: Optional[Sequence[float]] = None,
     euler0_rad: Optional[Sequence[float]] = None,
-    nav_frame: str = "ENU",
+    nav_frame: str = ...,
     gravity_m_s2: float = ...,
     coning: bool = True,
     sculling: bool = True,
-    accel_sign: str = "specific-force",
-    scheme: str = "auto",
+    accel_sign: str = ...,
+    scheme: str = ...,
     substeps: int = ...,
-    earth: str = "flat",
-    vertical: str = "free",
+    earth: str = ...,
+    vertical: str = ...,
     baro_time_constant_s: float = ...,
-    earth_gravity: str = "normal",
+    earth_gravity: str = ...,
     lat0_deg: Optional[float] = None,
     lon0_deg: Optional[float] = None,
     height0_m: Optional[float] = None,
@@ -268,7 +270,7 @@ def truth_from_body_rates(
     position0_m: Sequence[float] = ...,
     velocity0_m_s: Sequence[float] = ...,
     euler0_rad: Sequence[float] = ...,
-    nav_frame: str = "ENU",
+    nav_frame: str = ...,
 ) -> _Table: ...
 def truth_from_waypoints(
     t_s: npt.NDArray[np.float64],
@@ -277,7 +279,7 @@ def truth_from_waypoints(
     *,
     velocity_m_s: Optional[npt.NDArray[np.float64]] = None,
     euler_rad: Optional[npt.NDArray[np.float64]] = None,
-    nav_frame: str = "ENU",
+    nav_frame: str = ...,
 ) -> _Table: ...
 def cli_main(argv: Sequence[str]) -> int: ...
 def read_table_file(path: str) -> _Table: ...

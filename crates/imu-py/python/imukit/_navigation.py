@@ -13,6 +13,8 @@ from ._convert import _f64, _table_args, _times
 from ._table import Table, TableLike, _table
 from ._truth import DEFAULT_GRAVITY_M_S2
 
+_D = _core.DEFAULTS  # the library's request defaults, shared with the command line
+
 
 def planar_dead_reckon(
     t_s,
@@ -20,7 +22,7 @@ def planar_dead_reckon(
     accel_y_m_s2,
     gyro_z_rad_s,
     *,
-    scheme: str = "trapezoid",
+    scheme: str = _D["planar_scheme"],
     position0_m: Sequence[float] = (100.0, 100.0),
     heading0_rad: float = 0.0,
     velocity0_m_s: Sequence[float] = (0.0, 0.0),
@@ -47,17 +49,17 @@ def strapdown(
     imu: TableLike,
     *,
     initial: Optional[Union[TableLike, Mapping[str, Any]]] = None,
-    nav_frame: str = "ENU",
+    nav_frame: str = _D["nav_frame"],
     gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
-    coning: bool = True,
-    sculling: bool = True,
-    accel_sign: str = "specific-force",
-    scheme: str = "auto",
-    substeps: int = 4,
-    earth: str = "flat",
-    vertical: str = "free",
-    baro_time_constant_s: float = 100.0,
-    earth_gravity: str = "normal",
+    coning: bool = _D["coning"],
+    sculling: bool = _D["sculling"],
+    accel_sign: str = _D["accel_sign"],
+    scheme: str = _D["scheme"],
+    substeps: int = _D["substeps"],
+    earth: str = _D["earth"],
+    vertical: str = _D["vertical"],
+    baro_time_constant_s: float = _D["baro_time_constant_s"],
+    earth_gravity: str = _D["earth_gravity"],
     baro: Optional[TableLike] = None,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or

@@ -12,6 +12,8 @@ from ._core import ImuError
 from ._table import Simulation, Table, _table
 from ._warning import _emit
 
+_D = _core.DEFAULTS  # the library's request defaults, shared with the command line
+
 DEFAULT_GRAVITY_M_S2: float = _core.DEFAULT_GRAVITY_M_S2  # m/s², MATLAB imuSensor's value
 
 
@@ -111,7 +113,7 @@ def truth_from_expressions(
     pitch_rad=None,
     roll_rad=None,
     constants: Optional[Mapping[str, float]] = None,
-    nav_frame: str = "ENU",
+    nav_frame: str = _D["nav_frame"],
     min_speed_m_s: Optional[float] = None,
 ) -> Table:
     """Exact truth from formulas of ``t`` (strings, numbers or sympy expressions).
@@ -145,7 +147,7 @@ def truth_from_samples(
     quaternion=None,
     attitude: Optional[str] = None,
     order: int = 6,
-    nav_frame: str = "ENU",
+    nav_frame: str = _D["nav_frame"],
     min_speed_m_s: Optional[float] = None,
 ) -> Table:
     """Truth from sampled positions (N, 3) and attitude by finite differences.
@@ -173,11 +175,11 @@ def ideal_imu(
     truth: Table,
     *,
     lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
-    accel_sign: str = "specific-force",
+    accel_sign: str = _D["accel_sign"],
     gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
     magnetic_field_ut: Optional[Sequence[float]] = None,
-    nav_frame: str = "ENU",
-    kind: str = "accel-gyro-mag",
+    nav_frame: str = _D["nav_frame"],
+    kind: str = _D["imu_type"],
 ) -> Table:
     """Ideal IMU readings from truth: specific force at the lever arm (body frame, m), body
     rate, magnetic field (navigation frame, µT; MATLAB's default when ``None``)."""
@@ -201,7 +203,7 @@ def truth_from_body_rates(
     position0_m: Sequence[float] = (0.0, 0.0, 0.0),
     velocity0_m_s: Sequence[float] = (0.0, 0.0, 0.0),
     euler0_rad: Sequence[float] = (0.0, 0.0, 0.0),
-    nav_frame: str = "ENU",
+    nav_frame: str = _D["nav_frame"],
 ) -> Table:
     """Truth from body-frame acceleration (kinematic, no gravity) and angular velocity, as MATLAB's
     ``kinematicTrajectory`` builds it: exact rotation-vector attitude step,
@@ -211,7 +213,7 @@ def truth_from_body_rates(
         position0_m=[float(v) for v in position0_m], velocity0_m_s=[float(v) for v in velocity0_m_s],
         euler0_rad=[float(v) for v in euler0_rad], nav_frame=nav_frame))
 
-def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_rad=None, nav_frame: str = "ENU") -> Table:
+def truth_from_waypoints(t_s, time_s, position_m, *, velocity_m_s=None, euler_rad=None, nav_frame: str = _D["nav_frame"]) -> Table:
     """Exact truth at ``t_s`` of a waypoint trajectory (like MATLAB's waypointTrajectory): a natural
     cubic spline through ``position_m`` (N, 3) at ``time_s`` (N,), clamped to ``velocity_m_s`` when it
     has 2 rows (start, end) or through all of them when it has one row per waypoint; the attitude is

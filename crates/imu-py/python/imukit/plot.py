@@ -32,6 +32,8 @@ import numpy as np
 from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_csv
 from ._table import TableLike
 
+_D = _core.DEFAULTS  # the library's request defaults, shared with the command line
+
 __all__ = ["figure", "trajectory", "allan", "animate", "kind"]
 
 #: A table (anything :data:`imukit.TableLike`) or the path of a CSV file.
@@ -90,7 +92,7 @@ def _kinds(tables: list) -> str:
     return first
 
 
-def _points(t: Table, nav_frame: str = "ENU") -> np.ndarray:
+def _points(t: Table, nav_frame: str = _D["nav_frame"]) -> np.ndarray:
     """Positions (N, 3) in east, north, up (NED ones turned as ``imukit plot`` turns them)."""
     z = t["pos_z_m"] if "pos_z_m" in t else np.zeros(len(t))
     p = np.ascontiguousarray(np.column_stack([t["pos_x_m"], t["pos_y_m"], z]))
@@ -98,7 +100,7 @@ def _points(t: Table, nav_frame: str = "ENU") -> np.ndarray:
 
 
 def trajectory(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, ax: Any = None,
-               nav_frame: str = "ENU") -> Any:
+               nav_frame: str = _D["nav_frame"]) -> Any:
     """Paths of truth or navigation tables (``pos_*_m``): seen from above with equal scales when
     they stay in a plane, in 3D otherwise; start ● and end ✕ marked; ``nav_frame="NED"`` paths
     are drawn east, north, up. Returns the figure."""
@@ -169,7 +171,7 @@ def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = No
     return ax.figure
 
 
-def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = "ENU",
+def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = _D["nav_frame"],
            size_in: Optional[Tuple[float, float]] = None, dpi: Optional[float] = None) -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
@@ -222,7 +224,7 @@ def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_fra
 
 def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
             lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = 20.0,
-            speed: Optional[float] = None, nav_frame: str = "ENU") -> Any:
+            speed: Optional[float] = None, nav_frame: str = _D["nav_frame"]) -> Any:
     """The body moving along its path, as ``imukit animate`` draws it: a box of ``body_m``
     (length, width, height along body x, y, z; by default a tenth of the path's extent long)
     turned by the truth's attitude, its nose face red, the reference point (yellow) and the IMU

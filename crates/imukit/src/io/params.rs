@@ -298,6 +298,12 @@ pub enum Profile {
     Matlab,
 }
 
+impl crate::choice::Choice for Profile {
+    const WHAT: &'static str = "profile";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("default", Self::Default), ("matlab", Self::Matlab)];
+}
+
 impl Profile {
     /// The noise type a sensor gets when its table does not say.
     #[must_use]

@@ -128,16 +128,18 @@ pub enum ImuKind {
     AccelGyroMag,
 }
 
+impl crate::choice::Choice for ImuKind {
+    const WHAT: &'static str = "IMU type";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("accel-gyro", Self::AccelGyro),
+        ("accel-mag", Self::AccelMag),
+        ("accel-gyro-mag", Self::AccelGyroMag),
+    ];
+}
+
+crate::choice::display_as_name!(ImuKind);
+
 impl ImuKind {
-    /// The name as scenario files and MATLAB write it (`"accel-gyro"`, …).
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::AccelGyro => "accel-gyro",
-            Self::AccelMag => "accel-mag",
-            Self::AccelGyroMag => "accel-gyro-mag",
-        }
-    }
     /// True when the kind includes a gyroscope.
     #[must_use]
     pub fn has_gyro(self) -> bool {

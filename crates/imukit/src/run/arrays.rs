@@ -12,7 +12,7 @@ use crate::io::table::{TRUTH_COLUMNS, Table};
 use crate::motion::{SampledAttitudeData, SampledPath, Trajectory};
 use crate::run::simulate::motion_chunks;
 use crate::scenario::resolve::finite_vec;
-use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName, parse_name};
+use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName};
 
 fn in_frame<T>(nav: NavFrameName, enu: impl FnOnce() -> T, ned: impl FnOnce() -> T) -> T {
     match nav {
@@ -200,22 +200,22 @@ pub fn ideal_from_truth(
 /// Ideal readings of a truth table as a front end states them (names for the kind, the sign and
 /// the frame); checked once, in [`IdealRequest::run`]. Errors name the fields as written here.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct IdealRequest<'a> {
-    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
-    pub kind: &'a str,
+pub struct IdealRequest {
+    /// Which sensors.
+    pub kind: ImuKind,
     /// Lever arm from the reference point to the IMU, body frame, m.
     pub lever_arm_m: [f64; 3],
-    /// `"specific-force"` or `"matlab"`.
-    pub accel_sign: &'a str,
+    /// The accelerometer sign.
+    pub accel_sign: AccelSignName,
     /// Gravity magnitude, m/s².
     pub gravity_m_s2: f64,
     /// Magnetic field, navigation frame, µT (`None`: MATLAB's default).
     pub magnetic_field_ut: Option<[f64; 3]>,
-    /// `"ENU"` or `"NED"` (any case).
-    pub nav_frame: &'a str,
+    /// The navigation frame.
+    pub nav_frame: NavFrameName,
 }
 
-impl IdealRequest<'_> {
+impl IdealRequest {
     /// Ideal IMU readings of `truth`.
     ///
     /// # Errors
@@ -227,13 +227,12 @@ impl IdealRequest<'_> {
             .map(|m| finite_vec("magnetic_field_ut", m))
             .transpose()?;
         let imu = ImuSetup::ideal(
-            parse_name::<ImuKind>("kind", self.kind)?,
+            self.kind,
             lever_arm_m,
-            parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into(),
+            self.accel_sign.into(),
             magnetic_field_ut,
         );
-        let nav = parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?;
-        ideal_from_truth(truth, &imu, self.gravity_m_s2, nav)
+        ideal_from_truth(truth, &imu, self.gravity_m_s2, self.nav_frame)
     }
 }
 

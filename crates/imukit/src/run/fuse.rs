@@ -17,12 +17,13 @@ use imu_core::fusion::{
 use imu_core::strapdown::NavState;
 use imu_core::{AccelSign, Body, Vec3};
 
+use crate::choice::{Choice, display_as_name};
 use crate::error::{Error, Result, invalid};
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
 use crate::run::fuse_aids::AidStreams;
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
 use crate::run::navigate::{InitialState, NAV_COLUMNS};
-use crate::scenario::NavFrameName;
+use crate::scenario::{EarthName, NavFrameName};
 
 /// The one-sigma columns of a fused estimate: position, velocity and attitude error, axes of
 /// the navigation frame. `imukit compare` carries them into the errors, which `imukit plot`
@@ -247,43 +248,137 @@ pub enum Start<'a> {
 /// How long `--align static` averages, s.
 pub const STATIC_ALIGN_S: f64 = 60.0;
 
-impl<'a> Start<'a> {
-    /// The start a user asks for: an initial state (`initial`, a truth row) or an alignment by
-    /// name (`align`), exactly one of them.
-    ///
-    /// # Errors
-    /// Both or neither (field `initial`), or an alignment [`Start::alignment`] refuses.
-    pub fn choose(initial: Option<&'a InitialState>, align: Option<&str>) -> Result<Self> {
-        match (initial, align) {
-            (Some(s), None) => Ok(Self::State(s)),
-            (None, Some(name)) => Self::alignment(name),
-            (Some(_), Some(_)) => Err(invalid(
-                "initial",
-                "give the initial state or an alignment, not both",
-            )),
-            (None, None) => Err(invalid(
-                "initial",
-                "the filter needs a start: the initial state (a truth row) or the alignment \"gnss\"",
-            )),
+/// An alignment by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AlignName {
+    /// [`Start::AlignGnss`].
+    #[default]
+    Gnss,
+    /// [`Start::AlignStatic`] over [`STATIC_ALIGN_S`].
+    Static,
+}
+
+impl Choice for AlignName {
+    const WHAT: &'static str = "alignment";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("gnss", Self::Gnss), ("static", Self::Static)];
+}
+
+display_as_name!(AlignName);
+
+impl From<AlignName> for Start<'_> {
+    fn from(a: AlignName) -> Self {
+        match a {
+            AlignName::Gnss => Self::AlignGnss,
+            AlignName::Static => Self::AlignStatic {
+                duration_s: STATIC_ALIGN_S,
+            },
         }
     }
+}
 
-    /// The alignment a user names (`--align`, Python `align=`): `"gnss"` or `"static"`
-    /// ([`STATIC_ALIGN_S`] at rest).
+/// A fusion as a front end states it, beside the scenario that gives the filter its model;
+/// checked once, in [`FuseRequest::setup`], whose errors name the fields as written here
+/// (`initial`, `align`, `earth`, `nhc_sigma_m_s`, `covariance_interval_s`, `rest_s`). Its
+/// [`Default`] is every front end's default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FuseRequest<'a> {
+    /// Where the filter starts: a truth row…
+    pub initial: Option<&'a InitialState>,
+    /// …or an alignment (exactly one of the two).
+    pub align: Option<AlignName>,
+    /// The Earth the user expects; the scenario decides, so a different one is refused.
+    pub earth: Option<EarthName>,
+    /// The innovation gate ([`FuseSetup::gate`]) on.
+    pub gate: bool,
+    /// Non-holonomic constraints' one-sigma, m/s (`None`: off).
+    pub nhc_sigma_m_s: Option<f64>,
+    /// The covariance interval, s (`None`: [`DEFAULT_COVARIANCE_INTERVAL_S`]).
+    pub covariance_interval_s: Option<f64>,
+    /// Estimate the sensor errors (36 states).
+    pub sensor_errors: bool,
+    /// Seconds at rest at the start (`None`: no rest).
+    pub rest_s: Option<f64>,
+}
+
+impl Default for FuseRequest<'_> {
+    fn default() -> Self {
+        Self {
+            initial: None,
+            align: None,
+            earth: None,
+            gate: true,
+            nhc_sigma_m_s: None,
+            covariance_interval_s: None,
+            sensor_errors: false,
+            rest_s: None,
+        }
+    }
+}
+
+impl<'a> FuseRequest<'a> {
+    /// The fields an error of [`Self::setup`] or of the fusion it sets up may name.
+    pub const FIELDS: [&'static str; 6] = [
+        "initial",
+        "align",
+        "earth",
+        "nhc_sigma_m_s",
+        "covariance_interval_s",
+        "rest_s",
+    ];
+
+    /// The filter's setup from `scenario` and this request, and where it starts.
     ///
     /// # Errors
-    /// Any other name.
-    pub fn alignment(name: &str) -> Result<Self> {
-        match name {
-            "gnss" => Ok(Self::AlignGnss),
-            "static" => Ok(Self::AlignStatic {
-                duration_s: STATIC_ALIGN_S,
-            }),
-            other => Err(invalid(
-                "align",
-                format!("{other:?}: give \"gnss\" or \"static\" (or the initial state)"),
-            )),
+    /// Both starts or neither (field `initial`), an Earth other than the scenario's (field
+    /// `earth`), and as [`FuseSetup::from_scenario`].
+    pub fn setup(&self, scenario: &crate::Scenario) -> Result<(FuseSetup, Start<'a>)> {
+        let start = match (self.initial, self.align) {
+            (Some(s), None) => Start::State(s),
+            (None, Some(a)) => a.into(),
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "initial",
+                    "give the initial state or an alignment, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(invalid(
+                    "initial",
+                    "the filter needs a start: the initial state (a truth row) or the alignment \
+                     \"gnss\"",
+                ));
+            }
+        };
+        let mut setup = FuseSetup::from_scenario(scenario)?;
+        let earth = if setup.earth.is_some() {
+            EarthName::Wgs84
+        } else {
+            EarthName::Flat
+        };
+        if let Some(e) = self.earth
+            && e != earth
+        {
+            return Err(invalid(
+                "earth",
+                format!(
+                    "\"{e}\": the scenario is on the {earth} Earth, and the filter takes its \
+                     model from it"
+                ),
+            ));
         }
+        if !self.gate {
+            setup.gate = f64::INFINITY;
+        }
+        setup.aiding.nhc_sigma_m_s = self.nhc_sigma_m_s;
+        if let Some(s) = self.covariance_interval_s {
+            setup.covariance_interval_s = s;
+        }
+        setup.estimate_sensor_errors = self.sensor_errors;
+        if let Some(s) = self.rest_s {
+            setup.rest_s = s;
+        }
+        Ok((setup, start))
     }
 }
 

@@ -12,27 +12,27 @@ use crate::error::{Result, invalid};
 use crate::io::params::Profile;
 use crate::io::table::{ImuKind, check_finite};
 use crate::scenario::sensors::SensorSetup;
-use crate::scenario::{AccelSignName, ImuSetup, ImuSpec, NavFrameName, parse_name};
+use crate::scenario::{AccelSignName, ImuSetup, ImuSpec, NavFrameName};
 
 /// An imuSensor as MATLAB's constructor states it; checked once, in [`ImuSensor::new`]. Errors
 /// name MATLAB's (Python's) argument names: `imu_type`, `reference_frame`, `profile`,
 /// `accel_sign`, `temperature`, `magnetic_field`, and `accelerometer.…` for parameters.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ImuSensorRequest<'a> {
-    /// `"accel-gyro"`, `"accel-mag"` or `"accel-gyro-mag"`.
-    pub imu_type: &'a str,
-    /// `"NED"` or `"ENU"` (any case).
-    pub reference_frame: &'a str,
+pub struct ImuSensorRequest {
+    /// Which sensors.
+    pub imu_type: ImuKind,
+    /// The navigation frame.
+    pub reference_frame: NavFrameName,
     /// Sample rate, Hz.
     pub sample_rate_hz: f64,
     /// Sensor temperature, °C.
     pub temperature_c: f64,
     /// Magnetic field in the navigation frame, µT (`None`: MATLAB's default).
     pub magnetic_field_ut: Option<[f64; 3]>,
-    /// `"matlab"` (the class default: MATLAB's conventions) or `"default"`.
-    pub profile: &'a str,
+    /// MATLAB's conventions (the class default) or imukit's.
+    pub profile: Profile,
     /// The accelerometer sign; `None` follows the profile.
-    pub accel_sign: Option<&'a str>,
+    pub accel_sign: Option<AccelSignName>,
     /// Parameters: `preset`, `seed` and the three sensor tables (MATLAB's or imukit's names);
     /// its `profile` is set from [`ImuSensorRequest::profile`].
     pub params: ImuSpec,
@@ -156,9 +156,9 @@ impl ImuSensor {
     ///
     /// # Errors
     /// Unknown names, non-finite numbers, invalid parameters — each named.
-    pub fn new(r: &ImuSensorRequest<'_>) -> Result<Self> {
-        let kind = parse_name::<ImuKind>("imu_type", r.imu_type)?;
-        let profile = parse_name::<Profile>("profile", r.profile)?;
+    pub fn new(r: &ImuSensorRequest) -> Result<Self> {
+        let kind = r.imu_type;
+        let profile = r.profile;
         let spec = ImuSpec {
             profile: Some(profile),
             ..r.params.clone()
@@ -170,18 +170,13 @@ impl ImuSensor {
         {
             return Err(invalid("magnetic_field", "must be finite"));
         }
-        let sign: AccelSign = match r.accel_sign {
-            Some(s) => parse_name::<AccelSignName>("accel_sign", s)?.into(),
-            None => profile.accel_sign(),
-        };
+        let sign: AccelSign = r.accel_sign.map_or(profile.accel_sign(), AccelSign::from);
         let setup = ImuSetup {
             sensors,
             ..ImuSetup::ideal(kind, [0.0; 3], sign, r.magnetic_field_ut)
         };
         let g = DEFAULT_GRAVITY_M_S2;
-        let frame: NavFrameName =
-            parse_name("reference_frame", &r.reference_frame.to_ascii_uppercase())?;
-        let model = match frame {
+        let model = match r.reference_frame {
             NavFrameName::ENU => FrameModel::Enu(setup.model::<Enu>(g, r.sample_rate_hz)?),
             NavFrameName::NED => FrameModel::Ned(setup.model::<Ned>(g, r.sample_rate_hz)?),
         };

@@ -19,13 +19,14 @@ use imu_core::strapdown::{
 };
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
+use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{TimedRows, check_gaps};
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
 use crate::scenario::resolve::{check_gravity, finite_vec};
-use crate::scenario::{AccelSignName, NavFrameName, parse_name};
+use crate::scenario::{AccelSignName, EarthName, NavFrameName};
 
 /// Navigation output columns.
 pub const NAV_COLUMNS: [&str; 14] = [
@@ -354,24 +355,6 @@ pub const DEFAULT_RK4_SUBSTEPS: usize = 4;
 /// accuracy long before).
 pub const MAX_RK4_SUBSTEPS: usize = 1000;
 
-impl std::str::FromStr for NavScheme {
-    type Err = String;
-
-    /// `"coning"` or `"rk4"` (with [`DEFAULT_RK4_SUBSTEPS`]; see [`NavScheme::with_substeps`]).
-    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
-        match s {
-            "coning" => Ok(Self::ConingSculling),
-            "rk4" => Ok(Self::Rk4 {
-                substeps: DEFAULT_RK4_SUBSTEPS,
-            }),
-            "auto" => Ok(Self::Auto {
-                substeps: DEFAULT_RK4_SUBSTEPS,
-            }),
-            other => Err(format!("unknown scheme \"{other}\" (auto, coning, rk4)")),
-        }
-    }
-}
-
 impl NavScheme {
     /// The same scheme with `substeps` RK4 sub-steps per interval (the coning scheme has none).
     ///
@@ -390,17 +373,79 @@ impl NavScheme {
     }
 }
 
-/// A 3D integration as a front end states it (frame, sign and scheme by name); checked once, in
-/// [`NavRequest::setup`]. Errors name the fields as written here (`nav_frame`, `accel_sign`,
-/// `scheme`, `substeps`, `gravity_m_s2`).
+/// The 3D scheme by name (its sub-steps are [`NavRequest::substeps`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SchemeName {
+    /// [`NavScheme::Auto`] (the default).
+    #[default]
+    Auto,
+    /// [`NavScheme::ConingSculling`].
+    Coning,
+    /// [`NavScheme::Rk4`].
+    Rk4,
+}
+
+impl Choice for SchemeName {
+    const WHAT: &'static str = "scheme";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("auto", Self::Auto),
+        ("coning", Self::Coning),
+        ("rk4", Self::Rk4),
+    ];
+}
+
+/// The vertical channel on the WGS-84 Earth by name (the baro loop's time constant is
+/// [`NavRequest::baro_time_constant_s`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VerticalName {
+    /// Free inertial height (the default; unstable, as physics says).
+    #[default]
+    Free,
+    /// Height and vertical velocity held.
+    Hold,
+    /// A third-order loop on barometer readings.
+    Baro,
+}
+
+impl Choice for VerticalName {
+    const WHAT: &'static str = "vertical channel";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("free", Self::Free),
+        ("hold", Self::Hold),
+        ("baro", Self::Baro),
+    ];
+}
+
+/// Gravity on the WGS-84 Earth by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EarthGravityName {
+    /// WGS-84 normal gravity at the position (the default).
+    #[default]
+    Normal,
+    /// A constant magnitude ([`NavRequest::gravity_m_s2`]) along the local vertical.
+    Constant,
+}
+
+impl Choice for EarthGravityName {
+    const WHAT: &'static str = "gravity model";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("normal", Self::Normal), ("constant", Self::Constant)];
+}
+
+display_as_name!(SchemeName, VerticalName, EarthGravityName);
+
+/// A 3D integration as a front end states it; checked once, in [`NavRequest::setup`], whose
+/// errors name the fields as written here (`substeps`, `gravity_m_s2`, `vertical`,
+/// `earth_gravity`, `baro_time_constant_s`, `baro`). Its [`Default`] is every front end's
+/// default.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NavRequest<'a> {
-    /// `"ENU"` or `"NED"` (any case).
-    pub nav_frame: &'a str,
-    /// `"specific-force"` or `"matlab"`.
-    pub accel_sign: &'a str,
-    /// `"auto"` (the best for the input, see [`NavScheme::Auto`]), `"coning"` or `"rk4"`.
-    pub scheme: &'a str,
+pub struct NavRequest {
+    /// The navigation frame.
+    pub nav_frame: NavFrameName,
+    /// The accelerometer sign.
+    pub accel_sign: AccelSignName,
+    /// The scheme ([`NavScheme::Auto`]: the best for the input).
+    pub scheme: SchemeName,
     /// RK4 sub-steps per interval.
     pub substeps: usize,
     /// Gravity magnitude, m/s².
@@ -409,18 +454,17 @@ pub struct NavRequest<'a> {
     pub coning: bool,
     /// Rotation and sculling corrections.
     pub sculling: bool,
-    /// `"flat"` (a flat, non-rotating Earth) or `"wgs84"` (the rotating WGS-84 Earth).
-    pub earth: &'a str,
-    /// On the WGS-84 Earth: `"free"`, `"hold"` or `"baro"` (see [`VerticalChannel`]).
-    pub vertical: &'a str,
+    /// A flat, non-rotating Earth or the rotating WGS-84 Earth.
+    pub earth: EarthName,
+    /// On the WGS-84 Earth: the vertical channel (see [`VerticalChannel`]).
+    pub vertical: VerticalName,
     /// Time constant of the baro loop, s.
     pub baro_time_constant_s: f64,
-    /// On the WGS-84 Earth: `"normal"` (WGS-84 normal gravity) or `"constant"`
-    /// (`gravity_m_s2`).
-    pub earth_gravity: &'a str,
+    /// On the WGS-84 Earth: WGS-84 normal gravity or `gravity_m_s2`.
+    pub earth_gravity: EarthGravityName,
     /// Barometer readings come with the IMU data (the command line's `--baro` file, Python's
     /// `baro=`). They feed the baro-damped vertical channel only, so they need
-    /// `vertical = "baro"`: given with another channel they are refused (field `baro`), the same
+    /// `vertical = baro`: given with another channel they are refused (field `baro`), the same
     /// from every front end.
     pub barometer: bool,
 }
@@ -428,47 +472,48 @@ pub struct NavRequest<'a> {
 /// The baro loop's time constant unless told otherwise, s.
 pub const DEFAULT_BARO_TIME_CONSTANT_S: f64 = 100.0;
 
-impl Default for NavRequest<'_> {
+impl Default for NavRequest {
     fn default() -> Self {
         Self {
-            nav_frame: "ENU",
-            accel_sign: "specific-force",
-            scheme: "auto",
+            nav_frame: NavFrameName::default(),
+            accel_sign: AccelSignName::default(),
+            scheme: SchemeName::default(),
             substeps: DEFAULT_RK4_SUBSTEPS,
             gravity_m_s2: imu_core::DEFAULT_GRAVITY_M_S2,
             coning: true,
             sculling: true,
-            earth: "flat",
-            vertical: "free",
+            earth: EarthName::default(),
+            vertical: VerticalName::default(),
             barometer: false,
             baro_time_constant_s: DEFAULT_BARO_TIME_CONSTANT_S,
-            earth_gravity: "normal",
+            earth_gravity: EarthGravityName::default(),
         }
     }
 }
 
-impl NavRequest<'_> {
+impl NavRequest {
     /// The validated setup.
     ///
     /// # Errors
     /// [`crate::Error::Invalid`] naming the field.
     pub fn setup(&self) -> Result<NavSetup> {
-        if self.barometer && self.vertical != "baro" {
+        if self.barometer && self.vertical != VerticalName::Baro {
             return Err(invalid(
                 "baro",
                 "barometer readings feed the baro-damped vertical channel: use them with the \
                  WGS-84 Earth and the baro vertical channel",
             ));
         }
-        let scheme = self
-            .scheme
-            .parse::<NavScheme>()
-            .map_err(|m| invalid("scheme", m))?
-            .with_substeps(self.substeps)
-            .map_err(|m| invalid("substeps", m))?;
+        let scheme = match self.scheme {
+            SchemeName::Auto => NavScheme::Auto { substeps: 0 },
+            SchemeName::Coning => NavScheme::ConingSculling,
+            SchemeName::Rk4 => NavScheme::Rk4 { substeps: 0 },
+        }
+        .with_substeps(self.substeps)
+        .map_err(|m| invalid("substeps", m))?;
         Ok(NavSetup {
-            nav_frame: parse_name("nav_frame", &self.nav_frame.to_ascii_uppercase())?,
-            accel_sign: parse_name::<AccelSignName>("accel_sign", self.accel_sign)?.into(),
+            nav_frame: self.nav_frame,
+            accel_sign: self.accel_sign.into(),
             scheme,
             options: StrapdownOptions {
                 coning: self.coning,
@@ -484,9 +529,9 @@ impl NavRequest<'_> {
     /// `earth_gravity` must keep their defaults: they mean nothing there).
     fn earth_nav(&self) -> Result<Option<EarthNav>> {
         let vertical = match self.vertical {
-            "free" => VerticalChannel::Free,
-            "hold" => VerticalChannel::Hold,
-            "baro" => {
+            VerticalName::Free => VerticalChannel::Free,
+            VerticalName::Hold => VerticalChannel::Hold,
+            VerticalName::Baro => {
                 let tau = self.baro_time_constant_s;
                 if !(tau.is_finite() && tau > 0.0) {
                     return Err(invalid(
@@ -498,39 +543,25 @@ impl NavRequest<'_> {
                     time_constant_s: tau,
                 }
             }
-            other => {
-                return Err(invalid(
-                    "vertical",
-                    format!("unknown vertical channel \"{other}\" (free, hold, baro)"),
-                ));
-            }
         };
         let gravity = match self.earth_gravity {
-            "normal" => GravityModel::Normal,
-            "constant" => GravityModel::Constant(check_gravity("gravity_m_s2", self.gravity_m_s2)?),
-            other => {
-                return Err(invalid(
-                    "earth_gravity",
-                    format!("unknown gravity model \"{other}\" (normal, constant)"),
-                ));
+            EarthGravityName::Normal => GravityModel::Normal,
+            EarthGravityName::Constant => {
+                GravityModel::Constant(check_gravity("gravity_m_s2", self.gravity_m_s2)?)
             }
         };
         match self.earth {
-            "wgs84" => Ok(Some(EarthNav { vertical, gravity })),
-            "flat" if self.vertical != "free" => Err(invalid(
+            EarthName::Wgs84 => Ok(Some(EarthNav { vertical, gravity })),
+            EarthName::Flat if self.vertical != VerticalName::Free => Err(invalid(
                 "vertical",
-                "chooses the vertical channel of the WGS-84 Earth (earth = \"wgs84\"); the flat \
+                "chooses the vertical channel of the WGS-84 Earth (earth = wgs84); the flat \
                  Earth has none to choose",
             )),
-            "flat" if self.earth_gravity != "normal" => Err(invalid(
+            EarthName::Flat if self.earth_gravity != EarthGravityName::Normal => Err(invalid(
                 "earth_gravity",
-                "is for the WGS-84 Earth (earth = \"wgs84\"); the flat Earth takes gravity_m_s2",
+                "is for the WGS-84 Earth (earth = wgs84); the flat Earth takes gravity_m_s2",
             )),
-            "flat" => Ok(None),
-            other => Err(invalid(
-                "earth",
-                format!("unknown Earth model \"{other}\" (flat, wgs84)"),
-            )),
+            EarthName::Flat => Ok(None),
         }
     }
 }

@@ -9,12 +9,13 @@ use imu_core::orientation::{
 };
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
+use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
 use crate::io::rows::TimedRows;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
-use crate::scenario::{AccelSignName, NavFrameName, parse_name};
+use crate::scenario::{AccelSignName, NavFrameName};
 
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
 /// unwrapped).
@@ -30,9 +31,10 @@ pub const ORIENT_COLUMNS: [&str; 8] = [
 ];
 
 /// The filters, by name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FilterKind {
-    /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter.
+    /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter (the default).
+    #[default]
     ImuFilter,
     /// MATLAB `ahrsfilter`: + magnetometer.
     AhrsFilter,
@@ -46,9 +48,9 @@ pub enum FilterKind {
     Complementary,
 }
 
-impl FilterKind {
-    /// Every filter with its name.
-    pub const ALL: [(&'static str, Self); 6] = [
+impl Choice for FilterKind {
+    const WHAT: &'static str = "filter";
+    const NAMES: &'static [(&'static str, Self)] = &[
         ("imufilter", Self::ImuFilter),
         ("ahrsfilter", Self::AhrsFilter),
         ("ecompass", Self::Ecompass),
@@ -56,34 +58,9 @@ impl FilterKind {
         ("mahony", Self::Mahony),
         ("complementary", Self::Complementary),
     ];
+}
 
-    /// The filter called `name` (case-insensitive).
-    ///
-    /// # Errors
-    /// An unknown name, with the known ones listed.
-    pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .find(|(n, _)| n.eq_ignore_ascii_case(name))
-            .map(|(_, k)| *k)
-            .ok_or_else(|| {
-                let known: Vec<&str> = Self::ALL.iter().map(|(n, _)| *n).collect();
-                invalid(
-                    "filter",
-                    format!("unknown filter {name:?}; known: {}", known.join(", ")),
-                )
-            })
-    }
-
-    /// The filter's name (as [`FilterKind::parse`] takes it).
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, k)| *k == self)
-            .map_or("", |(n, _)| *n)
-    }
-
+impl FilterKind {
     /// Whether the filter must have a magnetometer (`Some(true)`), must not (`Some(false)`),
     /// or uses one when there is one (`None`).
     #[must_use]
@@ -144,22 +121,15 @@ pub enum Conventions {
     Matlab,
 }
 
-impl Conventions {
-    /// `"imukit"` or `"matlab"`.
-    ///
-    /// # Errors
-    /// Any other name (field `conventions`).
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "imukit" => Ok(Self::Imukit),
-            "matlab" => Ok(Self::Matlab),
-            other => Err(invalid(
-                "conventions",
-                format!("unknown conventions \"{other}\" (imukit, matlab)"),
-            )),
-        }
-    }
+impl Choice for Conventions {
+    const WHAT: &'static str = "conventions";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("imukit", Self::Imukit), ("matlab", Self::Matlab)];
+}
 
+display_as_name!(FilterKind, Conventions);
+
+impl Conventions {
     /// The navigation frame.
     #[must_use]
     pub fn nav_frame(self) -> NavFrameName {
@@ -179,57 +149,45 @@ impl Conventions {
     }
 }
 
-/// The frame and accelerometer sign of an orientation run: each as named, else the named
-/// conventions' (imukit's when none are named). Errors name the fields `conventions`,
-/// `nav_frame`, `accel_sign`.
-///
-/// # Errors
-/// Unknown names.
+/// The frame and accelerometer sign of an orientation run: each as chosen, else the
+/// conventions'.
+#[must_use]
 pub fn frame_and_sign(
-    conventions: Option<&str>,
-    nav_frame: Option<&str>,
-    accel_sign: Option<&str>,
-) -> Result<(NavFrameName, AccelSign)> {
-    let conventions = conventions.map_or(Ok(Conventions::default()), Conventions::parse)?;
-    let nav = match nav_frame {
-        Some(name) => parse_name("nav_frame", &name.to_ascii_uppercase())?,
-        None => conventions.nav_frame(),
-    };
-    let sign = match accel_sign {
-        Some(name) => parse_name::<AccelSignName>("accel_sign", name)?.into(),
-        None => conventions.accel_sign(),
-    };
-    Ok((nav, sign))
+    conventions: Conventions,
+    nav_frame: Option<NavFrameName>,
+    accel_sign: Option<AccelSignName>,
+) -> (NavFrameName, AccelSign) {
+    (
+        nav_frame.unwrap_or(conventions.nav_frame()),
+        accel_sign.map_or(conventions.accel_sign(), AccelSign::from),
+    )
 }
 
-/// An orientation run as a front end states it (filter, conventions, frame and sign by name,
-/// settings by MATLAB's property names); checked once, in [`OrientRequest::resolve`]. Errors
-/// name the fields as written here (`filter`, `conventions`, `nav_frame`, `accel_sign`) or the
-/// setting.
+/// An orientation run as a front end states it: the filter, the conventions, the frame and
+/// sign when they override the conventions, and settings by MATLAB's property names; checked
+/// once, in [`OrientRequest::resolve`], whose errors name a setting.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct OrientRequest<'a> {
-    /// The filter's name ([`FilterKind::ALL`]).
-    pub filter: &'a str,
-    /// `"imukit"` or `"matlab"` ([`Conventions`]; `None`: imukit's).
-    pub conventions: Option<&'a str>,
-    /// `"ENU"` or `"NED"` (any case; `None`: the conventions').
-    pub nav_frame: Option<&'a str>,
-    /// `"specific-force"` or `"matlab"` (`None`: the conventions').
-    pub accel_sign: Option<&'a str>,
+pub struct OrientRequest {
+    /// The filter.
+    pub filter: FilterKind,
+    /// The conventions the frame and the sign follow unless given.
+    pub conventions: Conventions,
+    /// The navigation frame (`None`: the conventions').
+    pub nav_frame: Option<NavFrameName>,
+    /// The accelerometer sign (`None`: the conventions').
+    pub accel_sign: Option<AccelSignName>,
     /// `(name, value)` settings.
     pub settings: Vec<(String, f64)>,
 }
 
-impl OrientRequest<'_> {
+impl OrientRequest {
     /// The filter spec and the navigation frame.
-    ///
-    /// # Errors
-    /// Unknown names, named by field.
-    pub fn resolve(&self) -> Result<(FilterSpec, NavFrameName)> {
-        let (nav, sign) = frame_and_sign(self.conventions, self.nav_frame, self.accel_sign)?;
-        let mut spec = FilterSpec::new(FilterKind::parse(self.filter)?, sign);
+    #[must_use]
+    pub fn resolve(&self) -> (FilterSpec, NavFrameName) {
+        let (nav, sign) = frame_and_sign(self.conventions, self.nav_frame, self.accel_sign);
+        let mut spec = FilterSpec::new(self.filter, sign);
         spec.settings.clone_from(&self.settings);
-        Ok((spec, nav))
+        (spec, nav)
     }
 }
 

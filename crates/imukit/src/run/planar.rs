@@ -5,10 +5,9 @@
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
 use std::path::Path;
 
-use imu_core::strapdown::planar::{
-    PlanarSample, PlanarScheme, PlanarState, UnknownPlanarScheme, dead_reckon,
-};
+use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
 
+use crate::choice::Choice;
 use crate::error::{Error, Result, invalid};
 use crate::io::output::write_atomically;
 use crate::io::table::{Table, read_columns, write_rows};
@@ -165,13 +164,18 @@ pub fn samples_table(samples: &[PlanarSample]) -> Table {
 /// `planar_dead_reckon`).
 pub const EXERCISE_POSITION0_M: [f64; 2] = [100.0, 100.0];
 
-/// A planar dead reckoning as a front end states it (the scheme by name); checked once, in
-/// [`PlanarRequest::run`]. Errors name the fields as written here (`scheme`, `position0_m`,
-/// `heading0_rad`, `velocity0_m_s`).
+impl Choice for PlanarScheme {
+    const WHAT: &'static str = "scheme";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("trapezoid", Self::Trapezoid), ("exercise", Self::Exercise)];
+}
+
+/// A planar dead reckoning as a front end states it; checked once, in [`PlanarRequest::run`].
+/// Errors name the fields as written here (`position0_m`, `heading0_rad`, `velocity0_m_s`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlanarRequest<'a> {
-    /// `"trapezoid"` or `"exercise"` ([`PlanarScheme::NAMES`]).
-    pub scheme: &'a str,
+pub struct PlanarRequest {
+    /// The scheme.
+    pub scheme: PlanarScheme,
     /// Start position, navigation X, Y, m.
     pub position0_m: [f64; 2],
     /// Start heading from nav X counter-clockwise, rad.
@@ -180,10 +184,10 @@ pub struct PlanarRequest<'a> {
     pub velocity0_m_s: [f64; 2],
 }
 
-impl Default for PlanarRequest<'_> {
+impl Default for PlanarRequest {
     fn default() -> Self {
         Self {
-            scheme: "trapezoid",
+            scheme: PlanarScheme::default(),
             position0_m: EXERCISE_POSITION0_M,
             heading0_rad: 0.0,
             velocity0_m_s: [0.0; 2],
@@ -191,24 +195,7 @@ impl Default for PlanarRequest<'_> {
     }
 }
 
-impl PlanarRequest<'_> {
-    /// The scheme named in the request.
-    ///
-    /// # Errors
-    /// [`Error::Invalid`] for `scheme`, listing the known names.
-    pub fn scheme(&self) -> Result<PlanarScheme> {
-        self.scheme.parse().map_err(|_: UnknownPlanarScheme| {
-            invalid(
-                "scheme",
-                format!(
-                    "unknown scheme \"{}\" ({})",
-                    self.scheme,
-                    PlanarScheme::NAMES
-                ),
-            )
-        })
-    }
-
+impl PlanarRequest {
     /// The state at the first sample's time `t0_s`: the body-frame velocity is the navigation
     /// velocity turned by −heading (`v_b = R(α)ᵀ v_n`).
     ///
@@ -234,7 +221,7 @@ impl PlanarRequest<'_> {
     /// # Errors
     /// As [`PlanarRequest::scheme`], [`PlanarRequest::initial_state`] and [`integrate`].
     pub fn run(&self, samples: &[PlanarSample]) -> Result<Table> {
-        let scheme = self.scheme()?;
+        let scheme = self.scheme;
         let initial = self.initial_state(samples.first().map_or(0.0, |x| x.t_s))?;
         integrate(samples, scheme, initial)
     }

@@ -32,8 +32,8 @@ pub mod times;
 pub use earth::{EarthSetup, TangentPlane};
 pub use imu::{ImuSetup, ReadingStream};
 pub use spec::{
-    AccelSignName, BodyRatesSpec, BuiltinSpec, ExpressionSpec, Formula, ImuSpec, NavFrameName,
-    SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
+    AccelSignName, BodyRatesSpec, BuiltinSpec, EarthName, ExpressionSpec, Formula, ImuSpec,
+    NavFrameName, SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
 };
 pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
 

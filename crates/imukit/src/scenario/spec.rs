@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use imu_core::AccelSign;
 use serde::{Deserialize, Serialize};
 
+use crate::choice::{Choice, display_as_name};
 use crate::error::{Error, Result, invalid};
 use crate::io::params::Profile;
 use crate::io::params::SensorTable;
@@ -30,15 +31,9 @@ pub enum NavFrameName {
     NED,
 }
 
-impl NavFrameName {
-    /// `"ENU"` or `"NED"`, as a scenario writes it.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::ENU => "ENU",
-            Self::NED => "NED",
-        }
-    }
+impl Choice for NavFrameName {
+    const WHAT: &'static str = "navigation frame";
+    const NAMES: &'static [(&'static str, Self)] = &[("ENU", Self::ENU), ("NED", Self::NED)];
 }
 
 /// Accelerometer sign convention, by name.
@@ -50,6 +45,14 @@ pub enum AccelSignName {
     SpecificForce,
     /// MATLAB imuSensor's gravity-minus-acceleration.
     Matlab,
+}
+
+impl Choice for AccelSignName {
+    const WHAT: &'static str = "accelerometer sign";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("specific-force", Self::SpecificForce),
+        ("matlab", Self::Matlab),
+    ];
 }
 
 impl From<AccelSignName> for AccelSign {
@@ -202,6 +205,13 @@ pub enum EarthName {
     /// The rotating WGS-84 ellipsoid with normal gravity.
     Wgs84,
 }
+
+impl Choice for EarthName {
+    const WHAT: &'static str = "Earth model";
+    const NAMES: &'static [(&'static str, Self)] = &[("flat", Self::Flat), ("wgs84", Self::Wgs84)];
+}
+
+display_as_name!(NavFrameName, AccelSignName, EarthName);
 
 /// A magnetic field model by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -1,0 +1,32 @@
+//! The library's request defaults by keyword (`imukit._core.DEFAULTS`): the Python layer's
+//! signatures take their defaults from here, so Python and the command line (whose flags take
+//! theirs from the same requests) cannot disagree.
+use imukit::choice::Choice;
+use imukit::io::table::ImuKind;
+use imukit::run::navigate::NavRequest;
+use imukit::run::orient::{Conventions, FilterKind};
+use imukit::run::planar::PlanarRequest;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Adds `DEFAULTS`.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let d = PyDict::new(m.py());
+    let nav = NavRequest::default();
+    d.set_item("nav_frame", nav.nav_frame.name())?;
+    d.set_item("accel_sign", nav.accel_sign.name())?;
+    d.set_item("scheme", nav.scheme.name())?;
+    d.set_item("substeps", nav.substeps)?;
+    d.set_item("gravity_m_s2", nav.gravity_m_s2)?;
+    d.set_item("coning", nav.coning)?;
+    d.set_item("sculling", nav.sculling)?;
+    d.set_item("earth", nav.earth.name())?;
+    d.set_item("vertical", nav.vertical.name())?;
+    d.set_item("baro_time_constant_s", nav.baro_time_constant_s)?;
+    d.set_item("earth_gravity", nav.earth_gravity.name())?;
+    d.set_item("planar_scheme", PlanarRequest::default().scheme.name())?;
+    d.set_item("conventions", Conventions::default_name())?;
+    d.set_item("filter", FilterKind::default_name())?;
+    d.set_item("imu_type", ImuKind::default_name())?;
+    m.add("DEFAULTS", d)
+}
