@@ -1,4 +1,5 @@
-//! Frame markers: the navigation frames [`Enu`] and [`Ned`], and the [`Body`] frame.
+//! Frame markers: the navigation frames [`Enu`] and [`Ned`], the [`Body`] frame in the
+//! navigation frame's convention, and [`Frd`], body axes forward-right-down whatever the frame.
 //!
 //! Frames are types, so a body-frame vector cannot be added to a navigation-frame one and generic
 //! code (`fn f<N: NavFrame>`) replaces an `is_enu` flag. The front ends pick `Enu` or `Ned` once.
@@ -10,6 +11,7 @@ mod sealed {
     impl Sealed for super::Enu {}
     impl Sealed for super::Ned {}
     impl Sealed for super::Body {}
+    impl Sealed for super::Frd {}
     impl Sealed for super::Ecef {}
 }
 
@@ -57,7 +59,7 @@ pub trait NavFrame: Frame {
     /// Body axes of this frame's convention from FRD: the identity under NED (FRD), a half turn
     /// about x under ENU (FLU: `(x, −y, −z)`).
     #[must_use]
-    fn frd_to_body() -> Rotation<Body, Body> {
+    fn frd_to_body() -> Rotation<Frd, Body> {
         if Self::Z_UP > 0.0 {
             Rotation::from_wxyz([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()
         } else {
@@ -74,9 +76,17 @@ pub struct Enu;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ned;
 
-/// The body frame of the moving rigid body (and of the IMU mounted on it).
+/// The body frame of the moving rigid body (and of the IMU mounted on it), in the navigation
+/// frame's convention: forward-left-up (FLU) under [`Enu`], forward-right-down (FRD) under
+/// [`Ned`]. Code generic over the navigation frame reads and writes the body axes through it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Body;
+
+/// Body axes forward-right-down, whatever the navigation frame: the convention of the Earth's
+/// kinematics (`earth::ideal`, local NED) and of alignment. [`NavFrame::frd_to_body`] is the
+/// typed turn from it to [`Body`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Frd;
 
 impl Frame for Enu {
     const NAME: &'static str = "ENU";
@@ -86,6 +96,9 @@ impl Frame for Ned {
 }
 impl Frame for Body {
     const NAME: &'static str = "body";
+}
+impl Frame for Frd {
+    const NAME: &'static str = "FRD";
 }
 
 /// The Earth-centred, Earth-fixed frame of WGS-84: x through the equator at the prime meridian,

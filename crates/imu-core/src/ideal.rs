@@ -3,7 +3,7 @@
 //! `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r` (rigid-body kinematics, eq. 9 of the MATLAB trajectory tool,
 //! with gravity taken out as a real accelerometer senses it), `ω_b` unchanged (the same at every
 //! point of a rigid body), `m_b = C_nbᵀ m_n`.
-use crate::frame::{Body, NavFrame};
+use crate::frame::{Body, Frame, NavFrame};
 use crate::kinematics::Truth;
 use crate::vector::Vec3;
 
@@ -42,15 +42,31 @@ impl<N: NavFrame> Default for ImuMount<N> {
     }
 }
 
-/// One ideal reading, body frame.
+/// One ideal reading in body axes `B` (the navigation frame's convention unless told, [`Frd`]
+/// from the Earth's kinematics).
+///
+/// [`Frd`]: crate::frame::Frd
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct IdealReading {
+pub struct IdealReading<B: Frame = Body> {
     /// Accelerometer, m/s² (sign per [`AccelSign`]).
-    pub accel_m_s2: Vec3<Body>,
+    pub accel_m_s2: Vec3<B>,
     /// Gyroscope, rad/s.
-    pub gyro_rad_s: Vec3<Body>,
+    pub gyro_rad_s: Vec3<B>,
     /// Magnetometer, µT.
-    pub mag_ut: Vec3<Body>,
+    pub mag_ut: Vec3<B>,
+}
+
+impl IdealReading<crate::frame::Frd> {
+    /// The reading in the body axes of `N`'s convention (turned by [`NavFrame::frd_to_body`]).
+    #[must_use]
+    pub fn to_body<N: NavFrame>(&self) -> IdealReading<Body> {
+        let turn = N::frd_to_body();
+        IdealReading {
+            accel_m_s2: turn.apply(self.accel_m_s2),
+            gyro_rad_s: turn.apply(self.gyro_rad_s),
+            mag_ut: turn.apply(self.mag_ut),
+        }
+    }
 }
 
 /// Acceleration-like quantity carried from the reference point S to a point at lever arm `r`
@@ -58,12 +74,12 @@ pub struct IdealReading {
 /// `a_I = a_S + ω_b × (ω_b × r) + α_b × r` (the MATLAB trajectory tool's eq. 9; centripetal and Euler terms).
 #[must_use]
 #[inline]
-pub fn at_lever_arm(
-    a_s: Vec3<Body>,
-    omega_b: Vec3<Body>,
-    alpha_b: Vec3<Body>,
-    r: Vec3<Body>,
-) -> Vec3<Body> {
+pub fn at_lever_arm<B: Frame>(
+    a_s: Vec3<B>,
+    omega_b: Vec3<B>,
+    alpha_b: Vec3<B>,
+    r: Vec3<B>,
+) -> Vec3<B> {
     a_s + omega_b.cross(&omega_b.cross(&r)) + alpha_b.cross(&r)
 }
 

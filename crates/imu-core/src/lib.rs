@@ -40,7 +40,7 @@ pub mod strapdown;
 pub mod trig;
 pub mod vector;
 
-pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, NavFrame, Ned};
+pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, Frd, NavFrame, Ned};
 pub use ideal::{AccelSign, IdealReading, ImuMount};
 pub use kinematics::{KinematicsError, Truth};
 pub use rotation::{EulerZyx, Rotation};

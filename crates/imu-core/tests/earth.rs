@@ -4,7 +4,7 @@
 use imu_core::earth::ideal::{EcefKinematics, earth_rate_ecef, ecef_specific_force_and_rate};
 use imu_core::earth::wgs84::{A_M, B_M, E2, OMEGA_IE_RAD_S};
 use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel, normal_gravity_m_s2};
-use imu_core::{AccelSign, Body, Ecef, EulerZyx, Ned, Rotation, Vec3};
+use imu_core::{AccelSign, Ecef, EulerZyx, Frd, Ned, Rotation, Vec3};
 
 fn close<F: imu_core::Frame>(got: Vec3<F>, want: Vec3<F>, rel: f64, what: &str) {
     let scale = want.norm().max(1e-300);
@@ -142,7 +142,7 @@ fn flying_east_along_a_parallel_is_a_circle_about_the_polar_axis() {
         height_m: h,
     };
     let attitude =
-        Rotation::<Body, Ned>::from_euler(EulerZyx::new(std::f64::consts::FRAC_PI_2, 0.02, -0.01));
+        Rotation::<Frd, Ned>::from_euler(EulerZyx::new(std::f64::consts::FRAC_PI_2, 0.02, -0.01));
     let truth = EarthTruth {
         position,
         velocity_m_s: Vec3::new(0.0, v, 0.0),
@@ -243,7 +243,7 @@ fn a_climbing_turn_reads_the_same_through_ned_and_through_ecef() {
 #[test]
 fn a_lever_arm_adds_the_rigid_body_terms_of_the_inertial_rate() {
     let truth = climbing_turn();
-    let r = Vec3::<Body>::new(1.2, -0.4, 0.3);
+    let r = Vec3::<Frd>::new(1.2, -0.4, 0.3);
     let at_arm = EarthMount {
         lever_arm_m: r,
         ..EarthMount::default()

@@ -53,8 +53,10 @@ fn start_ned() -> NavState<Wgs84<Ned>> {
 fn to_enu(s: &NavState<Wgs84<Ned>>) -> NavState<Wgs84<Enu>> {
     NavState {
         t_s: s.t_s,
+        // FLU → FRD → NED's body axes (the same, typed) → NED → ENU.
         attitude: Enu::frd_to_body()
             .inverse()
+            .then(&Ned::frd_to_body())
             .then(&s.attitude)
             .then(&Enu::from_ned()),
         velocity_m_s: Enu::from_ned_axes(s.velocity_m_s),

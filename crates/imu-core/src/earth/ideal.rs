@@ -23,7 +23,7 @@ use crate::earth::rates::{
     earth_rate_ned, geodetic_rates, transport_rate_derivative_ned, transport_rate_ned,
 };
 use crate::earth::wgs84::{Geodetic, OMEGA_IE_RAD_S};
-use crate::frame::{Body, Ecef, Ned};
+use crate::frame::{Ecef, Frd, Ned};
 use crate::ideal::{AccelSign, IdealReading, at_lever_arm};
 use crate::math;
 use crate::rotation::{EulerZyx, Rotation};
@@ -41,13 +41,13 @@ pub struct EarthTruth {
     /// Time derivative of the components of `v^n`, m/s².
     pub acceleration_m_s2: Vec3<Ned>,
     /// Attitude `C_nb` relative to the local NED frame.
-    pub attitude: Rotation<Body, Ned>,
+    pub attitude: Rotation<Frd, Ned>,
     /// The same attitude as z-y-x Euler angles (yaw from true north).
     pub euler: EulerZyx,
     /// Attitude rate `ω_nb^b`, rad/s.
-    pub omega_nb_b_rad_s: Vec3<Body>,
+    pub omega_nb_b_rad_s: Vec3<Frd>,
     /// Its derivative `α_nb^b`, rad/s².
-    pub alpha_nb_b_rad_s2: Vec3<Body>,
+    pub alpha_nb_b_rad_s2: Vec3<Frd>,
 }
 
 impl Default for EarthTruth {
@@ -77,11 +77,11 @@ pub struct EcefKinematics {
     /// Its derivative in ECEF, m/s².
     pub acceleration_m_s2: Vec3<Ecef>,
     /// Attitude `C_eb`.
-    pub attitude: Rotation<Body, Ecef>,
-    /// Body rate relative to the Earth `ω_eb^b`, rad/s.
-    pub omega_eb_b_rad_s: Vec3<Body>,
+    pub attitude: Rotation<Frd, Ecef>,
+    /// Frd rate relative to the Earth `ω_eb^b`, rad/s.
+    pub omega_eb_b_rad_s: Vec3<Frd>,
     /// Its derivative, rad/s².
-    pub alpha_eb_b_rad_s2: Vec3<Body>,
+    pub alpha_eb_b_rad_s2: Vec3<Frd>,
 }
 
 /// The Earth rate in ECEF, `[0, 0, ω_ie]`, rad/s.
@@ -145,7 +145,7 @@ impl EarthTruth {
     /// The inertial body rate `ω_ib^b = ω_nb^b + C_bn (ω_ie^n + ω_en^n)` and its derivative
     /// `α_ib^b = α_nb^b − ω_nb^b × C_bn ω_in^n + C_bn ω̇_in^n`, rad/s and rad/s².
     #[must_use]
-    pub fn inertial_rate(&self) -> (Vec3<Body>, Vec3<Body>) {
+    pub fn inertial_rate(&self) -> (Vec3<Frd>, Vec3<Frd>) {
         let p = &self.position;
         let v = self.velocity_m_s;
         let w_in = earth_rate_ned(p) + transport_rate_ned(p, v);
@@ -182,7 +182,7 @@ impl EarthTruth {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EarthMount {
     /// Lever arm `r` from the reference point to the IMU, body frame, m.
-    pub lever_arm_m: Vec3<Body>,
+    pub lever_arm_m: Vec3<Frd>,
     /// Accelerometer sign convention.
     pub accel_sign: AccelSign,
     /// Gravity model.
@@ -192,7 +192,7 @@ pub struct EarthMount {
 impl EarthMount {
     /// Specific force at the IMU point, body frame, m/s² (the physical sign).
     #[must_use]
-    pub fn specific_force(&self, truth: &EarthTruth) -> Vec3<Body> {
+    pub fn specific_force(&self, truth: &EarthTruth) -> Vec3<Frd> {
         let f_s = truth
             .attitude
             .inverse()
@@ -204,7 +204,7 @@ impl EarthMount {
     /// The ideal reading of the three sensors, with the magnetic field at the position given in
     /// local NED (µT).
     #[must_use]
-    pub fn read(&self, truth: &EarthTruth, magnetic_field_ned_ut: Vec3<Ned>) -> IdealReading {
+    pub fn read(&self, truth: &EarthTruth, magnetic_field_ned_ut: Vec3<Ned>) -> IdealReading<Frd> {
         let f = self.specific_force(truth);
         IdealReading {
             accel_m_s2: match self.accel_sign {
@@ -224,7 +224,7 @@ impl EarthMount {
 pub fn ecef_specific_force_and_rate(
     k: &EcefKinematics,
     gravity: &GravityModel,
-) -> Option<(Vec3<Body>, Vec3<Body>)> {
+) -> Option<(Vec3<Frd>, Vec3<Frd>)> {
     let position = Geodetic::from_ecef(k.position_m)?;
     let down = position
         .ned_to_ecef()

@@ -8,7 +8,7 @@
 //! Body axes follow the frame's convention (FLU under ENU, FRD under NED); the formulas are
 //! written in NED/FRD and the frames exchanged exactly.
 use crate::earth::EarthModel;
-use crate::frame::{Body, NavFrame};
+use crate::frame::{Body, Frd, NavFrame, Ned};
 use crate::math;
 use crate::rotation::{EulerZyx, Rotation};
 use crate::vector::Vec3;
@@ -135,10 +135,10 @@ pub fn at_rest<E: EarthModel>(
     }
     let roll = math::atan2(-f[1], -f[2]);
     let pitch = math::atan2(f[0], math::hypot(f[1], f[2]));
-    let level = Rotation::<Body, Body>::from_euler(EulerZyx::new(0.0, pitch, roll));
+    let level = Rotation::<Frd, Frd>::from_euler(EulerZyx::new(0.0, pitch, roll));
     let wl = level.apply(Vec3::from_array(w)).to_array();
     let yaw = math::atan2(-wl[1], wl[0]);
-    let frd_ned = Rotation::<Body, crate::frame::Ned>::from_euler(EulerZyx::new(yaw, pitch, roll));
+    let frd_ned = Rotation::<Frd, Ned>::from_euler(EulerZyx::new(yaw, pitch, roll));
     Ok(RestAlignment {
         attitude: E::Frame::frd_to_body()
             .inverse()

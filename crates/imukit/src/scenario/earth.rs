@@ -309,18 +309,12 @@ impl TangentPlane {
         lever_arm_m: Vec3<Body>,
         field_ned: Vec3<Ned>,
     ) -> IdealReading {
-        let to_body = N::frd_to_body();
         let mount = EarthMount {
-            lever_arm_m: to_body.inverse().apply(lever_arm_m),
+            lever_arm_m: N::frd_to_body().inverse().apply(lever_arm_m),
             accel_sign: imu_core::AccelSign::SpecificForce,
             gravity: self.gravity,
         };
-        let r = mount.read(earth, field_ned);
-        IdealReading {
-            accel_m_s2: to_body.apply(r.accel_m_s2),
-            gyro_rad_s: to_body.apply(r.gyro_rad_s),
-            mag_ut: to_body.apply(r.mag_ut),
-        }
+        mount.read(earth, field_ned).to_body::<N>()
     }
 }
 
