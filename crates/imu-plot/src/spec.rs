@@ -37,29 +37,20 @@ fn shown(columns: &[String]) -> String {
 }
 
 impl TableKind {
-    /// Recognises a table by its columns; `None` when it is none of imukit's kinds.
+    /// Recognises a table by its columns (the library's [`imukit::io::schema::TableKind`],
+    /// grouped by what a figure draws); `None` when it is none that imukit plots.
     #[must_use]
     pub fn detect(columns: &[String]) -> Option<Self> {
-        let has = |c: &str| columns.iter().any(|h| h == c);
-        if has("tau_s") && columns.iter().any(|c| c.starts_with("adev_")) {
-            Some(Self::Allan)
-        } else if has("pos_err_m") || has("att_err_rad") {
-            Some(Self::Errors)
-        } else if has("pos_x_m") && has("acc_x_m_s2") && has("omega_x_rad_s") {
-            Some(Self::Truth)
-        } else if has("pos_x_m") && has("pos_y_m") && has("yaw_rad") {
-            Some(Self::Navigation)
-        } else if has("t_s") && has("q_w") && has("yaw_rad") && !has("pos_x_m") {
-            Some(Self::Orientation)
-        } else if has("t_s")
-            && ["accel_x_m_s2", "dv_x_m_s", "gyro_z_rad_s", "mag_x_ut"]
-                .iter()
-                .any(|c| has(c))
-        {
-            Some(Self::Imu)
-        } else {
-            None
-        }
+        use imukit::io::schema::TableKind as Kind;
+        Some(match Kind::detect(columns)? {
+            Kind::Truth => Self::Truth,
+            Kind::Readings | Kind::PlanarReadings => Self::Imu,
+            Kind::Navigation | Kind::Fused | Kind::PlanarNavigation => Self::Navigation,
+            Kind::Allan => Self::Allan,
+            Kind::Errors | Kind::OrientationErrors => Self::Errors,
+            Kind::Orientation => Self::Orientation,
+            Kind::Gnss | Kind::GnssGeodetic | Kind::Baro | Kind::Odometer => return None,
+        })
     }
 
     /// Like [`TableKind::detect`], with an error naming `source` and its columns.
@@ -416,17 +407,36 @@ mod tests {
     #[test]
     fn kinds_are_recognised_by_their_columns() {
         let k = |c: &str| TableKind::detect(&cols(c));
+        let of =
+            |c: &[&str]| TableKind::detect(&c.iter().map(|s| s.to_string()).collect::<Vec<_>>());
         assert_eq!(
-            k("t_s,pos_x_m,acc_x_m_s2,omega_x_rad_s"),
+            of(&imukit::io::table::TRUTH_COLUMNS),
             Some(TableKind::Truth)
         );
         assert_eq!(
-            k("t_s,pos_x_m,pos_y_m,yaw_rad"),
+            of(&imukit::run::navigate::NAV_COLUMNS),
             Some(TableKind::Navigation)
+        );
+        assert_eq!(
+            of(&imukit::run::fuse::FUSE_COLUMNS),
+            Some(TableKind::Navigation)
+        );
+        assert_eq!(
+            of(&imukit::run::planar::PLANAR_NAV_COLUMNS),
+            Some(TableKind::Navigation)
+        );
+        assert_eq!(
+            of(&imukit::run::compare::ERROR_COLUMNS),
+            Some(TableKind::Errors)
+        );
+        assert_eq!(
+            of(&imukit::run::orient::ORIENT_COLUMNS),
+            Some(TableKind::Orientation)
         );
         assert_eq!(k("t_s,dv_x_m_s,dtheta_x_rad"), Some(TableKind::Imu));
         assert_eq!(k("tau_s,adev_gyro_x_rad_s"), Some(TableKind::Allan));
-        assert_eq!(k("t_s,pos_err_x_m,pos_err_m"), Some(TableKind::Errors));
+        // GNSS fixes are a kind of table, not one imukit draws.
+        assert_eq!(of(&imukit::scenario::gnss::GNSS_COLUMNS), None);
         assert_eq!(k("a,b"), None);
         let e = TableKind::of(&cols("a,b"), "f.csv")
             .unwrap_err()

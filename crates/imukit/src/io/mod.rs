@@ -11,6 +11,7 @@ pub mod params;
 pub mod parquet;
 pub mod presets;
 pub mod rows;
+pub mod schema;
 pub mod table;
 pub mod units;
 pub mod value_tree;
