@@ -3,6 +3,8 @@ use std::path::PathBuf;
 
 use imu_core::KinematicsError;
 use imu_core::allan::AllanError;
+use imu_core::fusion::EskfError;
+use imu_core::fusion::align::AlignError;
 use imu_core::orientation::OrientError;
 use imu_core::sensor::{ImuParamError, ParamError};
 use imu_core::strapdown::StrapdownError;
@@ -58,6 +60,25 @@ pub enum Error {
         value: String,
         /// The names it takes.
         choices: Vec<&'static str>,
+    },
+    /// The Kalman filter refused its settings or a sample (not a divergence: see
+    /// [`Error::Diverged`]).
+    #[error("{context}: {}{source}", row.map(|r| format!("row {r}: ")).unwrap_or_default())]
+    Filter {
+        /// The input or setting, e.g. `IMU data`, `sensor_error_sigma`.
+        context: String,
+        /// The 1-based row of the input (the header is row 1), when a sample was refused.
+        row: Option<usize>,
+        /// The core's error.
+        source: EskfError,
+    },
+    /// A static alignment that could not be made.
+    #[error("{field}: \"static\": {source}{}", align_hint(source))]
+    Align {
+        /// The request field, `align`.
+        field: String,
+        /// The core's error.
+        source: AlignError,
     },
     /// A Kalman filter that lost its measurements (its covariance no longer positive definite,
     /// or fixes rejected one after another): the estimate is not written.
@@ -217,6 +238,7 @@ impl Error {
             Self::Invalid { field: f, .. }
             | Self::ScenarioKey { field: f, .. }
             | Self::UnknownChoice { field: f, .. }
+            | Self::Align { field: f, .. }
             | Self::Expression { field: f, .. }
             | Self::BadQuaternion { field: f }
             | Self::Diverged { context: f, .. } => field(f),
@@ -232,6 +254,10 @@ impl Error {
                 field: None,
             },
             Self::CsvFormat { file: f, .. } => file(f),
+            Self::Filter { context, row, .. } => Location {
+                row: *row,
+                ..field(context)
+            },
             Self::NotFinite {
                 what, row, column, ..
             } => Location {
@@ -258,6 +284,14 @@ impl Error {
             | Self::Orientation { context, .. }
             | Self::Allan { context, .. } => field(context),
         }
+    }
+}
+
+/// What to do instead when a static alignment fails.
+fn align_hint(e: &AlignError) -> &'static str {
+    match e {
+        AlignError::NoNorth { .. } => "; use \"gnss\" or give the initial state",
+        AlignError::NotAtRest { .. } => "",
     }
 }
 

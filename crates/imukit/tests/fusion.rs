@@ -1285,3 +1285,53 @@ fn a_consumer_imu_needs_the_rest_and_the_sensor_error_states_and_learns_them_on_
         }
     }
 }
+
+#[test]
+fn a_consumer_gyroscope_cannot_gyrocompass_and_says_why_as_a_typed_source() {
+    use imu_core::fusion::align::AlignError;
+    use imukit::run::fuse::{AidTables, AlignName, Start, fuse_with};
+    let text = "rate_hz = 10.0\nduration_s = 70.0\nnav_frame = \"NED\"\nearth = \"wgs84\"\n\
+                origin = { latitude_deg = 45.0, longitude_deg = 7.0, height_m = 300.0 }\n\
+                [trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+                [imu]\nkind = \"accel-gyro\"\npreset = \"icm-42688-p\"\nseed = 5\n\
+                [gnss]\nrate_hz = 1.0\n";
+    let sc = ScenarioSpec::from_toml(text, "consumer.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap();
+    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    let sim = sc.simulate().unwrap();
+    let gnss = sim.gnss.as_ref().unwrap();
+    let e = fuse_with(
+        &sim.imu,
+        gnss,
+        AidTables::default(),
+        Start::from(AlignName::Static),
+        &setup,
+    )
+    .unwrap_err();
+    // The core's error is the source, not text: a program can tell why.
+    match &e {
+        imukit::Error::Align {
+            field,
+            source:
+                AlignError::NoNorth {
+                    horizontal_rate_rad_s,
+                    ..
+                },
+        } => {
+            assert_eq!(field, "align");
+            // Ω cos 45°: the horizontal Earth rate the part's bias drowns.
+            let omega_h = 7.292_115e-5 * std::f64::consts::FRAC_1_SQRT_2;
+            assert!((horizontal_rate_rad_s - omega_h).abs() < 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(e.location().field.as_deref(), Some("align"));
+    assert!(
+        e.to_string()
+            .contains("use \"gnss\" or give the initial state"),
+        "{e}"
+    );
+    assert!(std::error::Error::source(&e).is_some());
+}

@@ -99,6 +99,19 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             context: rename(context),
             message,
         },
+        Error::Filter {
+            context,
+            row,
+            source,
+        } => Error::Filter {
+            context: rename(context),
+            row,
+            source,
+        },
+        Error::Align { field, source } => Error::Align {
+            field: flag(&field),
+            source,
+        },
         other => other,
     })?;
     nav.write(a.out)?;

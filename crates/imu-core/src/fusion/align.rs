@@ -91,6 +91,8 @@ impl core::fmt::Display for AlignError {
     }
 }
 
+impl core::error::Error for AlignError {}
+
 /// The attitude of a vehicle at rest at `position` on `earth` from the mean specific force
 /// `specific_force_m_s2` and mean body rate `rate_rad_s` (body axes of the frame's convention)
 /// over `duration_s`: roll `atan2(−f_y, −f_z)` and pitch `atan2(f_x, √(f_y² + f_z²))` (FRD);

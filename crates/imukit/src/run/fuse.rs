@@ -8,7 +8,7 @@
 //! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU
 //! sample at or after its stamp (fixes are taken at IMU samples in imukit's simulations, so
 //! exactly there).
-use imu_core::fusion::align::{self, AlignError, PartFigures};
+use imu_core::fusion::align::{self, PartFigures};
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
@@ -534,10 +534,17 @@ fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<
 /// The filter's refusal of reading `index` (0-based) of `what` (`GNSS`, `odometer`, …) as an
 /// error naming its row: a divergence as [`Error::Diverged`], bad input as invalid data.
 pub(crate) fn filter_refusal(what: &str, index: usize, e: EskfError) -> Error {
-    let (context, message) = (format!("{what} data"), format!("row {}: {e}", index + 2));
+    let (context, row) = (format!("{what} data"), index + 2);
     match e {
-        EskfError::Diverged { .. } => Error::Diverged { context, message },
-        _ => invalid(context, message),
+        EskfError::Diverged { .. } => Error::Diverged {
+            context,
+            message: format!("row {row}: {e}"),
+        },
+        source => Error::Filter {
+            context,
+            row: Some(row),
+            source,
+        },
     }
 }
 
@@ -776,12 +783,9 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
                 t[i0] - t0,
                 &part,
             )
-            .map_err(|e| {
-                let hint = match e {
-                    AlignError::NoNorth { .. } => "; use \"gnss\" or give the initial state",
-                    AlignError::NotAtRest { .. } => "",
-                };
-                invalid("align", format!("\"static\": {e}{hint}"))
+            .map_err(|source| Error::Align {
+                field: "align".into(),
+                source,
             })?;
             let sigma = InitialSigma {
                 position_m: setup
@@ -826,7 +830,11 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         ..s0
     };
     aid_streams.start_at(t[first]);
-    let filter_error = |context: &str, e: EskfError| invalid(context, e.to_string());
+    let filter_error = |context: &str, source: EskfError| Error::Filter {
+        context: context.into(),
+        row: None,
+        source,
+    };
     let start = EskfState {
         nav: s0,
         accel_bias_m_s2: [0.0; 3],
