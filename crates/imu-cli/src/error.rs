@@ -58,17 +58,6 @@ pub fn by_flag(e: imukit::Error) -> imukit::Error {
             field: flag(&field),
             message,
         },
-        imukit::Error::UnknownChoice {
-            field,
-            what,
-            value,
-            choices,
-        } => imukit::Error::UnknownChoice {
-            field: flag(&field),
-            what,
-            value,
-            choices,
-        },
         other => other,
     }
 }

@@ -219,7 +219,7 @@ impl IdealRequest {
     /// Ideal IMU readings of `truth`.
     ///
     /// # Errors
-    /// Unknown names, non-finite vectors (named), and as [`ideal_from_truth`].
+    /// Non-finite vectors (named), and as [`ideal_from_truth`].
     pub fn run(&self, truth: &Table) -> Result<Table> {
         let lever_arm_m = finite_vec("lever_arm_m", self.lever_arm_m)?;
         let magnetic_field_ut = self

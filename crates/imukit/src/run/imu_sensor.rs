@@ -155,7 +155,7 @@ impl ImuSensor {
     /// Builds the validated model.
     ///
     /// # Errors
-    /// Unknown names, non-finite numbers, invalid parameters — each named.
+    /// Non-finite numbers, invalid parameters — each named.
     pub fn new(r: &ImuSensorRequest) -> Result<Self> {
         let kind = r.imu_type;
         let profile = r.profile;

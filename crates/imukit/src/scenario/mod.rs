@@ -33,7 +33,7 @@ pub use earth::{EarthSetup, TangentPlane};
 pub use imu::{ImuSetup, ReadingStream};
 pub use spec::{
     AccelSignName, BodyRatesSpec, BuiltinSpec, EarthName, ExpressionSpec, Formula, ImuSpec,
-    NavFrameName, SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec, parse_name,
+    NavFrameName, SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec,
 };
 pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
 

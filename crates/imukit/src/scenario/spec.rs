@@ -565,18 +565,6 @@ impl ImuSpec {
     }
 }
 
-/// Parses a name the way scenario files spell it (`"ENU"`, `"specific-force"`, `"accel-gyro"`…),
-/// for front ends that take names as strings.
-///
-/// # Errors
-/// [`Error::Invalid`] naming `field` and listing the accepted names.
-pub fn parse_name<T: serde::de::DeserializeOwned>(field: &str, name: &str) -> Result<T> {
-    use serde::de::IntoDeserializer;
-    let de: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
-        name.into_deserializer();
-    T::deserialize(de).map_err(|e| invalid(field, e.to_string()))
-}
-
 impl ExpressionSpec {
     /// The motion these formulas describe, parsed.
     ///
