@@ -7,93 +7,10 @@
 #![allow(missing_docs)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use imu_core::earth::{EarthModel, FlatEarth, Geodetic, Wgs84};
-use imu_core::fusion::{
-    BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma, SensorErrorSigma,
-};
-use imu_core::strapdown::NavState;
-use imu_core::{Enu, Ned, Rotation, Vec3};
-
-/// An Earth to run on and a position near its origin, `offset_m` north-east of it.
-trait BenchEarth: EarthModel {
-    fn make() -> Self;
-    fn at(offset_m: f64) -> Self::Position;
-}
-
-impl BenchEarth for FlatEarth<Enu> {
-    fn make() -> Self {
-        FlatEarth::new(9.81)
-    }
-    fn at(offset_m: f64) -> Vec3<Enu> {
-        Vec3::new(offset_m, offset_m, 0.0)
-    }
-}
-
-impl BenchEarth for Wgs84<Ned> {
-    fn make() -> Self {
-        Wgs84::default()
-    }
-    fn at(offset_m: f64) -> Geodetic {
-        Geodetic::from_degrees(
-            45.0 + offset_m / 111_000.0,
-            7.0 + offset_m / 78_800.0,
-            300.0,
-        )
-    }
-}
-
-fn filter<E: BenchEarth, const S: usize>() -> Eskf<E, S> {
-    let start = EskfState::<E> {
-        nav: NavState {
-            t_s: 0.0,
-            position: E::at(0.0),
-            velocity_m_s: Vec3::new(10.0, 0.0, 0.0),
-            attitude: Rotation::identity(),
-        },
-        accel_bias_m_s2: [0.0; 3],
-        gyro_bias_rad_s: [0.0; 3],
-    };
-    let sigma = InitialSigma {
-        position_m: 1.0,
-        velocity_m_s: 0.1,
-        attitude_rad: [0.01, 0.01, 0.05],
-        accel_bias_m_s2: 0.01,
-        gyro_bias_rad_s: 1e-4,
-    };
-    let noise = EskfNoise {
-        accel_psd: 3e-3,
-        gyro_psd: 2e-4,
-        accel_bias_psd: 2e-4,
-        gyro_bias_psd: 2e-6,
-    };
-    let f = Eskf::new(E::make(), &start, &sigma, noise).expect("valid");
-    if S == FULL_STATES {
-        f.with_sensor_error_sigma(&SensorErrorSigma {
-            accel_scale_factor: 1e-3,
-            accel_misalignment: 1e-3,
-            gyro_scale_factor: 1e-3,
-            gyro_misalignment: 1e-3,
-            gyro_g_sensitivity: 1e-5,
-        })
-        .expect("valid")
-    } else {
-        f
-    }
-}
-
-/// `n` samples at 100 Hz through a filter of `S` states, the covariance every `interval_s`.
-fn propagate<E: BenchEarth, const S: usize>(n: usize, interval_s: f64) -> Eskf<E, S> {
-    let mut f = filter::<E, S>()
-        .with_covariance_interval(interval_s)
-        .expect("valid");
-    for k in 0..n {
-        let t = k as f64 * 0.01;
-        let up = -<E::Frame as imu_core::NavFrame>::Z_UP;
-        f.propagate(t, [0.01, -0.02, 0.1 * t.sin()], [0.2, 1.0, -up * 9.81])
-            .expect("valid");
-    }
-    f
-}
+use imu_benches::{BenchEarth, propagate};
+use imu_core::earth::{FlatEarth, Wgs84};
+use imu_core::fusion::{BASE_STATES, Eskf, FULL_STATES, GnssFix};
+use imu_core::{Enu, Ned, Vec3};
 
 /// One GNSS position-and-velocity update of a filter of `S` states.
 fn gnss_update<E: BenchEarth, const S: usize>(f: &Eskf<E, S>) -> imu_core::fusion::UpdateOutcome {

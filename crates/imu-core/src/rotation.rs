@@ -6,11 +6,50 @@
 //! MATLAB's "frame rotation from navigation to body" orientation.
 use core::marker::PhantomData;
 
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::frame::Frame;
 use crate::math;
 use crate::vector::Vec3;
+
+/// The Hamilton product `a ⊗ b`, with nalgebra's operations in nalgebra's order (so bit for
+/// bit its `a * b`), always inlined: the strapdown's recursion calls it every sample, and an
+/// outlined call passes the quaternions through memory, where reloading them as vectors stalls
+/// on store forwarding.
+#[inline(always)]
+pub(crate) fn quaternion_product(a: &Quaternion<f64>, b: &Quaternion<f64>) -> Quaternion<f64> {
+    let (a, b) = (&a.coords, &b.coords); // [x, y, z, w]
+    Quaternion::new(
+        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
+        a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+        a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+        a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+    )
+}
+
+/// The unit quaternion of the rotation vector `phi` (`exp(phi/2)`; the identity when
+/// `|phi/2|² ≤ ε²`), nalgebra's `UnitQuaternion::from_scaled_axis` in nalgebra's order (so bit
+/// for bit), always inlined as [`quaternion_product`].
+#[inline(always)]
+pub(crate) fn rotation_vector_quaternion(phi: &Vector3<f64>) -> Quaternion<f64> {
+    let half = phi / 2.0;
+    let nn = half.x * half.x + half.y * half.y + half.z * half.z;
+    if nn <= f64::EPSILON * f64::EPSILON {
+        return Quaternion::identity();
+    }
+    let n = math::sqrt(nn);
+    Quaternion::from_parts(math::cos(n), half * (math::sin(n) / n))
+}
+
+/// `v` turned by the unit quaternion `q` (`q ⊗ v ⊗ q*`), nalgebra's formula in nalgebra's
+/// order (`t = 2 q_v × v`, `v + q_w t + q_v × t`), always inlined as [`quaternion_product`].
+#[inline(always)]
+pub(crate) fn rotate(q: &Quaternion<f64>, v: &Vector3<f64>) -> Vector3<f64> {
+    let u = q.vector();
+    let t = u.cross(v) * 2.0;
+    let cross = u.cross(&t);
+    t * q.scalar() + cross + v
+}
 
 /// `(sin, cos)` of half of each z-y-x Euler angle: what the attitude's quaternion is made of.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -212,7 +251,7 @@ impl<From: Frame, To: Frame> Rotation<From, To> {
     /// Re-resolves `v` from `From` axes into `To` axes.
     #[must_use]
     pub fn apply(&self, v: Vec3<From>) -> Vec3<To> {
-        Vec3::from_nalgebra(self.q * v.as_nalgebra())
+        Vec3::from_nalgebra(rotate(&self.q, v.as_nalgebra()))
     }
     /// The inverse rotation (`C_nbᵀ` for `C_nb`).
     #[must_use]
@@ -222,7 +261,9 @@ impl<From: Frame, To: Frame> Rotation<From, To> {
     /// `self` first, then `next`.
     #[must_use]
     pub fn then<Next: Frame>(&self, next: &Rotation<To, Next>) -> Rotation<From, Next> {
-        Rotation::assume_from_quaternion(next.q * self.q)
+        Rotation::assume_from_quaternion(UnitQuaternion::new_unchecked(quaternion_product(
+            &next.q, &self.q,
+        )))
     }
 }
 
@@ -235,5 +276,62 @@ impl Rotation<crate::frame::Ned, crate::frame::Enu> {
         Self::assume_from_quaternion(UnitQuaternion::new_unchecked(Quaternion::new(
             0.0, h, h, 0.0,
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_core::{Rng, SeedableRng};
+
+    /// A value in (−scale, scale), or an exact zero one time in eight (a zero angle is common).
+    fn value(rng: &mut rand_xoshiro::Xoshiro256PlusPlus, scale: f64) -> f64 {
+        let u = rng.next_u64();
+        if u.is_multiple_of(8) {
+            0.0
+        } else {
+            ((u >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * scale
+        }
+    }
+
+    fn vector(rng: &mut rand_xoshiro::Xoshiro256PlusPlus, scale: f64) -> Vector3<f64> {
+        Vector3::new(value(rng, scale), value(rng, scale), value(rng, scale))
+    }
+
+    fn bits<const N: usize>(a: impl IntoIterator<Item = f64>) -> [u64; N] {
+        let mut out = [0; N];
+        for (o, x) in out.iter_mut().zip(a) {
+            *o = x.to_bits();
+        }
+        out
+    }
+
+    /// The inlined kernels give nalgebra's results bit for bit, over angles from 1e-9 rad (below
+    /// nalgebra's identity threshold for some) to several turns.
+    #[test]
+    fn kernels_equal_nalgebra_bit_for_bit() {
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+        for k in 0..20_000 {
+            let scale = [1e-9, 1e-4, 0.1, 3.0, 20.0][k % 5];
+            let phi = vector(&mut rng, scale);
+            let q = rotation_vector_quaternion(&phi);
+            let want = UnitQuaternion::from_scaled_axis(phi);
+            assert_eq!(
+                bits::<4>(q.coords.iter().copied()),
+                bits::<4>(want.coords.iter().copied()),
+                "exp of {phi:?}"
+            );
+            let other = UnitQuaternion::from_scaled_axis(vector(&mut rng, 2.0));
+            let product = quaternion_product(&q, other.quaternion());
+            assert_eq!(
+                bits::<4>(product.coords.iter().copied()),
+                bits::<4>((want * other).coords.iter().copied())
+            );
+            let v = vector(&mut rng, 50.0);
+            assert_eq!(
+                bits::<3>(rotate(&q, &v).iter().copied()),
+                bits::<3>((want * v).iter().copied())
+            );
+        }
     }
 }

@@ -247,11 +247,11 @@ impl Blocks {
     }
 
     /// `self · m` (rows below the attitude zero), each block row the sum of its present
-    /// blocks' products in column order.
+    /// blocks' products in column order, formed apart and copied in (built in the product
+    /// itself, every call also paid a copy of the whole matrix).
     fn times<const S: usize>(&self, m: &Cov<S>) -> Cov<S> {
-        let mut out = Cov::<S>::zeros();
-        for i in 0..3 {
-            let mut row = out.fixed_view_mut::<3, S>(3 * i, 0);
+        let row = |i: usize| {
+            let mut row = Block::<S>::zeros();
             for j in 0..5 {
                 if let Some(b) = &self.m[i][j] {
                     row += b * m.fixed_view::<3, S>(3 * j, 0);
@@ -263,6 +263,12 @@ impl Blocks {
             if let Some(b) = &self.gyro[i] {
                 row += b * m.fixed_view::<12, S>(GYRO_ERRORS, 0);
             }
+            row
+        };
+        let rows = [row(0), row(1), row(2)];
+        let mut out = Cov::<S>::zeros();
+        for (i, row) in rows.iter().enumerate() {
+            out.fixed_view_mut::<3, S>(3 * i, 0).copy_from(row);
         }
         out
     }

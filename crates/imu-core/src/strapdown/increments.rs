@@ -16,10 +16,11 @@
 //! Weston, *Strapdown Inertial Navigation Technology* (2nd ed.), §11.2. The corrections can be
 //! switched off to compare. Rate inputs are turned into increments by the trapezoidal rule
 //! ([`RateIncrements`]).
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
 use crate::earth::EarthModel;
 use crate::frame::NavFrame;
+use crate::rotation::{quaternion_product, rotate, rotation_vector_quaternion};
 
 use super::equations::{State, all_finite, check_initial, earth_terms, finish, keep_unit, start};
 use super::{
@@ -114,6 +115,8 @@ impl<E: EarthModel> Increments<E> {
     ///
     /// # Errors
     /// As [`Self::step`].
+    #[inline(always)] // keeps the increments in registers: a caller's stores reloaded as
+    // vectors stall on store forwarding
     pub fn step_with_baro(
         &mut self,
         t_s: f64,
@@ -163,6 +166,7 @@ impl<E: EarthModel> Increments<E> {
     }
 
     /// One interval from `s0` with the Earth's terms evaluated at `mid`.
+    #[inline(always)]
     fn advance(
         &self,
         s0: &State,
@@ -173,21 +177,20 @@ impl<E: EarthModel> Increments<E> {
         baro_m: f64,
     ) -> State {
         let (acceleration, w_in) = earth_terms(&self.earth, mid);
-        let c0 = UnitQuaternion::new_unchecked(s0.q);
-        let d = c0 * dv_body;
+        let d = rotate(&s0.q, &dv_body);
+        let body_turn = rotation_vector_quaternion(&phi);
         let (dv_sf, q) = match w_in {
             Some(w_in) => {
                 // Specific force into the navigation frame at the start, less half the
                 // frame's turn over the interval.
                 let zeta = w_in * dt;
+                let frame_turn = rotation_vector_quaternion(&-zeta);
                 (
                     d - 0.5 * zeta.cross(&d),
-                    UnitQuaternion::from_scaled_axis(-zeta)
-                        * c0
-                        * UnitQuaternion::from_scaled_axis(phi),
+                    quaternion_product(&quaternion_product(&frame_turn, &s0.q), &body_turn),
                 )
             }
-            None => (d, c0 * UnitQuaternion::from_scaled_axis(phi)),
+            None => (d, quaternion_product(&s0.q, &body_turn)),
         };
         let mut v = s0.v + dv_sf + acceleration * dt;
         let v_mid = crate::vector::Vec3::<E::Frame>::from_nalgebra(0.5 * (s0.v + v));
@@ -210,12 +213,7 @@ impl<E: EarthModel> Increments<E> {
                 b += k3 * dh * dt;
             }
         }
-        State {
-            q: *q.quaternion(),
-            v,
-            c,
-            b,
-        }
+        State { q, v, c, b }
     }
 }
 
@@ -278,7 +276,7 @@ impl<E: EarthModel> RateIncrements<E> {
     }
 
     /// One sample: the trapezoid of the rates since the last one as increments.
-    #[inline]
+    #[inline(always)]
     fn sample(
         &mut self,
         t_s: f64,
