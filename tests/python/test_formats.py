@@ -119,3 +119,20 @@ def test_commands_read_numpy_files_made_by_numpy(tmp_path):
     # Unknown extensions are refused with the formats read.
     with pytest.raises(imukit.ImuError, match=r"\.npy, \.npz"):
         imukit.read(tmp_path / "imu.xlsx")
+
+
+def test_kalibr_imu_yaml_reads_with_kalibrs_parser_and_carries_the_presets_figures():
+    """`imukit presets NAME --format kalibr`: PyYAML (what Kalibr reads it with) gives floats, the
+    densities are the preset's (single-sided, as Kalibr's), the topic and rate are the options'."""
+    yaml = pytest.importorskip("yaml")
+    out = subprocess.run([imukit_bin(), "presets", "stim300", "--format", "kalibr",
+                          "--rate-hz", "125", "--topic", "/imu0"],
+                         check=True, capture_output=True, text=True).stdout
+    d = yaml.safe_load(out)
+    assert d["rostopic"] == "/imu0" and d["update_rate"] == 125.0
+    part = imukit.preset_params("stim300")
+    for sensor, key in (("gyroscope", "noise_density_rad_s_per_rt_hz"),
+                        ("accelerometer", "noise_density_m_s2_per_rt_hz")):
+        assert isinstance(d[f"{sensor}_noise_density"], float)
+        assert d[f"{sensor}_noise_density"] == pytest.approx(part[sensor][key], rel=5e-7)
+        assert isinstance(d[f"{sensor}_random_walk"], float) and d[f"{sensor}_random_walk"] > 0

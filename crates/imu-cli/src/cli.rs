@@ -301,10 +301,20 @@ pub enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
-    /// Lists the sensor presets, or prints one as a parameter file.
+    /// Lists the sensor presets, or prints one as a parameter file or as Kalibr's `imu.yaml`.
     Presets {
         /// Name of a preset.
         name: Option<String>,
+        /// What to print: imukit's parameter file, or Kalibr's IMU noise file (`imu.yaml`; its
+        /// comments say how each figure was reached).
+        #[arg(long, value_enum, default_value_t = PresetFormat::Toml)]
+        format: PresetFormat,
+        /// The IMU's rate written into Kalibr's file, Hz (the logger's rate).
+        #[arg(long, default_value_t = imukit::io::kalibr::DEFAULT_RATE_HZ)]
+        rate_hz: f64,
+        /// The IMU's topic written into Kalibr's file.
+        #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC)]
+        topic: String,
     },
     /// Converts a datasheet figure to imukit's SI parameter units (single-sided densities,
     /// g = 9.80665 m/s²), e.g. `imukit convert 0.15 "°/√h"`.
@@ -403,4 +413,13 @@ pub enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+}
+
+/// What `imukit presets NAME` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PresetFormat {
+    /// imukit's parameter file (TOML, each figure with its datasheet source).
+    Toml,
+    /// Kalibr's IMU noise file (`imu.yaml`).
+    Kalibr,
 }

@@ -46,7 +46,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         ),
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
-        Command::Presets { name } => presets::run(name.as_deref()),
+        Command::Presets {
+            name,
+            format,
+            rate_hz,
+            topic,
+        } => presets::run(name.as_deref(), format, rate_hz, &topic),
         Command::Integrate {
             input,
             init,

@@ -4,6 +4,7 @@
 //! presets of real parts ([`presets`]), datasheet units ([`units`]), the time-checked row
 //! reader of IMU files ([`rows`]) and typed values read from a tree of them ([`value_tree`]:
 //! a Python dict's way in).
+pub mod kalibr;
 pub mod npy;
 pub mod npz;
 pub mod output;
