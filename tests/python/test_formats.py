@@ -136,3 +136,6 @@ def test_kalibr_imu_yaml_reads_with_kalibrs_parser_and_carries_the_presets_figur
         assert isinstance(d[f"{sensor}_noise_density"], float)
         assert d[f"{sensor}_noise_density"] == pytest.approx(part[sensor][key], rel=5e-7)
         assert isinstance(d[f"{sensor}_random_walk"], float) and d[f"{sensor}_random_walk"] > 0
+    assert imukit.kalibr_yaml("stim300", rate_hz=125.0, topic="/imu0") == out
+    with pytest.raises(imukit.ImuError, match="rate_hz"):
+        imukit.kalibr_yaml("stim300", rate_hz=0.0)

@@ -223,6 +223,15 @@ fn preset_toml(name: &str) -> PyResult<&'static str> {
     presets::text(name).map_err(refused)
 }
 
+/// A preset as Kalibr's `imu.yaml` text at `rate_hz` on `topic`.
+#[pyfunction]
+#[pyo3(signature = (name, *, rate_hz = imukit::io::kalibr::DEFAULT_RATE_HZ, topic = imukit::io::kalibr::DEFAULT_TOPIC))]
+fn preset_kalibr_yaml(name: &str, rate_hz: f64, topic: &str) -> PyResult<String> {
+    let file = presets::load(name).map_err(refused)?;
+    let imu = imukit::io::kalibr::KalibrImu::from_params(&file, rate_hz, topic).map_err(refused)?;
+    Ok(imu.to_yaml())
+}
+
 /// A parameter file (imukit TOML/JSON or MATLAB loadparams JSON) as imukit TOML text, with what
 /// a MATLAB file had that was skipped (as MATLAB skips it).
 #[pyfunction]
@@ -240,6 +249,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(convert, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_kalibr_yaml, m)?)?;
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
     Ok(())
 }

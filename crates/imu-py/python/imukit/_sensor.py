@@ -209,6 +209,13 @@ def preset_params(name: str) -> dict:
     ``magnetometer`` tables with imukit's unit-suffixed keys (usable as ``ImuSensor`` arguments)."""
     return _toml_to_dict(_core.preset_toml(name))
 
+def kalibr_yaml(name: str, *, rate_hz: float = _core.DEFAULTS["kalibr_rate_hz"],
+                topic: str = _core.DEFAULTS["kalibr_topic"]) -> str:
+    """A preset as Kalibr's ``imu.yaml`` text (as ``imukit presets NAME --format kalibr``): the
+    densities in Kalibr's single-sided convention, the random walk a bias instability implies
+    where the part gives none, each choice in the file's comments. ``rate_hz`` is the logger's."""
+    return _core.preset_kalibr_yaml(name, rate_hz=rate_hz, topic=topic)
+
 def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dict:
     """Reads a parameter file — imukit TOML/JSON, or MATLAB ``loadparams`` JSON (``part`` picks one
     of several parts) — into a dict like :func:`preset_params`."""
