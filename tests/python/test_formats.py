@@ -2,6 +2,7 @@
 extension says so — the CSV contract's column names, float64 (Parquet also carries the scenario
 and navigation frame in its metadata) — and pyarrow, pandas, polars, NumPy and ``imukit.read``
 read them back bit for bit equal to the CSV output; the commands read what NumPy saves."""
+import json
 import subprocess
 
 import numpy as np
@@ -139,3 +140,20 @@ def test_kalibr_imu_yaml_reads_with_kalibrs_parser_and_carries_the_presets_figur
     assert imukit.kalibr_yaml("stim300", rate_hz=125.0, topic="/imu0") == out
     with pytest.raises(imukit.ImuError, match="rate_hz"):
         imukit.kalibr_yaml("stim300", rate_hz=0.0)
+
+
+def test_a_matlab_parameter_file_becomes_kalibrs_single_sided_figures(tmp_path):
+    """`imukit presets --params FILE --format kalibr`: a MATLAB ``loadparams`` file is double-sided,
+    so Kalibr's density is N/√2 and its random walk K·√2."""
+    yaml = pytest.importorskip("yaml")
+    part = tmp_path / "part.json"
+    part.write_text(json.dumps({"MyPart": {
+        "Accelerometer": {"NoiseDensity": 2e-3, "RandomWalk": 4e-4},
+        "Gyroscope": {"NoiseDensity": 1e-3, "RandomWalk": 2e-5}}}))
+    out = subprocess.run([imukit_bin(), "presets", "--params", str(part), "--format", "kalibr"],
+                         check=True, capture_output=True, text=True).stdout
+    d = yaml.safe_load(out)
+    assert d["gyroscope_noise_density"] == pytest.approx(1e-3 / 2**0.5, rel=5e-7)
+    assert d["gyroscope_random_walk"] == pytest.approx(2e-5 * 2**0.5, rel=5e-7)
+    assert d["accelerometer_noise_density"] == pytest.approx(2e-3 / 2**0.5, rel=5e-7)
+    assert "from MyPart" in out and "double-sided densities turned single-sided" in out

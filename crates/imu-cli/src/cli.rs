@@ -304,7 +304,15 @@ pub enum Command {
     /// Lists the sensor presets, or prints one as a parameter file or as Kalibr's `imu.yaml`.
     Presets {
         /// Name of a preset.
+        #[arg(conflicts_with = "params")]
         name: Option<String>,
+        /// A parameter file to print instead of a preset: imukit TOML/JSON or MATLAB
+        /// `loadparams` JSON (`--part` picks one of several parts).
+        #[arg(long, value_name = "FILE")]
+        params: Option<PathBuf>,
+        /// The part of a MATLAB parameter file that holds several.
+        #[arg(long, requires = "params")]
+        part: Option<String>,
         /// What to print: imukit's parameter file, or Kalibr's IMU noise file (`imu.yaml`; its
         /// comments say how each figure was reached).
         #[arg(long, value_enum, default_value_t = PresetFormat::Toml)]

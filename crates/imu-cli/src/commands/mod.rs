@@ -48,10 +48,15 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Scenario { name } => scenario::run(name.as_deref()),
         Command::Presets {
             name,
+            params,
+            part,
             format,
             rate_hz,
             topic,
-        } => presets::run(name.as_deref(), format, rate_hz, &topic),
+        } => match params {
+            Some(path) => presets::file(&path, part.as_deref(), format, rate_hz, &topic),
+            None => presets::run(name.as_deref(), format, rate_hz, &topic),
+        },
         Command::Integrate {
             input,
             init,

@@ -1,6 +1,9 @@
-//! `imukit presets [NAME]`: list the sensor presets or print one as a parameter file or as
-//! Kalibr's `imu.yaml`.
+//! `imukit presets [NAME]`: list the sensor presets or print one (or a parameter file, with
+//! `--params`) as a parameter file or as Kalibr's `imu.yaml`.
+use std::path::Path;
+
 use imukit::io::kalibr::KalibrImu;
+use imukit::io::params::{ParamFile, Profile, read_param_file, to_toml};
 use imukit::io::presets;
 
 use super::CliError;
@@ -24,18 +27,36 @@ pub fn run(
         }
         Some(n) => match format {
             PresetFormat::Toml => print!("{}", presets::text(n)?),
-            PresetFormat::Kalibr => {
-                let imu = KalibrImu::from_params(&presets::load(n)?, rate_hz, topic).map_err(
-                    |e| match e {
-                        imukit::Error::Invalid { ref field, .. } if field == "rate_hz" => {
-                            by_flag(e)
-                        }
-                        other => other,
-                    },
-                )?;
-                print!("{}", imu.to_yaml());
-            }
+            PresetFormat::Kalibr => kalibr(&presets::load(n)?, rate_hz, topic)?,
         },
     }
+    Ok(())
+}
+
+/// `imukit presets --params FILE`: a parameter file as imukit's TOML or Kalibr's file.
+pub fn file(
+    path: &Path,
+    part: Option<&str>,
+    format: PresetFormat,
+    rate_hz: f64,
+    topic: &str,
+) -> Result<(), CliError> {
+    let params = read_param_file(path, part, Profile::Default)?;
+    for warning in &params.warnings {
+        eprintln!("imukit: warning: {warning}");
+    }
+    match format {
+        PresetFormat::Toml => print!("{}", to_toml(&params)),
+        PresetFormat::Kalibr => kalibr(&params, rate_hz, topic)?,
+    }
+    Ok(())
+}
+
+fn kalibr(params: &ParamFile, rate_hz: f64, topic: &str) -> Result<(), CliError> {
+    let imu = KalibrImu::from_params(params, rate_hz, topic).map_err(|e| match e {
+        imukit::Error::Invalid { ref field, .. } if field == "rate_hz" => by_flag(e),
+        other => other,
+    })?;
+    print!("{}", imu.to_yaml());
     Ok(())
 }
