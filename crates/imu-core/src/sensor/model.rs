@@ -1,8 +1,7 @@
 //! One validated sensor triad and its drifting state.
 use crate::math;
 use crate::sensor::{
-    BiasInstabilityModel, FilterBuffer, InlineBuffer, NoiseSource, NoiseType, ParamError,
-    SensorParams,
+    BiasInstabilityModel, FilterBuffer, InlineBuffer, NoiseSource, ParamError, SensorParams,
 };
 
 /// Largest number of first-order sections of the flicker bias-instability model.
@@ -385,10 +384,7 @@ impl<B: FilterBuffer> SensorModel<B> {
                 value: sample_rate_hz,
             });
         }
-        let bandwidth = match params.noise_type {
-            NoiseType::SingleSided => sample_rate_hz,
-            NoiseType::DoubleSided => sample_rate_hz / 2.0,
-        };
+        let bandwidth = sample_rate_hz * params.noise_type.bandwidth_share();
         let root = math::sqrt(bandwidth);
         let misalignment = params
             .axes_misalignment_pct

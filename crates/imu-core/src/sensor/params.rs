@@ -70,6 +70,19 @@ pub enum NoiseType {
     DoubleSided,
 }
 
+impl NoiseType {
+    /// The densities' bandwidth as a share of the sample rate: 1 (single-sided) or ½
+    /// (double-sided). White noise of density `N` has the per-sample deviation
+    /// `N·√(share·fs)`, a random walk of density `K` the step `K/√(share·fs)`.
+    #[must_use]
+    pub const fn bandwidth_share(self) -> f64 {
+        match self {
+            Self::SingleSided => 1.0,
+            Self::DoubleSided => 0.5,
+        }
+    }
+}
+
 /// Numerator and denominator of the bias-instability filter (MATLAB `filter(Num, Den, x)`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilterCoefficients<B: FilterBuffer = InlineBuffer> {

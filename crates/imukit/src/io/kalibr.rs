@@ -19,6 +19,7 @@
 //! it implies no random walk. Every such choice is stated in the file's comments.
 use crate::error::{Error, Result};
 use crate::io::params::{ParamFile, Sensor};
+use imu_core::allan::BIAS_INSTABILITY_FACTOR;
 use imu_core::sensor::{BiasInstabilityModel, FilterBuffer, NoiseType, SensorParams};
 
 /// The topic written when none is given: imukit's IMU topic in a ROS bag.
@@ -27,9 +28,6 @@ pub const DEFAULT_TOPIC: &str = "/imu";
 /// The rate written when none is given, Hz (Kalibr's own example file's); the rate is the
 /// logger's, so a user sets it.
 pub const DEFAULT_RATE_HZ: f64 = 200.0;
-
-/// Flicker's Allan floor per unit bias instability, `√(2 ln 2/π)` (0.664).
-const FLICKER_FLOOR: f64 = imu_core::allan::BIAS_INSTABILITY_FACTOR;
 
 /// Kalibr's figures for one sensor (SI units) and what was done to reach them.
 #[derive(Clone, Debug, PartialEq)]
@@ -82,17 +80,17 @@ fn sensor<B: FilterBuffer>(p: &SensorParams<B>, unit: &str) -> KalibrSensor {
     if p.noise_density.iter().any(|&x| x != n) || p.random_walk.iter().any(|&x| x != k) {
         notes.push("the axes differ: the largest axis is written".to_owned());
     }
-    let (mut noise_density, mut random_walk) = (n, k);
+    // The same discrete noise over the whole rate: N·√(share·fs) = σ_c·√fs, K/√(share·fs) = σ_b/√fs.
+    let root_share = p.noise_type.bandwidth_share().sqrt();
+    let (noise_density, mut random_walk) = (n * root_share, k / root_share);
     if p.noise_type == NoiseType::DoubleSided {
-        noise_density = n / core::f64::consts::SQRT_2;
-        random_walk = k * core::f64::consts::SQRT_2;
         notes.push("double-sided densities turned single-sided (N/√2, K·√2)".to_owned());
     }
     let b = largest(p.bias_instability);
     if random_walk == 0.0 && b > 0.0 {
         match &p.bias_instability_model {
             BiasInstabilityModel::Flicker { tau_max_s, .. } => {
-                random_walk = FLICKER_FLOOR * b * (3.0 / tau_max_s).sqrt();
+                random_walk = BIAS_INSTABILITY_FACTOR * b * (3.0 / tau_max_s).sqrt();
                 notes.push(format!(
                     "random walk from the bias instability B = {b:.6e} {unit} (flicker floor \
                      0.664·B up to τ₂ = {tau_max_s} s): K = 0.664·B·√(3/τ₂)"
