@@ -9,7 +9,7 @@ use imu_core::fusion::{BASE_STATES, FULL_STATES};
 use imu_core::strapdown::NavState;
 use imu_core::{Enu, Ned};
 
-const NAMES: [&str; 7] = [
+const NAMES: [&str; 11] = [
     "strapdown/3d_rates",
     "strapdown/3d_increments_flat",
     "strapdown/3d_increments_earth",
@@ -17,6 +17,10 @@ const NAMES: [&str; 7] = [
     "fusion/propagate_36_states",
     "fusion/propagate_covariance_20hz",
     "fusion/propagate_covariance_20hz_36_states",
+    "fusion/propagate_earth",
+    "fusion/propagate_36_states_earth",
+    "fusion/propagate_covariance_20hz_earth",
+    "fusion/propagate_covariance_20hz_36_states_earth",
 ];
 
 /// One run of the workload; returns a number from its result so that none is optimised away.
@@ -43,6 +47,12 @@ fn run(name: &str) -> Option<f64> {
         "fusion/propagate_36_states" => fused::<FlatEarth<Enu>, FULL_STATES>(0.0),
         "fusion/propagate_covariance_20hz" => fused::<FlatEarth<Enu>, BASE_STATES>(0.05),
         "fusion/propagate_covariance_20hz_36_states" => fused::<FlatEarth<Enu>, FULL_STATES>(0.05),
+        "fusion/propagate_earth" => fused::<Wgs84<Ned>, BASE_STATES>(0.0),
+        "fusion/propagate_36_states_earth" => fused::<Wgs84<Ned>, FULL_STATES>(0.0),
+        "fusion/propagate_covariance_20hz_earth" => fused::<Wgs84<Ned>, BASE_STATES>(0.05),
+        "fusion/propagate_covariance_20hz_36_states_earth" => {
+            fused::<Wgs84<Ned>, FULL_STATES>(0.05)
+        }
         _ => return None,
     })
 }

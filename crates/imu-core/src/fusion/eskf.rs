@@ -163,113 +163,153 @@ pub(crate) fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
 /// A 3 × `C` block of the transition.
 type Block<const C: usize> = SMatrix<f64, 3, C>;
 
-/// The non-zero 3 × 3 (and sensor-error) blocks of a matrix whose rows below the attitude
-/// are zero, as `F` and `A = FΔt + (FΔt)²/2` are: block rows δp, δv, φ; block columns δp, δv,
-/// φ, δb_a, δb_g, then the sensor errors δm_a (9 columns) and δm_g (12). `None` is a zero block,
-/// skipped in every product.
-#[derive(Clone, Copy, Debug, Default)]
-struct Blocks {
-    m: [[Option<Matrix3<f64>>; 5]; 3],
-    accel: [Option<Block<9>>; 3],
-    gyro: [Option<Block<12>>; 3],
+/// The error dynamics `F` by its non-zero 3 × 3 blocks (the rows below the attitude are
+/// zero): on every Earth `δṗ = δv` (the identity), `F_vφ = −[Ĉf̂×]` and
+/// `F_v,ba = F_φ,bg = −Ĉ`; a curved Earth adds its couplings, a 36-state filter its sensor
+/// errors.
+struct Dynamics {
+    /// `F_vφ = −[Ĉf̂×]`.
+    v_phi: Matrix3<f64>,
+    /// `−Ĉ`, both `F_v,ba` and `F_φ,bg`.
+    minus_c: Matrix3<f64>,
+    earth: Option<EarthCouplings>,
+    /// `F_v,ma = −Ĉ D_a` (3 × 9) and `F_φ,mg = −Ĉ D_g` (3 × 12).
+    sensors: Option<(Block<9>, Block<12>)>,
 }
 
-/// `acc + term`, or `term` when nothing is accumulated yet (so that the sum of the present
-/// terms is formed in their order, with no zero added).
-#[inline(always)]
-fn accumulate<T: core::ops::Add<Output = T>>(acc: Option<T>, term: T) -> Option<T> {
-    Some(match acc {
-        Some(a) => a + term,
-        None => term,
-    })
+/// The blocks of `F` that a curved Earth adds.
+struct EarthCouplings {
+    /// `F_vp`, the gravity gradient.
+    v_p: Matrix3<f64>,
+    /// `F_vv = −[(2ω_ie + ω_en)×]`.
+    v_v: Matrix3<f64>,
+    /// `F_φp = −∂ω_in/∂p`.
+    phi_p: Matrix3<f64>,
+    /// `F_φv = −∂ω_en/∂v`.
+    phi_v: Matrix3<f64>,
+    /// `F_φφ = −[ω_in×]`.
+    phi_phi: Matrix3<f64>,
 }
 
-/// `FΔt + (Σ F F) Δt²/2` of a block: `first` (`F_ij`, if present) and the present products.
+/// `A = FΔt + (FΔt)²/2`, by its non-zero blocks (named row_column): those of every Earth,
+/// those a curved Earth adds and the sensor errors' columns. `Φ = I + A`.
+struct Transition {
+    p_v: Matrix3<f64>,
+    p_phi: Matrix3<f64>,
+    p_ba: Matrix3<f64>,
+    v_phi: Matrix3<f64>,
+    v_ba: Matrix3<f64>,
+    v_bg: Matrix3<f64>,
+    phi_bg: Matrix3<f64>,
+    earth: Option<EarthTransition>,
+    sensors: Option<SensorTransition>,
+}
+
+/// The blocks of `A` that are zero on the flat Earth.
+struct EarthTransition {
+    p_p: Matrix3<f64>,
+    v_p: Matrix3<f64>,
+    v_v: Matrix3<f64>,
+    phi_p: Matrix3<f64>,
+    phi_v: Matrix3<f64>,
+    phi_phi: Matrix3<f64>,
+    phi_ba: Matrix3<f64>,
+}
+
+/// The sensor errors' columns of `A` (36 states).
+struct SensorTransition {
+    p_ma: Block<9>,
+    v_ma: Block<9>,
+    /// Zero on the flat Earth.
+    phi_ma: Option<Block<9>>,
+    v_mg: Block<12>,
+    phi_mg: Block<12>,
+}
+
+/// `x`, plus `y` when there is one.
 #[inline(always)]
-fn second_order<T>(first: Option<T>, products: Option<T>, dt: f64, h: f64) -> Option<T>
-where
-    T: core::ops::Add<Output = T> + core::ops::Mul<f64, Output = T>,
-{
-    match (first, products) {
-        (Some(f), Some(p)) => Some(f * dt + p * h),
-        (Some(f), None) => Some(f * dt),
-        (None, Some(p)) => Some(p * h),
-        (None, None) => None,
+fn plus<T: core::ops::Add<Output = T>>(x: T, y: Option<T>) -> T {
+    match y {
+        Some(y) => x + y,
+        None => x,
     }
 }
 
-impl Blocks {
-    /// `A = FΔt + F²Δt²/2` of `F = self`: `A_ij = F_ij Δt + (Σ_k F_ik F_kj) Δt²/2`, `k` over
-    /// the three non-zero block rows. F's first block row is `δṗ = δv`, the identity at
-    /// `(0, 1)` and nothing else, so its products are taken without multiplying.
-    #[allow(clippy::needless_range_loop)] // the block indices index several arrays at once
-    fn transition(&self, dt: f64) -> Blocks {
+impl Transition {
+    /// `A_ij = F_ij Δt + (Σ_k F_ik F_kj) Δt²/2`, each sum over the present products in the
+    /// order of `k` (δp, δv, φ; F's first block row is the identity at δv, so its products
+    /// are taken without multiplying).
+    #[inline(always)]
+    fn new(f: &Dynamics, dt: f64) -> Self {
         let h = 0.5 * dt * dt;
-        let f = &self.m;
-        let mut a = Blocks::default();
-        for i in 0..3 {
-            for j in 0..5 {
-                let mut products = None;
-                for k in 0..3 {
-                    let term = match (i, k) {
-                        (0, 1) => f[1][j],
-                        (0, _) => None,
-                        (_, 0) if j == 1 => f[i][0],
-                        (_, 0) => None,
-                        _ => f[i][k].zip(f[k][j]).map(|(x, y)| x * y),
-                    };
-                    if let Some(t) = term {
-                        products = accumulate(products, t);
-                    }
-                }
-                a.m[i][j] = second_order(f[i][j], products, dt, h);
-            }
-            let (mut accel, mut gyro) = (None, None);
-            for k in 1..3 {
-                let through = if i == 0 {
-                    (k == 1).then(Matrix3::identity)
-                } else {
-                    f[i][k]
-                };
-                if let Some(x) = through {
-                    if let Some(y) = &self.accel[k] {
-                        accel = accumulate(accel, if i == 0 { *y } else { x * y });
-                    }
-                    if let Some(y) = &self.gyro[k] {
-                        gyro = accumulate(gyro, if i == 0 { *y } else { x * y });
-                    }
-                }
-            }
-            a.accel[i] = second_order(self.accel[i], accel, dt, h);
-            a.gyro[i] = second_order(self.gyro[i], gyro, dt, h);
+        let (x, mc) = (&f.v_phi, &f.minus_c);
+        let e = f.earth.as_ref();
+        Self {
+            p_v: plus(Matrix3::identity() * dt, e.map(|e| e.v_v * h)),
+            p_phi: x * h,
+            p_ba: mc * h,
+            v_phi: plus(x * dt, e.map(|e| (e.v_v * x + x * e.phi_phi) * h)),
+            v_ba: plus(mc * dt, e.map(|e| (e.v_v * mc) * h)),
+            v_bg: (x * mc) * h,
+            phi_bg: plus(mc * dt, e.map(|e| (e.phi_phi * mc) * h)),
+            earth: e.map(|e| EarthTransition {
+                p_p: e.v_p * h,
+                v_p: e.v_p * dt + (e.v_v * e.v_p + x * e.phi_p) * h,
+                v_v: e.v_v * dt + (e.v_p + e.v_v * e.v_v + x * e.phi_v) * h,
+                phi_p: e.phi_p * dt + (e.phi_v * e.v_p + e.phi_phi * e.phi_p) * h,
+                phi_v: e.phi_v * dt + (e.phi_p + e.phi_v * e.v_v + e.phi_phi * e.phi_v) * h,
+                phi_phi: e.phi_phi * dt + (e.phi_v * x + e.phi_phi * e.phi_phi) * h,
+                phi_ba: (e.phi_v * mc) * h,
+            }),
+            sensors: f.sensors.as_ref().map(|(va, pg)| SensorTransition {
+                p_ma: va * h,
+                v_ma: plus(va * dt, e.map(|e| (e.v_v * va) * h)),
+                phi_ma: e.map(|e| (e.phi_v * va) * h),
+                v_mg: (x * pg) * h,
+                phi_mg: plus(pg * dt, e.map(|e| (e.phi_phi * pg) * h)),
+            }),
         }
-        a
     }
 
-    /// `self · m` (rows below the attitude zero), each block row the sum of its present
-    /// blocks' products in column order, formed apart and copied in (built in the product
-    /// itself, every call also paid a copy of the whole matrix).
+    /// `A · m` (rows below the attitude zero), each block row the sum of its blocks'
+    /// products in column order, formed apart and copied in (built in the product itself,
+    /// every call also paid a copy of the whole matrix).
     fn times<const S: usize>(&self, m: &Cov<S>) -> Cov<S> {
-        let row = |i: usize| {
-            let mut row = Block::<S>::zeros();
-            for j in 0..5 {
-                if let Some(b) = &self.m[i][j] {
-                    row += b * m.fixed_view::<3, S>(3 * j, 0);
-                }
-            }
-            if let Some(b) = &self.accel[i] {
-                row += b * m.fixed_view::<9, S>(ACCEL_MATRIX, 0);
-            }
-            if let Some(b) = &self.gyro[i] {
-                row += b * m.fixed_view::<12, S>(GYRO_ERRORS, 0);
-            }
-            row
+        let row = |k: usize| m.fixed_view::<3, S>(3 * k, 0);
+        let accel = || m.fixed_view::<9, S>(ACCEL_MATRIX, 0);
+        let gyro = || m.fixed_view::<12, S>(GYRO_ERRORS, 0);
+        let (e, s) = (self.earth.as_ref(), self.sensors.as_ref());
+        // Each row starts from its first present term (no zero added), then the rest in
+        // column order.
+        let (mut r0, mut r1, mut r2) = match e {
+            Some(e) => (
+                e.p_p * row(0) + self.p_v * row(1),
+                e.v_p * row(0) + e.v_v * row(1) + self.v_phi * row(2),
+                e.phi_p * row(0)
+                    + e.phi_v * row(1)
+                    + e.phi_phi * row(2)
+                    + e.phi_ba * row(3)
+                    + self.phi_bg * row(4),
+            ),
+            None => (self.p_v * row(1), self.v_phi * row(2), self.phi_bg * row(4)),
         };
-        let rows = [row(0), row(1), row(2)];
-        let mut out = Cov::<S>::zeros();
-        for (i, row) in rows.iter().enumerate() {
-            out.fixed_view_mut::<3, S>(3 * i, 0).copy_from(row);
+        r0 += self.p_phi * row(2);
+        r0 += self.p_ba * row(3);
+        r1 += self.v_ba * row(3);
+        r1 += self.v_bg * row(4);
+        if let Some(s) = s {
+            r0 += s.p_ma * accel();
+            r1 += s.v_ma * accel();
+            r1 += s.v_mg * gyro();
+            if let Some(phi_ma) = &s.phi_ma {
+                r2 += phi_ma * accel();
+            }
+            r2 += s.phi_mg * gyro();
         }
+        let mut out = Cov::<S>::zeros();
+        out.fixed_view_mut::<3, S>(0, 0).copy_from(&r0);
+        out.fixed_view_mut::<3, S>(3, 0).copy_from(&r1);
+        out.fixed_view_mut::<3, S>(6, 0).copy_from(&r2);
         out
     }
 }
@@ -454,33 +494,35 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         let Some((dt, cf, c)) = self.intake.take_pending() else {
             return;
         };
-        let mut f = Blocks::default();
-        f.m[0][1] = Some(Matrix3::identity());
-        f.m[1][2] = Some(-skew(&cf));
-        f.m[1][3] = Some(-c);
-        f.m[2][4] = Some(-c);
         let earth = self.mechanization.earth();
         let coords = E::coordinates(&self.nav.position);
         let v = self.nav.velocity_m_s;
-        if let Some(k) = earth.couplings(&coords, &v) {
+        let couplings = earth.couplings(&coords, &v).map(|k| {
             let t = earth.terms(&coords, &v);
             let (w_ie, w_en) = (
                 *t.earth_rate_rad_s.as_nalgebra(),
                 *t.transport_rate_rad_s.as_nalgebra(),
             );
             let m = |a: [[f64; 3]; 3]| Matrix3::from_fn(|i, j| a[i][j]);
-            f.m[1][0] = Some(m(k.gravity_gradient));
-            f.m[1][1] = Some(-skew(&(2.0 * w_ie + w_en)));
-            f.m[2][0] = Some(-m(k.rate_by_position));
-            f.m[2][1] = Some(-m(k.rate_by_velocity));
-            f.m[2][2] = Some(-skew(&(w_ie + w_en)));
-        }
-        if S == FULL_STATES {
+            EarthCouplings {
+                v_p: m(k.gravity_gradient),
+                v_v: -skew(&(2.0 * w_ie + w_en)),
+                phi_p: -m(k.rate_by_position),
+                phi_v: -m(k.rate_by_velocity),
+                phi_phi: -skew(&(w_ie + w_en)),
+            }
+        });
+        let sensors = (S == FULL_STATES).then(|| {
             let (cda, cdg) = self.errors.take_pending(dt);
-            f.accel[1] = Some(-cda);
-            f.gyro[2] = Some(-cdg);
-        }
-        let a = f.transition(dt);
+            (-cda, -cdg)
+        });
+        let f = Dynamics {
+            v_phi: -skew(&cf),
+            minus_c: -c,
+            earth: couplings,
+            sensors,
+        };
+        let a = Transition::new(&f, dt);
         let ap = a.times(&self.cov);
         // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases;
         // Q_d = ½ (Φ Q Φᵀ + Q) Δt.
