@@ -42,6 +42,33 @@ def test_parquet_outputs_read_back_everywhere_with_their_metadata(tmp_path):
         assert ours.columns == csv.columns and np.array_equal(ours.values, csv.values)
 
 
+def test_a_csv_table_says_what_it_holds_in_a_line_pandas_and_numpy_skip(tmp_path):
+    scenario = ROOT / "examples" / "schuler.toml"
+    text = scenario.read_text().replace("duration_s = 5400.0", "duration_s = 2.0")
+    (tmp_path / "s.toml").write_text(text)
+    subprocess.run([imukit_bin(), "simulate", str(tmp_path / "s.toml"), "--out", str(tmp_path / "imu.csv"),
+                    "--truth", str(tmp_path / "truth.parquet")], check=True, capture_output=True)
+    first = (tmp_path / "imu.csv").read_text().splitlines()[0]
+    assert first.startswith("# imukit: ")
+    described = json.loads(first[len("# imukit: "):])
+    assert described["kind"] == "readings" and described["nav_frame"] == "NED"
+    assert described["body_frame"] == "FRD" and described["earth"] == "wgs84"
+    assert (described["origin_latitude_deg"], described["origin_longitude_deg"]) == (45.0, 7.0)
+    assert described["scenario"] == text
+    assert "[gyroscope]" in described["sensor"]
+    # The same entries in the Parquet file's metadata, as text.
+    meta = {k.decode(): v.decode() for k, v in pq.read_metadata(tmp_path / "truth.parquet").metadata.items()}
+    assert meta["imukit.kind"] == "truth" and meta["imukit.origin_height_m"] == "300"
+    # The readers the documentation names skip it and read the numbers bit for bit.
+    ours = imukit.read(tmp_path / "imu.csv")
+    frame = pd.read_csv(tmp_path / "imu.csv", comment="#", float_precision="round_trip")
+    assert list(frame.columns) == list(ours.columns)
+    assert np.array_equal(frame.to_numpy(), ours.values)
+    array = np.genfromtxt(tmp_path / "imu.csv", delimiter=",", names=True, skip_header=1)
+    assert list(array.dtype.names) == list(ours.columns)
+    assert np.array_equal(array["gyro_z_rad_s"], ours.values[:, ours.columns.index("gyro_z_rad_s")])
+
+
 def test_tables_write_parquet_and_the_commands_read_it(tmp_path):
     sim = imukit.simulate(ROOT / "examples" / "expression.toml")
     sim.truth.write(tmp_path / "truth.parquet")

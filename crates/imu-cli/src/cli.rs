@@ -96,15 +96,18 @@ pub enum Command {
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
         init: Option<PathBuf>,
-        /// 3D: navigation frame of the data.
-        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
-        nav_frame: NavFrameName,
-        /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling).
-        #[arg(long, alias = "gravity", default_value_t = imu_core::DEFAULT_GRAVITY_M_S2)]
-        gravity_m_s2: f64,
-        /// 3D: sign of the accelerometer columns.
-        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true, default_value_t)]
-        accel_sign: AccelSignName,
+        /// 3D: navigation frame of the data [default: what the input files' descriptions say,
+        /// else ENU].
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+        nav_frame: Option<NavFrameName>,
+        /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling) [default: what the input
+        /// files' descriptions say, else 9.81].
+        #[arg(long, alias = "gravity")]
+        gravity_m_s2: Option<f64>,
+        /// 3D: sign of the accelerometer columns [default: what the input files' descriptions
+        /// say, else specific-force].
+        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
+        accel_sign: Option<AccelSignName>,
         /// 3D: switch off the coning and sculling corrections (for comparison).
         #[arg(long)]
         no_corrections: bool,
@@ -140,9 +143,9 @@ pub enum Command {
         /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
         /// needs a geodetic position, from an --init truth file of a `wgs84` scenario or
         /// --lat0-deg/--lon0-deg/--height0-m). Writes lat_rad, lon_rad, height_m beside the
-        /// local columns.
-        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true, default_value_t)]
-        earth: EarthName,
+        /// local columns [default: what the input files' descriptions say, else flat].
+        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
+        earth: Option<EarthName>,
         /// 3D, `--earth wgs84`: the vertical channel: `free` (unstable, as physics says),
         /// `hold` (height and vertical velocity held) or `baro` (a third-order loop on the IMU
         /// file's `baro_height_m` column).
@@ -152,9 +155,9 @@ pub enum Command {
         #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
         baro_time_constant_s: f64,
         /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
-        /// (--gravity-m-s2).
-        #[arg(long, value_parser = choice::<EarthGravityName>(), ignore_case = true, default_value_t)]
-        earth_gravity: EarthGravityName,
+        /// (--gravity-m-s2) [default: what the input files' descriptions say, else normal].
+        #[arg(long, value_parser = choice::<EarthGravityName>(), ignore_case = true)]
+        earth_gravity: Option<EarthGravityName>,
         /// 3D, `--vertical baro`: barometer readings (`t_s, baro_height_m`, as `imukit simulate
         /// --baro` writes) instead of a `baro_height_m` column in the IMU file.
         #[arg(long)]

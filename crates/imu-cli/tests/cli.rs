@@ -13,6 +13,14 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
         .unwrap()
 }
 
+/// A CSV table's text after its description line (`# imukit: {…}`, which must be there).
+fn table_text(path: impl AsRef<std::path::Path>) -> String {
+    let text = std::fs::read_to_string(path.as_ref()).unwrap();
+    let (first, rest) = text.split_once('\n').unwrap();
+    assert!(first.starts_with("# imukit: {\"kind\": "), "{first}");
+    rest.to_string()
+}
+
 #[test]
 fn demo_writes_its_outputs_and_says_where() {
     let dir = temp_dir("demo");
@@ -40,7 +48,7 @@ fn demo_writes_its_outputs_and_says_where() {
     ] {
         assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
     }
-    let imu = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
+    let imu = table_text(dir.join("imu.csv"));
     assert_eq!(imu.lines().count(), 2002); // header + 2001 samples at 2 kHz over 1 s
 }
 
@@ -295,20 +303,107 @@ fn simulate_integrate_compare_closes_the_loop() {
     run(&["compare", "truth.csv", "nav4.csv", "--out", "err4.csv"]);
     let err4 = imukit::io::table::read_columns(&dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
     assert!(*err4.get("pos_err_m").last().unwrap() < 1e-6);
-    // Integrating in the wrong frame is visibly wrong (gravity the other way).
+    // The files say what they hold (NED, flat Earth, gravity, sign), so no flag is needed: the
+    // same numbers as with the flag, from CSV and from Parquet alike.
+    let readings = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
+    let description = readings.lines().next().unwrap();
+    for entry in [
+        "# imukit: {\"kind\": \"readings\"",
+        "\"nav_frame\": \"NED\", \"body_frame\": \"FRD\", \"earth\": \"flat\"",
+        "\"gravity_m_s2\": 9.81",
+        "\"scenario\": \"rate_hz = 400.0",
+    ] {
+        assert!(description.contains(entry), "{entry}: {description}");
+    }
     run(&[
         "integrate",
         "imu.csv",
         "--init",
         "truth.csv",
-        "--nav-frame",
-        "ENU",
         "--out",
-        "wrong.csv",
+        "plain.csv",
     ]);
-    run(&["compare", "truth.csv", "wrong.csv", "--out", "err2.csv"]);
-    let err2 = imukit::io::table::read_columns(&dir.join("err2.csv"), &["pos_err_m"], "").unwrap();
-    assert!(*err2.get("pos_err_m").last().unwrap() > 100.0);
+    let nav_text = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(dir.join("plain.csv")).unwrap(),
+        nav_text
+    );
+    assert!(nav_text.starts_with(
+        "# imukit: {\"kind\": \"navigation\", \"nav_frame\": \"NED\", \"body_frame\": \"FRD\", \"earth\": \"flat\""
+    ));
+    run(&[
+        "simulate",
+        "helix.toml",
+        "--out",
+        "imu.parquet",
+        "--truth",
+        "truth.parquet",
+    ]);
+    run(&[
+        "integrate",
+        "imu.parquet",
+        "--init",
+        "truth.parquet",
+        "--out",
+        "parquet.csv",
+    ]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("parquet.csv")).unwrap(),
+        nav_text
+    );
+    // A flag that contradicts the files is refused by name, naming the file and both frames,
+    // and nothing is written; so are inputs that disagree.
+    for (args, needles) in [
+        (
+            vec!["imu.csv", "--init", "truth.csv", "--nav-frame", "ENU"],
+            vec!["--nav-frame: ENU contradicts imu.csv", "says NED"],
+        ),
+        (
+            vec!["imu.parquet", "--earth", "wgs84"],
+            vec!["--earth: wgs84 contradicts imu.parquet", "says flat"],
+        ),
+        (
+            vec!["imu.csv", "--gravity-m-s2", "9.80665"],
+            vec!["--gravity-m-s2: 9.80665 contradicts imu.csv", "says 9.81"],
+        ),
+    ] {
+        let out = imukit()
+            .current_dir(dir)
+            .arg("integrate")
+            .args(&args)
+            .args(["--out", "wrong.csv"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(65), "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: {err}");
+        }
+        assert!(!dir.join("wrong.csv").exists());
+    }
+    let enu = readings.replace(
+        "\"nav_frame\": \"NED\", \"body_frame\": \"FRD\"",
+        "\"nav_frame\": \"ENU\", \"body_frame\": \"FLU\"",
+    );
+    std::fs::write(dir.join("enu.csv"), enu).unwrap();
+    let out = imukit()
+        .current_dir(dir)
+        .args([
+            "integrate",
+            "enu.csv",
+            "--init",
+            "truth.csv",
+            "--out",
+            "wrong.csv",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(65), "{err}");
+    assert!(
+        err.contains("the inputs disagree: enu.csv says ENU, truth.csv says NED"),
+        "{err}"
+    );
     // Missing columns are named.
     std::fs::write(dir.join("few.csv"), "t_s,accel_x_m_s2\n0,0\n0.1,0\n").unwrap();
     let out = imukit()
@@ -394,7 +489,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
     ] {
         let (code, err) = orient("imu.csv", &args);
         assert_eq!(code, Some(0), "{args:?}: {err}");
-        let text = std::fs::read_to_string(&out_file).unwrap();
+        let text = table_text(&out_file);
         assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with("t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,"));
         let q: Vec<f64> = text
@@ -417,7 +512,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         &["--conventions", "matlab", "--accel-sign", "specific-force"],
     );
     assert_eq!(code, Some(0), "{err}");
-    let text = std::fs::read_to_string(&out_file).unwrap();
+    let text = table_text(&out_file);
     let roll: f64 = text
         .lines()
         .nth(1)
@@ -884,7 +979,7 @@ fn a_bad_start_is_blamed_on_where_it_came_from_not_on_the_imu_file() {
         "{err}"
     );
     // A zero quaternion in the --init file's first row.
-    let truth = std::fs::read_to_string(dir.join("truth.csv")).unwrap();
+    let truth = table_text(dir.join("truth.csv"));
     let mut lines: Vec<String> = truth.lines().map(str::to_string).collect();
     let header: Vec<&str> = lines[0].split(',').collect();
     let q: Vec<usize> = ["q_w", "q_x", "q_y", "q_z"]
@@ -941,10 +1036,7 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
         stdout.contains("the last 2 samples do not fill a block"),
         "{stdout}"
     );
-    let rows = std::fs::read_to_string(dir.join("o.csv"))
-        .unwrap()
-        .lines()
-        .count();
+    let rows = table_text(dir.join("o.csv")).lines().count();
     assert_eq!(rows, 17);
 }
 
@@ -973,7 +1065,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
         ],
     );
     assert_eq!(code, Some(0), "{err}");
-    let truth_header = std::fs::read_to_string(dir.join("truth.csv")).unwrap();
+    let truth_header = table_text(dir.join("truth.csv"));
     assert!(
         truth_header
             .lines()
@@ -988,7 +1080,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
     };
     let (code, err) = integrate(&["--init", "truth.csv", "--earth", "wgs84"], "nav.csv");
     assert_eq!(code, Some(0), "{err}");
-    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let nav = table_text(dir.join("nav.csv"));
     assert!(
         nav.lines()
             .next()
@@ -1008,6 +1100,19 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
         .and_then(|v| v.parse().ok())
         .unwrap_or(f64::NAN);
     assert!(max_position < 1e-6, "{report}");
+    // Described, the readings start at the scenario's origin without --init or --lat0-deg
+    // (at rest and level there: far off for this flight, but on the WGS-84 Earth in NED).
+    let (code, err) = integrate(&[], "origin.csv");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        table_text(dir.join("origin.csv"))
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",lat_rad,lon_rad,height_m")
+    );
+    // A file without a description (another program's) takes every setting from the flags.
+    std::fs::write(dir.join("imu.csv"), table_text(dir.join("imu.csv"))).unwrap();
     // Without a geodetic start, with a flat-only flag, an unknown channel: named.
     for (extra, needle) in [
         (
@@ -1186,7 +1291,7 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     );
     assert_eq!(code, Some(0), "{err}");
     for r in 0..2 {
-        let text = std::fs::read_to_string(dir.join(format!("gnss_run{r:04}.csv"))).unwrap();
+        let text = table_text(dir.join(format!("gnss_run{r:04}.csv")));
         // 51 epochs at 5 Hz, 5 in the outage [2, 3).
         assert_eq!(text.lines().count(), 1 + 51 - 5, "run {r}");
         assert!(text.starts_with("t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n"));
@@ -1252,7 +1357,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
     assert!(err.contains("updates ("), "{err}");
     assert_eq!(numbers[1] + numbers[2], 301, "{err}");
     assert!(numbers[2] <= 2, "{err}");
-    let header = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let header = table_text(dir.join("nav.csv"));
     assert!(header.starts_with(
         "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad,pos_x_sigma_m,"
     ));
@@ -1327,7 +1432,7 @@ fn a_barometer_file_damps_the_vertical_channel_of_earth_navigation() {
         run_in(dir, &args)
     };
     let last_height = |file: &str| -> f64 {
-        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let text = table_text(dir.join(file));
         let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
         let k = header.iter().position(|h| *h == "height_m").unwrap();
         text.lines()
@@ -1501,7 +1606,7 @@ fn fuse_takes_an_odometer_a_barometer_and_the_vehicle_constraints_and_names_bad_
     assert_eq!(numbers[1] + numbers[2], 151 + 301 + 301, "{err}");
     std::fs::remove_file(dir.join("nav.csv")).unwrap();
     // Bad aids are named by file, row or flag, and nothing is written.
-    let odo = std::fs::read_to_string(dir.join("odo.csv")).unwrap();
+    let odo = table_text(dir.join("odo.csv"));
     let mut lines: Vec<&str> = odo.lines().collect();
     lines.swap(5, 6);
     std::fs::write(dir.join("odo_back.csv"), lines.join("\n")).unwrap();
@@ -1575,7 +1680,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     assert_eq!(code, Some(0), "{err}");
     // The estimate begins at the first fix at speed (the car waits 20 s, then drives), not at
     // t = 0.
-    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let nav = table_text(dir.join("nav.csv"));
     let t0: f64 = nav
         .lines()
         .nth(1)
@@ -1627,7 +1732,7 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     // Told of the wait and estimating the sensor errors: their columns follow the biases'.
     let (code, err) = fuse(&["--init", "truth.csv", "--rest-s", "20", "--sensor-errors"]);
     assert_eq!(code, Some(0), "{err}");
-    let nav = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let nav = table_text(dir.join("nav.csv"));
     let header: Vec<&str> = nav.lines().next().unwrap().split(',').collect();
     assert_eq!(header.len(), 35 + 42, "{header:?}");
     assert_eq!(header[35], "accel_scale_factor_x");
@@ -1677,7 +1782,7 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
         ],
     );
     assert_eq!(code, Some(0), "{err}");
-    let header = std::fs::read_to_string(dir.join("nav.csv")).unwrap();
+    let header = table_text(dir.join("nav.csv"));
     assert!(
         header
             .lines()

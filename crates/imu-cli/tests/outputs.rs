@@ -212,7 +212,7 @@ fn links_planted_beside_an_output_are_never_written_through() {
         assert!(
             std::fs::read_to_string(dir.join(out))
                 .unwrap()
-                .starts_with("t_s,")
+                .contains("}\nt_s,")
         );
     }
     assert_eq!(
@@ -227,7 +227,14 @@ fn links_planted_beside_an_output_are_never_written_through() {
         .output()
         .unwrap();
     assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stdout).starts_with("t_s,accel_x_m_s2,"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.starts_with("# imukit: {\"kind\": \"readings\""));
+    assert_eq!(
+        stdout.lines().nth(1),
+        Some(
+            "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,mag_x_ut,mag_y_ut,mag_z_ut"
+        )
+    );
     assert_eq!(std::fs::read(dir.join("s.toml")).unwrap(), before);
 }
 

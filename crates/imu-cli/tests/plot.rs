@@ -170,7 +170,8 @@ fn errors_of_a_fused_estimate_are_drawn_against_plus_minus_three_sigma() {
     let errors = std::fs::read_to_string(data().join("fused_errors.csv")).unwrap();
     let nav = std::fs::read_to_string(data().join("car_nav.csv")).unwrap();
     let column = |text: &str, name: &str| -> Vec<String> {
-        let mut lines = text.lines();
+        // After the description line.
+        let mut lines = text.lines().filter(|l| !l.starts_with('#'));
         let k = lines
             .next()
             .unwrap()
@@ -213,7 +214,7 @@ fn allan_table_has_one_curve_per_column() {
     let table = std::fs::read_to_string(data().join("allan.csv")).unwrap();
     let curves = table
         .lines()
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .filter(|c| c.starts_with("adev_"))

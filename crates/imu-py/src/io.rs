@@ -3,9 +3,11 @@
 use std::path::Path;
 
 use imukit::Table;
+use imukit::io::description::{Description, Value};
 use imukit::io::table::{read_table, run_path as run_file};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{TableOut, table_in, table_out};
 use crate::errors::refused;
@@ -48,6 +50,23 @@ fn write_csv(
         .map_err(refused)
 }
 
+/// What a table file says it holds (its description's entries, keys without the `imukit.`
+/// prefix), or `None` when it has none.
+#[pyfunction]
+fn read_description<'py>(py: Python<'py>, path: &str) -> PyResult<Option<Bound<'py, PyDict>>> {
+    let Some(d) = Description::read(Path::new(path)).map_err(refused)? else {
+        return Ok(None);
+    };
+    let out = PyDict::new(py);
+    for (k, v) in d.entries() {
+        match v {
+            Value::Text(s) => out.set_item(k, s)?,
+            Value::Number(x) => out.set_item(k, x)?,
+        }
+    }
+    Ok(Some(out))
+}
+
 /// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).
 #[pyfunction]
 fn run_path(out: &str, run: u64, runs: u64) -> String {
@@ -61,5 +80,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_table_file, m)?)?;
     m.add_function(wrap_pyfunction!(write_table_file, m)?)?;
     m.add_function(wrap_pyfunction!(run_path, m)?)?;
+    m.add_function(wrap_pyfunction!(read_description, m)?)?;
     Ok(())
 }

@@ -162,6 +162,37 @@ fn simulate_dict<'py>(
     run_spec(py, spec, base_dir, run, threads, truth, imu_out)
 }
 
+/// Writes one run's readings (`columns`, `values`) at `path` as the command line's `simulate
+/// --runs` writes them: described by the scenario (TOML or JSON text, or a dict with
+/// `format = "dict"`, resolved against `base_dir`), whose text goes into the description.
+#[pyfunction]
+#[pyo3(signature = (path, columns, values, scenario, *, format, origin, base_dir))]
+#[allow(clippy::too_many_arguments)]
+fn write_run(
+    py: Python<'_>,
+    path: &str,
+    columns: Vec<String>,
+    values: numpy::PyReadonlyArray2<'_, f64>,
+    scenario: &Bound<'_, PyAny>,
+    format: &str,
+    origin: &str,
+    base_dir: &str,
+) -> PyResult<()> {
+    let (spec, text) = if format == "dict" {
+        (dict_spec(scenario, origin)?, None)
+    } else {
+        let text: String = scenario.extract()?;
+        (text_spec(&text, format, origin)?, Some(text))
+    };
+    let table = crate::convert::table_in("values", columns, &values)?;
+    let base = std::path::PathBuf::from(base_dir);
+    py.detach(move || {
+        let described = spec.resolve(&base)?.description(text);
+        table.write_described(std::path::Path::new(path), &described)
+    })
+    .map_err(refused)
+}
+
 /// The rows and IMU columns one run of a scenario makes (TOML or JSON text, or a dict with
 /// `format = "dict"`), refused as a run would be, without running it: what a caller allocates
 /// for many runs' readings.
@@ -476,6 +507,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_text, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_dict, m)?)?;
     m.add_function(wrap_pyfunction!(simulation_shape, m)?)?;
+    m.add_function(wrap_pyfunction!(write_run, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_expressions, m)?)?;
     m.add_function(wrap_pyfunction!(truth_from_samples, m)?)?;
     m.add_function(wrap_pyfunction!(ideal_imu, m)?)?;

@@ -2,7 +2,10 @@
 //! bit for bit (Parquet's metadata kept), a value that is not finite refused before any file is
 //! made, a file of the wrong kind refused saying what it holds and where.
 use imukit::Table;
+use imukit::io::description::Description;
 use imukit::io::parquet::{read_metadata, read_table};
+use imukit::io::schema::TableKind;
+use imukit::scenario::NavFrameName;
 
 /// A fresh folder under the system's temporary folder, removed with its files when dropped.
 fn dir(name: &str) -> tempfile::TempDir {
@@ -43,12 +46,25 @@ fn parquet_tables_round_trip_bit_for_bit_across_row_groups() {
         e.contains("t.parquet") && e.contains("missing column(s) z"),
         "{e}"
     );
-    imukit::io::parquet::write_table(&t, &d.join("m.parquet"), &[("k".into(), "v".into())])
-        .unwrap();
-    assert!(
-        read_metadata(&d.join("m.parquet"))
-            .unwrap()
-            .contains(&("k".to_string(), "v".to_string()))
+    // What the table holds goes into its metadata, one key per entry, and comes back.
+    let described = Description {
+        nav_frame: Some(NavFrameName::NED),
+        scenario: Some("rate_hz = 10.0\n".into()),
+        ..Description::of_kind(TableKind::Truth)
+    };
+    imukit::io::parquet::write_table(&t, &d.join("m.parquet"), &described).unwrap();
+    let metadata = read_metadata(&d.join("m.parquet")).unwrap();
+    for (k, v) in [
+        ("imukit.kind", "truth"),
+        ("imukit.nav_frame", "NED"),
+        ("imukit.body_frame", "FRD"),
+        ("imukit.scenario", "rate_hz = 10.0\n"),
+    ] {
+        assert!(metadata.contains(&(k.to_string(), v.to_string())), "{k}");
+    }
+    assert_eq!(
+        Description::read(&d.join("m.parquet")).unwrap(),
+        Some(described)
     );
 }
 

@@ -5,8 +5,9 @@ use std::path::Path;
 use imu_core::EulerZyx;
 use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
+use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
-use imukit::run::navigate::{InitialState, NavRequest, integrate_csv};
+use imukit::run::navigate::{InitialState, NavAsked, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
@@ -73,17 +74,31 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
     Ok(())
 }
 
-pub fn three_d(c: &Common<'_>, o: &Options3d<'_>, request: &NavRequest) -> Result<(), CliError> {
-    let setup = NavRequest {
-        barometer: o.baro.is_some(),
-        ..*request
-    }
-    .setup()
-    .map_err(by_flag)?;
+pub fn three_d(
+    c: &Common<'_>,
+    o: &Options3d<'_>,
+    request: &NavRequest,
+    asked: &NavAsked,
+) -> Result<(), CliError> {
     let mut inputs = vec![("input", c.input)];
     inputs.extend(o.init.map(|p| ("--init file", p)));
     inputs.extend(o.baro.map(|p| ("--baro file", p)));
     check_outputs(&inputs, &[("--out", c.out)])?;
+    // What the input files say they hold fills the settings left out, and refuses a flag that
+    // contradicts it.
+    let described = Described::read(
+        &[Some(c.input), o.init]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+    )?;
+    let request = NavRequest {
+        barometer: o.baro.is_some(),
+        ..*request
+    }
+    .with_described(asked, &described)
+    .map_err(by_flag)?;
+    let setup = request.setup().map_err(by_flag)?;
     let mut initial = match o.init {
         Some(p) => InitialState::from_csv(p)?,
         None => InitialState::default(),
@@ -106,7 +121,10 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>, request: &NavRequest) -> Resul
         };
     }
     let (lat, lon, h) = o.geodetic0;
-    initial = initial.with_geodetic0(lat, lon, h).map_err(by_flag)?;
+    initial = initial
+        .with_geodetic0(lat, lon, h)
+        .map_err(by_flag)?
+        .at_origin(described.origin()?);
     // Checked here, so that a bad start is blamed on where it came from, not on the IMU file.
     // The start options are checked as they are read; what remains is the --init file's row.
     if let Some(p) = o.init {
@@ -130,7 +148,7 @@ pub fn three_d(c: &Common<'_>, o: &Options3d<'_>, request: &NavRequest) -> Resul
                 message: e.to_string(),
             }
         })?;
-        nav.write(c.out)?;
+        nav.write_described(c.out, &setup.description())?;
         report(
             &nav,
             "strapdown on the WGS-84 Earth, baro-damped height",

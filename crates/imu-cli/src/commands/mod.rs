@@ -14,7 +14,7 @@ mod simulate;
 mod study;
 
 use imukit::choice::Choice;
-use imukit::run::navigate::{NavRequest, SchemeName};
+use imukit::run::navigate::{NavAsked, NavRequest, SchemeName};
 
 use crate::CliError;
 use crate::cli::{Cli, Command};
@@ -95,18 +95,20 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     .transpose()?
                     .unwrap_or_default();
                 let request = NavRequest {
-                    nav_frame,
-                    accel_sign,
                     scheme,
                     substeps,
-                    gravity_m_s2,
                     coning: !no_corrections,
                     sculling: !no_corrections,
-                    earth,
                     vertical,
                     baro_time_constant_s,
+                    ..NavRequest::default()
+                };
+                let asked = NavAsked {
+                    nav_frame,
+                    accel_sign,
+                    gravity_m_s2,
+                    earth,
                     earth_gravity,
-                    barometer: false,
                 };
                 let opts = integrate::Options3d {
                     init: init.as_deref(),
@@ -114,7 +116,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     baro: baro.as_deref(),
                     geodetic0: (lat0_deg, lon0_deg, height0_m),
                 };
-                integrate::three_d(&common, &opts, &request)
+                integrate::three_d(&common, &opts, &request, &asked)
             }
         }
         Command::Fuse {

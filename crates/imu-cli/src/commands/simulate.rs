@@ -52,17 +52,8 @@ pub fn run(
     for w in &sc.warnings {
         crate::report::warn(w);
     }
-    // What made the files, for formats that carry it (Parquet).
-    let metadata = vec![
-        (
-            imukit::io::parquet::SCENARIO_KEY.to_string(),
-            std::fs::read_to_string(scenario).unwrap_or_default(),
-        ),
-        (
-            imukit::io::parquet::NAV_FRAME_KEY.to_string(),
-            imukit::choice::Choice::name(sc.nav_frame).to_string(),
-        ),
-    ];
+    // What the files hold, written into those whose format has room for it.
+    let description = sc.description(std::fs::read_to_string(scenario).ok());
     let Some(runs) = runs else {
         // Streamed: chunks are written as they are made, so memory does not grow with duration.
         let outputs = StreamOutputs {
@@ -71,7 +62,7 @@ pub fn run(
             gnss,
             baro,
             odometer,
-            metadata: &metadata,
+            description: &description,
         };
         let report = sc
             .stream_to_files(None, run_threads, &outputs)
@@ -131,7 +122,7 @@ pub fn run(
                         gnss: gnss_file.as_deref(),
                         baro: baro_file.as_deref(),
                         odometer: odometer_file.as_deref(),
-                        metadata: &metadata,
+                        description: &description,
                     },
                 )?;
                 if let Ok(mut m) = merged.lock() {

@@ -27,6 +27,7 @@ from ._table import Simulation, Table, TableLike
 from ._truth import (
     builtin_scenario_toml,
     builtin_scenarios,
+    describe,
     ideal_imu,
     read,
     read_csv,
@@ -101,6 +102,7 @@ __all__ = [
     "planar_dead_reckon",
     "read_planar",
     "read",
+    "describe",
     "read_csv",
     "builtin_scenarios",
     "builtin_scenario_toml",

@@ -22,6 +22,8 @@ __all__ = [
     "DEFAULT_GRAVITY_M_S2",
     "read_csv",
     "read_table_file",
+    "read_description",
+    "write_run",
     "write_table_file",
     "write_csv",
     "run_path",
@@ -285,6 +287,17 @@ def truth_from_waypoints(
 ) -> _Table: ...
 def cli_main(argv: Sequence[str]) -> int: ...
 def read_table_file(path: str) -> _Table: ...
+def read_description(path: str) -> Optional[dict[str, Union[str, float]]]: ...
+def write_run(
+    path: str,
+    columns: Sequence[str],
+    values: npt.NDArray[np.float64],
+    scenario: Union[str, dict[str, Any]],
+    *,
+    format: str,
+    origin: str,
+    base_dir: str,
+) -> None: ...
 def write_table_file(path: str, columns: Sequence[str], values: npt.NDArray[np.float64]) -> None: ...
 def read_csv(path: str) -> _Table: ...
 def table_kind(columns: list[str]) -> Optional[str]: ...

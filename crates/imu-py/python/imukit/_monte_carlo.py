@@ -88,7 +88,8 @@ def _run(spec: Tuple[Any, str, str, str], run: int, out: Optional[str], runs: in
     if out is None:
         return imu, truth
     path = _core.run_path(out, run, runs)
-    _core.write_csv(path, list(imu[0]), np.ascontiguousarray(imu[1]))
+    _core.write_run(path, list(imu[0]), np.ascontiguousarray(imu[1]), text, format=fmt, origin=origin,
+                    base_dir=base_dir)
     return path, None
 
 

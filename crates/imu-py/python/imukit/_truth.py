@@ -81,6 +81,21 @@ def read(path: Union[str, os.PathLike]) -> Table:
                    f"(read: {', '.join(TABLE_FORMATS)})")
 
 
+def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:
+    """What an imukit table file says it holds: the entries of its description (``kind``,
+    ``nav_frame``, ``body_frame``, ``earth``, ``origin_latitude_deg``, …, ``scenario``), from a
+    CSV file's first line or a Parquet file's metadata; empty for a file without one (``.npy``,
+    ``.npz``, another program's CSV). See docs/formats.md.
+
+    >>> import imukit, tempfile, pathlib
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "truth.csv"
+    >>> imukit.simulate({"trajectory": {"type": "builtin", "name": "static"}}).truth.write(path)
+    >>> imukit.describe(path)["kind"]
+    'truth'
+    """
+    return dict(_core.read_description(str(path)) or {})
+
+
 #: The extensions of the table files imukit reads and writes.
 TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz")
 

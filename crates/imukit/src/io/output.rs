@@ -14,6 +14,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
+use crate::io::description::Description;
 use crate::io::npy::NpySink;
 use crate::io::npz::NpzSink;
 use crate::io::parquet::ParquetSink;
@@ -425,18 +426,24 @@ impl AtomicFile {
     }
 
     /// Starts a table of `columns` in the format the path's extension names
-    /// ([`TableFormat`]): Parquet (with `metadata` in the file), `.npy` or `.npz` (which have no
-    /// place for it), else a CSV header line.
+    /// ([`TableFormat`]): Parquet (with `description` in its metadata), `.npy` or `.npz` (which
+    /// have no place for it), else CSV: the description's line (when it says anything), then
+    /// the header line.
     ///
     /// # Errors
     /// [`Error::Io`] naming the file; the Parquet writer's refusal.
-    pub fn begin_table(&mut self, columns: &[String], metadata: &[(String, String)]) -> Result<()> {
+    pub fn begin_table(&mut self, columns: &[String], description: &Description) -> Result<()> {
         check_column_names(columns, &self.path)?;
         self.columns = columns.to_vec();
         match TableFormat::of(&self.path) {
             TableFormat::Parquet => {
                 let writer = self.writer.take().expect("a table is begun once");
-                self.parquet = Some(ParquetSink::create(writer, &self.path, columns, metadata)?);
+                self.parquet = Some(ParquetSink::create(
+                    writer,
+                    &self.path,
+                    columns,
+                    &description.metadata(),
+                )?);
                 return Ok(());
             }
             TableFormat::Npy => {
@@ -455,9 +462,11 @@ impl AtomicFile {
             }
             TableFormat::Csv => {}
         }
+        let line = description.csv_line();
         let w = self.writer();
-        let written = w
-            .write_all(columns.join(",").as_bytes())
+        let written = line
+            .map_or(Ok(()), |l| writeln!(w, "{l}"))
+            .and_then(|()| w.write_all(columns.join(",").as_bytes()))
             .and_then(|()| w.write_all(b"\n"));
         written.map_err(|e| self.error(e))
     }
@@ -490,13 +499,14 @@ impl AtomicFile {
         self.writer.as_mut().expect("the writer lives until commit")
     }
 
-    /// Starts a table of `columns` ([`Self::begin_table`] without metadata).
+    /// Starts a table of `columns` described by its kind alone ([`Self::begin_table`] with the
+    /// kind [`crate::io::schema::TableKind::detect`] finds in the columns).
     ///
     /// # Errors
     /// As [`Self::begin_table`].
     pub fn write_header(&mut self, columns: &[&str]) -> Result<()> {
         let columns: Vec<String> = columns.iter().map(|c| (*c).to_string()).collect();
-        self.begin_table(&columns, &[])
+        self.begin_table(&columns, &Description::of_columns(&columns))
     }
 
     /// Writes one CSV row of `values` (shortest round-trip form).

@@ -18,13 +18,9 @@ use parquet::file::metadata::{KeyValue, ParquetMetaData};
 use parquet::file::properties::WriterProperties;
 
 use crate::error::{Error, Result};
+use crate::io::description::Description;
 use crate::io::output::OutputFile;
 use crate::io::table::Table;
-
-/// Metadata key of the scenario a file was simulated from (its text as given).
-pub const SCENARIO_KEY: &str = "imukit.scenario";
-/// Metadata key of the navigation frame of a file's columns (`ENU` or `NED`).
-pub const NAV_FRAME_KEY: &str = "imukit.nav_frame";
 
 /// Rows per row group (and per write): memory stays flat however long the table.
 pub const ROW_GROUP: usize = 65_536;
@@ -174,14 +170,15 @@ impl ParquetSink {
     }
 }
 
-/// Writes `table` as a Parquet file at `path` (named `.parquet`) with `metadata`, atomically
+/// Writes `table` as a Parquet file at `path` (named `.parquet`) with `description` in its
+/// metadata, atomically
 /// ([`Table::write`]'s binary path); every value must be
 /// finite (refused, naming row and column, before the file is made).
 ///
 /// # Errors
 /// A value that is not finite; the writer's or the file system's refusal, naming the file.
-pub fn write_table(table: &Table, path: &Path, metadata: &[(String, String)]) -> Result<()> {
-    table.write_binary(path, metadata)
+pub fn write_table(table: &Table, path: &Path, description: &Description) -> Result<()> {
+    table.write_binary(path, description)
 }
 
 /// A Parquet file's key-value metadata.

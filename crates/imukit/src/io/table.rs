@@ -13,6 +13,7 @@ use imu_core::{NavFrame, Truth};
 
 use crate::error::{Error, Result};
 use crate::io::TableFormat;
+use crate::io::description::Description;
 use crate::io::output::write_atomically;
 
 /// The columns `head` followed by the columns `tail`, for a schema that extends another
@@ -433,37 +434,66 @@ impl Table {
     /// # Errors
     /// A value that is not finite; [`Error::Io`] naming the file.
     pub fn write(&self, path: &Path) -> Result<()> {
+        self.write_described(path, &Description::of_columns(&self.columns))
+    }
+
+    /// [`Self::write`] with `description` in the file ([`crate::io::description`]: Parquet's
+    /// metadata, CSV's first line; the NumPy formats have no room for it), its kind, when it
+    /// gives none, found from the columns.
+    ///
+    /// # Errors
+    /// As [`Self::write`].
+    pub fn write_described(&self, path: &Path, description: &Description) -> Result<()> {
+        let kinded;
+        let description = if description.kind.is_none() {
+            kinded = Description {
+                kind: crate::io::schema::TableKind::detect(&self.columns),
+                ..description.clone()
+            };
+            &kinded
+        } else {
+            description
+        };
         match TableFormat::of(path) {
             TableFormat::Parquet | TableFormat::Npy | TableFormat::Npz => {
-                self.write_binary(path, &[])
+                self.write_binary(path, description)
             }
-            TableFormat::Csv => self.write_csv(path),
+            TableFormat::Csv => self.write_csv_described(path, description),
         }
     }
 
     /// Writes the table in the binary format its path's extension names (Parquet, `.npy`,
-    /// `.npz`), with `metadata` where the format has room for it, atomically; every value must
+    /// `.npz`), with `description` where the format has room for it, atomically; every value must
     /// be finite (refused, naming row and column — rows from 1, no header row — before the file
     /// is made).
     ///
     /// # Errors
     /// A value that is not finite; the writer's or the file system's refusal, naming the file.
-    pub(crate) fn write_binary(&self, path: &Path, metadata: &[(String, String)]) -> Result<()> {
+    pub(crate) fn write_binary(&self, path: &Path, description: &Description) -> Result<()> {
         check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
         let mut file = crate::io::output::AtomicFile::create(path)?;
-        file.begin_table(&self.columns, metadata)?;
+        file.begin_table(&self.columns, description)?;
         file.write_table_rows(&self.data)?;
         file.commit()
     }
 
-    /// Writes the table as CSV with a header row, atomically (temporary file, then rename).
+    /// Writes the table as CSV with a header row, atomically (temporary file, then rename),
+    /// described by its kind ([`Self::write`]).
     ///
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
+        self.write_csv_described(path, &Description::of_columns(&self.columns))
+    }
+
+    fn write_csv_described(&self, path: &Path, description: &Description) -> Result<()> {
         check_column_names(&self.columns, path)?;
         self.check_finite(&path.display().to_string())?;
+        let line = description.csv_line();
         write_atomically(path, |w| {
+            if let Some(l) = &line {
+                writeln!(w, "{l}")?;
+            }
             self.write_header(w)?;
             self.write_body(w)
         })
@@ -651,7 +681,47 @@ fn reader(path: &Path) -> Result<csv::Reader<File>> {
         .from_reader(file))
 }
 
+/// The number of comment lines (`#` first) at the start of the file at `path`, read through
+/// without keeping them.
+fn leading_comment_lines(path: &Path) -> Result<usize> {
+    use std::io::BufRead;
+    let io = |source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    let mut r = std::io::BufReader::new(File::open(path).map_err(io)?);
+    let mut count = 0;
+    loop {
+        if r.fill_buf().map_err(io)?.first() != Some(&b'#') {
+            return Ok(count);
+        }
+        // Through the end of the line, a buffer at a time.
+        loop {
+            let buf = r.fill_buf().map_err(io)?;
+            if buf.is_empty() {
+                return Ok(count + 1);
+            }
+            if let Some(end) = buf.iter().position(|&b| b == b'\n') {
+                r.consume(end + 1);
+                break;
+            }
+            let n = buf.len();
+            r.consume(n);
+        }
+        count += 1;
+    }
+}
+
 fn csv_error(path: &Path, e: &csv::Error) -> Error {
+    csv_error_after(path, e, 0)
+}
+
+/// A CSV reader's error, its row counted without the `comments` lines before the header.
+fn csv_error_after(path: &Path, e: &csv::Error, comments: usize) -> Error {
+    let row = |pos: &Option<csv::Position>| {
+        pos.as_ref()
+            .map_or(0, |p| (p.line() as usize).saturating_sub(comments))
+    };
     let message = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             pos,
@@ -659,13 +729,10 @@ fn csv_error(path: &Path, e: &csv::Error) -> Error {
             len,
         } => format!(
             "row {} has {len} fields, the header has {expected_len} (truncated or malformed file)",
-            pos.as_ref().map_or(0, |p| p.line())
+            row(pos)
         ),
         csv::ErrorKind::Utf8 { pos, .. } => {
-            format!(
-                "row {} is not valid UTF-8",
-                pos.as_ref().map_or(0, |p| p.line())
-            )
+            format!("row {} is not valid UTF-8", row(pos))
         }
         _ => e.to_string(),
     };
@@ -765,6 +832,8 @@ pub struct CsvRows {
     names: Vec<String>,
     /// (field index, column name) of each requested column, in request order.
     wanted: Vec<(usize, String)>,
+    /// Comment lines before a CSV file's header (its description line): not rows.
+    comments: usize,
 }
 
 impl CsvRows {
@@ -804,12 +873,19 @@ impl CsvRows {
             TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
             TableFormat::Csv => RowSource::Csv(reader(path)?),
         };
+        // Rows are counted from the header, row 1, whatever comment lines (the description's)
+        // come before it.
+        let comments = match reader {
+            RowSource::Csv(_) => leading_comment_lines(path)?,
+            _ => 0,
+        };
         Ok(Self {
             path: path.into(),
             reader,
             record: csv::ByteRecord::new(),
             names,
             wanted,
+            comments,
         })
     }
 
@@ -838,9 +914,12 @@ impl CsvRows {
         match reader.read_byte_record(&mut self.record) {
             Ok(false) => return Ok(None),
             Ok(true) => {}
-            Err(e) => return Err(csv_error(&self.path, &e)),
+            Err(e) => return Err(csv_error_after(&self.path, &e, self.comments)),
         }
-        let row = self.record.position().map_or(0, |p| p.line() as usize);
+        let row = self
+            .record
+            .position()
+            .map_or(0, |p| (p.line() as usize).saturating_sub(self.comments));
         for ((k, name), slot) in self.wanted.iter().zip(out.iter_mut()) {
             let field = self.record.get(*k).unwrap_or_default();
             let bad = |message: String| Error::CsvValue {

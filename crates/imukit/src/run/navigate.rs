@@ -21,8 +21,10 @@ use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
+use crate::io::description::{Described, Description, Origin};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{TimedRows, check_gaps};
+use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
 use crate::scenario::resolve::{check_gravity, finite_vec};
@@ -173,6 +175,23 @@ impl InitialState {
         }
         self.geodetic = Some(Geodetic::from_degrees(values[0], values[1], values[2]));
         Ok(self)
+    }
+
+    /// The same state placed at `origin` (an input's description of the tangent plane's
+    /// origin) when it has no geodetic position yet and starts at the tangent plane's origin;
+    /// kept as it is otherwise.
+    #[must_use]
+    pub fn at_origin(mut self, origin: Option<Origin>) -> Self {
+        if let (None, Some(o)) = (self.geodetic, origin)
+            && self.position_m == [0.0; 3]
+        {
+            self.geodetic = Some(Geodetic::from_degrees(
+                o.latitude_deg,
+                o.longitude_deg,
+                o.height_m,
+            ));
+        }
+        self
     }
 
     /// Refuses a state that cannot start an integration: values that are not finite, or a
@@ -335,6 +354,29 @@ pub struct NavSetup {
     pub earth: Option<EarthNav>,
 }
 
+impl NavSetup {
+    /// What a navigation table made with this setup holds ([`Description`]).
+    #[must_use]
+    pub fn description(&self) -> Description {
+        let (earth, earth_gravity, gravity_m_s2) = match &self.earth {
+            None => (EarthName::Flat, None, Some(self.gravity_m_s2)),
+            Some(e) => match e.gravity {
+                GravityModel::Normal => (EarthName::Wgs84, Some(EarthGravityName::Normal), None),
+                GravityModel::Constant(g) => {
+                    (EarthName::Wgs84, Some(EarthGravityName::Constant), Some(g))
+                }
+            },
+        };
+        Description {
+            nav_frame: Some(self.nav_frame),
+            earth: Some(earth),
+            earth_gravity,
+            gravity_m_s2,
+            ..Description::of_kind(TableKind::Navigation)
+        }
+    }
+}
+
 impl Default for NavSetup {
     fn default() -> Self {
         Self {
@@ -469,6 +511,22 @@ pub struct NavRequest {
     pub barometer: bool,
 }
 
+/// The settings of a [`NavRequest`] that its inputs' descriptions can fix
+/// ([`crate::io::description`]), as the user gave them (`None`: left out).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NavAsked {
+    /// The navigation frame.
+    pub nav_frame: Option<NavFrameName>,
+    /// The accelerometer sign.
+    pub accel_sign: Option<AccelSignName>,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: Option<f64>,
+    /// The Earth.
+    pub earth: Option<EarthName>,
+    /// Gravity on the WGS-84 Earth.
+    pub earth_gravity: Option<EarthGravityName>,
+}
+
 /// The baro loop's time constant unless told otherwise, s.
 pub const DEFAULT_BARO_TIME_CONSTANT_S: f64 = 100.0;
 
@@ -492,6 +550,49 @@ impl Default for NavRequest {
 }
 
 impl NavRequest {
+    /// This request with the settings of `asked`, each one left out taken from the inputs'
+    /// descriptions (`described`) or else the library's default: data simulated on WGS-84 in
+    /// NED is integrated so without a flag.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming the setting, when an option contradicts an input's
+    /// description or two inputs disagree.
+    pub fn with_described(self, asked: &NavAsked, described: &Described) -> Result<Self> {
+        // A value that is no gravity at all is refused as such, before it is compared.
+        if let Some(g) = asked.gravity_m_s2 {
+            check_gravity("gravity_m_s2", g)?;
+        }
+        let d = Self::default();
+        Ok(Self {
+            nav_frame: described.pick(
+                "nav_frame",
+                asked.nav_frame,
+                |x| x.nav_frame,
+                d.nav_frame,
+            )?,
+            accel_sign: described.pick(
+                "accel_sign",
+                asked.accel_sign,
+                |x| x.accel_sign,
+                d.accel_sign,
+            )?,
+            gravity_m_s2: described.pick(
+                "gravity_m_s2",
+                asked.gravity_m_s2,
+                |x| x.gravity_m_s2,
+                d.gravity_m_s2,
+            )?,
+            earth: described.pick("earth", asked.earth, |x| x.earth, d.earth)?,
+            earth_gravity: described.pick(
+                "earth_gravity",
+                asked.earth_gravity,
+                |x| x.earth_gravity,
+                d.earth_gravity,
+            )?,
+            ..self
+        })
+    }
+
     /// The validated setup.
     ///
     /// # Errors
@@ -759,7 +860,7 @@ pub fn integrate_csv(
             .iter()
             .chain(&GYRO_COLUMNS)
             .all(|c| imu.columns.iter().any(|h| h == c));
-        nav.write(out)?;
+        nav.write_described(out, &setup.description())?;
         let last = |c: &str| nav.column(c).and_then(|v| v.last().copied()).unwrap_or(0.0);
         return Ok(NavSummary {
             rows: nav.rows(),
@@ -1035,7 +1136,11 @@ impl EarthJob for IntegrateCsv<'_> {
             AccelSign::Matlab => -1.0,
         };
         let mut file = AtomicFile::create(out)?;
-        file.write_header(&nav_earth::nav_columns::<E>())?;
+        let columns: Vec<String> = nav_earth::nav_columns::<E>()
+            .iter()
+            .map(|c| (*c).to_string())
+            .collect();
+        file.begin_table(&columns, &setup.description())?;
         let width = nav_earth::nav_width::<E>();
         let (mut last_yaw, mut end, mut written) = (None, s0, 0usize);
         let mut write = |state: NavState<E>, file: &mut AtomicFile| -> Result<()> {

@@ -18,7 +18,9 @@ use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
 use crate::io::TableFormat;
+use crate::io::description::Description;
 use crate::io::output::AtomicFile;
+use crate::io::schema::TableKind;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
@@ -86,7 +88,7 @@ pub struct AidTables {
 
 /// Where [`Scenario::stream_to_files`] writes: the IMU readings, and the truth and the aids'
 /// readings when asked for.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct StreamOutputs<'a> {
     /// IMU readings.
     pub imu: Option<&'a Path>,
@@ -98,8 +100,35 @@ pub struct StreamOutputs<'a> {
     pub baro: Option<&'a Path>,
     /// Odometer readings (`[odometer]`).
     pub odometer: Option<&'a Path>,
-    /// Key-value metadata of Parquet outputs (what made them: the scenario, its frame).
-    pub metadata: &'a [(String, String)],
+    /// What the outputs hold ([`Scenario::description`]; each file's kind is added from its
+    /// columns).
+    pub description: &'a Description,
+}
+
+/// An empty description, for outputs that say nothing beyond their kind.
+static NO_DESCRIPTION: Description = Description {
+    kind: None,
+    nav_frame: None,
+    earth: None,
+    origin: None,
+    gravity_m_s2: None,
+    earth_gravity: None,
+    accel_sign: None,
+    sensor: None,
+    scenario: None,
+};
+
+impl Default for StreamOutputs<'_> {
+    fn default() -> Self {
+        Self {
+            imu: None,
+            truth: None,
+            gnss: None,
+            baro: None,
+            odometer: None,
+            description: &NO_DESCRIPTION,
+        }
+    }
 }
 
 impl Scenario {
@@ -172,7 +201,7 @@ impl Scenario {
             }
         }
         let open = |p: Option<&Path>| {
-            p.map(|p| TableSink::create(p, outputs.metadata))
+            p.map(|p| TableSink::create(p, outputs.description))
                 .transpose()
         };
         let (mut imu, mut truth) = (open(outputs.imu)?, open(outputs.truth)?);
@@ -449,19 +478,19 @@ struct TableSink {
     name: String,
     /// The next row's number in the file (a CSV file's header is row 1).
     next_row: usize,
-    metadata: Vec<(String, String)>,
+    description: Description,
     started: bool,
 }
 
 impl TableSink {
-    fn create(path: &Path, metadata: &[(String, String)]) -> Result<Self> {
+    fn create(path: &Path, description: &Description) -> Result<Self> {
         let format = TableFormat::of(path);
         Ok(Self {
             file: AtomicFile::create(path)?,
             format,
             name: path.display().to_string(),
             next_row: format.first_row(),
-            metadata: metadata.to_vec(),
+            description: description.clone(),
             started: false,
         })
     }
@@ -470,7 +499,12 @@ impl TableSink {
         // Nothing that is not a finite number reaches a file.
         check_finite_from(&table.columns, &table.data, &self.name, self.next_row)?;
         if !self.started {
-            self.file.begin_table(&table.columns, &self.metadata)?;
+            let kind = TableKind::detect(&table.columns);
+            let description = Description {
+                kind,
+                ..self.description.clone()
+            };
+            self.file.begin_table(&table.columns, &description)?;
             self.started = true;
         }
         self.file.write_table_rows(&table.data)?;

@@ -43,8 +43,10 @@ use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
+use crate::io::description::{Description, Origin};
 use crate::io::table::{ImuOutput, Table};
 use crate::motion::Trajectory;
+use crate::run::navigate::EarthGravityName;
 
 /// Bytes an in-memory simulation holds per sample: the truth (23 numbers) and the readings
 /// (9), and both as tables (23 and up to 10 columns), with the times.
@@ -113,6 +115,52 @@ pub struct Simulation {
 }
 
 impl Scenario {
+    /// What the scenario's tables hold ([`Description`], the kind left to each table): the
+    /// navigation frame, the Earth with its origin and gravity, the accelerometer sign, the
+    /// IMU's parameters as an imukit parameter file, and `text`, the scenario file's text, when
+    /// given.
+    #[must_use]
+    pub fn description(&self, text: Option<String>) -> Description {
+        let (earth, origin, earth_gravity, gravity_m_s2) = match &self.earth {
+            EarthSetup::Flat => (EarthName::Flat, None, None, Some(self.gravity_m_s2)),
+            EarthSetup::Wgs84(plane) => {
+                let o = plane.origin;
+                let origin = Origin {
+                    latitude_deg: o.latitude_rad.to_degrees(),
+                    longitude_deg: o.longitude_rad.to_degrees(),
+                    height_m: o.height_m,
+                };
+                let (gravity, g) = match plane.gravity {
+                    imu_core::earth::GravityModel::Normal => (EarthGravityName::Normal, None),
+                    imu_core::earth::GravityModel::Constant(g) => {
+                        (EarthGravityName::Constant, Some(g))
+                    }
+                };
+                (EarthName::Wgs84, Some(origin), Some(gravity), g)
+            }
+        };
+        let kind = self.imu.kind;
+        let sensor = crate::io::params::to_toml(&crate::io::params::ParamFile {
+            params: self.imu.sensors.params.clone(),
+            present: [true, kind.has_gyro(), kind.has_mag()],
+            ..Default::default()
+        });
+        Description {
+            kind: None,
+            nav_frame: Some(self.nav_frame),
+            earth: Some(earth),
+            origin,
+            gravity_m_s2,
+            earth_gravity,
+            accel_sign: Some(match self.imu.accel_sign {
+                imu_core::AccelSign::SpecificForce => AccelSignName::SpecificForce,
+                imu_core::AccelSign::Matlab => AccelSignName::Matlab,
+            }),
+            sensor: Some(sensor),
+            scenario: text,
+        }
+    }
+
     /// Reads and resolves a scenario file.
     ///
     /// # Errors
