@@ -118,7 +118,9 @@ def run_cli(run: Run, work: Path, args: list, inputs: list, case: str) -> None:
             if p.name in inputs or not p.is_file():
                 continue
             if p.suffix == ".csv":
-                text = p.read_text(errors="replace").lower()
+                # The table, after its description line (whose sensor may say `inf`: no limit).
+                text = "\n".join(l for l in p.read_text(errors="replace").lower().splitlines()
+                                  if not l.startswith("#"))
                 if "nan" in text.replace("nan_", "") or "inf" in text:
                     problems.append(f"non-finite value written to {p.name}")
                 p.unlink()
@@ -493,11 +495,13 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
             if rng.random() < 0.5:
                 data = mutate(rng, data)
             else:  # times shifted, stretched or reversed
-                lines = data.decode().splitlines()
+                # The description line (`# imukit: {...}`) is kept as it is, before the header.
+                described = [l for l in data.decode().splitlines() if l.startswith("#")]
+                lines = [l for l in data.decode().splitlines() if not l.startswith("#")]
                 shift = rng.choice(["1e4", "-1e4", "1e308", "0"])
                 body = [f"{float(l.split(',')[0]) * rng.choice([1, -1, 1e6]) + float(shift)},{l.split(',', 1)[1]}"
                         for l in lines[1:]]
-                data = ("\n".join([lines[0], *rng.choice([body, body[::-1]])]) + "\n").encode()
+                data = ("\n".join([*described, lines[0], *rng.choice([body, body[::-1]])]) + "\n").encode()
             (work / "ax.csv").write_bytes(data)
             args = rng.choice([
                 ["integrate", "ai.csv", "--init", "at.csv", "--nav-frame", "NED", "--earth", "wgs84",

@@ -221,9 +221,21 @@ def test_cli_orient_equals_the_python_filters(tmp_path, filter_name, conventions
     imu = imukit.read_csv(imu_csv)
     a, g, m = (np.column_stack([imu[f"{s}_{x}_{u}"] for x in "xyz"])
                for s, u in (("accel", "m_s2"), ("gyro", "rad_s"), ("mag", "ut")))
-    np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m, conventions=conventions))
+    # The readings say they are NED with MATLAB's sign (the scenario's profile): the command takes
+    # that from the file whatever the conventions, the numbers of Python's filters told so.
+    np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m, conventions="matlab"))
     report = run("compare", str(truth_csv), str(out)).stdout
     assert "attitude" in report and "position" not in report
+    # Without the description (another program's file) the conventions decide, as in Python.
+    bare = tmp_path / "bare.csv"
+    bare.write_text("".join(line for line in imu_csv.read_text().splitlines(keepends=True)
+                            if not line.startswith("#")))
+    run("orient", str(bare), "--filter", filter_name, *asked, "--param", "SampleRate=100", "--out", str(out))
+    header, rows = read_csv(out)
+    np.testing.assert_array_equal(rows[:, 1:5], PYTHON_FILTERS[filter_name](a, g, m, conventions=conventions))
+    if conventions is None:  # an ENU estimate against the NED truth: refused, not compared
+        refused = subprocess.run([imukit_bin(), "compare", str(truth_csv), str(out)], capture_output=True, text=True)
+        assert refused.returncode == 65 and "says NED" in refused.stderr and "says ENU" in refused.stderr
 
 
 def test_one_version_for_the_package_the_command_and_the_workspace():

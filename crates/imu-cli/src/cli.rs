@@ -193,13 +193,15 @@ pub enum Command {
         params: Vec<String>,
         /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
         /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
-        /// override either.
+        /// override either, and so does what the input's description says.
         #[arg(long, value_parser = choice::<Conventions>(), ignore_case = true, default_value_t)]
         conventions: Conventions,
-        /// Navigation frame of the estimate (default: the conventions').
+        /// Navigation frame of the estimate (default: the input's description's, else the
+        /// conventions').
         #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
         nav_frame: Option<NavFrameName>,
-        /// Sign of the accelerometer columns (default: the conventions').
+        /// Sign of the accelerometer columns (default: the input's description's, else the
+        /// conventions').
         #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
         accel_sign: Option<AccelSignName>,
         /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,

@@ -1829,3 +1829,126 @@ fn fuse_runs_on_the_wgs84_earth_with_geodetic_fixes() {
     assert!(err.contains("flat.csv") && err.contains("lat_rad"), "{err}");
     assert!(!dir.join("nav2.csv").exists());
 }
+
+#[test]
+fn orient_estimates_in_the_frame_the_readings_say_they_have() {
+    let dir = temp_dir("orient-described");
+    let dir = dir.path();
+    // A level IMU at rest in NED: FRD body axes, specific force -g on z.
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 100.0\nduration_s = 1.0\nnav_frame = \"NED\"\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "imu.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    let last_roll = |file: &str| -> f64 {
+        let text = table_text(dir.join(file));
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let k = header.iter().position(|h| *h == "roll_rad").unwrap();
+        text.lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .nth(k)
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    // No flag: NED from the file, level (read as ENU's FLU axes it would be upside down).
+    let (code, err) = run_in(
+        dir,
+        &[
+            "orient", "imu.csv", "--filter", "ecompass", "--out", "o.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(last_roll("o.csv").abs() < 1e-9, "{}", last_roll("o.csv"));
+    let o = std::fs::read_to_string(dir.join("o.csv")).unwrap();
+    assert!(
+        o.starts_with("# imukit: {\"kind\": \"orientation\", \"nav_frame\": \"NED\""),
+        "{o}"
+    );
+    // MATLAB's conventions fill only what the file does not say: its sign is specific force.
+    let (code, err) = run_in(
+        dir,
+        &[
+            "orient",
+            "imu.csv",
+            "--filter",
+            "ecompass",
+            "--conventions",
+            "matlab",
+            "--out",
+            "m.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(table_text(dir.join("m.csv")), table_text(dir.join("o.csv")));
+    // A flag that contradicts the file is refused, naming both; nothing is written.
+    for (flag, value, says) in [
+        ("--nav-frame", "ENU", "says NED"),
+        ("--accel-sign", "matlab", "says specific-force"),
+    ] {
+        let (code, err) = run_in(
+            dir,
+            &[
+                "orient", "imu.csv", "--filter", "ecompass", flag, value, "--out", "x.csv",
+            ],
+        );
+        assert_eq!(code, Some(65), "{err}");
+        assert!(
+            err.contains(&format!("{flag}: {value} contradicts imu.csv")) && err.contains(says),
+            "{err}"
+        );
+        assert!(!dir.join("x.csv").exists());
+    }
+}
+
+#[test]
+fn compare_refuses_a_truth_and_an_estimate_in_different_frames() {
+    let dir = temp_dir("compare-described");
+    let dir = dir.path();
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 100.0\nduration_s = 1.0\nnav_frame = \"NED\"\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(
+        dir,
+        &[
+            "orient", "imu.csv", "--filter", "ecompass", "--out", "o.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(dir, &["compare", "truth.csv", "o.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    // The same estimate said to be in ENU: refused, both files named.
+    let o = std::fs::read_to_string(dir.join("o.csv")).unwrap();
+    std::fs::write(
+        dir.join("enu.csv"),
+        o.replace(
+            "\"nav_frame\": \"NED\", \"body_frame\": \"FRD\"",
+            "\"nav_frame\": \"ENU\", \"body_frame\": \"FLU\"",
+        ),
+    )
+    .unwrap();
+    let (code, err) = run_in(dir, &["compare", "truth.csv", "enu.csv"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("the inputs disagree: truth.csv says NED, enu.csv says ENU"),
+        "{err}"
+    );
+}

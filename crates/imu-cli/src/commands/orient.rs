@@ -1,6 +1,7 @@
 //! `imukit orient IMU.csv --filter NAME [--param KEY=VALUE …] --out ORIENT.csv`.
 use std::path::Path;
 
+use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
 use imukit::scenario::{AccelSignName, NavFrameName};
@@ -16,6 +17,8 @@ pub fn run(
     accel_sign: Option<AccelSignName>,
     out: &Path,
 ) -> Result<(), CliError> {
+    check_outputs(&[("input", input)], &[("--out", out)])?;
+    // The frame and sign the input says it has, unless the flags say (and do not contradict it).
     let (spec, nav) = OrientRequest {
         filter,
         conventions,
@@ -23,8 +26,9 @@ pub fn run(
         accel_sign,
         settings: FilterSpec::parse_settings(params)?,
     }
+    .with_described(&Described::read(&[input])?)
+    .map_err(crate::error::by_flag)?
     .resolve();
-    check_outputs(&[("input", input)], &[("--out", out)])?;
     let s = orient_csv(input, &spec, nav, out)?;
     println!(
         "imukit: {} samples at {} Hz through {filter}: {} orientations in {}",

@@ -437,6 +437,20 @@ impl Described {
         get: impl Fn(&Description) -> Option<T>,
         default: T,
     ) -> Result<T> {
+        Ok(self.known(field, asked, get)?.unwrap_or(default))
+    }
+
+    /// The setting `field` when the user or the files fix it: `asked` if given, else what the
+    /// files say, else `None` (for a default that depends on other settings).
+    ///
+    /// # Errors
+    /// As [`Self::pick`].
+    pub fn known<T: PartialEq + Copy + core::fmt::Display>(
+        &self,
+        field: &str,
+        asked: Option<T>,
+        get: impl Fn(&Description) -> Option<T>,
+    ) -> Result<Option<T>> {
         match (asked, self.agreed(field, get)?) {
             (Some(a), Some((d, path))) if a != d => Err(Error::Invalid {
                 field: field.to_string(),
@@ -445,9 +459,8 @@ impl Described {
                     path.display()
                 ),
             }),
-            (Some(a), _) => Ok(a),
-            (None, Some((d, _))) => Ok(d),
-            (None, None) => Ok(default),
+            (Some(a), _) => Ok(Some(a)),
+            (None, found) => Ok(found.map(|(d, _)| d)),
         }
     }
 

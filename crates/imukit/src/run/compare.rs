@@ -274,6 +274,10 @@ fn next_state(
 /// # Errors
 /// As [`compare`], CSV errors naming file, row and column, and I/O errors.
 pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+    // Two tables in different frames or on different Earths are not compared axis by axis.
+    let described = crate::io::description::Described::read(&[truth, estimate])?;
+    described.known("nav_frame", None, |d| d.nav_frame)?;
+    described.known("earth", None, |d| d.earth)?;
     let header = crate::io::table::read_header(estimate)?;
     let kind = EstimateKind::of(&header)?;
     let sigmas = has_sigmas(&header, kind);

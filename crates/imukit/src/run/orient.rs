@@ -11,8 +11,10 @@ use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
+use crate::io::description::{Described, Description};
 use crate::io::output::AtomicFile;
 use crate::io::rows::TimedRows;
+use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
 use crate::scenario::{AccelSignName, NavFrameName};
@@ -181,6 +183,21 @@ pub struct OrientRequest {
 }
 
 impl OrientRequest {
+    /// This request with the frame and the accelerometer sign, when not given, taken from the
+    /// input's description (`described`); the conventions then fill only what neither says. A
+    /// run simulated in NED is so estimated in NED, with the body axes the readings have.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming `nav_frame` or `accel_sign` when the option contradicts
+    /// the input's description.
+    pub fn with_described(self, described: &Described) -> Result<Self> {
+        Ok(Self {
+            nav_frame: described.known("nav_frame", self.nav_frame, |d| d.nav_frame)?,
+            accel_sign: described.known("accel_sign", self.accel_sign, |d| d.accel_sign)?,
+            ..self
+        })
+    }
+
     /// The filter spec and the navigation frame.
     #[must_use]
     pub fn resolve(&self) -> (FilterSpec, NavFrameName) {
@@ -481,14 +498,15 @@ pub fn orient_csv(
     out: &Path,
 ) -> Result<OrientSummary> {
     match nav {
-        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, out),
-        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, out),
+        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, nav, out),
+        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, nav, out),
     }
 }
 
 fn orient_csv_in<N: NavFrame>(
     input: &Path,
     spec: &FilterSpec,
+    nav: NavFrameName,
     out: &Path,
 ) -> Result<OrientSummary> {
     let header = crate::io::table::read_header(input)?;
@@ -539,7 +557,14 @@ fn orient_csv_in<N: NavFrame>(
     }
     let mut filter = spec.build::<N>(rate)?;
     let mut file = AtomicFile::create(out)?;
-    file.write_header(&ORIENT_COLUMNS)?;
+    let out_columns: Vec<String> = ORIENT_COLUMNS.iter().map(|c| (*c).to_string()).collect();
+    file.begin_table(
+        &out_columns,
+        &Description {
+            nav_frame: Some(nav),
+            ..Description::of_kind(TableKind::Orientation)
+        },
+    )?;
     let (mut samples, mut written, mut last_yaw) = (0usize, 0usize, None);
     let mut r = vec![0.0; columns.len()];
     while rows.next_row(&mut r)? {
