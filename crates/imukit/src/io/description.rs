@@ -51,6 +51,16 @@ impl core::fmt::Display for Origin {
     }
 }
 
+/// How a WGS-84 table's gravity is described: the model's name, and its magnitude when it is a
+/// constant.
+#[must_use]
+pub fn wgs84_gravity(model: imu_core::earth::GravityModel) -> (EarthGravityName, Option<f64>) {
+    match model {
+        imu_core::earth::GravityModel::Normal => (EarthGravityName::Normal, None),
+        imu_core::earth::GravityModel::Constant(g) => (EarthGravityName::Constant, Some(g)),
+    }
+}
+
 /// What a table holds; every entry optional (absent: not known, the reader's default applies).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Description {

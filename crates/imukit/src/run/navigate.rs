@@ -21,7 +21,7 @@ use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
-use crate::io::description::{Described, Description, Origin};
+use crate::io::description::{Described, Description, Origin, wgs84_gravity};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{TimedRows, check_gaps};
 use crate::io::schema::TableKind;
@@ -360,12 +360,10 @@ impl NavSetup {
     pub fn description(&self) -> Description {
         let (earth, earth_gravity, gravity_m_s2) = match &self.earth {
             None => (EarthName::Flat, None, Some(self.gravity_m_s2)),
-            Some(e) => match e.gravity {
-                GravityModel::Normal => (EarthName::Wgs84, Some(EarthGravityName::Normal), None),
-                GravityModel::Constant(g) => {
-                    (EarthName::Wgs84, Some(EarthGravityName::Constant), Some(g))
-                }
-            },
+            Some(e) => {
+                let (gravity, g) = wgs84_gravity(e.gravity);
+                (EarthName::Wgs84, Some(gravity), g)
+            }
         };
         Description {
             nav_frame: Some(self.nav_frame),

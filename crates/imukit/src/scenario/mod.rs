@@ -43,10 +43,9 @@ use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
-use crate::io::description::{Description, Origin};
+use crate::io::description::{Description, Origin, wgs84_gravity};
 use crate::io::table::{ImuOutput, Table};
 use crate::motion::Trajectory;
-use crate::run::navigate::EarthGravityName;
 
 /// Bytes an in-memory simulation holds per sample: the truth (23 numbers) and the readings
 /// (9), and both as tables (23 and up to 10 columns), with the times.
@@ -130,12 +129,7 @@ impl Scenario {
                     longitude_deg: o.longitude_rad.to_degrees(),
                     height_m: o.height_m,
                 };
-                let (gravity, g) = match plane.gravity {
-                    imu_core::earth::GravityModel::Normal => (EarthGravityName::Normal, None),
-                    imu_core::earth::GravityModel::Constant(g) => {
-                        (EarthGravityName::Constant, Some(g))
-                    }
-                };
+                let (gravity, g) = wgs84_gravity(plane.gravity);
                 (EarthName::Wgs84, Some(origin), Some(gravity), g)
             }
         };
