@@ -21,6 +21,7 @@ fn inputs(n: usize) -> Vec<FilterInput> {
             accel_m_s2: [jitter(0.02), jitter(0.02), 9.81 + jitter(0.02)],
             gyro_rad_s: [jitter(1e-3), jitter(1e-3), jitter(1e-3)],
             mag_ut: [27.5 + jitter(0.1), -2.4 + jitter(0.1), -16.1 + jitter(0.1)],
+            interval_s: None,
         })
         .collect()
 }

@@ -188,7 +188,9 @@ pub enum Command {
         /// A filter setting, `KEY=VALUE`, repeatable: MATLAB's property names
         /// (`GyroscopeNoise=7.6154e-7`, `DecimationFactor=2`, `InitialProcessNoiseScale=10`,
         /// `SampleRate=100`; `Beta` for madgwick, `Kp`/`Ki` for mahony, `AccelerometerGain`/
-        /// `MagnetometerGain` for complementary). The sample rate defaults to the data's.
+        /// `MagnetometerGain` for complementary). Each sample is integrated over its own
+        /// interval from `t_s`; `SampleRate=…` runs the filter at that fixed rate instead, as
+        /// MATLAB's filters do.
         #[arg(long = "param", value_name = "KEY=VALUE")]
         params: Vec<String>,
         /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and

@@ -117,7 +117,7 @@ fn strapdown<'py>(
     height0_m: Option<f64>,
     baro_columns: Option<Vec<String>>,
     baro_values: Option<PyReadonlyArray2<'py, f64>>,
-) -> PyResult<TableOut<'py>> {
+) -> PyResult<(TableOut<'py>, Vec<String>)> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
     let setup = NavRequest {
         nav_frame: choice("nav_frame", nav_frame)?,
@@ -154,7 +154,12 @@ fn strapdown<'py>(
     let out = py
         .detach(|| integrate(&imu, &initial, &setup))
         .map_err(refused)?;
-    table_out(py, out)
+    // The gaps the integration bridged, as warnings (row 0 is the first sample).
+    let t = imu.column("t_s").unwrap_or_default();
+    let notes = imukit::io::rows::Gaps::of_times(&t, 0)
+        .message("imu")
+        .into_iter();
+    Ok((table_out(py, out)?, notes.collect()))
 }
 
 /// Errors of an estimate against truth: (error table, summary dict).

@@ -1,13 +1,14 @@
 //! Orientation estimation for Python: the e-compass, every filter behind one class, and the
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
 use imu_core::{Enu, Ned};
+use imukit::io::rows::SampleClock;
 use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows};
 use imukit::scenario::NavFrameName;
-use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::convert::{array2, choice, choice_opt, flat_rows};
+use crate::convert::{array2, choice, choice_opt, flat_rows, vector};
 use crate::errors::refused;
 use imukit::run::orient::{ecompass_rows, frame_and_sign, quaternion_distances};
 
@@ -21,6 +22,7 @@ enum Filter {
 #[pyclass(module = "imukit._core", name = "OrientationFilter")]
 pub(crate) struct PyOrientationFilter {
     filter: Filter,
+    clock: SampleClock,
     gyroscope: bool,
     magnetometer: bool,
 }
@@ -61,21 +63,24 @@ impl PyOrientationFilter {
         };
         Ok(Self {
             filter,
+            clock: SampleClock::default(),
             gyroscope: kind != FilterKind::Ecompass,
             magnetometer: spec.magnetometer,
         })
     }
 
-    /// Readings (N, 3) → `(q_nb (M, 4), angular velocity (M, 3))`, M = N / decimation; the
-    /// state carries over to the next call.
-    #[pyo3(signature = (accel, gyro = None, mag = None))]
+    /// Readings (N, 3) and their times (N,) when known → `(q_nb (M, 4), angular velocity
+    /// (M, 3))`, M = N / decimation; the state and the last time carry over to the next call.
+    #[pyo3(signature = (accel, gyro = None, mag = None, t_s = None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         accel: PyReadonlyArray2<'py, f64>,
         gyro: Option<PyReadonlyArray2<'py, f64>>,
         mag: Option<PyReadonlyArray2<'py, f64>>,
+        t_s: Option<PyReadonlyArray1<'py, f64>>,
     ) -> PyResult<Estimates<'py>> {
+        let t = t_s.as_ref().map(vector);
         let a = flat_rows::<3>("accel", &accel)?;
         let g = match (&gyro, self.gyroscope) {
             (Some(g), _) => Some(flat_rows::<3>("gyro", g)?),
@@ -96,11 +101,11 @@ impl PyOrientationFilter {
             }
             (None, false) => None,
         };
-        let filter = &mut self.filter;
+        let (filter, clock) = (&mut self.filter, &mut self.clock);
         let out = py
             .detach(|| match filter {
-                Filter::Enu(f) => run_rows(f, a, g, m),
-                Filter::Ned(f) => run_rows(f, a, g, m),
+                Filter::Enu(f) => run_rows(f, clock, a, g, m, t.as_deref()),
+                Filter::Ned(f) => run_rows(f, clock, a, g, m, t.as_deref()),
             })
             .map_err(refused)?;
         let rows = out.quaternions.len();
@@ -113,6 +118,7 @@ impl PyOrientationFilter {
     /// Back to the state before the first sample.
     fn reset(&mut self) {
         use imu_core::orientation::OrientationFilter;
+        self.clock = SampleClock::default();
         match &mut self.filter {
             Filter::Enu(f) => f.reset(),
             Filter::Ned(f) => f.reset(),

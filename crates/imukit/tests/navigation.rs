@@ -136,7 +136,7 @@ fn rk4_recovers_the_figure8_to_a_micrometre_after_60_s_at_1_khz() {
 }
 
 #[test]
-fn gaps_and_disorder_in_the_times_are_named() {
+fn gaps_are_integrated_across_and_reported_and_disorder_is_named() {
     let sim = scenario("", "ENU");
     let init = InitialState::from_table(&sim.truth).unwrap();
     // Drop samples 100..110: a gap between rows 101 and 102 of the file (header is row 1).
@@ -151,11 +151,24 @@ fn gaps_and_disorder_in_the_times_are_named() {
     for r in (0..sim.imu.rows()).filter(|r| !(100..110).contains(r)) {
         gappy.push_row(&sim.imu.data[r * w..(r + 1) * w]);
     }
-    let e = integrate(&gappy, &init, &NavSetup::default())
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
-    assert!(e.contains("gap") && e.contains("rows 101 and 102"), "{e}");
+    let nav = integrate(&gappy, &init, &NavSetup::default()).unwrap();
+    assert_eq!(nav.rows(), gappy.rows());
+    let t = gappy.column("t_s").unwrap();
+    let gaps = imukit::io::rows::Gaps::of_times(&t, 2);
+    assert_eq!((gaps.count, gaps.longest_after_row), (1, 101));
+    assert!(
+        (gaps.longest_s - 11.0 * gaps.median_s).abs() < 1e-9,
+        "{gaps:?}"
+    );
+    let m = gaps.message("imu.csv").unwrap();
+    assert!(
+        m.starts_with("imu.csv: 1 gap longer than 2.5 median intervals") && m.contains("row 101"),
+        "{m}"
+    );
+    assert_eq!(
+        imukit::io::rows::Gaps::of_times(&sim.imu.column("t_s").unwrap(), 2).message("x"),
+        None
+    );
     let mut swapped = sim.imu.clone();
     swapped.data[5 * w] = swapped.data[4 * w];
     let e = integrate(&swapped, &init, &NavSetup::default())
@@ -257,7 +270,8 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
             ),
         }
     }
-    // A gap after the look-ahead window is found, named by its rows, and no output is left.
+    // A gap after the look-ahead window is integrated across and reported by its row; the
+    // streamed file gives the whole table's numbers.
     let sim = scenario("", "ENU");
     let mut gappy = sim.imu.clone();
     let w = gappy.columns.len();
@@ -266,10 +280,14 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
     }
     let (input, out) = (dir.join("gappy.csv"), dir.join("gappy_nav.csv"));
     gappy.write_csv(&input).unwrap();
-    let e =
-        integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap_err();
-    assert!(e.to_string().contains("between rows 3001 and 3002"), "{e}");
-    assert!(!out.exists());
+    let summary =
+        integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap();
+    assert_eq!(
+        (summary.gaps.count, summary.gaps.longest_after_row),
+        (1, 3001)
+    );
+    let whole = integrate(&gappy, &InitialState::default(), &NavSetup::default()).unwrap();
+    assert!(imukit::io::table::read_table(&out).unwrap() == whole);
     let _ = std::fs::remove_dir_all(dir);
 }
 

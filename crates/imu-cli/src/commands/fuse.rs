@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use imukit::io::output::check_outputs;
+use imukit::io::rows::Gaps;
 use imukit::io::table::read_table;
 use imukit::run::fuse::{AidTables, AlignName, FuseRequest, fuse_with};
 use imukit::run::navigate::InitialState;
@@ -115,6 +116,10 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         other => other,
     })?;
     nav.write(a.out)?;
+    let t = imu.column("t_s").unwrap_or_default();
+    if let Some(m) = Gaps::of_times(&t, 2).message(&a.imu.display().to_string()) {
+        crate::report::warn(&m);
+    }
     let last = |c: &str| {
         nav.column(c)
             .and_then(|v| v.last().copied())

@@ -7,6 +7,7 @@ use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
+use imukit::io::rows::Gaps;
 use imukit::run::navigate::{InitialState, NavAsked, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
@@ -70,6 +71,10 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
         message: e.to_string(),
     })?;
     nav.write(c.out)?;
+    // A whitespace `.dat` file has no header: its first sample is row 1.
+    let dat = c.input.extension().is_some_and(|e| e == "dat");
+    let t: Vec<f64> = samples.iter().map(|x| x.t_s).collect();
+    warn_gaps(&t, if dat { 1 } else { 2 }, c.input);
     report(&nav, &format!("{} scheme", scheme.name()), c.out);
     Ok(())
 }
@@ -149,6 +154,7 @@ pub fn three_d(
             }
         })?;
         nav.write_described(c.out, &setup.description())?;
+        warn_gaps(&joined.column("t_s").unwrap_or_default(), 2, c.input);
         report(
             &nav,
             "strapdown on the WGS-84 Earth, baro-damped height",
@@ -164,6 +170,9 @@ pub fn three_d(
         },
         other => other,
     })?;
+    if let Some(m) = summary.gaps.message(&c.input.display().to_string()) {
+        crate::report::warn(&m);
+    }
     let [x, y, z] = summary.end_position_m;
     crate::note!(
         "imukit: {} samples, strapdown ({}); end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
@@ -172,6 +181,14 @@ pub fn three_d(
         c.out.display()
     );
     Ok(())
+}
+
+/// Warns of the gaps in the times `t_s` of `input` (sample 0 at file row `first_row`), which
+/// the integration bridged.
+fn warn_gaps(t_s: &[f64], first_row: usize, input: &Path) {
+    if let Some(m) = Gaps::of_times(t_s, first_row).message(&input.display().to_string()) {
+        crate::report::warn(&m);
+    }
 }
 
 fn report(nav: &Table, what: &str, out: &Path) {

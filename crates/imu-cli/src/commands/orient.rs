@@ -30,13 +30,21 @@ pub fn run(
     .map_err(crate::error::by_flag)?
     .resolve();
     let s = orient_csv(input, &spec, nav, out)?;
+    let rate = (s.sample_rate_hz * 1e6).round() / 1e6;
+    let timing = if s.per_sample {
+        format!("each over its own interval (median rate {rate} Hz)")
+    } else {
+        format!("at a fixed {rate} Hz (SampleRate)")
+    };
     println!(
-        "imukit: {} samples at {} Hz through {filter}: {} orientations in {}",
+        "imukit: {} samples, {timing}, through {filter}: {} orientations in {}",
         s.samples,
-        (s.sample_rate_hz * 1e6).round() / 1e6,
         s.rows,
         out.display()
     );
+    if let Some(m) = s.gaps.message(&input.display().to_string()) {
+        crate::report::warn(&m);
+    }
     if s.unfinished > 0 {
         println!(
             "imukit: the last {} samples do not fill a block of DecimationFactor samples and \

@@ -13,8 +13,10 @@
 //! with no east component). The error state is `x = [θ, δb, δa, δd]`, where the true attitude
 //! is `C_nb = Ĉ_nb (I + [θ×])`.
 //!
-//! **Predict** (every sample, `Δt = 1/SampleRate`): `q ← q ⊗ exp((ω − b̂) Δt)`. Every
-//! `DecimationFactor` samples (`κ = DecimationFactor/SampleRate`) the filter corrects:
+//! **Predict** (every sample): `q ← q ⊗ exp((ω − b̂) Δt)`, with `Δt` the sample's own interval
+//! when it carries one ([`FilterInput::interval_s`]), else `1/SampleRate` (MATLAB's fixed
+//! rate). Every `DecimationFactor` samples the filter corrects; the block's duration `κ` is the
+//! sum of its samples' intervals, else MATLAB's `DecimationFactor/SampleRate`:
 //!
 //! * priors `â⁻ = ν â`, `d̂⁻ = σ d̂` (`ν` LinearAccelerationDecayFactor, `σ`
 //!   MagneticDisturbanceDecayFactor);
@@ -32,7 +34,8 @@
 //!   `m_n ← (|h|, 0, v)` for `(h, v)` the horizontal and vertical parts of `Ĉ_nb (y_m − d̂)`.
 //!
 //! **Covariance between corrections** (MATLAB's block form: only the diagonal blocks of `P⁺`
-//! are carried; `θ` absorbs the offset error over `κ`):
+//! are carried; `θ` absorbs the offset error over `κ`, formed at each correction with that
+//! block's `κ`, so a gap in the data widens the attitude's uncertainty by the time it lasted):
 //! `P⁻_θθ = P⁺_θθ + κ²(P⁺_bb + β + η)`, `P⁻_θb = κ(P⁺_bb + β)`, `P⁻_bb = P⁺_bb + β`,
 //! `P⁻_aa = ν²P⁺_aa + ξ`, `P⁻_dd = σ²P⁺_dd + δ`; the first prior is InitialProcessNoise.
 //!
@@ -188,6 +191,25 @@ struct Prior {
     dd: Matrix3<f64>,
 }
 
+impl Prior {
+    /// The prior of a correction from the last one's posterior blocks, over a block of `kappa`
+    /// seconds (MATLAB's block form; `θ` absorbs the offset error over `κ`).
+    fn propagated(posterior: &[Matrix3<f64>; 4], kappa: f64, p: &KalmanParams) -> Self {
+        let [tt, bb, aa, dd] = *posterior;
+        let beta = p.gyroscope_drift_noise;
+        Self {
+            tt: tt
+                + (bb + Matrix3::from_diagonal_element(beta + p.gyroscope_noise)) * (kappa * kappa),
+            tb: (bb + Matrix3::from_diagonal_element(beta)) * kappa,
+            bb: bb + Matrix3::from_diagonal_element(beta),
+            aa: aa * (p.linear_acceleration_decay * p.linear_acceleration_decay)
+                + Matrix3::from_diagonal_element(p.linear_acceleration_noise),
+            dd: dd * (p.magnetic_disturbance_decay * p.magnetic_disturbance_decay)
+                + Matrix3::from_diagonal_element(p.magnetic_disturbance_noise),
+        }
+    }
+}
+
 /// What the filter carries between samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KalmanState {
@@ -199,6 +221,12 @@ pub struct KalmanState {
     mag_nav: Vector3<f64>,
     prior: Prior,
     in_block: usize,
+    /// The diagonal blocks of the last correction's `P⁺` (θθ, bb, aa, dd), propagated over the
+    /// next block once its duration is known (`None` before the first correction).
+    posterior: Option<[Matrix3<f64>; 4]>,
+    /// The time the current decimation block has spanned, s, when its samples carried their
+    /// intervals (`None`: MATLAB's fixed `DecimationFactor / SampleRate`).
+    block_s: Option<f64>,
 }
 
 impl KalmanState {
@@ -222,6 +250,8 @@ impl KalmanState {
                 dd: d(3),
             },
             in_block: 0,
+            posterior: None,
+            block_s: None,
         }
     }
 
@@ -301,8 +331,15 @@ impl<N: NavFrame> KalmanFilter<N> {
         y_m: &Vector3<f64>,
     ) -> Result<(), OrientError> {
         let p = &self.params;
-        let kappa = p.decimation as f64 / p.sample_rate_hz;
+        // The block's duration κ: MATLAB's fixed one, or the time its samples spanned.
+        let kappa = s
+            .block_s
+            .take()
+            .unwrap_or(p.decimation as f64 / p.sample_rate_hz);
         let gyro_term = kappa * kappa * (p.gyroscope_drift_noise + p.gyroscope_noise);
+        if let Some(posterior) = s.posterior.take() {
+            s.prior = Prior::propagated(&posterior, kappa, p);
+        }
         let mut cov = SMatrix::<f64, STATES, STATES>::zeros();
         let pr = &s.prior;
         cov.fixed_view_mut::<3, 3>(0, 0).copy_from(&pr.tt);
@@ -355,18 +392,7 @@ impl<N: NavFrame> KalmanFilter<N> {
         if use_mag {
             s.mag_nav = horizontal_north(&(s.q * (y_m - s.mag_disturbance)));
         }
-        let [tt, bb, aa, dd] = posterior;
-        let beta = p.gyroscope_drift_noise;
-        s.prior = Prior {
-            tt: tt
-                + (bb + Matrix3::from_diagonal_element(beta + p.gyroscope_noise)) * (kappa * kappa),
-            tb: (bb + Matrix3::from_diagonal_element(beta)) * kappa,
-            bb: bb + Matrix3::from_diagonal_element(beta),
-            aa: aa * (p.linear_acceleration_decay * p.linear_acceleration_decay)
-                + Matrix3::from_diagonal_element(p.linear_acceleration_noise),
-            dd: dd * (p.magnetic_disturbance_decay * p.magnetic_disturbance_decay)
-                + Matrix3::from_diagonal_element(p.magnetic_disturbance_noise),
-        };
+        s.posterior = Some(posterior);
         Ok(())
     }
 }
@@ -409,8 +435,14 @@ impl<N: NavFrame> OrientationFilter<N> for KalmanFilter<N> {
         let y_m = Vector3::from(input.mag_ut);
         let w = Vector3::from(input.gyro_rad_s);
         let mut s = self.state;
+        if let Some(dt) = input.interval_s {
+            s.block_s = Some(s.block_s.unwrap_or(0.0) + dt);
+        }
         if s.started {
-            let step = (w - s.gyro_offset) / p.sample_rate_hz;
+            let step = match input.interval_s {
+                Some(dt) => (w - s.gyro_offset) * dt,
+                None => (w - s.gyro_offset) / p.sample_rate_hz,
+            };
             s.q *= UnitQuaternion::from_scaled_axis(step);
         } else {
             s.q = if self.magnetometer {

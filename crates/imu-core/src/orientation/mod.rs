@@ -37,6 +37,18 @@ pub struct FilterInput {
     pub gyro_rad_s: [f64; 3],
     /// Magnetometer, µT (ignored by filters without a magnetometer).
     pub mag_ut: [f64; 3],
+    /// Time since the previous sample, s; `None`: the filter's sample period (`1/SampleRate`,
+    /// MATLAB's fixed-rate behaviour). Readings with real time stamps carry it, so jitter and
+    /// gaps are integrated over the time that passed (ignored on a filter's first sample, which
+    /// only sets the start-up attitude, and by [`ecompass()`]).
+    pub interval_s: Option<f64>,
+}
+
+impl FilterInput {
+    /// The interval to integrate over: [`FilterInput::interval_s`], else `1/sample_rate_hz`.
+    pub(crate) fn interval_or(&self, sample_rate_hz: f64) -> f64 {
+        self.interval_s.unwrap_or(1.0 / sample_rate_hz)
+    }
 }
 
 /// A filter's output for one sample (or one decimation block).
@@ -106,8 +118,11 @@ pub trait OrientationFilter<N: NavFrame> {
     fn reset(&mut self);
 }
 
-/// Checks a sample's sensors (the magnetometer only when `mag` is set).
+/// Checks a sample's sensors (the magnetometer only when `mag` is set) and its interval.
 pub(crate) fn check_finite(input: &FilterInput, gyro: bool, mag: bool) -> Result<(), OrientError> {
+    if let Some(dt) = input.interval_s {
+        positive("sample interval", dt, false)?;
+    }
     let finite = |v: &[f64; 3]| v.iter().all(|c| c.is_finite());
     if !finite(&input.accel_m_s2) {
         return Err(OrientError::NotFinite {

@@ -28,7 +28,9 @@ use crate::frame::NavFrame;
 use crate::ideal::AccelSign;
 use crate::math;
 
-/// What the three filters share: rate, sensors, sign, and the running quaternion.
+/// What the three filters share: rate, sensors, sign, and the running quaternion. Each sample
+/// is integrated over its own interval when it has one ([`FilterInput::interval_s`]), else over
+/// `1/sample_rate_hz`; the complementary filter's gains stay fractions per sample, as MATLAB's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Core {
     sample_rate_hz: f64,
@@ -65,7 +67,7 @@ impl Core {
         let m = Vector3::from(input.mag_ut);
         let w = Vector3::from(input.gyro_rad_s);
         let (q, w) = match self.q {
-            Some(q) => advance(&Step { a, m, w, q }, 1.0 / self.sample_rate_hz),
+            Some(q) => advance(&Step { a, m, w, q }, input.interval_or(self.sample_rate_hz)),
             None if self.magnetometer => (ecompass_ned(&a, &m)?, w),
             None => (tilt::<N>(&a)?, w),
         };

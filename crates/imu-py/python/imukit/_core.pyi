@@ -237,7 +237,7 @@ def strapdown(
     height0_m: Optional[float] = None,
     baro_columns: Optional[Sequence[str]] = None,
     baro_values: Optional[npt.NDArray[np.float64]] = None,
-) -> _Table: ...
+) -> tuple[_Table, list[str]]: ...
 def fuse(
     imu_columns: Sequence[str],
     imu_values: npt.NDArray[np.float64],
@@ -333,6 +333,7 @@ class OrientationFilter:
         accel: npt.NDArray[np.float64],
         gyro: Optional[npt.NDArray[np.float64]] = None,
         mag: Optional[npt.NDArray[np.float64]] = None,
+        t_s: Optional[npt.NDArray[np.float64]] = None,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
     def reset(self) -> None: ...
     @property

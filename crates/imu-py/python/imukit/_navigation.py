@@ -8,6 +8,7 @@ from typing import Any, Dict, Mapping, NamedTuple, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
+from ._warning import _emit
 from ._core import ImuError
 from ._convert import _f64, _table_args, _times
 from ._table import Table, TableLike, _table
@@ -84,6 +85,10 @@ def strapdown(
     ``baro_time_constant_s`` on barometer readings: ``baro=sim.baro`` or the IMU table's
     ``baro_height_m`` column). The output adds
     ``lat_rad, lon_rad, height_m``; ``pos_*`` stay in the tangent plane of the truth's origin.
+
+    Each sample is integrated over its own interval (``t_s`` as stamped): jitter and gaps are
+    integrated across, and gaps longer than 2.5 median intervals are reported as an
+    :class:`ImuWarning`.
     """
     start: dict = {}
     if isinstance(initial, (Table, np.ndarray)) or hasattr(initial, "to_numpy"):  # a truth table or frame
@@ -99,12 +104,14 @@ def strapdown(
         start.update({scalars[k]: float(v) for k, v in initial.items() if k in scalars})
     elif initial is not None:
         raise TypeError("initial must be a truth Table or a dict")
-    return _table(_core.strapdown(
+    nav, notes = _core.strapdown(
         *_table_args("imu", imu), **start,
         nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
         accel_sign=accel_sign, scheme=scheme, substeps=int(substeps), earth=earth, vertical=vertical,
         baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity,
-        **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro))))))
+        **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro)))))
+    _emit(notes, stacklevel=2)
+    return _table(nav)
 
 class Comparison(NamedTuple):
     """What :func:`compare` returns: the errors over time and their summary. It unpacks as

@@ -88,11 +88,12 @@ class _Filter:
             magnetometer=magnetometer, settings=[(k, float(v)) for k, v in settings.items()],
             initial_process_noise=initial_process_noise)
 
-    def _run(self, accel, gyro, mag, return_angular_velocity: bool):
+    def _run(self, accel, gyro, mag, t_s, return_angular_velocity: bool):
         a = _rows("accel", accel)
         g = _rows("gyro", gyro, a.shape[0])
         m = None if mag is None else _rows("mag", mag, a.shape[0])
-        q, w = self._filter.step(a, g, m)
+        t = None if t_s is None else np.ascontiguousarray(t_s, dtype=np.float64).reshape(-1)
+        q, w = self._filter.step(a, g, m, t)
         q = _format(q, self.orientation_format)
         return (q, w) if return_angular_velocity else q
 
@@ -149,10 +150,15 @@ class ImuFilter(_Filter):
                          settings, orientation_format, _diagonal(initial_process_noise, self._states))
         self.decimation_factor = int(decimation_factor)
 
-    def __call__(self, accel, gyro, *, return_angular_velocity: bool = False):
+    def __call__(self, accel, gyro, *, t_s=None, return_angular_velocity: bool = False):
         """Readings (N, 3) → orientations (N / decimation_factor of them), and with
-        ``return_angular_velocity=True`` also the bias-corrected body rates (M, 3)."""
-        return self._run(accel, gyro, None, return_angular_velocity)
+        ``return_angular_velocity=True`` also the bias-corrected body rates (M, 3).
+
+        ``t_s`` (N,), the readings' times in seconds, integrates each sample over its own
+        interval (the first from the previous call's last time), so jitter and gaps cost only
+        what the motion did meanwhile; without it the filter runs at ``sample_rate``, as
+        MATLAB's."""
+        return self._run(accel, gyro, None, t_s, return_angular_velocity)
 
     @property
     def gyroscope_offset(self) -> np.ndarray:
@@ -176,19 +182,22 @@ class AhrsFilter(ImuFilter):
                          MagneticDisturbanceDecayFactor=magnetic_disturbance_decay_factor,
                          ExpectedMagneticFieldStrength=expected_magnetic_field_strength, **kwargs)
 
-    def __call__(self, accel, gyro, mag, *, return_angular_velocity: bool = False):  # type: ignore[override]
-        """Readings (N, 3) each → orientations, and optionally body rates."""
-        return self._run(accel, gyro, mag, return_angular_velocity)
+    def __call__(self, accel, gyro, mag, *, t_s=None,  # type: ignore[override]
+                 return_angular_velocity: bool = False):
+        """Readings (N, 3) each → orientations, and optionally body rates; ``t_s`` as for
+        :class:`ImuFilter`."""
+        return self._run(accel, gyro, mag, t_s, return_angular_velocity)
 
 
 class _SimpleFilter(_Filter):
-    def __call__(self, accel, gyro, mag=None, *, return_angular_velocity: bool = False):
+    def __call__(self, accel, gyro, mag=None, *, t_s=None, return_angular_velocity: bool = False):
         """Readings (N, 3) (``mag`` when built with ``has_magnetometer=True``) → orientations
-        (N, 4), and optionally body rates."""
+        (N, 4), and optionally body rates; ``t_s`` (N,), the readings' times in seconds,
+        integrates each sample over its own interval (else ``1/sample_rate``)."""
         if (mag is None) == self._magnetometer:
             raise ValueError("give mag readings exactly when the filter has a magnetometer "
                              f"(has_magnetometer={self._magnetometer})")
-        return self._run(accel, gyro, mag, return_angular_velocity)
+        return self._run(accel, gyro, mag, t_s, return_angular_velocity)
 
 
 class ComplementaryFilter(_SimpleFilter):

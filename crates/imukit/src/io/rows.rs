@@ -1,6 +1,11 @@
-//! Time-ordered rows of IMU files: the one rule for sample times (increasing, no gaps longer
-//! than [`MAX_GAP_FACTOR`] median intervals) and the streamed row reader that applies it
-//! (`TimedRows`) for `imukit integrate` and `imukit orient`.
+//! Time-ordered rows of IMU files: the one rule for sample times, and the streamed row reader
+//! that applies it (`TimedRows`) for `imukit integrate` and `imukit orient`.
+//!
+//! Times must increase. Each sample is integrated over its own interval, whatever its length,
+//! so jitter and lost samples cost only what the motion did meanwhile. An interval longer than
+//! [`MAX_GAP_FACTOR`] median intervals is a *gap*: it is bridged like any other (the strapdown
+//! and the filters carry their state across it), and counted and reported ([`Gaps`]) so that a
+//! user knows the data had holes. Nothing is refused for jitter or gaps.
 use std::collections::VecDeque;
 use std::path::Path;
 
@@ -10,25 +15,74 @@ use crate::io::table::CsvRows;
 /// Intervals longer than this many median intervals count as gaps in the data.
 pub const MAX_GAP_FACTOR: f64 = 2.5;
 
-/// Refuses a gap in sample times: an interval longer than [`MAX_GAP_FACTOR`] median intervals
-/// (missing samples would be bridged silently by the integration). `first_row` is the file row of
-/// sample 0 (2 below a CSV header), for the message.
-///
-/// # Errors
-/// [`crate::Error::Invalid`] naming the rows and the intervals.
-pub fn check_gaps(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
-    if t_s.len() < 3 {
-        return Ok(());
+/// The gaps in a run's sample times: intervals longer than [`MAX_GAP_FACTOR`] times the
+/// reference (median) interval, bridged and reported.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Gaps {
+    /// The reference interval, s: the median interval (of the first
+    /// [`GAP_WINDOW`] rows when streamed); 0 with fewer than two samples.
+    pub median_s: f64,
+    /// How many intervals are gaps.
+    pub count: usize,
+    /// The time the gaps span in all, s.
+    pub total_s: f64,
+    /// The longest gap, s (0 without gaps).
+    pub longest_s: f64,
+    /// The file row (a CSV header is row 1) of the sample before the longest gap.
+    pub longest_after_row: usize,
+}
+
+impl Gaps {
+    /// No gaps yet, against the reference interval `median_s`.
+    #[must_use]
+    pub fn against(median_s: f64) -> Self {
+        Self {
+            median_s,
+            ..Self::default()
+        }
     }
-    let median = median_interval(t_s);
-    let found = t_s
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .enumerate()
-        .find(|(_, d)| *d > MAX_GAP_FACTOR * median);
-    match found {
-        Some((i, d)) => Err(gap_error(what, i + first_row, d, median)),
-        None => Ok(()),
+
+    /// The gaps of increasing times `t_s`, sample 0 being file row `first_row`.
+    #[must_use]
+    pub fn of_times(t_s: &[f64], first_row: usize) -> Self {
+        if t_s.len() < 2 {
+            return Self::default();
+        }
+        let mut gaps = Self::against(median_interval(t_s));
+        for (i, w) in t_s.windows(2).enumerate() {
+            gaps.note(w[1] - w[0], i + first_row);
+        }
+        gaps
+    }
+
+    /// Notes one interval, after the sample at file row `row`.
+    pub fn note(&mut self, interval_s: f64, row: usize) {
+        if interval_s > MAX_GAP_FACTOR * self.median_s {
+            self.count += 1;
+            self.total_s += interval_s;
+            if interval_s > self.longest_s {
+                self.longest_s = interval_s;
+                self.longest_after_row = row;
+            }
+        }
+    }
+
+    /// What a run tells its user about the gaps of `what` (`None` without gaps).
+    #[must_use]
+    pub fn message(&self, what: &str) -> Option<String> {
+        (self.count > 0).then(|| {
+            let (n, s) = (self.count, if self.count == 1 { "" } else { "s" });
+            // To the microsecond: what a reader compares, not the stamps' last digits.
+            let us = |v: f64| (v * 1e6).round() / 1e6;
+            format!(
+                "{what}: {n} gap{s} longer than {MAX_GAP_FACTOR} median intervals ({} s), \
+                 {} s in all, integrated across; the longest, {} s, after row {}",
+                us(self.median_s),
+                us(self.total_s),
+                us(self.longest_s),
+                self.longest_after_row
+            )
+        })
     }
 }
 
@@ -39,30 +93,91 @@ pub(crate) fn median_interval(t_s: &[f64]) -> f64 {
     dt[dt.len() / 2]
 }
 
-pub(crate) fn gap_error(what: &str, row: usize, d: f64, median: f64) -> crate::Error {
+/// The refusal of a time that does not increase, at file row `row`.
+pub(crate) fn not_increasing(what: &str, row: usize) -> crate::Error {
     invalid(
         what,
-        format!(
-            "gap in the sample times between rows {row} and {} ({d} s, the median interval is {median} s)",
-            row + 1
-        ),
+        format!("time at row {row} does not increase after row {}", row - 1),
     )
 }
 
-/// Rows a streamed integration reads ahead to set the reference interval of the gap check (the
-/// median of their intervals; files this short are checked exactly as [`integrate`](crate::run::navigate::integrate) checks).
+/// Checks that the times `t_s` increase (sample 0 at file row `first_row`).
+///
+/// # Errors
+/// [`crate::Error::Invalid`] naming the first row whose time does not increase (or is NaN).
+pub fn check_increasing(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
+    match (1..t_s.len()).find(|&i| t_s[i].is_nan() || t_s[i] <= t_s[i - 1]) {
+        Some(i) => Err(not_increasing(what, i + first_row)),
+        None => Ok(()),
+    }
+}
+
+/// The time of the last sample a run in chunks has taken, so that each chunk's first sample
+/// gets its interval from the chunk before.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SampleClock {
+    last_t_s: Option<f64>,
+}
+
+impl SampleClock {
+    /// The interval before each of `t_s` (`None` for the first sample of a run), after
+    /// checking the times are finite and increase, from the last time of the chunk before.
+    /// The clock moves to the last time only through [`SampleClock::advance`], once the chunk
+    /// has been taken.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming `t_s` and the index of a time that is not finite or
+    /// does not increase.
+    pub fn intervals(&self, t_s: &[f64]) -> Result<Vec<Option<f64>>> {
+        let mut previous = self.last_t_s;
+        t_s.iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                if !t.is_finite() {
+                    return Err(invalid("t_s", format!("row {i}: {t} is not a finite time")));
+                }
+                let interval = match previous {
+                    Some(p) if t <= p => {
+                        return Err(invalid(
+                            "t_s",
+                            format!("row {i}: the time {t} s does not increase (after {p} s)"),
+                        ));
+                    }
+                    Some(p) => Some(t - p),
+                    None => None,
+                };
+                previous = Some(t);
+                Ok(interval)
+            })
+            .collect()
+    }
+
+    /// Moves the clock to the last of `t_s` (`None`: forgets the time, so the next sample
+    /// starts a new run's timing).
+    pub fn advance(&mut self, t_s: Option<&[f64]>) {
+        self.last_t_s = match t_s {
+            Some(t) => t.last().copied().or(self.last_t_s),
+            None => None,
+        };
+    }
+}
+
+/// Rows a streamed run reads ahead to set the reference interval of [`Gaps`] (the median of
+/// their intervals; files this short are judged exactly as a whole table is).
 pub const GAP_WINDOW: usize = 1001;
 
 /// Rows of an IMU CSV file in time order, for the streamed integration and orientation: each
-/// row's time must increase, and no interval may exceed [`MAX_GAP_FACTOR`] median intervals of
-/// the first [`GAP_WINDOW`] rows (read ahead when the file is opened). Memory does not grow with
-/// the file.
+/// row's time must increase; intervals longer than [`MAX_GAP_FACTOR`] median intervals of the
+/// first [`GAP_WINDOW`] rows (read ahead when the file is opened) are noted as [`Gaps`]. Memory
+/// does not grow with the file.
 pub(crate) struct TimedRows {
     rows: CsvRows,
     ahead: VecDeque<Vec<f64>>,
     first_t: f64,
     median: Option<f64>,
     previous_t: Option<f64>,
+    interval: Option<f64>,
+    gaps: Gaps,
     taken: usize,
 }
 
@@ -86,12 +201,17 @@ impl TimedRows {
         };
         let first_t = first[0];
         let times: Vec<f64> = ahead.iter().map(|r| r[0]).collect();
+        // Out-of-order look-ahead rows are refused by row when they are read; the reference
+        // interval is then never used.
+        let median = (times.len() > 1).then(|| median_interval(&times));
         Ok(Self {
             rows,
             first_t,
-            median: (times.len() > 1).then(|| median_interval(&times)),
+            median,
             ahead,
             previous_t: None,
+            interval: None,
+            gaps: Gaps::against(median.unwrap_or(0.0)),
             taken: 0,
         })
     }
@@ -106,6 +226,16 @@ impl TimedRows {
         self.median
     }
 
+    /// The interval from the row before to the row last read, s (`None` for the first row).
+    pub(crate) fn interval(&self) -> Option<f64> {
+        self.interval
+    }
+
+    /// The gaps among the rows read so far.
+    pub(crate) fn gaps(&self) -> Gaps {
+        self.gaps
+    }
+
     /// The file row (header = 1) of the row last read.
     pub(crate) fn last_row(&self) -> usize {
         self.taken + 1
@@ -114,7 +244,7 @@ impl TimedRows {
     /// Reads the next row into `row`; `false` at the end of the file.
     ///
     /// # Errors
-    /// Bad cells, times that do not increase, gaps (rows named).
+    /// Bad cells, times that do not increase (rows named).
     pub(crate) fn next_row(&mut self, row: &mut [f64]) -> Result<bool> {
         match self.ahead.pop_front() {
             Some(r) => row.copy_from_slice(&r),
@@ -128,17 +258,10 @@ impl TimedRows {
         let (t, line) = (row[0], self.last_row());
         if let Some(p) = self.previous_t {
             if t <= p {
-                return Err(invalid(
-                    "IMU data",
-                    format!(
-                        "time at row {line} does not increase after row {}",
-                        line - 1
-                    ),
-                ));
+                return Err(not_increasing("IMU data", line));
             }
-            if let Some(m) = self.median.filter(|m| t - p > MAX_GAP_FACTOR * m) {
-                return Err(gap_error("IMU data", line - 1, t - p, m));
-            }
+            self.gaps.note(t - p, line - 1);
+            self.interval = Some(t - p);
         }
         self.previous_t = Some(t);
         Ok(true)

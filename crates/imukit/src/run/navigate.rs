@@ -23,7 +23,7 @@ use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::description::{Described, Description, Origin, wgs84_gravity};
 use crate::io::output::AtomicFile;
-use crate::io::rows::{TimedRows, check_gaps};
+use crate::io::rows::{Gaps, TimedRows, check_increasing};
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
@@ -736,17 +736,7 @@ impl EarthJob for Integrate<'_> {
         let t = imu
             .column("t_s")
             .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
-        if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1] || t[i].is_nan()) {
-            return Err(invalid(
-                "IMU data",
-                format!(
-                    "time at row {} does not increase after row {}",
-                    i + 2,
-                    i + 1
-                ),
-            ));
-        }
-        check_gaps(&t, "IMU data", 2)?;
+        check_increasing(&t, "IMU data", 2)?;
         let (s0, origin) = nav_earth::start::<E>(initial, t.first().copied().unwrap_or(0.0))?;
         let baro = match options.vertical {
             VerticalChannel::Baro { .. } => Some(imu.column(BARO_COLUMN).ok_or_else(|| {
@@ -830,12 +820,15 @@ pub struct NavSummary {
     pub scheme: NavScheme,
     /// The last position in the plane, m.
     pub end_position_m: [f64; 3],
+    /// The gaps in the sample times, integrated across.
+    pub gaps: Gaps,
 }
 
 /// Integrates the IMU CSV file `input` into the navigation CSV `out` (the columns of
 /// [`integrate`]), the same numbers as [`integrate`], streamed: memory does not grow with the
 /// file (the RK4 scheme holds the six samples around its current interval); gaps are judged
-/// against the median interval of the first [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows.
+/// against the median interval of the first [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows
+/// and reported in the summary.
 /// The baro-damped vertical channel reads the file whole (within the memory budget of
 /// [`read_whole`]). `out` appears only when complete.
 ///
@@ -866,6 +859,7 @@ pub fn integrate_csv(
                 .scheme
                 .for_input(rates, setup.options.coning || setup.options.sculling),
             end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
+            gaps: Gaps::of_times(&imu.column("t_s").unwrap_or_default(), 2),
         });
     }
     with_earth(
@@ -1166,6 +1160,7 @@ impl EarthJob for IntegrateCsv<'_> {
             rows: written,
             scheme,
             end_position_m: E::plane_m(&end.position, &origin),
+            gaps: rows.gaps(),
         })
     }
 }

@@ -13,7 +13,7 @@ use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::description::{Described, Description};
 use crate::io::output::AtomicFile;
-use crate::io::rows::TimedRows;
+use crate::io::rows::{Gaps, SampleClock, TimedRows};
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
@@ -294,7 +294,16 @@ impl FilterSpec {
     /// # Errors
     /// An unknown setting.
     pub fn sample_rate_hz(&self, data_rate_hz: f64) -> Result<f64> {
-        Ok(self.setting("SampleRate")?.unwrap_or(data_rate_hz))
+        Ok(self.fixed_rate_hz()?.unwrap_or(data_rate_hz))
+    }
+
+    /// The `SampleRate` setting: a fixed rate that replaces the samples' own intervals, as in
+    /// MATLAB's filters (`None`: each sample over its own interval).
+    ///
+    /// # Errors
+    /// An unknown setting.
+    pub fn fixed_rate_hz(&self) -> Result<Option<f64>> {
+        self.setting("SampleRate")
     }
 
     /// The Kalman parameters these settings give.
@@ -477,8 +486,13 @@ pub struct OrientSummary {
     /// Samples at the end that do not fill a decimation block, so give no estimate (0 without
     /// decimation; MATLAB's filters refuse such a call, a file is read whole instead).
     pub unfinished: usize,
-    /// The sample rate used, Hz.
+    /// The sample rate: the `SampleRate` setting, or the median rate of the file, Hz.
     pub sample_rate_hz: f64,
+    /// Whether each sample was integrated over its own interval (no `SampleRate` setting) or
+    /// at the fixed `SampleRate`, as MATLAB's filters do.
+    pub per_sample: bool,
+    /// The gaps in the sample times, integrated across.
+    pub gaps: Gaps,
 }
 
 /// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
@@ -549,6 +563,7 @@ fn orient_csv_in<N: NavFrame>(
     let mut rows = TimedRows::open(input, &columns, &hint)?;
     let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
     let rate = spec.sample_rate_hz(data_rate)?;
+    let per_sample = spec.fixed_rate_hz()?.is_none();
     if !(rate.is_finite() && rate > 0.0) {
         return Err(invalid(
             "SampleRate",
@@ -577,6 +592,7 @@ fn orient_csv_in<N: NavFrame>(
             } else {
                 [0.0; 3]
             },
+            interval_s: rows.interval().filter(|_| per_sample),
         };
         let estimate = filter
             .update(&sample)
@@ -593,6 +609,8 @@ fn orient_csv_in<N: NavFrame>(
         rows: written,
         unfinished: samples - written * filter.decimation(),
         sample_rate_hz: rate,
+        per_sample,
+        gaps: rows.gaps(),
     })
 }
 
@@ -606,23 +624,34 @@ pub struct Estimates {
 }
 
 /// Runs `filter` over rows of readings given as flat slices (three values per row):
-/// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use).
-/// The filter carries its state into the next call, so a run in chunks equals a run whole; on
-/// an error the filter is left as it was before the call. As in MATLAB's `imufilter` and
+/// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use), and
+/// their times `t_s` when known: each sample is then integrated over its own interval, the
+/// first from the last time `clock` holds (else at the filter's sample rate).
+/// The filter and the clock carry their state into the next call, so a run in chunks equals a
+/// run whole; on an error both are left as they were before the call. As in MATLAB's `imufilter` and
 /// `ahrsfilter`, each call takes whole decimation blocks: the row count must be a multiple of
 /// the `DecimationFactor`.
 ///
 /// # Errors
 /// Slices of different lengths, a row count that is not a multiple of the decimation factor,
-/// the filter's refusals naming the row index (non-finite readings among them), and estimates
-/// that are not finite.
+/// times that are not finite or do not increase, the filter's refusals naming the row index
+/// (non-finite readings among them), and estimates that are not finite.
 pub fn run_rows<N: NavFrame>(
     filter: &mut AnyFilter<N>,
+    clock: &mut SampleClock,
     accel: &[f64],
     gyro: Option<&[f64]>,
     mag: Option<&[f64]>,
+    t_s: Option<&[f64]>,
 ) -> Result<Estimates> {
     let n = accel.len() / 3;
+    if let Some(t) = t_s.filter(|t| t.len() != n) {
+        return Err(invalid(
+            "t_s",
+            format!("has {} times, the accelerometer {n} rows", t.len()),
+        ));
+    }
+    let intervals = t_s.map(|t| clock.intervals(t)).transpose()?;
     for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
         if let Some(s) = s.filter(|s| s.len() != accel.len()) {
             return Err(invalid(
@@ -651,6 +680,7 @@ pub fn run_rows<N: NavFrame>(
             accel_m_s2: three(Some(accel), i),
             gyro_rad_s: three(gyro, i),
             mag_ut: three(mag, i),
+            interval_s: intervals.as_ref().and_then(|d| d[i]),
         };
         let estimate = working
             .update(&input)
@@ -671,6 +701,7 @@ pub fn run_rows<N: NavFrame>(
         }
     }
     *filter = working;
+    clock.advance(t_s);
     Ok(out)
 }
 

@@ -236,10 +236,6 @@ pub fn integrate(
     scheme: PlanarScheme,
     initial: PlanarState,
 ) -> Result<Table> {
-    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
-    if t.windows(2).all(|w| w[1] > w[0]) {
-        crate::io::rows::check_gaps(&t, "planar IMU", 1)?;
-    }
     let mut states = vec![PlanarState::default(); samples.len()];
     dead_reckon(samples, scheme, initial, &mut states).map_err(|source| Error::Planar {
         context: "planar IMU".into(),
