@@ -184,3 +184,29 @@ def test_a_matlab_parameter_file_becomes_kalibrs_single_sided_figures(tmp_path):
     assert d["gyroscope_random_walk"] == pytest.approx(2e-5 * 2**0.5, rel=5e-7)
     assert d["accelerometer_noise_density"] == pytest.approx(2e-3 / 2**0.5, rel=5e-7)
     assert "from MyPart" in out and "double-sided densities turned single-sided" in out
+
+
+EUROC_IMU = ("#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+             "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]")
+
+
+def test_a_euroc_imu_file_is_read_by_its_header_with_stamps_to_the_nanosecond(tmp_path):
+    first = 1403636579758555392  # EuRoC MH_01_easy's first IMU stamp
+    stamps = first + np.array([0, 5_000_213, 9_999_871, 15_000_000, 20_000_001, 25_000_000], dtype=np.int64)
+    readings = np.random.default_rng(3).normal(size=(stamps.size, 6)) + [0, 0, 0, 0, 0, 9.81]
+    path = tmp_path / "mav0" / "imu0" / "data.csv"
+    path.parent.mkdir(parents=True)
+    with open(path, "w") as f:
+        f.write(EUROC_IMU + "\n")
+        for s, row in zip(stamps, readings):
+            f.write(",".join([str(s)] + [repr(float(v)) for v in row]) + "\n")
+    table = imukit.read(path)
+    assert list(table) == ["t_s", "gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s",
+                           "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]
+    np.testing.assert_array_equal(np.column_stack([table[c] for c in list(table)[1:]]), readings)
+    origin = first // 86_400_000_000_000 * 86_400_000_000_000
+    np.testing.assert_array_equal(np.round(table["t_s"] * 1e9).astype(np.int64) + origin, stamps)
+    out = tmp_path / "o.csv"
+    done = subprocess.run([imukit_bin(), "orient", str(path), "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert len(imukit.read(out)) == stamps.size

@@ -1,10 +1,12 @@
-//! Files in and out: tables and CSV ([`table`]), tables as Parquet ([`parquet`]) and as NumPy
+//! Files in and out: tables and CSV ([`table`]), the EuRoC/TUM-VI ASL layout read by its header
+//! ([`asl`]), tables as Parquet ([`parquet`]) and as NumPy
 //! `.npy` and `.npz` ([`npy`], [`npz`]), each chosen by its path's extension ([`TableFormat`]),
 //! what a table holds, written into it ([`description`]), parameter
 //! files ([`params`]), the built-in
 //! presets of real parts ([`presets`]), datasheet units ([`units`]), the time-checked row
 //! reader of IMU files ([`rows`]) and typed values read from a tree of them ([`value_tree`]:
 //! a Python dict's way in).
+pub mod asl;
 pub mod description;
 pub mod kalibr;
 pub mod npy;

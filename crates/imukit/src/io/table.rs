@@ -640,7 +640,10 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
         TableFormat::Npz => return crate::io::npz::column_names(path),
         TableFormat::Csv => {}
     }
-    let mut r = reader(path)?;
+    if let Some(line) = asl_header(path)? {
+        return crate::io::asl::column_names(&line, &path.display().to_string());
+    }
+    let mut r = reader(path, true)?;
     let h = r.headers().map_err(|e| csv_error(path, &e))?;
     let names: Vec<String> = h.iter().map(|s| s.trim().to_string()).collect();
     if names.iter().all(String::is_empty) {
@@ -667,7 +670,9 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
-fn reader(path: &Path) -> Result<csv::Reader<File>> {
+/// A CSV reader of `path`, its header row read as the header; `#` lines are comments unless
+/// `comments` is false (an ASL file's header starts with `#`).
+fn reader(path: &Path, comments: bool) -> Result<csv::Reader<File>> {
     let file = File::open(path).map_err(|source| Error::Io {
         path: path.into(),
         source,
@@ -677,8 +682,27 @@ fn reader(path: &Path) -> Result<csv::Reader<File>> {
     Ok(csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::Headers)
-        .comment(Some(b'#'))
+        .comment(comments.then_some(b'#'))
         .from_reader(file))
+}
+
+/// The longest first line read to recognise a layout, bytes.
+const FIRST_LINE_LIMIT: u64 = 1 << 20;
+
+/// The first line of a CSV file when it is an ASL header ([`crate::io::asl`]).
+fn asl_header(path: &Path) -> Result<Option<String>> {
+    use std::io::{BufRead, Read};
+    let io = |source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    let file = File::open(path).map_err(io)?;
+    let mut line = Vec::new();
+    std::io::BufReader::new(file.take(FIRST_LINE_LIMIT))
+        .read_until(b'\n', &mut line)
+        .map_err(io)?;
+    let line = String::from_utf8_lossy(&line);
+    Ok(crate::io::asl::is_header(&line).then(|| line.into_owned()))
 }
 
 /// The number of comment lines (`#` first) at the start of the file at `path`, read through
@@ -834,6 +858,12 @@ pub struct CsvRows {
     wanted: Vec<(usize, String)>,
     /// Comment lines before a CSV file's header (its description line): not rows.
     comments: usize,
+    /// The field of an ASL file's integer-nanosecond stamps, which `t_s` is read from.
+    stamp_field: Option<usize>,
+    /// The time origin of those stamps, set by the first row ([`crate::io::asl`]).
+    origin_ns: Option<i64>,
+    /// An ASL file's own column names, by field, for messages.
+    file_names: Option<Vec<String>>,
 }
 
 impl CsvRows {
@@ -843,6 +873,11 @@ impl CsvRows {
     /// Missing columns (all named at once, with `hint`), unreadable or empty files.
     pub fn open(path: &Path, required: &[&str], hint: &str) -> Result<Self> {
         let names = read_header(path)?;
+        let asl_line = match TableFormat::of(path) {
+            TableFormat::Csv => asl_header(path)?,
+            _ => None,
+        };
+        let asl = asl_line.is_some();
         // Looked up by name, so a file of many columns costs linear time, not quadratic.
         let index: HashMap<&str, usize> = names
             .iter()
@@ -871,14 +906,15 @@ impl CsvRows {
             }
             TableFormat::Npy => RowSource::Npy(crate::io::npy::NpyRows::open(path)?.1),
             TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
-            TableFormat::Csv => RowSource::Csv(reader(path)?),
+            TableFormat::Csv => RowSource::Csv(reader(path, !asl)?),
         };
         // Rows are counted from the header, row 1, whatever comment lines (the description's)
         // come before it.
         let comments = match reader {
-            RowSource::Csv(_) => leading_comment_lines(path)?,
+            RowSource::Csv(_) if !asl => leading_comment_lines(path)?,
             _ => 0,
         };
+        let stamp_field = asl.then(|| index.get("t_s").copied()).flatten();
         Ok(Self {
             path: path.into(),
             reader,
@@ -886,6 +922,9 @@ impl CsvRows {
             names,
             wanted,
             comments,
+            stamp_field,
+            origin_ns: None,
+            file_names: asl_line.as_deref().map(crate::io::asl::file_names),
         })
     }
 
@@ -925,7 +964,11 @@ impl CsvRows {
             let bad = |message: String| Error::CsvValue {
                 file: self.path.clone(),
                 row,
-                column: name.clone(),
+                // An ASL file's column by its own name, then imukit's.
+                column: match self.file_names.as_ref().and_then(|f| f.get(*k)) {
+                    Some(own) if own != name => format!("{own} ({name})"),
+                    _ => name.clone(),
+                },
                 message,
             };
             let not_a_number = || {
@@ -936,6 +979,18 @@ impl CsvRows {
             let text = std::str::from_utf8(field)
                 .map_err(|_| not_a_number())?
                 .trim();
+            if Some(*k) == self.stamp_field {
+                let ns = crate::io::asl::parse_stamp_ns(text).ok_or_else(|| {
+                    bad(format!(
+                        "not a time stamp in integer nanoseconds: \"{text}\""
+                    ))
+                })?;
+                let origin = *self
+                    .origin_ns
+                    .get_or_insert_with(|| crate::io::asl::time_origin_ns(ns));
+                *slot = crate::io::asl::seconds_after(ns, origin);
+                continue;
+            }
             let v: f64 = text.parse().map_err(|_| not_a_number())?;
             if !v.is_finite() {
                 return Err(bad(format!("not a finite number: \"{text}\"")));
