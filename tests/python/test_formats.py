@@ -210,3 +210,78 @@ def test_a_euroc_imu_file_is_read_by_its_header_with_stamps_to_the_nanosecond(tm
     done = subprocess.run([imukit_bin(), "orient", str(path), "--out", str(out)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert len(imukit.read(out)) == stamps.size
+
+
+VENDOR_MAP = """time = { column = "Timestamp", unit = "ms" }
+accel = { columns = ["AccX", "AccY", "AccZ"], unit = "g" }
+gyro = { columns = ["GyrX", "GyrY", "GyrZ"], unit = "deg/s" }
+mag = { columns = ["MagX", "MagY", "MagZ"], unit = "mG" }
+axes = ["x", "-y", "-z"]
+"""
+
+
+def vendor_log(tmp_path):
+    """A simulated run as a vendor writes it (pandas): epoch milliseconds, g, deg/s and
+    milligauss, the y and z axes flipped, a temperature column; and its map."""
+    sim = imukit.simulate({"rate_hz": 100.0, "duration_s": 5.0,
+                           "trajectory": {"type": "builtin", "name": "platform-turn"}})
+    imu = sim.imu.to_pandas()
+    g, deg = 9.80665, np.pi / 180
+    flip = {"x": 1.0, "y": -1.0, "z": -1.0}
+    log = pd.DataFrame({"Timestamp": np.round(imu.t_s * 1e3).astype(np.int64) + 1_700_000_000_000})
+    for ax in "xyz":
+        log[f"Acc{ax.upper()}"] = flip[ax] * imu[f"accel_{ax}_m_s2"] / g
+    for ax in "xyz":
+        log[f"Gyr{ax.upper()}"] = flip[ax] * imu[f"gyro_{ax}_rad_s"] / deg
+    for ax in "xyz":
+        log[f"Mag{ax.upper()}"] = flip[ax] * imu[f"mag_{ax}_ut"] * 10.0
+    log["Temp"] = 25.0
+    path, map_path = tmp_path / "vendor.csv", tmp_path / "vendor.map.toml"
+    log.to_csv(path, index=False)
+    map_path.write_text(VENDOR_MAP)
+    return sim, path, map_path
+
+
+def test_a_vendor_csv_reads_through_its_column_map_in_si_and_body_axes(tmp_path):
+    sim, path, map_path = vendor_log(tmp_path)
+    table = imukit.read(path, map=map_path)
+    assert list(table)[:10] == list(sim.imu)[:10] and list(table)[-1] == "Temp"
+    for column in list(sim.imu)[1:]:
+        np.testing.assert_allclose(table[column], sim.imu[column], rtol=1e-14, atol=1e-14, err_msg=column)
+    # Integer milliseconds since 1970, kept exactly: seconds from that day's midnight.
+    ms = np.round((table["t_s"] - table["t_s"][0]) * 1e3)
+    np.testing.assert_array_equal(ms, np.round(sim.imu["t_s"] * 1e3))
+    as_dict = imukit.read(path, map={
+        "time": {"column": "Timestamp", "unit": "ms"},
+        "accel": {"columns": ["AccX", "AccY", "AccZ"], "unit": "g"},
+        "gyro": {"columns": ["GyrX", "GyrY", "GyrZ"], "unit": "deg/s"},
+        "mag": {"columns": ["MagX", "MagY", "MagZ"], "unit": "mG"},
+        "axes": ["x", "-y", "-z"]})
+    for column in table:
+        np.testing.assert_array_equal(as_dict[column], table[column])
+
+
+def test_commands_take_a_column_map_and_refuse_a_bad_one_by_name(tmp_path):
+    sim, path, map_path = vendor_log(tmp_path)
+    plain = tmp_path / "plain.csv"
+    sim.imu.write(plain)
+    outs = {}
+    for name, extra in [("vendor", [str(path), "--map", str(map_path)]), ("plain", [str(plain)])]:
+        out = tmp_path / f"{name}_orient.csv"
+        done = subprocess.run([imukit_bin(), "orient", *extra, "--filter", "ahrsfilter", "--out", str(out)],
+                              capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        outs[name] = imukit.read(out)
+    for column in ("q_w", "q_x", "q_y", "q_z"):
+        np.testing.assert_allclose(outs["vendor"][column], outs["plain"][column], atol=1e-9)
+    bad = tmp_path / "bad.toml"
+    for text, expected in [
+        (VENDOR_MAP.replace('"GyrZ"', '"GyroZ"'), 'names column "GyroZ", which the header does not have'),
+        (VENDOR_MAP.replace('"deg/s"', '"furlong/s"'), 'gyro.unit: "furlong/s" is not a unit of rad/s'),
+    ]:
+        bad.write_text(text)
+        out = tmp_path / "never.csv"
+        done = subprocess.run([imukit_bin(), "orient", str(path), "--map", str(bad), "--out", str(out)],
+                              capture_output=True, text=True)
+        assert done.returncode == 65 and expected in done.stderr, done.stderr
+        assert not out.exists()

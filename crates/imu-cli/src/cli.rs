@@ -92,6 +92,11 @@ pub enum Command {
         /// (`dv_*_m_s`, `dtheta_*_rad`). Planar: CSV (`t_s, accel_x_m_s2, accel_y_m_s2,
         /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
         input: PathBuf,
+        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
+        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
+        /// axes in the body frame (docs/formats.md).
+        #[arg(long, value_name = "FILE")]
+        map: Option<PathBuf>,
         /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
@@ -182,6 +187,11 @@ pub enum Command {
         /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
         /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
         input: PathBuf,
+        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
+        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
+        /// axes in the body frame (docs/formats.md).
+        #[arg(long, value_name = "FILE")]
+        map: Option<PathBuf>,
         /// The filter.
         #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
         filter: FilterKind,
@@ -218,6 +228,11 @@ pub enum Command {
     Fuse {
         /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
         imu: PathBuf,
+        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
+        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
+        /// axes in the body frame (docs/formats.md).
+        #[arg(long, value_name = "FILE")]
+        map: Option<PathBuf>,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
         gnss: PathBuf,
         /// The initial state: the first row of this truth CSV.
@@ -343,6 +358,11 @@ pub enum Command {
     Allan {
         /// IMU readings CSV (with `t_s`).
         input: PathBuf,
+        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
+        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
+        /// axes in the body frame (docs/formats.md).
+        #[arg(long, value_name = "FILE")]
+        map: Option<PathBuf>,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,

@@ -3,8 +3,9 @@
 use std::path::Path;
 
 use imukit::Table;
+use imukit::io::column_map::ColumnMap;
 use imukit::io::description::{Description, Value};
-use imukit::io::table::{read_table, run_path as run_file};
+use imukit::io::table::{read_table, read_table_through, run_path as run_file};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -18,10 +19,27 @@ fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
     table_out(py, read_table(Path::new(path)).map_err(refused)?)
 }
 
-/// Every column of a table file, its format by its extension (`.parquet`, else CSV).
+/// Every column of a table file, its format by its extension (`.parquet`, else CSV); a CSV
+/// file through a column map when one is given (a TOML file's path, or JSON text).
 #[pyfunction]
-fn read_table_file<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
-    let t = py.detach(|| read_table(Path::new(path))).map_err(refused)?;
+#[pyo3(signature = (path, map_path = None, map_json = None))]
+fn read_table_file<'py>(
+    py: Python<'py>,
+    path: &str,
+    map_path: Option<&str>,
+    map_json: Option<&str>,
+) -> PyResult<TableOut<'py>> {
+    let map = match (map_path, map_json) {
+        (Some(p), _) => Some(ColumnMap::read(Path::new(p)).map_err(refused)?),
+        (None, Some(text)) => Some(ColumnMap::from_json(text, "map").map_err(refused)?),
+        (None, None) => None,
+    };
+    let t = py
+        .detach(|| match &map {
+            Some(m) => read_table_through(Path::new(path), m),
+            None => read_table(Path::new(path)),
+        })
+        .map_err(refused)?;
     table_out(py, t)
 }
 

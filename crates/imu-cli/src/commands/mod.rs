@@ -59,6 +59,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         },
         Command::Integrate {
             input,
+            map,
             init,
             nav_frame,
             gravity_m_s2,
@@ -81,6 +82,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             height0_m,
             out,
         } => {
+            attach_map(&input, map.as_deref())?;
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -121,6 +123,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Fuse {
             imu,
+            map,
             gnss,
             init,
             align,
@@ -134,40 +137,47 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             sensor_errors,
             rest_s,
             out,
-        } => fuse::run(&fuse::Args {
-            imu: &imu,
-            gnss: &gnss,
-            init: init.as_deref(),
-            align,
-            scenario: &scenario,
-            earth,
-            no_gate,
-            odometer: odometer.as_deref(),
-            baro: baro.as_deref(),
-            nhc,
-            covariance_interval_s,
-            sensor_errors,
-            rest_s,
-            out: &out,
-        }),
+        } => {
+            attach_map(&imu, map.as_deref())?;
+            fuse::run(&fuse::Args {
+                imu: &imu,
+                gnss: &gnss,
+                init: init.as_deref(),
+                align,
+                scenario: &scenario,
+                earth,
+                no_gate,
+                odometer: odometer.as_deref(),
+                baro: baro.as_deref(),
+                nhc,
+                covariance_interval_s,
+                sensor_errors,
+                rest_s,
+                out: &out,
+            })
+        }
         Command::Study { study, out, plot } => study::run(&study, &out, plot.as_deref()),
         Command::Orient {
             input,
+            map,
             filter,
             params,
             conventions,
             nav_frame,
             accel_sign,
             out,
-        } => orient::run(
-            &input,
-            filter,
-            &params,
-            conventions,
-            nav_frame,
-            accel_sign,
-            &out,
-        ),
+        } => {
+            attach_map(&input, map.as_deref())?;
+            orient::run(
+                &input,
+                filter,
+                &params,
+                conventions,
+                nav_frame,
+                accel_sign,
+                &out,
+            )
+        }
         Command::Compare {
             truth,
             estimate,
@@ -181,17 +191,21 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Allan {
             input,
+            map,
             columns,
             out,
             plot,
             figure,
-        } => allan::run(
-            &input,
-            &columns,
-            &out,
-            plot.as_deref(),
-            plot::figure_size(&figure)?,
-        ),
+        } => {
+            attach_map(&input, map.as_deref())?;
+            allan::run(
+                &input,
+                &columns,
+                &out,
+                plot.as_deref(),
+                plot::figure_size(&figure)?,
+            )
+        }
         Command::Plot {
             files,
             out,
@@ -211,4 +225,13 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             plot::animate(&truth, &out, &opts)
         }
     }
+}
+
+/// Reads the column map `map` (`--map FILE`) and attaches it to `input`: every reader of the
+/// input then reads it through the map.
+fn attach_map(input: &std::path::Path, map: Option<&std::path::Path>) -> Result<(), CliError> {
+    if let Some(m) = map {
+        imukit::io::column_map::attach(input, imukit::io::column_map::ColumnMap::read(m)?);
+    }
+    Ok(())
 }

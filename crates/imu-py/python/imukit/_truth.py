@@ -2,9 +2,10 @@
 ideal readings, CSV files and the built-in scenarios."""
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
-from typing import Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 from . import _core
 from ._convert import _f64, _flag, _table_args, _times, _whole
@@ -69,16 +70,31 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
     return _table(_core.read_csv(str(path)))
 
-def read(path: Union[str, os.PathLike]) -> Table:
-    """An imukit table file as a :class:`Table`, its format by its extension: ``.csv``,
-    ``.parquet`` (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy``
-    (a structured array of float64 fields) or ``.npz`` (one float64 array per column, as
-    ``numpy.savez`` writes them). Any other extension is refused with the formats read."""
+def read(path: Union[str, os.PathLike], *, map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None) -> Table:
+    """A table file as a :class:`Table`, its format by its extension: ``.csv``, ``.parquet``
+    (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy`` (a structured
+    array of float64 fields) or ``.npz`` (one float64 array per column, as ``numpy.savez`` writes
+    them). Any other extension is refused with the formats read. A EuRoC/TUM-VI file
+    (``#timestamp [ns],w_RS_S_x [rad s^-1],…``) is read as imukit's columns by its header.
+
+    ``map`` reads a vendor's CSV through a column map — the path of a TOML map, or the same keys
+    as a dict — giving ``t_s`` and the sensors' columns in SI units and body axes
+    (docs/formats.md)::
+
+        imukit.read("log.csv", map={"time": {"column": "Timestamp", "unit": "ms"},
+                                    "accel": {"columns": ["AccX", "AccY", "AccZ"], "unit": "g"},
+                                    "gyro": {"columns": ["GyrX", "GyrY", "GyrZ"], "unit": "deg/s"},
+                                    "axes": ["x", "-y", "-z"]})
+    """
     suffix = Path(path).suffix.lower()
-    if suffix in TABLE_FORMATS:
+    if suffix not in TABLE_FORMATS:
+        raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
+                       f"(read: {', '.join(TABLE_FORMATS)})")
+    if map is None:
         return _table(_core.read_table_file(str(path)))
-    raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
-                   f"(read: {', '.join(TABLE_FORMATS)})")
+    if isinstance(map, Mapping):
+        return _table(_core.read_table_file(str(path), map_json=json.dumps(dict(map))))
+    return _table(_core.read_table_file(str(path), map_path=str(map)))
 
 
 def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:

@@ -1,5 +1,5 @@
 //! Files in and out: tables and CSV ([`table`]), the EuRoC/TUM-VI ASL layout read by its header
-//! ([`asl`]), tables as Parquet ([`parquet`]) and as NumPy
+//! ([`asl`]), a vendor's CSV through a column map ([`column_map`]), tables as Parquet ([`parquet`]) and as NumPy
 //! `.npy` and `.npz` ([`npy`], [`npz`]), each chosen by its path's extension ([`TableFormat`]),
 //! what a table holds, written into it ([`description`]), parameter
 //! files ([`params`]), the built-in
@@ -7,6 +7,7 @@
 //! reader of IMU files ([`rows`]) and typed values read from a tree of them ([`value_tree`]:
 //! a Python dict's way in).
 pub mod asl;
+pub mod column_map;
 pub mod description;
 pub mod kalibr;
 pub mod npy;

@@ -13,6 +13,7 @@ use imu_core::{NavFrame, Truth};
 
 use crate::error::{Error, Result};
 use crate::io::TableFormat;
+use crate::io::column_map::{ColumnMap, Source, TimeUnit};
 use crate::io::description::Description;
 use crate::io::output::write_atomically;
 
@@ -635,14 +636,68 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
 /// Unreadable or empty file, a column name that appears twice.
 pub fn read_header(path: &Path) -> Result<Vec<String>> {
     match TableFormat::of(path) {
-        TableFormat::Parquet => return crate::io::parquet::column_names(path),
-        TableFormat::Npy => return crate::io::npy::column_names(path),
-        TableFormat::Npz => return crate::io::npz::column_names(path),
-        TableFormat::Csv => {}
+        TableFormat::Parquet => crate::io::parquet::column_names(path),
+        TableFormat::Npy => crate::io::npy::column_names(path),
+        TableFormat::Npz => crate::io::npz::column_names(path),
+        TableFormat::Csv => Ok(csv_layout(path, None)?.names),
+    }
+}
+
+/// How a CSV file's fields become a table's columns: as they are, through the ASL layout its
+/// header announces ([`crate::io::asl`]), or through the column map attached to it
+/// ([`crate::io::column_map`]).
+struct Layout {
+    /// The table's column names.
+    names: Vec<String>,
+    /// How each column is made (`None`: column k is field k).
+    sources: Option<Vec<Source>>,
+    /// The file's own column names, when they differ from the table's (for messages).
+    file_names: Option<Vec<String>>,
+    /// Whether `#` lines are comments (not in an ASL file, whose header starts with `#`).
+    comments: bool,
+}
+
+/// The layout of the CSV file at `path`, read through `map` when given, else through the map
+/// attached to it, else by its header.
+fn csv_layout(path: &Path, map: Option<&ColumnMap>) -> Result<Layout> {
+    let attached = crate::io::column_map::attached(path);
+    if let Some(map) = map.or(attached.as_deref()) {
+        let raw = plain_header(path)?;
+        let (names, sources) = map.resolve(&raw, path)?;
+        return Ok(Layout {
+            names,
+            sources: Some(sources),
+            file_names: Some(raw),
+            comments: true,
+        });
     }
     if let Some(line) = asl_header(path)? {
-        return crate::io::asl::column_names(&line, &path.display().to_string());
+        let names = crate::io::asl::column_names(&line, &path.display().to_string())?;
+        let sources = names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| match n.as_str() {
+                "t_s" => Source::Time(k, TimeUnit::Nanoseconds),
+                _ => Source::Field(k),
+            })
+            .collect();
+        return Ok(Layout {
+            names,
+            sources: Some(sources),
+            file_names: Some(crate::io::asl::file_names(&line)),
+            comments: false,
+        });
     }
+    Ok(Layout {
+        names: plain_header(path)?,
+        sources: None,
+        file_names: None,
+        comments: true,
+    })
+}
+
+/// A CSV file's header row as it is (trimmed names), after any comment lines.
+fn plain_header(path: &Path) -> Result<Vec<String>> {
     let mut r = reader(path, true)?;
     let h = r.headers().map_err(|e| csv_error(path, &e))?;
     let names: Vec<String> = h.iter().map(|s| s.trim().to_string()).collect();
@@ -670,8 +725,6 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
-/// A CSV reader of `path`, its header row read as the header; `#` lines are comments unless
-/// `comments` is false (an ASL file's header starts with `#`).
 fn reader(path: &Path, comments: bool) -> Result<csv::Reader<File>> {
     let file = File::open(path).map_err(|source| Error::Io {
         path: path.into(),
@@ -782,6 +835,29 @@ pub fn read_table(path: &Path) -> Result<Table> {
     read_table_columns(path, &names, "")
 }
 
+/// Reads every column a vendor's CSV file gives through the column `map` ([`ColumnMap`]):
+/// `t_s` and the sensors' columns in SI and body axes, then its other columns.
+///
+/// # Errors
+/// As [`read_table`], and a column the map names that the file lacks.
+pub fn read_table_through(path: &Path, map: &ColumnMap) -> Result<Table> {
+    let names = csv_layout(path, Some(map))?.names;
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut rows = CsvRows::open_through(path, &names, "", Some(map))?;
+    let mut t = Table::new(&names);
+    let mut row = vec![0.0; names.len()];
+    while rows.next_row(&mut row)?.is_some() {
+        t.push_row(&row);
+    }
+    if t.rows() == 0 {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "no data rows after the header".into(),
+        });
+    }
+    Ok(t)
+}
+
 /// Reads the named columns of a CSV file as a table with those columns, in that order.
 ///
 /// # Errors
@@ -858,11 +934,11 @@ pub struct CsvRows {
     wanted: Vec<(usize, String)>,
     /// Comment lines before a CSV file's header (its description line): not rows.
     comments: usize,
-    /// The field of an ASL file's integer-nanosecond stamps, which `t_s` is read from.
-    stamp_field: Option<usize>,
-    /// The time origin of those stamps, set by the first row ([`crate::io::asl`]).
-    origin_ns: Option<i64>,
-    /// An ASL file's own column names, by field, for messages.
+    /// How each column is made from the fields ([`Layout`]; `None`: column k is field k).
+    sources: Option<Vec<Source>>,
+    /// The time origin of the stamps, set by the first row ([`TimeUnit::seconds_after_origin`]).
+    origin_ns: std::cell::Cell<Option<i64>>,
+    /// The file's own column names, by field, for messages.
     file_names: Option<Vec<String>>,
 }
 
@@ -872,12 +948,29 @@ impl CsvRows {
     /// # Errors
     /// Missing columns (all named at once, with `hint`), unreadable or empty files.
     pub fn open(path: &Path, required: &[&str], hint: &str) -> Result<Self> {
-        let names = read_header(path)?;
-        let asl_line = match TableFormat::of(path) {
-            TableFormat::Csv => asl_header(path)?,
-            _ => None,
+        Self::open_through(path, required, hint, None)
+    }
+
+    /// [`CsvRows::open`], the CSV file read through `map` (a vendor's columns and units).
+    ///
+    /// # Errors
+    /// As [`CsvRows::open`], and a column the map names that the file lacks.
+    pub fn open_through(
+        path: &Path,
+        required: &[&str],
+        hint: &str,
+        map: Option<&ColumnMap>,
+    ) -> Result<Self> {
+        let layout = match TableFormat::of(path) {
+            TableFormat::Csv => csv_layout(path, map)?,
+            _ => Layout {
+                names: read_header(path)?,
+                sources: None,
+                file_names: None,
+                comments: true,
+            },
         };
-        let asl = asl_line.is_some();
+        let names = layout.names;
         // Looked up by name, so a file of many columns costs linear time, not quadratic.
         let index: HashMap<&str, usize> = names
             .iter()
@@ -906,15 +999,14 @@ impl CsvRows {
             }
             TableFormat::Npy => RowSource::Npy(crate::io::npy::NpyRows::open(path)?.1),
             TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
-            TableFormat::Csv => RowSource::Csv(reader(path, !asl)?),
+            TableFormat::Csv => RowSource::Csv(reader(path, layout.comments)?),
         };
         // Rows are counted from the header, row 1, whatever comment lines (the description's)
         // come before it.
         let comments = match reader {
-            RowSource::Csv(_) if !asl => leading_comment_lines(path)?,
+            RowSource::Csv(_) if layout.comments => leading_comment_lines(path)?,
             _ => 0,
         };
-        let stamp_field = asl.then(|| index.get("t_s").copied()).flatten();
         Ok(Self {
             path: path.into(),
             reader,
@@ -922,9 +1014,9 @@ impl CsvRows {
             names,
             wanted,
             comments,
-            stamp_field,
-            origin_ns: None,
-            file_names: asl_line.as_deref().map(crate::io::asl::file_names),
+            sources: layout.sources,
+            origin_ns: std::cell::Cell::new(None),
+            file_names: layout.file_names,
         })
     }
 
@@ -960,44 +1052,67 @@ impl CsvRows {
             .position()
             .map_or(0, |p| (p.line() as usize).saturating_sub(self.comments));
         for ((k, name), slot) in self.wanted.iter().zip(out.iter_mut()) {
-            let field = self.record.get(*k).unwrap_or_default();
-            let bad = |message: String| Error::CsvValue {
-                file: self.path.clone(),
-                row,
-                // An ASL file's column by its own name, then imukit's.
-                column: match self.file_names.as_ref().and_then(|f| f.get(*k)) {
-                    Some(own) if own != name => format!("{own} ({name})"),
-                    _ => name.clone(),
-                },
-                message,
+            *slot = match self.sources.as_ref().map(|s| &s[*k]) {
+                None => self.number(*k, name, row)?,
+                Some(Source::Field(f)) => self.number(*f, name, row)?,
+                Some(Source::Time(f, unit)) => {
+                    let text = self.text(*f, name, row)?;
+                    let mut origin = self.origin_ns.get();
+                    let t = unit
+                        .seconds_after_origin(text, &mut origin)
+                        .ok_or_else(|| {
+                            self.bad(*f, name, row, format!("not a time stamp: \"{text}\""))
+                        })?;
+                    self.origin_ns.set(origin);
+                    t
+                }
+                Some(Source::Combination(terms)) => {
+                    let mut v = 0.0;
+                    for (f, c) in terms {
+                        v += c * self.number(*f, name, row)?;
+                    }
+                    v
+                }
             };
-            let not_a_number = || {
-                let lossy = String::from_utf8_lossy(field);
-                bad(format!("not a number: \"{}\"", lossy.trim()))
-            };
-            // Whitespace around a value, Unicode's definition, as the csv crate's trimming had it.
-            let text = std::str::from_utf8(field)
-                .map_err(|_| not_a_number())?
-                .trim();
-            if Some(*k) == self.stamp_field {
-                let ns = crate::io::asl::parse_stamp_ns(text).ok_or_else(|| {
-                    bad(format!(
-                        "not a time stamp in integer nanoseconds: \"{text}\""
-                    ))
-                })?;
-                let origin = *self
-                    .origin_ns
-                    .get_or_insert_with(|| crate::io::asl::time_origin_ns(ns));
-                *slot = crate::io::asl::seconds_after(ns, origin);
-                continue;
-            }
-            let v: f64 = text.parse().map_err(|_| not_a_number())?;
-            if !v.is_finite() {
-                return Err(bad(format!("not a finite number: \"{text}\"")));
-            }
-            *slot = v;
         }
         Ok(Some(row))
+    }
+
+    /// The error of field `f` in `row`, read for column `name`: the file's column by its own
+    /// name, then the table's.
+    fn bad(&self, f: usize, name: &str, row: usize, message: String) -> Error {
+        Error::CsvValue {
+            file: self.path.clone(),
+            row,
+            column: match self.file_names.as_ref().and_then(|n| n.get(f)) {
+                Some(own) if own != name => format!("{own} ({name})"),
+                _ => name.to_string(),
+            },
+            message,
+        }
+    }
+
+    /// Field `f` of the current record as trimmed text.
+    fn text(&self, f: usize, name: &str, row: usize) -> Result<&str> {
+        let field = self.record.get(f).unwrap_or_default();
+        // Whitespace around a value, Unicode's definition, as the csv crate's trimming had it.
+        std::str::from_utf8(field).map(str::trim).map_err(|_| {
+            let lossy = String::from_utf8_lossy(field);
+            self.bad(f, name, row, format!("not a number: \"{}\"", lossy.trim()))
+        })
+    }
+
+    /// Field `f` of the current record as a finite number.
+    fn number(&self, f: usize, name: &str, row: usize) -> Result<f64> {
+        let text = self.text(f, name, row)?;
+        let v: f64 = text
+            .parse()
+            .map_err(|_| self.bad(f, name, row, format!("not a number: \"{text}\"")))?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.bad(f, name, row, format!("not a finite number: \"{text}\"")))
+        }
     }
 }
 

@@ -141,6 +141,28 @@ const UNITS: &[(&[&str], f64, &str, &str)] = &[
         "magnetometer measurement_range, constant_bias",
     ),
     (
+        &["m/s^2", "m/s2", "m/s²", "m s^-2"],
+        1.0,
+        "m/s²",
+        "accelerometer readings",
+    ),
+    (&["rad/s", "rad s^-1"], 1.0, "rad/s", "gyroscope readings"),
+    (
+        &["mdps", "mdeg/s"],
+        DEG * 1e-3,
+        "rad/s",
+        "gyroscope readings",
+    ),
+    (&["mrad/s"], 1e-3, "rad/s", "gyroscope readings"),
+    (&["nt"], 1e-3, "µT", "magnetometer readings"),
+    (
+        &["mg", "mgauss", "milligauss"],
+        0.1,
+        "µT",
+        "magnetometer readings (milligauss)",
+    ),
+    (&["g"], 100.0, "µT", "magnetometer readings (gauss)"),
+    (
         &["ppm"],
         1e-4,
         "% (add to the diagonal of axes_misalignment_pct)",
@@ -181,6 +203,30 @@ pub fn convert(value: f64, unit: &str) -> Result<Converted> {
                 format!("unknown unit \"{unit}\" (known: {})", known.join(", ")),
             )
         })
+}
+
+/// The factor that takes readings in `unit` to the SI unit `si` (`"m/s²"`, `"rad/s"`, `"µT"`):
+/// the unit is looked up among those of that quantity, so `mG` for a magnetometer is
+/// milligauss and `mg` for an accelerometer milli-g (case-insensitive).
+///
+/// # Errors
+/// An unknown unit, or one of another quantity, with the units of `si` listed.
+pub fn factor_to(unit: &str, si: &str) -> std::result::Result<f64, String> {
+    let key = unit.trim().to_lowercase().replace(' ', "");
+    let key = key.as_str();
+    let of_si = || {
+        UNITS
+            .iter()
+            .filter(|(_, _, u, _)| *u == si)
+            .flat_map(|(names, ..)| names.iter().copied())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    UNITS
+        .iter()
+        .find(|(names, _, u, _)| *u == si && names.contains(&key))
+        .map(|(_, factor, ..)| *factor)
+        .ok_or_else(|| format!("\"{unit}\" is not a unit of {si} (known: {})", of_si()))
 }
 
 /// IEEE 952's bias-instability coefficient B from a datasheet's bias instability quoted as the

@@ -754,35 +754,31 @@ impl EarthJob for Integrate<'_> {
         };
         let mut out = vec![NavState::<E>::default(); t.len()];
         let corrections = options.coning || options.sculling;
-        let result = if let (Some(f), Some(w)) =
-            (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS))
-        {
-            let f = flip(f);
-            match setup.scheme.for_input(true, corrections) {
-                NavScheme::ConingSculling => {
-                    strapdown_rates(earth, &t, &w, &f, baro, s0, options, &mut out)
+        let result =
+            if let (Some(f), Some(w)) = (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS)) {
+                let f = flip(f);
+                match setup.scheme.for_input(true, corrections) {
+                    NavScheme::ConingSculling => {
+                        strapdown_rates(earth, &t, &w, &f, baro, s0, options, &mut out)
+                    }
+                    NavScheme::Rk4 { substeps } => strapdown_rates_rk4(
+                        earth, &t, &w, &f, baro, s0, options, substeps, &mut out,
+                    ),
+                    NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
                 }
-                NavScheme::Rk4 { substeps } => {
-                    strapdown_rates_rk4(earth, &t, &w, &f, baro, s0, options, substeps, &mut out)
+            } else if let (Some(dv), Some(dth)) =
+                (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS))
+            {
+                if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
+                    return Err(invalid(
+                        "IMU data",
+                        "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
+                    ));
                 }
-                NavScheme::Auto { .. } => unreachable!("for_input chooses a concrete scheme"),
-            }
-        } else if let (Some(dv), Some(dth)) =
-            (imu.triples(&DV_COLUMNS), imu.triples(&DTHETA_COLUMNS))
-        {
-            if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
-                return Err(invalid(
-                    "IMU data",
-                    "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
-                ));
-            }
-            strapdown_increments(earth, &t, &dth, &flip(dv), baro, s0, options, &mut out)
-        } else {
-            return Err(invalid(
-                "IMU data",
-                "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
-            ));
-        };
+                strapdown_increments(earth, &t, &dth, &flip(dv), baro, s0, options, &mut out)
+            } else {
+                return Err(invalid("IMU data", NEEDS_READINGS));
+            };
         result.map_err(|source| crate::Error::Strapdown {
             context: "IMU data".into(),
             source,
@@ -934,6 +930,11 @@ pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
     Ok(out)
 }
 
+/// What the strapdown needs of its input, and the way to it from a vendor's columns.
+const NEEDS_READINGS: &str = "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s \
+     and dtheta_x/y/z_rad (increments); a vendor's CSV is read through a column map (--map FILE, \
+     docs/formats.md)";
+
 /// The per-sample integrator of a streamed file.
 enum Stepper<E: EarthModel> {
     Rates(RateIncrements<E>),
@@ -1081,10 +1082,7 @@ impl EarthJob for IntegrateCsv<'_> {
         } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
             (DV_COLUMNS, DTHETA_COLUMNS)
         } else {
-            return Err(invalid(
-                "IMU data",
-                "needs accel_x/y/z_m_s2 and gyro_x/y/z_rad_s (rates) or dv_x/y/z_m_s and dtheta_x/y/z_rad (increments)",
-            ));
+            return Err(invalid("IMU data", NEEDS_READINGS));
         };
         let mut columns = vec!["t_s"];
         columns.extend(force);
