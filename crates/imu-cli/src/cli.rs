@@ -85,6 +85,11 @@ pub enum Command {
         /// time. The numbers are the same however many.
         #[arg(long, allow_negative_numbers = true)]
         threads: Option<i64>,
+        /// `euroc`: write the run as a EuRoC sequence, `--out` its folder: the readings in
+        /// `mav0/imu0/data.csv` and the truth in `mav0/state_groundtruth_estimate0/data.csv`, in
+        /// the ASL layout (nanosecond stamps; docs/formats.md).
+        #[arg(long, value_parser = ["euroc"])]
+        layout: Option<String>,
     },
     /// Strapdown navigation (3D) or planar dead reckoning (`--planar`) of IMU data.
     Integrate {
@@ -244,9 +249,38 @@ pub enum Command {
         /// estimate begins there.
         #[arg(long, value_parser = choice::<AlignName>(), ignore_case = true)]
         align: Option<AlignName>,
-        /// The scenario whose `[imu]` and `[gnss]` describe the data's errors.
-        #[arg(long)]
-        scenario: PathBuf,
+        /// The scenario whose `[imu]` and `[gnss]` describe the data's errors (or: --imu and
+        /// the --gnss-* accuracies).
+        #[arg(
+            long,
+            required_unless_present = "imu_model",
+            conflicts_with = "imu_model"
+        )]
+        scenario: Option<PathBuf>,
+        /// The IMU part, instead of a scenario: a preset's name (`imukit presets`) or a parameter
+        /// file (imukit TOML, MATLAB JSON). The data's frame, Earth and accelerometer sign come
+        /// from the input files' descriptions (else ENU, flat, specific force).
+        #[arg(long = "imu", value_name = "PRESET|FILE")]
+        imu_model: Option<String>,
+        /// With --imu: the part in a MATLAB parameter file of several.
+        #[arg(long, requires = "imu_model")]
+        part: Option<String>,
+        /// With --imu: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
+        /// when left out).
+        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        gnss_horizontal_accuracy_m: Option<f64>,
+        /// With --imu: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
+        /// left out).
+        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        gnss_vertical_accuracy_m: Option<f64>,
+        /// With --imu: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
+        /// when left out).
+        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        gnss_velocity_accuracy_m_s: Option<f64>,
+        /// With --imu: the antenna's position from the IMU, body frame, m.
+        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true,
+              requires = "imu_model")]
+        gnss_lever_arm_m: Option<Vec<f64>>,
         /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
         /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
         /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.

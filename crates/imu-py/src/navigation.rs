@@ -191,7 +191,11 @@ fn compare<'py>(
                     scenario, *, format = "dict", base_dir = ".", gate = true, align = None,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
-                    sensor_errors = false, rest_s = None))]
+                    sensor_errors = false, rest_s = None, imu_model = None, part = None,
+                    gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
+                    gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None,
+                    nav_frame = None, earth = None, earth_gravity = None, accel_sign = None,
+                    gravity_m_s2 = None))]
 #[allow(clippy::too_many_arguments)]
 fn fuse<'py>(
     py: Python<'py>,
@@ -214,23 +218,67 @@ fn fuse<'py>(
     covariance_interval_s: Option<f64>,
     sensor_errors: bool,
     rest_s: Option<f64>,
+    imu_model: Option<String>,
+    part: Option<String>,
+    gnss_horizontal_accuracy_m: Option<f64>,
+    gnss_vertical_accuracy_m: Option<f64>,
+    gnss_velocity_accuracy_m_s: Option<f64>,
+    gnss_lever_arm_m: Option<Vec<f64>>,
+    nav_frame: Option<&str>,
+    earth: Option<&str>,
+    earth_gravity: Option<&str>,
+    accel_sign: Option<&str>,
+    gravity_m_s2: Option<f64>,
 ) -> PyResult<(TableOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{AidTables, FuseRequest, fuse_with};
-    let spec = match format {
-        "dict" => ScenarioSpec::from_tree(
-            &crate::convert::value_tree(scenario, "scenario")?,
-            "scenario dict",
-        ),
-        "toml" => ScenarioSpec::from_toml(&scenario.extract::<String>()?, "scenario"),
-        "json" => ScenarioSpec::from_json(&scenario.extract::<String>()?, "scenario"),
-        other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "format must be \"dict\", \"toml\" or \"json\", got {other:?}"
-            )));
-        }
+    use imukit::run::fuse::{AidTables, FuseRequest, PartModel, fuse_with};
+    use imukit::run::navigate::NavRequest;
+    // The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
+    // made once per call: its size does not matter).
+    #[allow(clippy::large_enum_variant)]
+    enum Model {
+        Scenario(ScenarioSpec),
+        Part(PartModel, NavRequest, Option<imu_core::AccelSign>),
     }
-    .map_err(refused)?;
+    let model = match imu_model {
+        Some(imu) => {
+            let d = NavRequest::default();
+            let nav = NavRequest {
+                nav_frame: choice_opt("nav_frame", nav_frame)?.unwrap_or(d.nav_frame),
+                earth: choice_opt("earth", earth)?.unwrap_or(d.earth),
+                earth_gravity: choice_opt("earth_gravity", earth_gravity)?
+                    .unwrap_or(d.earth_gravity),
+                gravity_m_s2: gravity_m_s2.unwrap_or(d.gravity_m_s2),
+                ..d
+            };
+            let sign = choice_opt::<imukit::scenario::AccelSignName>("accel_sign", accel_sign)?
+                .map(imu_core::AccelSign::from);
+            let gnss = imukit::scenario::gnss::GnssSpec {
+                horizontal_accuracy_m: gnss_horizontal_accuracy_m,
+                vertical_accuracy_m: gnss_vertical_accuracy_m,
+                velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
+                lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m)?,
+                ..Default::default()
+            };
+            Model::Part(PartModel { imu, part, gnss }, nav, sign)
+        }
+        None => Model::Scenario(
+            match format {
+                "dict" => ScenarioSpec::from_tree(
+                    &crate::convert::value_tree(scenario, "scenario")?,
+                    "scenario dict",
+                ),
+                "toml" => ScenarioSpec::from_toml(&scenario.extract::<String>()?, "scenario"),
+                "json" => ScenarioSpec::from_json(&scenario.extract::<String>()?, "scenario"),
+                other => {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "format must be \"dict\", \"toml\" or \"json\", got {other:?}"
+                    )));
+                }
+            }
+            .map_err(refused)?,
+        ),
+    };
     let imu = table_in("imu", imu_columns, &imu_values)?;
     let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
     let initial = match (initial_columns, &initial_values) {
@@ -252,8 +300,7 @@ fn fuse<'py>(
     let base = base_dir.to_string();
     let (table, summary) = py
         .detach(move || {
-            let sc = spec.resolve(Path::new(&base))?;
-            let (setup, start) = FuseRequest {
+            let request = FuseRequest {
                 initial: initial.as_ref(),
                 align,
                 earth: None,
@@ -262,8 +309,13 @@ fn fuse<'py>(
                 covariance_interval_s,
                 sensor_errors,
                 rest_s,
-            }
-            .setup(&sc)?;
+            };
+            let (setup, start) = match model {
+                Model::Scenario(spec) => request.setup(&spec.resolve(Path::new(&base))?)?,
+                Model::Part(part, nav, sign) => {
+                    request.apply(part.setup_for(&nav.setup()?, sign, &imu)?)?
+                }
+            };
             let aids = AidTables {
                 odometer: odometer.as_ref(),
                 baro: baro.as_ref(),

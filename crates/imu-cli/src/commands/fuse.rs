@@ -2,11 +2,13 @@
 //! library's fuse job with the filter's model from the scenario.
 use std::path::Path;
 
+use imu_core::AccelSign;
+use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::Gaps;
 use imukit::io::table::read_table;
-use imukit::run::fuse::{AidTables, AlignName, FuseRequest, fuse_with};
-use imukit::run::navigate::InitialState;
+use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
+use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::scenario::EarthName;
 use imukit::{Error, ScenarioSpec};
 
@@ -19,7 +21,8 @@ pub struct Args<'a> {
     pub gnss: &'a Path,
     pub init: Option<&'a Path>,
     pub align: Option<AlignName>,
-    pub scenario: &'a Path,
+    pub scenario: Option<&'a Path>,
+    pub model: Option<PartModel>,
     pub earth: Option<EarthName>,
     pub no_gate: bool,
     pub odometer: Option<&'a Path>,
@@ -31,18 +34,44 @@ pub struct Args<'a> {
     pub out: &'a Path,
 }
 
+/// The filter's setup from `--imu PART` and the `--gnss-*` accuracies: the data's frame, Earth
+/// and sign from the input files' descriptions (`--earth` checked against them), the sample
+/// rate from the IMU's times.
+fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<FuseSetup, CliError> {
+    let described = Described::read(&[a.imu, a.gnss])?;
+    let asked = NavAsked {
+        earth: a.earth,
+        ..NavAsked::default()
+    };
+    let nav = NavRequest::default()
+        .with_described(&asked, &described)
+        .map_err(by_flag)?
+        .setup()
+        .map_err(by_flag)?;
+    let sign = described
+        .known("accel_sign", None, |d| d.accel_sign)
+        .map_err(by_flag)?
+        .map(AccelSign::from);
+    Ok(model.setup_for(&nav, sign, imu).map_err(|e| match e {
+        Error::Invalid { field, message } if field == "IMU data" => Error::Invalid {
+            field: a.imu.display().to_string(),
+            message,
+        },
+        Error::Invalid { field, message } => Error::Invalid {
+            field: field.replace("gnss.", "--gnss-").replace('_', "-"),
+            message,
+        },
+        other => by_flag(other),
+    })?)
+}
+
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
-    let mut inputs = vec![
-        ("IMU file", a.imu),
-        ("GNSS file", a.gnss),
-        ("--scenario", a.scenario),
-    ];
+    let mut inputs = vec![("IMU file", a.imu), ("GNSS file", a.gnss)];
+    inputs.extend(a.scenario.map(|p| ("--scenario", p)));
     inputs.extend(a.init.map(|p| ("--init file", p)));
     inputs.extend(a.odometer.map(|p| ("--odometer", p)));
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
-    let base = a.scenario.parent().unwrap_or_else(|| Path::new("."));
-    let scenario = ScenarioSpec::from_file(a.scenario)?.resolve(base)?;
     let initial = match a.init {
         Some(init) => {
             let s = InitialState::from_csv(init)?;
@@ -51,7 +80,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         None => None,
     };
-    let (setup, start) = FuseRequest {
+    let request = FuseRequest {
         initial: initial.as_ref(),
         align: a.align,
         earth: a.earth,
@@ -60,17 +89,33 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         covariance_interval_s: a.covariance_interval_s,
         sensor_errors: a.sensor_errors,
         rest_s: a.rest_s,
-    }
-    .setup(&scenario)
-    .map_err(|e| match e {
-        // The scenario decides the Earth: say which file.
-        Error::Invalid { field, message } if field == "earth" => Error::Invalid {
-            field: flag(&field),
-            message: format!("{message} ({})", a.scenario.display()),
-        },
-        other => by_flag(other),
-    })?;
+    };
     let imu = read_table(a.imu)?;
+    let (setup, start) = match (a.scenario, &a.model) {
+        (Some(path), _) => {
+            let base = path.parent().unwrap_or_else(|| Path::new("."));
+            let scenario = ScenarioSpec::from_file(path)?.resolve(base)?;
+            request.setup(&scenario).map_err(|e| match e {
+                // The scenario decides the Earth: say which file.
+                Error::Invalid { field, message } if field == "earth" => Error::Invalid {
+                    field: flag(&field),
+                    message: format!("{message} ({})", path.display()),
+                },
+                other => by_flag(other),
+            })?
+        }
+        (None, Some(model)) => {
+            let setup = part_setup(a, model, &imu)?;
+            request.apply(setup).map_err(by_flag)?
+        }
+        (None, None) => {
+            return Err(Error::Invalid {
+                field: "--scenario".into(),
+                message: "the filter needs the data's errors: --scenario FILE or --imu PART".into(),
+            }
+            .into());
+        }
+    };
     let gnss = read_table(a.gnss)?;
     let odometer = a.odometer.map(read_table).transpose()?;
     let baro = a.baro.map(read_table).transpose()?;

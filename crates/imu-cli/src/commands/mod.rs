@@ -34,16 +34,23 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             odometer,
             runs,
             threads,
-        } => simulate::run(
-            &scenario,
-            &out,
-            truth.as_deref(),
-            gnss.as_deref(),
-            baro.as_deref(),
-            odometer.as_deref(),
-            runs,
-            threads,
-        ),
+            layout,
+        } => {
+            if layout.is_some() {
+                simulate::euroc(&scenario, &out, truth.as_deref(), runs, threads)
+            } else {
+                simulate::run(
+                    &scenario,
+                    &out,
+                    truth.as_deref(),
+                    gnss.as_deref(),
+                    baro.as_deref(),
+                    odometer.as_deref(),
+                    runs,
+                    threads,
+                )
+            }
+        }
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
         Command::Presets {
@@ -128,6 +135,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             init,
             align,
             scenario,
+            imu_model,
+            part,
+            gnss_horizontal_accuracy_m,
+            gnss_vertical_accuracy_m,
+            gnss_velocity_accuracy_m_s,
+            gnss_lever_arm_m,
             earth,
             no_gate,
             odometer,
@@ -144,7 +157,18 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 gnss: &gnss,
                 init: init.as_deref(),
                 align,
-                scenario: &scenario,
+                scenario: scenario.as_deref(),
+                model: imu_model.map(|imu| imukit::run::fuse::PartModel {
+                    imu,
+                    part,
+                    gnss: imukit::scenario::gnss::GnssSpec {
+                        horizontal_accuracy_m: gnss_horizontal_accuracy_m,
+                        vertical_accuracy_m: gnss_vertical_accuracy_m,
+                        velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
+                        lever_arm_m: gnss_lever_arm_m.map(|v| [v[0], v[1], v[2]]),
+                        ..Default::default()
+                    },
+                }),
                 earth,
                 no_gate,
                 odometer: odometer.as_deref(),

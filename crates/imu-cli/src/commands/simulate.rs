@@ -63,6 +63,7 @@ pub fn run(
             baro,
             odometer,
             description: &description,
+            asl: false,
         };
         let report = sc
             .stream_to_files(None, run_threads, &outputs)
@@ -123,6 +124,7 @@ pub fn run(
                         baro: baro_file.as_deref(),
                         odometer: odometer_file.as_deref(),
                         description: &description,
+                        asl: false,
                     },
                 )?;
                 if let Ok(mut m) = merged.lock() {
@@ -151,6 +153,78 @@ pub fn run(
 
 /// The library names its `threads` setting (a refused second thread) by the field; here it is
 /// the flag that set it.
+/// `imukit simulate SCENARIO --layout euroc --out DIR`: one run as a EuRoC sequence, the
+/// readings and the truth in the ASL layout under `DIR/mav0/`.
+pub fn euroc(
+    scenario: &Path,
+    out: &Path,
+    truth: Option<&Path>,
+    runs: Option<u64>,
+    threads: Option<i64>,
+) -> Result<(), CliError> {
+    if truth.is_some() {
+        return Err(imukit::Error::Invalid {
+            field: "--truth".into(),
+            message: "a EuRoC sequence keeps its ground truth in \
+                      DIR/mav0/state_groundtruth_estimate0/data.csv: leave --truth out"
+                .into(),
+        }
+        .into());
+    }
+    if runs.is_some() {
+        return Err(imukit::Error::Invalid {
+            field: "--runs".into(),
+            message: "--layout euroc writes one run".into(),
+        }
+        .into());
+    }
+    let run_threads = RunThreads::at_most(threads, "--threads")?;
+    let (imu, truth) = (
+        out.join("mav0/imu0/data.csv"),
+        out.join("mav0/state_groundtruth_estimate0/data.csv"),
+    );
+    let spec = ScenarioSpec::from_file(scenario)?;
+    let base = scenario.parent().unwrap_or_else(|| Path::new("."));
+    let files = spec.input_files(base);
+    let mut inputs = vec![("scenario file", scenario)];
+    inputs.extend(files.iter().map(|(what, p)| (*what, p.as_path())));
+    let sc = spec.resolve(base)?;
+    for w in &sc.warnings {
+        crate::report::warn(w);
+    }
+    for dir in [&imu, &truth].into_iter().filter_map(|p| p.parent()) {
+        std::fs::create_dir_all(dir).map_err(|source| imukit::Error::Io {
+            path: dir.into(),
+            source,
+        })?;
+    }
+    check_outputs(
+        &inputs,
+        &[("--out", imu.as_path()), ("--out", truth.as_path())],
+    )?;
+    let description = sc.description(None);
+    let outputs = StreamOutputs {
+        imu: Some(&imu),
+        truth: Some(&truth),
+        description: &description,
+        asl: true,
+        ..StreamOutputs::default()
+    };
+    let report = sc
+        .stream_to_files(None, run_threads, &outputs)
+        .map_err(threads_by_flag)?;
+    for w in report.warnings(sc.sample_rate_hz) {
+        crate::report::warn(&w);
+    }
+    crate::note!(
+        "imukit: {} samples as a EuRoC sequence: readings in {}, ground truth in {}",
+        sc.t_s.len(),
+        imu.display(),
+        truth.display()
+    );
+    Ok(())
+}
+
 fn threads_by_flag(e: imukit::Error) -> imukit::Error {
     match e {
         imukit::Error::Invalid { ref field, .. } if field == "threads" => crate::error::by_flag(e),

@@ -259,6 +259,17 @@ def fuse(
     covariance_interval_s: Optional[float] = None,
     sensor_errors: bool = False,
     rest_s: Optional[float] = None,
+    imu_model: Optional[str] = None,
+    part: Optional[str] = None,
+    gnss_horizontal_accuracy_m: Optional[float] = None,
+    gnss_vertical_accuracy_m: Optional[float] = None,
+    gnss_velocity_accuracy_m_s: Optional[float] = None,
+    gnss_lever_arm_m: Optional[Sequence[float]] = None,
+    nav_frame: Optional[str] = None,
+    earth: Optional[str] = None,
+    earth_gravity: Optional[str] = None,
+    accel_sign: Optional[str] = None,
+    gravity_m_s2: Optional[float] = None,
 ) -> tuple[_Table, int, int]: ...
 def compare(
     truth_columns: Sequence[str],

@@ -139,12 +139,18 @@ def compare(truth: TableLike, estimate: TableLike) -> Comparison:
     return Comparison(_table(table), {str(k): float(v) for k, v in dict(summary).items()})
 
 
-def fuse(imu: TableLike, gnss: TableLike, *, scenario: Union[str, os.PathLike, Mapping[str, Any]],
+def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None,
          initial: Optional[TableLike] = None, align: Optional[str] = None,
          gate: bool = True,
          odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
-         sensor_errors: bool = False, rest_s: Optional[float] = None) -> Table:
+         sensor_errors: bool = False, rest_s: Optional[float] = None,
+         imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
+         gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
+         gnss_velocity_accuracy_m_s: Optional[float] = None,
+         gnss_lever_arm_m: Optional[Sequence[float]] = None,
+         nav_frame: Optional[str] = None, earth: Optional[str] = None, earth_gravity: Optional[str] = None,
+         accel_sign: Optional[str] = None, gravity_m_s2: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
     GNSS fixes (``imukit.simulate(...).gnss``), on the scenario's Earth (flat, or WGS-84 with
     geodetic fixes and ``lat_rad, lon_rad, height_m`` added to the output). The filter's model comes from
@@ -166,8 +172,26 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Union[str, os.PathLike, M
     and their ``…_sigma`` added). ``rest_s=20`` tells the filter the vehicle stands still for the
     first 20 s (zero-velocity and zero-rate updates at every sample: the gyroscope biases are
     calibrated before the drive) — a consumer IMU needs both.
+
+    Without a scenario, ``imu_model`` names the part — a preset (``"stim300"``) or a parameter
+    file — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
+    ``gnss_velocity_accuracy_m_s`` and ``gnss_lever_arm_m`` the receiver (MATLAB gpsSensor's
+    defaults for those left out); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
+    ``gravity_m_s2`` say what the tables are in (imukit's defaults; the sign by default the part's
+    profile's). The sample rate is the IMU's median.
     """
-    if isinstance(scenario, Mapping):
+    if (scenario is None) == (imu_model is None):
+        raise ValueError("give scenario= (the data's [imu] and [gnss]) or imu_model= (a part), not both or neither")
+    part_keys = dict(imu_model=None if imu_model is None else str(imu_model), part=part,
+                     gnss_horizontal_accuracy_m=gnss_horizontal_accuracy_m,
+                     gnss_vertical_accuracy_m=gnss_vertical_accuracy_m,
+                     gnss_velocity_accuracy_m_s=gnss_velocity_accuracy_m_s,
+                     gnss_lever_arm_m=None if gnss_lever_arm_m is None else [float(v) for v in gnss_lever_arm_m],
+                     nav_frame=nav_frame, earth=earth, earth_gravity=earth_gravity, accel_sign=accel_sign,
+                     gravity_m_s2=None if gravity_m_s2 is None else float(gravity_m_s2))
+    if scenario is None:
+        source, fmt, base = None, "dict", os.getcwd()
+    elif isinstance(scenario, Mapping):
         source, fmt, base = dict(scenario), "dict", os.getcwd()
     else:
         path = Path(scenario)
@@ -188,5 +212,5 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Union[str, os.PathLike, M
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
                              sensor_errors=bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s),
-                             **aids)
+                             **aids, **part_keys)
     return _table(table)

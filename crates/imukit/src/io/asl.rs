@@ -13,7 +13,8 @@
 //! | `q_RS_w []` … | `q_w` … (`q_RS`: sensor to reference, imukit's `q_nb`) |
 //!
 //! Other columns (the ground truth's bias estimates `b_w_RS_S_x`, …) keep their name without the
-//! unit. A known column in another unit than the layout's is refused by name.
+//! unit. A known column in another unit than the layout's is refused by name. [`AslWriter`]
+//! writes the layout (`imukit simulate --layout euroc`).
 //!
 //! **Time.** Stamps are integer nanoseconds since the Unix epoch. They are kept exactly: `t_s`
 //! counts seconds from the UTC midnight before the file's first stamp (the *time origin*,
@@ -48,6 +49,100 @@ const COLUMNS: &[(&str, &str, &str)] = &[
     ("q_RS_y", "", "q_y"),
     ("q_RS_z", "", "q_z"),
 ];
+
+/// Writes tables in the ASL layout: an IMU file (`#timestamp [ns]`, then `w_RS_S_*` and
+/// `a_RS_S_*`, the order EuRoC's readers index) or a ground truth (`p_RS_R_*`, `q_RS_*`,
+/// `v_RS_R_*`), stamps as integer nanoseconds (`t_s` rounded to the nanosecond); other
+/// columns are left out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AslWriter {
+    /// The table's column of each file column; the first is `t_s`.
+    order: Vec<usize>,
+}
+
+/// The imukit columns of an ASL IMU file and of a ground truth, in the file's order.
+const IMU_ORDER: [&str; 6] = [
+    "gyro_x_rad_s",
+    "gyro_y_rad_s",
+    "gyro_z_rad_s",
+    "accel_x_m_s2",
+    "accel_y_m_s2",
+    "accel_z_m_s2",
+];
+const TRUTH_ORDER: [&str; 10] = [
+    "pos_x_m",
+    "pos_y_m",
+    "pos_z_m",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "vel_x_m_s",
+    "vel_y_m_s",
+    "vel_z_m_s",
+];
+
+impl AslWriter {
+    /// The writer of a table with `columns`, and its header line (without the line end).
+    ///
+    /// # Errors
+    /// A table that is neither IMU rates nor a ground truth, named by `file`.
+    pub fn for_columns(columns: &[String], file: &str) -> Result<(Self, String)> {
+        let find = |name: &str| columns.iter().position(|c| c == name);
+        let pick = |names: &[&str]| -> Option<Vec<usize>> {
+            std::iter::once("t_s")
+                .chain(names.iter().copied())
+                .map(find)
+                .collect()
+        };
+        let order = pick(&IMU_ORDER)
+            .or_else(|| pick(&TRUTH_ORDER))
+            .ok_or_else(|| crate::Error::CsvFormat {
+                file: file.into(),
+                message: "the ASL layout holds IMU rates (t_s, gyro_*, accel_*) or a ground \
+                          truth (t_s, pos_*, q_*, vel_*)"
+                    .into(),
+            })?;
+        let header: Vec<String> = order
+            .iter()
+            .map(|&k| {
+                let (asl, unit, _) = COLUMNS
+                    .iter()
+                    .find(|(.., imukit)| *imukit == columns[k])
+                    .expect("every written column is one of the layout's");
+                format!("{asl} [{unit}]")
+            })
+            .collect();
+        Ok((Self { order }, header.join(",")))
+    }
+
+    /// Writes row-major `data` (rows of `width` values, finite) in the layout.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn write_rows(
+        &self,
+        w: &mut impl std::io::Write,
+        data: &[f64],
+        width: usize,
+    ) -> std::io::Result<()> {
+        let mut line = String::new();
+        for row in data.chunks_exact(width.max(1)) {
+            use std::fmt::Write as _;
+            line.clear();
+            // Finite times of any run fit: i64 nanoseconds reach 292 years.
+            #[allow(clippy::cast_possible_truncation)]
+            let ns = (row[self.order[0]] * 1e9).round() as i64;
+            let _ = write!(line, "{ns}");
+            for &k in &self.order[1..] {
+                let _ = write!(line, ",{}", row[k]);
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        Ok(())
+    }
+}
 
 /// Whether the first line of a CSV file is an ASL header.
 #[must_use]

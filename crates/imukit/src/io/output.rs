@@ -14,6 +14,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
+use crate::io::asl::AslWriter;
 use crate::io::description::Description;
 use crate::io::npy::NpySink;
 use crate::io::npz::NpzSink;
@@ -357,6 +358,8 @@ pub struct AtomicFile {
     npy: Option<NpySink>,
     /// A `.npz` table being gathered (the archive is written at the commit).
     npz: Option<NpzSink>,
+    /// A CSV table in the ASL layout ([`AtomicFile::begin_asl`]).
+    asl: Option<AslWriter>,
 }
 
 impl AtomicFile {
@@ -417,6 +420,7 @@ impl AtomicFile {
             parquet: None,
             npy: None,
             npz: None,
+            asl: None,
         })
     }
     /// The file's path (its final name).
@@ -471,6 +475,22 @@ impl AtomicFile {
         written.map_err(|e| self.error(e))
     }
 
+    /// Starts a table of `columns` in the ASL layout of EuRoC sequences ([`AslWriter`]): its
+    /// header line, then rows of integer-nanosecond stamps and the layout's columns.
+    ///
+    /// # Errors
+    /// A table the layout has no place for; [`Error::Io`] naming the file.
+    pub fn begin_asl(&mut self, columns: &[String]) -> Result<()> {
+        let (asl, header) = AslWriter::for_columns(columns, &self.path.display().to_string())?;
+        self.columns = columns.to_vec();
+        self.asl = Some(asl);
+        let w = self.writer();
+        let written = w
+            .write_all(header.as_bytes())
+            .and_then(|()| w.write_all(b"\n"));
+        written.map_err(|e| self.error(e))
+    }
+
     /// Appends row-major `data` (rows of the table's width) to the table begun; the caller has
     /// checked the values finite.
     ///
@@ -487,6 +507,11 @@ impl AtomicFile {
             return n.write(data);
         }
         let width = self.columns.len().max(1);
+        if let Some(asl) = self.asl.take() {
+            let written = asl.write_rows(self.writer(), data, width);
+            self.asl = Some(asl);
+            return written.map_err(|e| self.error(e));
+        }
         let written = write_rows(self.writer(), data, width, b",");
         written.map_err(|e| self.error(e))
     }

@@ -333,6 +333,16 @@ impl<'a> FuseRequest<'a> {
     /// Both starts or neither (field `initial`), an Earth other than the scenario's (field
     /// `earth`), and as [`FuseSetup::from_scenario`].
     pub fn setup(&self, scenario: &crate::Scenario) -> Result<(FuseSetup, Start<'a>)> {
+        self.apply(FuseSetup::from_scenario(scenario)?)
+    }
+
+    /// This request applied to the filter's model `setup` (from a scenario or a
+    /// [`PartModel`]), and where it starts.
+    ///
+    /// # Errors
+    /// Both starts or neither (field `initial`), an Earth other than the model's (field
+    /// `earth`).
+    pub fn apply(&self, mut setup: FuseSetup) -> Result<(FuseSetup, Start<'a>)> {
         let start = match (self.initial, self.align) {
             (Some(s), None) => Start::State(s),
             (None, Some(a)) => a.into(),
@@ -350,7 +360,6 @@ impl<'a> FuseRequest<'a> {
                 ));
             }
         };
-        let mut setup = FuseSetup::from_scenario(scenario)?;
         let earth = if setup.earth.is_some() {
             EarthName::Wgs84
         } else {
@@ -362,8 +371,8 @@ impl<'a> FuseRequest<'a> {
             return Err(invalid(
                 "earth",
                 format!(
-                    "\"{e}\": the scenario is on the {earth} Earth, and the filter takes its \
-                     model from it"
+                    "\"{e}\": the filter's model (the scenario's, or the data's) is on the \
+                     {earth} Earth"
                 ),
             ));
         }
@@ -954,20 +963,43 @@ impl FuseSetup {
     /// # Errors
     /// A scenario without `[gnss]`.
     pub fn from_scenario(scenario: &crate::Scenario) -> Result<Self> {
-        use imu_core::aiding::PositionNoise;
         let gnss = scenario.gnss.as_ref().ok_or_else(|| {
             invalid(
                 "scenario",
                 "has no [gnss] receiver: the filter takes the fixes' accuracy from it",
             )
         })?;
-        let earth = match &scenario.earth {
-            crate::scenario::EarthSetup::Flat => None,
-            crate::scenario::EarthSetup::Wgs84(plane) => Some(plane.gravity),
-        };
-        let p = &scenario.imu.sensors.params;
-        let noise = eskf_noise(&p.accelerometer, &p.gyroscope, scenario.sample_rate_hz);
-        let g = &gnss.params;
+        Ok(Self::from_model(&FuseModel {
+            nav_frame: scenario.nav_frame,
+            earth: match &scenario.earth {
+                crate::scenario::EarthSetup::Flat => None,
+                crate::scenario::EarthSetup::Wgs84(plane) => Some(plane.gravity),
+            },
+            accel_sign: scenario.imu.accel_sign,
+            gravity_m_s2: scenario.gravity_m_s2,
+            imu: &scenario.imu.sensors.params,
+            sample_rate_hz: scenario.sample_rate_hz,
+            gnss: &gnss.params,
+            lever_arm_m: gnss.lever_arm_m,
+            gnss_latency_s: gnss.latency_s,
+            odometer: scenario.odometer.map(|o| OdometerModel {
+                noise_m_s: o.error.noise,
+                scale_factor_error: o.error.constant,
+            }),
+            baro_sigma_m: scenario.baro.map(|b| b.error.noise.hypot(b.error.constant)),
+        }))
+    }
+
+    /// The filter's setup from its model ([`FuseModel`]): noise from the part's densities at
+    /// the sample rate, initial uncertainty from its biases and the fixes' accuracy, the
+    /// GNSS one-sigmas from the receiver's accuracies (MATLAB's decay factor's steady share),
+    /// the gate at 99.9 %, the covariance every [`DEFAULT_COVARIANCE_INTERVAL_S`].
+    #[must_use]
+    pub fn from_model(m: &FuseModel<'_>) -> Self {
+        use imu_core::aiding::PositionNoise;
+        let p = m.imu;
+        let noise = eskf_noise(&p.accelerometer, &p.gyroscope, m.sample_rate_hz);
+        let g = m.gnss;
         let scale = match g.position_noise {
             PositionNoise::DecayFactor(k) => (2.0 / (1.0 + k)).sqrt(),
             PositionNoise::GaussMarkov { .. } => 1.0,
@@ -981,11 +1013,11 @@ impl FuseSetup {
         let max_abs = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
         let (accel_scale_factor, accel_misalignment) = matrix_sigma(&p.accelerometer);
         let (gyro_scale_factor, gyro_misalignment) = matrix_sigma(&p.gyroscope);
-        Ok(Self {
-            nav_frame: scenario.nav_frame,
-            earth,
-            accel_sign: scenario.imu.accel_sign,
-            gravity_m_s2: scenario.gravity_m_s2,
+        Self {
+            nav_frame: m.nav_frame,
+            earth: m.earth,
+            accel_sign: m.accel_sign,
+            gravity_m_s2: m.gravity_m_s2,
             noise,
             initial_sigma: InitialSigma {
                 position_m: h.max(v),
@@ -1002,16 +1034,13 @@ impl FuseSetup {
             ],
             gnss_position_sigma_m: [h, h, v],
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
-            lever_arm_m: gnss.lever_arm_m,
-            gnss_latency_s: gnss.latency_s,
+            lever_arm_m: m.lever_arm_m,
+            gnss_latency_s: m.gnss_latency_s,
             gate: CHI2_99_9_6DOF,
             aiding: AidingSetup {
-                odometer: scenario.odometer.map(|o| OdometerModel {
-                    noise_m_s: o.error.noise,
-                    scale_factor_error: o.error.constant,
-                }),
+                odometer: m.odometer,
                 nhc_sigma_m_s: None,
-                baro_sigma_m: scenario.baro.map(|b| b.error.noise.hypot(b.error.constant)),
+                baro_sigma_m: m.baro_sigma_m,
             },
             covariance_interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
             estimate_sensor_errors: false,
@@ -1024,7 +1053,114 @@ impl FuseSetup {
                     .max(MIN_G_SENSITIVITY_SIGMA),
             },
             rest_s: 0.0,
-        })
+        }
+    }
+}
+
+/// What the filter's model is made of, from a scenario ([`FuseSetup::from_scenario`]) or
+/// stated apart from any ([`PartModel`]): the data's frame, Earth, gravity and accelerometer
+/// sign, the part's error figures at the data's sample rate, and the aids' accuracies.
+#[derive(Clone, Copy, Debug)]
+pub struct FuseModel<'a> {
+    /// Navigation frame of the tables.
+    pub nav_frame: NavFrameName,
+    /// `None`: the flat Earth; on the WGS-84 Earth its gravity model.
+    pub earth: Option<imu_core::earth::GravityModel>,
+    /// Sign of the accelerometer columns.
+    pub accel_sign: AccelSign,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// The part's error figures.
+    pub imu: &'a crate::io::params::ImuParams,
+    /// The data's sample rate, Hz (a double-sided density's bandwidth).
+    pub sample_rate_hz: f64,
+    /// The receiver's accuracies and noise model.
+    pub gnss: &'a imu_core::aiding::GnssParams,
+    /// Antenna lever arm, body frame, m.
+    pub lever_arm_m: [f64; 3],
+    /// The receiver's latency, s.
+    pub gnss_latency_s: f64,
+    /// The odometer's model (`None`: none).
+    pub odometer: Option<OdometerModel>,
+    /// The barometer's one-sigma, m (`None`: none).
+    pub baro_sigma_m: Option<f64>,
+}
+
+/// The filter's model apart from any scenario: the part by a preset's name or a parameter
+/// file (`imukit fuse --imu stim300`, `--imu part.toml`), the GNSS receiver as `[gnss]` keys
+/// (`--gnss-horizontal-accuracy-m` …; MATLAB's defaults for the rest), the data's frame and
+/// Earth from the inputs' descriptions ([`PartModel::setup`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PartModel {
+    /// A preset's name, or the path of a parameter file (imukit TOML, MATLAB JSON).
+    pub imu: String,
+    /// The part in a MATLAB file of several.
+    pub part: Option<String>,
+    /// The receiver (its rate is not used).
+    pub gnss: crate::scenario::gnss::GnssSpec,
+}
+
+impl PartModel {
+    /// [`PartModel::setup`] for the IMU table `imu`, at its median sample rate.
+    ///
+    /// # Errors
+    /// As [`PartModel::setup`]; fewer than two samples with increasing times.
+    pub fn setup_for(
+        &self,
+        nav: &crate::run::navigate::NavSetup,
+        accel_sign: Option<AccelSign>,
+        imu: &Table,
+    ) -> Result<FuseSetup> {
+        let t = imu.column("t_s").unwrap_or_default();
+        let median = crate::io::rows::Gaps::of_times(&t, 0).median_s;
+        if median.is_nan() || median <= 0.0 {
+            return Err(invalid(
+                "IMU data",
+                "needs at least two samples with increasing t_s (the sample rate sets the noise)",
+            ));
+        }
+        self.setup(nav, accel_sign, 1.0 / median)
+    }
+
+    /// The filter's setup for data in the frame, Earth and sign of `nav` (the accelerometer
+    /// sign, when `accel_sign` is `None`, the part's profile's) sampled at `sample_rate_hz`.
+    ///
+    /// # Errors
+    /// An unknown preset, an unreadable or invalid parameter file, GNSS keys out of range (named
+    /// `gnss.…`).
+    pub fn setup(
+        &self,
+        nav: &crate::run::navigate::NavSetup,
+        accel_sign: Option<AccelSign>,
+        sample_rate_hz: f64,
+    ) -> Result<FuseSetup> {
+        let path = std::path::Path::new(&self.imu);
+        let is_file = path.extension().is_some() || path.exists();
+        let spec = crate::scenario::ImuSpec {
+            preset: (!is_file).then(|| self.imu.clone()),
+            params: is_file.then(|| path.to_path_buf()),
+            part: self.part.clone(),
+            ..crate::scenario::ImuSpec::default()
+        };
+        let sensors =
+            crate::scenario::sensors::SensorSetup::resolve(&spec, std::path::Path::new("."))?;
+        let gnss = self.gnss.params()?;
+        Ok(FuseSetup::from_model(&FuseModel {
+            nav_frame: nav.nav_frame,
+            earth: nav.earth.map(|e| e.gravity),
+            accel_sign: accel_sign.unwrap_or(sensors.profile.accel_sign()),
+            gravity_m_s2: nav.gravity_m_s2,
+            imu: &sensors.params,
+            sample_rate_hz,
+            gnss: &gnss,
+            lever_arm_m: crate::scenario::resolve::finite_vec(
+                "gnss.lever_arm_m",
+                self.gnss.lever_arm_m.unwrap_or([0.0; 3]),
+            )?,
+            gnss_latency_s: self.gnss.latency_s.unwrap_or(0.0),
+            odometer: None,
+            baro_sigma_m: None,
+        }))
     }
 }
 

@@ -103,6 +103,9 @@ pub struct StreamOutputs<'a> {
     /// What the outputs hold ([`Scenario::description`]; each file's kind is added from its
     /// columns).
     pub description: &'a Description,
+    /// The IMU readings and the truth in the ASL layout of a EuRoC sequence
+    /// ([`crate::io::asl`]) instead of imukit's tables.
+    pub asl: bool,
 }
 
 /// An empty description, for outputs that say nothing beyond their kind.
@@ -127,6 +130,7 @@ impl Default for StreamOutputs<'_> {
             baro: None,
             odometer: None,
             description: &NO_DESCRIPTION,
+            asl: false,
         }
     }
 }
@@ -200,15 +204,18 @@ impl Scenario {
                 return Err(crate::error::invalid(field, what));
             }
         }
-        let open = |p: Option<&Path>| {
-            p.map(|p| TableSink::create(p, outputs.description))
+        let open = |p: Option<&Path>, asl: bool| {
+            p.map(|p| TableSink::create(p, outputs.description, asl))
                 .transpose()
         };
-        let (mut imu, mut truth) = (open(outputs.imu)?, open(outputs.truth)?);
+        let (mut imu, mut truth) = (
+            open(outputs.imu, outputs.asl)?,
+            open(outputs.truth, outputs.asl)?,
+        );
         let (mut gnss, mut baro, mut odometer) = (
-            open(outputs.gnss)?,
-            open(outputs.baro)?,
-            open(outputs.odometer)?,
+            open(outputs.gnss, false)?,
+            open(outputs.baro, false)?,
+            open(outputs.odometer, false)?,
         );
         let tabulate = truth.is_some();
         // Whether any file is CSV: it decides how two threads share the run (below).
@@ -480,10 +487,12 @@ struct TableSink {
     next_row: usize,
     description: Description,
     started: bool,
+    /// In the ASL layout ([`AtomicFile::begin_asl`]).
+    asl: bool,
 }
 
 impl TableSink {
-    fn create(path: &Path, description: &Description) -> Result<Self> {
+    fn create(path: &Path, description: &Description, asl: bool) -> Result<Self> {
         let format = TableFormat::of(path);
         Ok(Self {
             file: AtomicFile::create(path)?,
@@ -492,12 +501,17 @@ impl TableSink {
             next_row: format.first_row(),
             description: description.clone(),
             started: false,
+            asl,
         })
     }
 
     fn write(&mut self, table: &Table) -> Result<()> {
         // Nothing that is not a finite number reaches a file.
         check_finite_from(&table.columns, &table.data, &self.name, self.next_row)?;
+        if !self.started && self.asl {
+            self.file.begin_asl(&table.columns)?;
+            self.started = true;
+        }
         if !self.started {
             let kind = TableKind::detect(&table.columns);
             let description = Description {

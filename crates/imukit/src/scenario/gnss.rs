@@ -92,13 +92,12 @@ pub struct GnssSetup {
 }
 
 impl GnssSpec {
-    /// Checks the table against the scenario's sample rate `imu_rate_hz`; errors name the key
-    /// (`gnss.rate_hz`, …).
+    /// The receiver's error model: these keys, MATLAB's defaults for the others (the rate
+    /// unchecked against any IMU's).
     ///
     /// # Errors
-    /// A parameter out of range, a rate that does not divide the IMU's, both a decay factor and
-    /// a correlation time, an outage of non-positive length.
-    pub fn resolve(&self, imu_rate_hz: f64, seed: u64) -> Result<GnssSetup> {
+    /// A parameter out of range, both a decay factor and a correlation time (named by key).
+    pub fn params(&self) -> Result<GnssParams> {
         let d = GnssParams::default();
         let position_noise = match (self.decay_factor, self.correlation_time_s) {
             (Some(_), Some(_)) => {
@@ -125,6 +124,17 @@ impl GnssSpec {
             position_noise,
         };
         GnssModel::new(&params).map_err(|e| invalid(format!("gnss.{}", e.field), e.to_string()))?;
+        Ok(params)
+    }
+
+    /// Checks the table against the scenario's sample rate `imu_rate_hz`; errors name the key
+    /// (`gnss.rate_hz`, …).
+    ///
+    /// # Errors
+    /// A parameter out of range, a rate that does not divide the IMU's, both a decay factor and
+    /// a correlation time, an outage of non-positive length.
+    pub fn resolve(&self, imu_rate_hz: f64, seed: u64) -> Result<GnssSetup> {
+        let params = self.params()?;
         let ratio = imu_rate_hz / params.rate_hz;
         let every = ratio.round();
         if !(every >= 1.0 && (ratio - every).abs() < 1e-9 * ratio) {

@@ -1,0 +1,71 @@
+"""The filter's model apart from any scenario: `imukit fuse IMU GNSS --imu PART --gnss-*` and
+`imukit.fuse(imu, gnss, imu_model=…)` give the numbers of the scenario route when they state the
+same part and receiver, and refuse a bad part or accuracy by name."""
+import subprocess
+
+import numpy as np
+import pytest
+
+import imukit
+from test_cli_vs_python import ROOT, imukit_bin
+
+PART = ["--imu", "stim300", "--gnss-horizontal-accuracy-m", "1.5", "--gnss-vertical-accuracy-m", "3",
+        "--gnss-velocity-accuracy-m-s", "0.1"]
+
+
+@pytest.fixture(scope="module")
+def drive(tmp_path_factory):
+    """The car of examples/car_tunnel.toml with MATLAB's default GNSS noise model (what the
+    part route assumes), simulated once."""
+    tmp = tmp_path_factory.mktemp("fuse_part")
+    text = (ROOT / "examples" / "car_tunnel.toml").read_text()
+    scenario = tmp / "car.toml"
+    scenario.write_text("\n".join(line for line in text.splitlines() if not line.startswith("decay_factor")))
+    files = {name: tmp / f"{name}.csv" for name in ("imu", "truth", "gnss")}
+    done = subprocess.run([imukit_bin(), "simulate", str(scenario), "--out", str(files["imu"]),
+                           "--truth", str(files["truth"]), "--gnss", str(files["gnss"]), "--quiet"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return tmp, scenario, files
+
+
+def fuse(files, out, *extra):
+    return subprocess.run([imukit_bin(), "fuse", str(files["imu"]), str(files["gnss"]), "--init", str(files["truth"]),
+                           "--out", str(out), *extra], capture_output=True, text=True)
+
+
+def test_a_part_and_its_receiver_give_the_scenario_routes_numbers(drive):
+    tmp, scenario, files = drive
+    by_scenario, by_part = tmp / "scenario.csv", tmp / "part.csv"
+    for out, extra in [(by_scenario, ["--scenario", str(scenario)]), (by_part, PART)]:
+        done = fuse(files, out, *extra)
+        assert done.returncode == 0, done.stderr
+    assert by_part.read_bytes() == by_scenario.read_bytes()
+    imu, gnss, truth = (imukit.read(files[k]) for k in ("imu", "gnss", "truth"))
+    python = imukit.fuse(imu, gnss, initial=truth, imu_model="stim300", gnss_horizontal_accuracy_m=1.5,
+                         gnss_vertical_accuracy_m=3.0, gnss_velocity_accuracy_m_s=0.1)
+    cli = imukit.read(by_part)
+    for column in cli:
+        np.testing.assert_array_equal(python[column], cli[column], err_msg=column)
+    # The part as a parameter file (what `imukit presets` prints) is the same part.
+    params = tmp / "stim300.toml"
+    params.write_text(subprocess.run([imukit_bin(), "presets", "stim300"], capture_output=True, text=True,
+                                     check=True).stdout)
+    by_file = tmp / "file.csv"
+    done = fuse(files, by_file, *(["--imu", str(params)] + PART[2:]))
+    assert done.returncode == 0, done.stderr
+    assert by_file.read_bytes() == by_scenario.read_bytes()
+
+
+def test_a_bad_part_or_accuracy_is_refused_by_name(drive):
+    tmp, scenario, files = drive
+    out = tmp / "never.csv"
+    done = fuse(files, out, "--imu", "stim301")
+    assert done.returncode == 65 and "stim301" in done.stderr, done.stderr
+    done = fuse(files, out, "--imu", "stim300", "--gnss-horizontal-accuracy-m", "-1")
+    assert done.returncode == 65 and "--gnss-horizontal-accuracy-m" in done.stderr, done.stderr
+    done = fuse(files, out, "--imu", "stim300", "--scenario", str(scenario))
+    assert done.returncode == 2, done.stderr
+    assert not out.exists()
+    with pytest.raises(ValueError, match="scenario= .* or imu_model="):
+        imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]))
