@@ -69,3 +69,14 @@ def test_a_bad_part_or_accuracy_is_refused_by_name(drive):
     assert not out.exists()
     with pytest.raises(ValueError, match="scenario= .* or imu_model="):
         imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]))
+
+
+def test_a_scenario_that_contradicts_the_datas_description_is_refused(drive):
+    tmp, scenario, files = drive
+    ned = tmp / "ned.toml"
+    ned.write_text(scenario.read_text().replace('nav_frame = "ENU"', 'nav_frame = "NED"'))
+    out = tmp / "never.csv"
+    done = fuse(files, out, "--scenario", str(ned))
+    assert done.returncode == 65, done.stderr
+    assert f"nav_frame: the scenario {ned} says NED, the description of {files['imu']} says ENU" in done.stderr
+    assert not out.exists()

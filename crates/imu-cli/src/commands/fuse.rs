@@ -95,6 +95,16 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         (Some(path), _) => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));
             let scenario = ScenarioSpec::from_file(path)?.resolve(base)?;
+            // Data described in another frame, on another Earth or with the other sign than the
+            // scenario's are not the scenario's data.
+            let described = Described::read(&[a.imu, a.gnss])?;
+            let source = format!("the scenario {}", path.display());
+            described.check("nav_frame", scenario.nav_frame, &source, |d| d.nav_frame)?;
+            let earth = match scenario.earth {
+                imukit::scenario::EarthSetup::Flat => EarthName::Flat,
+                imukit::scenario::EarthSetup::Wgs84(_) => EarthName::Wgs84,
+            };
+            described.check("earth", earth, &source, |d| d.earth)?;
             request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.
                 Error::Invalid { field, message } if field == "earth" => Error::Invalid {

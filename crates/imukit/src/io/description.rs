@@ -474,6 +474,31 @@ impl Described {
         }
     }
 
+    /// Refuses files whose description says another `field` than `value`, which `source` (a
+    /// scenario file, say) fixes.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming `field`, `source`, the file and both values; two files that
+    /// disagree.
+    pub fn check<T: PartialEq + Copy + core::fmt::Display>(
+        &self,
+        field: &str,
+        value: T,
+        source: &str,
+        get: impl Fn(&Description) -> Option<T>,
+    ) -> Result<()> {
+        match self.agreed(field, get)? {
+            Some((d, path)) if d != value => Err(Error::Invalid {
+                field: field.to_string(),
+                message: format!(
+                    "{source} says {value}, the description of {} says {d}",
+                    path.display()
+                ),
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// The origin the files agree on, if any.
     ///
     /// # Errors
