@@ -222,12 +222,6 @@ pub fn seconds_after(stamp_ns: i64, origin_ns: i64) -> f64 {
     ns as f64 * 1e-9
 }
 
-/// A stamp's text as integer nanoseconds (`None` if it is not an integer in `i64`).
-#[must_use]
-pub fn parse_stamp_ns(text: &str) -> Option<i64> {
-    text.trim().parse::<i64>().ok()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,8 +276,6 @@ mod tests {
             let t = seconds_after(stamp, origin);
             assert_eq!((t * 1e9).round() as i64 + origin, stamp, "{k}");
         }
-        assert_eq!(parse_stamp_ns(" 1403636579758555392 "), Some(first));
-        assert_eq!(parse_stamp_ns("1.4e18"), None);
         assert_eq!(time_origin_ns(-1), -DAY_NS);
     }
 }

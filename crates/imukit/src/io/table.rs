@@ -843,19 +843,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
 pub fn read_table_through(path: &Path, map: &ColumnMap) -> Result<Table> {
     let names = csv_layout(path, Some(map))?.names;
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    let mut rows = CsvRows::open_through(path, &names, "", Some(map))?;
-    let mut t = Table::new(&names);
-    let mut row = vec![0.0; names.len()];
-    while rows.next_row(&mut row)?.is_some() {
-        t.push_row(&row);
-    }
-    if t.rows() == 0 {
-        return Err(Error::CsvFormat {
-            file: path.into(),
-            message: "no data rows after the header".into(),
-        });
-    }
-    Ok(t)
+    whole_table(CsvRows::open_through(path, &names, "", Some(map))?, &names)
 }
 
 /// Reads the named columns of a CSV file as a table with those columns, in that order.
@@ -863,7 +851,11 @@ pub fn read_table_through(path: &Path, map: &ColumnMap) -> Result<Table> {
 /// # Errors
 /// As [`read_columns`].
 pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Table> {
-    let mut rows = CsvRows::open(path, names, hint)?;
+    whole_table(CsvRows::open(path, names, hint)?, names)
+}
+
+/// Every row of `rows` (opened for `names`) as a table, refused when there is none.
+fn whole_table(mut rows: CsvRows, names: &[&str]) -> Result<Table> {
     let mut t = Table::new(names);
     let mut row = vec![0.0; names.len()];
     while rows.next_row(&mut row)?.is_some() {
@@ -871,7 +863,7 @@ pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Tab
     }
     if t.rows() == 0 {
         return Err(Error::CsvFormat {
-            file: path.into(),
+            file: rows.path,
             message: "no data rows after the header".into(),
         });
     }
