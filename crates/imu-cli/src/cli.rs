@@ -102,6 +102,10 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
+        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
+        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
         /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
@@ -197,6 +201,10 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
+        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
+        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
         /// The filter.
         #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
         filter: FilterKind,
@@ -238,6 +246,10 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
+        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
+        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
         gnss: PathBuf,
         /// The initial state: the first row of this truth CSV.
@@ -343,6 +355,10 @@ pub enum Command {
         truth: PathBuf,
         /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
+        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
+        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -397,6 +413,10 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
+        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
+        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,

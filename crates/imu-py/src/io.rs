@@ -22,13 +22,26 @@ fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 /// Every column of a table file, its format by its extension (`.parquet`, else CSV); a CSV
 /// file through a column map when one is given (a TOML file's path, or JSON text).
 #[pyfunction]
-#[pyo3(signature = (path, map_path = None, map_json = None))]
+#[pyo3(signature = (path, map_path = None, map_json = None, topic = None))]
 fn read_table_file<'py>(
     py: Python<'py>,
     path: &str,
     map_path: Option<&str>,
     map_json: Option<&str>,
+    topic: Option<String>,
 ) -> PyResult<TableOut<'py>> {
+    if let Some(topic) = topic {
+        let t = py
+            .detach(|| {
+                imukit::io::bag::read(Path::new(path))?.table_among(
+                    &[topic],
+                    &[],
+                    imukit::io::bag::Role::Any,
+                )
+            })
+            .map_err(refused)?;
+        return table_out(py, t);
+    }
     let map = match (map_path, map_json) {
         (Some(p), _) => Some(ColumnMap::read(Path::new(p)).map_err(refused)?),
         (None, Some(text)) => Some(ColumnMap::from_json(text, "map").map_err(refused)?),

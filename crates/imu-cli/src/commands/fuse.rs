@@ -3,10 +3,11 @@
 use std::path::Path;
 
 use imu_core::AccelSign;
+use imukit::io::bag::Role;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::Gaps;
-use imukit::io::table::read_table;
+use imukit::io::table::{read_table, read_table_as};
 use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
 use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::scenario::EarthName;
@@ -90,7 +91,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         sensor_errors: a.sensor_errors,
         rest_s: a.rest_s,
     };
-    let imu = read_table(a.imu)?;
+    let imu = read_table_as(a.imu, Role::Readings)?;
     let (setup, start) = match (a.scenario, &a.model) {
         (Some(path), _) => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));
@@ -126,7 +127,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             .into());
         }
     };
-    let gnss = read_table(a.gnss)?;
+    let gnss = read_table_as(a.gnss, Role::Fixes)?;
     let odometer = a.odometer.map(read_table).transpose()?;
     let baro = a.baro.map(read_table).transpose()?;
     let aids = AidTables {

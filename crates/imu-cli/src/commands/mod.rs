@@ -67,6 +67,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Integrate {
             input,
             map,
+            topics,
             init,
             nav_frame,
             gravity_m_s2,
@@ -90,6 +91,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&input, map.as_deref())?;
+            attach_topics(&[Some(&input), init.as_deref()], &topics);
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -131,6 +133,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Fuse {
             imu,
             map,
+            topics,
             gnss,
             init,
             align,
@@ -152,6 +155,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&imu, map.as_deref())?;
+            attach_topics(&[Some(&imu), Some(&gnss), init.as_deref()], &topics);
             fuse::run(&fuse::Args {
                 imu: &imu,
                 gnss: &gnss,
@@ -184,6 +188,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Orient {
             input,
             map,
+            topics,
             filter,
             params,
             conventions,
@@ -192,6 +197,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&input, map.as_deref())?;
+            attach_topics(&[Some(&input)], &topics);
             orient::run(
                 &input,
                 filter,
@@ -205,8 +211,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Compare {
             truth,
             estimate,
+            topics,
             out,
-        } => compare::run(&truth, &estimate, out.as_deref()),
+        } => {
+            attach_topics(&[Some(&truth), Some(&estimate)], &topics);
+            compare::run(&truth, &estimate, out.as_deref())
+        }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
             let c = imukit::io::units::convert(value, &unit)?;
@@ -216,12 +226,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Allan {
             input,
             map,
+            topics,
             columns,
             out,
             plot,
             figure,
         } => {
             attach_map(&input, map.as_deref())?;
+            attach_topics(&[Some(&input)], &topics);
             allan::run(
                 &input,
                 &columns,
@@ -247,6 +259,15 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         } => {
             let opts = plot::options(body.as_deref(), lever_arm.as_deref(), fps, speed, nav_frame);
             plot::animate(&truth, &out, &opts)
+        }
+    }
+}
+
+/// Names `topics` (`--topic`) as the ones to read from each of `inputs` that is a bag.
+fn attach_topics(inputs: &[Option<&std::path::Path>], topics: &[String]) {
+    for input in inputs.iter().flatten() {
+        if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
+            imukit::io::bag::attach_topics(input, topics.to_vec());
         }
     }
 }

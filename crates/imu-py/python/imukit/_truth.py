@@ -70,12 +70,16 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
     return _table(_core.read_csv(str(path)))
 
-def read(path: Union[str, os.PathLike], *, map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None) -> Table:
+def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None,
+         map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None) -> Table:
     """A table file as a :class:`Table`, its format by its extension: ``.csv``, ``.parquet``
     (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy`` (a structured
     array of float64 fields) or ``.npz`` (one float64 array per column, as ``numpy.savez`` writes
-    them). Any other extension is refused with the formats read. A EuRoC/TUM-VI file
-    (``#timestamp [ns],w_RS_S_x [rad s^-1],…``) is read as imukit's columns by its header.
+    them), ``.mcap`` (a ROS 2 bag: one topic's messages — ``sensor_msgs/Imu``, ``NavSatFix``,
+    ``nav_msgs/Odometry``, … — as imukit's columns; ``topic`` names it where the bag holds
+    several, else its IMU topic is read). Any other extension is refused with the formats read.
+    A EuRoC/TUM-VI file (``#timestamp [ns],w_RS_S_x [rad s^-1],…``) is read as imukit's columns
+    by its header.
 
     ``map`` reads a vendor's CSV through a column map — the path of a TOML map, or the same keys
     as a dict — giving ``t_s`` and the sensors' columns in SI units and body axes
@@ -87,9 +91,17 @@ def read(path: Union[str, os.PathLike], *, map: Optional[Union[str, os.PathLike,
                                     "axes": ["x", "-y", "-z"]})
     """
     suffix = Path(path).suffix.lower()
+    if Path(path).is_dir() and (Path(path) / "metadata.yaml").is_file():
+        suffix = ".mcap"  # a ROS 2 bag's folder
     if suffix not in TABLE_FORMATS:
         raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
                        f"(read: {', '.join(TABLE_FORMATS)})")
+    if topic is not None:
+        if suffix != ".mcap":
+            raise ImuError(f"{path}: topic= names a topic of a ROS 2 bag (.mcap), not of a {suffix} file")
+        if map is not None:
+            raise ImuError(f"{path}: map= reads a vendor's CSV; a bag's topics have their own columns")
+        return _table(_core.read_table_file(str(path), topic=str(topic)))
     if map is None:
         return _table(_core.read_table_file(str(path)))
     if isinstance(map, Mapping):
@@ -113,7 +125,7 @@ def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:
 
 
 #: The extensions of the table files imukit reads and writes.
-TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz")
+TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz", ".mcap")
 
 
 def builtin_scenarios() -> list:

@@ -131,8 +131,7 @@ impl AslWriter {
             use std::fmt::Write as _;
             line.clear();
             // Finite times of any run fit: i64 nanoseconds reach 292 years.
-            #[allow(clippy::cast_possible_truncation)]
-            let ns = (row[self.order[0]] * 1e9).round() as i64;
+            let ns = stamp_ns(row[self.order[0]]).unwrap_or_default();
             let _ = write!(line, "{ns}");
             for &k in &self.order[1..] {
                 let _ = write!(line, ",{}", row[k]);
@@ -211,6 +210,16 @@ pub fn file_names(header_line: &str) -> Vec<String> {
 #[must_use]
 pub fn time_origin_ns(first_ns: i64) -> i64 {
     first_ns.div_euclid(DAY_NS) * DAY_NS
+}
+
+/// `t_s` as an integer-nanosecond stamp (rounded to the nanosecond); `None` when it is not
+/// finite or beyond ±292 years.
+#[must_use]
+#[allow(clippy::cast_possible_truncation)]
+pub fn stamp_ns(t_s: f64) -> Option<i64> {
+    let ns = (t_s * 1e9).round();
+    // i64::MAX as f64 rounds up to 2⁶³: the range is checked below it.
+    (ns.is_finite() && ns.abs() < 9.2e18).then_some(ns as i64)
 }
 
 /// A stamp in integer nanoseconds as seconds after `origin_ns`.

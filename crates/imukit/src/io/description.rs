@@ -227,7 +227,7 @@ impl Description {
 
     /// A description from its entries (keys without the prefix), each value checked; `place`
     /// names where they were read (the file and where in it).
-    fn from_entries<'a>(
+    pub(crate) fn from_entries<'a>(
         entries: impl IntoIterator<Item = (&'a str, Value)>,
         place: &str,
     ) -> Result<Self> {
@@ -333,6 +333,7 @@ impl Description {
                 Self::from_entries(entries, &place).map(Some)
             }
             TableFormat::Npy | TableFormat::Npz => Ok(None),
+            TableFormat::Mcap => Ok(crate::io::bag::read(path)?.description),
             TableFormat::Csv => Self::read_csv(path),
         }
     }

@@ -1,12 +1,14 @@
 //! Files in and out: tables and CSV ([`table`]), the EuRoC/TUM-VI ASL layout read by its header
 //! ([`asl`]), a vendor's CSV through a column map ([`column_map`]), tables as Parquet ([`parquet`]) and as NumPy
-//! `.npy` and `.npz` ([`npy`], [`npz`]), each chosen by its path's extension ([`TableFormat`]),
+//! `.npy` and `.npz` ([`npy`], [`npz`]), a topic of a ROS 2 bag ([`bag`]), each chosen by its
+//! path's extension ([`TableFormat`]),
 //! what a table holds, written into it ([`description`]), parameter
 //! files ([`params`]), the built-in
 //! presets of real parts ([`presets`]), datasheet units ([`units`]), the time-checked row
 //! reader of IMU files ([`rows`]) and typed values read from a tree of them ([`value_tree`]:
 //! a Python dict's way in).
 pub mod asl;
+pub mod bag;
 pub mod column_map;
 pub mod description;
 pub mod kalibr;
@@ -83,12 +85,19 @@ pub enum TableFormat {
     Npy,
     /// A NumPy archive of one array per column ([`npz`]).
     Npz,
+    /// A ROS 2 bag, one MCAP file or a bag's folder (`metadata.yaml` beside its storage
+    /// files) ([`bag`]): a topic's table.
+    Mcap,
 }
 
 impl TableFormat {
     /// The format `path` names.
     #[must_use]
     pub fn of(path: &Path) -> Self {
+        // A ROS 2 bag's folder: its metadata file and the storage files beside it.
+        if path.is_dir() && path.join("metadata.yaml").is_file() {
+            return Self::Mcap;
+        }
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
         if ext.eq_ignore_ascii_case("parquet") {
             Self::Parquet
@@ -96,6 +105,8 @@ impl TableFormat {
             Self::Npy
         } else if ext.eq_ignore_ascii_case("npz") {
             Self::Npz
+        } else if ext.eq_ignore_ascii_case("mcap") {
+            Self::Mcap
         } else {
             Self::Csv
         }
@@ -107,7 +118,7 @@ impl TableFormat {
     pub fn first_row(self) -> usize {
         match self {
             Self::Csv => 2,
-            Self::Parquet | Self::Npy | Self::Npz => 1,
+            Self::Parquet | Self::Npy | Self::Npz | Self::Mcap => 1,
         }
     }
 }

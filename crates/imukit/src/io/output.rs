@@ -15,11 +15,12 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
 use crate::io::asl::AslWriter;
+use crate::io::bag::BagWriter;
 use crate::io::description::Description;
 use crate::io::npy::NpySink;
 use crate::io::npz::NpzSink;
 use crate::io::parquet::ParquetSink;
-use crate::io::table::{check_column_names, check_finite, write_rows};
+use crate::io::table::{Table, check_column_names, check_finite, write_rows};
 
 /// The longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
@@ -360,6 +361,8 @@ pub struct AtomicFile {
     npz: Option<NpzSink>,
     /// A CSV table in the ASL layout ([`AtomicFile::begin_asl`]).
     asl: Option<AslWriter>,
+    /// A ROS 2 bag ([`AtomicFile::begin_bag`]; it holds the writer until the commit).
+    bag: Option<BagWriter>,
 }
 
 impl AtomicFile {
@@ -421,6 +424,7 @@ impl AtomicFile {
             npy: None,
             npz: None,
             asl: None,
+            bag: None,
         })
     }
     /// The file's path (its final name).
@@ -464,6 +468,7 @@ impl AtomicFile {
                 self.npz = Some(NpzSink::create(&self.path, columns)?);
                 return Ok(());
             }
+            TableFormat::Mcap => return self.begin_bag(description),
             TableFormat::Csv => {}
         }
         let line = description.csv_line();
@@ -491,6 +496,33 @@ impl AtomicFile {
         written.map_err(|e| self.error(e))
     }
 
+    /// Starts a ROS 2 bag ([`BagWriter`]), each channel carrying `description`; tables go in
+    /// with [`Self::write_bag`].
+    ///
+    /// # Errors
+    /// The bag writer's refusal, naming the file.
+    pub fn begin_bag(&mut self, description: &Description) -> Result<()> {
+        let writer = self.writer.take().expect("a bag is begun once");
+        self.bag = Some(BagWriter::create(
+            writer,
+            &self.path.display().to_string(),
+            description,
+        )?);
+        Ok(())
+    }
+
+    /// Writes `tables` (IMU rates, a truth, GNSS fixes) into the bag begun, as their topics'
+    /// messages in stamp order; the caller has checked the values finite.
+    ///
+    /// # Errors
+    /// A table a bag has no topic for; the writer's refusal.
+    ///
+    /// # Panics
+    /// When no bag was begun.
+    pub fn write_bag(&mut self, tables: &[&Table]) -> Result<()> {
+        self.bag.as_mut().expect("a bag was begun").write(tables)
+    }
+
     /// Appends row-major `data` (rows of the table's width) to the table begun; the caller has
     /// checked the values finite.
     ///
@@ -505,6 +537,12 @@ impl AtomicFile {
         }
         if let Some(n) = self.npz.as_mut() {
             return n.write(data);
+        }
+        if let Some(b) = self.bag.as_mut() {
+            return b.write(&[&Table {
+                columns: self.columns.clone(),
+                data: data.to_vec(),
+            }]);
         }
         let width = self.columns.len().max(1);
         if let Some(asl) = self.asl.take() {
@@ -586,6 +624,9 @@ impl AtomicFile {
         if let Some(n) = self.npz.take() {
             let writer = self.writer.take().expect("the writer lives until commit");
             self.writer = Some(n.finish(writer)?);
+        }
+        if let Some(b) = self.bag.take() {
+            self.writer = Some(b.finish()?);
         }
         let file = match self.writer.take() {
             Some(w) => w

@@ -456,7 +456,7 @@ impl Table {
             description
         };
         match TableFormat::of(path) {
-            TableFormat::Parquet | TableFormat::Npy | TableFormat::Npz => {
+            TableFormat::Parquet | TableFormat::Npy | TableFormat::Npz | TableFormat::Mcap => {
                 self.write_binary(path, description)
             }
             TableFormat::Csv => self.write_csv_described(path, description),
@@ -639,6 +639,7 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
         TableFormat::Parquet => crate::io::parquet::column_names(path),
         TableFormat::Npy => crate::io::npy::column_names(path),
         TableFormat::Npz => crate::io::npz::column_names(path),
+        TableFormat::Mcap => crate::io::bag::column_names(path, &[]),
         TableFormat::Csv => Ok(csv_layout(path, None)?.names),
     }
 }
@@ -828,11 +829,23 @@ pub fn read_table(path: &Path) -> Result<Table> {
     match TableFormat::of(path) {
         TableFormat::Parquet => return crate::io::parquet::read_table(path),
         TableFormat::Npz => return crate::io::npz::read_table(path),
+        TableFormat::Mcap => return crate::io::bag::read_table(path, &[]),
         TableFormat::Npy | TableFormat::Csv => {}
     }
     let header = read_header(path)?;
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
     read_table_columns(path, &names, "")
+}
+
+/// [`read_table`], a bag's topic chosen among those of `role` (other formats hold one table).
+///
+/// # Errors
+/// As [`read_table`].
+pub fn read_table_as(path: &Path, role: crate::io::bag::Role) -> Result<Table> {
+    match TableFormat::of(path) {
+        TableFormat::Mcap => crate::io::bag::read_table_as(path, role),
+        _ => read_table(path),
+    }
 }
 
 /// Reads every column a vendor's CSV file gives through the column `map` ([`ColumnMap`]):
@@ -953,8 +966,19 @@ impl CsvRows {
         hint: &str,
         map: Option<&ColumnMap>,
     ) -> Result<Self> {
+        // A bag's topic is chosen by the columns asked for, and read whole.
+        let bag = match TableFormat::of(path) {
+            TableFormat::Mcap => Some(crate::io::bag::read_table(path, required)?),
+            _ => None,
+        };
         let layout = match TableFormat::of(path) {
             TableFormat::Csv => csv_layout(path, map)?,
+            TableFormat::Mcap => Layout {
+                names: bag.as_ref().map(|t| t.columns.clone()).unwrap_or_default(),
+                sources: None,
+                file_names: None,
+                comments: true,
+            },
             _ => Layout {
                 names: read_header(path)?,
                 sources: None,
@@ -991,6 +1015,7 @@ impl CsvRows {
             }
             TableFormat::Npy => RowSource::Npy(crate::io::npy::NpyRows::open(path)?.1),
             TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
+            TableFormat::Mcap => RowSource::Whole(bag.unwrap_or_default(), 0),
             TableFormat::Csv => RowSource::Csv(reader(path, layout.comments)?),
         };
         // Rows are counted from the header, row 1, whatever comment lines (the description's)
@@ -1010,6 +1035,12 @@ impl CsvRows {
             origin_ns: std::cell::Cell::new(None),
             file_names: layout.file_names,
         })
+    }
+
+    /// The columns of the table read (a CSV file's header, a bag topic's columns).
+    #[must_use]
+    pub fn columns(&self) -> &[String] {
+        &self.names
     }
 
     /// Parses the next data row into `out` (the requested columns in order) and returns its

@@ -257,31 +257,31 @@ impl InitialState {
     /// Missing columns, a bad first row (file, row, column), an empty file.
     pub fn from_csv(path: &Path) -> Result<Self> {
         // The state columns after t_s: position, velocity, quaternion.
-        let columns = &STATE_COLUMNS[1..];
-        let mut rows = CsvRows::open(path, columns, "the initial state comes from a truth CSV")?;
-        let mut r = [0.0; 10];
-        if rows.next_row(&mut r)?.is_none() {
+        let hint = "the initial state comes from a truth CSV";
+        let mut columns = STATE_COLUMNS[1..].to_vec();
+        let mut rows = CsvRows::open(path, &columns, hint)?;
+        // Read with the geodetic position where the table has it (the same table: a bag's
+        // topic chosen once for all of them).
+        let header = rows.columns();
+        if GEODETIC_COLUMNS
+            .iter()
+            .all(|c| header.iter().any(|h| h == c))
+        {
+            columns.extend(GEODETIC_COLUMNS);
+            rows = CsvRows::open(path, &columns, hint)?;
+        }
+        let mut r = [0.0; 13];
+        if rows.next_row(&mut r[..columns.len()])?.is_none() {
             return Err(crate::Error::CsvFormat {
                 file: path.into(),
                 message: "no data rows after the header".into(),
             });
         }
-        let header = crate::io::table::read_header(path)?;
-        let geodetic = if GEODETIC_COLUMNS
-            .iter()
-            .all(|c| header.iter().any(|h| h == c))
-        {
-            let mut rows = CsvRows::open(path, &GEODETIC_COLUMNS, "")?;
-            let mut g = [0.0; 3];
-            rows.next_row(&mut g)?;
-            Some(Geodetic {
-                latitude_rad: g[0],
-                longitude_rad: g[1],
-                height_m: g[2],
-            })
-        } else {
-            None
-        };
+        let geodetic = (columns.len() == 13).then_some(Geodetic {
+            latitude_rad: r[10],
+            longitude_rad: r[11],
+            height_m: r[12],
+        });
         Ok(Self {
             position_m: [r[0], r[1], r[2]],
             velocity_m_s: [r[3], r[4], r[5]],

@@ -217,7 +217,11 @@ impl Scenario {
             open(outputs.baro, false)?,
             open(outputs.odometer, false)?,
         );
-        let tabulate = truth.is_some();
+        // A bag given for the readings holds the truth and the fixes too (unless they have files
+        // of their own).
+        let bag = imu.as_ref().is_some_and(|s| s.format == TableFormat::Mcap);
+        let (bag_truth, bag_gnss) = (bag && truth.is_none(), bag && gnss.is_none());
+        let tabulate = truth.is_some() || bag_truth;
         // Whether any file is CSV: it decides how two threads share the run (below).
         let text = [&imu, &truth, &gnss, &baro, &odometer]
             .into_iter()
@@ -227,8 +231,17 @@ impl Scenario {
         let mut write = |chunks: &[Chunk]| -> Result<()> {
             for chunk in chunks {
                 report.merge(&chunk.report);
+                if let Some(sink) = imu.as_mut().filter(|_| bag) {
+                    let tables = [
+                        Some(&chunk.imu),
+                        Some(&chunk.truth).filter(|_| bag_truth),
+                        chunk.gnss.as_ref().filter(|_| bag_gnss),
+                    ];
+                    let tables: Vec<&Table> = tables.into_iter().flatten().collect();
+                    sink.write_bag(&tables)?;
+                }
                 for (sink, table) in [
-                    (&mut imu, Some(&chunk.imu)),
+                    (&mut imu, Some(&chunk.imu).filter(|_| !bag)),
                     (&mut truth, Some(&chunk.truth)),
                     (&mut gnss, chunk.gnss.as_ref()),
                     (&mut baro, chunk.baro.as_ref()),
@@ -506,6 +519,9 @@ impl TableSink {
     }
 
     fn write(&mut self, table: &Table) -> Result<()> {
+        if self.format == TableFormat::Mcap {
+            return self.write_bag(&[table]);
+        }
         // Nothing that is not a finite number reaches a file.
         check_finite_from(&table.columns, &table.data, &self.name, self.next_row)?;
         if !self.started && self.asl {
@@ -524,6 +540,23 @@ impl TableSink {
         self.file.write_table_rows(&table.data)?;
         self.next_row += table.rows();
         Ok(())
+    }
+
+    /// Writes a chunk of `tables` (readings, truth, fixes of one stretch of time) into the bag
+    /// this sink writes, their messages in stamp order.
+    fn write_bag(&mut self, tables: &[&Table]) -> Result<()> {
+        for t in tables {
+            check_finite_from(&t.columns, &t.data, &self.name, 1)?;
+        }
+        if !self.started {
+            let mut description = self.description.clone();
+            if let [only] = tables {
+                description.kind = TableKind::detect(&only.columns);
+            }
+            self.file.begin_bag(&description)?;
+            self.started = true;
+        }
+        self.file.write_bag(tables)
     }
 
     fn commit(self) -> Result<()> {

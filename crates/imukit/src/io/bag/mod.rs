@@ -1,0 +1,1128 @@
+//! ROS 2 bags in MCAP (`.mcap`): a topic read as an imukit table, and IMU readings, truth and
+//! GNSS fixes written as topics a ROS 2 user replays as they are.
+//!
+//! **Reading.** One pass through the file (the `mcap` crate's streaming reader: memory follows
+//! the largest chunk, not the file) decodes every message of a type imukit knows
+//! ([`ros::MessageType`]) into its topic's rows, in header-stamp order:
+//!
+//! | type | columns |
+//! |---|---|
+//! | `sensor_msgs/Imu` | `t_s`, `accel_*_m_s2`, `gyro_*_rad_s` (+ `mag_*_ut` of a `MagneticField` topic stamped alike) |
+//! | `sensor_msgs/MagneticField` | `t_s`, `mag_*_ut` |
+//! | `sensor_msgs/NavSatFix` | `t_s`, `lat_rad`, `lon_rad`, `height_m` (+ `vel_n/e/d_m_s` of a `TwistStamped` topic stamped alike, its axes east, north, up) |
+//! | `geometry_msgs/PointStamped` | `t_s`, `pos_*_m` (+ `vel_*_m_s` of a `TwistStamped` topic stamped alike) |
+//! | `geometry_msgs/TwistStamped` | `t_s`, `vel_*_m_s` |
+//! | `nav_msgs/Odometry` | `t_s`, `pos_*_m`, `vel_*_m_s` (turned from the child frame into the pose's), `q_w…q_z` (+ `lat_rad`, `lon_rad`, `height_m` of a `NavSatFix` topic stamped alike) |
+//! | `geometry_msgs/PoseStamped` | `t_s`, `pos_*_m`, `q_w…q_z` (+ the same) |
+//!
+//! Stamps are the header's, integer nanoseconds, as seconds after the UTC midnight before the
+//! bag's earliest stamp (the rule of [`crate::io::asl`]: every topic of one bag on one clock, to
+//! the nanosecond). A fix without a fix (`status` −1) is left out.
+//!
+//! **Choosing a topic.** A reader asks for the columns it needs; the topics whose table has
+//! them are the candidates, narrowed to those named with [`attach_topics`] (`--topic`,
+//! Python's `topic=`). One candidate is read; none or several is an error that lists the
+//! bag's topics. A topic merged into another (a magnetometer into its IMU) is a candidate only
+//! when named.
+//!
+//! **Writing** ([`BagWriter`]): `/imu` (`sensor_msgs/Imu`, no orientation: its covariance's
+//! first element −1), `/imu/mag` (`MagneticField`, tesla), `/ground_truth`
+//! (`nav_msgs/Odometry`; on the WGS-84 Earth with `/ground_truth/fix`, the reference point's
+//! latitude, longitude and height), a strapdown or fused estimate as `/odometry`, and GNSS fixes as `/gnss/fix` (`NavSatFix`, on the WGS-84 Earth) or
+//! `/gnss/position` (`PointStamped`, on the flat one) with `/gnss/vel` (`TwistStamped`), CDR
+//! encoded, zstd chunks, stamps `t_s` rounded to the nanosecond. Each channel carries the
+//! table's description ([`Description::metadata`]) in its metadata. ROS's frames are ENU with
+//! FLU bodies: a NED run is written as it is (its description says so).
+pub mod ros;
+
+use std::collections::BTreeMap;
+use std::io::{BufReader, BufWriter};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use mcap::sans_io::LinearReaderOptions;
+
+use crate::error::{Error, Result};
+use crate::io::asl::{seconds_after, stamp_ns, time_origin_ns};
+use crate::io::description::Description;
+use crate::io::output::OutputFile;
+use crate::io::schema::TableKind;
+use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Table};
+use ros::MessageType;
+
+/// The largest record (a chunk, compressed or not) read whole, bytes: ROS 2 writes chunks of
+/// about 1 MB (compressed or not); a damaged length beyond this is refused before anything is
+/// allocated for it.
+const RECORD_LIMIT: usize = 1 << 28;
+
+/// One topic of a bag.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Topic {
+    /// The topic's name.
+    pub name: String,
+    /// Its schema's (message type's) name.
+    pub message_type: String,
+    /// Its messages.
+    pub messages: u64,
+}
+
+impl core::fmt::Display for Topic {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "{} ({}, {} messages)",
+            self.name, self.message_type, self.messages
+        )
+    }
+}
+
+/// A topic of a known type, decoded: its stamps and rows of its type's columns.
+#[derive(Debug)]
+struct Decoded {
+    name: String,
+    kind: MessageType,
+    stamps_ns: Vec<i64>,
+    /// Row-major, [`columns_of`] wide.
+    rows: Vec<f64>,
+}
+
+/// What one pass through a bag gives.
+#[derive(Debug)]
+pub struct Contents {
+    path: PathBuf,
+    /// Every topic, known type or not, in the order first seen.
+    pub topics: Vec<Topic>,
+    decoded: Vec<Decoded>,
+    /// The description the first channel carries.
+    pub description: Option<Description>,
+}
+
+/// The columns of a type's own table (without `t_s`).
+fn columns_of(kind: MessageType) -> Vec<&'static str> {
+    const POS: [&str; 3] = ["pos_x_m", "pos_y_m", "pos_z_m"];
+    const VEL: [&str; 3] = ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"];
+    const Q: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
+    match kind {
+        MessageType::Imu => [ACCEL_COLUMNS, GYRO_COLUMNS].concat(),
+        MessageType::MagneticField => MAG_COLUMNS.to_vec(),
+        MessageType::NavSatFix => vec!["lat_rad", "lon_rad", "height_m"],
+        MessageType::PointStamped => POS.to_vec(),
+        MessageType::TwistStamped => VEL.to_vec(),
+        MessageType::Odometry => [&POS[..], &VEL, &Q].concat(),
+        MessageType::PoseStamped => [&POS[..], &Q].concat(),
+    }
+}
+
+/// Rotates `v` by the unit quaternion `q` (scalar first): `q ⊗ v ⊗ q*`.
+fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let [w, x, y, z] = q;
+    let u = [x, y, z];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let t = cross(u, v).map(|c| 2.0 * c);
+    let ut = cross(u, t);
+    [
+        v[0] + w * t[0] + ut[0],
+        v[1] + w * t[1] + ut[1],
+        v[2] + w * t[2] + ut[2],
+    ]
+}
+
+/// Decodes one message of `kind` into its stamp and row (`None`: a message left out, a fix
+/// without a fix).
+fn decode_row(
+    kind: MessageType,
+    data: &[u8],
+) -> std::result::Result<Option<(i64, Vec<f64>)>, String> {
+    use ros::decode;
+    Ok(Some(match kind {
+        MessageType::Imu => {
+            let m: ros::Imu = decode(data, 1)?;
+            let row = [m.linear_acceleration.array(), m.angular_velocity.array()].concat();
+            (m.header.stamp.ns(), row)
+        }
+        MessageType::MagneticField => {
+            let m: ros::MagneticField = decode(data, 1)?;
+            (
+                m.header.stamp.ns(),
+                m.magnetic_field.array().map(|b| b * 1e6).to_vec(),
+            )
+        }
+        MessageType::NavSatFix => {
+            let m: ros::NavSatFix = decode(data, 1)?;
+            if m.status.status == ros::STATUS_NO_FIX {
+                return Ok(None);
+            }
+            let row = vec![
+                m.latitude.to_radians(),
+                m.longitude.to_radians(),
+                m.altitude,
+            ];
+            (m.header.stamp.ns(), row)
+        }
+        MessageType::PointStamped => {
+            let m: ros::PointStamped = decode(data, 1)?;
+            (m.header.stamp.ns(), m.point.array().to_vec())
+        }
+        MessageType::TwistStamped => {
+            let m: ros::TwistStamped = decode(data, 1)?;
+            (m.header.stamp.ns(), m.twist.linear.array().to_vec())
+        }
+        MessageType::Odometry => {
+            let m: ros::Odometry = decode(data, 2)?;
+            let q = m.pose.pose.orientation.wxyz();
+            let v = rotate(q, m.twist.twist.linear.array());
+            let row = [&m.pose.pose.position.array()[..], &v, &q].concat();
+            (m.header.stamp.ns(), row)
+        }
+        MessageType::PoseStamped => {
+            let m: ros::PoseStamped = decode(data, 1)?;
+            let row = [&m.pose.position.array()[..], &m.pose.orientation.wxyz()].concat();
+            (m.header.stamp.ns(), row)
+        }
+    }))
+}
+
+/// Reads every topic of the bag at `path` (one pass).
+///
+/// # Errors
+/// An unreadable or damaged file (a truncated one included), a message that is not what its
+/// schema names, a value that is not finite, a topic of a known type in another encoding than
+/// CDR — each naming the file and the topic; more rows than fit in memory.
+pub fn read(path: &Path) -> Result<Contents> {
+    let mut contents = Contents {
+        path: path.into(),
+        topics: Vec::new(),
+        decoded: Vec::new(),
+        description: None,
+    };
+    for file in storage_files(path)? {
+        read_file(&file, &mut contents)?;
+    }
+    for d in &mut contents.decoded {
+        sort_by_stamp(d);
+    }
+    Ok(contents)
+}
+
+/// The MCAP files of the bag at `path`: the file itself, or a bag folder's `.mcap` files in
+/// name order (a split recording's parts).
+fn storage_files(path: &Path) -> Result<Vec<PathBuf>> {
+    if !path.is_dir() {
+        return Ok(vec![path.into()]);
+    }
+    let io = |source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    let mut files = Vec::new();
+    let mut sqlite = false;
+    for entry in std::fs::read_dir(path).map_err(io)? {
+        let p = entry.map_err(io)?.path();
+        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("mcap") && p.is_file() {
+            files.push(p);
+        } else if ext.eq_ignore_ascii_case("db3") {
+            sqlite = true;
+        }
+    }
+    files.sort();
+    if files.is_empty() {
+        let message = if sqlite {
+            "a bag in ROS 2's sqlite3 storage: imukit reads MCAP storage (convert it with              `ros2 bag convert`, or record with `--storage mcap`, ROS 2's default since Iron)"
+        } else {
+            "a bag folder with no .mcap file"
+        };
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: message.into(),
+        });
+    }
+    Ok(files)
+}
+
+/// Reads the MCAP file at `path` into `contents`.
+fn read_file(path: &Path, contents: &mut Contents) -> Result<()> {
+    let (file, _) = crate::io::open_with_length(path)?;
+    let bad = |message: String| Error::CsvFormat {
+        file: path.into(),
+        message,
+    };
+    let options = LinearReaderOptions::default()
+        .with_record_length_limit(RECORD_LIMIT)
+        .with_prevalidate_chunk_crcs(true);
+    let reader = mcap::io::MessageReader::new_with_options(BufReader::new(file), options);
+    let Contents {
+        topics,
+        decoded,
+        description,
+        ..
+    } = contents;
+    let mut first = topics.is_empty();
+    let mut values: usize = decoded
+        .iter()
+        .map(|d| d.rows.len() + d.stamps_ns.len())
+        .sum();
+    let read = crate::io::contained(|| -> Result<()> {
+        for message in reader {
+            let message = message.map_err(|e| bad(format!("not a readable MCAP file: {e}")))?;
+            let channel = &message.channel;
+            if first {
+                first = false;
+                *description = channel_description(path, &channel.metadata)?;
+            }
+            let schema = channel.schema.as_ref().map_or("", |s| s.name.as_str());
+            let at = match topics.iter().position(|t| t.name == channel.topic) {
+                Some(at) => at,
+                None => {
+                    topics.push(Topic {
+                        name: channel.topic.clone(),
+                        message_type: schema.to_string(),
+                        messages: 0,
+                    });
+                    topics.len() - 1
+                }
+            };
+            topics[at].messages += 1;
+            let Some(kind) = MessageType::of_name(schema) else {
+                continue;
+            };
+            if channel.message_encoding != "cdr" {
+                return Err(bad(format!(
+                    "topic {}: {} messages encoded as \"{}\" (imukit reads ROS 2's CDR)",
+                    channel.topic, schema, channel.message_encoding
+                )));
+            }
+            let topic_error = |e: String| {
+                bad(format!(
+                    "topic {}, message {}: not a {}: {e}",
+                    channel.topic,
+                    topics[at].messages,
+                    kind.name()
+                ))
+            };
+            let Some((stamp, row)) = decode_row(kind, &message.data).map_err(topic_error)? else {
+                continue;
+            };
+            if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+                return Err(topic_error(format!(
+                    "{} is {}",
+                    columns_of(kind)[k],
+                    row[k]
+                )));
+            }
+            let slot = match decoded.iter().position(|d| d.name == channel.topic) {
+                Some(s) => s,
+                None => {
+                    decoded.push(Decoded {
+                        name: channel.topic.clone(),
+                        kind,
+                        stamps_ns: Vec::new(),
+                        rows: Vec::new(),
+                    });
+                    decoded.len() - 1
+                }
+            };
+            values += row.len() + 1;
+            crate::scenario::check_in_memory(values, 8, &path.display().to_string())?;
+            decoded[slot].stamps_ns.push(stamp);
+            decoded[slot].rows.extend(row);
+        }
+        Ok(())
+    });
+    match read {
+        Ok(r) => r,
+        Err(panic) => Err(bad(format!("not a readable MCAP file ({panic})"))),
+    }
+}
+
+/// The description in a channel's metadata (`imukit.` keys), if any.
+fn channel_description(
+    path: &Path,
+    metadata: &BTreeMap<String, String>,
+) -> Result<Option<Description>> {
+    let entries: Vec<(&str, crate::io::description::Value)> = metadata
+        .iter()
+        .filter_map(|(k, v)| {
+            k.strip_prefix(crate::io::description::KEY_PREFIX)
+                .map(|k| (k, crate::io::description::Value::Text(v.clone())))
+        })
+        .collect();
+    if entries.is_empty() {
+        return Ok(None);
+    }
+    let place = format!("{}, channel metadata", path.display());
+    let mut d = Description::from_entries(entries, &place)?;
+    d.kind = None;
+    Ok(Some(d))
+}
+
+/// Puts a topic's rows in header-stamp order (a stable sort: equal stamps keep their order).
+fn sort_by_stamp(d: &mut Decoded) {
+    if d.stamps_ns.is_sorted() {
+        return;
+    }
+    let width = columns_of(d.kind).len();
+    let mut order: Vec<usize> = (0..d.stamps_ns.len()).collect();
+    order.sort_by_key(|&k| d.stamps_ns[k]);
+    d.stamps_ns = order.iter().map(|&k| d.stamps_ns[k]).collect();
+    d.rows = order
+        .iter()
+        .flat_map(|&k| d.rows[k * width..(k + 1) * width].iter().copied())
+        .collect();
+}
+
+/// The topics named for each bag (the command line's `--topic`, Python's `topic=`).
+static TOPICS: Mutex<Vec<(PathBuf, Vec<String>)>> = Mutex::new(Vec::new());
+
+/// Names the topics to read from the bag at `path`: from now on in this process, a reader of
+/// that bag chooses among them only.
+pub fn attach_topics(path: &Path, topics: Vec<String>) {
+    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut all = TOPICS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    all.retain(|(p, _)| *p != key);
+    if !topics.is_empty() {
+        all.push((key, topics));
+    }
+}
+
+fn attached_topics(path: &Path) -> Vec<String> {
+    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    TOPICS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .iter()
+        .find(|(p, _)| *p == key)
+        .map(|(_, t)| t.clone())
+        .unwrap_or_default()
+}
+
+impl Contents {
+    /// The time origin: the UTC midnight before the earliest stamp of any topic read.
+    fn origin_ns(&self) -> i64 {
+        let first = self
+            .decoded
+            .iter()
+            .filter_map(|d| d.stamps_ns.first())
+            .min()
+            .copied()
+            .unwrap_or(0);
+        time_origin_ns(first)
+    }
+
+    /// The topic of `kind` other than `of` whose stamps are `stamps` exactly (a partner to
+    /// merge), when there is one only.
+    fn partner(&self, of: &str, kind: MessageType, stamps: &[i64]) -> Option<&Decoded> {
+        let mut matching = self
+            .decoded
+            .iter()
+            .filter(|d| d.name != of && d.kind == kind && d.stamps_ns == stamps);
+        let found = matching.next();
+        found.filter(|_| matching.next().is_none())
+    }
+
+    /// The type of topic a topic of `kind` takes columns from, and those columns.
+    fn partner_kind(kind: MessageType) -> Option<(MessageType, [&'static str; 3])> {
+        match kind {
+            MessageType::Imu => Some((MessageType::MagneticField, MAG_COLUMNS)),
+            MessageType::NavSatFix => Some((
+                MessageType::TwistStamped,
+                ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"],
+            )),
+            MessageType::PointStamped => Some((
+                MessageType::TwistStamped,
+                ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"],
+            )),
+            MessageType::Odometry | MessageType::PoseStamped => {
+                Some((MessageType::NavSatFix, ["lat_rad", "lon_rad", "height_m"]))
+            }
+            _ => None,
+        }
+    }
+
+    /// The topic whose columns topic `d` takes, if any.
+    fn partner_of(&self, d: &Decoded) -> Option<&Decoded> {
+        let (kind, _) = Self::partner_kind(d.kind)?;
+        self.partner(&d.name, kind, &d.stamps_ns)
+    }
+
+    /// The table of topic `d`, with its partner's columns merged.
+    fn table_of(&self, d: &Decoded) -> Table {
+        let origin = self.origin_ns();
+        let own = columns_of(d.kind);
+        let partner = self.partner_of(d);
+        let extra = Self::partner_kind(d.kind).map_or(Vec::new(), |(_, c)| c.to_vec());
+        let mut columns = vec!["t_s"];
+        columns.extend(&own);
+        if partner.is_some() {
+            columns.extend(&extra);
+        }
+        let mut t = Table::new(&columns);
+        let mut row = Vec::with_capacity(columns.len());
+        for (k, &stamp) in d.stamps_ns.iter().enumerate() {
+            row.clear();
+            row.push(seconds_after(stamp, origin));
+            row.extend_from_slice(&d.rows[k * own.len()..(k + 1) * own.len()]);
+            if let Some(p) = partner {
+                let v = &p.rows[k * 3..(k + 1) * 3];
+                if d.kind == MessageType::NavSatFix {
+                    // ROS's east, north, up as north, east, down.
+                    row.extend_from_slice(&[v[1], v[0], -v[2]]);
+                } else {
+                    row.extend_from_slice(v);
+                }
+            }
+            t.push_row(&row);
+        }
+        t
+    }
+
+    /// The table of the one topic that gives every column of `wanted` (all topics' when it is
+    /// empty), among the topics named with [`attach_topics`] when any are.
+    ///
+    /// # Errors
+    /// No such topic, or several, naming the file and listing its topics; a named topic the
+    /// bag does not hold.
+    pub fn table(&self, wanted: &[&str]) -> Result<Table> {
+        self.table_as(wanted, Role::Any)
+    }
+
+    /// [`Contents::table`] among the topics of `role`'s types; when several fit a reader that
+    /// asks for no columns and one of them is an IMU's, that one (a bag's readings are its
+    /// main table).
+    ///
+    /// # Errors
+    /// As [`Contents::table`].
+    pub fn table_as(&self, wanted: &[&str], role: Role) -> Result<Table> {
+        self.table_among(&attached_topics(&self.path), wanted, role)
+    }
+
+    /// [`Contents::table_as`] among the topics `named` (all when empty) instead of those
+    /// attached to the bag.
+    ///
+    /// # Errors
+    /// As [`Contents::table`].
+    pub fn table_among(&self, named: &[String], wanted: &[&str], role: Role) -> Result<Table> {
+        let bad = |message: String| Error::CsvFormat {
+            file: self.path.clone(),
+            message,
+        };
+        let listing = || {
+            if self.topics.is_empty() {
+                "it holds no messages".to_string()
+            } else {
+                let all: Vec<String> = self.topics.iter().map(ToString::to_string).collect();
+                format!("its topics: {}", all.join("; "))
+            }
+        };
+        for n in named {
+            if !self.topics.iter().any(|t| &t.name == n) {
+                return Err(bad(format!("no topic {n} ({})", listing())));
+            }
+            if !self.decoded.iter().any(|d| &d.name == n) {
+                let kind = self
+                    .topics
+                    .iter()
+                    .find(|t| &t.name == n)
+                    .map_or("", |t| t.message_type.as_str());
+                let known: Vec<&str> = MessageType::ALL.iter().map(|t| t.name()).collect();
+                return Err(bad(format!(
+                    "topic {n} holds {kind}, a type imukit does not read (it reads {})",
+                    known.join(", ")
+                )));
+            }
+        }
+        // A topic merged into another is not a candidate of its own unless named.
+        let merged: Vec<&str> = self
+            .decoded
+            .iter()
+            .filter_map(|d| self.partner_of(d).map(|p| p.name.as_str()))
+            .collect();
+        let mut tables: Vec<(&Decoded, Table)> = self
+            .decoded
+            .iter()
+            .filter(|d| named.is_empty() || named.contains(&d.name))
+            .filter(|d| role.holds(d.kind))
+            .filter(|d| named.contains(&d.name) || !merged.contains(&d.name.as_str()))
+            .map(|d| (d, self.table_of(d)))
+            .collect();
+        tables.retain(|(_, t)| wanted.iter().all(|w| t.columns.iter().any(|c| c == w)));
+        let imus = tables
+            .iter()
+            .filter(|(d, _)| d.kind == MessageType::Imu)
+            .count();
+        if tables.len() > 1 && wanted.is_empty() && imus == 1 {
+            tables.retain(|(d, _)| d.kind == MessageType::Imu);
+        }
+        match tables.len() {
+            1 => Ok(tables.pop().map(|(_, t)| t).unwrap_or_default()),
+            0 => {
+                let what = if wanted.is_empty() {
+                    "no topic of a type imukit reads".to_string()
+                } else {
+                    format!("no topic gives the columns {}", wanted.join(", "))
+                };
+                Err(bad(format!("{what} ({})", listing())))
+            }
+            _ => {
+                let fits: Vec<String> = tables
+                    .iter()
+                    .map(|(d, _)| format!("{} ({})", d.name, d.kind.name()))
+                    .collect();
+                Err(bad(format!(
+                    "several topics fit: {}; name one with --topic (Python: topic=)",
+                    fits.join(", ")
+                )))
+            }
+        }
+    }
+}
+
+/// What a table is read as, where a file holds several (a bag's topics).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Role {
+    /// Whatever gives the columns asked for.
+    #[default]
+    Any,
+    /// IMU (and magnetometer) readings.
+    Readings,
+    /// GNSS fixes (`NavSatFix`, or positions with their velocities).
+    Fixes,
+    /// A reference trajectory (`Odometry`, `PoseStamped`).
+    Reference,
+}
+
+impl Role {
+    fn holds(self, kind: MessageType) -> bool {
+        use MessageType as M;
+        match self {
+            Self::Any => true,
+            Self::Readings => matches!(kind, M::Imu | M::MagneticField),
+            Self::Fixes => matches!(kind, M::NavSatFix | M::PointStamped),
+            Self::Reference => matches!(kind, M::Odometry | M::PoseStamped),
+        }
+    }
+}
+
+/// The table of the bag at `path` that gives `wanted` ([`Contents::table`]).
+///
+/// # Errors
+/// As [`read`] and [`Contents::table`].
+pub fn read_table(path: &Path, wanted: &[&str]) -> Result<Table> {
+    read(path)?.table(wanted)
+}
+
+/// The table of the bag at `path` of `role` ([`Contents::table_as`]).
+///
+/// # Errors
+/// As [`read`] and [`Contents::table`].
+pub fn read_table_as(path: &Path, role: Role) -> Result<Table> {
+    read(path)?.table_as(&[], role)
+}
+
+/// The names of the columns [`read_table`] gives for `wanted`.
+///
+/// # Errors
+/// As [`read_table`].
+pub fn column_names(path: &Path, wanted: &[&str]) -> Result<Vec<String>> {
+    Ok(read_table(path, wanted)?.columns)
+}
+
+/// A topic being written: its channel and what it holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stream {
+    Imu,
+    Mag,
+    Truth,
+    TruthFix,
+    Estimate,
+    Fix,
+    Position,
+    Velocity,
+}
+
+impl Stream {
+    fn topic(self) -> &'static str {
+        match self {
+            Self::Imu => "/imu",
+            Self::Mag => "/imu/mag",
+            Self::Truth => "/ground_truth",
+            Self::TruthFix => "/ground_truth/fix",
+            Self::Estimate => "/odometry",
+            Self::Fix => "/gnss/fix",
+            Self::Position => "/gnss/position",
+            Self::Velocity => "/gnss/vel",
+        }
+    }
+
+    fn message_type(self) -> MessageType {
+        match self {
+            Self::Imu => MessageType::Imu,
+            Self::Mag => MessageType::MagneticField,
+            Self::Truth | Self::Estimate => MessageType::Odometry,
+            Self::Fix | Self::TruthFix => MessageType::NavSatFix,
+            Self::Position => MessageType::PointStamped,
+            Self::Velocity => MessageType::TwistStamped,
+        }
+    }
+
+    /// The frame its header names.
+    fn frame(self) -> &'static str {
+        match self {
+            Self::Imu | Self::Mag => "imu_link",
+            Self::Truth | Self::Estimate | Self::Position => "map",
+            Self::Fix | Self::Velocity => "gnss",
+            Self::TruthFix => "base_link",
+        }
+    }
+}
+
+/// A fix at latitude, longitude (rad) and height (m), its accuracy not given.
+fn nav_sat_fix(header: ros::Header, [lat, lon, height]: [f64; 3]) -> ros::NavSatFix {
+    ros::NavSatFix {
+        header,
+        status: ros::NavSatStatus {
+            status: 0,
+            service: ros::SERVICE_GPS,
+        },
+        latitude: lat.to_degrees(),
+        longitude: lon.to_degrees(),
+        altitude: height,
+        position_covariance: [0.0; 9],
+        position_covariance_type: ros::COVARIANCE_TYPE_UNKNOWN,
+    }
+}
+
+/// A ROS 2 bag (one MCAP file) being written from imukit's tables.
+pub struct BagWriter {
+    writer: mcap::Writer<BufWriter<OutputFile>>,
+    name: String,
+    metadata: BTreeMap<String, String>,
+    channels: Vec<(Stream, u16)>,
+    sequence: u32,
+    /// Poses are an estimate (`/odometry`), not the truth (`/ground_truth`).
+    estimate: bool,
+}
+
+impl core::fmt::Debug for BagWriter {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("BagWriter")
+            .field("name", &self.name)
+            .finish()
+    }
+}
+
+/// Finds the columns `names` in `columns`.
+fn find<const N: usize>(columns: &[String], names: [&str; N]) -> Option<[usize; N]> {
+    let mut out = [0; N];
+    for (slot, name) in out.iter_mut().zip(names) {
+        *slot = columns.iter().position(|c| c == name)?;
+    }
+    Some(out)
+}
+
+impl BagWriter {
+    /// Starts a bag on `writer` (the file named `name` in messages), each channel carrying
+    /// `description`; poses go to `/odometry` when its kind is an estimate (strapdown or fused),
+    /// else to `/ground_truth`.
+    ///
+    /// # Errors
+    /// The MCAP writer's refusal, naming the file.
+    pub fn create(
+        writer: BufWriter<OutputFile>,
+        name: &str,
+        description: &Description,
+    ) -> Result<Self> {
+        let mut d = description.clone();
+        let estimate = matches!(d.kind, Some(TableKind::Navigation | TableKind::Fused));
+        d.kind = None;
+        let writer = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library(format!("imukit {}", env!("CARGO_PKG_VERSION")))
+            .create(writer)
+            .map_err(|e| Self::error_of(name, &e))?;
+        Ok(Self {
+            writer,
+            name: name.to_string(),
+            metadata: d.metadata().into_iter().collect(),
+            channels: Vec::new(),
+            sequence: 0,
+            estimate,
+        })
+    }
+
+    fn error_of(name: &str, e: &mcap::McapError) -> Error {
+        Error::CsvFormat {
+            file: name.into(),
+            message: format!("writing the bag: {e}"),
+        }
+    }
+
+    fn channel(&mut self, stream: Stream) -> Result<u16> {
+        if let Some((_, id)) = self.channels.iter().find(|(s, _)| *s == stream) {
+            return Ok(*id);
+        }
+        let kind = stream.message_type();
+        let name = self.name.clone();
+        let schema = self
+            .writer
+            .add_schema(kind.name(), "ros2msg", kind.schema().as_bytes())
+            .map_err(|e| Self::error_of(&name, &e))?;
+        let id = self
+            .writer
+            .add_channel(schema, stream.topic(), "cdr", &self.metadata)
+            .map_err(|e| Self::error_of(&name, &e))?;
+        self.channels.push((stream, id));
+        Ok(id)
+    }
+
+    /// Writes `tables` (IMU rates, truth or GNSS fixes, each known by its columns) as their
+    /// topics' messages, in stamp order (equal stamps in the tables' order).
+    ///
+    /// # Errors
+    /// A table a bag has no topic for; a time stamp outside a ROS stamp's range (before 1970
+    /// or after 2038); the writer's refusal.
+    pub fn write(&mut self, tables: &[&Table]) -> Result<()> {
+        // (stamp, stream, payload) of every message of the tables.
+        let mut messages: Vec<(i64, Stream, Vec<u8>)> = Vec::new();
+        for table in tables {
+            self.messages_of(table, &mut messages)?;
+        }
+        messages.sort_by_key(|(ns, _, _)| *ns);
+        for (ns, stream, data) in messages {
+            let channel_id = self.channel(stream)?;
+            self.sequence = self.sequence.wrapping_add(1);
+            let time = u64::try_from(ns).unwrap_or(0);
+            let header = mcap::records::MessageHeader {
+                channel_id,
+                sequence: self.sequence,
+                log_time: time,
+                publish_time: time,
+            };
+            let name = self.name.clone();
+            self.writer
+                .write_to_known_channel(&header, &data)
+                .map_err(|e| Self::error_of(&name, &e))?;
+        }
+        Ok(())
+    }
+
+    /// Appends the messages of `table` to `messages`.
+    #[allow(clippy::too_many_lines)]
+    fn messages_of(&self, table: &Table, messages: &mut Vec<(i64, Stream, Vec<u8>)>) -> Result<()> {
+        let c = &table.columns;
+        let width = c.len().max(1);
+        let header = |stamp: ros::Time, stream: Stream| ros::Header {
+            stamp,
+            frame_id: stream.frame().into(),
+        };
+        let v3 = |row: &[f64], at: [usize; 3]| ros::Vector3::of(at.map(|k| row[k]));
+        let Some([t]) = find(c, ["t_s"]) else {
+            return Err(self.unwritable(c));
+        };
+        let imu = find(c, ACCEL_COLUMNS).zip(find(c, GYRO_COLUMNS));
+        let mag = find(c, MAG_COLUMNS);
+        let truth = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"])
+            .zip(find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]))
+            .zip(find(c, ["q_w", "q_x", "q_y", "q_z"]));
+        let fix = find(c, ["lat_rad", "lon_rad", "height_m"])
+            .zip(find(c, ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]));
+        let position = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"])
+            .zip(find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]));
+        for (k, row) in table.data.chunks_exact(width).enumerate() {
+            let ns = stamp_ns(row[t]).filter(|&ns| ros::Time::from_ns(ns).is_some());
+            let Some(ns) = ns else {
+                return Err(Error::CsvFormat {
+                    file: self.name.clone().into(),
+                    message: format!(
+                        "row {}: t_s = {} is outside a ROS time stamp's range (1970 to 2038)",
+                        k + 1,
+                        row[t]
+                    ),
+                });
+            };
+            let stamp = ros::Time::from_ns(ns).unwrap_or_default();
+            if let Some((a, g)) = imu {
+                let m = ros::Imu {
+                    header: header(stamp, Stream::Imu),
+                    orientation: ros::Quaternion::default(),
+                    orientation_covariance: ros::UNKNOWN_COVARIANCE,
+                    angular_velocity: v3(row, g),
+                    angular_velocity_covariance: [0.0; 9],
+                    linear_acceleration: v3(row, a),
+                    linear_acceleration_covariance: [0.0; 9],
+                };
+                messages.push((ns, Stream::Imu, ros::encode(&m)));
+                if let Some(b) = mag {
+                    let m = ros::MagneticField {
+                        header: header(stamp, Stream::Mag),
+                        magnetic_field: ros::Vector3::of(b.map(|k| row[k] / 1e6)),
+                        magnetic_field_covariance: [0.0; 9],
+                    };
+                    messages.push((ns, Stream::Mag, ros::encode(&m)));
+                }
+            } else if let Some(((p, v), q)) = truth {
+                let q = q.map(|k| row[k]);
+                let conj = [q[0], -q[1], -q[2], -q[3]];
+                let m = ros::Odometry {
+                    header: header(stamp, Stream::Truth),
+                    child_frame_id: "base_link".into(),
+                    pose: ros::PoseWithCovariance {
+                        pose: ros::Pose {
+                            position: v3(row, p),
+                            orientation: ros::Quaternion::of_wxyz(q),
+                        },
+                        covariance: ros::Covariance6::default(),
+                    },
+                    twist: ros::TwistWithCovariance {
+                        twist: ros::Twist {
+                            linear: ros::Vector3::of(rotate(conj, v.map(|k| row[k]))),
+                            angular: find(c, ["omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"])
+                                .map_or_else(ros::Vector3::default, |w| v3(row, w)),
+                        },
+                        covariance: ros::Covariance6::default(),
+                    },
+                };
+                let stream = if self.estimate {
+                    Stream::Estimate
+                } else {
+                    Stream::Truth
+                };
+                messages.push((ns, stream, ros::encode(&m)));
+                // On the WGS-84 Earth, the reference point's latitude, longitude and height.
+                if let (Some(llh), false) =
+                    (find(c, ["lat_rad", "lon_rad", "height_m"]), self.estimate)
+                {
+                    let m = nav_sat_fix(header(stamp, Stream::TruthFix), llh.map(|k| row[k]));
+                    messages.push((ns, Stream::TruthFix, ros::encode(&m)));
+                }
+            } else if let Some((llh, ned)) = fix {
+                let m = nav_sat_fix(header(stamp, Stream::Fix), llh.map(|k| row[k]));
+                messages.push((ns, Stream::Fix, ros::encode(&m)));
+                let [n, e, d] = ned.map(|k| row[k]);
+                let m = ros::TwistStamped {
+                    header: header(stamp, Stream::Velocity),
+                    twist: ros::Twist {
+                        linear: ros::Vector3::of([e, n, -d]),
+                        angular: ros::Vector3::default(),
+                    },
+                };
+                messages.push((ns, Stream::Velocity, ros::encode(&m)));
+            } else if let Some((p, v)) = position {
+                let m = ros::PointStamped {
+                    header: header(stamp, Stream::Position),
+                    point: v3(row, p),
+                };
+                messages.push((ns, Stream::Position, ros::encode(&m)));
+                let m = ros::TwistStamped {
+                    header: header(stamp, Stream::Velocity),
+                    twist: ros::Twist {
+                        linear: v3(row, v),
+                        angular: ros::Vector3::default(),
+                    },
+                };
+                messages.push((ns, Stream::Velocity, ros::encode(&m)));
+            } else {
+                return Err(self.unwritable(c));
+            }
+        }
+        Ok(())
+    }
+
+    fn unwritable(&self, columns: &[String]) -> Error {
+        Error::CsvFormat {
+            file: self.name.clone().into(),
+            message: format!(
+                "a bag holds IMU rates, a truth or GNSS fixes; not a table of {}",
+                columns.join(", ")
+            ),
+        }
+    }
+
+    /// Writes the bag's summary and gives back the file's writer.
+    ///
+    /// # Errors
+    /// The writer's refusal.
+    pub fn finish(mut self) -> Result<BufWriter<OutputFile>> {
+        let name = self.name.clone();
+        self.writer
+            .finish()
+            .map_err(|e| Self::error_of(&name, &e))?;
+        Ok(self.writer.into_inner())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::table::Table;
+
+    fn write_bag(path: &Path, tables: &[&Table], description: &Description) {
+        let mut file = crate::io::output::AtomicFile::create(path).expect("created");
+        file.begin_bag(description).expect("begun");
+        file.write_bag(tables).expect("written");
+        file.commit().expect("committed");
+    }
+
+    fn readings(rows: usize, mag: bool) -> Table {
+        let mut columns = vec!["t_s"];
+        columns.extend(ACCEL_COLUMNS);
+        columns.extend(GYRO_COLUMNS);
+        if mag {
+            columns.extend(MAG_COLUMNS);
+        }
+        let mut t = Table::new(&columns);
+        for k in 0..rows {
+            let x = k as f64;
+            let mut row = vec![
+                x * 0.01,
+                0.1 + x,
+                -9.8,
+                1e-3 * x,
+                0.3,
+                -0.2,
+                1.0 / (x + 3.0),
+            ];
+            if mag {
+                row.extend([20.0 + x, -3.5, 41.25]);
+            }
+            t.push_row(&row);
+        }
+        t
+    }
+
+    #[test]
+    fn readings_come_back_bit_for_bit_and_stamps_to_the_nanosecond() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("run.mcap");
+        let imu = readings(250, true);
+        write_bag(&path, &[&imu], &Description::default());
+        assert_eq!(&std::fs::read(&path).expect("read")[..8], b"\x89MCAP0\r\n");
+        let contents = read(&path).expect("read");
+        let names: Vec<&str> = contents.topics.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["/imu", "/imu/mag"]);
+        let back = contents
+            .table(&[])
+            .expect("the IMU topic, its magnetometer merged");
+        assert_eq!(back.columns, imu.columns);
+        let w = imu.columns.len();
+        for (a, b) in imu.data.chunks(w).zip(back.data.chunks(w)) {
+            assert_eq!(stamp_ns(a[0]), stamp_ns(b[0]));
+            assert_eq!(a[1..7], b[1..7], "accelerometer and gyroscope bit for bit");
+            for (x, y) in a[7..].iter().zip(&b[7..]) {
+                assert!((x - y).abs() <= 1e-15 * x.abs(), "{x} {y}");
+            }
+        }
+        // The magnetometer alone, when named.
+        attach_topics(&path, vec!["/imu/mag".into()]);
+        let mag = read_table(&path, &[]).expect("named");
+        assert_eq!(mag.columns, ["t_s", "mag_x_ut", "mag_y_ut", "mag_z_ut"]);
+        attach_topics(&path, vec!["/nope".into()]);
+        let e = read_table(&path, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("no topic /nope") && e.contains("/imu (sensor_msgs/msg/Imu, 250 messages)"),
+            "{e}"
+        );
+        attach_topics(&path, Vec::new());
+    }
+
+    #[test]
+    fn a_truth_and_fixes_come_back_and_a_reader_picks_by_columns() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("run.mcap");
+        let mut truth = Table::new(&[
+            "t_s",
+            "pos_x_m",
+            "pos_y_m",
+            "pos_z_m",
+            "vel_x_m_s",
+            "vel_y_m_s",
+            "vel_z_m_s",
+            "q_w",
+            "q_x",
+            "q_y",
+            "q_z",
+        ]);
+        let (c, s) = (0.6_f64.cos(), 0.6_f64.sin());
+        truth.push_row(&[0.0, 1.0, 2.0, 3.0, 4.0, -5.0, 0.5, c, 0.0, 0.0, s]);
+        truth.push_row(&[0.5, 1.5, 2.0, 3.0, 4.0, -5.0, 0.5, c, s, 0.0, 0.0]);
+        let mut fixes = Table::new(&[
+            "t_s",
+            "lat_rad",
+            "lon_rad",
+            "height_m",
+            "vel_n_m_s",
+            "vel_e_m_s",
+            "vel_d_m_s",
+        ]);
+        fixes.push_row(&[0.0, 0.8, -0.1, 120.0, 3.0, 4.0, -0.5]);
+        let imu = readings(3, false);
+        write_bag(&path, &[&imu, &truth, &fixes], &Description::default());
+        let contents = read(&path).expect("read");
+        let t = contents.table(&["q_w"]).expect("the truth");
+        assert_eq!(t.columns, truth.columns);
+        for (a, b) in truth.data.iter().zip(&t.data) {
+            assert!((a - b).abs() < 1e-14, "{a} {b}");
+        }
+        let f = contents.table(&["lat_rad"]).expect("the fixes");
+        assert_eq!(f.columns, fixes.columns);
+        for (a, b) in fixes.data.iter().zip(&f.data) {
+            assert!((a - b).abs() < 1e-14, "{a} {b}");
+        }
+        // Several fit a reader that asks for nothing: the IMU's readings.
+        assert_eq!(contents.table(&[]).expect("readings").columns, imu.columns);
+        let e = contents.table(&["t_s"]).unwrap_err().to_string();
+        assert!(
+            e.contains("several topics fit") && e.contains("/ground_truth"),
+            "{e}"
+        );
+        let f = contents.table_as(&[], Role::Fixes).expect("the fixes");
+        assert_eq!(f.columns, fixes.columns);
+        let e = contents.table(&["mag_x_ut"]).unwrap_err().to_string();
+        assert!(e.contains("no topic gives the columns mag_x_ut"), "{e}");
+    }
+
+    #[test]
+    fn a_truncated_bag_is_refused_by_name() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("run.mcap");
+        write_bag(&path, &[&readings(2000, true)], &Description::default());
+        let bytes = std::fs::read(&path).expect("read");
+        let cut = dir.path().join("cut.mcap");
+        std::fs::write(&cut, &bytes[..bytes.len() / 2]).expect("written");
+        let e = read(&cut).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&cut.display().to_string()) && e.contains("MCAP"),
+            "{e}"
+        );
+        std::fs::write(&cut, b"not a bag at all").expect("written");
+        assert!(read(&cut).is_err());
+    }
+
+    #[test]
+    fn a_description_rides_in_the_channels() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("run.mcap");
+        let d = Description {
+            nav_frame: Some(crate::scenario::spec::NavFrameName::NED),
+            ..Description::default()
+        };
+        write_bag(&path, &[&readings(3, false)], &d);
+        let back = read(&path).expect("read").description.expect("described");
+        assert_eq!(back.nav_frame, d.nav_frame);
+    }
+
+    #[test]
+    fn a_vector_turns_as_the_quaternion_says() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let v = rotate([h, 0.0, 0.0, h], [1.0, 0.0, 0.0]);
+        assert!((v[0]).abs() < 1e-15 && (v[1] - 1.0).abs() < 1e-15 && v[2].abs() < 1e-15);
+    }
+}
