@@ -14,7 +14,7 @@ says no cleanly.
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
 long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
 (extreme origins, geodetic formulas, dates, vertical channels); mutated and truncated Parquet,
-``.npy`` and ``.npz`` tables fed to the commands that read tables; crafted binary tables (archives whose members
+``.npy`` and ``.npz`` tables and ROS 2 bags (``.mcap``) fed to the commands that read tables; crafted binary tables (archives whose members
 lie about their sizes, repeat, fail their CRC or expand like bombs, ``.npy`` headers against their files, Parquet
 footers damaged field by field, a column twice); barometer and odometer files fed to ``integrate`` and ``fuse``;
 output paths that collide with inputs, special files and folders; real signals (SIGINT, SIGTERM, SIGHUP) sent to
@@ -421,7 +421,7 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 
-        for fmt in ("parquet", "npy", "npz"):
+        for fmt in ("parquet", "npy", "npz", "mcap"):
             r = Run(f"{fmt} files, mutated")
             base = work / "pq.toml"
             base.write_text('rate_hz = 50.0\nduration_s = 4.0\n[trajectory]\ntype = "builtin"\nname = "figure8"\n'

@@ -5,6 +5,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
@@ -13,18 +14,10 @@ import imukit
 from test_cli_vs_python import ROOT, imukit_bin
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
+STORE1 = get_typestore(Stores.ROS1_NOETIC)
 # 2023-11-14 22:13:20 UTC: a real clock, far from the epoch.
 START_NS = 1_700_000_000_000_000_000
 DAY_NS = 86_400 * 10**9
-
-
-def header(ns, frame):
-    Header, Time = STORE.types["std_msgs/msg/Header"], STORE.types["builtin_interfaces/msg/Time"]
-    return Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=frame)
-
-
-def vec(x, y, z):
-    return STORE.types["geometry_msgs/msg/Vector3"](x=x, y=y, z=z)
 
 
 def imu_values(n):
@@ -37,40 +30,61 @@ def imu_values(n):
     return stamps, accel, gyro
 
 
-def write_foreign_bag(folder, n=600):
-    """A ROS 2 bag in MCAP storage as rosbags writes it: an IMU, its fixes, a string topic."""
+def write_foreign_bag(path, storage="mcap", n=600):
+    """A bag as rosbags writes it — ROS 2 with MCAP or sqlite3 storage, or ROS 1 — holding an
+    IMU, its fixes and a string topic. Returns what it holds and the bag's path."""
     stamps, accel, gyro = imu_values(n)
-    Imu, Quaternion = STORE.types["sensor_msgs/msg/Imu"], STORE.types["geometry_msgs/msg/Quaternion"]
-    Fix, Status = STORE.types["sensor_msgs/msg/NavSatFix"], STORE.types["sensor_msgs/msg/NavSatStatus"]
-    String = STORE.types["std_msgs/msg/String"]
+    store = STORE1 if storage == "ros1" else STORE
+    T = store.types
+    Imu, Quaternion, Vector3 = (T["sensor_msgs/msg/Imu"], T["geometry_msgs/msg/Quaternion"],
+                                T["geometry_msgs/msg/Vector3"])
+    Fix, Status, String = T["sensor_msgs/msg/NavSatFix"], T["sensor_msgs/msg/NavSatStatus"], T["std_msgs/msg/String"]
+    Header, Time = T["std_msgs/msg/Header"], T["builtin_interfaces/msg/Time"]
+
+    def header(ns, frame):
+        time = Time(sec=ns // 10**9, nanosec=ns % 10**9)
+        return Header(seq=0, stamp=time, frame_id=frame) if storage == "ros1" else Header(stamp=time, frame_id=frame)
+
+    def serialize(m):
+        return store.serialize_ros1(m, m.__msgtype__) if storage == "ros1" else store.serialize_cdr(m, m.__msgtype__)
+
     fixes = [(START_NS + k * 10**9, 48.1 + 1e-5 * k, 11.5 - 2e-5 * k, 520.0 + k) for k in range(3)]
-    with Writer(folder, version=9, storage_plugin=StoragePlugin.MCAP) as w:
-        imu = w.add_connection("/sensors/imu", Imu.__msgtype__, typestore=STORE)
-        fix = w.add_connection("/sensors/fix", Fix.__msgtype__, typestore=STORE)
-        note = w.add_connection("/note", String.__msgtype__, typestore=STORE)
-        w.write(note, int(START_NS), STORE.serialize_cdr(String(data="hello"), String.__msgtype__))
+    if storage == "ros1":
+        path = path.with_suffix(".bag")
+        writer = Writer1(path)
+        add = lambda topic, kind: writer.add_connection(topic, kind, typestore=store)  # noqa: E731
+    else:
+        plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+        writer = Writer(path, version=9 if storage == "mcap" else 8, storage_plugin=plugin)
+        add = lambda topic, kind: writer.add_connection(topic, kind, typestore=store)  # noqa: E731
+    with writer as w:
+        imu = add("/sensors/imu", Imu.__msgtype__)
+        fix = add("/sensors/fix", Fix.__msgtype__)
+        note = add("/note", String.__msgtype__)
+        w.write(note, int(START_NS), serialize(String(data="hello")))
         nine = np.zeros(9)
         for k in range(n):
             m = Imu(header=header(int(stamps[k]), "imu_link"),
                     orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
                     orientation_covariance=np.array([-1.0, 0, 0, 0, 0, 0, 0, 0, 0]),
-                    angular_velocity=vec(*gyro[k]), angular_velocity_covariance=nine,
-                    linear_acceleration=vec(*accel[k]), linear_acceleration_covariance=nine)
+                    angular_velocity=Vector3(*gyro[k]), angular_velocity_covariance=nine,
+                    linear_acceleration=Vector3(*accel[k]), linear_acceleration_covariance=nine)
             # Received a little late: the header's stamp is the one read.
-            w.write(imu, int(stamps[k]) + 1_234_567, STORE.serialize_cdr(m, Imu.__msgtype__))
+            w.write(imu, int(stamps[k]) + 1_234_567, serialize(m))
         for ns, lat, lon, alt in fixes:
             m = Fix(header=header(ns, "gnss"), status=Status(status=0, service=1), latitude=lat,
                     longitude=lon, altitude=alt, position_covariance=nine, position_covariance_type=0)
-            w.write(fix, ns, STORE.serialize_cdr(m, Fix.__msgtype__))
-    return stamps, accel, gyro, fixes
+            w.write(fix, ns, serialize(m))
+    return (stamps, accel, gyro, fixes), path
 
 
-def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_cli(tmp_path):
-    folder = tmp_path / "walk"
-    stamps, accel, gyro, fixes = write_foreign_bag(folder)
-    # The folder (metadata.yaml beside the .mcap) and its one MCAP file read alike.
-    (mcap,) = folder.glob("*.mcap")
-    for path in (folder, mcap):
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3", "ros1"])
+def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_cli(tmp_path, storage):
+    (stamps, accel, gyro, fixes), bag = write_foreign_bag(tmp_path / "walk", storage)
+    # A ROS 2 bag's folder (metadata.yaml beside its storage file) and the file itself read alike.
+    paths = [bag] if storage == "ros1" else [bag, *bag.glob("*.mcap"), *bag.glob("*.db3")]
+    assert len(paths) == (1 if storage == "ros1" else 2)
+    for path in paths:
         t = imukit.read(path)  # several topics: the IMU's is the bag's main table
         assert t.columns == ("t_s", "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2",
                              "gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s")
@@ -78,18 +92,18 @@ def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_
         # Seconds after the UTC midnight before the first stamp, to the nanosecond.
         midnight = START_NS // DAY_NS * DAY_NS
         assert np.array_equal(np.round(t["t_s"] * 1e9).astype(np.int64), stamps - midnight)
-    f = imukit.read(folder, topic="/sensors/fix")
+    f = imukit.read(bag, topic="/sensors/fix")
     assert f.columns == ("t_s", "lat_rad", "lon_rad", "height_m")
     assert np.allclose(f.values[:, 1:3], np.radians([[lat, lon] for _, lat, lon, _ in fixes]), rtol=0, atol=1e-16)
     assert np.array_equal(f["height_m"], [alt for *_, alt in fixes])
     # The CLI reads the bag as Python does: the same Allan table and orientation as from the CSV
     # Python wrote of the same table.
-    imukit.read(folder).write(tmp_path / "imu.csv")
+    imukit.read(bag).write(tmp_path / "imu.csv")
     for command in (["allan"], ["orient", "--filter", "complementary"]):
         outs = []
-        for source in (folder, tmp_path / "imu.csv"):
+        for source in (bag, tmp_path / "imu.csv"):
             out = tmp_path / f"{command[0]}-{source.suffix or 'bag'}.csv"
-            extra = ["--topic", "/sensors/imu"] if source == folder else []
+            extra = ["--topic", "/sensors/imu"] if source == bag else []
             run = subprocess.run([imukit_bin(), command[0], str(source), *command[1:], *extra, "--out", str(out)],
                                  capture_output=True, text=True)
             assert run.returncode == 0, run.stderr
@@ -98,13 +112,12 @@ def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_
 
 
 def test_bad_bags_and_bad_topics_are_refused_by_file_and_topic(tmp_path):
-    folder = tmp_path / "walk"
-    write_foreign_bag(folder, n=50)
+    _, folder = write_foreign_bag(tmp_path / "walk", n=50)
     with pytest.raises(imukit.ImuError, match=r"no topic /nope \(its topics: /note \(std_msgs/msg/String"):
         imukit.read(folder, topic="/nope")
     with pytest.raises(imukit.ImuError, match="topic /note holds std_msgs/msg/String, a type imukit does not read"):
         imukit.read(folder, topic="/note")
-    with pytest.raises(imukit.ImuError, match="topic= names a topic of a ROS 2 bag"):
+    with pytest.raises(imukit.ImuError, match="topic= names a topic of a ROS bag"):
         imukit.read(ROOT / "examples" / "data" / "vendor_log.csv", topic="/imu")
     # A truncated file: refused by name, nothing written by the command that read it.
     (mcap,) = folder.glob("*.mcap")
@@ -115,11 +128,15 @@ def test_bad_bags_and_bad_topics_are_refused_by_file_and_topic(tmp_path):
     out = tmp_path / "o.csv"
     run = subprocess.run([imukit_bin(), "orient", str(cut), "--out", str(out)], capture_output=True, text=True)
     assert run.returncode == 65 and "cut.mcap" in run.stderr and not out.exists(), run.stderr
-    # ROS 2's older default storage is named, with the way to MCAP.
-    with Writer(tmp_path / "old", version=8) as w:
-        w.add_connection("/imu", "sensor_msgs/msg/Imu", typestore=STORE)
-    with pytest.raises(imukit.ImuError, match="sqlite3 storage.*ros2 bag convert"):
-        imukit.read(tmp_path / "old")
+    # A ROS 1 bag cut short, and a file that is no bag at all.
+    _, bag1 = write_foreign_bag(tmp_path / "old", "ros1", n=50)
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(bag1.read_bytes()[: bag1.stat().st_size // 2])
+    with pytest.raises(imukit.ImuError, match="cut.bag: not a readable ROS 1 bag"):
+        imukit.read(cut)
+    (tmp_path / "noise.db3").write_bytes(b"not sqlite" * 100)
+    with pytest.raises(imukit.ImuError, match="noise.db3: not a readable ROS 2 sqlite3 bag"):
+        imukit.read(tmp_path / "noise.db3")
 
 
 def test_imukit_writes_a_bag_rosbags_replays_and_its_commands_read_as_the_csv(tmp_path):

@@ -102,8 +102,9 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
-        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
-        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+        /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
         /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
@@ -201,8 +202,9 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
-        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
-        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+        /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
         /// The filter.
@@ -246,8 +248,9 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
-        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
-        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+        /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
@@ -355,8 +358,9 @@ pub enum Command {
         truth: PathBuf,
         /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
-        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
-        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+        /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
@@ -413,8 +417,9 @@ pub enum Command {
         /// axes in the body frame (docs/formats.md).
         #[arg(long, value_name = "FILE")]
         map: Option<PathBuf>,
-        /// A topic to read from a ROS 2 bag (`.mcap`) that holds several that fit; given once
-        /// per topic the command reads (the IMU's, the fixes', the reference's).
+        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+        /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
         /// Columns to analyse (default: every gyro and accel column present).

@@ -75,7 +75,7 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None,
     """A table file as a :class:`Table`, its format by its extension: ``.csv``, ``.parquet``
     (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy`` (a structured
     array of float64 fields) or ``.npz`` (one float64 array per column, as ``numpy.savez`` writes
-    them), ``.mcap`` (a ROS 2 bag: one topic's messages — ``sensor_msgs/Imu``, ``NavSatFix``,
+    them), ``.mcap``, ``.db3`` or ``.bag`` (a ROS 2 or ROS 1 bag: one topic's messages — ``sensor_msgs/Imu``, ``NavSatFix``,
     ``nav_msgs/Odometry``, … — as imukit's columns; ``topic`` names it where the bag holds
     several, else its IMU topic is read). Any other extension is refused with the formats read.
     A EuRoC/TUM-VI file (``#timestamp [ns],w_RS_S_x [rad s^-1],…``) is read as imukit's columns
@@ -97,8 +97,8 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None,
         raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
                        f"(read: {', '.join(TABLE_FORMATS)})")
     if topic is not None:
-        if suffix != ".mcap":
-            raise ImuError(f"{path}: topic= names a topic of a ROS 2 bag (.mcap), not of a {suffix} file")
+        if suffix not in (".mcap", ".db3", ".bag"):
+            raise ImuError(f"{path}: topic= names a topic of a ROS bag (.mcap, .db3, .bag), not of a {suffix} file")
         if map is not None:
             raise ImuError(f"{path}: map= reads a vendor's CSV; a bag's topics have their own columns")
         return _table(_core.read_table_file(str(path), topic=str(topic)))
@@ -125,7 +125,7 @@ def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:
 
 
 #: The extensions of the table files imukit reads and writes.
-TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz", ".mcap")
+TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz", ".mcap", ".db3", ".bag")
 
 
 def builtin_scenarios() -> list:

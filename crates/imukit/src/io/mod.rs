@@ -85,8 +85,8 @@ pub enum TableFormat {
     Npy,
     /// A NumPy archive of one array per column ([`npz`]).
     Npz,
-    /// A ROS 2 bag, one MCAP file or a bag's folder (`metadata.yaml` beside its storage
-    /// files) ([`bag`]): a topic's table.
+    /// A ROS bag ([`bag`]): a topic's table. ROS 2's MCAP file, its sqlite3 file (`.db3`) or
+    /// a bag's folder (`metadata.yaml` beside its storage files), or a ROS 1 `.bag`.
     Mcap,
 }
 
@@ -105,7 +105,10 @@ impl TableFormat {
             Self::Npy
         } else if ext.eq_ignore_ascii_case("npz") {
             Self::Npz
-        } else if ext.eq_ignore_ascii_case("mcap") {
+        } else if ["mcap", "bag", "db3"]
+            .iter()
+            .any(|e| ext.eq_ignore_ascii_case(e))
+        {
             Self::Mcap
         } else {
             Self::Csv

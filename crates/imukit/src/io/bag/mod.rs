@@ -95,6 +95,8 @@ pub struct Contents {
     decoded: Vec<Decoded>,
     /// The description the first channel carries.
     pub description: Option<Description>,
+    /// The numbers decoded so far (checked against the memory limit).
+    values: usize,
 }
 
 /// The columns of a type's own table (without `t_s`).
@@ -135,26 +137,26 @@ fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
 
 /// Decodes one message of `kind` into its stamp and row (`None`: a message left out, a fix
 /// without a fix).
-fn decode_row(
+fn decode_row<W: ros::Wire>(
     kind: MessageType,
     data: &[u8],
 ) -> std::result::Result<Option<(i64, Vec<f64>)>, String> {
-    use ros::decode;
+    use ros::Stamped;
     Ok(Some(match kind {
         MessageType::Imu => {
-            let m: ros::Imu = decode(data, 1)?;
+            let m: ros::Imu<W::Header> = W::parse(data, 1)?;
             let row = [m.linear_acceleration.array(), m.angular_velocity.array()].concat();
-            (m.header.stamp.ns(), row)
+            (m.header.stamp_ns(), row)
         }
         MessageType::MagneticField => {
-            let m: ros::MagneticField = decode(data, 1)?;
+            let m: ros::MagneticField<W::Header> = W::parse(data, 1)?;
             (
-                m.header.stamp.ns(),
+                m.header.stamp_ns(),
                 m.magnetic_field.array().map(|b| b * 1e6).to_vec(),
             )
         }
         MessageType::NavSatFix => {
-            let m: ros::NavSatFix = decode(data, 1)?;
+            let m: ros::NavSatFix<W::Header> = W::parse(data, 1)?;
             if m.status.status == ros::STATUS_NO_FIX {
                 return Ok(None);
             }
@@ -163,27 +165,27 @@ fn decode_row(
                 m.longitude.to_radians(),
                 m.altitude,
             ];
-            (m.header.stamp.ns(), row)
+            (m.header.stamp_ns(), row)
         }
         MessageType::PointStamped => {
-            let m: ros::PointStamped = decode(data, 1)?;
-            (m.header.stamp.ns(), m.point.array().to_vec())
+            let m: ros::PointStamped<W::Header> = W::parse(data, 1)?;
+            (m.header.stamp_ns(), m.point.array().to_vec())
         }
         MessageType::TwistStamped => {
-            let m: ros::TwistStamped = decode(data, 1)?;
-            (m.header.stamp.ns(), m.twist.linear.array().to_vec())
+            let m: ros::TwistStamped<W::Header> = W::parse(data, 1)?;
+            (m.header.stamp_ns(), m.twist.linear.array().to_vec())
         }
         MessageType::Odometry => {
-            let m: ros::Odometry = decode(data, 2)?;
+            let m: ros::Odometry<W::Header> = W::parse(data, 2)?;
             let q = m.pose.pose.orientation.wxyz();
             let v = rotate(q, m.twist.twist.linear.array());
             let row = [&m.pose.pose.position.array()[..], &v, &q].concat();
-            (m.header.stamp.ns(), row)
+            (m.header.stamp_ns(), row)
         }
         MessageType::PoseStamped => {
-            let m: ros::PoseStamped = decode(data, 1)?;
+            let m: ros::PoseStamped<W::Header> = W::parse(data, 1)?;
             let row = [&m.pose.position.array()[..], &m.pose.orientation.wxyz()].concat();
-            (m.header.stamp.ns(), row)
+            (m.header.stamp_ns(), row)
         }
     }))
 }
@@ -200,6 +202,7 @@ pub fn read(path: &Path) -> Result<Contents> {
         topics: Vec::new(),
         decoded: Vec::new(),
         description: None,
+        values: 0,
     };
     for file in storage_files(path)? {
         read_file(&file, &mut contents)?;
@@ -210,8 +213,8 @@ pub fn read(path: &Path) -> Result<Contents> {
     Ok(contents)
 }
 
-/// The MCAP files of the bag at `path`: the file itself, or a bag folder's `.mcap` files in
-/// name order (a split recording's parts).
+/// The storage files of the bag at `path`: the file itself, or a bag folder's `.mcap` or
+/// `.db3` files in name order (a split recording's parts).
 fn storage_files(path: &Path) -> Result<Vec<PathBuf>> {
     if !path.is_dir() {
         return Ok(vec![path.into()]);
@@ -221,22 +224,22 @@ fn storage_files(path: &Path) -> Result<Vec<PathBuf>> {
         source,
     };
     let mut files = Vec::new();
-    let mut sqlite = false;
+    let mut compressed = false;
     for entry in std::fs::read_dir(path).map_err(io)? {
         let p = entry.map_err(io)?.path();
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
-        if ext.eq_ignore_ascii_case("mcap") && p.is_file() {
+        if (ext.eq_ignore_ascii_case("mcap") || ext.eq_ignore_ascii_case("db3")) && p.is_file() {
             files.push(p);
-        } else if ext.eq_ignore_ascii_case("db3") {
-            sqlite = true;
+        } else if ext.eq_ignore_ascii_case("zstd") {
+            compressed = true;
         }
     }
     files.sort();
     if files.is_empty() {
-        let message = if sqlite {
-            "a bag in ROS 2's sqlite3 storage: imukit reads MCAP storage (convert it with              `ros2 bag convert`, or record with `--storage mcap`, ROS 2's default since Iron)"
+        let message = if compressed {
+            "a bag compressed file by file (.zstd): `ros2 bag decompress` it first"
         } else {
-            "a bag folder with no .mcap file"
+            "a bag folder with no .mcap or .db3 storage file"
         };
         return Err(Error::CsvFormat {
             file: path.into(),
@@ -246,99 +249,234 @@ fn storage_files(path: &Path) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// Reads the MCAP file at `path` into `contents`.
+/// The way a bag's messages are encoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Encoding {
+    /// ROS 2's CDR.
+    Cdr,
+    /// ROS 1's serialisation.
+    Ros1,
+}
+
+impl Contents {
+    /// Counts one message of `topic` (schema `schema`, encoded as `encoding` names it) and,
+    /// when imukit reads its type, decodes it into the topic's rows. `file` names the storage
+    /// file in messages.
+    fn ingest(
+        &mut self,
+        file: &Path,
+        topic: &str,
+        schema: &str,
+        encoding: &str,
+        data: &[u8],
+    ) -> Result<()> {
+        let bad = |message: String| Error::CsvFormat {
+            file: file.into(),
+            message,
+        };
+        let at = match self.topics.iter().position(|t| t.name == topic) {
+            Some(at) => at,
+            None => {
+                self.topics.push(Topic {
+                    name: topic.to_string(),
+                    message_type: schema.to_string(),
+                    messages: 0,
+                });
+                self.topics.len() - 1
+            }
+        };
+        self.topics[at].messages += 1;
+        let Some(kind) = MessageType::of_name(schema) else {
+            return Ok(());
+        };
+        let wire = match encoding {
+            "cdr" => Encoding::Cdr,
+            "ros1" => Encoding::Ros1,
+            other => {
+                return Err(bad(format!(
+                    "topic {topic}: {schema} messages encoded as \"{other}\" (imukit reads ROS \
+                     2's CDR and ROS 1's own)"
+                )));
+            }
+        };
+        let count = self.topics[at].messages;
+        let topic_error = |e: String| {
+            bad(format!(
+                "topic {topic}, message {count}: not a {}: {e}",
+                kind.name()
+            ))
+        };
+        let decoded = match wire {
+            Encoding::Cdr => decode_row::<ros::Cdr>(kind, data),
+            Encoding::Ros1 => decode_row::<ros::Ros1>(kind, data),
+        };
+        let Some((stamp, row)) = decoded.map_err(topic_error)? else {
+            return Ok(());
+        };
+        if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+            return Err(topic_error(format!(
+                "{} is {}",
+                columns_of(kind)[k],
+                row[k]
+            )));
+        }
+        let slot = match self.decoded.iter().position(|d| d.name == topic) {
+            Some(s) => s,
+            None => {
+                self.decoded.push(Decoded {
+                    name: topic.to_string(),
+                    kind,
+                    stamps_ns: Vec::new(),
+                    rows: Vec::new(),
+                });
+                self.decoded.len() - 1
+            }
+        };
+        self.values += row.len() + 1;
+        crate::scenario::check_in_memory(self.values, 8, &self.path.display().to_string())?;
+        self.decoded[slot].stamps_ns.push(stamp);
+        self.decoded[slot].rows.extend(row);
+        Ok(())
+    }
+}
+
+/// A reader of one kind of storage file.
+type StorageReader = fn(&Path, &mut Contents) -> Result<()>;
+
+/// Reads the storage file at `path` (MCAP, ROS 2's sqlite3, or a ROS 1 bag, by its
+/// extension) into `contents`; a panic in a reader is that file's error.
 fn read_file(path: &Path, contents: &mut Contents) -> Result<()> {
-    let (file, _) = crate::io::open_with_length(path)?;
-    let bad = |message: String| Error::CsvFormat {
-        file: path.into(),
-        message,
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let (reader, what): (StorageReader, &str) = if ext.eq_ignore_ascii_case("bag") {
+        (read_ros1, "ROS 1 bag")
+    } else if ext.eq_ignore_ascii_case("db3") {
+        (read_sqlite, "ROS 2 sqlite3 bag")
+    } else {
+        (read_mcap, "MCAP file")
     };
+    match crate::io::contained(|| reader(path, contents)) {
+        Ok(r) => r,
+        Err(panic) => Err(Error::CsvFormat {
+            file: path.into(),
+            message: format!("not a readable {what} ({panic})"),
+        }),
+    }
+}
+
+/// Reads an MCAP file (the `mcap` crate's streaming reader).
+fn read_mcap(path: &Path, contents: &mut Contents) -> Result<()> {
+    let (file, _) = crate::io::open_with_length(path)?;
     let options = LinearReaderOptions::default()
         .with_record_length_limit(RECORD_LIMIT)
         .with_prevalidate_chunk_crcs(true);
     let reader = mcap::io::MessageReader::new_with_options(BufReader::new(file), options);
-    let Contents {
-        topics,
-        decoded,
-        description,
-        ..
-    } = contents;
-    let mut first = topics.is_empty();
-    let mut values: usize = decoded
-        .iter()
-        .map(|d| d.rows.len() + d.stamps_ns.len())
-        .sum();
-    let read = crate::io::contained(|| -> Result<()> {
-        for message in reader {
-            let message = message.map_err(|e| bad(format!("not a readable MCAP file: {e}")))?;
-            let channel = &message.channel;
-            if first {
-                first = false;
-                *description = channel_description(path, &channel.metadata)?;
-            }
-            let schema = channel.schema.as_ref().map_or("", |s| s.name.as_str());
-            let at = match topics.iter().position(|t| t.name == channel.topic) {
-                Some(at) => at,
-                None => {
-                    topics.push(Topic {
-                        name: channel.topic.clone(),
-                        message_type: schema.to_string(),
-                        messages: 0,
-                    });
-                    topics.len() - 1
-                }
-            };
-            topics[at].messages += 1;
-            let Some(kind) = MessageType::of_name(schema) else {
-                continue;
-            };
-            if channel.message_encoding != "cdr" {
-                return Err(bad(format!(
-                    "topic {}: {} messages encoded as \"{}\" (imukit reads ROS 2's CDR)",
-                    channel.topic, schema, channel.message_encoding
-                )));
-            }
-            let topic_error = |e: String| {
-                bad(format!(
-                    "topic {}, message {}: not a {}: {e}",
-                    channel.topic,
-                    topics[at].messages,
-                    kind.name()
-                ))
-            };
-            let Some((stamp, row)) = decode_row(kind, &message.data).map_err(topic_error)? else {
-                continue;
-            };
-            if let Some(k) = row.iter().position(|v| !v.is_finite()) {
-                return Err(topic_error(format!(
-                    "{} is {}",
-                    columns_of(kind)[k],
-                    row[k]
-                )));
-            }
-            let slot = match decoded.iter().position(|d| d.name == channel.topic) {
-                Some(s) => s,
-                None => {
-                    decoded.push(Decoded {
-                        name: channel.topic.clone(),
-                        kind,
-                        stamps_ns: Vec::new(),
-                        rows: Vec::new(),
-                    });
-                    decoded.len() - 1
-                }
-            };
-            values += row.len() + 1;
-            crate::scenario::check_in_memory(values, 8, &path.display().to_string())?;
-            decoded[slot].stamps_ns.push(stamp);
-            decoded[slot].rows.extend(row);
+    let mut first = contents.topics.is_empty();
+    for message in reader {
+        let message = message.map_err(|e| Error::CsvFormat {
+            file: path.into(),
+            message: format!("not a readable MCAP file: {e}"),
+        })?;
+        let channel = &message.channel;
+        if first {
+            first = false;
+            contents.description = channel_description(path, &channel.metadata)?;
         }
-        Ok(())
-    });
-    match read {
-        Ok(r) => r,
-        Err(panic) => Err(bad(format!("not a readable MCAP file ({panic})"))),
+        let schema = channel.schema.as_ref().map_or("", |s| s.name.as_str());
+        contents.ingest(
+            path,
+            &channel.topic,
+            schema,
+            &channel.message_encoding,
+            &message.data,
+        )?;
     }
+    Ok(())
+}
+
+/// Reads a ROS 1 bag (the `rosbag` crate: chunks decompressed one at a time, messages in
+/// file order).
+fn read_ros1(path: &Path, contents: &mut Contents) -> Result<()> {
+    use rosbag::{ChunkRecord, MessageRecord, RosBag};
+    let bad = |e: rosbag::Error| Error::CsvFormat {
+        file: path.into(),
+        message: format!("not a readable ROS 1 bag: {e}"),
+    };
+    let bag = RosBag::new(path).map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })?;
+    // Connection id → (topic, type).
+    let mut connections: BTreeMap<u32, (String, String)> = BTreeMap::new();
+    for record in bag.chunk_records() {
+        let ChunkRecord::Chunk(chunk) = record.map_err(bad)? else {
+            continue;
+        };
+        for message in chunk.messages() {
+            match message.map_err(bad)? {
+                MessageRecord::Connection(c) => {
+                    connections.insert(c.id, (c.topic.to_string(), c.tp.to_string()));
+                }
+                MessageRecord::MessageData(m) => {
+                    let Some((topic, tp)) = connections.get(&m.conn_id) else {
+                        return Err(Error::CsvFormat {
+                            file: path.into(),
+                            message: format!(
+                                "a message of connection {} before the connection",
+                                m.conn_id
+                            ),
+                        });
+                    };
+                    contents.ingest(path, topic, tp, "ros1", m.data)?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads a ROS 2 bag's sqlite3 storage file (the `rusqlite` crate, the file opened read-only,
+/// messages in stamp order).
+fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
+    use rusqlite::{Connection, OpenFlags};
+    let bad = |e: rusqlite::Error| Error::CsvFormat {
+        file: path.into(),
+        message: format!("not a readable ROS 2 sqlite3 bag: {e}"),
+    };
+    let db = Connection::open_with_flags(
+        path,
+        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+    )
+    .map_err(bad)?;
+    let mut topics: BTreeMap<i64, (String, String, String)> = BTreeMap::new();
+    {
+        let mut query = db
+            .prepare("SELECT id, name, type, serialization_format FROM topics")
+            .map_err(bad)?;
+        let rows = query
+            .query_map([], |r| Ok((r.get(0)?, (r.get(1)?, r.get(2)?, r.get(3)?))))
+            .map_err(bad)?;
+        for row in rows {
+            let (id, topic) = row.map_err(bad)?;
+            topics.insert(id, topic);
+        }
+    }
+    let mut query = db
+        .prepare("SELECT topic_id, data FROM messages ORDER BY timestamp, id")
+        .map_err(bad)?;
+    let mut rows = query.query([]).map_err(bad)?;
+    while let Some(row) = rows.next().map_err(bad)? {
+        let id: i64 = row.get(0).map_err(bad)?;
+        let Some((topic, tp, format)) = topics.get(&id) else {
+            return Err(Error::CsvFormat {
+                file: path.into(),
+                message: format!("a message of topic id {id}, which the topics table lacks"),
+            });
+        };
+        let data = row.get_ref(1).map_err(bad)?;
+        let data = data.as_blob().map_err(|e| bad(e.into()))?;
+        contents.ingest(path, topic, tp, format, data)?;
+    }
+    Ok(())
 }
 
 /// The description in a channel's metadata (`imukit.` keys), if any.

@@ -47,6 +47,81 @@ pub struct Header {
     pub frame_id: String,
 }
 
+/// ROS 1's `Time`: unsigned seconds and nanoseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Time1 {
+    /// Whole seconds.
+    pub secs: u32,
+    /// Nanoseconds after `secs`.
+    pub nsecs: u32,
+}
+
+/// ROS 1's `std_msgs/Header`: a sequence number before the stamp.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Header1 {
+    /// The publisher's sequence number.
+    pub seq: u32,
+    /// The time of the data.
+    pub stamp: Time1,
+    /// The frame the data are expressed in.
+    pub frame_id: String,
+}
+
+/// A message header's stamp, in nanoseconds after the epoch.
+pub trait Stamped {
+    /// The stamp, ns.
+    fn stamp_ns(&self) -> i64;
+}
+
+impl Stamped for Header {
+    fn stamp_ns(&self) -> i64 {
+        self.stamp.ns()
+    }
+}
+
+impl Stamped for Header1 {
+    fn stamp_ns(&self) -> i64 {
+        i64::from(self.stamp.secs) * SECOND_NS + i64::from(self.stamp.nsecs)
+    }
+}
+
+/// How a bag lays its messages out.
+pub trait Wire {
+    /// The header its messages open with.
+    type Header: Stamped + serde::de::DeserializeOwned;
+    /// Parses a message whose header holds `strings` strings.
+    ///
+    /// # Errors
+    /// The parser's message for bytes that are not such a message.
+    fn parse<T: serde::de::DeserializeOwned>(data: &[u8], strings: usize) -> Result<T, String>;
+}
+
+/// ROS 2's CDR ([`decode`]).
+#[derive(Debug)]
+pub struct Cdr;
+
+impl Wire for Cdr {
+    type Header = Header;
+    fn parse<T: serde::de::DeserializeOwned>(data: &[u8], strings: usize) -> Result<T, String> {
+        decode(data, strings)
+    }
+}
+
+/// ROS 1's serialisation: little-endian, unaligned, strings and sequences after their
+/// length (the `serde_rosmsg` crate parses it; every length is checked against the message's
+/// before anything is allocated).
+#[derive(Debug)]
+pub struct Ros1;
+
+impl Wire for Ros1 {
+    type Header = Header1;
+    fn parse<T: serde::de::DeserializeOwned>(data: &[u8], _strings: usize) -> Result<T, String> {
+        let length = u32::try_from(data.len()).map_err(|_| "a message over 4 GB".to_string())?;
+        let mut parser = serde_rosmsg::de::Deserializer::new(std::io::Cursor::new(data), length);
+        T::deserialize(&mut parser).map_err(|e| e.to_string())
+    }
+}
+
 /// `geometry_msgs/Vector3` (and `Point`, laid out alike).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Vector3 {
@@ -119,9 +194,9 @@ pub const UNKNOWN_COVARIANCE: [f64; 9] = [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.
 
 /// `sensor_msgs/Imu`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Imu {
+pub struct Imu<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// Attitude estimate (its covariance's first element −1 when there is none).
     pub orientation: Quaternion,
     /// Row-major covariance of `orientation`.
@@ -138,9 +213,9 @@ pub struct Imu {
 
 /// `sensor_msgs/MagneticField`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MagneticField {
+pub struct MagneticField<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// Field, tesla.
     pub magnetic_field: Vector3,
     /// Row-major covariance (0: not known).
@@ -167,9 +242,9 @@ pub const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
 
 /// `sensor_msgs/NavSatFix`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct NavSatFix {
+pub struct NavSatFix<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// Fix status.
     pub status: NavSatStatus,
     /// Latitude, degrees (WGS-84).
@@ -265,9 +340,9 @@ pub struct TwistWithCovariance {
 
 /// `nav_msgs/Odometry`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Odometry {
+pub struct Odometry<H = Header> {
     /// Stamp and the pose's frame.
-    pub header: Header,
+    pub header: H,
     /// The body frame (the twist's).
     pub child_frame_id: String,
     /// Pose in the header's frame.
@@ -278,27 +353,27 @@ pub struct Odometry {
 
 /// `geometry_msgs/PoseStamped`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PoseStamped {
+pub struct PoseStamped<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// The pose.
     pub pose: Pose,
 }
 
 /// `geometry_msgs/PointStamped`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PointStamped {
+pub struct PointStamped<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// The point, m.
     pub point: Vector3,
 }
 
 /// `geometry_msgs/TwistStamped`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct TwistStamped {
+pub struct TwistStamped<H = Header> {
     /// Stamp and frame.
-    pub header: Header,
+    pub header: H,
     /// The twist.
     pub twist: Twist,
 }
@@ -509,14 +584,14 @@ mod tests {
                 frame_id: "imu".into(),
             },
             angular_velocity: Vector3::of([0.1, 0.2, 0.3]),
-            ..Imu::default()
+            ..Imu::<Header>::default()
         };
         let bytes = encode(&m);
         // Encapsulation (4) + stamp (8) + "imu\0" with its length (8) + the quaternion (32,
         // aligned to 8 from the payload's start: 16 is) + 3 × 9 covariances and 2 vectors.
         assert_eq!(&bytes[..4], &[0, 1, 0, 0]);
         assert_eq!(bytes.len(), 4 + 8 + 8 + 32 + 3 * 72 + 2 * 24);
-        assert_eq!(decode::<Imu>(&bytes, 1), Ok(m));
+        assert_eq!(decode::<Imu<Header>>(&bytes, 1), Ok(m));
     }
 
     #[test]
@@ -545,20 +620,20 @@ mod tests {
                 covariance: Covariance6(c),
                 ..PoseWithCovariance::default()
             },
-            ..Odometry::default()
+            ..Odometry::<Header>::default()
         };
-        assert_eq!(decode::<Odometry>(&encode(&o), 2), Ok(o));
+        assert_eq!(decode::<Odometry<Header>>(&encode(&o), 2), Ok(o));
     }
 
     #[test]
     fn a_truncated_message_is_refused_not_read_past() {
-        let bytes = encode(&NavSatFix::default());
-        assert!(decode::<NavSatFix>(&bytes[..bytes.len() - 3], 1).is_err());
+        let bytes = encode(&NavSatFix::<Header>::default());
+        assert!(decode::<NavSatFix<Header>>(&bytes[..bytes.len() - 3], 1).is_err());
         // A string length far beyond the message.
-        let mut bad = encode(&PointStamped::default());
+        let mut bad = encode(&PointStamped::<Header>::default());
         bad[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(
-            decode::<PointStamped>(&bad, 1)
+            decode::<PointStamped<Header>>(&bad, 1)
                 .unwrap_err()
                 .contains("a string of 4294967295 bytes")
         );
