@@ -83,7 +83,7 @@ pub enum Command {
         /// sensors and the files, each a chunk ahead of the next; on two, CSV is written on its
         /// own thread, binary files beside the sensors. With --runs, this many runs go at a
         /// time. The numbers are the same however many.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         threads: Option<i64>,
         /// `euroc`: write the run as a EuRoC sequence, `--out` its folder: the readings in
         /// `mav0/imu0/data.csv` and the truth in `mav0/state_groundtruth_estimate0/data.csv`, in
@@ -107,7 +107,8 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
-        /// 3D: initial state from the first row of this truth CSV (else at rest, level, at the
+        /// 3D: initial state from the first row of this truth file, or of a reference in
+        /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
         init: Option<PathBuf>,
@@ -127,7 +128,7 @@ pub enum Command {
         #[arg(long)]
         no_corrections: bool,
         /// 3D: initial attitude yaw, pitch, roll, rad.
-        #[arg(long = "euler0-rad", alias = "euler0", num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_negative_numbers = true)]
+        #[arg(long = "euler0-rad", alias = "euler0", num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_hyphen_values = true)]
         euler0: Option<Vec<f64>>,
         /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
         #[arg(long)]
@@ -141,18 +142,18 @@ pub enum Command {
         #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
         substeps: usize,
         /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
-        #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_negative_numbers = true)]
+        #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_hyphen_values = true)]
         position0: Option<Vec<f64>>,
         /// Planar: initial heading, rad from nav X, counter-clockwise.
         #[arg(
             long = "heading0-rad",
             alias = "heading0",
             default_value_t = 0.0,
-            allow_negative_numbers = true
+            allow_hyphen_values = true
         )]
         heading0: f64,
         /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
-        #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_negative_numbers = true)]
+        #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_hyphen_values = true)]
         velocity0: Option<Vec<f64>>,
         /// 3D: the Earth: `flat` (non-rotating, constant gravity) or `wgs84` (the
         /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
@@ -179,13 +180,13 @@ pub enum Command {
         baro: Option<PathBuf>,
         /// 3D, `--earth wgs84`: the starting latitude, degrees (with --lon0-deg and
         /// --height0-m; instead of, or over, the --init file's).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         lat0_deg: Option<f64>,
         /// 3D, `--earth wgs84`: the starting longitude, degrees.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         lon0_deg: Option<f64>,
         /// 3D, `--earth wgs84`: the starting height above the WGS-84 ellipsoid, m.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         height0_m: Option<f64>,
         /// Where to write the trajectory (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
@@ -255,7 +256,8 @@ pub enum Command {
         topics: Vec<String>,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
         gnss: PathBuf,
-        /// The initial state: the first row of this truth CSV.
+        /// The initial state: the first row of this truth file, or of a reference in latitude,
+        /// longitude and height or ECEF (docs/earth.md; without an attitude, with --align).
         #[arg(long)]
         init: Option<PathBuf>,
         /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
@@ -282,18 +284,18 @@ pub enum Command {
         part: Option<String>,
         /// With --imu: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
         /// when left out).
-        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
         gnss_horizontal_accuracy_m: Option<f64>,
         /// With --imu: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
         /// left out).
-        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
         gnss_vertical_accuracy_m: Option<f64>,
         /// With --imu: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
         /// when left out).
-        #[arg(long, requires = "imu_model", allow_negative_numbers = true)]
+        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
         gnss_velocity_accuracy_m_s: Option<f64>,
         /// With --imu: the antenna's position from the IMU, body frame, m.
-        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true,
+        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
               requires = "imu_model")]
         gnss_lever_arm_m: Option<Vec<f64>>,
         /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
@@ -354,7 +356,9 @@ pub enum Command {
     /// Errors of an estimate against truth over time: a navigation output (position, velocity,
     /// attitude) or an orientation output (attitude), with RMS, maximum and final values printed.
     Compare {
-        /// Truth CSV (`t_s, pos_*, vel_*, q_*`).
+        /// Truth CSV (`t_s, pos_*, vel_*, q_*`), or a reference on the Earth (`lat_rad,
+        /// lon_rad, height_m`, `lat_deg, lon_deg, height_m` or `ecef_*_m`, with velocity and
+        /// attitude where it has them): errors then north, east, down (docs/earth.md).
         truth: PathBuf,
         /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
@@ -481,7 +485,7 @@ pub enum Command {
         #[arg(long = "body-m", alias = "body", num_args = 3, value_names = ["L", "W", "H"])]
         body: Option<Vec<f64>>,
         /// Lever arm of the IMU point from the reference point, body frame, m.
-        #[arg(long = "lever-arm-m", alias = "lever-arm", num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true)]
+        #[arg(long = "lever-arm-m", alias = "lever-arm", num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
         lever_arm: Option<Vec<f64>>,
         /// Frames per second.
         #[arg(long, default_value_t = 20.0)]

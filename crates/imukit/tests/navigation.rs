@@ -37,7 +37,8 @@ fn rates_and_increments_round_trip_in_both_frames_and_signs() {
         let nav = integrate(&sim.imu, &init, &setup).unwrap();
         let c = compare(&sim.truth, &nav).unwrap();
         assert!(
-            c.summary.position.unwrap().last() < 1e-3 && c.summary.attitude.last() < 1e-5,
+            c.summary.position.unwrap().last() < 1e-3
+                && c.summary.attitude.expect("compared").last() < 1e-5,
             "{frame}: {c:?}"
         );
         // MATLAB's sign, flipped back, gives the same numbers.
@@ -71,7 +72,7 @@ fn compare_reports_zero_against_itself_and_refuses_times_outside_the_truth() {
         ),
         (0.0, 0.0)
     );
-    assert!(c.summary.attitude.rms() < 1e-7);
+    assert!(c.summary.attitude.expect("compared").rms() < 1e-7);
     let mut shifted = sim.truth.clone();
     let w = shifted.columns.len();
     for r in 0..shifted.rows() {

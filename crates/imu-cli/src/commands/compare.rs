@@ -34,7 +34,9 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
     if let Some(v) = &c.velocity {
         line("velocity", v, 1.0, "m/s");
     }
-    line("attitude", &c.attitude, 1f64.to_degrees(), "deg");
+    if let Some(a) = &c.attitude {
+        line("attitude", a, 1f64.to_degrees(), "deg");
+    }
     println!("({} rows compared)", c.rows());
     if let Some(o) = out {
         println!("\nErrors over time written to {}", o.display());

@@ -9,8 +9,8 @@ use imukit::io::output::check_outputs;
 use imukit::io::rows::Gaps;
 use imukit::io::table::{read_table, read_table_as};
 use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
-use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
-use imukit::scenario::EarthName;
+use imukit::run::navigate::{NavAsked, NavRequest};
+use imukit::scenario::{EarthName, NavFrameName};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
@@ -66,6 +66,25 @@ fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<Fu
     })?)
 }
 
+/// The data's navigation frame and whether they are on the WGS-84 Earth: the scenario's, else
+/// the options' and the input files' descriptions.
+fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
+    if let Some(path) = a.scenario {
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        let scenario = ScenarioSpec::from_file(path)?.resolve(base)?;
+        let on_earth = matches!(scenario.earth, imukit::scenario::EarthSetup::Wgs84(_));
+        return Ok((scenario.nav_frame, on_earth));
+    }
+    let described = Described::read(&[a.imu, a.gnss])?;
+    let frame = described
+        .pick("nav_frame", None, |d| d.nav_frame, NavFrameName::default())
+        .map_err(by_flag)?;
+    let earth = described
+        .pick("earth", a.earth, |d| d.earth, EarthName::Flat)
+        .map_err(by_flag)?;
+    Ok((frame, earth == EarthName::Wgs84))
+}
+
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let mut inputs = vec![("IMU file", a.imu), ("GNSS file", a.gnss)];
     inputs.extend(a.scenario.map(|p| ("--scenario", p)));
@@ -75,7 +94,18 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     check_outputs(&inputs, &[("--out", a.out)])?;
     let initial = match a.init {
         Some(init) => {
-            let s = InitialState::from_csv(init)?;
+            let (frame, on_earth) = data_frame(a)?;
+            let s = super::integrate::start_from(init, frame, on_earth, a.align.is_some())
+                .map_err(|e| match e {
+                    CliError::Library(Error::Invalid { field, message }) if field == "--init" => {
+                        Error::Invalid {
+                            field,
+                            message: message.replace("--euler0-rad", "--align"),
+                        }
+                        .into()
+                    }
+                    other => other,
+                })?;
             s.check(&format!("{}, row 2", init.display()))?;
             Some(s)
         }

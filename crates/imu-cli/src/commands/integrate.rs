@@ -79,6 +79,40 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
     Ok(())
 }
 
+/// The start the `--init` file `path` gives for a run in `frame`: a reference on the Earth
+/// (latitude, longitude and height, or ECEF) needs the WGS-84 Earth, and an attitude from the
+/// file or from `--euler0-rad` (`euler0`).
+pub(crate) fn start_from(
+    path: &Path,
+    frame: imukit::scenario::NavFrameName,
+    on_earth: bool,
+    euler0: bool,
+) -> Result<InitialState, CliError> {
+    let (initial, given) = InitialState::from_reference(path, frame)?;
+    if given.on_earth && !on_earth {
+        return Err(Error::Invalid {
+            field: "--init".into(),
+            message: format!(
+                "{} gives positions on the Earth (latitude, longitude, height or ECEF): \
+                 navigate on it with --earth wgs84",
+                path.display()
+            ),
+        }
+        .into());
+    }
+    if !given.attitude && !euler0 {
+        return Err(Error::Invalid {
+            field: "--init".into(),
+            message: format!(
+                "{} gives no attitude (q_w, q_x, q_y, q_z): give it with --euler0-rad",
+                path.display()
+            ),
+        }
+        .into());
+    }
+    Ok(initial)
+}
+
 pub fn three_d(
     c: &Common<'_>,
     o: &Options3d<'_>,
@@ -105,7 +139,12 @@ pub fn three_d(
     .map_err(by_flag)?;
     let setup = request.setup().map_err(by_flag)?;
     let mut initial = match o.init {
-        Some(p) => InitialState::from_csv(p)?,
+        Some(p) => start_from(
+            p,
+            setup.nav_frame,
+            setup.earth.is_some(),
+            o.euler0.is_some(),
+        )?,
         None => InitialState::default(),
     };
     if let Some(p) = c.position0 {

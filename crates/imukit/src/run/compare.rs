@@ -9,14 +9,17 @@
 //! does not grow with the files.
 use std::path::Path;
 
+use imu_core::earth::Geodetic;
 use imu_core::orientation::{DistanceStats, quaternion_distance};
-use imu_core::{Body, Enu, Rotation};
+use imu_core::{Body, Ecef, Enu, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
 use crate::io::table::{CsvRows, Table};
 use crate::run::fuse::SIGMA_COLUMNS;
-use crate::run::navigate::STATE_COLUMNS;
+use crate::run::navigate::{GEODETIC_COLUMNS, STATE_COLUMNS};
+use crate::run::reference::{Layout, Position, ecef, ned_of_difference};
+use crate::scenario::NavFrameName;
 
 /// Error columns of a navigation estimate.
 pub const ERROR_COLUMNS: [&str; 9] = [
@@ -28,6 +31,21 @@ pub const ERROR_COLUMNS: [&str; 9] = [
     "vel_err_x_m_s",
     "vel_err_y_m_s",
     "vel_err_z_m_s",
+    "att_err_rad",
+];
+
+/// Error columns of a navigation estimate against a reference on the Earth (latitude,
+/// longitude and height, or ECEF): north, east, down at the reference point. A reference
+/// without a velocity or an attitude gives no `vel_err_*` or `att_err_rad`.
+pub const EARTH_ERROR_COLUMNS: [&str; 9] = [
+    "t_s",
+    "pos_err_n_m",
+    "pos_err_e_m",
+    "pos_err_d_m",
+    "pos_err_m",
+    "vel_err_n_m_s",
+    "vel_err_e_m_s",
+    "vel_err_d_m_s",
     "att_err_rad",
 ];
 
@@ -92,14 +110,16 @@ pub struct ErrorSummary {
     pub position: Option<DistanceStats>,
     /// Velocity error norm, m/s.
     pub velocity: Option<DistanceStats>,
-    /// Attitude error angle (quaternion distance), rad.
-    pub attitude: DistanceStats,
+    /// Attitude error angle (quaternion distance), rad (`None`: a reference without one).
+    pub attitude: Option<DistanceStats>,
+    /// Rows compared.
+    pub rows: usize,
 }
 
 impl ErrorSummary {
     /// Every figure by name with its unit: `position_rms_m`, `position_max_m`,
     /// `position_final_m`, the same for `velocity` (`_m_s`) and `attitude` (`_rad`); position and
-    /// velocity only for navigation estimates.
+    /// velocity only for navigation estimates, each only where the reference has it.
     #[must_use]
     pub fn entries(&self) -> Vec<(String, f64)> {
         let mut out = Vec::new();
@@ -114,14 +134,16 @@ impl ErrorSummary {
         if let Some(v) = &self.velocity {
             put("velocity", "m_s", v);
         }
-        put("attitude", "rad", &self.attitude);
+        if let Some(a) = &self.attitude {
+            put("attitude", "rad", a);
+        }
         out
     }
 
     /// Rows compared.
     #[must_use]
     pub fn rows(&self) -> usize {
-        self.attitude.count()
+        self.rows
     }
 }
 
@@ -132,6 +154,44 @@ pub struct Comparison {
     pub table: Table,
     /// RMS, maximum and final values.
     pub summary: ErrorSummary,
+}
+
+/// What a comparison of navigation estimates covers, and in which axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Parts {
+    /// Positions are ECEF points and their errors north, east, down at the reference point
+    /// (else plane coordinates, errors in the plane's axes).
+    earth: bool,
+    /// Velocities are compared.
+    velocity: bool,
+    /// Attitudes are compared.
+    attitude: bool,
+}
+
+impl Parts {
+    /// Plane coordinates, everything compared.
+    const PLANE: Self = Self {
+        earth: false,
+        velocity: true,
+        attitude: true,
+    };
+
+    /// The error columns.
+    fn columns(self) -> Vec<&'static str> {
+        let all = if self.earth {
+            &EARTH_ERROR_COLUMNS
+        } else {
+            &ERROR_COLUMNS
+        };
+        let mut c = all[..5].to_vec();
+        if self.velocity {
+            c.extend(&all[5..8]);
+        }
+        if self.attitude {
+            c.push(all[8]);
+        }
+        c
+    }
 }
 
 /// A state row in [`STATE_COLUMNS`] order: `t_s`, position, velocity, `q_wxyz` (position and
@@ -199,6 +259,7 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
     let mut out = Vec::with_capacity(table.columns.len());
     let summary = compare_rows(
         kind,
+        Parts::PLANE,
         ["truth", "estimate"],
         |row| Ok(tr.next().map(|r| *row = r).is_some()),
         |row| Ok(er.next().map(|r| *row = r).is_some()),
@@ -274,6 +335,16 @@ fn next_state(
 /// # Errors
 /// As [`compare`], CSV errors naming file, row and column, and I/O errors.
 pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+    // A reference on the Earth (latitude, longitude, height or ECEF, without imukit's plane
+    // coordinates) is compared in the Earth's terms.
+    let truth_header = crate::io::table::read_header(truth)?;
+    if !matches!(
+        EstimateKind::of(&truth_header),
+        Ok(EstimateKind::Navigation)
+    ) && let Some(layout) = Layout::on_earth(&truth_header)
+    {
+        return compare_on_earth(truth, estimate, layout, out);
+    }
     // Two tables in different frames or on different Earths are not compared axis by axis.
     let described = crate::io::description::Described::read(&[truth, estimate])?;
     described.known("nav_frame", None, |d| d.nav_frame)?;
@@ -308,6 +379,7 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
     let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
     let summary = compare_rows(
         kind,
+        Parts::PLANE,
         [&truth_name, &estimate_name],
         |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
         |row| {
@@ -334,6 +406,109 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
     Ok(summary)
 }
 
+/// [`compare_csv`] of an estimate on the WGS-84 Earth against a reference whose position is
+/// on the Earth (`layout`): ECEF points, errors north, east, down at the reference point;
+/// velocities and attitudes where both have them, each table's in its own frame (its
+/// description's, else ENU).
+fn compare_on_earth(
+    truth: &Path,
+    estimate: &Path,
+    layout: Layout,
+    out: Option<&Path>,
+) -> Result<ErrorSummary> {
+    let frame_of = |p: &Path| -> Result<NavFrameName> {
+        Ok(crate::io::description::Description::read(p)?
+            .and_then(|d| d.nav_frame)
+            .unwrap_or_default())
+    };
+    let (truth_frame, estimate_frame) = (frame_of(truth)?, frame_of(estimate)?);
+    let header = crate::io::table::read_header(estimate)?;
+    let own = Layout::of(&header, &[Position::GeodeticRad]).ok_or_else(|| {
+        invalid(
+            estimate.display().to_string(),
+            format!(
+                "the reference {} gives positions on the Earth: the estimate needs {} (an \
+                 estimate on the WGS-84 Earth, as integrate and fuse write it)",
+                truth.display(),
+                GEODETIC_COLUMNS.join(", ")
+            ),
+        )
+    })?;
+    let parts = Parts {
+        earth: true,
+        velocity: layout.velocity.is_some() && own.velocity.is_some(),
+        attitude: layout.attitude && own.attitude,
+    };
+    let (truth_columns, estimate_columns) = (layout.columns(), own.columns());
+    let mut truth_rows = CsvRows::open(truth, &truth_columns, "")?;
+    let mut estimate_rows = CsvRows::open(estimate, &estimate_columns, "")?;
+    let (mut truth_buffer, mut estimate_buffer) = (
+        vec![0.0; truth_columns.len()],
+        vec![0.0; estimate_columns.len()],
+    );
+    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
+    // A row of the Earth's terms as a state row: ECEF, NED velocity, FRD-to-NED attitude.
+    let next = |rows: &mut CsvRows,
+                buffer: &mut [f64],
+                layout: &Layout,
+                frame: NavFrameName,
+                name: &str,
+                state: &mut StateRow|
+     -> Result<bool> {
+        let Some(line) = rows.next_row(buffer)? else {
+            return Ok(false);
+        };
+        let r = layout.earth_row(buffer, frame).ok_or_else(|| {
+            invalid(
+                format!("{name}, row {line}"),
+                "not a point on the Earth (a latitude beyond ±90°), or a quaternion of zero norm",
+            )
+        })?;
+        *state = [0.0; 11];
+        state[0] = r.t_s;
+        state[1..4].copy_from_slice(&ecef(&r.position));
+        if let Some(v) = r.velocity_ned {
+            state[4..7].copy_from_slice(&v);
+        }
+        if let Some(q) = r.attitude {
+            state[7..].copy_from_slice(&q);
+        }
+        Ok(true)
+    };
+    let mut file = out.map(AtomicFile::create).transpose()?;
+    if let Some(f) = file.as_mut() {
+        f.write_header(&parts.columns())?;
+    }
+    let summary = compare_rows(
+        EstimateKind::Navigation,
+        parts,
+        [&truth_name, &estimate_name],
+        |row| {
+            next(
+                &mut truth_rows,
+                &mut truth_buffer,
+                &layout,
+                truth_frame,
+                &truth_name,
+                row,
+            )
+        },
+        |row| {
+            next(
+                &mut estimate_rows,
+                &mut estimate_buffer,
+                &own,
+                estimate_frame,
+                &estimate_name,
+                row,
+            )
+        },
+        |e| file.as_mut().map_or(Ok(()), |f| f.write_row(e)),
+    )?;
+    file.map_or(Ok(()), AtomicFile::commit)?;
+    Ok(summary)
+}
+
 /// The angle `a − b` wrapped to (−π, π].
 fn angle_difference(a: f64, b: f64) -> f64 {
     let tau = std::f64::consts::TAU;
@@ -346,6 +521,7 @@ fn angle_difference(a: f64, b: f64) -> f64 {
 /// but within 1e-9 s use the last two), errors handed to `sink`.
 fn compare_rows(
     kind: EstimateKind,
+    parts: Parts,
     names: [&str; 2],
     mut read_truth: impl FnMut(&mut StateRow) -> Result<bool>,
     mut estimate: impl FnMut(&mut StateRow) -> Result<bool>,
@@ -387,8 +563,10 @@ fn compare_rows(
         DistanceStats::default(),
     );
     let mut previous_t = f64::NEG_INFINITY;
+    let mut rows = 0;
     while estimate(&mut e)? {
-        let (t, row) = (e[0], att.count() + 2);
+        let (t, row) = (e[0], rows + 2);
+        rows += 1;
         if !t.is_finite() {
             return Err(invalid(
                 estimate_name,
@@ -427,27 +605,54 @@ fn compare_rows(
             ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
         };
         let q = |r: &StateRow| Rotation::<Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
-        let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
-            return Err(invalid(
-                "compare",
-                format!("zero quaternion near estimate row {row}"),
-            ));
+        let attitude = parts.attitude || kind == EstimateKind::Orientation;
+        let (qe, qt, angle) = if attitude {
+            let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
+                return Err(invalid(
+                    "compare",
+                    format!("zero quaternion near estimate row {row}"),
+                ));
+            };
+            let qt = Rotation::<Body, Enu>::assume_from_quaternion(
+                qa.quaternion().slerp(qb.quaternion(), w),
+            );
+            let angle = quaternion_distance(&qe, &qt);
+            att.push(angle);
+            (qe, qt, angle)
+        } else {
+            (Rotation::identity(), Rotation::identity(), 0.0)
         };
-        let qt = Rotation::<Body, Enu>::assume_from_quaternion(
-            qa.quaternion().slerp(qb.quaternion(), w),
-        );
-        let angle = quaternion_distance(&qe, &qt);
-        att.push(angle);
         match kind {
             EstimateKind::Navigation => {
                 let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
-                let dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
+                let mut dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
+                if parts.earth {
+                    let point = Vec3::<Ecef>::from_array([lerp(1), lerp(2), lerp(3)]);
+                    let at = Geodetic::from_ecef(point).ok_or_else(|| {
+                        invalid(
+                            truth_name,
+                            format!("no point on the Earth near estimate row {row}"),
+                        )
+                    })?;
+                    dp = ned_of_difference(&at, dp);
+                }
                 let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
                 let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let (np, nv) = (norm(&dp), norm(&dv));
+                let np = norm(&dp);
                 pos.push(np);
-                vel.push(nv);
-                sink(&[t, dp[0], dp[1], dp[2], np, dv[0], dv[1], dv[2], angle])?;
+                let mut out = [0.0; 9];
+                out[..5].copy_from_slice(&[t, dp[0], dp[1], dp[2], np]);
+                let mut width = 5;
+                if parts.velocity {
+                    vel.push(norm(&dv));
+                    out[5..8].copy_from_slice(&dv);
+                    width = 8;
+                }
+                if parts.attitude {
+                    out[width] = angle;
+                    width += 1;
+                }
+                sink(&out[..width])?;
             }
             EstimateKind::Orientation => {
                 let (ee, et) = (qe.to_euler(), qt.to_euler());
@@ -461,7 +666,7 @@ fn compare_rows(
             }
         }
     }
-    if att.count() == 0 {
+    if rows == 0 {
         return Err(invalid("compare", "empty table"));
     }
     // The truth rows past the last estimate are read too: a truth file is refused whole or not
@@ -471,7 +676,8 @@ fn compare_rows(
     Ok(ErrorSummary {
         kind,
         position: navigation.then_some(pos),
-        velocity: navigation.then_some(vel),
-        attitude: att,
+        velocity: (navigation && parts.velocity).then_some(vel),
+        attitude: (!navigation || parts.attitude).then_some(att),
+        rows,
     })
 }

@@ -13,5 +13,6 @@ pub mod navigate;
 pub mod orient;
 pub mod pipeline;
 pub mod planar;
+pub mod reference;
 pub mod simulate;
 pub mod study;

@@ -27,6 +27,7 @@ use crate::io::rows::{Gaps, TimedRows, check_increasing};
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
+use crate::run::reference::{Given, Velocity};
 use crate::scenario::resolve::{check_gravity, finite_vec};
 use crate::scenario::{AccelSignName, EarthName, NavFrameName};
 
@@ -249,6 +250,77 @@ impl InitialState {
                 _ => None,
             },
         })
+    }
+
+    /// The start a reference file gives, for a run in `frame`: imukit's truth or navigation
+    /// table ([`Self::from_csv`]), or a reference on the Earth ([`crate::run::reference`]:
+    /// latitude, longitude and height, or ECEF, its velocity and attitude where it has them, in
+    /// its own frame — its description's, else ENU). Without a velocity the first two rows'
+    /// positions give one; the attitude is said to be missing in [`Given`].
+    ///
+    /// # Errors
+    /// As [`Self::from_csv`]; a first row that names no point on the Earth.
+    pub fn from_reference(path: &Path, frame: NavFrameName) -> Result<(Self, Given)> {
+        use crate::run::reference::{Layout, Position, VelocitySource, ecef, ned_of_difference};
+        let header = crate::io::table::read_header(path)?;
+        let plane = Layout::of(&header, &[Position::Plane]);
+        let Some(layout) = Layout::on_earth(&header).filter(|_| {
+            // imukit's own tables (plane coordinates, velocity and attitude) start as they did.
+            !plane.is_some_and(|p| p.velocity == Some(Velocity::Nav) && p.attitude)
+        }) else {
+            return Ok((Self::from_csv(path)?, Given::FULL));
+        };
+        let own = crate::io::description::Description::read(path)?
+            .and_then(|d| d.nav_frame)
+            .unwrap_or_default();
+        let columns = layout.columns();
+        let mut rows = CsvRows::open(path, &columns, "")?;
+        let mut values = vec![0.0; columns.len()];
+        let mut read = |rows: &mut CsvRows| -> Result<Option<crate::run::reference::EarthRow>> {
+            let Some(line) = rows.next_row(&mut values)? else {
+                return Ok(None);
+            };
+            layout.earth_row(&values, own).map(Some).ok_or_else(|| {
+                invalid(
+                    format!("{}, row {line}", path.display()),
+                    "not a point on the Earth (a latitude beyond ±90°), or a quaternion of zero \
+                     norm",
+                )
+            })
+        };
+        let Some(first) = read(&mut rows)? else {
+            return Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            });
+        };
+        let (velocity_ned, source) = match first.velocity_ned {
+            Some(v) => (v, VelocitySource::Columns),
+            None => match read(&mut rows)? {
+                Some(second) if second.t_s > first.t_s => {
+                    let (a, b) = (ecef(&first.position), ecef(&second.position));
+                    let d =
+                        ned_of_difference(&first.position, std::array::from_fn(|k| b[k] - a[k]));
+                    let dt = second.t_s - first.t_s;
+                    (d.map(|x| x / dt), VelocitySource::Positions)
+                }
+                _ => ([0.0; 3], VelocitySource::Rest),
+            },
+        };
+        let state = Self {
+            position_m: [0.0; 3],
+            velocity_m_s: crate::run::reference::from_ned(frame, velocity_ned),
+            quaternion: first.attitude.map_or([1.0, 0.0, 0.0, 0.0], |q| {
+                crate::run::reference::attitude_in(frame, q)
+            }),
+            geodetic: Some(first.position),
+        };
+        let given = Given {
+            attitude: first.attitude.is_some(),
+            velocity: source,
+            on_earth: true,
+        };
+        Ok((state, given))
     }
 
     /// The first row of a truth CSV file (read alone: memory does not grow with the file).
