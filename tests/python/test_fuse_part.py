@@ -80,3 +80,34 @@ def test_a_scenario_that_contradicts_the_datas_description_is_refused(drive):
     assert done.returncode == 65, done.stderr
     assert f"nav_frame: the scenario {ned} says NED, the description of {files['imu']} says ENU" in done.stderr
     assert not out.exists()
+
+
+def test_a_kalibr_file_is_a_part_of_its_four_figures(drive):
+    """`--imu imu.yaml` (Kalibr's file, here as `imukit presets … --format kalibr` writes it):
+    the filter of white noise and bias random walk alone, the same as the parameter file
+    `imukit presets --params imu.yaml` prints; Python's `imu_model=` reads it alike."""
+    tmp, _, files = drive
+    kalibr = tmp / "imu.yaml"
+    kalibr.write_text(subprocess.run([imukit_bin(), "presets", "stim300", "--format", "kalibr", "--rate-hz", "100"],
+                                     capture_output=True, text=True, check=True).stdout)
+    params = tmp / "kalibr_params.toml"
+    params.write_text(subprocess.run([imukit_bin(), "presets", "--params", str(kalibr)],
+                                     capture_output=True, text=True, check=True).stdout)
+    assert "random_walk_rad_s_rt_hz = 1.327716e-7" in params.read_text()
+    assert "bias_instability_rad_s = 0.0" in params.read_text()
+    gnss = PART[2:]
+    outs = []
+    for model in (kalibr, params):
+        out = tmp / f"fused-{model.suffix[1:]}.csv"
+        done = fuse(files, out, "--imu", str(model), *gnss)
+        assert done.returncode == 0, done.stderr
+        outs.append(imukit.read(out))
+    assert outs[0].columns == outs[1].columns and np.array_equal(outs[0].values, outs[1].values)
+    fused = imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]),
+                        imu_model=str(kalibr), gnss_horizontal_accuracy_m=1.5, gnss_vertical_accuracy_m=3.0,
+                        gnss_velocity_accuracy_m_s=0.1)
+    assert np.array_equal(fused.values, outs[0].values)
+    # A Kalibr file missing a figure is refused by file and key.
+    kalibr.write_text("\n".join(l for l in kalibr.read_text().splitlines() if not l.startswith("gyroscope_random")))
+    done = fuse(files, tmp / "bad.csv", "--imu", str(kalibr), *gnss)
+    assert done.returncode == 65 and "imu.yaml" in done.stderr and "gyroscope_random_walk: missing" in done.stderr

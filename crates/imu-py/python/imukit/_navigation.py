@@ -173,8 +173,8 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     first 20 s (zero-velocity and zero-rate updates at every sample: the gyroscope biases are
     calibrated before the drive) — a consumer IMU needs both.
 
-    Without a scenario, ``imu_model`` names the part — a preset (``"stim300"``) or a parameter
-    file — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
+    Without a scenario, ``imu_model`` names the part — a preset (``"stim300"``), a parameter
+    file or Kalibr's ``imu.yaml`` — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
     ``gnss_velocity_accuracy_m_s`` and ``gnss_lever_arm_m`` the receiver (MATLAB gpsSensor's
     defaults for those left out); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
     ``gravity_m_s2`` say what the tables are in (imukit's defaults; the sign by default the part's

@@ -684,8 +684,9 @@ fn parse_document(
     Ok(out)
 }
 
-/// Reads a parameter file: imukit TOML or JSON, or a MATLAB `loadparams` JSON (a part name
-/// holding `Accelerometer`/`Gyroscope`/`Magnetometer`); `part` picks one of several parts.
+/// Reads a parameter file: imukit TOML or JSON, a MATLAB `loadparams` JSON (a part name
+/// holding `Accelerometer`/`Gyroscope`/`Magnetometer`; `part` picks one of several parts), or
+/// Kalibr's `imu.yaml` ([`crate::io::kalibr::read`]).
 ///
 /// # Errors
 /// Unreadable file, syntax errors with their line, unknown parts and keys, invalid values.
@@ -698,7 +699,17 @@ pub fn read_param_file(path: &Path, part: Option<&str>, profile: Profile) -> Res
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let doc: ParamValue = if is_json {
+    let is_yaml = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+    let doc: ParamValue = if is_yaml {
+        // Kalibr's imu.yaml: its four figures as a parameter file.
+        let params = crate::io::kalibr::read(path)?.to_params_toml();
+        toml::from_str(&params).map_err(|e| Error::Scenario {
+            origin: origin.clone(),
+            message: e.to_string(),
+        })?
+    } else if is_json {
         serde_json::from_str(&text).map_err(|e| Error::Scenario {
             origin: origin.clone(),
             message: e.to_string(),
