@@ -111,3 +111,29 @@ def test_a_kalibr_file_is_a_part_of_its_four_figures(drive):
     kalibr.write_text("\n".join(l for l in kalibr.read_text().splitlines() if not l.startswith("gyroscope_random")))
     done = fuse(files, tmp / "bad.csv", "--imu", str(kalibr), *gnss)
     assert done.returncode == 65 and "imu.yaml" in done.stderr and "gyroscope_random_walk: missing" in done.stderr
+
+
+def test_fixes_of_positions_only_update_the_position_alone(drive):
+    """A fix table without velocity columns (a NavSatFix topic, an NMEA log without RMC): the
+    filter updates on positions alone, its velocity's one-sigma the wider for it; the alignment
+    that takes the heading from the fixes' velocity says why it cannot."""
+    tmp, scenario, files = drive
+    gnss = imukit.read(files["gnss"])
+    positions = tmp / "positions.csv"
+    imukit.Table(["t_s", "pos_x_m", "pos_y_m", "pos_z_m"],
+                 gnss.values[:, [gnss.columns.index(c) for c in ("t_s", "pos_x_m", "pos_y_m", "pos_z_m")]]).write(positions)
+    outs = {}
+    for name, fixes in (("full", files["gnss"]), ("positions", positions)):
+        out = tmp / f"fused-{name}.csv"
+        done = subprocess.run([imukit_bin(), "fuse", str(files["imu"]), str(fixes), "--init", str(files["truth"]),
+                               "--scenario", str(scenario), "--out", str(out)], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        outs[name] = imukit.read(out)
+    truth = imukit.read(files["truth"])
+    err = {n: imukit.compare(truth, o).summary for n, o in outs.items()}
+    # Worse without velocities, yet a working solution: metres, not kilometres.
+    assert err["full"]["position_rms_m"] <= err["positions"]["position_rms_m"] < 5.0, err
+    assert outs["positions"]["vel_x_sigma_m_s"][-1] > outs["full"]["vel_x_sigma_m_s"][-1]
+    done = subprocess.run([imukit_bin(), "fuse", str(files["imu"]), str(positions), "--align", "gnss",
+                           "--scenario", str(scenario), "--out", str(tmp / "aligned.csv")], capture_output=True, text=True)
+    assert done.returncode == 65 and "no velocity" in done.stderr, done.stderr

@@ -125,7 +125,7 @@ def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:
 
 
 #: The extensions of the table files imukit reads and writes.
-TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz", ".mcap", ".db3", ".bag")
+TABLE_FORMATS = (".csv", ".parquet", ".npy", ".npz", ".mcap", ".db3", ".bag", ".nmea")
 
 
 def builtin_scenarios() -> list:

@@ -332,7 +332,7 @@ impl Description {
                 let place = format!("{}, metadata", path.display());
                 Self::from_entries(entries, &place).map(Some)
             }
-            TableFormat::Npy | TableFormat::Npz => Ok(None),
+            TableFormat::Npy | TableFormat::Npz | TableFormat::Nmea => Ok(None),
             TableFormat::Mcap => Ok(crate::io::bag::read(path)?.description),
             TableFormat::Csv => Self::read_csv(path),
         }

@@ -1,6 +1,7 @@
 //! Files in and out: tables and CSV ([`table`]), the EuRoC/TUM-VI ASL layout read by its header
 //! ([`asl`]), a vendor's CSV through a column map ([`column_map`]), tables as Parquet ([`parquet`]) and as NumPy
-//! `.npy` and `.npz` ([`npy`], [`npz`]), a topic of a ROS 2 bag ([`bag`]), each chosen by its
+//! `.npy` and `.npz` ([`npy`], [`npz`]), a topic of a ROS bag ([`bag`]), NMEA logs ([`nmea`]),
+//! each chosen by its
 //! path's extension ([`TableFormat`]),
 //! what a table holds, written into it ([`description`]), parameter
 //! files ([`params`]), the built-in
@@ -12,6 +13,7 @@ pub mod bag;
 pub mod column_map;
 pub mod description;
 pub mod kalibr;
+pub mod nmea;
 pub mod npy;
 pub mod npz;
 pub mod output;
@@ -85,6 +87,8 @@ pub enum TableFormat {
     Npy,
     /// A NumPy archive of one array per column ([`npz`]).
     Npz,
+    /// An NMEA 0183 log ([`nmea`]): GNSS fixes.
+    Nmea,
     /// A ROS bag ([`bag`]): a topic's table. ROS 2's MCAP file, its sqlite3 file (`.db3`) or
     /// a bag's folder (`metadata.yaml` beside its storage files), or a ROS 1 `.bag`.
     Mcap,
@@ -105,6 +109,8 @@ impl TableFormat {
             Self::Npy
         } else if ext.eq_ignore_ascii_case("npz") {
             Self::Npz
+        } else if ext.eq_ignore_ascii_case("nmea") {
+            Self::Nmea
         } else if ["mcap", "bag", "db3"]
             .iter()
             .any(|e| ext.eq_ignore_ascii_case(e))
@@ -121,7 +127,7 @@ impl TableFormat {
     pub fn first_row(self) -> usize {
         match self {
             Self::Csv => 2,
-            Self::Parquet | Self::Npy | Self::Npz | Self::Mcap => 1,
+            Self::Parquet | Self::Npy | Self::Npz | Self::Mcap | Self::Nmea => 1,
         }
     }
 }

@@ -469,6 +469,14 @@ impl AtomicFile {
                 return Ok(());
             }
             TableFormat::Mcap => return self.begin_bag(description),
+            TableFormat::Nmea => {
+                return Err(Error::Invalid {
+                    field: self.path.display().to_string(),
+                    message: "NMEA logs are read, not written: write fixes as CSV, Parquet, \
+                              .npy, .npz or a bag (.mcap)"
+                        .into(),
+                });
+            }
             TableFormat::Csv => {}
         }
         let line = description.csv_line();

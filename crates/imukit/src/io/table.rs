@@ -456,9 +456,11 @@ impl Table {
             description
         };
         match TableFormat::of(path) {
-            TableFormat::Parquet | TableFormat::Npy | TableFormat::Npz | TableFormat::Mcap => {
-                self.write_binary(path, description)
-            }
+            TableFormat::Parquet
+            | TableFormat::Npy
+            | TableFormat::Npz
+            | TableFormat::Mcap
+            | TableFormat::Nmea => self.write_binary(path, description),
             TableFormat::Csv => self.write_csv_described(path, description),
         }
     }
@@ -640,6 +642,7 @@ pub fn read_header(path: &Path) -> Result<Vec<String>> {
         TableFormat::Npy => crate::io::npy::column_names(path),
         TableFormat::Npz => crate::io::npz::column_names(path),
         TableFormat::Mcap => crate::io::bag::column_names(path, &[]),
+        TableFormat::Nmea => Ok(crate::io::nmea::read_table(path)?.columns),
         TableFormat::Csv => Ok(csv_layout(path, None)?.names),
     }
 }
@@ -830,6 +833,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
         TableFormat::Parquet => return crate::io::parquet::read_table(path),
         TableFormat::Npz => return crate::io::npz::read_table(path),
         TableFormat::Mcap => return crate::io::bag::read_table(path, &[]),
+        TableFormat::Nmea => return crate::io::nmea::read_table(path),
         TableFormat::Npy | TableFormat::Csv => {}
     }
     let header = read_header(path)?;
@@ -966,15 +970,19 @@ impl CsvRows {
         hint: &str,
         map: Option<&ColumnMap>,
     ) -> Result<Self> {
-        // A bag's topic is chosen by the columns asked for, and read whole.
-        let bag = match TableFormat::of(path) {
+        // A bag's topic is chosen by the columns asked for, and read whole; an NMEA log too.
+        let whole = match TableFormat::of(path) {
             TableFormat::Mcap => Some(crate::io::bag::read_table(path, required)?),
+            TableFormat::Nmea => Some(crate::io::nmea::read_table(path)?),
             _ => None,
         };
         let layout = match TableFormat::of(path) {
             TableFormat::Csv => csv_layout(path, map)?,
-            TableFormat::Mcap => Layout {
-                names: bag.as_ref().map(|t| t.columns.clone()).unwrap_or_default(),
+            TableFormat::Mcap | TableFormat::Nmea => Layout {
+                names: whole
+                    .as_ref()
+                    .map(|t| t.columns.clone())
+                    .unwrap_or_default(),
                 sources: None,
                 file_names: None,
                 comments: true,
@@ -1015,7 +1023,7 @@ impl CsvRows {
             }
             TableFormat::Npy => RowSource::Npy(crate::io::npy::NpyRows::open(path)?.1),
             TableFormat::Npz => RowSource::Whole(crate::io::npz::read_table(path)?, 0),
-            TableFormat::Mcap => RowSource::Whole(bag.unwrap_or_default(), 0),
+            TableFormat::Mcap | TableFormat::Nmea => RowSource::Whole(whole.unwrap_or_default(), 0),
             TableFormat::Csv => RowSource::Csv(reader(path, layout.comments)?),
         };
         // Rows are counted from the header, row 1, whatever comment lines (the description's)

@@ -565,13 +565,32 @@ struct FusionInputs {
     w: Vec<[f64; 3]>,
     g_t: Vec<f64>,
     g_p: Vec<[f64; 3]>,
+    /// The fixes' velocities (zeros where they have none).
     g_v: Vec<[f64; 3]>,
+    /// What the fixes give of their velocity.
+    velocities: FixVelocity,
 }
+
+/// What a table of fixes gives of the velocity, by its columns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FixVelocity {
+    /// No velocity column: positions only (a `NavSatFix`, an NMEA `GGA`).
+    None,
+    /// The two horizontal columns only (NMEA's speed and course over ground): the vertical one
+    /// is not known.
+    Horizontal,
+    /// All three.
+    Full,
+}
+
+/// The one-sigma given to a vertical velocity the fixes do not know, m/s: no information.
+const UNKNOWN_VELOCITY_SIGMA_M_S: f64 = 1e4;
 
 impl FusionInputs {
     /// Reads `imu` (rates) and `gnss` (`columns`: `t_s`, three position and three velocity
-    /// columns; `hint` follows the list of missing ones) and checks the stamps
-    /// ([`check_fix_times`]).
+    /// columns, the velocity's optional, or its vertical one alone; `hint` follows the list of
+    /// missing ones)
+    /// and checks the stamps ([`check_fix_times`]).
     ///
     /// # Errors
     /// Missing columns, named; the stamps' refusals.
@@ -591,11 +610,20 @@ impl FusionInputs {
                 format!("{} rows: fusion needs at least two samples", t.len()),
             ));
         }
-        let missing: Vec<&str> = columns
-            .iter()
-            .copied()
-            .filter(|c| !gnss.columns.iter().any(|h| h == c))
-            .collect();
+        let has = |c: &&str| gnss.columns.iter().any(|h| h == c);
+        // Positions only when none of the velocity's columns is there; the horizontal velocity
+        // alone when the vertical one is missing.
+        let velocities = match (columns[4..6].iter().any(has), has(&columns[6])) {
+            (false, false) => FixVelocity::None,
+            (true, false) => FixVelocity::Horizontal,
+            _ => FixVelocity::Full,
+        };
+        let needed = match velocities {
+            FixVelocity::None => &columns[..4],
+            FixVelocity::Horizontal => &columns[..6],
+            FixVelocity::Full => &columns[..],
+        };
+        let missing: Vec<&str> = needed.iter().copied().filter(|c| !has(c)).collect();
         if !missing.is_empty() {
             return Err(invalid(
                 "GNSS data",
@@ -606,9 +634,15 @@ impl FusionInputs {
         let g_p = gnss
             .triples(&[columns[1], columns[2], columns[3]])
             .unwrap_or_default();
-        let g_v = gnss
-            .triples(&[columns[4], columns[5], columns[6]])
-            .unwrap_or_default();
+        let g_v = match velocities {
+            FixVelocity::Full => gnss.triples(&[columns[4], columns[5], columns[6]]),
+            FixVelocity::Horizontal => gnss
+                .column(columns[4])
+                .zip(gnss.column(columns[5]))
+                .map(|(a, b)| a.into_iter().zip(b).map(|(x, y)| [x, y, 0.0]).collect()),
+            FixVelocity::None => None,
+        }
+        .unwrap_or_else(|| vec![[0.0; 3]; g_t.len()]);
         check_fix_times(&g_t, (t[0], t[t.len() - 1]), t.len())?;
         Ok(Self {
             t,
@@ -617,6 +651,7 @@ impl FusionInputs {
             g_t,
             g_p,
             g_v,
+            velocities,
         })
     }
 
@@ -631,6 +666,13 @@ impl FusionInputs {
     /// # Errors
     /// No fix that fast.
     fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
+        if self.velocities == FixVelocity::None {
+            return Err(invalid(
+                "GNSS data",
+                "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
+                 GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
+            ));
+        }
         let k = self
             .g_v
             .iter()
@@ -698,6 +740,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         g_t,
         g_p,
         g_v,
+        velocities,
     } = &inputs;
     let (t0, t1) = inputs.span();
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
@@ -862,6 +905,12 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
     };
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
+    // The third axis is the vertical in either frame (up in ENU, down in NED).
+    let vertical_sigma = if *velocities == FixVelocity::Horizontal {
+        UNKNOWN_VELOCITY_SIGMA_M_S
+    } else {
+        vel_sigma
+    };
     let mut columns: Vec<&str> = FUSE_COLUMNS.to_vec();
     columns.extend(E::POSITION_COLUMNS);
     let mut table = Table {
@@ -881,10 +930,11 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
                 position: fixes[next_fix],
                 velocity_m_s: setup
                     .gnss_velocity_sigma_m_s
+                    .filter(|_| *velocities != FixVelocity::None)
                     .map(|_| fix_velocity[next_fix]),
                 lever_arm_m: lever,
                 position_sigma_m: setup.gnss_position_sigma_m,
-                velocity_sigma_m_s: [vel_sigma; 3],
+                velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma],
                 // Valid at its stamp minus the latency; applied at this IMU sample.
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
             };
