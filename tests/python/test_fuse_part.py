@@ -137,3 +137,33 @@ def test_fixes_of_positions_only_update_the_position_alone(drive):
     done = subprocess.run([imukit_bin(), "fuse", str(files["imu"]), str(positions), "--align", "gnss",
                            "--scenario", str(scenario), "--out", str(tmp / "aligned.csv")], capture_output=True, text=True)
     assert done.returncode == 65 and "no velocity" in done.stderr, done.stderr
+
+
+def test_each_fix_s_own_accuracy_weighs_it(drive):
+    """Fixes that say they are poor (`horizontal_accuracy_m`, `vertical_accuracy_m` per fix, as a
+    receiver's covariance gives them) are weighed as such: 20 s of fixes 30 m off, marked 1 km
+    one-sigma, leave the estimate where the good fixes put it; unmarked, they pull it away."""
+    tmp, scenario, files = drive
+    gnss = imukit.read(files["gnss"])
+    values = gnss.values.copy()
+    bad = (gnss["t_s"] >= 60.0) & (gnss["t_s"] < 80.0)
+    values[bad, gnss.columns.index("pos_y_m")] += 30.0
+    h = np.where(bad, 1000.0, 1.5)
+    v = np.where(bad, 1000.0, 3.0)
+    paths = {"clean": files["gnss"], "marked": tmp / "marked.csv", "unmarked": tmp / "unmarked.csv"}
+    imukit.Table(list(gnss.columns) + ["horizontal_accuracy_m", "vertical_accuracy_m"],
+                 np.column_stack([values, h, v])).write(paths["marked"])
+    imukit.Table(list(gnss.columns), values).write(paths["unmarked"])
+    truth = imukit.read(files["truth"])
+    worst = {}
+    for name, path in paths.items():
+        out = tmp / f"fused-{name}.csv"
+        done = fuse({**files, "gnss": path}, out, "--scenario", str(scenario), "--no-gate")
+        assert done.returncode == 0, done.stderr
+        worst[name] = imukit.compare(truth, imukit.read(out)).summary["position_max_m"]
+    assert worst["marked"] < 1.5 * worst["clean"] < 15.0 < worst["unmarked"], worst
+    # An accuracy that is no accuracy is refused by its row.
+    h[3] = -1.0
+    imukit.Table(list(gnss.columns) + ["horizontal_accuracy_m"], np.column_stack([values, h])).write(paths["marked"])
+    done = fuse({**files, "gnss": paths["marked"]}, tmp / "refused.csv", "--scenario", str(scenario))
+    assert done.returncode == 65 and "row 5: the fix's accuracy must be positive" in done.stderr, done.stderr

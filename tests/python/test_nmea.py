@@ -55,7 +55,8 @@ def test_a_drive_s_fixes_as_nmea_read_back_and_fuse_as_the_csv_fixes(tmp_path):
     cols = ("t_s", "lat_rad", "lon_rad", "height_m", "vel_n_m_s", "vel_e_m_s")
     (tmp_path / "fixes.nmea").write_text("\r\n".join(nmea_lines(np.column_stack([gnss[c] for c in cols]))) + "\r\n")
     fixes = imukit.read(tmp_path / "fixes.nmea")
-    assert fixes.columns == gnss.columns[:6]  # no vertical speed in NMEA
+    assert fixes.columns == gnss.columns[:6] + ("hdop",)  # no vertical speed in NMEA
+    assert np.all(fixes["hdop"] == np.float32(0.8))
     assert np.allclose(fixes["t_s"], gnss["t_s"], rtol=0, atol=5e-10)
     # Minutes to nine decimals (2e-6 m); the altitude as the nmea crate keeps it (f32: 1e-4 m at 500 m);
     # the speed to its six decimals of a knot and the crate's f32.
@@ -79,6 +80,23 @@ def test_a_drive_s_fixes_as_nmea_read_back_and_fuse_as_the_csv_fixes(tmp_path):
     # simulated: 1e-16 s apart) may be applied at that sample or the next, and that row then
     # differs by the fix's correction.
     assert np.sort(horizontal)[-2] < 0.2, np.sort(horizontal)[-5:]
+    # HDOP × UERE as each fix's horizontal accuracy: the filter's horizontal one-sigma follows
+    # it, the vertical stays the receiver's; Python's gnss_uere_m= gives the same file.
+    sigma = {}
+    for uere in ("1", "10"):
+        out = tmp_path / f"fused-uere-{uere}.csv"
+        done = subprocess.run([imukit_bin(), "fuse", files["imu"], tmp_path / "fixes.nmea", "--init", files["truth"],
+                               "--scenario", scenario, "--gnss-uere-m", uere, "--out", out], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        fused = imukit.read(out)
+        sigma[uere] = (fused["pos_x_sigma_m"][-1], fused["pos_z_sigma_m"][-1])
+    assert sigma["10"][0] > 3 * sigma["1"][0] and abs(sigma["10"][1] / sigma["1"][1] - 1) < 0.2, sigma
+    python = imukit.fuse(imukit.read(files["imu"]), fixes, initial=imukit.read(files["truth"]), scenario=scenario,
+                         gnss_uere_m=10.0)
+    assert np.array_equal(python.values, imukit.read(tmp_path / "fused-uere-10.csv").values)
+    done = subprocess.run([imukit_bin(), "fuse", files["imu"], files["gnss"], "--init", files["truth"],
+                           "--scenario", scenario, "--gnss-uere-m", "1.875", "--out", out], capture_output=True, text=True)
+    assert done.returncode == 65 and "--gnss-uere-m" in done.stderr and "no hdop column" in done.stderr, done.stderr
     # A log whose checksum is wrong is refused by file and line; nothing is written.
     lines = (tmp_path / "fixes.nmea").read_text().splitlines()
     lines[7] = lines[7][:-2] + ("00" if not lines[7].endswith("00") else "01")

@@ -298,6 +298,10 @@ pub enum Command {
         #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
               requires = "imu_model")]
         gnss_lever_arm_m: Option<Vec<f64>>,
+        /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
+        /// user-equivalent range error, m (one-sigma).
+        #[arg(long, allow_hyphen_values = true)]
+        gnss_uere_m: Option<f64>,
         /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
         /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
         /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.

@@ -193,7 +193,7 @@ fn compare<'py>(
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
                     sensor_errors = false, rest_s = None, imu_model = None, part = None,
                     gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
-                    gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None,
+                    gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None, gnss_uere_m = None,
                     nav_frame = None, earth = None, earth_gravity = None, accel_sign = None,
                     gravity_m_s2 = None))]
 #[allow(clippy::too_many_arguments)]
@@ -224,6 +224,7 @@ fn fuse<'py>(
     gnss_vertical_accuracy_m: Option<f64>,
     gnss_velocity_accuracy_m_s: Option<f64>,
     gnss_lever_arm_m: Option<Vec<f64>>,
+    gnss_uere_m: Option<f64>,
     nav_frame: Option<&str>,
     earth: Option<&str>,
     earth_gravity: Option<&str>,
@@ -281,6 +282,10 @@ fn fuse<'py>(
     };
     let imu = table_in("imu", imu_columns, &imu_values)?;
     let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
+    let gnss = match gnss_uere_m {
+        Some(uere) => imukit::io::nmea::with_uere(&gnss, uere).map_err(refused)?,
+        None => gnss,
+    };
     let initial = match (initial_columns, &initial_values) {
         (Some(c), Some(v)) => {
             Some(InitialState::from_table(&table_in("initial", c, v)?).map_err(refused)?)

@@ -25,6 +25,8 @@ pub struct Args<'a> {
     pub scenario: Option<&'a Path>,
     pub model: Option<PartModel>,
     pub earth: Option<EarthName>,
+    /// `--gnss-uere-m`: the fixes' horizontal accuracy from their HDOP.
+    pub gnss_uere_m: Option<f64>,
     pub no_gate: bool,
     pub odometer: Option<&'a Path>,
     pub baro: Option<&'a Path>,
@@ -158,6 +160,16 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
     };
     let gnss = read_table_as(a.gnss, Role::Fixes)?;
+    let gnss = match a.gnss_uere_m {
+        Some(uere) => imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
+            Error::Invalid { message, .. } => Error::Invalid {
+                field: format!("--gnss-uere-m ({})", a.gnss.display()),
+                message,
+            },
+            other => other,
+        })?,
+        None => gnss,
+    };
     let odometer = a.odometer.map(read_table).transpose()?;
     let baro = a.baro.map(read_table).transpose()?;
     let aids = AidTables {

@@ -144,6 +144,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             gnss_vertical_accuracy_m,
             gnss_velocity_accuracy_m_s,
             gnss_lever_arm_m,
+            gnss_uere_m,
             earth,
             no_gate,
             odometer,
@@ -173,6 +174,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                         ..Default::default()
                     },
                 }),
+                gnss_uere_m,
                 earth,
                 no_gate,
                 odometer: odometer.as_deref(),

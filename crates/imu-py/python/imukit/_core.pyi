@@ -265,6 +265,7 @@ def fuse(
     gnss_vertical_accuracy_m: Optional[float] = None,
     gnss_velocity_accuracy_m_s: Optional[float] = None,
     gnss_lever_arm_m: Optional[Sequence[float]] = None,
+    gnss_uere_m: Optional[float] = None,
     nav_frame: Optional[str] = None,
     earth: Optional[str] = None,
     earth_gravity: Optional[str] = None,

@@ -148,7 +148,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
          imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
          gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
          gnss_velocity_accuracy_m_s: Optional[float] = None,
-         gnss_lever_arm_m: Optional[Sequence[float]] = None,
+         gnss_lever_arm_m: Optional[Sequence[float]] = None, gnss_uere_m: Optional[float] = None,
          nav_frame: Optional[str] = None, earth: Optional[str] = None, earth_gravity: Optional[str] = None,
          accel_sign: Optional[str] = None, gravity_m_s2: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
@@ -179,6 +179,11 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     defaults for those left out); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
     ``gravity_m_s2`` say what the tables are in (imukit's defaults; the sign by default the part's
     profile's). The sample rate is the IMU's median.
+
+    Fixes may carry their own accuracy, one-sigma per fix: ``horizontal_accuracy_m`` and
+    ``vertical_accuracy_m`` columns (a ROS ``NavSatFix``'s covariance gives them) replace the
+    receiver's figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
+    ``hdop`` column (HDOP × UERE).
     """
     if (scenario is None) == (imu_model is None):
         raise ValueError("give scenario= (the data's [imu] and [gnss]) or imu_model= (a part), not both or neither")
@@ -187,6 +192,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
                      gnss_vertical_accuracy_m=gnss_vertical_accuracy_m,
                      gnss_velocity_accuracy_m_s=gnss_velocity_accuracy_m_s,
                      gnss_lever_arm_m=None if gnss_lever_arm_m is None else [float(v) for v in gnss_lever_arm_m],
+                     gnss_uere_m=None if gnss_uere_m is None else float(gnss_uere_m),
                      nav_frame=nav_frame, earth=earth, earth_gravity=earth_gravity, accel_sign=accel_sign,
                      gravity_m_s2=None if gravity_m_s2 is None else float(gravity_m_s2))
     if scenario is None:

@@ -5,7 +5,9 @@
 //! `lat_rad`, `lon_rad`, `height_m` — the ellipsoidal height, `GGA`'s altitude above the geoid
 //! plus its geoid separation — and, when every fix has a speed and a course, `vel_n_m_s` and
 //! `vel_e_m_s` (NMEA gives no vertical speed: the filter takes such fixes' velocity as
-//! horizontal only; without velocities the fixes are positions only and it updates on those).
+//! horizontal only; without velocities the fixes are positions only and it updates on those),
+//! and `hdop` when every `GGA` gives it ([`with_uere`] turns it into each fix's horizontal
+//! accuracy).
 //! Epochs without a fix (`GGA` quality 0) are left out; an `RMC` marked void gives no velocity.
 //!
 //! `t_s` is the UTC time of day counted from the midnight before the first fix (the rule of
@@ -37,6 +39,8 @@ struct Epoch {
     /// UTC time of day, s.
     time_of_day_s: f64,
     position: Option<[f64; 3]>,
+    /// `GGA`'s horizontal dilution of precision.
+    hdop: Option<f64>,
     /// Speed over ground (m/s) and true course (rad).
     ground: Option<(f64, f64)>,
 }
@@ -99,7 +103,9 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 let altitude = f64::from(g.altitude.unwrap_or(0.0));
                 let separation = f64::from(g.geoid_separation.unwrap_or(0.0));
                 let position = [lat.to_radians(), lon.to_radians(), altitude + separation];
-                epoch_at(&mut epochs, seconds_of(time)).position = Some(position);
+                let epoch = epoch_at(&mut epochs, seconds_of(time));
+                epoch.position = Some(position);
+                epoch.hdop = g.hdop.map(f64::from).filter(|h| h.is_finite() && *h > 0.0);
             }
             Ok(ParseResult::RMC(r)) => {
                 let (Some(time), Some(speed), Some(course)) =
@@ -147,8 +153,13 @@ pub fn read_table(path: &Path) -> Result<Table> {
         });
     }
     let velocities = fixes.iter().all(|e| e.ground.is_some());
+    let hdop = fixes.iter().all(|e| e.hdop.is_some());
     let width = if velocities { 6 } else { 4 };
-    let mut table = Table::new(&COLUMNS[..width]);
+    let mut columns = COLUMNS[..width].to_vec();
+    if hdop {
+        columns.push(HDOP_COLUMN);
+    }
+    let mut table = Table::new(&columns);
     let (mut day, mut previous) = (0.0, fixes[0].time_of_day_s);
     for e in &fixes {
         // Past midnight: the clock starts again.
@@ -161,9 +172,57 @@ pub fn read_table(path: &Path) -> Result<Table> {
         if let Some((speed, course)) = e.ground.filter(|_| velocities) {
             row.extend([speed * course.cos(), speed * course.sin()]);
         }
+        if let Some(h) = e.hdop.filter(|_| hdop) {
+            row.push(h);
+        }
         table.push_row(&row);
     }
     Ok(table)
+}
+
+/// The column of `GGA`'s horizontal dilution of precision.
+pub const HDOP_COLUMN: &str = "hdop";
+
+/// `fixes` with a `horizontal_accuracy_m` column of their `hdop` times the user-equivalent
+/// range error `uere_m` (one-sigma, m): the horizontal accuracy a receiver's geometry gives.
+///
+/// # Errors
+/// A `uere_m` that is not positive and finite; fixes without `hdop`.
+pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
+    if !(uere_m.is_finite() && uere_m > 0.0) {
+        return Err(crate::error::invalid(
+            "gnss_uere_m",
+            format!("must be a positive number of metres, got {uere_m}"),
+        ));
+    }
+    let Some(hdop) = fixes.column(HDOP_COLUMN) else {
+        return Err(crate::error::invalid(
+            "gnss_uere_m",
+            "the fixes have no hdop column (an NMEA log's GGA gives it) to scale",
+        ));
+    };
+    let name = crate::run::fuse::FIX_ACCURACY_COLUMNS[0];
+    let mut columns: Vec<&str> = fixes
+        .columns
+        .iter()
+        .map(String::as_str)
+        .filter(|c| *c != name)
+        .collect();
+    columns.push(name);
+    let mut out = Table::new(&columns);
+    let index: Vec<usize> = columns[..columns.len() - 1]
+        .iter()
+        .filter_map(|c| fixes.columns.iter().position(|h| h == c))
+        .collect();
+    let width = fixes.columns.len().max(1);
+    let mut row = Vec::with_capacity(columns.len());
+    for (r, h) in fixes.data.chunks_exact(width).zip(hdop) {
+        row.clear();
+        row.extend(index.iter().map(|&k| r[k]));
+        row.push(h * uere_m);
+        out.push_row(&row);
+    }
+    Ok(out)
 }
 
 /// The epoch at time of day `t` (the last one when it is the same time, else a new one).
@@ -220,9 +279,16 @@ mod tests {
             sentence("GPGGA,000001.50,4807.041,N,01131.003,E,0,00,,,M,,M,,"),
         ];
         let t = read_table(&write(&dir, &lines)).expect("read");
-        assert_eq!(t.columns, COLUMNS);
+        assert_eq!(t.columns, [&COLUMNS[..], &[HDOP_COLUMN]].concat());
         assert_eq!(t.rows(), 2, "the epoch without a fix is left out");
-        let (a, b) = (&t.data[..6], &t.data[6..]);
+        let (a, b) = (&t.data[..7], &t.data[7..]);
+        assert_eq!((a[6], b[6]), (f64::from(0.9_f32), f64::from(0.9_f32)));
+        let scaled = with_uere(&t, 4.0).expect("scaled");
+        assert_eq!(
+            scaled.column("horizontal_accuracy_m"),
+            Some(vec![f64::from(0.9_f32) * 4.0; 2])
+        );
+        assert!(with_uere(&t, 0.0).is_err());
         assert_eq!(a[0], 86_399.5);
         assert_eq!(b[0], 86_400.5, "a day added past midnight");
         assert!((a[1] - (48.0 + 7.038 / 60.0_f64).to_radians()).abs() < 1e-15);
@@ -246,7 +312,7 @@ mod tests {
         let dir = tempfile::tempdir().expect("dir");
         let gga = sentence("GPGGA,120000.00,4807.038,N,01131.000,E,1,08,0.9,545.4,M,47.0,M,,");
         let t = read_table(&write(&dir, std::slice::from_ref(&gga))).expect("read");
-        assert_eq!(t.columns, COLUMNS[..4]);
+        assert_eq!(t.columns, [&COLUMNS[..4], &[HDOP_COLUMN]].concat());
         let mut broken = gga.clone();
         broken.replace_range(gga.len() - 2.., "00");
         let e = read_table(&write(&dir, &[gga.clone(), broken]))

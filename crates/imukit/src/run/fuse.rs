@@ -569,6 +569,9 @@ struct FusionInputs {
     g_v: Vec<[f64; 3]>,
     /// What the fixes give of their velocity.
     velocities: FixVelocity,
+    /// Each fix's own horizontal and vertical one-sigma ([`FIX_ACCURACY_COLUMNS`]), if the
+    /// table gives them.
+    accuracy: Option<Vec<[f64; 2]>>,
 }
 
 /// What a table of fixes gives of the velocity, by its columns.
@@ -586,6 +589,11 @@ enum FixVelocity {
 /// The one-sigma given to a vertical velocity the fixes do not know, m/s: no information.
 const UNKNOWN_VELOCITY_SIGMA_M_S: f64 = 1e4;
 
+/// A fix table's own accuracy per fix (what a receiver reports: a `NavSatFix` covariance, an
+/// NMEA HDOP times a UERE), one-sigma per horizontal axis and vertically, m; where a table has
+/// them (either alone, or both) they replace the setup's for that fix.
+pub const FIX_ACCURACY_COLUMNS: [&str; 2] = ["horizontal_accuracy_m", "vertical_accuracy_m"];
+
 impl FusionInputs {
     /// Reads `imu` (rates) and `gnss` (`columns`: `t_s`, three position and three velocity
     /// columns, the velocity's optional, or its vertical one alone; `hint` follows the list of
@@ -594,7 +602,13 @@ impl FusionInputs {
     ///
     /// # Errors
     /// Missing columns, named; the stamps' refusals.
-    fn read(imu: &Table, gnss: &Table, columns: &[&str; 7], hint: &str) -> Result<Self> {
+    fn read(
+        imu: &Table,
+        gnss: &Table,
+        columns: &[&str; 7],
+        hint: &str,
+        accuracy: [f64; 2],
+    ) -> Result<Self> {
         let t = imu
             .column("t_s")
             .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
@@ -644,6 +658,7 @@ impl FusionInputs {
         }
         .unwrap_or_else(|| vec![[0.0; 3]; g_t.len()]);
         check_fix_times(&g_t, (t[0], t[t.len() - 1]), t.len())?;
+        let accuracy = fix_accuracy(gnss, accuracy)?;
         Ok(Self {
             t,
             f,
@@ -652,6 +667,7 @@ impl FusionInputs {
             g_p,
             g_v,
             velocities,
+            accuracy,
         })
     }
 
@@ -693,6 +709,32 @@ impl FusionInputs {
     }
 }
 
+/// A fix table's own accuracy ([`FIX_ACCURACY_COLUMNS`]; where one of the two is missing,
+/// `setup`'s for it), each value a positive finite number; `None` without either column.
+///
+/// # Errors
+/// A value that is not positive and finite (its row).
+fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 2]>>> {
+    let columns = FIX_ACCURACY_COLUMNS.map(|c| gnss.column(c));
+    if columns.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    let rows = gnss.rows();
+    let [h, v] = [0, 1].map(|k| columns[k].clone().unwrap_or_else(|| vec![setup[k]; rows]));
+    for (k, (a, b)) in h.iter().zip(&v).enumerate() {
+        if !(a.is_finite() && b.is_finite() && *a > 0.0 && *b > 0.0) {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "row {}: the fix's accuracy must be positive and finite, got {a} m and {b} m",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok(Some(h.into_iter().zip(v).map(|(a, b)| [a, b]).collect()))
+}
+
 /// Counts fix `index`'s outcome: fixes rejected one after another (`in_a_row`) up to
 /// [`MAX_REJECTED_IN_A_ROW`] are a divergence, reported instead of an estimate.
 ///
@@ -732,7 +774,8 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         start,
         setup,
     } = job;
-    let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT)?;
+    let [h, _, v] = setup.gnss_position_sigma_m;
+    let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT, [h, v])?;
     let FusionInputs {
         t,
         f,
@@ -741,6 +784,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         g_p,
         g_v,
         velocities,
+        accuracy,
     } = &inputs;
     let (t0, t1) = inputs.span();
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
@@ -933,7 +977,10 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
                     .filter(|_| *velocities != FixVelocity::None)
                     .map(|_| fix_velocity[next_fix]),
                 lever_arm_m: lever,
-                position_sigma_m: setup.gnss_position_sigma_m,
+                position_sigma_m: accuracy.as_ref().map_or(setup.gnss_position_sigma_m, |a| {
+                    let [h, v] = a[next_fix];
+                    [h, h, v]
+                }),
                 velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma],
                 // Valid at its stamp minus the latency; applied at this IMU sample.
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,

@@ -48,6 +48,7 @@ use crate::io::description::Description;
 use crate::io::output::OutputFile;
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Table};
+use crate::run::fuse::FIX_ACCURACY_COLUMNS;
 use ros::MessageType;
 
 /// The largest record (a chunk, compressed or not) read whole, bytes: ROS 2 writes chunks of
@@ -107,7 +108,13 @@ fn columns_of(kind: MessageType) -> Vec<&'static str> {
     match kind {
         MessageType::Imu => [ACCEL_COLUMNS, GYRO_COLUMNS].concat(),
         MessageType::MagneticField => MAG_COLUMNS.to_vec(),
-        MessageType::NavSatFix => vec!["lat_rad", "lon_rad", "height_m"],
+        MessageType::NavSatFix => vec![
+            "lat_rad",
+            "lon_rad",
+            "height_m",
+            FIX_ACCURACY_COLUMNS[0],
+            FIX_ACCURACY_COLUMNS[1],
+        ],
         MessageType::PointStamped => POS.to_vec(),
         MessageType::TwistStamped => VEL.to_vec(),
         MessageType::Odometry => [&POS[..], &VEL, &Q].concat(),
@@ -160,10 +167,20 @@ fn decode_row<W: ros::Wire>(
             if m.status.status == ros::STATUS_NO_FIX {
                 return Ok(None);
             }
+            // The covariance's east and north variances' mean per horizontal axis, its up
+            // variance vertically; −1: not given.
+            let c = m.position_covariance;
+            let (h, v) = if m.position_covariance_type == ros::COVARIANCE_TYPE_UNKNOWN {
+                (-1.0, -1.0)
+            } else {
+                (((c[0] + c[4]) / 2.0).sqrt(), c[8].sqrt())
+            };
             let row = vec![
                 m.latitude.to_radians(),
                 m.longitude.to_radians(),
                 m.altitude,
+                if h > 0.0 { h } else { -1.0 },
+                if v > 0.0 { v } else { -1.0 },
             ];
             (m.header.stamp_ns(), row)
         }
@@ -595,10 +612,20 @@ impl Contents {
     fn table_of(&self, d: &Decoded) -> Table {
         let origin = self.origin_ns();
         let own = columns_of(d.kind);
+        // A fix's accuracy is a column only when every fix gives it.
+        let kept = if d.kind == MessageType::NavSatFix
+            && d.rows
+                .chunks_exact(own.len())
+                .any(|r| r[3] <= 0.0 || r[4] <= 0.0)
+        {
+            3
+        } else {
+            own.len()
+        };
         let partner = self.partner_of(d);
         let extra = Self::partner_kind(d.kind).map_or(Vec::new(), |(_, c)| c.to_vec());
         let mut columns = vec!["t_s"];
-        columns.extend(&own);
+        columns.extend(&own[..kept]);
         if partner.is_some() {
             columns.extend(&extra);
         }
@@ -607,7 +634,7 @@ impl Contents {
         for (k, &stamp) in d.stamps_ns.iter().enumerate() {
             row.clear();
             row.push(seconds_after(stamp, origin));
-            row.extend_from_slice(&d.rows[k * own.len()..(k + 1) * own.len()]);
+            row.extend_from_slice(&d.rows[k * own.len()..k * own.len() + kept]);
             if let Some(p) = partner {
                 let v = &p.rows[k * 3..(k + 1) * 3];
                 if d.kind == MessageType::NavSatFix {
