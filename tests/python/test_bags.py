@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.convert import convert
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
@@ -92,6 +93,10 @@ def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_
         # Seconds after the UTC midnight before the first stamp, to the nanosecond.
         midnight = START_NS // DAY_NS * DAY_NS
         assert np.array_equal(np.round(t["t_s"] * 1e9).astype(np.int64), stamps - midnight)
+    # The recorder's receive times instead (written 1 234 567 ns after each header stamp).
+    late = imukit.read(bag, topic="/sensors/imu", receive_time=True)
+    assert np.array_equal(np.round(late["t_s"] * 1e9).astype(np.int64), stamps + 1_234_567 - midnight)
+    assert np.array_equal(late.values[:, 1:], t.values[:, 1:])
     f = imukit.read(bag, topic="/sensors/fix")
     assert f.columns == ("t_s", "lat_rad", "lon_rad", "height_m")
     assert np.allclose(f.values[:, 1:3], np.radians([[lat, lon] for _, lat, lon, _ in fixes]), rtol=0, atol=1e-16)
@@ -104,6 +109,14 @@ def test_a_bag_written_by_rosbags_reads_with_the_same_numbers_in_python_and_the_
         for source in (bag, tmp_path / "imu.csv"):
             out = tmp_path / f"{command[0]}-{source.suffix or 'bag'}.csv"
             extra = ["--topic", "/sensors/imu"] if source == bag else []
+            if source != bag and command[0] == "allan":
+                imukit.read(bag, receive_time=True).write(tmp_path / "late.csv")
+                done = subprocess.run([imukit_bin(), "allan", str(bag), "--receive-time", "--out", str(tmp_path / "a1.csv")],
+                                      capture_output=True, text=True)
+                assert done.returncode == 0, done.stderr
+                done = subprocess.run([imukit_bin(), "allan", str(tmp_path / "late.csv"), "--out", str(tmp_path / "a2.csv")],
+                                      capture_output=True, text=True)
+                assert np.array_equal(imukit.read(tmp_path / "a1.csv").values, imukit.read(tmp_path / "a2.csv").values)
             run = subprocess.run([imukit_bin(), command[0], str(source), *command[1:], *extra, "--out", str(out)],
                                  capture_output=True, text=True)
             assert run.returncode == 0, run.stderr
@@ -117,7 +130,7 @@ def test_bad_bags_and_bad_topics_are_refused_by_file_and_topic(tmp_path):
         imukit.read(folder, topic="/nope")
     with pytest.raises(imukit.ImuError, match="topic /note holds std_msgs/msg/String, a type imukit does not read"):
         imukit.read(folder, topic="/note")
-    with pytest.raises(imukit.ImuError, match="topic= names a topic of a ROS bag"):
+    with pytest.raises(imukit.ImuError, match="topic= and receive_time= are a ROS bag"):
         imukit.read(ROOT / "examples" / "data" / "vendor_log.csv", topic="/imu")
     # A truncated file: refused by name, nothing written by the command that read it.
     (mcap,) = folder.glob("*.mcap")
@@ -167,6 +180,14 @@ def test_imukit_writes_a_bag_rosbags_replays_and_its_commands_read_as_the_csv(tm
     # imukit reads its bag back: each topic by the columns a reader asks for.
     bag = tmp_path / "run.mcap"
     assert np.array_equal(imukit.read(bag).values[:, 1:], imu.values[:, 1:])
+    # For ROS 1, rosbags' converter makes a .bag of it (imukit writes ROS 2's MCAP only), which
+    # reads back as the MCAP does.
+    convert([bag], tmp_path / "run.bag", dst_storage="sqlite3", dst_version=9, compress=None,
+            compress_mode="file", default_typestore=None, typestore=None, exclude_topics=[],
+            include_topics=[], exclude_msgtypes=[], include_msgtypes=[])
+    for topic in ("/imu", "/gnss/position"):
+        a, b = imukit.read(bag, topic=topic), imukit.read(tmp_path / "run.bag", topic=topic)
+        assert a.columns == b.columns and np.array_equal(a.values, b.values), topic
     back = imukit.read(bag, topic="/gnss/position")
     assert back.columns == gnss.columns
     assert np.array_equal(back.values[:, 1:], gnss.values[:, 1:])

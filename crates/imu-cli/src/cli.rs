@@ -107,6 +107,10 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them, not at their
+        /// header stamps.
+        #[arg(long)]
+        receive_time: bool,
         /// 3D: initial state from the first row of this truth file, or of a reference in
         /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
@@ -208,6 +212,10 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them, not at their
+        /// header stamps.
+        #[arg(long)]
+        receive_time: bool,
         /// The filter.
         #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
         filter: FilterKind,
@@ -254,6 +262,10 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them, not at their
+        /// header stamps.
+        #[arg(long)]
+        receive_time: bool,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
         gnss: PathBuf,
         /// The initial state: the first row of this truth file, or of a reference in latitude,
@@ -371,6 +383,10 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them, not at their
+        /// header stamps.
+        #[arg(long)]
+        receive_time: bool,
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -430,6 +446,10 @@ pub enum Command {
         /// reference's).
         #[arg(long = "topic", value_name = "NAME")]
         topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them, not at their
+        /// header stamps.
+        #[arg(long)]
+        receive_time: bool,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,

@@ -22,23 +22,25 @@ fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 /// Every column of a table file, its format by its extension (`.parquet`, else CSV); a CSV
 /// file through a column map when one is given (a TOML file's path, or JSON text).
 #[pyfunction]
-#[pyo3(signature = (path, map_path = None, map_json = None, topic = None))]
+#[pyo3(signature = (path, map_path = None, map_json = None, topic = None, receive_time = false))]
 fn read_table_file<'py>(
     py: Python<'py>,
     path: &str,
     map_path: Option<&str>,
     map_json: Option<&str>,
     topic: Option<String>,
+    receive_time: bool,
 ) -> PyResult<TableOut<'py>> {
-    if let Some(topic) = topic {
+    use imukit::io::bag::{Clock, Role, read_on};
+    if topic.is_some() || receive_time {
+        let clock = if receive_time {
+            Clock::Receive
+        } else {
+            Clock::Header
+        };
+        let named: Vec<String> = topic.into_iter().collect();
         let t = py
-            .detach(|| {
-                imukit::io::bag::read(Path::new(path))?.table_among(
-                    &[topic],
-                    &[],
-                    imukit::io::bag::Role::Any,
-                )
-            })
+            .detach(|| read_on(Path::new(path), clock)?.table_among(&named, &[], Role::Any))
             .map_err(refused)?;
         return table_out(py, t);
     }

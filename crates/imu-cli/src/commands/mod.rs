@@ -68,6 +68,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             input,
             map,
             topics,
+            receive_time,
             init,
             nav_frame,
             gravity_m_s2,
@@ -91,7 +92,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input), init.as_deref()], &topics);
+            attach_topics(&[Some(&input), init.as_deref()], &topics, receive_time);
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -134,6 +135,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             imu,
             map,
             topics,
+            receive_time,
             gnss,
             init,
             align,
@@ -156,7 +158,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&imu, map.as_deref())?;
-            attach_topics(&[Some(&imu), Some(&gnss), init.as_deref()], &topics);
+            attach_topics(
+                &[Some(&imu), Some(&gnss), init.as_deref()],
+                &topics,
+                receive_time,
+            );
             fuse::run(&fuse::Args {
                 imu: &imu,
                 gnss: &gnss,
@@ -191,6 +197,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             input,
             map,
             topics,
+            receive_time,
             filter,
             params,
             conventions,
@@ -199,7 +206,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input)], &topics);
+            attach_topics(&[Some(&input)], &topics, receive_time);
             orient::run(
                 &input,
                 filter,
@@ -214,9 +221,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             truth,
             estimate,
             topics,
+            receive_time,
             out,
         } => {
-            attach_topics(&[Some(&truth), Some(&estimate)], &topics);
+            attach_topics(&[Some(&truth), Some(&estimate)], &topics, receive_time);
             compare::run(&truth, &estimate, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
@@ -229,13 +237,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             input,
             map,
             topics,
+            receive_time,
             columns,
             out,
             plot,
             figure,
         } => {
             attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input)], &topics);
+            attach_topics(&[Some(&input)], &topics, receive_time);
             allan::run(
                 &input,
                 &columns,
@@ -265,11 +274,24 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// Names `topics` (`--topic`) as the ones to read from each of `inputs` that is a bag.
-fn attach_topics(inputs: &[Option<&std::path::Path>], topics: &[String]) {
+/// Names `topics` (`--topic`) as the ones to read from each of `inputs` that is a bag, at the
+/// recorder's receive times when `receive_time` (`--receive-time`).
+fn attach_topics(inputs: &[Option<&std::path::Path>], topics: &[String], receive_time: bool) {
+    use imukit::io::bag::{Clock, Selection};
     for input in inputs.iter().flatten() {
         if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
-            imukit::io::bag::attach_topics(input, topics.to_vec());
+            let clock = if receive_time {
+                Clock::Receive
+            } else {
+                Clock::Header
+            };
+            imukit::io::bag::attach(
+                input,
+                Selection {
+                    topics: topics.to_vec(),
+                    clock,
+                },
+            );
         }
     }
 }

@@ -70,7 +70,7 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     table) as a :class:`Table`; :class:`ImuError` names the file, row and column of bad input."""
     return _table(_core.read_csv(str(path)))
 
-def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None,
+def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_time: bool = False,
          map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None) -> Table:
     """A table file as a :class:`Table`, its format by its extension: ``.csv``, ``.parquet``
     (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy`` (a structured
@@ -96,12 +96,13 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None,
     if suffix not in TABLE_FORMATS:
         raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
                        f"(read: {', '.join(TABLE_FORMATS)})")
-    if topic is not None:
+    if topic is not None or receive_time:
         if suffix not in (".mcap", ".db3", ".bag"):
-            raise ImuError(f"{path}: topic= names a topic of a ROS bag (.mcap, .db3, .bag), not of a {suffix} file")
+            raise ImuError(f"{path}: topic= and receive_time= are a ROS bag's (.mcap, .db3, .bag), not a {suffix} file's")
         if map is not None:
             raise ImuError(f"{path}: map= reads a vendor's CSV; a bag's topics have their own columns")
-        return _table(_core.read_table_file(str(path), topic=str(topic)))
+        return _table(_core.read_table_file(str(path), topic=None if topic is None else str(topic),
+                                            receive_time=bool(receive_time)))
     if map is None:
         return _table(_core.read_table_file(str(path)))
     if isinstance(map, Mapping):

@@ -15,8 +15,8 @@
 //! | `nav_msgs/Odometry` | `t_s`, `pos_*_m`, `vel_*_m_s` (turned from the child frame into the pose's), `q_w…q_z` (+ `lat_rad`, `lon_rad`, `height_m` of a `NavSatFix` topic stamped alike) |
 //! | `geometry_msgs/PoseStamped` | `t_s`, `pos_*_m`, `q_w…q_z` (+ the same) |
 //!
-//! Stamps are the header's, integer nanoseconds, as seconds after the UTC midnight before the
-//! bag's earliest stamp (the rule of [`crate::io::asl`]: every topic of one bag on one clock, to
+//! Stamps are the header's (or, with [`Clock::Receive`], the recorder's receive times), integer
+//! nanoseconds, as seconds after the UTC midnight before the bag's earliest stamp (the rule of [`crate::io::asl`]: every topic of one bag on one clock, to
 //! the nanosecond). A fix without a fix (`status` −1) is left out.
 //!
 //! **Choosing a topic.** A reader asks for the columns it needs; the topics whose table has
@@ -98,6 +98,19 @@ pub struct Contents {
     pub description: Option<Description>,
     /// The numbers decoded so far (checked against the memory limit).
     values: usize,
+    /// Whose stamps the rows carry.
+    clock: Clock,
+}
+
+/// Which time a message of a bag is read at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Clock {
+    /// Its header's stamp: when the data were taken (the default).
+    #[default]
+    Header,
+    /// When the recorder received it (the bag's log time): for drivers whose header stamps
+    /// are missing or wrong.
+    Receive,
 }
 
 /// The columns of a type's own table (without `t_s`).
@@ -214,12 +227,21 @@ fn decode_row<W: ros::Wire>(
 /// schema names, a value that is not finite, a topic of a known type in another encoding than
 /// CDR — each naming the file and the topic; more rows than fit in memory.
 pub fn read(path: &Path) -> Result<Contents> {
+    read_on(path, attached(path).clock)
+}
+
+/// [`read`] with the stamps of `clock` instead of those attached to the bag.
+///
+/// # Errors
+/// As [`read`].
+pub fn read_on(path: &Path, clock: Clock) -> Result<Contents> {
     let mut contents = Contents {
         path: path.into(),
         topics: Vec::new(),
         decoded: Vec::new(),
         description: None,
         values: 0,
+        clock,
     };
     for file in storage_files(path)? {
         read_file(&file, &mut contents)?;
@@ -286,6 +308,7 @@ impl Contents {
         schema: &str,
         encoding: &str,
         data: &[u8],
+        receive_ns: i64,
     ) -> Result<()> {
         let bad = |message: String| Error::CsvFormat {
             file: file.into(),
@@ -327,8 +350,12 @@ impl Contents {
             Encoding::Cdr => decode_row::<ros::Cdr>(kind, data),
             Encoding::Ros1 => decode_row::<ros::Ros1>(kind, data),
         };
-        let Some((stamp, row)) = decoded.map_err(topic_error)? else {
+        let Some((header_ns, row)) = decoded.map_err(topic_error)? else {
             return Ok(());
+        };
+        let stamp = match self.clock {
+            Clock::Header => header_ns,
+            Clock::Receive => receive_ns,
         };
         if let Some(k) = row.iter().position(|v| !v.is_finite()) {
             return Err(topic_error(format!(
@@ -405,6 +432,7 @@ fn read_mcap(path: &Path, contents: &mut Contents) -> Result<()> {
             schema,
             &channel.message_encoding,
             &message.data,
+            i64::try_from(message.log_time).unwrap_or(i64::MAX),
         )?;
     }
     Ok(())
@@ -443,7 +471,8 @@ fn read_ros1(path: &Path, contents: &mut Contents) -> Result<()> {
                             ),
                         });
                     };
-                    contents.ingest(path, topic, tp, "ros1", m.data)?;
+                    let receive = i64::try_from(m.time).unwrap_or(i64::MAX);
+                    contents.ingest(path, topic, tp, "ros1", m.data, receive)?;
                 }
             }
         }
@@ -478,7 +507,7 @@ fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
         }
     }
     let mut query = db
-        .prepare("SELECT topic_id, data FROM messages ORDER BY timestamp, id")
+        .prepare("SELECT topic_id, data, timestamp FROM messages ORDER BY timestamp, id")
         .map_err(bad)?;
     let mut rows = query.query([]).map_err(bad)?;
     while let Some(row) = rows.next().map_err(bad)? {
@@ -491,7 +520,8 @@ fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
         };
         let data = row.get_ref(1).map_err(bad)?;
         let data = data.as_blob().map_err(|e| bad(e.into()))?;
-        contents.ingest(path, topic, tp, format, data)?;
+        let receive: i64 = row.get(2).map_err(bad)?;
+        contents.ingest(path, topic, tp, format, data, receive)?;
     }
     Ok(())
 }
@@ -532,30 +562,50 @@ fn sort_by_stamp(d: &mut Decoded) {
         .collect();
 }
 
-/// The topics named for each bag (the command line's `--topic`, Python's `topic=`).
-static TOPICS: Mutex<Vec<(PathBuf, Vec<String>)>> = Mutex::new(Vec::new());
+/// What to read from a bag: its topics (all when empty) and at which time.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Selection {
+    /// The topics to choose among (the command line's `--topic`, Python's `topic=`).
+    pub topics: Vec<String>,
+    /// Whose stamps (`--receive-time`, Python's `receive_time=`).
+    pub clock: Clock,
+}
 
-/// Names the topics to read from the bag at `path`: from now on in this process, a reader of
-/// that bag chooses among them only.
-pub fn attach_topics(path: &Path, topics: Vec<String>) {
+/// The selection attached to each bag.
+static SELECTIONS: Mutex<Vec<(PathBuf, Selection)>> = Mutex::new(Vec::new());
+
+/// Attaches `selection` to the bag at `path`: from now on in this process, a reader of that bag
+/// chooses among its topics only, at its clock.
+pub fn attach(path: &Path, selection: Selection) {
     let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut all = TOPICS
+    let mut all = SELECTIONS
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     all.retain(|(p, _)| *p != key);
-    if !topics.is_empty() {
-        all.push((key, topics));
+    if selection != Selection::default() {
+        all.push((key, selection));
     }
 }
 
-fn attached_topics(path: &Path) -> Vec<String> {
+/// Names the topics to read from the bag at `path` ([`attach`] with the header clock).
+pub fn attach_topics(path: &Path, topics: Vec<String>) {
+    attach(
+        path,
+        Selection {
+            topics,
+            clock: Clock::Header,
+        },
+    );
+}
+
+fn attached(path: &Path) -> Selection {
     let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    TOPICS
+    SELECTIONS
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
         .iter()
         .find(|(p, _)| *p == key)
-        .map(|(_, t)| t.clone())
+        .map(|(_, s)| s.clone())
         .unwrap_or_default()
 }
 
@@ -666,7 +716,7 @@ impl Contents {
     /// # Errors
     /// As [`Contents::table`].
     pub fn table_as(&self, wanted: &[&str], role: Role) -> Result<Table> {
-        self.table_among(&attached_topics(&self.path), wanted, role)
+        self.table_among(&attached(&self.path).topics, wanted, role)
     }
 
     /// [`Contents::table_as`] among the topics `named` (all when empty) instead of those
