@@ -14,7 +14,8 @@ says no cleanly.
 Classes: byte mutations of valid scenario, CSV and parameter files; generated formulas (deep,
 long, extreme numbers); extreme numeric options; scenarios and navigation on the WGS-84 Earth
 (extreme origins, geodetic formulas, dates, vertical channels); mutated and truncated Parquet,
-``.npy`` and ``.npz`` tables and ROS 2 bags (``.mcap``) fed to the commands that read tables; crafted binary tables (archives whose members
+``.npy`` and ``.npz`` tables and ROS 2 bags (``.mcap``) fed to the commands that read tables; NMEA logs (checksums
+wrong, or right over damaged sentences) and Kalibr files fed to ``fuse``; crafted binary tables (archives whose members
 lie about their sizes, repeat, fail their CRC or expand like bombs, ``.npy`` headers against their files, Parquet
 footers damaged field by field, a column twice); barometer and odometer files fed to ``integrate`` and ``fuse``;
 output paths that collide with inputs, special files and folders; real signals (SIGINT, SIGTERM, SIGHUP) sent to
@@ -33,6 +34,7 @@ import time
 import zipfile
 import zlib
 import json
+import math
 import os
 import random
 import shutil
@@ -512,7 +514,45 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                  "--nhc", "--out", "an.csv"],
             ])
             run_cli(r, work, args, ["ax.csv", "ai.csv", "at.csv", "ag.csv", "ae.toml"], f"case {k} ({name})")
-        for n in ("ae.toml", "ai.csv", "at.csv", "ag.csv", "ab.csv", "ao.csv", "ax.csv", "an.csv"):
+        runs.append(r)
+
+        r = Run("NMEA logs and Kalibr files, mutated")
+        # The fixes as GGA and RMC sentences, and a part as Kalibr's imu.yaml.
+        def sentence(body: str) -> str:
+            total = 0
+            for ch in body.encode(errors="replace"):
+                total ^= ch
+            return f"${body}*{total:02X}"
+        fixes = [l.split(",") for l in (work / "ag.csv").read_text().splitlines() if l and not l.startswith(("#", "t_s"))]
+        nmea = []
+        for t, lat, lon, h, *_ in fixes:
+            hh, rest = divmod(float(t), 3600.0)
+            mm, ss = divmod(rest, 60.0)
+            la, lo = abs(math.degrees(float(lat))), abs(math.degrees(float(lon)))
+            pos = f"{int(la):02d}{(la % 1) * 60:09.6f},N,{int(lo):03d}{(lo % 1) * 60:09.6f},E"
+            stamp = f"{int(hh):02d}{int(mm):02d}{ss:05.2f}"
+            nmea.append(sentence(f"GPGGA,{stamp},{pos},1,08,0.9,{float(h):.3f},M,0.0,M,,"))
+            nmea.append(sentence(f"GPRMC,{stamp},A,{pos},19.4,90.0,270326,,,A"))
+        kalibr = subprocess.run([imukit_bin(), "presets", "mpu-6050", "--format", "kalibr"], cwd=work,
+                                capture_output=True).stdout
+        for k in range(per if nmea and kalibr else 0):
+            if rng.random() < 0.5:
+                lines = list(nmea)
+                for _ in range(rng.randint(1, 4)):
+                    i = rng.randrange(len(lines))
+                    body = lines[i][1:].rsplit("*", 1)[0]
+                    body = mutate(rng, body.encode()).decode(errors="replace").replace("\n", "")
+                    # The checksum made right again half the time: the parser sees the damage.
+                    lines[i] = sentence(body) if rng.random() < 0.5 else "$" + body + lines[i][-3:]
+                (work / "ax.nmea").write_text("\r\n".join(lines) + "\r\n")
+                args = ["fuse", "ai.csv", "ax.nmea", "--init", "at.csv", "--scenario", "ae.toml",
+                        *rng.choice([[], ["--gnss-uere-m", rng.choice(["2", "0", "-1", "1e308"])]]), "--out", "an.csv"]
+                run_cli(r, work, args, ["ax.nmea", "ai.csv", "at.csv", "ae.toml"], f"case {k} (nmea)")
+            else:
+                (work / "kx.yaml").write_bytes(mutate(rng, kalibr))
+                args = ["fuse", "ai.csv", "ag.csv", "--init", "at.csv", "--imu", "kx.yaml", "--out", "an.csv"]
+                run_cli(r, work, args, ["kx.yaml", "ai.csv", "at.csv", "ag.csv"], f"case {k} (kalibr)")
+        for n in ("ae.toml", "ai.csv", "at.csv", "ag.csv", "ab.csv", "ao.csv", "ax.csv", "an.csv", "ax.nmea", "kx.yaml"):
             (work / n).unlink(missing_ok=True)
         runs.append(r)
 
