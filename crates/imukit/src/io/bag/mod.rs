@@ -1047,10 +1047,12 @@ impl BagWriter {
         let truth = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"])
             .zip(find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]))
             .zip(find(c, ["q_w", "q_x", "q_y", "q_z"]));
-        let fix = find(c, ["lat_rad", "lon_rad", "height_m"])
-            .zip(find(c, ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]));
-        let position = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"])
-            .zip(find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]));
+        // Fixes: a position, and where the table has them a velocity and each fix's accuracy.
+        let fix = find(c, ["lat_rad", "lon_rad", "height_m"]);
+        let fix_velocity = find(c, ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]);
+        let position = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"]);
+        let position_velocity = find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]);
+        let accuracy = find(c, FIX_ACCURACY_COLUMNS);
         for (k, row) in table.data.chunks_exact(width).enumerate() {
             let ns = stamp_ns(row[t]).filter(|&ns| ros::Time::from_ns(ns).is_some());
             let Some(ns) = ns else {
@@ -1118,32 +1120,42 @@ impl BagWriter {
                     let m = nav_sat_fix(header(stamp, Stream::TruthFix), llh.map(|k| row[k]));
                     messages.push((ns, Stream::TruthFix, ros::encode(&m)));
                 }
-            } else if let Some((llh, ned)) = fix {
-                let m = nav_sat_fix(header(stamp, Stream::Fix), llh.map(|k| row[k]));
+            } else if let Some(llh) = fix {
+                let mut m = nav_sat_fix(header(stamp, Stream::Fix), llh.map(|k| row[k]));
+                if let Some([h, v]) = accuracy.map(|a| a.map(|k| row[k])) {
+                    // East, north, up variances.
+                    let (h2, v2) = (h * h, v * v);
+                    m.position_covariance = [h2, 0.0, 0.0, 0.0, h2, 0.0, 0.0, 0.0, v2];
+                    m.position_covariance_type = ros::COVARIANCE_TYPE_DIAGONAL_KNOWN;
+                }
                 messages.push((ns, Stream::Fix, ros::encode(&m)));
-                let [n, e, d] = ned.map(|k| row[k]);
-                let m = ros::TwistStamped {
-                    header: header(stamp, Stream::Velocity),
-                    twist: ros::Twist {
-                        linear: ros::Vector3::of([e, n, -d]),
-                        angular: ros::Vector3::default(),
-                    },
-                };
-                messages.push((ns, Stream::Velocity, ros::encode(&m)));
-            } else if let Some((p, v)) = position {
+                if let Some(ned) = fix_velocity {
+                    let [n, e, d] = ned.map(|k| row[k]);
+                    let m = ros::TwistStamped {
+                        header: header(stamp, Stream::Velocity),
+                        twist: ros::Twist {
+                            linear: ros::Vector3::of([e, n, -d]),
+                            angular: ros::Vector3::default(),
+                        },
+                    };
+                    messages.push((ns, Stream::Velocity, ros::encode(&m)));
+                }
+            } else if let Some(p) = position {
                 let m = ros::PointStamped {
                     header: header(stamp, Stream::Position),
                     point: v3(row, p),
                 };
                 messages.push((ns, Stream::Position, ros::encode(&m)));
-                let m = ros::TwistStamped {
-                    header: header(stamp, Stream::Velocity),
-                    twist: ros::Twist {
-                        linear: v3(row, v),
-                        angular: ros::Vector3::default(),
-                    },
-                };
-                messages.push((ns, Stream::Velocity, ros::encode(&m)));
+                if let Some(v) = position_velocity {
+                    let m = ros::TwistStamped {
+                        header: header(stamp, Stream::Velocity),
+                        twist: ros::Twist {
+                            linear: v3(row, v),
+                            angular: ros::Vector3::default(),
+                        },
+                    };
+                    messages.push((ns, Stream::Velocity, ros::encode(&m)));
+                }
             } else {
                 return Err(self.unwritable(c));
             }
@@ -1286,7 +1298,9 @@ mod tests {
         for (a, b) in truth.data.iter().zip(&t.data) {
             assert!((a - b).abs() < 1e-14, "{a} {b}");
         }
-        let f = contents.table(&["lat_rad"]).expect("the fixes");
+        let f = contents
+            .table(&["lat_rad", "vel_n_m_s"])
+            .expect("the fixes");
         assert_eq!(f.columns, fixes.columns);
         for (a, b) in fixes.data.iter().zip(&f.data) {
             assert!((a - b).abs() < 1e-14, "{a} {b}");
@@ -1302,6 +1316,28 @@ mod tests {
         assert_eq!(f.columns, fixes.columns);
         let e = contents.table(&["mag_x_ut"]).unwrap_err().to_string();
         assert!(e.contains("no topic gives the columns mag_x_ut"), "{e}");
+    }
+
+    #[test]
+    fn fixes_keep_their_accuracy_through_the_covariance() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("fixes.mcap");
+        let mut fixes = Table::new(&[
+            "t_s",
+            "lat_rad",
+            "lon_rad",
+            "height_m",
+            "horizontal_accuracy_m",
+            "vertical_accuracy_m",
+        ]);
+        fixes.push_row(&[1.0, 0.8, -0.1, 120.0, 1.5, 3.0]);
+        fixes.push_row(&[2.0, 0.8, -0.1, 121.0, 0.02, 0.05]);
+        write_bag(&path, &[&fixes], &Description::default());
+        let back = read_table(&path, &[]).expect("the fixes, positions only");
+        assert_eq!(back.columns, fixes.columns);
+        for (a, b) in fixes.data.iter().zip(&back.data) {
+            assert!((a - b).abs() <= 1e-15 * a.abs().max(1.0), "{a} {b}");
+        }
     }
 
     #[test]
