@@ -265,3 +265,78 @@ fn the_covariance_stays_symmetric_and_positive_definite_for_a_million_steps() {
     long_run::<Wgs84<Ned>, BASE_STATES>("WGS-84, 15 states");
     long_run::<FlatEarth<Enu>, FULL_STATES>("flat, 36 states");
 }
+
+/// A reset to a fix: the reference point moves to the fix less the lever arm, the velocity to
+/// the fix's, the heading along it; their variances are the fix's and their correlations with
+/// every other state are gone; tilt, biases and their covariance are kept.
+#[test]
+fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
+    let earth = FlatEarth::<Enu>::new(9.81);
+    let start = EskfState::<FlatEarth<Enu>> {
+        nav: NavState {
+            t_s: 0.0,
+            position: Vec3::new(0.0, 0.0, 0.0),
+            velocity_m_s: Vec3::zeros(),
+            attitude: Rotation::identity(),
+        },
+        accel_bias_m_s2: [0.01, 0.0, 0.0],
+        gyro_bias_rad_s: [0.0; 3],
+    };
+    let mut f = Eskf::<FlatEarth<Enu>, BASE_STATES>::new(earth, &start, &SIGMA, NOISE).unwrap();
+    for k in 0..=100 {
+        f.propagate(k as f64 / RATE_HZ, [0.0; 3], [0.0, 0.0, 9.81])
+            .unwrap();
+    }
+    let tilt_before = f.covariance(6, 6);
+    // A fix 40 m north-east with a velocity due north, the antenna 1 m ahead of the reference
+    // point (the body's x axis points east at identity attitude in ENU).
+    let fix = GnssFix::<FlatEarth<Enu>> {
+        position: Vec3::new(30.0, 40.0, 0.0),
+        velocity_m_s: Some(Vec3::new(0.0, 5.0, 0.0)),
+        lever_arm_m: Vec3::new(1.0, 0.0, 0.0),
+        position_sigma_m: [1.5, 1.5, 3.0],
+        velocity_sigma_m_s: [0.1, 0.1, 0.2],
+        age_s: 0.0,
+    };
+    f.reset_to_gnss(&fix, Some(0.02)).unwrap();
+    let s = f.state();
+    // The reference point is the antenna less the lever arm, turned by the attitude after the
+    // reset (forward now north): 1 m south of the fix.
+    let p = s.nav.position.to_array();
+    assert!(
+        (p[0] - 30.0).abs() < 1e-12 && (p[1] - 39.0).abs() < 1e-12 && p[2].abs() < 1e-12,
+        "{p:?}"
+    );
+    let v = s.nav.velocity_m_s.to_array();
+    assert!(v[0].abs() < 1e-12 && (v[1] - 5.0).abs() < 1e-12, "{v:?}");
+    // Heading along the velocity: the body's forward axis now points north.
+    let forward = s.nav.attitude.apply(Vec3::new(1.0, 0.0, 0.0)).to_array();
+    assert!(
+        forward[0].abs() < 1e-12 && (forward[1] - 1.0).abs() < 1e-12,
+        "{forward:?}"
+    );
+    let expected = [1.5, 1.5, 3.0, 0.1, 0.1, 0.2];
+    for (k, sigma) in expected.iter().enumerate() {
+        assert!((f.covariance(k, k) - sigma * sigma).abs() < 1e-15, "{k}");
+        for j in 0..BASE_STATES {
+            if j != k {
+                assert_eq!(f.covariance(k, j), 0.0, "({k}, {j})");
+            }
+        }
+    }
+    assert!((f.covariance(8, 8) - 0.02 * 0.02).abs() < 1e-18);
+    assert_eq!(f.covariance(6, 6), tilt_before, "tilt kept");
+    assert_eq!(s.accel_bias_m_s2, [0.01, 0.0, 0.0], "biases kept");
+    assert_eq!(
+        f.update_counts(),
+        (0, 0),
+        "a reset is neither an update nor a rejection"
+    );
+    // A heading asked for without a horizontal velocity is refused.
+    let still = GnssFix {
+        velocity_m_s: None,
+        ..fix
+    };
+    assert!(f.reset_to_gnss(&still, Some(0.02)).is_err());
+    assert!(f.reset_to_gnss(&still, None).is_ok());
+}

@@ -9,8 +9,8 @@ use crate::convert::{TableOut, table_out};
 use crate::errors::refused;
 
 /// One run of an outage study (`imukit study`'s file at `path`): preset number `case`, run
-/// `run` → `(t_s, horizontal_error_m, horizontal_sigma_m, None)` through the first outage, or
-/// `(None, None, None, message)` when the filter diverged.
+/// `run` → `(t_s, horizontal_error_m, horizontal_sigma_m, None, resets)` through the first
+/// outage, or `(None, None, None, message, 0)` when the filter diverged.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn study_run<'py>(
@@ -23,6 +23,7 @@ fn study_run<'py>(
     Option<Bound<'py, PyArray1<f64>>>,
     Option<Bound<'py, PyArray1<f64>>>,
     Option<String>,
+    usize,
 )> {
     use imukit::run::study::{RunOutcome, Study};
     let path = Path::new(path).to_path_buf();
@@ -35,8 +36,9 @@ fn study_run<'py>(
             Some(r.horizontal_error_m.into_pyarray(py)),
             Some(r.horizontal_sigma_m.into_pyarray(py)),
             None,
+            r.resets,
         ),
-        RunOutcome::Diverged(message) => (None, None, None, Some(message)),
+        RunOutcome::Diverged(message) => (None, None, None, Some(message), 0),
     })
 }
 
@@ -60,11 +62,12 @@ fn study_summarise<'py>(
             Option<Vec<f64>>,
             Option<Vec<f64>>,
             Option<String>,
+            usize,
         )>,
     >,
 ) -> PyResult<(
     TableOut<'py>,
-    Vec<(String, usize, usize, Option<f64>, Option<f64>, f64)>,
+    Vec<(String, usize, usize, Option<f64>, Option<f64>, f64, usize)>,
 )> {
     use imukit::run::study::{OutageRun, RunOutcome, Study};
     let study = Study::from_file(Path::new(path)).map_err(refused)?;
@@ -72,12 +75,13 @@ fn study_summarise<'py>(
         .into_iter()
         .map(|runs| {
             runs.into_iter()
-                .map(|(t, e, s, message)| match (t, e, s) {
+                .map(|(t, e, s, message, resets)| match (t, e, s) {
                     (Some(t_s), Some(horizontal_error_m), Some(horizontal_sigma_m)) => {
                         RunOutcome::Outage(OutageRun {
                             t_s,
                             horizontal_error_m,
                             horizontal_sigma_m,
+                            resets,
                         })
                     }
                     _ => RunOutcome::Diverged(message.unwrap_or_default()),
@@ -96,6 +100,7 @@ fn study_summarise<'py>(
                 m.rms_error_m,
                 m.sigma_m,
                 m.outage_s,
+                m.resets.1,
             )
         })
         .collect();

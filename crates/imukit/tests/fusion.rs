@@ -472,7 +472,7 @@ fn fixes_stamped_late_are_compared_with_the_state_back_then() {
 }
 
 #[test]
-fn fixes_that_jump_are_rejected_and_ten_in_a_row_are_reported_as_divergence() {
+fn fixes_that_jump_are_rejected_and_after_ten_in_a_row_the_filter_is_reset_to_them() {
     let text = scenario("", "decay_factor = 0.0");
     let sim = simulate(&text, 0);
     let sc = ScenarioSpec::from_toml(&text, "fusion.toml")
@@ -487,16 +487,42 @@ fn fixes_that_jump_are_rejected_and_ten_in_a_row_are_reported_as_divergence() {
     gnss.data[50 * width + 1] += 200.0;
     let (_, summary) = fuse(&sim.imu, &gnss, &initial, &setup).unwrap();
     assert_eq!((summary.updates, summary.rejected), (200, 1));
-    // From fix 100 on, every fix 200 m off: divergence reported at the tenth, by row.
+    assert_eq!(summary.resets, 0);
+    // From fix 100 on, every fix 200 m off: the tenth rejected in a row resets the filter to
+    // it, and it follows the fixes from there, its reset counted and in the column.
     for k in 100..gnss.rows() {
         gnss.data[k * width + 1] += 200.0;
+    }
+    let (nav, summary) = fuse(&sim.imu, &gnss, &initial, &setup).unwrap();
+    assert_eq!(summary.resets, 1);
+    assert_eq!(summary.rejected, 1 + 10);
+    let t_fix = gnss.data[109 * width];
+    let (t, resets) = (col(&nav, "t_s"), col(&nav, "gnss_resets"));
+    let first = resets.iter().position(|&r| r == 1.0).unwrap();
+    assert!(
+        t[first] >= t_fix && t[first - 1] < t_fix,
+        "{} {t_fix}",
+        t[first]
+    );
+    assert_eq!(resets.last(), Some(&1.0));
+    // At the end, where the jumped fixes put it (200 m along x), within three of its sigmas.
+    let (x, sx) = (col(&nav, "pos_x_m"), col(&nav, "pos_x_sigma_m"));
+    let truth_x = col(&sim.truth, "pos_x_m");
+    let end = x.len() - 1;
+    let off = x[end] - (truth_x[end] + 200.0);
+    assert!(off.abs() < 3.0 * sx[end], "{off} m (σ {})", sx[end]);
+    // Fixes that jump again and again after each reset are a divergence, reported by row.
+    for k in 100..gnss.rows() {
+        let jump = 200.0 * ((k - 100) / 10) as f64;
+        gnss.data[k * width + 1] += jump;
     }
     let e = match fuse(&sim.imu, &gnss, &initial, &setup) {
         Ok((_, summary)) => panic!("no divergence reported: {summary:?}"),
         Err(e) => e.to_string(),
     };
     assert!(
-        e.contains("row 111: 10 fixes in a row rejected by the innovation gate"),
+        e.contains("fixes in a row rejected by the innovation gate")
+            && e.contains("after 3 resets to the fixes"),
         "{e}"
     );
 }
@@ -694,7 +720,7 @@ fn on_the_earth_ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         let initial = InitialState::from_table(&sim.truth).unwrap();
         let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
         assert_eq!(summary.updates, 201);
-        assert_eq!(nav.columns.len(), 38);
+        assert_eq!(nav.columns.len(), 39); // FUSE_COLUMNS, the geodetic position, gnss_resets
         let worst = |a: &str, b: &str| {
             col(&sim.truth, a)
                 .iter()
@@ -1255,10 +1281,15 @@ fn a_consumer_imu_needs_the_rest_and_the_sensor_error_states_and_learns_them_on_
                 ..plain
             },
         ] {
-            let e = fuse(&sim.imu, gnss, &initial, &setup).unwrap_err();
-            assert!(matches!(e, Error::Diverged { .. }), "run {run}: {e}");
+            // Without both, the filter loses the fixes: it is reset to them (or, when the
+            // resets do not bring it back, diverges), said either way.
+            match fuse(&sim.imu, gnss, &initial, &setup) {
+                Ok((_, summary)) => assert!(summary.resets > 0, "run {run}: {summary:?}"),
+                Err(e) => assert!(matches!(e, Error::Diverged { .. }), "run {run}: {e}"),
+            }
         }
-        let (nav, _) = fuse(&sim.imu, gnss, &initial, &full).unwrap();
+        let (nav, summary) = fuse(&sim.imu, gnss, &initial, &full).unwrap();
+        assert_eq!(summary.resets, 0, "run {run}");
         let i = col(&nav, "t_s").partition_point(|&x| x < 119.9);
         let mut learned = Vec::new();
         for (k, truth) in truth.iter().enumerate() {

@@ -234,5 +234,26 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         last("pos_z_sigma_m"),
         a.out.display()
     );
+    if summary.resets > 0 {
+        let t = nav.column("t_s").unwrap_or_default();
+        let resets = nav
+            .column(imukit::run::fuse::RESETS_COLUMN)
+            .unwrap_or_default();
+        let at: Vec<String> = resets
+            .windows(2)
+            .zip(&t[1..])
+            .filter(|(r, _)| r[1] > r[0])
+            .map(|(_, t)| format!("{t:.2}"))
+            .collect();
+        crate::report::warn(&format!(
+            "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
+             time(s), at t = {} s (column {}): its one-sigma understates its error around them",
+            a.gnss.display(),
+            imukit::run::fuse::MAX_REJECTED_IN_A_ROW,
+            summary.resets,
+            at.join(", "),
+            imukit::run::fuse::RESETS_COLUMN
+        ));
+    }
     Ok(())
 }

@@ -55,14 +55,21 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
                 first.as_deref().unwrap_or("")
             ),
         };
+        let reset = match m.resets {
+            (0, _) => String::new(),
+            (k, total) => format!(
+                "; the filter lost the fixes and was reset to them {total} times in {k} of {runs} \
+                 runs: its one-sigma understates its error"
+            ),
+        };
         match (m.rms_error_m, m.sigma_m) {
             (Some(e), Some(s)) => {
                 crate::note!(
-                    "  {:<14} {e:>10.3} m   (filter: {s:.3} m){diverged}",
+                    "  {:<14} {e:>10.3} m   (filter: {s:.3} m){reset}{diverged}",
                     m.preset
                 );
             }
-            _ => crate::note!("  {:<14} not reported{diverged}", m.preset),
+            _ => crate::note!("  {:<14} not reported{reset}{diverged}", m.preset),
         }
     }
     crate::note!(

@@ -370,10 +370,11 @@ def study_run(
     Optional[npt.NDArray[np.float64]],
     Optional[npt.NDArray[np.float64]],
     Optional[str],
+    int,
 ]: ...
 def study_summarise(
     path: str,
     outcomes: Sequence[
-        Sequence[tuple[Optional[Sequence[float]], Optional[Sequence[float]], Optional[Sequence[float]], Optional[str]]]
+        Sequence[tuple[Optional[Sequence[float]], Optional[Sequence[float]], Optional[Sequence[float]], Optional[str], int]]
     ],
-) -> tuple[_Table, list[tuple[str, int, int, Optional[float], Optional[float], float]]]: ...
+) -> tuple[_Table, list[tuple[str, int, int, Optional[float], Optional[float], float, int]]]: ...

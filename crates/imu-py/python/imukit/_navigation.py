@@ -184,6 +184,10 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     ``vertical_accuracy_m`` columns (a ROS ``NavSatFix``'s covariance gives them) replace the
     receiver's figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
     ``hdop`` column (HDOP × UERE).
+
+    When the gate rejects ten fixes in a row the filter has lost them: it is reset to the last
+    (position, velocity and, moving, heading), counted in the last column ``gnss_resets``, with
+    an :class:`ImuWarning`; fixes still rejected after three resets in a row raise ``ImuError``.
     """
     if (scenario is None) == (imu_model is None):
         raise ValueError("give scenario= (the data's [imu] and [gnss]) or imu_model= (a part), not both or neither")
@@ -219,4 +223,9 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
                              sensor_errors=bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s),
                              **aids, **part_keys)
-    return _table(table)
+    fused = _table(table)
+    resets = fused["gnss_resets"]
+    if len(resets) and resets[-1] > 0:
+        _emit([f"the filter lost the fixes (the gate rejected them one after another) and was reset to them "
+               f"{int(resets[-1])} time(s) (column gnss_resets): its one-sigma understates its error around them"])
+    return fused

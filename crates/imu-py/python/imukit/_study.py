@@ -20,7 +20,9 @@ from ._table import Table, _table
 class PresetSummary:
     """One preset at the last IMU sample of the first outage: the RMS over completed runs of the
     horizontal error and of the filter's horizontal one-sigma (``None`` with fewer than two
-    completed runs), the runs completed and diverged, and that sample's time into the outage."""
+    completed runs), the runs completed and diverged, that sample's time into the outage, and the
+    times the filter lost the fixes and was reset to them over the completed runs (its one-sigma
+    then understates its error)."""
 
     preset: str
     completed: int
@@ -28,6 +30,7 @@ class PresetSummary:
     rms_error_m: Optional[float]
     sigma_m: Optional[float]
     outage_s: float
+    resets: int
 
 
 @dataclass(frozen=True)
@@ -41,10 +44,10 @@ class StudyResult:
 
 def _run(path: str, case: int, run: int):
     """One run (a thread's job or a Dask task): plain lists, as the summary takes them."""
-    t, error, sigma, diverged = _core.study_run(path, case, run)
+    t, error, sigma, diverged, resets = _core.study_run(path, case, run)
     if diverged is not None:
-        return None, None, None, diverged
-    return t.tolist(), error.tolist(), sigma.tolist(), None
+        return None, None, None, diverged, 0
+    return t.tolist(), error.tolist(), sigma.tolist(), None, resets
 
 
 def study(path: Union[str, os.PathLike], *, client: Any = None, threads: Optional[int] = None) -> StudyResult:

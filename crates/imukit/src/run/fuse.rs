@@ -223,7 +223,12 @@ pub struct FuseSummary {
     pub updates: usize,
     /// Updates rejected by the gate.
     pub rejected: usize,
+    /// Resets to the fixes after [`MAX_REJECTED_IN_A_ROW`] of them were rejected in a row.
+    pub resets: usize,
 }
+
+/// The fused estimate's last column: the resets to the fixes so far (a step at each).
+pub const RESETS_COLUMN: &str = "gnss_resets";
 
 /// Where the filter starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -735,32 +740,62 @@ fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 2]>>> 
     Ok(Some(h.into_iter().zip(v).map(|(a, b)| [a, b]).collect()))
 }
 
-/// Counts fix `index`'s outcome: fixes rejected one after another (`in_a_row`) up to
-/// [`MAX_REJECTED_IN_A_ROW`] are a divergence, reported instead of an estimate.
-///
-/// # Errors
-/// The filter's refusal ([`filter_refusal`]) or the divergence.
-fn count_fix(
-    outcome: std::result::Result<imu_core::fusion::UpdateOutcome, EskfError>,
-    index: usize,
-    in_a_row: &mut usize,
-    gate: f64,
-) -> Result<()> {
-    let outcome = outcome.map_err(|e| filter_refusal("GNSS", index, e))?;
-    *in_a_row = if outcome.accepted { 0 } else { *in_a_row + 1 };
-    if *in_a_row >= MAX_REJECTED_IN_A_ROW {
-        return Err(Error::Diverged {
-            context: "GNSS data".into(),
-            message: format!(
-                "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation gate \
-                 (the last with NIS {:.1} against {gate:.1}): the filter has lost the fixes or the \
-                 fixes have jumped; nothing is written",
-                index + 2,
-                outcome.nis
-            ),
-        });
+/// Resets after which the fixes are still rejected, one after another, before the fusion is
+/// a divergence: the filter could not be brought back to them.
+pub const MAX_RESETS_IN_A_ROW: usize = 3;
+
+/// The fixes' acceptance, counted: rejected one after another, and the resets to them.
+#[derive(Debug, Default)]
+struct Acceptance {
+    /// Fixes rejected since the last accepted one (or reset).
+    rejected_in_a_row: usize,
+    /// Resets since the last accepted fix.
+    resets_in_a_row: usize,
+    /// Resets in all.
+    resets: usize,
+}
+
+impl Acceptance {
+    /// Counts fix `index`'s outcome; `true` when it is the [`MAX_REJECTED_IN_A_ROW`]th rejected
+    /// in a row: the filter is to be reset to it.
+    ///
+    /// # Errors
+    /// The filter's refusal ([`filter_refusal`]); a divergence: as many fixes rejected in a row
+    /// again after [`MAX_RESETS_IN_A_ROW`] resets.
+    fn count(
+        &mut self,
+        outcome: std::result::Result<imu_core::fusion::UpdateOutcome, EskfError>,
+        index: usize,
+        gate: f64,
+    ) -> Result<bool> {
+        let outcome = outcome.map_err(|e| filter_refusal("GNSS", index, e))?;
+        if outcome.accepted {
+            self.rejected_in_a_row = 0;
+            self.resets_in_a_row = 0;
+            return Ok(false);
+        }
+        self.rejected_in_a_row += 1;
+        if self.rejected_in_a_row < MAX_REJECTED_IN_A_ROW {
+            return Ok(false);
+        }
+        if self.resets_in_a_row >= MAX_RESETS_IN_A_ROW {
+            return Err(Error::Diverged {
+                context: "GNSS data".into(),
+                message: format!(
+                    "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
+                     gate (the last with NIS {:.1} against {gate:.1}) after {MAX_RESETS_IN_A_ROW} \
+                     resets to the fixes: the fixes have jumped, or the IMU is not the one \
+                     described; nothing is written",
+                    index + 2,
+                    outcome.nis
+                ),
+            });
+        }
+        self.rejected_in_a_row = 0;
+        self.resets_in_a_row += 1;
+        self.resets += 1;
+        Ok(true)
     }
-    Ok(())
 }
 
 /// The GNSS speed above which a vehicle is not at rest for the static alignment, m/s.
@@ -957,12 +992,14 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
     };
     let mut columns: Vec<&str> = FUSE_COLUMNS.to_vec();
     columns.extend(E::POSITION_COLUMNS);
+    let mut columns = fused_columns(&columns, S == FULL_STATES);
+    columns.push(RESETS_COLUMN.to_string());
     let mut table = Table {
-        columns: fused_columns(&columns, S == FULL_STATES),
+        columns,
         data: Vec::new(),
     };
     let (nav_width, base) = (nav_earth::nav_width::<E>(), NAV_COLUMNS.len());
-    let mut rejected_in_a_row = 0;
+    let mut acceptance = Acceptance::default();
     let mut last_yaw = None;
     let mut row = Vec::with_capacity(table.columns.len());
     for i in first..t.len() {
@@ -985,12 +1022,20 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
                 // Valid at its stamp minus the latency; applied at this IMU sample.
                 age_s: t[i] - g_t[next_fix] + setup.gnss_latency_s,
             };
-            count_fix(
-                filter.update_gnss(&fix, setup.gate),
-                next_fix,
-                &mut rejected_in_a_row,
-                setup.gate,
-            )?;
+            if acceptance.count(filter.update_gnss(&fix, setup.gate), next_fix, setup.gate)? {
+                // Lost: back to the fix, the heading along its velocity when the vehicle moves.
+                let heading = fix.velocity_m_s.and_then(|v| {
+                    let speed = v.x().hypot(v.y());
+                    (speed >= ALIGN_MIN_SPEED_M_S).then(|| {
+                        (vel_sigma / speed)
+                            .atan()
+                            .hypot(ALIGN_ATTITUDE_ALLOWANCE_RAD[0])
+                    })
+                });
+                filter
+                    .reset_to_gnss(&fix, heading)
+                    .map_err(|e| filter_refusal("GNSS", next_fix, e))?;
+            }
             next_fix += 1;
         }
         aid_streams.apply(&mut filter, t[i], i)?;
@@ -1007,11 +1052,20 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         if S == FULL_STATES {
             push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..]);
         }
+        #[allow(clippy::cast_precision_loss)]
+        row.push(acceptance.resets as f64);
         table.push_row(&row);
     }
     table.check_finite("fused navigation")?;
     let (updates, rejected) = filter.update_counts();
-    Ok((table, FuseSummary { updates, rejected }))
+    Ok((
+        table,
+        FuseSummary {
+            updates,
+            rejected,
+            resets: acceptance.resets,
+        },
+    ))
 }
 
 /// The refusal of `setup`'s covariance interval.
@@ -1261,7 +1315,8 @@ impl PartModel {
     }
 }
 
-/// Fixes rejected one after another before the fusion reports divergence instead of an estimate.
+/// Fixes rejected one after another before the filter is reset to the last of them
+/// ([`Eskf::reset_to_gnss`](imu_core::fusion::Eskf::reset_to_gnss)).
 pub const MAX_REJECTED_IN_A_ROW: usize = 10;
 
 /// The default innovation gate of a position-and-velocity fix: the chi-square 99.9 % quantile

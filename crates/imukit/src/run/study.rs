@@ -92,6 +92,9 @@ pub struct OutageRun {
     pub horizontal_error_m: Vec<f64>,
     /// The filter's horizontal one-sigma `√(σ_x² + σ_y²)`, m.
     pub horizontal_sigma_m: Vec<f64>,
+    /// Times the filter lost the fixes and was reset to them over the whole run
+    /// ([`crate::run::fuse::FuseSummary::resets`]): its one-sigma then understates its error.
+    pub resets: usize,
 }
 
 /// How one run ended.
@@ -113,6 +116,8 @@ pub struct PresetSummary {
     pub completed: usize,
     /// Runs whose filter diverged, and the first one's message.
     pub diverged: (usize, Option<String>),
+    /// Completed runs whose filter was reset to the fixes, and the resets in all.
+    pub resets: (usize, usize),
     /// RMS over completed runs of the horizontal error at the last IMU sample of the outage
     /// (before the first fix after it), m (`None` with fewer than two completed runs).
     pub rms_error_m: Option<f64>,
@@ -301,8 +306,9 @@ impl Study {
             odometer: sim.odometer.as_ref().filter(|_| self.odometer),
             baro: sim.baro.as_ref().filter(|_| self.baro),
         };
-        let nav = match fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &c.setup) {
-            Ok((nav, _)) => nav,
+        let (nav, resets) = match fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &c.setup)
+        {
+            Ok((nav, summary)) => (nav, summary.resets),
             Err(Error::Diverged { context, message }) => {
                 return Ok(RunOutcome::Diverged(format!(
                     "preset {}, run {run}: {context}: {message}",
@@ -324,6 +330,7 @@ impl Study {
             t_s: Vec::new(),
             horizontal_error_m: Vec::new(),
             horizontal_sigma_m: Vec::new(),
+            resets,
         };
         // The row at the outage's end already holds the first fix after it: stop before it.
         for i in (0..t.len()).filter(|&i| t[i] >= start && t[i] < end) {
@@ -430,6 +437,10 @@ impl Study {
                     preset: case.preset.clone(),
                     completed: completed[c].len(),
                     diverged: (outcomes[c].len() - completed[c].len(), first_divergence),
+                    resets: (
+                        completed[c].iter().filter(|r| r.resets > 0).count(),
+                        completed[c].iter().map(|r| r.resets).sum(),
+                    ),
                     rms_error_m: ok.then(|| rms(&completed[c], last, error)),
                     sigma_m: ok.then(|| rms(&completed[c], last, sigma)),
                     outage_s: t[last],
