@@ -42,6 +42,14 @@ fn study_run<'py>(
     })
 }
 
+/// The study at `path`: the presets it compares that are not described alike, a line each
+/// (`Study::undescribed`).
+#[pyfunction]
+fn study_undescribed(path: &str) -> PyResult<Vec<String>> {
+    let s = imukit::run::study::Study::from_file(Path::new(path)).map_err(refused)?;
+    Ok(s.undescribed())
+}
+
 /// The study at `path`: its presets and runs per preset.
 #[pyfunction]
 fn study_plan(path: &str) -> PyResult<(Vec<String>, u64)> {
@@ -110,6 +118,7 @@ fn study_summarise<'py>(
 /// Adds this module's functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(study_undescribed, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;
     m.add_function(wrap_pyfunction!(study_summarise, m)?)?;
     Ok(())

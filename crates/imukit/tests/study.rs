@@ -175,3 +175,26 @@ fn an_odometer_and_the_vehicle_constraints_shrink_the_drift_through_the_tunnel()
     assert!(wheels < 0.5 * gnss_only, "{wheels} vs {gnss_only}");
     assert!((wheels / sigma - 1.0).abs() < 0.25, "{wheels} vs σ {sigma}");
 }
+
+#[test]
+fn parts_not_described_alike_are_named_before_the_study_runs() {
+    // The ICM-42688-P preset gives noise only; the STIM300 a turn-on bias, a drift and
+    // scale-factor and misalignment errors, on both sensors: six terms, each named.
+    let lines = study(&["stim300", "icm-42688-p"], 2).undescribed();
+    assert_eq!(lines.len(), 6, "{lines:#?}");
+    for (sensor, term) in [
+        ("accelerometer", "turn-on bias"),
+        ("gyroscope", "bias drift"),
+        ("gyroscope", "scale-factor and misalignment errors"),
+    ] {
+        let line = format!("icm-42688-p: no {sensor} {term}");
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.starts_with(&line) && l.contains("(given by stim300")),
+            "{line}: {lines:#?}"
+        );
+    }
+    // Parts described alike (neither gives any of the terms): nothing to say.
+    assert!(study(&["ideal", "icm-42688-p"], 2).undescribed().is_empty());
+}

@@ -18,6 +18,9 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
     let mut outputs = vec![("--out", out)];
     outputs.extend(plot.map(|p| ("--plot", p)));
     check_outputs(&inputs, &outputs)?;
+    for line in s.undescribed() {
+        crate::report::warn(&format!("the presets are not described alike: {line}"));
+    }
     let presets = s.presets().count();
     let runs = s.runs();
     let total = presets as u64 * runs;

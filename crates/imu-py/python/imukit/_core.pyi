@@ -17,6 +17,7 @@ __all__ = [
     "DEFAULTS",
     "ImuError",
     "study_plan",
+    "study_undescribed",
     "study_run",
     "study_summarise",
     "DEFAULT_GRAVITY_M_S2",
@@ -363,6 +364,7 @@ def ecompass(
 ) -> npt.NDArray[np.float64]: ...
 def quaternion_distance(q1: npt.NDArray[np.float64], q2: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def study_plan(path: str) -> tuple[list[str], int]: ...
+def study_undescribed(path: str) -> list[str]: ...
 def study_run(
     path: str, case: int, run: int
 ) -> tuple[

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any, List, Optional, Union
 
 from . import _core
+from ._warning import _emit
 from ._table import Table, _table
 
 
@@ -56,10 +57,13 @@ def study(path: Union[str, os.PathLike], *, client: Any = None, threads: Optiona
 
     Without a ``client`` the runs share this machine's cores (``threads``, default all; imukit
     releases the GIL). With a ``dask.distributed.Client`` every run is a Dask task; the workers
-    need imukit installed and the study and scenario files at the same path.
+    need imukit installed and the study and scenario files at the same path. Presets not
+    described alike (one gives a turn-on bias, a bias drift or scale-factor and misalignment
+    errors that another leaves out, taken as zero) are named in an :class:`ImuWarning` first.
     """
     where = str(Path(path).resolve())
     presets, runs = _core.study_plan(where)
+    _emit(f"the presets are not described alike: {line}" for line in _core.study_undescribed(where))
     jobs = [(case, run) for case in range(len(presets)) for run in range(runs)]
     cases = [c for c, _ in jobs]
     ids = [r for _, r in jobs]

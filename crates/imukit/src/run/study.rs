@@ -273,6 +273,65 @@ impl Study {
         self.cases.iter().map(|c| c.preset.as_str())
     }
 
+    /// The presets not described alike: for each error term (a turn-on bias, a bias drift —
+    /// bias instability or random walk —, scale-factor and misalignment errors) of the
+    /// accelerometer or gyroscope that some preset gives and others leave out, a line naming
+    /// those that leave it out. A term left out counts as zero, so such parts are not compared
+    /// on the same footing: the study says so before it runs.
+    #[must_use]
+    pub fn undescribed(&self) -> Vec<String> {
+        type Given = fn(&crate::sensor::SensorParams) -> bool;
+        let terms: [(&str, Given); 3] = [
+            ("turn-on bias", |p| {
+                p.constant_bias.iter().any(|&b| b != 0.0)
+            }),
+            ("bias drift (bias instability or random walk)", |p| {
+                p.bias_instability
+                    .iter()
+                    .chain(&p.random_walk)
+                    .any(|&b| b != 0.0)
+            }),
+            ("scale-factor and misalignment errors", |p| {
+                p.axes_misalignment_pct.iter().enumerate().any(|(r, row)| {
+                    row.iter()
+                        .enumerate()
+                        .any(|(c, &v)| v != if r == c { 100.0 } else { 0.0 })
+                })
+            }),
+        ];
+        let mut lines = Vec::new();
+        for (sensor, pick) in [
+            (
+                "accelerometer",
+                (|p| &p.accelerometer)
+                    as fn(&crate::io::params::ImuParams) -> &crate::sensor::SensorParams,
+            ),
+            ("gyroscope", |p| &p.gyroscope),
+        ] {
+            for (term, given) in terms {
+                let (with, without): (Vec<&Case>, Vec<&Case>) = self
+                    .cases
+                    .iter()
+                    .partition(|c| given(pick(&c.scenario.imu.sensors.params)));
+                if !with.is_empty() && !without.is_empty() {
+                    let names = |cs: &[&Case]| {
+                        cs.iter()
+                            .map(|c| c.preset.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    };
+                    lines.push(format!(
+                        "{}: no {sensor} {term} (given by {}); taken as zero, it makes those \
+                         parts look better than the others",
+                        names(&without),
+                        names(&with)
+                    ));
+                }
+            }
+        }
+        lines
+    }
+
     /// Runs per preset.
     #[must_use]
     pub fn runs(&self) -> u64 {
