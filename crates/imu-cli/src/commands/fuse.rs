@@ -97,17 +97,8 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let initial = match a.init {
         Some(init) => {
             let (frame, on_earth) = data_frame(a)?;
-            let s = super::integrate::start_from(init, frame, on_earth, a.align.is_some())
-                .map_err(|e| match e {
-                    CliError::Library(Error::Invalid { field, message }) if field == "--init" => {
-                        Error::Invalid {
-                            field,
-                            message: message.replace("--euler0-rad", "--align"),
-                        }
-                        .into()
-                    }
-                    other => other,
-                })?;
+            let attitude = a.align.is_some().then_some("--align");
+            let s = super::integrate::start_from(init, frame, on_earth, attitude.ok_or("--align"))?;
             s.check(&format!("{}, row 2", init.display()))?;
             Some(s)
         }

@@ -81,12 +81,12 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
 
 /// The start the `--init` file `path` gives for a run in `frame`: a reference on the Earth
 /// (latitude, longitude and height, or ECEF) needs the WGS-84 Earth, and an attitude from the
-/// file or from `--euler0-rad` (`euler0`).
+/// file or from the option `attitude` names (`Ok`: given, `Err`: the option to ask for).
 pub(crate) fn start_from(
     path: &Path,
     frame: imukit::scenario::NavFrameName,
     on_earth: bool,
-    euler0: bool,
+    attitude: Result<&str, &str>,
 ) -> Result<InitialState, CliError> {
     let (initial, given) = InitialState::from_reference(path, frame)?;
     if given.on_earth && !on_earth {
@@ -100,11 +100,11 @@ pub(crate) fn start_from(
         }
         .into());
     }
-    if !given.attitude && !euler0 {
+    if let (false, Err(option)) = (given.attitude, attitude) {
         return Err(Error::Invalid {
             field: "--init".into(),
             message: format!(
-                "{} gives no attitude (q_w, q_x, q_y, q_z): give it with --euler0-rad",
+                "{} gives no attitude (q_w, q_x, q_y, q_z): give it with {option}",
                 path.display()
             ),
         }
@@ -139,12 +139,10 @@ pub fn three_d(
     .map_err(by_flag)?;
     let setup = request.setup().map_err(by_flag)?;
     let mut initial = match o.init {
-        Some(p) => start_from(
-            p,
-            setup.nav_frame,
-            setup.earth.is_some(),
-            o.euler0.is_some(),
-        )?,
+        Some(p) => {
+            let attitude = o.euler0.map(|_| "--euler0-rad").ok_or("--euler0-rad");
+            start_from(p, setup.nav_frame, setup.earth.is_some(), attitude)?
+        }
         None => InitialState::default(),
     };
     if let Some(p) = c.position0 {

@@ -333,7 +333,7 @@ impl Description {
                 Self::from_entries(entries, &place).map(Some)
             }
             TableFormat::Npy | TableFormat::Npz | TableFormat::Nmea => Ok(None),
-            TableFormat::Mcap => Ok(crate::io::bag::read(path)?.description),
+            TableFormat::Mcap => crate::io::bag::description(path),
             TableFormat::Csv => Self::read_csv(path),
         }
     }

@@ -23,6 +23,7 @@ use nmea::ParseResult;
 
 use crate::error::{Error, Result};
 use crate::io::table::Table;
+use crate::scenario::gnss::GNSS_EARTH_COLUMNS;
 
 /// The longest line read, bytes (NMEA's limit is 82 characters; loggers add their own stamp).
 const MAX_LINE_BYTES: u64 = 4096;
@@ -45,15 +46,9 @@ struct Epoch {
     ground: Option<(f64, f64)>,
 }
 
-/// The columns of a table of fixes with velocities.
-const COLUMNS: [&str; 6] = [
-    "t_s",
-    "lat_rad",
-    "lon_rad",
-    "height_m",
-    "vel_n_m_s",
-    "vel_e_m_s",
-];
+/// The columns of a table of fixes with horizontal velocities: the geodetic fix table's
+/// ([`GNSS_EARTH_COLUMNS`]) without `vel_d_m_s`.
+const COLUMNS: &[&str] = GNSS_EARTH_COLUMNS.split_at(6).0;
 
 /// Reads the NMEA log at `path` as a table of fixes (see the module documentation).
 ///
@@ -279,7 +274,7 @@ mod tests {
             sentence("GPGGA,000001.50,4807.041,N,01131.003,E,0,00,,,M,,M,,"),
         ];
         let t = read_table(&write(&dir, &lines)).expect("read");
-        assert_eq!(t.columns, [&COLUMNS[..], &[HDOP_COLUMN]].concat());
+        assert_eq!(t.columns, [COLUMNS, &[HDOP_COLUMN]].concat());
         assert_eq!(t.rows(), 2, "the epoch without a fix is left out");
         let (a, b) = (&t.data[..7], &t.data[7..]);
         assert_eq!((a[6], b[6]), (f64::from(0.9_f32), f64::from(0.9_f32)));

@@ -10,6 +10,7 @@
 use imu_core::earth::{Geodetic, MAX_LATITUDE_RAD};
 use imu_core::{Body, Ecef, Enu, Frd, NavFrame, Ned, Rotation, Vec3};
 
+use crate::run::navigate::GEODETIC_COLUMNS;
 use crate::scenario::NavFrameName;
 
 /// How a reference gives its position.
@@ -36,10 +37,10 @@ impl Position {
 
     /// Its columns.
     #[must_use]
-    pub fn columns(self) -> [&'static str; 3] {
+    pub const fn columns(self) -> [&'static str; 3] {
         match self {
             Self::Plane => ["pos_x_m", "pos_y_m", "pos_z_m"],
-            Self::GeodeticRad => ["lat_rad", "lon_rad", "height_m"],
+            Self::GeodeticRad => GEODETIC_COLUMNS,
             Self::GeodeticDeg => ["lat_deg", "lon_deg", "height_m"],
             Self::Ecef => ["ecef_x_m", "ecef_y_m", "ecef_z_m"],
         }
@@ -78,7 +79,7 @@ pub enum Velocity {
 impl Velocity {
     /// Its columns.
     #[must_use]
-    pub fn columns(self) -> [&'static str; 3] {
+    pub const fn columns(self) -> [&'static str; 3] {
         match self {
             Self::Nav => ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"],
             Self::Ned => ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"],

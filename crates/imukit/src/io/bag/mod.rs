@@ -49,6 +49,8 @@ use crate::io::output::OutputFile;
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Table};
 use crate::run::fuse::FIX_ACCURACY_COLUMNS;
+use crate::run::navigate::GEODETIC_COLUMNS;
+use crate::run::reference::{Position, QUATERNION_COLUMNS, Velocity};
 use ros::MessageType;
 
 /// The largest record (a chunk, compressed or not) read whole, bytes: ROS 2 writes chunks of
@@ -115,19 +117,13 @@ pub enum Clock {
 
 /// The columns of a type's own table (without `t_s`).
 fn columns_of(kind: MessageType) -> Vec<&'static str> {
-    const POS: [&str; 3] = ["pos_x_m", "pos_y_m", "pos_z_m"];
-    const VEL: [&str; 3] = ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"];
-    const Q: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
+    const POS: [&str; 3] = Position::Plane.columns();
+    const VEL: [&str; 3] = Velocity::Nav.columns();
+    const Q: [&str; 4] = QUATERNION_COLUMNS;
     match kind {
         MessageType::Imu => [ACCEL_COLUMNS, GYRO_COLUMNS].concat(),
         MessageType::MagneticField => MAG_COLUMNS.to_vec(),
-        MessageType::NavSatFix => vec![
-            "lat_rad",
-            "lon_rad",
-            "height_m",
-            FIX_ACCURACY_COLUMNS[0],
-            FIX_ACCURACY_COLUMNS[1],
-        ],
+        MessageType::NavSatFix => [&GEODETIC_COLUMNS[..], &FIX_ACCURACY_COLUMNS].concat(),
         MessageType::PointStamped => POS.to_vec(),
         MessageType::TwistStamped => VEL.to_vec(),
         MessageType::Odometry => [&POS[..], &VEL, &Q].concat(),
@@ -250,6 +246,40 @@ pub fn read_on(path: &Path, clock: Clock) -> Result<Contents> {
         sort_by_stamp(d);
     }
     Ok(contents)
+}
+
+/// The description the bag at `path` carries in its channels' metadata (what imukit writes),
+/// read from its first message alone: only an MCAP file can carry one.
+///
+/// # Errors
+/// An unreadable or damaged start of the file, naming it.
+pub fn description(path: &Path) -> Result<Option<Description>> {
+    let Some(file) = storage_files(path)?.into_iter().next() else {
+        return Ok(None);
+    };
+    let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !ext.eq_ignore_ascii_case("mcap") {
+        return Ok(None);
+    }
+    let (handle, _) = crate::io::open_with_length(&file)?;
+    let options = LinearReaderOptions::default()
+        .with_record_length_limit(RECORD_LIMIT)
+        .with_prevalidate_chunk_crcs(true);
+    let first = crate::io::contained(|| {
+        mcap::io::MessageReader::new_with_options(BufReader::new(handle), options).next()
+    })
+    .map_err(|panic| Error::CsvFormat {
+        file: file.clone(),
+        message: format!("not a readable MCAP file ({panic})"),
+    })?;
+    match first {
+        None => Ok(None),
+        Some(Err(e)) => Err(Error::CsvFormat {
+            file,
+            message: format!("not a readable MCAP file: {e}"),
+        }),
+        Some(Ok(message)) => channel_description(&file, &message.channel.metadata),
+    }
 }
 
 /// The storage files of the bag at `path`: the file itself, or a bag folder's `.mcap` or
@@ -637,16 +667,10 @@ impl Contents {
     fn partner_kind(kind: MessageType) -> Option<(MessageType, [&'static str; 3])> {
         match kind {
             MessageType::Imu => Some((MessageType::MagneticField, MAG_COLUMNS)),
-            MessageType::NavSatFix => Some((
-                MessageType::TwistStamped,
-                ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"],
-            )),
-            MessageType::PointStamped => Some((
-                MessageType::TwistStamped,
-                ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"],
-            )),
+            MessageType::NavSatFix => Some((MessageType::TwistStamped, Velocity::Ned.columns())),
+            MessageType::PointStamped => Some((MessageType::TwistStamped, Velocity::Nav.columns())),
             MessageType::Odometry | MessageType::PoseStamped => {
-                Some((MessageType::NavSatFix, ["lat_rad", "lon_rad", "height_m"]))
+                Some((MessageType::NavSatFix, GEODETIC_COLUMNS))
             }
             _ => None,
         }
@@ -1044,14 +1068,14 @@ impl BagWriter {
         };
         let imu = find(c, ACCEL_COLUMNS).zip(find(c, GYRO_COLUMNS));
         let mag = find(c, MAG_COLUMNS);
-        let truth = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"])
-            .zip(find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]))
-            .zip(find(c, ["q_w", "q_x", "q_y", "q_z"]));
+        let position = find(c, Position::Plane.columns());
+        let position_velocity = find(c, Velocity::Nav.columns());
+        let truth = position
+            .zip(position_velocity)
+            .zip(find(c, QUATERNION_COLUMNS));
         // Fixes: a position, and where the table has them a velocity and each fix's accuracy.
-        let fix = find(c, ["lat_rad", "lon_rad", "height_m"]);
-        let fix_velocity = find(c, ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"]);
-        let position = find(c, ["pos_x_m", "pos_y_m", "pos_z_m"]);
-        let position_velocity = find(c, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]);
+        let fix = find(c, GEODETIC_COLUMNS);
+        let fix_velocity = find(c, Velocity::Ned.columns());
         let accuracy = find(c, FIX_ACCURACY_COLUMNS);
         for (k, row) in table.data.chunks_exact(width).enumerate() {
             let ns = stamp_ns(row[t]).filter(|&ns| ros::Time::from_ns(ns).is_some());
@@ -1114,9 +1138,7 @@ impl BagWriter {
                 };
                 messages.push((ns, stream, ros::encode(&m)));
                 // On the WGS-84 Earth, the reference point's latitude, longitude and height.
-                if let (Some(llh), false) =
-                    (find(c, ["lat_rad", "lon_rad", "height_m"]), self.estimate)
-                {
+                if let (Some(llh), false) = (fix, self.estimate) {
                     let m = nav_sat_fix(header(stamp, Stream::TruthFix), llh.map(|k| row[k]));
                     messages.push((ns, Stream::TruthFix, ros::encode(&m)));
                 }
