@@ -432,7 +432,8 @@ pub enum Command {
         /// Its unit (°/√h, °/h, °/s/√Hz, µg/√Hz, m/s/√h, mg, ppm, …).
         unit: String,
     },
-    /// Allan deviation of IMU columns (octave τ) with N, K and B identified.
+    /// Allan deviation of IMU columns (octave τ) with white noise N, bias instability B and
+    /// random walk K fitted (a term not resolved shows as its bound).
     Allan {
         /// IMU readings CSV (with `t_s`).
         input: PathBuf,
@@ -457,6 +458,48 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// The figure's size and resolution.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// Noise identification of a static log: Allan curves with 95 % bands, the noise terms
+    /// (quantisation, white noise, bias instability, rate random walk, rate ramp) each with its
+    /// 95 % interval or, not resolved, its bound and the record that would resolve it; an imukit
+    /// parameter file, a Kalibr imu.yaml, the fusion filter's noise.
+    Identify {
+        /// The static log (any format imukit reads, with `t_s`).
+        input: PathBuf,
+        /// A column map (TOML) for a vendor's CSV (docs/formats.md).
+        #[arg(long, value_name = "FILE")]
+        map: Option<PathBuf>,
+        /// A topic to read from a ROS bag that holds several that fit.
+        #[arg(long = "topic", value_name = "NAME")]
+        topics: Vec<String>,
+        /// Read a ROS bag's messages at the times the recorder received them.
+        #[arg(long)]
+        receive_time: bool,
+        /// Columns to analyse (default: every gyro and accel column present).
+        #[arg(long = "column")]
+        columns: Vec<String>,
+        /// Where to write `tau_s` and per column `adev_`, `lower95_`, `upper95_`, `edf_`, `fit_`
+        /// (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+        #[arg(long)]
+        out: PathBuf,
+        /// Also write the identified part as an imukit parameter file (TOML) for `--imu`.
+        #[arg(long, value_name = "FILE")]
+        params: Option<PathBuf>,
+        /// Also write the identified part as Kalibr's imu.yaml.
+        #[arg(long, value_name = "FILE")]
+        kalibr: Option<PathBuf>,
+        /// Factor on the Kalibr file's densities (stated in the file).
+        #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+        kalibr_inflation: f64,
+        /// The IMU topic written in the Kalibr file.
+        #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC, value_name = "TOPIC")]
+        kalibr_topic: String,
+        /// Also draw the curves, their bands and the fitted terms (`.svg` or `.png`).
         #[arg(long)]
         plot: Option<PathBuf>,
         /// The figure's size and resolution.

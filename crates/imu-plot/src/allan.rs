@@ -1,4 +1,5 @@
-//! The Allan-deviation figure: log-log curves with the fitted −½, 0 and +½ lines dashed.
+//! The Allan-deviation figure: log-log curves with their 95 % bands and the fitted noise terms'
+//! sum dashed.
 use std::path::Path;
 
 use imukit::run::allan::AllanResult;
@@ -41,7 +42,8 @@ fn unit_of(column: &str) -> &'static str {
 }
 
 /// Draws `result` (one curve per column) into `path` (SVG or PNG) at `size`: one panel per
-/// unit (the gyroscopes' rad/s apart from the accelerometers' m/s²), the fitted lines dashed,
+/// unit (the gyroscopes' rad/s apart from the accelerometers' m/s²), each curve's 95 % band and
+/// fitted terms drawn where `result` has them,
 /// titled with `source` (the data's file).
 ///
 /// # Errors
@@ -135,23 +137,37 @@ pub fn allan_figure(
                 chart
                     .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))
                     .map_err(err)?;
-                let Some((_, id)) = result.noise.get(k) else {
+                let Some(noise) = result.noise.get(k) else {
                     continue;
                 };
-                for line in [id.white_line, id.bias_line, id.random_walk_line]
-                    .into_iter()
-                    .flatten()
-                {
-                    let ends = [tau[0], tau[tau.len() - 1]].map(|t| (t, line.at(t)));
+                // The 95 % band of each deviation, thin; the fitted terms' sum, dashed.
+                for edge in [&noise.lower, &noise.upper] {
+                    let points: Vec<(f64, f64)> = tau
+                        .iter()
+                        .copied()
+                        .zip(edge.iter().copied())
+                        .filter(|(_, a)| *a > 0.0)
+                        .collect();
                     chart
-                        .draw_series(DashedLineSeries::new(
-                            ends,
-                            6,
-                            4,
-                            color.mix(0.6).stroke_width(1),
-                        ))
+                        .draw_series(LineSeries::new(points, color.mix(0.35).stroke_width(1)))
                         .map_err(err)?;
                 }
+                let (t0, t1) = (tau[0], tau[tau.len() - 1]);
+                let fitted: Vec<(f64, f64)> = (0..=64)
+                    .map(|i| {
+                        let t = t0 * (t1 / t0).powf(f64::from(i) / 64.0);
+                        (t, noise.fit.variance_at(t).sqrt())
+                    })
+                    .filter(|(_, a)| *a > 0.0)
+                    .collect();
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        fitted,
+                        6,
+                        4,
+                        color.mix(0.8).stroke_width(1),
+                    ))
+                    .map_err(err)?;
             }
             draw_legend(&mut chart)?;
         }

@@ -2,7 +2,6 @@
 use std::path::{Path, PathBuf};
 
 use crate::spec::{PanelSpec, TableKind};
-use imu_core::allan::identify_noise;
 use imukit::Table;
 use imukit::run::allan::AllanResult;
 
@@ -189,7 +188,8 @@ pub fn plot_tables(
     })
 }
 
-/// Allan tables: the curves with the noise lines identified from each curve.
+/// Allan tables: the curves (a table does not say how long its record was, so no terms are
+/// fitted; `imukit identify` draws them).
 fn allan_from_tables(
     out: &Path,
     files: &[(String, Table)],
@@ -197,7 +197,6 @@ fn allan_from_tables(
     size: FigureSize,
 ) -> Result<(), PlotError> {
     let mut columns = vec!["tau_s".to_string()];
-    let mut noise = Vec::new();
     let first = &files[0].1;
     let tau = first.column("tau_s").unwrap_or_default();
     let mut curves = Vec::new();
@@ -215,7 +214,6 @@ fn allan_from_tables(
             } else {
                 c.clone()
             };
-            noise.push((label.clone(), identify_noise(&tau, &adev)));
             columns.push(label);
             curves.push(adev);
         }
@@ -229,7 +227,9 @@ fn allan_from_tables(
         out,
         &AllanResult {
             table: Table { columns, data },
-            noise,
+            noise: Vec::new(),
+            samples: 0,
+            sample_rate_hz: 0.0,
         },
         source,
         size,

@@ -9,8 +9,8 @@ use imukit::run::imu_sensor::{ImuSensor, ImuSensorRequest, Orientation};
 use imukit::scenario::ImuSpec;
 use numpy::ndarray::Array2;
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3, PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -18,7 +18,6 @@ use pyo3::types::PyDict;
 
 use crate::convert::{
     check_len, choice, choice_opt, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table,
-    vector,
 };
 use crate::errors::{refused, shape_error};
 
@@ -180,27 +179,95 @@ fn allan_deviation<'py>(
     Ok((PyArray1::from_vec(py, tau), adev.into_pyarray(py)))
 }
 
-/// N, K, B and the fitted lines of an Allan curve, as a dict.
+/// Noise identification of the named columns of `x` (N, k) sampled at `sample_rate_hz`: a dict
+/// with `tau_s` and (T, k) `adev`, `lower95`, `upper95`, `edf`, `fit`; `terms`, one tuple per
+/// column and term `(column, term, symbol, value, lower, upper, resolved, needs_record_s,
+/// unit, datasheet_unit, datasheet_factor)`; `reduced_chi2` per column; `params_toml` (None
+/// without gyroscope or accelerometer columns) and `kalibr_yaml` (None without both).
 #[pyfunction]
-fn identify_noise<'py>(
+#[pyo3(signature = (x, sample_rate_hz, names, source, *, kalibr_inflation = 1.0, kalibr_topic = imukit::io::kalibr::DEFAULT_TOPIC))]
+fn identify<'py>(
     py: Python<'py>,
-    tau_s: PyReadonlyArray1<'py, f64>,
-    adev: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray2<'py, f64>,
+    sample_rate_hz: f64,
+    names: Vec<String>,
+    source: &str,
+    kalibr_inflation: f64,
+    kalibr_topic: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (tau, a) = (vector(&tau_s), vector(&adev));
-    check_len("adev", a.len(), tau.len())?;
-    let id = imu_core::allan::identify_noise(&tau, &a);
+    use imukit::run::identify as id;
+    let v = x.as_array();
+    check_len("names", names.len(), v.ncols())?;
+    let series: Vec<(String, Vec<f64>)> = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (n.clone(), v.column(k).to_vec()))
+        .collect();
+    let result = py
+        .detach(move || allan::allan(&series, sample_rate_hz))
+        .map_err(refused)?;
+    let curve = id::curve_table(&result);
+    let tau = curve.column("tau_s").unwrap_or_default();
     let d = PyDict::new(py);
-    d.set_item("noise_density", id.noise_density)?;
-    d.set_item("bias_instability", id.bias_instability)?;
-    d.set_item("random_walk", id.random_walk)?;
-    for (name, line) in [
-        ("white_line", id.white_line),
-        ("random_walk_line", id.random_walk_line),
-        ("bias_line", id.bias_line),
-    ] {
-        d.set_item(name, line.map(|l| (l.slope, l.intercept)))?;
+    d.set_item("tau_s", PyArray1::from_vec(py, tau.clone()))?;
+    for prefix in ["adev", "lower95", "upper95", "edf", "fit"] {
+        let mut values = Vec::with_capacity(tau.len() * names.len());
+        for i in 0..tau.len() {
+            for n in &names {
+                values.push(
+                    curve
+                        .column(&format!("{prefix}_{n}"))
+                        .map_or(f64::NAN, |c| c[i]),
+                );
+            }
+        }
+        let a = Array2::from_shape_vec((tau.len(), names.len()), values)
+            .map_err(|e| shape_error(e.to_string()))?;
+        d.set_item(prefix, a.into_pyarray(py))?;
     }
+    let terms: Vec<_> = id::term_rows(&result)
+        .into_iter()
+        .map(|r| {
+            let e = r.estimate;
+            (
+                r.column,
+                e.term.name(),
+                e.term.symbol(),
+                e.value,
+                e.lower,
+                e.upper,
+                e.resolved,
+                e.needs_record_s,
+                r.unit,
+                r.datasheet.map(|(u, _)| u),
+                r.datasheet.map(|(_, f)| f),
+            )
+        })
+        .collect();
+    d.set_item("terms", terms)?;
+    let chi2: Vec<f64> = result.noise.iter().map(|c| c.fit.reduced_chi2).collect();
+    d.set_item("reduced_chi2", chi2)?;
+    let file = id::param_file(&result, source).ok();
+    d.set_item(
+        "params_toml",
+        file.as_ref().map(imukit::io::params::to_toml),
+    )?;
+    let yaml = match &file {
+        Some(f) if f.present[0] && f.present[1] => {
+            Some(id::kalibr(&result, f, kalibr_inflation, kalibr_topic).map_err(refused)?)
+        }
+        _ => None,
+    };
+    d.set_item("kalibr_yaml", yaml)?;
+    let filter: Vec<_> = file
+        .as_ref()
+        .map(|f| id::filter_noise(f, result.sample_rate_hz))
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(s, w, b)| (s.key(), w, b))
+        .collect();
+    d.set_item("filter_noise", filter)?;
+    d.set_item("samples", result.samples)?;
     Ok(d)
 }
 
@@ -245,7 +312,7 @@ fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<(String, Vec<Str
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyImuSensor>()?;
     m.add_function(wrap_pyfunction!(allan_deviation, m)?)?;
-    m.add_function(wrap_pyfunction!(identify_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(convert, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;

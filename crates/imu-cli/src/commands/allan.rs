@@ -3,7 +3,7 @@ use std::path::Path;
 
 use imukit::io::output::check_outputs;
 use imukit::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
-use imukit::run::allan::{allan, mean_rate};
+use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;
 
@@ -20,6 +20,58 @@ pub fn run(
     let mut outputs = vec![("--out", out)];
     outputs.extend(plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
+    let result = analyse(input, columns)?;
+    result.table.write(out)?;
+    if let Some(p) = plot {
+        imu_plot::allan_figure(p, &result, &file_name(input), size)?;
+    }
+    println!(
+        "{:<16} {:>14} {:>14} {:>14}",
+        "column", "N (·/√Hz)", "B", "K (·√Hz)"
+    );
+    // A term the curve does not resolve shows as its 95 % bound.
+    let show = |e: &imu_core::allan::TermEstimate| {
+        if e.resolved {
+            format!("{:.4e}", e.value)
+        } else {
+            format!("<{:.3e}", e.upper)
+        }
+    };
+    for c in &result.noise {
+        use imu_core::allan::NoiseTerm as T;
+        println!(
+            "{:<16} {:>14} {:>14} {:>14}",
+            c.column,
+            show(c.fit.term(T::White)),
+            show(c.fit.term(T::BiasInstability)),
+            show(c.fit.term(T::RandomWalk))
+        );
+    }
+    println!("(\"<x\": not resolved, below x with 95 % confidence; `imukit identify` says more)");
+    if let Some(p) = plot {
+        println!("\nFigure written to {}", p.display());
+    }
+    println!(
+        "\nAllan deviation of {} columns at {} τ values ({} Hz) written to {}",
+        result.noise.len(),
+        result.table.rows(),
+        result.sample_rate_hz,
+        out.display()
+    );
+    Ok(())
+}
+
+/// The input's file name, to title figures.
+pub(crate) fn file_name(input: &Path) -> String {
+    input.file_name().map_or_else(
+        || input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// Reads `columns` (default: every gyro and accel column) and `t_s` of `input` and computes
+/// their Allan curves and noise terms; errors name the file and column.
+pub(crate) fn analyse(input: &Path, columns: &[String]) -> Result<AllanResult, CliError> {
     let header = read_header(input)?;
     let chosen: Vec<String> = if columns.is_empty() {
         GYRO_COLUMNS
@@ -57,35 +109,5 @@ pub fn run(
         },
         other => other,
     })?;
-    result.table.write(out)?;
-    if let Some(p) = plot {
-        let source = input.file_name().map_or_else(
-            || input.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        imu_plot::allan_figure(p, &result, &source, size)?;
-    }
-    println!(
-        "{:<16} {:>14} {:>14} {:>14}",
-        "column", "N (·/√Hz)", "B", "K (·√Hz)"
-    );
-    let show = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |x| format!("{x:.4e}"));
-    for (name, id) in &result.noise {
-        println!(
-            "{name:<16} {:>14} {:>14} {:>14}",
-            show(id.noise_density),
-            show(id.bias_instability),
-            show(id.random_walk)
-        );
-    }
-    if let Some(p) = plot {
-        println!("\nFigure written to {}", p.display());
-    }
-    println!(
-        "\nAllan deviation of {} columns at {} τ values ({rate} Hz) written to {}",
-        series.len(),
-        result.table.rows(),
-        out.display()
-    );
-    Ok(())
+    Ok(result)
 }

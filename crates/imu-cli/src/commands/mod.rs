@@ -4,6 +4,7 @@ mod compare;
 mod demo;
 mod exercise;
 mod fuse;
+mod identify;
 mod integrate;
 mod manual;
 mod orient;
@@ -250,6 +251,36 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 &columns,
                 &out,
                 plot.as_deref(),
+                plot::figure_size(&figure)?,
+            )
+        }
+        Command::Identify {
+            input,
+            map,
+            topics,
+            receive_time,
+            columns,
+            out,
+            params,
+            kalibr,
+            kalibr_inflation,
+            kalibr_topic,
+            plot,
+            figure,
+        } => {
+            attach_map(&input, map.as_deref())?;
+            attach_topics(&[Some(&input)], &topics, receive_time);
+            identify::run(
+                &input,
+                &columns,
+                &identify::Outputs {
+                    out: &out,
+                    params: params.as_deref(),
+                    kalibr: kalibr.as_deref(),
+                    kalibr_inflation,
+                    kalibr_topic: &kalibr_topic,
+                    plot: plot.as_deref(),
+                },
                 plot::figure_size(&figure)?,
             )
         }

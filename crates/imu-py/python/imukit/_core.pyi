@@ -56,7 +56,7 @@ __all__ = [
     "dcm_to_quaternion",
     "ImuSensor",
     "allan_deviation",
-    "identify_noise",
+    "identify",
     "convert",
     "preset_names",
     "preset_toml",
@@ -194,7 +194,15 @@ class ImuSensor:
 def allan_deviation(
     x: npt.NDArray[np.float64], sample_rate_hz: float
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
-def identify_noise(tau_s: npt.NDArray[np.float64], adev: npt.NDArray[np.float64]) -> dict[str, Any]: ...
+def identify(
+    x: npt.NDArray[np.float64],
+    sample_rate_hz: float,
+    names: list[str],
+    source: str,
+    *,
+    kalibr_inflation: float = 1.0,
+    kalibr_topic: str = ...,
+) -> dict[str, Any]: ...
 def preset_names() -> list[str]: ...
 def preset_toml(name: str) -> str: ...
 def preset_kalibr_yaml(name: str, *, rate_hz: float = ..., topic: str = ...) -> str: ...

@@ -180,10 +180,86 @@ def allan_deviation(x, sample_rate_hz: float):
     tau, adev = _core.allan_deviation(a[:, None] if a.ndim == 1 else a, float(sample_rate_hz))
     return tau, (adev[:, 0] if a.ndim == 1 else adev)
 
-def identify_noise(tau_s, adev) -> dict:
-    """N (at τ = 1 s on the −½ line), K (at τ = 3 s on the +½ line) and B (floor / 0.664) of an
-    Allan curve, with the fitted lines as ``(slope, log10 intercept)``; ``None`` where absent."""
-    return _core.identify_noise(np.ascontiguousarray(tau_s, dtype=np.float64), np.ascontiguousarray(adev, dtype=np.float64))
+class Identification:
+    """Noise terms of a static log (:func:`identify`).
+
+    ``terms`` is a list of dicts, one per column and term (``column``, ``term``, ``symbol``,
+    ``value``, ``lower``, ``upper``, ``resolved``, ``needs_record_s``, ``unit``,
+    ``datasheet_unit``, ``datasheet_value``): ``pandas.DataFrame(ident.terms)`` tabulates them.
+    A term not resolved has ``value`` as fitted, ``lower`` 0 and ``upper`` its 95 % bound.
+    ``tau_s`` (T,) and ``adev``, ``lower95``, ``upper95``, ``edf``, ``fit`` (T, k) are the curves;
+    ``params_toml`` the part as an imukit parameter file, ``kalibr_yaml`` as Kalibr's imu.yaml;
+    ``filter_noise`` the fusion filter's ``(sensor, white, bias drift)`` for it."""
+
+    def __init__(self, columns, raw: dict) -> None:
+        self.columns = list(columns)
+        self.tau_s = raw["tau_s"]
+        self.adev, self.lower95, self.upper95 = raw["adev"], raw["lower95"], raw["upper95"]
+        self.edf, self.fit = raw["edf"], raw["fit"]
+        self.reduced_chi2 = dict(zip(self.columns, raw["reduced_chi2"]))
+        self.samples = raw["samples"]
+        keys = ("column", "term", "symbol", "value", "lower", "upper", "resolved", "needs_record_s",
+                "unit", "datasheet_unit", "datasheet_factor")
+        self.terms = []
+        for row in raw["terms"]:
+            d = dict(zip(keys, row))
+            factor = d.pop("datasheet_factor")
+            shown = d["value"] if d["resolved"] else d["upper"]
+            d["datasheet_value"] = None if factor is None else shown / factor
+            self.terms.append(d)
+        self.params_toml = raw["params_toml"]
+        self.kalibr_yaml = raw["kalibr_yaml"]
+        self.filter_noise = raw["filter_noise"]
+
+    def term(self, column: str, term: str) -> dict:
+        """The row of ``term`` (``white_noise``, ``bias_instability``, ``random_walk``,
+        ``quantization``, ``rate_ramp`` or its symbol N, B, K, Q, R) of ``column``."""
+        for d in self.terms:
+            if d["column"] == column and term in (d["term"], d["symbol"]):
+                return d
+        raise KeyError(f"no term {term!r} of column {column!r}")
+
+    def __repr__(self) -> str:
+        resolved = sum(d["resolved"] for d in self.terms)
+        return f"Identification({len(self.columns)} columns, {resolved} of {len(self.terms)} terms resolved)"
+
+
+def identify(data, sample_rate_hz: Optional[float] = None, *, columns=None, kalibr_inflation: float = 1.0,
+             kalibr_topic: str = "/imu", **read_options) -> "Identification":
+    """Noise identification of a static log, as ``imukit identify`` does it.
+
+    ``data`` is a path (any format :func:`imukit.read` takes; ``read_options`` such as ``map=`` or
+    ``topic=`` go to it), a table or mapping with ``t_s`` (the rate from its times), or an (N,) or
+    (N, k) array with ``sample_rate_hz``. ``columns`` default to every ``gyro_*``/``accel_*``
+    column. Each term comes with its 95 % interval, or, not resolved, its bound and the record
+    length that would resolve it."""
+    source = "array"
+    if isinstance(data, (str, os.PathLike)):
+        source = os.path.basename(os.fspath(data))
+        from . import read as _read
+        data = _read(data, **read_options)
+    if isinstance(data, np.ndarray):
+        if sample_rate_hz is None:
+            raise ValueError("an array needs sample_rate_hz")
+        a = np.ascontiguousarray(data, dtype=np.float64)
+        a = a[:, None] if a.ndim == 1 else a
+        names = list(columns) if columns is not None else [f"column {k}" for k in range(a.shape[1])]
+    else:
+        from ._table import Table
+        table = Table.of(data)
+        names = list(columns) if columns is not None else [
+            c for c in table.keys() if c.startswith(("gyro_", "accel_"))]
+        if not names:
+            raise ValueError("no gyro_* or accel_* columns: name them with columns=")
+        a = np.column_stack([np.asarray(table[c], dtype=np.float64) for c in names])
+        if sample_rate_hz is None:
+            t = np.asarray(table["t_s"], dtype=np.float64)
+            if t.size < 2 or not t[-1] > t[0]:
+                raise ValueError("t_s needs at least 2 increasing times to give the sample rate")
+            sample_rate_hz = (t.size - 1) / (t[-1] - t[0])
+    raw = _core.identify(np.ascontiguousarray(a), float(sample_rate_hz), names, source,
+                         kalibr_inflation=float(kalibr_inflation), kalibr_topic=kalibr_topic)
+    return Identification(names, raw)
 
 def convert(value: float, unit: str) -> tuple:
     """A datasheet figure in imukit's SI parameter units: ``(value, unit, parameters it fits)``.

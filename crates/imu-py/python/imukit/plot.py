@@ -10,7 +10,7 @@ Tables, CSV paths and dicts of NumPy arrays keyed by imukit's column names are a
 * :func:`figure` — the default figure of one or more tables or CSV files of one kind (truth,
   IMU readings, navigation output, Allan table, errors); later ones dashed, dotted, … (truth vs estimate).
 * :func:`trajectory` — paths in the plane (equal scales) or in 3D, start ● and end ✕ marked.
-* :func:`allan` — Allan deviation on log axes with the fitted −½, 0, +½ lines dashed.
+* :func:`allan` — Allan deviation on log axes.
 * :func:`animate` — the body as a box moving and turning along its path, the reference point and
   the IMU point at the lever arm marked, the trail drawn.
 
@@ -29,7 +29,7 @@ from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import ImuError, Table, _core, identify_noise, quaternion_to_dcm, read_csv
+from . import ImuError, Table, _core, quaternion_to_dcm, read_csv
 from ._table import TableLike
 
 _D = _core.DEFAULTS  # the library's request defaults, shared with the command line
@@ -134,7 +134,8 @@ def trajectory(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, ax:
 
 def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = None, *,
           labels: Optional[Sequence[str]] = None, ax: Any = None) -> Any:
-    """Allan deviation on log axes with the lines fitted by :func:`imukit.identify_noise` dashed.
+    """Allan deviation on log axes (the fitted terms and bands: :func:`imukit.identify`, or
+    ``imukit identify --plot``).
 
     Give ``tau_s`` and ``adev`` ((T,) or (T, k)) as from :func:`imukit.allan_deviation`, or an
     Allan table / CSV (``tau_s, adev_*``) alone. Returns the figure."""
@@ -158,11 +159,6 @@ def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = No
     for k, name in enumerate(names):
         colour = f"C{k}"
         ax.loglog(tau, curves[:, k], "o-", color=colour, markersize=3, label=name)
-        fit = identify_noise(tau, curves[:, k])
-        for key in ("white_line", "bias_line", "random_walk_line"):
-            if fit.get(key) is not None:
-                slope, log_intercept = fit[key]
-                ax.loglog(tau, 10.0 ** log_intercept * tau ** slope, "--", color=colour, alpha=0.6, linewidth=1)
     ax.set_xlabel("τ (s)")
     ax.set_ylabel("σ(τ) (unit of the column)")
     ax.set_title("Allan deviation")

@@ -99,6 +99,12 @@ const UNITS: &[(&[&str], f64, &str, &str)] = &[
         "accelerometer noise_density (velocity random walk)",
     ),
     (
+        &["m/s/h/√h", "m/s/h/rt-h", "m/s/h/sqrt(h)"],
+        1.0 / 3600.0 / 60.0,
+        "m/s²·√Hz",
+        "accelerometer random_walk",
+    ),
+    (
         &["g"],
         STANDARD_GRAVITY,
         "m/s²",

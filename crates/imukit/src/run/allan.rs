@@ -1,20 +1,40 @@
 //! Allan deviation of IMU columns and noise identification, shared by the CLI and Python.
-use imu_core::allan::{NoiseIdentification, allan_deviation, identify_noise, octave_cluster_sizes};
+use imu_core::allan::{
+    NoiseFit, allan_deviation, deviation_interval, fit_noise, octave_cluster_sizes,
+};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
+
+/// One column's noise terms and its curve's 95 % confidence band.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColumnNoise {
+    /// The column.
+    pub column: String,
+    /// The fitted terms.
+    pub fit: NoiseFit,
+    /// Lower end of each deviation's 95 % interval, at the table's τ.
+    pub lower: Vec<f64>,
+    /// Upper end.
+    pub upper: Vec<f64>,
+}
 
 /// Allan deviations of several rate columns at octave-spaced τ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AllanResult {
     /// `tau_s` then `adev_<column>` per column.
     pub table: Table,
-    /// Identification per column, in column order.
-    pub noise: Vec<(String, NoiseIdentification)>,
+    /// Noise terms per column, in column order (empty for curves read back from a file, whose
+    /// record length is not known).
+    pub noise: Vec<ColumnNoise>,
+    /// Samples per column.
+    pub samples: usize,
+    /// Their rate, Hz.
+    pub sample_rate_hz: f64,
 }
 
 /// Overlapping Allan deviation of each `(name, samples)` at octave cluster sizes, sampled at
-/// `sample_rate_hz`, with N, K and B read off each curve.
+/// `sample_rate_hz`, with the noise terms fitted to each curve (`imu_core::allan::fit`).
 ///
 /// # Errors
 /// Fewer than 3 samples, non-finite samples (column and index named), a bad rate, a deviation
@@ -54,7 +74,19 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
                 ),
             ));
         }
-        noise.push((name.clone(), identify_noise(&tau, &adev)));
+        let fit =
+            fit_noise(&tau, &adev, &m, n).map_err(|e| invalid(name.clone(), e.to_string()))?;
+        let (lower, upper) = adev
+            .iter()
+            .zip(&fit.edf)
+            .map(|(a, nu)| deviation_interval(*a, *nu))
+            .unzip();
+        noise.push(ColumnNoise {
+            column: name.clone(),
+            fit,
+            lower,
+            upper,
+        });
         names.push(format!("adev_{name}"));
         curves.push(adev);
     }
@@ -69,6 +101,8 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
             data,
         },
         noise,
+        samples: n,
+        sample_rate_hz,
     })
 }
 

@@ -7,6 +7,7 @@ pub mod arrays;
 pub mod compare;
 pub mod fuse;
 mod fuse_aids;
+pub mod identify;
 pub mod imu_sensor;
 pub(crate) mod nav_earth;
 pub mod navigate;
