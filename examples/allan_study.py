@@ -35,10 +35,12 @@ def main():
     print(f"STIM300 preset, static, {HOURS:g} h at {FS:g} Hz")
     print(f"{'axis':<5} {'ARW (°/√h)':>12} {'floor, white removed (°/h)':>28} {'raw curve minimum (°/h)':>25}")
     reliable = tau <= HOURS * 3600 / 10  # at least ~10 clusters
+    ident = imukit.identify(gyro, sample_rate_hz=FS)
     for k, axis in enumerate("xyz"):
-        n = imukit.identify_noise(tau, adev[:, k])
-        arw = n["noise_density"] * deg * 60
-        floor = n["bias_instability"] * 0.664 * deg * 3600
+        n = ident.term(f"column {k}", "N")
+        b = ident.term(f"column {k}", "B")
+        arw = n["value"] * deg * 60
+        floor = (b["value"] if b["resolved"] else b["upper"]) * 0.664 * deg * 3600
         raw_min = np.min(adev[reliable, k]) * deg * 3600
         print(f"{axis:<5} {arw:>12.4f} {floor:>28.3f} {raw_min:>25.3f}")
     print("datasheet: ARW 0.15 °/√h, bias instability 0.5 °/h (the Allan minimum of a 20 h test)")

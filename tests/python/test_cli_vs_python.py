@@ -164,8 +164,8 @@ def test_cli_allan_reads_what_python_computes(tmp_path):
     tau, adev = imukit.allan_deviation(sim.imu["gyro_z_rad_s"], 100.0)
     np.testing.assert_allclose(values[:, 0], tau, rtol=1e-12)
     np.testing.assert_allclose(values[:, 1], adev, rtol=1e-12)
-    n = imukit.identify_noise(tau, adev)["noise_density"]
-    assert abs(n / 2e-3 - 1) < 0.1
+    n = imukit.identify(sim.imu, columns=["gyro_z_rad_s"]).term("gyro_z_rad_s", "N")
+    assert n["lower"] <= 2e-3 <= n["upper"], n
 
 
 ORIENT_SCENARIO = """
