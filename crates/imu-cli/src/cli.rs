@@ -339,13 +339,17 @@ pub enum Command {
         /// sample; default 0.05).
         #[arg(long)]
         covariance_interval_s: Option<f64>,
-        /// Also estimate the IMU's scale-factor, misalignment and g-sensitivity errors (36 error
-        /// states instead of 15; their one-sigma at the start from the part's
-        /// `axes_misalignment_pct` and `acceleration_bias`); the estimate gains their columns.
-        #[arg(long)]
-        sensor_errors: bool,
+        /// Estimate the IMU's scale-factor, misalignment and g-sensitivity errors (36 error states
+        /// instead of 15; their one-sigma at the start from the part's `axes_misalignment_pct`
+        /// and `acceleration_bias`); the estimate gains their columns. Default: when the part's
+        /// figures reach 0.5 % (or 1e-5 (rad/s)/(m/s²) of g-sensitivity); `--sensor-errors`
+        /// alone is `true`.
+        #[arg(long, value_name = "true|false", num_args = 0..=1, default_missing_value = "true")]
+        sensor_errors: Option<bool>,
         /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
-        /// zero-rate updates at every sample there calibrate the gyroscope biases.
+        /// zero-rate updates at every sample there calibrate the gyroscope biases. Default: the
+        /// rest found in the readings (blocks of 0.5 s whose spread and mean stay within the
+        /// part's noise); 0: none.
         #[arg(long, value_name = "SECONDS")]
         rest_s: Option<f64>,
         /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).

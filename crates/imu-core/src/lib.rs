@@ -36,6 +36,7 @@ mod math;
 pub mod orientation;
 pub mod rotation;
 pub mod sensor;
+pub mod stillness;
 pub mod strapdown;
 pub mod trig;
 pub mod vector;

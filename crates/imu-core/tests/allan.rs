@@ -322,9 +322,12 @@ fn octave_correlation_is_that_of_white_noise_estimators() {
 fn fits_refuse_curves_they_cannot_use() {
     use imu_core::allan::FitError;
     assert_eq!(
-        fit_noise(&[1.0], &[1.0], &[1], 10),
-        Err(FitError::BadCurve { points: 1 })
+        fit_noise(&[], &[], &[], 10),
+        Err(FitError::BadCurve { points: 0 })
     );
+    // One point: fitted, nothing resolved.
+    let one = fit_noise(&[1.0], &[1.0], &[1], 3).unwrap();
+    assert!(one.terms.iter().all(|t| !t.resolved));
     assert_eq!(
         fit_noise(&[1.0, 1.5], &[1.0, 1.0], &[2, 3], 100),
         Err(FitError::BadPoint { index: 1 })

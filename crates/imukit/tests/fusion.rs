@@ -87,6 +87,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
             gyro_g_sensitivity: 1e-5,
         },
         rest_s: 0.0,
+        detect_rest: false,
     };
     // The 15-state filter and the one that also estimates the sensor matrices (which stay 0).
     for estimate_sensor_errors in [false, true] {

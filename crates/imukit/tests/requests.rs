@@ -677,14 +677,16 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
     assert!(matches!(start, Start::AlignStatic { .. }));
     assert!(setup.gate.is_finite());
     assert_eq!(setup.covariance_interval_s, DEFAULT_COVARIANCE_INTERVAL_S);
-    assert!(!setup.estimate_sensor_errors);
+    // Not told: the sensor errors as the part warrants, the rest found in the readings.
+    assert_eq!(setup.estimate_sensor_errors, setup.warrants_sensor_errors());
+    assert!(setup.detect_rest);
     assert_eq!(setup.aiding.nhc_sigma_m_s, None);
     let (setup, start) = FuseRequest {
         initial: Some(&initial),
         gate: false,
         nhc_sigma_m_s: Some(0.2),
         covariance_interval_s: Some(0.0),
-        sensor_errors: true,
+        sensor_errors: Some(true),
         rest_s: Some(5.0),
         ..d
     }
@@ -696,4 +698,5 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
     assert_eq!(setup.covariance_interval_s, 0.0);
     assert!(setup.estimate_sensor_errors);
     assert_eq!(setup.rest_s, 5.0);
+    assert!(!setup.detect_rest);
 }

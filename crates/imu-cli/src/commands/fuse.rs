@@ -32,7 +32,7 @@ pub struct Args<'a> {
     pub baro: Option<&'a Path>,
     pub nhc: Option<f64>,
     pub covariance_interval_s: Option<f64>,
-    pub sensor_errors: bool,
+    pub sensor_errors: Option<bool>,
     pub rest_s: Option<f64>,
     pub out: &'a Path,
 }
@@ -225,6 +225,18 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         last("pos_z_sigma_m"),
         a.out.display()
     );
+    let states = if summary.sensor_errors {
+        "36 states (with the sensor errors)"
+    } else {
+        "15 states"
+    };
+    let rest = match (summary.rest_detected, summary.rest_s > 0.0) {
+        (true, true) => format!("a rest of {:.2} s found at the start", summary.rest_s),
+        (true, false) => "no rest found at the start".to_owned(),
+        (false, true) => format!("a rest of {:.2} s at the start (--rest-s)", summary.rest_s),
+        (false, false) => "no rest (--rest-s 0)".to_owned(),
+    };
+    crate::note!("imukit: the filter had {states} and {rest}");
     if summary.resets > 0 {
         let t = nav.column("t_s").unwrap_or_default();
         let resets = nav

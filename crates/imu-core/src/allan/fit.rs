@@ -211,8 +211,8 @@ impl core::fmt::Display for FitError {
         match *self {
             Self::BadCurve { points } => write!(
                 f,
-                "a noise fit needs τ, deviations and cluster sizes of one length, at least 2 \
-                 points (got {points})"
+                "a noise fit needs τ, deviations and cluster sizes of one length, at least one \
+                 point (got {points})"
             ),
             Self::BadPoint { index } => write!(
                 f,
@@ -458,11 +458,11 @@ fn weights(curve: &Curve, c: Option<&Vec5>, w: &mut [f64]) {
 /// record's sample count).
 ///
 /// # Errors
-/// Slices of different lengths or shorter than 2 (or longer than [`MAX_POINTS`]), a point that is
-/// not finite, or τ not increasing.
+/// Slices of different lengths, empty or longer than [`MAX_POINTS`], a point that is not finite,
+/// or τ not increasing by at least a factor 2. A curve of fewer points than terms resolves none.
 pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<NoiseFit, FitError> {
     let len = tau_s.len();
-    if !(2..=MAX_POINTS).contains(&len) || adev.len() != len || m.len() != len {
+    if !(1..=MAX_POINTS).contains(&len) || adev.len() != len || m.len() != len {
         return Err(FitError::BadCurve { points: len });
     }
     let mut var = [0.0; MAX_POINTS];

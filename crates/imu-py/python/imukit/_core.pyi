@@ -266,7 +266,7 @@ def fuse(
     baro_values: Optional[npt.NDArray[np.float64]] = None,
     nhc_sigma_m_s: Optional[float] = None,
     covariance_interval_s: Optional[float] = None,
-    sensor_errors: bool = False,
+    sensor_errors: Optional[bool] = None,
     rest_s: Optional[float] = None,
     imu_model: Optional[str] = None,
     part: Optional[str] = None,

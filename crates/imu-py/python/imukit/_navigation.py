@@ -144,7 +144,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
          gate: bool = True,
          odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
-         sensor_errors: bool = False, rest_s: Optional[float] = None,
+         sensor_errors: Optional[bool] = None, rest_s: Optional[float] = None,
          imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
          gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
          gnss_velocity_accuracy_m_s: Optional[float] = None,
@@ -169,9 +169,12 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     than the IMU samples, for speed. ``sensor_errors=True`` also estimates the IMU's scale
     factors, misalignment and gyroscope g-sensitivity (36 states, their one-sigma at the start
     from the part's figures; columns ``accel_scale_factor_x`` … ``gyro_g_sensitivity_z_rad_s_per_m_s2``
-    and their ``…_sigma`` added). ``rest_s=20`` tells the filter the vehicle stands still for the
-    first 20 s (zero-velocity and zero-rate updates at every sample: the gyroscope biases are
-    calibrated before the drive) — a consumer IMU needs both.
+    and their ``…_sigma`` added); by default (``None``) they are estimated when the part's figures
+    reach 0.5 % (or 1e-5 (rad/s)/(m/s²) of g-sensitivity). ``rest_s=20`` tells the filter the
+    vehicle stands still for the first 20 s (zero-velocity and zero-rate updates at every sample:
+    the gyroscope biases are calibrated before the drive); by default (``None``) the rest is found
+    in the readings (blocks of 0.5 s whose spread and mean stay within the part's noise), and
+    ``rest_s=0`` turns it off.
 
     Without a scenario, ``imu_model`` names the part — a preset (``"stim300"``), a parameter
     file or Kalibr's ``imu.yaml`` — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
@@ -220,7 +223,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
                              align=None if align is None else str(align),
                              nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
-                             sensor_errors=bool(sensor_errors),
+                             sensor_errors=None if sensor_errors is None else bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s),
                              **aids, **part_keys)
     fused = _table(table)

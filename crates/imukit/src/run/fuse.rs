@@ -159,6 +159,9 @@ pub struct FuseSetup {
     /// rate within one sample's gyroscope noise), which calibrates the gyroscope biases
     /// before the vehicle moves. 0 (the default): no rest.
     pub rest_s: f64,
+    /// Find the rest at the start from the readings instead (`imu_core::stillness`, with the
+    /// part's white noise); `rest_s` is then replaced by what is found.
+    pub detect_rest: bool,
     /// The covariance is propagated once per this interval and at every update, s (0: every
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
@@ -225,6 +228,12 @@ pub struct FuseSummary {
     pub rejected: usize,
     /// Resets to the fixes after [`MAX_REJECTED_IN_A_ROW`] of them were rejected in a row.
     pub resets: usize,
+    /// The rest at the start the filter used, s (given, or found in the readings).
+    pub rest_s: f64,
+    /// Whether that rest was found in the readings ([`FuseSetup::detect_rest`]).
+    pub rest_detected: bool,
+    /// Whether the sensor-error states were estimated (36 states).
+    pub sensor_errors: bool,
 }
 
 /// The fused estimate's last column: the resets to the fixes so far (a step at each).
@@ -300,9 +309,10 @@ pub struct FuseRequest<'a> {
     pub nhc_sigma_m_s: Option<f64>,
     /// The covariance interval, s (`None`: [`DEFAULT_COVARIANCE_INTERVAL_S`]).
     pub covariance_interval_s: Option<f64>,
-    /// Estimate the sensor errors (36 states).
-    pub sensor_errors: bool,
-    /// Seconds at rest at the start (`None`: no rest).
+    /// Estimate the sensor errors (36 states); `None`: when the part warrants it
+    /// ([`FuseSetup::warrants_sensor_errors`]).
+    pub sensor_errors: Option<bool>,
+    /// Seconds at rest at the start (`None`: found in the readings; `Some(0.0)`: no rest).
     pub rest_s: Option<f64>,
 }
 
@@ -315,7 +325,7 @@ impl Default for FuseRequest<'_> {
             gate: true,
             nhc_sigma_m_s: None,
             covariance_interval_s: None,
-            sensor_errors: false,
+            sensor_errors: None,
             rest_s: None,
         }
     }
@@ -388,9 +398,15 @@ impl<'a> FuseRequest<'a> {
         if let Some(s) = self.covariance_interval_s {
             setup.covariance_interval_s = s;
         }
-        setup.estimate_sensor_errors = self.sensor_errors;
-        if let Some(s) = self.rest_s {
-            setup.rest_s = s;
+        setup.estimate_sensor_errors = self
+            .sensor_errors
+            .unwrap_or_else(|| setup.warrants_sensor_errors());
+        match self.rest_s {
+            Some(s) => {
+                setup.rest_s = s;
+                setup.detect_rest = false;
+            }
+            None => setup.detect_rest = true,
         }
         Ok((setup, start))
     }
@@ -822,6 +838,51 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         accuracy,
     } = &inputs;
     let (t0, t1) = inputs.span();
+    let found;
+    let setup = if setup.detect_rest {
+        let moving_at_start = match start {
+            Start::State(initial) => {
+                let v = initial.velocity_m_s;
+                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() > REST_START_SPEED_M_S
+            }
+            // Aligned from a fix at speed: the vehicle moves.
+            Start::AlignGnss => true,
+            Start::AlignStatic { .. } => false,
+        };
+        let readings_still = if moving_at_start {
+            0.0
+        } else {
+            detected_rest_s(t, f, w, setup)
+        };
+        // Steady motion in a straight line reads like rest: a fix moving faster than 5σ of its
+        // velocity before the rest's end overrules the readings (no rest at all: the readings
+        // could not tell it from motion).
+        let moves_at = (*velocities != FixVelocity::None)
+            .then(|| {
+                let limit = 5.0 * setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
+                g_t.iter().zip(g_v).find(|(_, v)| {
+                    let vertical = if *velocities == FixVelocity::Full {
+                        v[2]
+                    } else {
+                        0.0
+                    };
+                    (v[0] * v[0] + v[1] * v[1] + vertical * vertical).sqrt() > limit
+                })
+            })
+            .flatten()
+            .map_or(f64::INFINITY, |(tk, _)| tk - t0);
+        found = FuseSetup {
+            rest_s: if moves_at < readings_still {
+                0.0
+            } else {
+                readings_still
+            },
+            ..*setup
+        };
+        &found
+    } else {
+        setup
+    };
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
     let fixes = g_p
         .iter()
@@ -1064,8 +1125,47 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
             updates,
             rejected,
             resets: acceptance.resets,
+            rest_s: setup.rest_s,
+            rest_detected: setup.detect_rest,
+            sensor_errors: setup.estimate_sensor_errors,
         },
     ))
+}
+
+/// Block length of the rest detector, s.
+pub const REST_WINDOW_S: f64 = 0.5;
+
+/// A start faster than this, m/s, is not at rest: no rest is looked for.
+pub const REST_START_SPEED_M_S: f64 = 0.1;
+
+/// The rest at the start of readings `f`, `w` at times `t`, s ([`imu_core::stillness`] with the
+/// part's white noise per sample and blocks of [`REST_WINDOW_S`]).
+fn detected_rest_s(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> f64 {
+    use imu_core::stillness::{ReadingNoise, initial_rest};
+    let n = t.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let interval = (t[n - 1] - t[0]) / (n - 1) as f64;
+    if interval.is_nan() || interval <= 0.0 {
+        return 0.0;
+    }
+    let per_sample = |psd: f64| psd / interval.sqrt();
+    let noise = ReadingNoise {
+        accel: per_sample(setup.noise.accel_psd),
+        gyro: per_sample(setup.noise.gyro_psd),
+    };
+    let axis = |v: &[[f64; 3]], k: usize| v.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (f_axes, w_axes) = ([0, 1, 2].map(|k| axis(f, k)), [0, 1, 2].map(|k| axis(w, k)));
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let window = ((REST_WINDOW_S / interval).round() as usize).max(2);
+    let still = initial_rest(
+        [&f_axes[0], &f_axes[1], &f_axes[2]],
+        [&w_axes[0], &w_axes[1], &w_axes[2]],
+        noise,
+        window,
+    );
+    if still == 0 { 0.0 } else { t[still] - t[0] }
 }
 
 /// The refusal of `setup`'s covariance interval.
@@ -1100,7 +1200,34 @@ fn matrix_sigma(p: &crate::sensor::SensorParams) -> (f64, f64) {
     )
 }
 
+/// The scale-factor or misalignment one-sigma (a fraction: 0.5 %) from which a part's errors
+/// are estimated by default: a 0.5 % scale-factor error turns a 90° turn into 8 mrad of
+/// heading. Consumer parts' 1–2 % cross-axis sensitivity is above it; the tactical and
+/// industrial presets' 0.1 % and less are below.
+pub const SENSOR_ERROR_STATES_FROM: f64 = 5e-3;
+
+/// The gyroscope g-sensitivity, (rad/s)/(m/s²), from which a part's errors are estimated by
+/// default (about 0.06 °/s per g: a car's 0.3 g of braking then reads as 30 °/h).
+pub const G_SENSITIVITY_STATES_FROM: f64 = 1e-5;
+
 impl FuseSetup {
+    /// Whether the part's scale-factor, misalignment or g-sensitivity figures are large enough
+    /// ([`SENSOR_ERROR_STATES_FROM`], [`G_SENSITIVITY_STATES_FROM`]) that the filter should
+    /// estimate them: what `fuse` does when not told.
+    #[must_use]
+    pub fn warrants_sensor_errors(&self) -> bool {
+        let e = &self.sensor_error_sigma;
+        [
+            e.accel_scale_factor,
+            e.accel_misalignment,
+            e.gyro_scale_factor,
+            e.gyro_misalignment,
+        ]
+        .iter()
+        .any(|s| *s >= SENSOR_ERROR_STATES_FROM)
+            || e.gyro_g_sensitivity >= G_SENSITIVITY_STATES_FROM
+    }
+
     /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
     /// IMU's noise (white and drift PSDs, `imu_core::fusion::process_noise`) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
     /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
@@ -1204,6 +1331,7 @@ impl FuseSetup {
                     .max(MIN_G_SENSITIVITY_SIGMA),
             },
             rest_s: 0.0,
+            detect_rest: false,
         }
     }
 }
