@@ -352,6 +352,10 @@ pub enum Command {
         /// part's noise); 0: none.
         #[arg(long, value_name = "SECONDS")]
         rest_s: Option<f64>,
+        /// Smooth the estimate forward–backward (Rauch–Tung–Striebel over the filter): each
+        /// sample's best estimate from all the data, before and after it, with its one-sigma.
+        #[arg(long)]
+        smooth: bool,
         /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,

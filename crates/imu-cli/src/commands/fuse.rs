@@ -34,6 +34,7 @@ pub struct Args<'a> {
     pub covariance_interval_s: Option<f64>,
     pub sensor_errors: Option<bool>,
     pub rest_s: Option<f64>,
+    pub smooth: bool,
     pub out: &'a Path,
 }
 
@@ -113,6 +114,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         covariance_interval_s: a.covariance_interval_s,
         sensor_errors: a.sensor_errors,
         rest_s: a.rest_s,
+        smooth: a.smooth,
     };
     let imu = read_table_as(a.imu, Role::Readings)?;
     let (setup, start) = match (a.scenario, &a.model) {

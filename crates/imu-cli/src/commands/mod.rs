@@ -156,6 +156,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             covariance_interval_s,
             sensor_errors,
             rest_s,
+            smooth,
             out,
         } => {
             attach_map(&imu, map.as_deref())?;
@@ -190,6 +191,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 covariance_interval_s,
                 sensor_errors,
                 rest_s,
+                smooth,
                 out: &out,
             })
         }

@@ -37,6 +37,7 @@ use super::sensor_errors::{
     ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, SensorErrorEstimate, SensorErrorSigma,
     SensorErrors, d_gyro, d_matrix,
 };
+use super::smoother::{EpochRecord, SmoothingLog};
 
 pub(crate) type Cov<const S: usize> = SMatrix<f64, S, S>;
 /// An error-state vector of `S` states.
@@ -329,6 +330,7 @@ pub struct Eskf<E: EarthModel, const S: usize = BASE_STATES> {
     intake: Intake,
     updates: usize,
     rejected: usize,
+    smoothing: Option<SmoothingLog<S>>,
 }
 
 impl<E: EarthModel, const S: usize> Eskf<E, S> {
@@ -371,7 +373,40 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             intake: Intake::new(),
             updates: 0,
             rejected: 0,
+            smoothing: None,
         })
+    }
+
+    /// Keeps what a forward–backward smoother needs ([`super::smoother`]): an
+    /// [`EpochRecord`] at every time the state is corrected and at least every `max_gap_s` of
+    /// propagation, taken with [`Self::take_epoch`] after each call. Set after the covariance
+    /// is complete (after [`Self::with_sensor_error_sigma`]).
+    ///
+    /// # Errors
+    /// A gap that is not finite and positive.
+    pub fn with_smoothing(mut self, max_gap_s: f64) -> Result<Self, EskfError> {
+        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
+            return Err(EskfError::BadParameter {
+                field: "smoothing gap",
+            });
+        }
+        self.smoothing = Some(SmoothingLog::new(max_gap_s, self.nav.t_s, &self.cov));
+        Ok(self)
+    }
+
+    /// The next finished epoch of a filter kept for smoothing ([`Self::with_smoothing`]).
+    pub fn take_epoch(&mut self) -> Option<EpochRecord<S>> {
+        self.smoothing.as_mut().and_then(SmoothingLog::take)
+    }
+
+    /// Ends the smoother's record: the pending covariance step taken, the last epochs closed
+    /// (then taken with [`Self::take_epoch`]).
+    pub fn finish_smoothing(&mut self) {
+        self.step_covariance();
+        let (t, cov) = (self.nav.t_s, self.cov);
+        if let Some(log) = self.smoothing.as_mut() {
+            log.finish(t, &cov);
+        }
     }
 
     /// Propagates the covariance once per `interval_s` (or at the next update, whichever comes
@@ -523,6 +558,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             sensors,
         };
         let a = Transition::new(&f, dt);
+        let before = self.smoothing.is_some().then_some(self.cov);
         let ap = a.times(&self.cov);
         // G Q Gᵀ: velocity and attitude noise through Ĉ (isotropic: C q Cᵀ = q I), biases;
         // Q_d = ½ (Φ Q Φᵀ + Q) Δt.
@@ -531,6 +567,10 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         let qd = (qc * 2.0 + aq + aq.transpose() + a.times(&aq.transpose())) * (0.5 * dt);
         self.cov += ap + ap.transpose() + a.times(&ap.transpose()) + qd;
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
+        if let (Some(log), Some(before)) = (self.smoothing.as_mut(), before) {
+            let phi = Cov::<S>::identity() + a.times(&Cov::<S>::identity());
+            log.step(&before, &phi, dt, &self.cov, self.nav.t_s);
+        }
     }
 
     /// A GNSS position (and, when given, velocity) fix valid `fix.age_s = τ` before the
@@ -644,6 +684,10 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         }
         if !dx.iter().all(|x| x.is_finite()) {
             return Err(EskfError::NotFinite { index });
+        }
+        let (t, prior) = (self.nav.t_s, self.cov);
+        if let Some(log) = self.smoothing.as_mut() {
+            log.correction(t, &prior, &dx, true);
         }
         self.inject(&dx, index)?;
         let mut set = |k: usize, variance: f64| {
@@ -818,6 +862,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         index: usize,
     ) -> Result<UpdateOutcome, EskfError> {
         self.step_covariance();
+        let prior = self.smoothing.is_some().then_some(self.cov);
         let (nis, dx) = kalman_update(&mut self.cov, h, y, r, gate, index)?;
         let Some(dx) = dx else {
             self.rejected += 1;
@@ -826,6 +871,9 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
                 accepted: false,
             });
         };
+        if let (Some(log), Some(prior)) = (self.smoothing.as_mut(), prior) {
+            log.correction(self.nav.t_s, &prior, &dx, false);
+        }
         self.inject(&dx, index)?;
         self.updates += 1;
         Ok(UpdateOutcome {
@@ -838,27 +886,41 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     /// [`EarthModel::offset`]), and the mechanization restarted from it (its coning and
     /// sculling memory kept).
     fn inject(&mut self, dx: &StateVec<S>, index: usize) -> Result<(), EskfError> {
-        let earth = self.mechanization.earth();
-        let coords = E::coordinates(&self.nav.position);
-        let position = E::position(earth.offset(&coords, &Vec3::new(dx[0], dx[1], dx[2])));
-        let phi = Vector3::new(dx[6], dx[7], dx[8]);
-        let q = UnitQuaternion::from_scaled_axis(phi) * *self.nav.attitude.quaternion();
-        self.nav = NavState {
-            t_s: self.nav.t_s,
-            attitude: Rotation::assume_from_quaternion(q),
-            velocity_m_s: Vec3::from_nalgebra(
-                *self.nav.velocity_m_s.as_nalgebra() + Vector3::new(dx[3], dx[4], dx[5]),
-            ),
-            position,
-        };
-        self.ba += Vector3::new(dx[9], dx[10], dx[11]);
-        self.bg += Vector3::new(dx[12], dx[13], dx[14]);
+        let corrected = corrected_state(self.mechanization.earth(), &self.state(), dx.as_slice());
+        self.nav = corrected.nav;
+        self.ba = Vector3::from(corrected.accel_bias_m_s2);
+        self.bg = Vector3::from(corrected.gyro_bias_rad_s);
         if !self.errors.inject(dx) {
             return Err(EskfError::Diverged { index });
         }
         self.mechanization
             .reset(&self.nav)
             .map_err(|_| EskfError::Diverged { index })
+    }
+}
+
+/// `state` with the error estimate `dx` (at least the 15 navigation and bias states) put into
+/// it, as the filter's closed loop does: position through [`EarthModel::offset`], attitude by
+/// the small rotation `φ` on the left, velocity and biases added. How a smoothed correction
+/// ([`super::smoother`]) is applied to a filtered state.
+#[must_use]
+pub fn corrected_state<E: EarthModel>(earth: &E, state: &EskfState<E>, dx: &[f64]) -> EskfState<E> {
+    let d = |k: usize| dx.get(k).copied().unwrap_or(0.0);
+    let coords = E::coordinates(&state.nav.position);
+    let position = E::position(earth.offset(&coords, &Vec3::new(d(0), d(1), d(2))));
+    let phi = Vector3::new(d(6), d(7), d(8));
+    let q = UnitQuaternion::from_scaled_axis(phi) * *state.nav.attitude.quaternion();
+    EskfState {
+        nav: NavState {
+            t_s: state.nav.t_s,
+            attitude: Rotation::assume_from_quaternion(q),
+            velocity_m_s: Vec3::from_nalgebra(
+                *state.nav.velocity_m_s.as_nalgebra() + Vector3::new(d(3), d(4), d(5)),
+            ),
+            position,
+        },
+        accel_bias_m_s2: core::array::from_fn(|k| state.accel_bias_m_s2[k] + d(9 + k)),
+        gyro_bias_rad_s: core::array::from_fn(|k| state.gyro_bias_rad_s[k] + d(12 + k)),
     }
 }
 

@@ -1,13 +1,17 @@
 //! Fusion of the IMU with aiding sensors: [`eskf`], a loosely coupled error-state Kalman filter
 //! (15 states, or 36 with the sensors' scale-factor, misalignment and g-sensitivity errors of
 //! [`sensor_errors`]; fixed-size matrices, no heap) on any [`crate::earth::EarthModel`], and
-//! [`align`], where it starts without a reference attitude, [`gate`], its innovation gate, and
+//! [`smoother`], its forward–backward (RTS) smoothing, [`align`], where it starts without a
+//! reference attitude, [`gate`], its innovation gate, and
 //! [`process_noise`], its model of a part from the part's figures.
 pub mod align;
 pub mod eskf;
 pub mod gate;
 pub mod process_noise;
 pub mod sensor_errors;
+pub mod smoother;
 
-pub use eskf::{Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome};
+pub use eskf::{
+    Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome, corrected_state,
+};
 pub use sensor_errors::{BASE_STATES, FULL_STATES, SensorErrorEstimate, SensorErrorSigma};

@@ -268,6 +268,7 @@ def fuse(
     covariance_interval_s: Optional[float] = None,
     sensor_errors: Optional[bool] = None,
     rest_s: Optional[float] = None,
+    smooth: bool = False,
     imu_model: Optional[str] = None,
     part: Optional[str] = None,
     gnss_horizontal_accuracy_m: Optional[float] = None,

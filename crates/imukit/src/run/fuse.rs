@@ -10,9 +10,10 @@
 //! exactly there).
 use imu_core::fusion::align::{self, PartFigures};
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
+use imu_core::fusion::smoother::{Covariance, EpochRecord, ErrorVector, rts_backward};
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
-    SensorErrorEstimate, SensorErrorSigma,
+    SensorErrorEstimate, SensorErrorSigma, corrected_state,
 };
 use imu_core::strapdown::NavState;
 use imu_core::{AccelSign, Body, Vec3};
@@ -162,6 +163,9 @@ pub struct FuseSetup {
     /// Find the rest at the start from the readings instead (`imu_core::stillness`, with the
     /// part's white noise); `rest_s` is then replaced by what is found.
     pub detect_rest: bool,
+    /// Smooth the estimate forward–backward (`imu_core::fusion::smoother`): the output is the
+    /// smoothed estimate and its one-sigma.
+    pub smooth: bool,
     /// The covariance is propagated once per this interval and at every update, s (0: every
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
@@ -314,6 +318,8 @@ pub struct FuseRequest<'a> {
     pub sensor_errors: Option<bool>,
     /// Seconds at rest at the start (`None`: found in the readings; `Some(0.0)`: no rest).
     pub rest_s: Option<f64>,
+    /// Smooth the estimate forward–backward ([`FuseSetup::smooth`]).
+    pub smooth: bool,
 }
 
 impl Default for FuseRequest<'_> {
@@ -327,6 +333,7 @@ impl Default for FuseRequest<'_> {
             covariance_interval_s: None,
             sensor_errors: None,
             rest_s: None,
+            smooth: false,
         }
     }
 }
@@ -408,6 +415,7 @@ impl<'a> FuseRequest<'a> {
             }
             None => setup.detect_rest = true,
         }
+        setup.smooth = self.smooth;
         Ok((setup, start))
     }
 }
@@ -1036,13 +1044,23 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
         .map_err(|_| covariance_interval_refusal(setup))?;
-    let mut filter = if S == FULL_STATES {
+    let filter = if S == FULL_STATES {
         filter
             .with_sensor_error_sigma(&setup.sensor_error_sigma)
             .map_err(|e| filter_error("sensor_error_sigma", e))?
     } else {
         filter
     };
+    let mut filter = if setup.smooth {
+        filter
+            .with_smoothing(SMOOTHING_GAP_S)
+            .map_err(|e| filter_error("smooth", e))?
+    } else {
+        filter
+    };
+    // What the backward pass needs: the epochs, and each sample's filtered state.
+    let mut epochs = Vec::new();
+    let mut filtered: Vec<(EskfState<E>, SensorErrorEstimate, usize)> = Vec::new();
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     // The third axis is the vertical in either frame (up in ENU, down in NED).
@@ -1059,7 +1077,6 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         columns,
         data: Vec::new(),
     };
-    let (nav_width, base) = (nav_earth::nav_width::<E>(), NAV_COLUMNS.len());
     let mut acceptance = Acceptance::default();
     let mut last_yaw = None;
     let mut row = Vec::with_capacity(table.columns.len());
@@ -1101,21 +1118,35 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         }
         aid_streams.apply(&mut filter, t[i], i)?;
         let s = filter.state();
-        let sig = filter.sigmas();
-        let nav = nav_earth::nav_row(&s.nav, &origin, &mut last_yaw);
-        row.clear();
-        row.extend_from_slice(&nav[..base]);
-        row.extend_from_slice(&sig[..9]);
-        row.extend_from_slice(&s.accel_bias_m_s2);
-        row.extend_from_slice(&s.gyro_bias_rad_s);
-        row.extend_from_slice(&sig[9..15]);
-        row.extend_from_slice(&nav[base..nav_width]);
-        if S == FULL_STATES {
-            push_sensor_errors(&mut row, &filter.sensor_errors(), &sig[15..]);
+        if setup.smooth {
+            while let Some(e) = filter.take_epoch() {
+                epochs.push(e);
+            }
+            filtered.push((s, filter.sensor_errors(), acceptance.resets));
+            continue;
         }
-        #[allow(clippy::cast_precision_loss)]
-        row.push(acceptance.resets as f64);
-        table.push_row(&row);
+        let sig = filter.sigmas();
+        push_fused_row(
+            &mut table,
+            &mut row,
+            (&s, &filter.sensor_errors(), &sig),
+            (&origin, &mut last_yaw),
+            acceptance.resets,
+        );
+    }
+    if setup.smooth {
+        filter.finish_smoothing();
+        while let Some(e) = filter.take_epoch() {
+            epochs.push(e);
+        }
+        smoothed_rows::<E, S>(
+            filter.earth(),
+            &epochs,
+            &filtered,
+            &t[first..],
+            (&mut table, &mut row),
+            &origin,
+        );
     }
     table.check_finite("fused navigation")?;
     let (updates, rejected) = filter.update_counts();
@@ -1130,6 +1161,92 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
             sensor_errors: setup.estimate_sensor_errors,
         },
     ))
+}
+
+/// The longest propagation without an epoch the smoother keeps, s: the spacing of its estimate
+/// through an outage (between epochs the correction is interpolated linearly).
+pub const SMOOTHING_GAP_S: f64 = 0.5;
+
+/// Appends one row of the fused table: the state `s` (with the sensor errors and one-sigmas
+/// `sig`), in the frame of `origin`, the yaw unwrapped against the last, the resets so far.
+fn push_fused_row<E: NavEarth, const S: usize>(
+    table: &mut Table,
+    row: &mut Vec<f64>,
+    (s, errors, sig): (&EskfState<E>, &SensorErrorEstimate, &[f64; S]),
+    (origin, last_yaw): (&E::Origin, &mut Option<f64>),
+    resets: usize,
+) {
+    let (nav_width, base) = (nav_earth::nav_width::<E>(), NAV_COLUMNS.len());
+    let nav = nav_earth::nav_row(&s.nav, origin, last_yaw);
+    row.clear();
+    row.extend_from_slice(&nav[..base]);
+    row.extend_from_slice(&sig[..9]);
+    row.extend_from_slice(&s.accel_bias_m_s2);
+    row.extend_from_slice(&s.gyro_bias_rad_s);
+    row.extend_from_slice(&sig[9..15]);
+    row.extend_from_slice(&nav[base..nav_width]);
+    if S == FULL_STATES {
+        push_sensor_errors(row, errors, &sig[15..]);
+    }
+    #[allow(clippy::cast_precision_loss)]
+    row.push(resets as f64);
+    table.push_row(row);
+}
+
+/// The smoothed table: the backward pass over `epochs`, each sample's filtered state
+/// (`filtered`, at times `t`) corrected by the smoothed correction interpolated between the
+/// epochs around it (none across a reset), its one-sigma likewise.
+fn smoothed_rows<E: NavEarth, const S: usize>(
+    earth: &E,
+    epochs: &[EpochRecord<S>],
+    filtered: &[(EskfState<E>, SensorErrorEstimate, usize)],
+    t: &[f64],
+    (table, row): (&mut Table, &mut Vec<f64>),
+    origin: &E::Origin,
+) {
+    let mut smoothed = vec![ErrorVector::<S>::zeros(); epochs.len()];
+    let mut covariance = vec![Covariance::<S>::zeros(); epochs.len()];
+    rts_backward(epochs, &mut smoothed, &mut covariance);
+    let mut last_yaw = None;
+    let mut j = 0;
+    for (i, (state, errors, resets)) in filtered.iter().enumerate() {
+        let ti = t[i];
+        while j + 1 < epochs.len() && epochs[j + 1].t_s <= ti {
+            j += 1;
+        }
+        let (dx, var) = match epochs.get(j + 1) {
+            Some(next) if !next.reset && epochs[j].t_s <= ti => {
+                let span = next.t_s - epochs[j].t_s;
+                let w = if span > 0.0 {
+                    (ti - epochs[j].t_s) / span
+                } else {
+                    0.0
+                };
+                let end = next.correction + smoothed[j + 1];
+                (
+                    smoothed[j] * (1.0 - w) + end * w,
+                    covariance[j].diagonal() * (1.0 - w) + covariance[j + 1].diagonal() * w,
+                )
+            }
+            _ => match epochs.get(j) {
+                Some(e) if e.t_s <= ti => (smoothed[j], covariance[j].diagonal()),
+                _ => (ErrorVector::<S>::zeros(), ErrorVector::<S>::zeros()),
+            },
+        };
+        let s = corrected_state(earth, state, dx.as_slice());
+        let mut e = *errors;
+        if S == FULL_STATES {
+            for k in 0..9 {
+                e.accel[k / 3][k % 3] += dx[15 + k];
+                e.gyro[k / 3][k % 3] += dx[24 + k];
+            }
+            for k in 0..3 {
+                e.gyro_g_sensitivity[k] += dx[33 + k];
+            }
+        }
+        let sig: [f64; S] = core::array::from_fn(|k| var[k].max(0.0).sqrt());
+        push_fused_row(table, row, (&s, &e, &sig), (origin, &mut last_yaw), *resets);
+    }
 }
 
 /// Block length of the rest detector, s.
@@ -1332,6 +1449,7 @@ impl FuseSetup {
             },
             rest_s: 0.0,
             detect_rest: false,
+            smooth: false,
         }
     }
 }
