@@ -38,12 +38,12 @@ fn run_parsed(args: cli::Cli) -> u8 {
     match commands::run(args).and_then(|()| outputs.commit().map_err(CliError::from)) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("imukit: {e}");
+            crate::err_line!("imukit: {e}");
             let mut source = std::error::Error::source(&e);
             while let Some(s) = source {
                 // The scenario errors already include their sources in their message.
                 if !e.to_string().contains(&s.to_string()) {
-                    eprintln!("  caused by: {s}");
+                    crate::err_line!("  caused by: {s}");
                 }
                 source = s.source();
             }

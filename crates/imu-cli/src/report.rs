@@ -34,14 +34,42 @@ pub fn quiet() -> bool {
 macro_rules! note {
     ($($arg:tt)*) => {
         if !$crate::report::quiet() {
-            eprintln!($($arg)*);
+            $crate::err_line!($($arg)*);
         }
     };
 }
 
+/// Text on standard output. A reader that has gone (`imukit … | head`) is not the command's
+/// failure: what it prints is dropped, and the command still finishes and writes its files.
+#[macro_export]
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// A line on standard output ([`out!`]'s rule).
+#[macro_export]
+macro_rules! out_line {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// A line on standard error, dropped when standard error is closed ([`out!`]'s rule).
+#[macro_export]
+macro_rules! err_line {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// A warning on standard error, always printed: `imukit: warning: …`.
 pub fn warn(message: &str) {
-    eprintln!("imukit: warning: {message}");
+    crate::err_line!("imukit: warning: {message}");
 }
 
 fn line_interval() -> Duration {
@@ -107,7 +135,7 @@ impl Progress {
                     if *finished {
                         return;
                     }
-                    eprintln!(
+                    crate::err_line!(
                         "{}",
                         progress_line(done2.load(Ordering::Relaxed), total, unit, began.elapsed())
                     );

@@ -1969,3 +1969,23 @@ fn compare_refuses_a_truth_and_an_estimate_in_different_frames() {
         "{err}"
     );
 }
+
+/// A reader that goes away (`imukit … | head`) does not fail the command: it finishes and its
+/// files are written.
+#[test]
+fn a_closed_standard_output_does_not_lose_the_files() {
+    let dir = temp_dir("closed-stdout");
+    let bin = env!("CARGO_BIN_EXE_imukit");
+    let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let script = format!(
+        "set -o pipefail; \"{bin}\" simulate {examples}/static_log.toml --out still.csv \
+         --quiet && \"{bin}\" identify still.csv --out curve.csv | true"
+    );
+    let status = Command::new("bash")
+        .args(["-c", &script])
+        .current_dir(dir.path())
+        .status()
+        .unwrap();
+    assert!(status.success(), "{status}");
+    assert!(dir.path().join("curve.csv").exists());
+}

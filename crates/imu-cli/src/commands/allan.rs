@@ -25,9 +25,12 @@ pub fn run(
     if let Some(p) = plot {
         imu_plot::allan_figure(p, &result, &file_name(input), size)?;
     }
-    println!(
+    crate::out_line!(
         "{:<16} {:>14} {:>14} {:>14}",
-        "column", "N (·/√Hz)", "B", "K (·√Hz)"
+        "column",
+        "N (·/√Hz)",
+        "B",
+        "K (·√Hz)"
     );
     // A term the curve does not resolve shows as its 95 % bound.
     let show = |e: &imu_core::allan::TermEstimate| {
@@ -39,7 +42,7 @@ pub fn run(
     };
     for c in &result.noise {
         use imu_core::allan::NoiseTerm as T;
-        println!(
+        crate::out_line!(
             "{:<16} {:>14} {:>14} {:>14}",
             c.column,
             show(c.fit.term(T::White)),
@@ -47,11 +50,13 @@ pub fn run(
             show(c.fit.term(T::RandomWalk))
         );
     }
-    println!("(\"<x\": not resolved, below x with 95 % confidence; `imukit identify` says more)");
+    crate::out_line!(
+        "(\"<x\": not resolved, below x with 95 % confidence; `imukit identify` says more)"
+    );
     if let Some(p) = plot {
-        println!("\nFigure written to {}", p.display());
+        crate::out_line!("\nFigure written to {}", p.display());
     }
-    println!(
+    crate::out_line!(
         "\nAllan deviation of {} columns at {} τ values ({} Hz) written to {}",
         result.noise.len(),
         result.table.rows(),

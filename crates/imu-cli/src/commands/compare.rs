@@ -16,12 +16,15 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
         &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
     )?;
     let c = compare_csv(truth, estimate, out)?;
-    println!(
+    crate::out_line!(
         "{:<10} {:>16} {:>16} {:>16}",
-        "error", "RMS", "max", "final"
+        "error",
+        "RMS",
+        "max",
+        "final"
     );
     let line = |name: &str, s: &DistanceStats, scale: f64, unit: &str| {
-        println!(
+        crate::out_line!(
             "{name:<10} {:>12.6e} {unit:<3} {:>12.6e} {unit:<3} {:>12.6e} {unit:<3}",
             s.rms() * scale,
             s.max() * scale,
@@ -37,9 +40,9 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
     if let Some(a) = &c.attitude {
         line("attitude", a, 1f64.to_degrees(), "deg");
     }
-    println!("({} rows compared)", c.rows());
+    crate::out_line!("({} rows compared)", c.rows());
     if let Some(o) = out {
-        println!("\nErrors over time written to {}", o.display());
+        crate::out_line!("\nErrors over time written to {}", o.display());
     }
     Ok(())
 }

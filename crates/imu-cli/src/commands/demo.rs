@@ -59,8 +59,8 @@ pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let summary = summary(name, &sim);
     let summary_path = out_dir.join("summary.txt");
     write_atomically(&summary_path, |w| w.write_all(summary.as_bytes()))?;
-    print!("{summary}");
-    println!(
+    crate::out!("{summary}");
+    crate::out_line!(
         "\nWrote scenario.toml, truth.csv, imu.csv, summary.txt, the figures truth.png and imu.png \
          and the animation animation.html (open it in a browser) to {}",
         out_dir.display()

@@ -91,8 +91,8 @@ pub fn run(out_dir: &Path, seed: u64) -> Result<(), CliError> {
     imukit::io::output::write_atomically(&out_dir.join("summary.txt"), |w| {
         std::io::Write::write_all(w, summary.as_bytes())
     })?;
-    print!("{summary}");
-    println!(
+    crate::out!("{summary}");
+    crate::out_line!(
         "\nWrote inertial_data.dat, inertial_data_errors.dat, truth.csv, the four trajectories (CSV), \
          trajectories.svg and summary.txt to {}",
         out_dir.display()

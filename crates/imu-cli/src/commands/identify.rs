@@ -61,29 +61,31 @@ pub fn run(
     }
     let rows = term_rows(&result);
     for c in &result.noise {
-        println!(
+        crate::out_line!(
             "{}",
             column_header(&c.column, &c.fit, result.samples, result.sample_rate_hz)
         );
         for row in rows.iter().filter(|r| r.column == c.column) {
-            println!("{}", row.line());
+            crate::out_line!("{}", row.line());
         }
     }
     if let Some(file) = &file {
-        println!("\nThe fusion filter's noise for this part (fuse --imu with the parameter file):");
+        crate::out_line!(
+            "\nThe fusion filter's noise for this part (fuse --imu with the parameter file):"
+        );
         for (sensor, white, drift) in filter_noise(file, result.sample_rate_hz) {
             let u = if sensor == imukit::io::params::Sensor::Gyroscope {
                 "rad/s"
             } else {
                 "m/s²"
             };
-            println!(
+            crate::out_line!(
                 "  {:<13} white {white:.4e} {u}/√Hz, bias drift {drift:.4e} {u}·√Hz",
                 sensor.key()
             );
         }
     }
-    println!(
+    crate::out_line!(
         "\nAllan curves with 95 % bands and fitted terms of {} columns written to {}",
         result.noise.len(),
         to.out.display()
@@ -94,7 +96,7 @@ pub fn run(
         ("Figure", to.plot),
     ] {
         if let Some(p) = path {
-            println!("{what} written to {}", p.display());
+            crate::out_line!("{what} written to {}", p.display());
         }
     }
     Ok(())

@@ -233,7 +233,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
             let c = imukit::io::units::convert(value, &unit)?;
-            println!("{} {}   ({})", c.value, c.unit, c.fits);
+            crate::out_line!("{} {}   ({})", c.value, c.unit, c.fits);
             Ok(())
         }
         Command::Allan {

@@ -36,7 +36,7 @@ pub fn run(
     } else {
         format!("at a fixed {rate} Hz (SampleRate)")
     };
-    println!(
+    crate::out_line!(
         "imukit: {} samples, {timing}, through {filter}: {} orientations in {}",
         s.samples,
         s.rows,
@@ -46,7 +46,7 @@ pub fn run(
         crate::report::warn(&m);
     }
     if s.unfinished > 0 {
-        println!(
+        crate::out_line!(
             "imukit: the last {} samples do not fill a block of DecimationFactor samples and \
              give no orientation",
             s.unfinished

@@ -22,7 +22,7 @@ pub fn plot(
     let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
     check_outputs(&inputs, &[("--out", out)])?;
     plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
-    println!("Wrote {}", out.display());
+    crate::out_line!("Wrote {}", out.display());
     Ok(())
 }
 
@@ -62,7 +62,7 @@ pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), Cl
     let table = read_table(truth)?;
     let info = anim::animate(&table, &truth.display().to_string(), out, opts)
         .map_err(crate::plot_by_flag)?;
-    println!(
+    crate::out_line!(
         "Wrote {} ({} frames at {} frames/s, {}× real time)",
         out.display(),
         info.frames,

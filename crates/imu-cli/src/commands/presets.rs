@@ -22,11 +22,11 @@ pub fn run(
                 let info = presets::load(n)?.info;
                 let grade = info.get("grade").map(String::as_str).unwrap_or("");
                 let source = info.get("source").map(String::as_str).unwrap_or("");
-                println!("{n:<14} {grade:<11} {source}");
+                crate::out_line!("{n:<14} {grade:<11} {source}");
             }
         }
         Some(n) => match format {
-            PresetFormat::Toml => print!("{}", presets::text(n)?),
+            PresetFormat::Toml => crate::out!("{}", presets::text(n)?),
             PresetFormat::Kalibr => kalibr(&presets::load(n)?, rate_hz, topic)?,
         },
     }
@@ -43,10 +43,10 @@ pub fn file(
 ) -> Result<(), CliError> {
     let params = read_param_file(path, part, Profile::Default)?;
     for warning in &params.warnings {
-        eprintln!("imukit: warning: {warning}");
+        crate::err_line!("imukit: warning: {warning}");
     }
     match format {
-        PresetFormat::Toml => print!("{}", to_toml(&params)),
+        PresetFormat::Toml => crate::out!("{}", to_toml(&params)),
         PresetFormat::Kalibr => kalibr(&params, rate_hz, topic)?,
     }
     Ok(())
@@ -57,6 +57,6 @@ fn kalibr(params: &ParamFile, rate_hz: f64, topic: &str) -> Result<(), CliError>
         imukit::Error::Invalid { ref field, .. } if field == "rate_hz" => by_flag(e),
         other => other,
     })?;
-    print!("{}", imu.to_yaml());
+    crate::out!("{}", imu.to_yaml());
     Ok(())
 }

@@ -7,10 +7,10 @@ pub fn run(name: Option<&str>) -> Result<(), CliError> {
     match name {
         None => {
             for n in builtin::NAMES {
-                println!("{n}");
+                crate::out_line!("{n}");
             }
         }
-        Some(n) => print!("{}", builtin::toml(n)?),
+        Some(n) => crate::out!("{}", builtin::toml(n)?),
     }
     Ok(())
 }
