@@ -15,10 +15,11 @@ fn bench(c: &mut Criterion) {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut group = c.benchmark_group("study");
     group.sample_size(10);
-    for (name, odometer, full) in [
-        ("tunnel_run", false, false),
-        ("tunnel_run_with_wheels", true, false),
-        ("tunnel_run_rest_and_36_states", false, true),
+    for (name, odometer, full, smooth) in [
+        ("tunnel_run", false, false, false),
+        ("tunnel_run_with_wheels", true, false, false),
+        ("tunnel_run_rest_and_36_states", false, true, false),
+        ("tunnel_run_rest_and_36_states_smoothed", false, true, true),
     ] {
         let spec = StudySpec {
             scenario: "car_tunnel.toml".into(),
@@ -29,6 +30,7 @@ fn bench(c: &mut Criterion) {
             nhc_sigma_m_s: odometer.then_some(0.05),
             sensor_errors: full,
             rest_s: if full { 20.0 } else { 0.0 },
+            smooth,
             draw_parts: true,
         };
         let study = Study::new(&spec, &examples, "bench").expect("the example study resolves");

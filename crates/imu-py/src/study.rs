@@ -9,8 +9,9 @@ use crate::convert::{TableOut, table_out};
 use crate::errors::refused;
 
 /// One run of an outage study (`imukit study`'s file at `path`): preset number `case`, run
-/// `run` → `(t_s, horizontal_error_m, horizontal_sigma_m, None, resets)` through the first
-/// outage, or `(None, None, None, message, 0)` when the filter diverged.
+/// `run` → `(t_s, horizontal_error_m, horizontal_sigma_m, None, resets, smoothed_error_m)`
+/// through the first outage (the last empty unless the study smooths), or
+/// `(None, None, None, message, 0, None)` when the filter diverged.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn study_run<'py>(
@@ -24,6 +25,7 @@ fn study_run<'py>(
     Option<Bound<'py, PyArray1<f64>>>,
     Option<String>,
     usize,
+    Option<Bound<'py, PyArray1<f64>>>,
 )> {
     use imukit::run::study::{RunOutcome, Study};
     let path = Path::new(path).to_path_buf();
@@ -37,8 +39,9 @@ fn study_run<'py>(
             Some(r.horizontal_sigma_m.into_pyarray(py)),
             None,
             r.resets,
+            Some(r.smoothed_error_m.into_pyarray(py)),
         ),
-        RunOutcome::Diverged(message) => (None, None, None, Some(message), 0),
+        RunOutcome::Diverged(message) => (None, None, None, Some(message), 0, None),
     })
 }
 
@@ -71,11 +74,21 @@ fn study_summarise<'py>(
             Option<Vec<f64>>,
             Option<String>,
             usize,
+            Option<Vec<f64>>,
         )>,
     >,
 ) -> PyResult<(
     TableOut<'py>,
-    Vec<(String, usize, usize, Option<f64>, Option<f64>, f64, usize)>,
+    Vec<(
+        String,
+        usize,
+        usize,
+        Option<f64>,
+        Option<f64>,
+        f64,
+        usize,
+        Option<(f64, f64)>,
+    )>,
 )> {
     use imukit::run::study::{OutageRun, RunOutcome, Study};
     let study = Study::from_file(Path::new(path)).map_err(refused)?;
@@ -83,12 +96,13 @@ fn study_summarise<'py>(
         .into_iter()
         .map(|runs| {
             runs.into_iter()
-                .map(|(t, e, s, message, resets)| match (t, e, s) {
+                .map(|(t, e, s, message, resets, smoothed)| match (t, e, s) {
                     (Some(t_s), Some(horizontal_error_m), Some(horizontal_sigma_m)) => {
                         RunOutcome::Outage(OutageRun {
                             t_s,
                             horizontal_error_m,
                             horizontal_sigma_m,
+                            smoothed_error_m: smoothed.unwrap_or_default(),
                             resets,
                         })
                     }
@@ -109,6 +123,7 @@ fn study_summarise<'py>(
                 m.sigma_m,
                 m.outage_s,
                 m.resets.1,
+                m.smoothed_rms_error_m,
             )
         })
         .collect();

@@ -12,6 +12,10 @@ fn examples() -> PathBuf {
 }
 
 fn study(presets: &[&str], runs: u64) -> Study {
+    study_smoothed(presets, runs, false)
+}
+
+fn study_smoothed(presets: &[&str], runs: u64, smooth: bool) -> Study {
     let spec = StudySpec {
         scenario: "car_tunnel.toml".into(),
         presets: presets.iter().map(|p| p.to_string()).collect(),
@@ -21,6 +25,7 @@ fn study(presets: &[&str], runs: u64) -> Study {
         nhc_sigma_m_s: None,
         sensor_errors: true,
         rest_s: 20.0,
+        smooth,
         draw_parts: true,
     };
     Study::new(&spec, &examples(), "test study").unwrap()
@@ -74,6 +79,26 @@ fn through_the_tunnel_the_rms_error_matches_the_filters_sigma_for_each_preset() 
             );
         }
     }
+}
+
+/// With `smooth`, the study reports the smoothed error beside the filter's: the same filtered
+/// numbers, and a smoothed RMS through the tunnel well below the filter's at its end.
+#[test]
+fn a_smoothed_study_reports_both_side_by_side() {
+    let (plain, smoothed) = (
+        study(&["stim300"], 4),
+        study_smoothed(&["stim300"], 4, true),
+    );
+    let outcomes = run_on_threads(&smoothed, 1, 4);
+    let (table, summaries) = smoothed.summarise(&outcomes).unwrap();
+    let (_, plain_summaries) = plain.summarise(&run_on_threads(&plain, 1, 4)).unwrap();
+    let m = &summaries[0];
+    assert_eq!(m.rms_error_m, plain_summaries[0].rms_error_m);
+    let (end, worst) = m.smoothed_rms_error_m.unwrap();
+    let filtered = m.rms_error_m.unwrap();
+    assert!(worst < 0.5 * filtered && end <= worst, "{m:?}");
+    assert!(table.column("stim300_smoothed_rms_error_m").is_some());
+    assert!(plain_summaries[0].smoothed_rms_error_m.is_none());
 }
 
 #[test]
@@ -160,6 +185,7 @@ fn an_odometer_and_the_vehicle_constraints_shrink_the_drift_through_the_tunnel()
             nhc_sigma_m_s: wheels.then_some(0.05),
             sensor_errors: true,
             rest_s: 20.0,
+            smooth: false,
             draw_parts: true,
         };
         let s = Study::new(&spec, &examples(), "wheels study").unwrap();

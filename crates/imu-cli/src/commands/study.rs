@@ -65,10 +65,16 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
                  runs: its one-sigma understates its error"
             ),
         };
+        let smoothed = m
+            .smoothed_rms_error_m
+            .map(|(end, worst)| {
+                format!("; smoothed: {end:.3} m there, at most {worst:.3} m along the outage")
+            })
+            .unwrap_or_default();
         match (m.rms_error_m, m.sigma_m) {
             (Some(e), Some(s)) => {
                 crate::note!(
-                    "  {:<14} {e:>10.3} m   (filter: {s:.3} m){reset}{diverged}",
+                    "  {:<14} {e:>10.3} m   (filter: {s:.3} m){smoothed}{reset}{diverged}",
                     m.preset
                 );
             }

@@ -382,10 +382,23 @@ def study_run(
     Optional[npt.NDArray[np.float64]],
     Optional[str],
     int,
+    Optional[npt.NDArray[np.float64]],
 ]: ...
 def study_summarise(
     path: str,
     outcomes: Sequence[
-        Sequence[tuple[Optional[Sequence[float]], Optional[Sequence[float]], Optional[Sequence[float]], Optional[str], int]]
+        Sequence[
+            tuple[
+                Optional[Sequence[float]],
+                Optional[Sequence[float]],
+                Optional[Sequence[float]],
+                Optional[str],
+                int,
+                Optional[Sequence[float]],
+            ]
+        ]
     ],
-) -> tuple[_Table, list[tuple[str, int, int, Optional[float], Optional[float], float, int]]]: ...
+) -> tuple[
+    _Table,
+    list[tuple[str, int, int, Optional[float], Optional[float], float, int, Optional[tuple[float, float]]]],
+]: ...

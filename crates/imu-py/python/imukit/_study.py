@@ -10,7 +10,7 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, List, Optional, Union
+from typing import Tuple, Any, List, Optional, Union
 
 from . import _core
 from ._warning import _emit
@@ -23,7 +23,8 @@ class PresetSummary:
     horizontal error and of the filter's horizontal one-sigma (``None`` with fewer than two
     completed runs), the runs completed and diverged, that sample's time into the outage, and the
     times the filter lost the fixes and was reset to them over the completed runs (its one-sigma
-    then understates its error)."""
+    then understates its error). With ``smooth = true`` in the study, ``smoothed_rms_error_m``
+    is the smoothed estimate's RMS error at the same sample and the largest along the outage."""
 
     preset: str
     completed: int
@@ -32,6 +33,7 @@ class PresetSummary:
     sigma_m: Optional[float]
     outage_s: float
     resets: int
+    smoothed_rms_error_m: Optional[Tuple[float, float]] = None
 
 
 @dataclass(frozen=True)
@@ -45,10 +47,10 @@ class StudyResult:
 
 def _run(path: str, case: int, run: int):
     """One run (a thread's job or a Dask task): plain lists, as the summary takes them."""
-    t, error, sigma, diverged, resets = _core.study_run(path, case, run)
+    t, error, sigma, diverged, resets, smoothed = _core.study_run(path, case, run)
     if diverged is not None:
-        return None, None, None, diverged, 0
-    return t.tolist(), error.tolist(), sigma.tolist(), None, resets
+        return None, None, None, diverged, 0, None
+    return t.tolist(), error.tolist(), sigma.tolist(), None, resets, smoothed.tolist()
 
 
 def study(path: Union[str, os.PathLike], *, client: Any = None, threads: Optional[int] = None) -> StudyResult:

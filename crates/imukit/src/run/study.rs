@@ -49,6 +49,10 @@ pub struct StudySpec {
     /// (see [`FuseSetup::rest_s`]); 0 when absent.
     #[serde(default)]
     pub rest_s: f64,
+    /// Also smooth each run forward–backward ([`FuseSetup::smooth`]) and report the smoothed
+    /// error beside the filter's.
+    #[serde(default)]
+    pub smooth: bool,
     /// Each run draws its own part of each preset's type (constant biases, scale factors,
     /// misalignment and g-sensitivity from normal distributions whose one-sigma are the
     /// preset's figures, see `scenario::perturb::drawn_part`): the study then speaks of the
@@ -75,6 +79,7 @@ struct Case {
 pub struct Study {
     cases: Vec<Case>,
     runs: u64,
+    smooth: bool,
     odometer: bool,
     baro: bool,
     outage: (f64, f64),
@@ -92,6 +97,9 @@ pub struct OutageRun {
     pub horizontal_error_m: Vec<f64>,
     /// The filter's horizontal one-sigma `√(σ_x² + σ_y²)`, m.
     pub horizontal_sigma_m: Vec<f64>,
+    /// The smoothed estimate's horizontal error at the same samples, m (empty when the study
+    /// does not smooth).
+    pub smoothed_error_m: Vec<f64>,
     /// Times the filter lost the fixes and was reset to them over the whole run
     /// ([`crate::run::fuse::FuseSummary::resets`]): its one-sigma then understates its error.
     pub resets: usize,
@@ -123,6 +131,10 @@ pub struct PresetSummary {
     pub rms_error_m: Option<f64>,
     /// RMS over completed runs of the filter's horizontal one-sigma there, m.
     pub sigma_m: Option<f64>,
+    /// With smoothing: RMS over completed runs of the smoothed horizontal error at the same
+    /// sample, and the largest such RMS along the outage (the smoothed error is largest inside
+    /// it, not at its end), m.
+    pub smoothed_rms_error_m: Option<(f64, f64)>,
     /// Time from the outage's start to that last sample, s.
     pub outage_s: f64,
 }
@@ -201,6 +213,7 @@ impl Study {
             setup.aiding.nhc_sigma_m_s = spec.nhc_sigma_m_s;
             setup.estimate_sensor_errors = spec.sensor_errors;
             setup.rest_s = spec.rest_s;
+            setup.smooth = false;
             cases.push(Case {
                 preset: preset.clone(),
                 scenario,
@@ -248,6 +261,7 @@ impl Study {
         Ok(Self {
             cases,
             runs: spec.runs,
+            smooth: spec.smooth,
             odometer: spec.odometer,
             baro: spec.baro,
             outage: (start, end),
@@ -385,10 +399,22 @@ impl Study {
         let (tx, ty) = (col(&sim.truth, "pos_x_m")?, col(&sim.truth, "pos_y_m")?);
         let (sx, sy) = (col(&nav, "pos_x_sigma_m")?, col(&nav, "pos_y_sigma_m")?);
         let (start, end) = self.outage;
+        let smoothed = if self.smooth {
+            let setup = FuseSetup {
+                smooth: true,
+                ..c.setup
+            };
+            let (nav, _) =
+                fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &setup).map_err(named)?;
+            Some((col(&nav, "pos_x_m")?, col(&nav, "pos_y_m")?))
+        } else {
+            None
+        };
         let mut out = OutageRun {
             t_s: Vec::new(),
             horizontal_error_m: Vec::new(),
             horizontal_sigma_m: Vec::new(),
+            smoothed_error_m: Vec::new(),
             resets,
         };
         // The row at the outage's end already holds the first fix after it: stop before it.
@@ -397,6 +423,10 @@ impl Study {
             out.horizontal_error_m
                 .push((px[i] - tx[i]).hypot(py[i] - ty[i]));
             out.horizontal_sigma_m.push(sx[i].hypot(sy[i]));
+            if let Some((qx, qy)) = &smoothed {
+                out.smoothed_error_m
+                    .push((qx[i] - tx[i]).hypot(qy[i] - ty[i]));
+            }
         }
         Ok(RunOutcome::Outage(out))
     }
@@ -413,7 +443,8 @@ impl Study {
 
     /// The study's table and per-preset summaries from `outcomes[case][run]`. Table columns:
     /// `t_s` (time since the outage began), then per preset with at least two completed runs
-    /// `<preset>_rms_error_m` and `<preset>_sigma_m` (RMS over its completed runs).
+    /// `<preset>_rms_error_m` and `<preset>_sigma_m` (RMS over its completed runs), and with
+    /// smoothing `<preset>_smoothed_rms_error_m`.
     ///
     /// # Errors
     /// Outcomes that do not match the study (presets, runs or samples), or no preset with two
@@ -454,6 +485,17 @@ impl Study {
         fn sigma(r: &OutageRun) -> &[f64] {
             &r.horizontal_sigma_m
         }
+        fn smoothed(r: &OutageRun) -> &[f64] {
+            &r.smoothed_error_m
+        }
+        if self.smooth
+            && completed
+                .iter()
+                .flatten()
+                .any(|r| r.smoothed_error_m.len() != t.len())
+        {
+            return Err(mismatch());
+        }
         let reported: Vec<usize> = (0..self.cases.len())
             .filter(|&c| completed[c].len() >= 2)
             .collect();
@@ -467,6 +509,9 @@ impl Study {
         for &c in &reported {
             names.push(format!("{}_rms_error_m", self.cases[c].preset));
             names.push(format!("{}_sigma_m", self.cases[c].preset));
+            if self.smooth {
+                names.push(format!("{}_smoothed_rms_error_m", self.cases[c].preset));
+            }
         }
         let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
         let mut table = Table::new(&name_refs);
@@ -477,6 +522,9 @@ impl Study {
             for &c in &reported {
                 row.push(rms(&completed[c], k, error));
                 row.push(rms(&completed[c], k, sigma));
+                if self.smooth {
+                    row.push(rms(&completed[c], k, smoothed));
+                }
             }
             table.push_row(&row);
         }
@@ -502,6 +550,12 @@ impl Study {
                     ),
                     rms_error_m: ok.then(|| rms(&completed[c], last, error)),
                     sigma_m: ok.then(|| rms(&completed[c], last, sigma)),
+                    smoothed_rms_error_m: (ok && self.smooth).then(|| {
+                        let worst = (0..=last)
+                            .map(|k| rms(&completed[c], k, smoothed))
+                            .fold(0.0, f64::max);
+                        (rms(&completed[c], last, smoothed), worst)
+                    }),
                     outage_s: t[last],
                 }
             })
