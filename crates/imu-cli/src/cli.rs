@@ -196,7 +196,8 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Orientation from IMU readings by a filter: `imufilter` and `ahrsfilter` (MATLAB's
+    /// Orientation from IMU readings by a filter: `robust` (imukit's own, the default: bias
+    /// learnt at rest only, rejected readings flagged), `imufilter` and `ahrsfilter` (MATLAB's
     /// Kalman filters), `ecompass`, `madgwick`, `mahony` or `complementary`.
     Orient {
         /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that

@@ -445,12 +445,12 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         (
             "imu.csv",
             vec!["--filter", "kalman"],
-            "invalid value 'kalman' for '--filter <FILTER>'\n  [possible values: imufilter, ahrsfilter, ecompass, madgwick, mahony, complementary]",
+            "invalid value 'kalman' for '--filter <FILTER>'\n  [possible values: robust, imufilter, ahrsfilter, ecompass, madgwick, mahony, complementary]",
         ),
         (
             "imu.csv",
             vec!["--param", "GyroNoise=1"],
-            "GyroNoise: unknown setting for imufilter",
+            "GyroNoise: unknown setting for robust",
         ),
         (
             "imu.csv",
@@ -459,7 +459,7 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         ),
         (
             "imu.csv",
-            vec!["--param", "GyroscopeNoise=-2"],
+            vec!["--filter", "imufilter", "--param", "GyroscopeNoise=-2"],
             "GyroscopeNoise = -2: must be finite and > 0",
         ),
         ("imu.csv", vec!["--filter", "ahrsfilter"], "missing"),
@@ -491,7 +491,11 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         assert_eq!(code, Some(0), "{args:?}: {err}");
         let text = table_text(&out_file);
         assert_eq!(text.lines().count(), 4);
-        assert!(text.starts_with("t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad\n0.0,"));
+        // The default filter (robust) adds its bias estimate and flags.
+        assert!(text.starts_with(
+            "t_s,q_w,q_x,q_y,q_z,yaw_rad,pitch_rad,roll_rad,gyro_bias_x_rad_s,gyro_bias_y_rad_s,\
+             gyro_bias_z_rad_s,at_rest,accel_rejected,mag_disturbed\n0.0,"
+        ));
         let q: Vec<f64> = text
             .lines()
             .nth(1)
@@ -517,8 +521,8 @@ fn orient_refuses_bad_input_by_name_and_row_and_leaves_no_output() {
         .lines()
         .nth(1)
         .unwrap()
-        .rsplit(',')
-        .next()
+        .split(',')
+        .nth(7)
         .unwrap()
         .parse()
         .unwrap();
@@ -1025,7 +1029,8 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
     std::fs::write(dir.join("imu.csv"), text).unwrap();
     let out = imukit()
         .current_dir(dir)
-        .args(["orient", "imu.csv", "--param", "DecimationFactor=3"])
+        .args(["orient", "imu.csv", "--filter", "imufilter"])
+        .args(["--param", "DecimationFactor=3"])
         .args(["--out", "o.csv"])
         .output()
         .unwrap();

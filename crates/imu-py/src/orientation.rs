@@ -25,6 +25,8 @@ pub(crate) struct PyOrientationFilter {
     clock: SampleClock,
     gyroscope: bool,
     magnetometer: bool,
+    /// The robust filter's bias and flags of the last call's estimates (empty for the others).
+    last_status: Vec<[f64; 6]>,
 }
 
 type Estimates<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
@@ -66,6 +68,7 @@ impl PyOrientationFilter {
             clock: SampleClock::default(),
             gyroscope: kind != FilterKind::Ecompass,
             magnetometer: spec.magnetometer,
+            last_status: Vec::new(),
         })
     }
 
@@ -109,6 +112,7 @@ impl PyOrientationFilter {
             })
             .map_err(refused)?;
         let rows = out.quaternions.len();
+        self.last_status = out.status;
         Ok((
             array2(py, rows, 4, out.quaternions.concat())?,
             array2(py, rows, 3, out.angular_velocity_rad_s.concat())?,
@@ -123,6 +127,20 @@ impl PyOrientationFilter {
             Filter::Enu(f) => f.reset(),
             Filter::Ned(f) => f.reset(),
         }
+    }
+
+    /// The robust filter's gyroscope bias (rad/s) and flags (at rest, accelerometer rejected,
+    /// magnetic disturbance; 1 or 0) for each estimate of the last call, (M, 6); `None` for the
+    /// other filters.
+    fn status<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        if !matches!(
+            self.filter,
+            Filter::Enu(AnyFilter::Robust(_)) | Filter::Ned(AnyFilter::Robust(_))
+        ) {
+            return Ok(None);
+        }
+        let rows = self.last_status.len();
+        array2(py, rows, 6, self.last_status.concat()).map(Some)
     }
 
     /// The gyroscope offset estimate of a Kalman filter, rad/s (None for the others).
@@ -140,6 +158,9 @@ impl PyOrientationFilter {
         match &self.filter {
             Filter::Enu(AnyFilter::Kalman(k)) => Some(k.state().gyroscope_offset()),
             Filter::Ned(AnyFilter::Kalman(k)) => Some(k.state().gyroscope_offset()),
+            Filter::Enu(AnyFilter::Robust(r)) | Filter::Ned(AnyFilter::Robust(r)) => {
+                Some(r.status().gyro_bias_rad_s)
+            }
             _ => None,
         }
     }

@@ -1,5 +1,6 @@
 //! Orientation from IMU readings: the e-compass, Kalman filters equivalent in structure to
-//! MATLAB's `imufilter` and `ahrsfilter`, and the complementary, Madgwick and Mahony filters,
+//! MATLAB's `imufilter` and `ahrsfilter`, the complementary, Madgwick and Mahony filters, and
+//! imukit's own [`robust`] filter (bias learnt at rest only, rejections flagged),
 //! all behind one per-sample trait ([`OrientationFilter`]); and the quaternion distance that
 //! judges them against truth ([`metrics`]).
 //!
@@ -15,11 +16,13 @@
 pub mod ecompass;
 pub mod kalman;
 pub mod metrics;
+pub mod robust;
 pub mod simple;
 
 pub use ecompass::{Ecompass, ecompass};
 pub use kalman::{KalmanFilter, KalmanParams};
 pub use metrics::{DistanceStats, quaternion_distance};
+pub use robust::{RobustFilter, RobustParams, RobustStatus};
 pub use simple::{Complementary, Madgwick, Mahony};
 
 use nalgebra::{UnitQuaternion, Vector3};

@@ -68,6 +68,7 @@ from ._orientation import (
     ImuFilter,
     MadgwickFilter,
     MahonyFilter,
+    RobustFilter,
     ecompass,
     quaternion_distance,
 )
@@ -126,4 +127,5 @@ __all__ = [
     "ComplementaryFilter",
     "MadgwickFilter",
     "MahonyFilter",
+    "RobustFilter",
 ]

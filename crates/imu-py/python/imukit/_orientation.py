@@ -229,6 +229,44 @@ class MadgwickFilter(_SimpleFilter):
                          orientation_format)
 
 
+class RobustFilter(_SimpleFilter):
+    """imukit's own attitude (and, with ``has_magnetometer=True``, heading) filter, made for real
+    motion: the gyroscope bias is learnt only at rest, accelerometer readings that are not gravity
+    (linear acceleration) and magnetometer readings that are not the Earth's field (a magnet
+    nearby) are rejected and flagged. ``status`` holds, for the last call's estimates, the bias
+    estimate (rad/s) and the flags: a dict of ``gyro_bias`` (M, 3), ``at_rest``,
+    ``accel_rejected`` and ``mag_disturbed`` (M,) booleans. Settings (times in s, angles in rad):
+    ``accelerometer_time_constant`` 3, ``magnetometer_time_constant`` 9, ``bias_time_constant``
+    3, and the rest as ``imukit orient --filter robust --param`` names them."""
+
+    _kind = "robust"
+
+    def __init__(self, sample_rate: float = 100.0, *, has_magnetometer: bool = False,
+                 accelerometer_time_constant: float = 3.0, magnetometer_time_constant: float = 9.0,
+                 bias_time_constant: float = 3.0, settings: Optional[dict] = None,
+                 conventions: Optional[str] = None, reference_frame: Optional[str] = None,
+                 orientation_format: str = "quaternion", accel_sign: Optional[str] = None) -> None:
+        all_settings = dict(AccelerometerTimeConstant=accelerometer_time_constant,
+                            MagnetometerTimeConstant=magnetometer_time_constant,
+                            BiasTimeConstant=bias_time_constant)
+        all_settings.update(settings or {})
+        super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer,
+                         all_settings, orientation_format)
+
+    @property
+    def status(self) -> dict:
+        s = self._filter.status()
+        if s is None:
+            s = np.zeros((0, 6))
+        return {"gyro_bias": s[:, 0:3], "at_rest": s[:, 3] > 0.5, "accel_rejected": s[:, 4] > 0.5,
+                "mag_disturbed": s[:, 5] > 0.5}
+
+    @property
+    def gyroscope_offset(self):
+        """The gyroscope bias estimate after the last sample, rad/s."""
+        return self._filter.gyroscope_offset
+
+
 class MahonyFilter(_SimpleFilter):
     """Mahony's complementary filter with proportional and integral gains."""
 

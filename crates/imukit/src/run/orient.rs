@@ -5,7 +5,7 @@ use std::path::Path;
 
 use imu_core::orientation::{
     Complementary, Ecompass, Estimate, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
-    OrientError, OrientationFilter,
+    OrientError, OrientationFilter, RobustFilter, RobustParams, RobustStatus,
 };
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
@@ -32,11 +32,41 @@ pub const ORIENT_COLUMNS: [&str; 8] = [
     "roll_rad",
 ];
 
+/// What the robust filter adds to [`ORIENT_COLUMNS`]: its gyroscope bias estimate and its
+/// flags (1 or 0): at rest (the bias was learnt), accelerometer rejected, magnetic disturbance.
+pub const ROBUST_COLUMNS: [&str; 6] = [
+    "gyro_bias_x_rad_s",
+    "gyro_bias_y_rad_s",
+    "gyro_bias_z_rad_s",
+    "at_rest",
+    "accel_rejected",
+    "mag_disturbed",
+];
+
+/// The robust filter's status as the values of [`ROBUST_COLUMNS`].
+#[must_use]
+pub fn robust_row(s: &RobustStatus) -> [f64; 6] {
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    let [x, y, z] = s.gyro_bias_rad_s;
+    [
+        x,
+        y,
+        z,
+        flag(s.at_rest),
+        flag(s.accel_rejected),
+        flag(s.mag_disturbed),
+    ]
+}
+
 /// The filters, by name.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FilterKind {
-    /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter (the default).
+    /// imukit's own filter, the default: gyroscope bias learnt at rest only, accelerometer and
+    /// magnetometer readings that are not gravity and north rejected and flagged
+    /// (`imu_core::orientation::robust`).
     #[default]
+    Robust,
+    /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter.
     ImuFilter,
     /// MATLAB `ahrsfilter`: + magnetometer.
     AhrsFilter,
@@ -53,6 +83,7 @@ pub enum FilterKind {
 impl Choice for FilterKind {
     const WHAT: &'static str = "filter";
     const NAMES: &'static [(&'static str, Self)] = &[
+        ("robust", Self::Robust),
         ("imufilter", Self::ImuFilter),
         ("ahrsfilter", Self::AhrsFilter),
         ("ecompass", Self::Ecompass),
@@ -70,7 +101,7 @@ impl FilterKind {
         match self {
             Self::AhrsFilter | Self::Ecompass => Some(true),
             Self::ImuFilter => Some(false),
-            Self::Madgwick | Self::Mahony | Self::Complementary => None,
+            Self::Robust | Self::Madgwick | Self::Mahony | Self::Complementary => None,
         }
     }
 
@@ -85,9 +116,29 @@ impl FilterKind {
             Self::Madgwick => vec!["SampleRate", "Beta"],
             Self::Mahony => vec!["SampleRate", "Kp", "Ki"],
             Self::Complementary => vec!["SampleRate", "AccelerometerGain", "MagnetometerGain"],
+            Self::Robust => ROBUST_SETTINGS.to_vec(),
         }
     }
 }
+
+/// Settings of the robust filter (`RobustParams`; angles in rad, times in s).
+const ROBUST_SETTINGS: [&str; 15] = [
+    "SampleRate",
+    "Gravity",
+    "AccelerometerTimeConstant",
+    "MagnetometerTimeConstant",
+    "RestTimeConstant",
+    "RestGyroscopeThreshold",
+    "RestAccelerometerThreshold",
+    "RestMinimumTime",
+    "BiasTimeConstant",
+    "AccelerationRejection",
+    "AccelerationRejectionAngle",
+    "RecoveryTime",
+    "MagneticRejection",
+    "DipRejection",
+    "MagneticRecoveryTime",
+];
 
 /// Settings of both Kalman filters.
 const KALMAN_SETTINGS: [&str; 9] = [
@@ -400,6 +451,35 @@ impl FilterSpec {
                 let ki = self.setting("Ki")?.unwrap_or(0.3);
                 AnyFilter::Mahony(Mahony::new(rate, kp, ki, mag, sign).map_err(refused)?)
             }
+            FilterKind::Robust => {
+                let mut p = RobustParams {
+                    sample_rate_hz: rate,
+                    accel_sign: sign,
+                    magnetometer: mag,
+                    ..RobustParams::default()
+                };
+                for (name, field) in [
+                    ("Gravity", &mut p.gravity_m_s2),
+                    ("AccelerometerTimeConstant", &mut p.tau_accel_s),
+                    ("MagnetometerTimeConstant", &mut p.tau_mag_s),
+                    ("RestTimeConstant", &mut p.rest_tau_s),
+                    ("RestGyroscopeThreshold", &mut p.rest_gyro_rad_s),
+                    ("RestAccelerometerThreshold", &mut p.rest_accel_m_s2),
+                    ("RestMinimumTime", &mut p.rest_min_s),
+                    ("BiasTimeConstant", &mut p.bias_tau_s),
+                    ("AccelerationRejection", &mut p.accel_rejection_g),
+                    ("AccelerationRejectionAngle", &mut p.accel_rejection_rad),
+                    ("RecoveryTime", &mut p.recovery_s),
+                    ("MagneticRejection", &mut p.mag_rejection),
+                    ("DipRejection", &mut p.dip_rejection_rad),
+                    ("MagneticRecoveryTime", &mut p.mag_recovery_s),
+                ] {
+                    if let Some(v) = self.setting(name)? {
+                        *field = v;
+                    }
+                }
+                AnyFilter::Robust(RobustFilter::new(p).map_err(refused)?)
+            }
             FilterKind::Complementary => {
                 let ka = self.setting("AccelerometerGain")?.unwrap_or(0.01);
                 let km = self.setting("MagnetometerGain")?.unwrap_or(0.01);
@@ -426,6 +506,8 @@ pub enum AnyFilter<N: NavFrame> {
     Mahony(Mahony),
     /// `complementaryFilter`.
     Complementary(Complementary),
+    /// imukit's robust filter.
+    Robust(RobustFilter),
 }
 
 impl<N: NavFrame> AnyFilter<N> {
@@ -435,6 +517,16 @@ impl<N: NavFrame> AnyFilter<N> {
         match self {
             Self::Kalman(f) => f.params().decimation,
             _ => 1,
+        }
+    }
+
+    /// The robust filter's bias estimate and flags after the last sample (`None` for the
+    /// others).
+    #[must_use]
+    pub fn status(&self) -> Option<RobustStatus> {
+        match self {
+            Self::Robust(f) => Some(f.status()),
+            _ => None,
         }
     }
 }
@@ -450,6 +542,7 @@ impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
             Self::Madgwick(f) => f.update(input),
             Self::Mahony(f) => f.update(input),
             Self::Complementary(f) => f.update(input),
+            Self::Robust(f) => f.update(input),
         }
     }
 
@@ -460,6 +553,7 @@ impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
             Self::Madgwick(f) => OrientationFilter::<N>::reset(f),
             Self::Mahony(f) => OrientationFilter::<N>::reset(f),
             Self::Complementary(f) => OrientationFilter::<N>::reset(f),
+            Self::Robust(f) => OrientationFilter::<N>::reset(f),
         }
     }
 }
@@ -572,7 +666,12 @@ fn orient_csv_in<N: NavFrame>(
     }
     let mut filter = spec.build::<N>(rate)?;
     let mut file = AtomicFile::create(out)?;
-    let out_columns: Vec<String> = ORIENT_COLUMNS.iter().map(|c| (*c).to_string()).collect();
+    let robust = spec.kind == FilterKind::Robust;
+    let out_columns: Vec<String> = ORIENT_COLUMNS
+        .iter()
+        .chain(if robust { &ROBUST_COLUMNS[..] } else { &[] })
+        .map(|c| (*c).to_string())
+        .collect();
     file.begin_table(
         &out_columns,
         &Description {
@@ -598,7 +697,11 @@ fn orient_csv_in<N: NavFrame>(
             .update(&sample)
             .map_err(|e| invalid("IMU data", format!("row {}: {e}", rows.last_row())))?;
         if let Some(est) = estimate {
-            file.write_row(&orient_row(r[0], &est.orientation, &mut last_yaw))?;
+            let row = orient_row(r[0], &est.orientation, &mut last_yaw);
+            match filter.status() {
+                Some(status) => file.write_row(&[&row[..], &robust_row(&status)].concat())?,
+                None => file.write_row(&row)?,
+            }
             written += 1;
         }
         samples += 1;
@@ -621,6 +724,9 @@ pub struct Estimates {
     pub quaternions: Vec<[f64; 4]>,
     /// Angular velocities, rad/s.
     pub angular_velocity_rad_s: Vec<[f64; 3]>,
+    /// The robust filter's bias and flags per estimate ([`ROBUST_COLUMNS`]); empty for the
+    /// others.
+    pub status: Vec<[f64; 6]>,
 }
 
 /// Runs `filter` over rows of readings given as flat slices (three values per row):
@@ -698,6 +804,9 @@ pub fn run_rows<N: NavFrame>(
             }
             out.quaternions.push(q);
             out.angular_velocity_rad_s.push(w);
+            if let Some(status) = working.status() {
+                out.status.push(robust_row(&status));
+            }
         }
     }
     *filter = working;
