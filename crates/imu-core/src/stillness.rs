@@ -1,5 +1,6 @@
 //! Whether the IMU stands still, from its readings alone: the rest at the start of a log that a
-//! filter can use to calibrate its gyroscopes.
+//! filter can use to calibrate its gyroscopes ([`initial_rest`]), and the stance phases of a
+//! foot-mounted IMU ([`detect_stance`], the SHOE detector) where zero-velocity updates apply.
 //!
 //! The readings are cut into blocks of `window` samples. A block is still when, on each of the
 //! six axes, (a) its sample variance is within what the sensor's white noise allows —
@@ -104,4 +105,80 @@ pub fn initial_rest(
         still += 1;
     }
     if still < 2 { 0 } else { (still - 1) * window }
+}
+
+/// The stance hypothesis' statistic of Skog et al.'s SHOE detector ("Zero-velocity detection —
+/// an algorithm evaluation", IEEE Trans. Biomed. Eng. 57(11), 2010) over one window of
+/// specific forces `accel` (m/s², body axes, either sign) and bias-free body rates `gyro`
+/// (rad/s): `T = (1/W) Σ ( |a_k − g ā/|ā||²/σ_a² + |ω_k|²/σ_ω² )`, `W` the window's length. A
+/// still sensor gives `T` about `6 − 3/W` (χ² of `6W − 3` degrees of freedom over `W`).
+/// `None` for an empty window or a zero mean acceleration.
+#[must_use]
+pub fn shoe_statistic(
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
+    gravity_m_s2: f64,
+    noise: ReadingNoise,
+) -> Option<f64> {
+    let w = accel.len().min(gyro.len());
+    if w == 0 {
+        return None;
+    }
+    let mut mean = [0.0; 3];
+    for a in &accel[..w] {
+        for k in 0..3 {
+            mean[k] += a[k] / w as f64;
+        }
+    }
+    let norm = math::sqrt(mean.iter().map(|m| m * m).sum::<f64>());
+    if norm.is_nan() || norm <= 0.0 {
+        return None;
+    }
+    let g_dir = mean.map(|m| gravity_m_s2 * m / norm);
+    let (va, vg) = (noise.accel * noise.accel, noise.gyro * noise.gyro);
+    let sum: f64 = accel[..w]
+        .iter()
+        .zip(&gyro[..w])
+        .map(|(a, g)| {
+            let da: f64 = (0..3).map(|k| (a[k] - g_dir[k]) * (a[k] - g_dir[k])).sum();
+            let dg: f64 = g.iter().map(|x| x * x).sum();
+            da / va + dg / vg
+        })
+        .sum();
+    Some(sum / w as f64)
+}
+
+/// The SHOE threshold at false-alarm probability `p` for windows of `window` samples: the
+/// `1 − p` quantile of χ² with `6·window − 3` degrees of freedom, over `window`.
+#[must_use]
+pub fn shoe_threshold(window: usize, p: f64) -> f64 {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let dof = (6 * window).saturating_sub(3).max(1) as f64;
+    ChiSquared::new(dof).map_or(f64::INFINITY, |c| c.inverse_cdf(1.0 - p) / window as f64)
+}
+
+/// Marks each sample whose centred window of `window` samples passes the SHOE test against
+/// `threshold` ([`shoe_statistic`], [`shoe_threshold`]) as stance, in `stance` (the length of
+/// the readings; samples whose window would run off either end take the nearest full window).
+pub fn detect_stance(
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
+    gravity_m_s2: f64,
+    noise: ReadingNoise,
+    window: usize,
+    threshold: f64,
+    stance: &mut [bool],
+) {
+    let n = accel.len().min(gyro.len()).min(stance.len());
+    let window = window.max(1);
+    if n < window {
+        stance[..n].fill(false);
+        return;
+    }
+    for (i, s) in stance[..n].iter_mut().enumerate() {
+        let start = i.saturating_sub(window / 2).min(n - window);
+        let range = start..start + window;
+        *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
+            .is_some_and(|t| t < threshold);
+    }
 }

@@ -59,3 +59,72 @@ fn vibration_above_the_noise_is_not_rest() {
         0
     );
 }
+
+/// A foot walking at one stride a second: 60 % stance, then a swing forward 1.4 m with a quintic
+/// profile and a 0.1 m lift. The SHOE detector on readings with white noise finds the stances
+/// (few stance samples missed) and never calls a moving foot (faster than 0.05 m/s) still.
+#[test]
+fn shoe_finds_the_stances_of_a_walking_foot() {
+    use imu_core::stillness::{detect_stance, shoe_threshold};
+    let (fs, f, stride, lift, g) = (100.0, 1.0, 1.4, 0.1, 9.81);
+    let noise = ReadingNoise {
+        accel: 0.02,
+        gyro: 0.002,
+    };
+    let n = 6000;
+    let accel_noise = noisy(3 * n, noise.accel, 0.0, 11);
+    let gyro_noise = noisy(3 * n, noise.gyro, 0.0, 12);
+    let rate = f / 0.4;
+    let (mut accel, mut gyro, mut speed, mut truth) = (vec![], vec![], vec![], vec![]);
+    for i in 0..n {
+        let u = i as f64 / fs * f;
+        let phase = u - u.floor();
+        let (ax, az, vx, vz, still) = if phase < 0.6 {
+            (0.0, 0.0, 0.0, 0.0, true)
+        } else {
+            let p = (phase - 0.6) / 0.4;
+            (
+                stride * (60.0 * p - 180.0 * p * p + 120.0 * p.powi(3)) * rate * rate,
+                lift * 32.0 * (1.0 - 6.0 * p + 6.0 * p * p) * rate * rate,
+                stride * 30.0 * p * p * (1.0 - p).powi(2) * rate,
+                lift * 32.0 * p * (1.0 - p) * (1.0 - 2.0 * p) * rate,
+                false,
+            )
+        };
+        accel.push([
+            ax + accel_noise[3 * i],
+            accel_noise[3 * i + 1],
+            az + g + accel_noise[3 * i + 2],
+        ]);
+        gyro.push([
+            gyro_noise[3 * i],
+            gyro_noise[3 * i + 1],
+            gyro_noise[3 * i + 2],
+        ]);
+        speed.push(vx.hypot(vz));
+        truth.push(still);
+    }
+    let window = 5;
+    let mut stance = vec![false; n];
+    detect_stance(
+        &accel,
+        &gyro,
+        g,
+        noise,
+        window,
+        shoe_threshold(window, 1e-3),
+        &mut stance,
+    );
+    // Stance samples a window or more from either end of their stance.
+    let inner = |i: usize| (i.saturating_sub(window)..(i + window).min(n)).all(|j| truth[j]);
+    let (stance_inner, missed) = (0..n)
+        .filter(|&i| inner(i))
+        .fold((0, 0), |(s, m), i| (s + 1, m + usize::from(!stance[i])));
+    let false_stance = (0..n).filter(|&i| stance[i] && speed[i] > 0.05).count();
+    eprintln!("SHOE: missed {missed} of {stance_inner} stance samples, {false_stance} false");
+    assert!(
+        missed * 100 <= stance_inner,
+        "missed {missed} of {stance_inner}"
+    );
+    assert_eq!(false_stance, 0);
+}
