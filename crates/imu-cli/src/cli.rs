@@ -357,6 +357,10 @@ pub enum Command {
         /// sample's best estimate from all the data, before and after it, with its one-sigma.
         #[arg(long)]
         smooth: bool,
+        /// Zero-velocity updates wherever the readings show a stance (a foot-mounted IMU: the
+        /// SHOE detector with the part's noise), zero velocity and zero rate at each.
+        #[arg(long)]
+        zupt: bool,
         /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: PathBuf,

@@ -191,7 +191,7 @@ fn compare<'py>(
                     scenario, *, format = "dict", base_dir = ".", gate = true, align = None,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
-                    sensor_errors = None, rest_s = None, smooth = false, imu_model = None, part = None,
+                    sensor_errors = None, rest_s = None, smooth = false, zupt = false, imu_model = None, part = None,
                     gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
                     gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None, gnss_uere_m = None,
                     nav_frame = None, earth = None, earth_gravity = None, accel_sign = None,
@@ -219,6 +219,7 @@ fn fuse<'py>(
     sensor_errors: Option<bool>,
     rest_s: Option<f64>,
     smooth: bool,
+    zupt: bool,
     imu_model: Option<String>,
     part: Option<String>,
     gnss_horizontal_accuracy_m: Option<f64>,
@@ -316,6 +317,7 @@ fn fuse<'py>(
                 sensor_errors,
                 rest_s,
                 smooth,
+                zupt,
             };
             let (setup, start) = match model {
                 Model::Scenario(spec) => request.setup(&spec.resolve(Path::new(&base))?)?,

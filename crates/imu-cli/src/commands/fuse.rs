@@ -35,6 +35,7 @@ pub struct Args<'a> {
     pub sensor_errors: Option<bool>,
     pub rest_s: Option<f64>,
     pub smooth: bool,
+    pub zupt: bool,
     pub out: &'a Path,
 }
 
@@ -115,6 +116,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         sensor_errors: a.sensor_errors,
         rest_s: a.rest_s,
         smooth: a.smooth,
+        zupt: a.zupt,
     };
     let imu = read_table_as(a.imu, Role::Readings)?;
     let (setup, start) = match (a.scenario, &a.model) {
@@ -239,6 +241,12 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         (false, false) => "no rest (--rest-s 0)".to_owned(),
     };
     crate::note!("imukit: the filter had {states} and {rest}");
+    if a.zupt {
+        crate::note!(
+            "imukit: {} samples taken as stances (zero-velocity updates)",
+            summary.stance_samples
+        );
+    }
     if summary.resets > 0 {
         let t = nav.column("t_s").unwrap_or_default();
         let resets = nav

@@ -157,6 +157,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             sensor_errors,
             rest_s,
             smooth,
+            zupt,
             out,
         } => {
             attach_map(&imu, map.as_deref())?;
@@ -192,6 +193,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 sensor_errors,
                 rest_s,
                 smooth,
+                zupt,
                 out: &out,
             })
         }

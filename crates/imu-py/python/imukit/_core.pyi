@@ -269,6 +269,7 @@ def fuse(
     sensor_errors: Optional[bool] = None,
     rest_s: Optional[float] = None,
     smooth: bool = False,
+    zupt: bool = False,
     imu_model: Optional[str] = None,
     part: Optional[str] = None,
     gnss_horizontal_accuracy_m: Optional[float] = None,

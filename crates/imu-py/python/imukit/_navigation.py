@@ -145,6 +145,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
          odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
          sensor_errors: Optional[bool] = None, rest_s: Optional[float] = None, smooth: bool = False,
+         zupt: bool = False,
          imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
          gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
          gnss_velocity_accuracy_m_s: Optional[float] = None,
@@ -188,6 +189,8 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     receiver's figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
     ``hdop`` column (HDOP × UERE).
 
+    ``zupt=True`` applies zero-velocity (and zero-rate) updates wherever the readings show a
+    stance — a foot-mounted IMU — by the SHOE detector with the part's noise.
     ``smooth=True`` returns the forward–backward (Rauch–Tung–Striebel) smoothed estimate instead:
     each sample's best estimate from all the data, with its one-sigma, in the same columns.
 
@@ -228,6 +231,7 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
                              sensor_errors=None if sensor_errors is None else bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s), smooth=bool(smooth),
+                             zupt=bool(zupt),
                              **aids, **part_keys)
     fused = _table(table)
     resets = fused["gnss_resets"]

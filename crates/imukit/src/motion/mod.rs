@@ -1,5 +1,5 @@
 //! Exact and sampled motions: formulas ([`expression`] over [`expr`]), Rust functions over dual
-//! numbers ([`analytic`]), tracks, waypoints, samples and body rates, and the [`Trajectory`]
+//! numbers ([`analytic`]), tracks, waypoints, samples, body rates and a walking foot ([`walk`]), and the [`Trajectory`]
 //! any of them resolves to.
 pub mod analytic;
 pub mod body_rates;
@@ -8,6 +8,7 @@ pub mod expr;
 pub mod expression;
 pub mod sampled;
 pub mod track;
+pub mod walk;
 pub mod waypoints;
 
 pub use body_rates::BodyRatesData;
@@ -35,6 +36,8 @@ pub enum Trajectory {
     Samples(SampledPath),
     /// Body rates.
     BodyRates(BodyRatesData),
+    /// A walking foot.
+    Walk(walk::WalkMotion),
 }
 
 /// Exact truth of an analytic motion, with the time of a refused sample in the error.
@@ -69,6 +72,9 @@ impl Trajectory {
                 analytic_truth(k, t_s, AnalyticOptions::default(), "trajectory (track)")
             }
             Self::Samples(s) => s.truth(),
+            Self::Walk(w) => {
+                analytic_truth(w, t_s, AnalyticOptions::default(), "trajectory (walk)")
+            }
             Self::Waypoints(w) => {
                 analytic_truth(w, t_s, AnalyticOptions::default(), "trajectory (waypoints)")
             }

@@ -166,6 +166,11 @@ pub struct FuseSetup {
     /// Smooth the estimate forward–backward (`imu_core::fusion::smoother`): the output is the
     /// smoothed estimate and its one-sigma.
     pub smooth: bool,
+    /// Zero-velocity updates wherever the readings show a stance (a foot-mounted IMU): the SHOE
+    /// detector (`imu_core::stillness::detect_stance`) with the part's noise, the gyroscope's
+    /// mean over the rest at the start taken off; zero velocity and zero rate at each stance
+    /// sample, as at rest.
+    pub zupt: bool,
     /// The covariance is propagated once per this interval and at every update, s (0: every
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
@@ -238,6 +243,8 @@ pub struct FuseSummary {
     pub rest_detected: bool,
     /// Whether the sensor-error states were estimated (36 states).
     pub sensor_errors: bool,
+    /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
+    pub stance_samples: usize,
 }
 
 /// The fused estimate's last column: the resets to the fixes so far (a step at each).
@@ -320,6 +327,8 @@ pub struct FuseRequest<'a> {
     pub rest_s: Option<f64>,
     /// Smooth the estimate forward–backward ([`FuseSetup::smooth`]).
     pub smooth: bool,
+    /// Zero-velocity updates at stances ([`FuseSetup::zupt`]).
+    pub zupt: bool,
 }
 
 impl Default for FuseRequest<'_> {
@@ -334,6 +343,7 @@ impl Default for FuseRequest<'_> {
             sensor_errors: None,
             rest_s: None,
             smooth: false,
+            zupt: false,
         }
     }
 }
@@ -416,6 +426,7 @@ impl<'a> FuseRequest<'a> {
             None => setup.detect_rest = true,
         }
         setup.smooth = self.smooth;
+        setup.zupt = self.zupt;
         Ok((setup, start))
     }
 }
@@ -892,6 +903,14 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         setup
     };
     let mut aid_streams = AidStreams::new(aids, setup, (t0, t1), t.len())?;
+    let stances = if setup.zupt {
+        let stance = stance_samples(t, f, w, setup);
+        let count = stance.iter().filter(|s| **s).count();
+        aid_streams.set_stance(stance);
+        count
+    } else {
+        0
+    };
     let fixes = g_p
         .iter()
         .enumerate()
@@ -1159,6 +1178,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
             rest_s: setup.rest_s,
             rest_detected: setup.detect_rest,
             sensor_errors: setup.estimate_sensor_errors,
+            stance_samples: stances,
         },
     ))
 }
@@ -1247,6 +1267,57 @@ fn smoothed_rows<E: NavEarth, const S: usize>(
         let sig: [f64; S] = core::array::from_fn(|k| var[k].max(0.0).sqrt());
         push_fused_row(table, row, (&s, &e, &sig), (origin, &mut last_yaw), *resets);
     }
+}
+
+/// One-sigma of the zero-velocity update at a stance on the move, m/s (OpenShoe's figure).
+pub const STANCE_VELOCITY_SIGMA_M_S: f64 = 0.01;
+
+/// Window of the stance detector, s (Skog et al. use 3 to 5 samples at 100 Hz and more).
+pub const STANCE_WINDOW_S: f64 = 0.05;
+
+/// False-alarm probability of the stance detector per sample.
+pub const STANCE_FALSE_ALARM: f64 = 1e-3;
+
+/// The samples of readings `f`, `w` (specific force and rate, times `t`) that are stances
+/// ([`FuseSetup::zupt`]), as the fusion finds them.
+pub fn stance_samples(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> Vec<bool> {
+    use imu_core::stillness::{ReadingNoise, detect_stance, shoe_threshold};
+    let n = t.len();
+    let mut stance = vec![false; n];
+    if n < 3 {
+        return stance;
+    }
+    let interval = (t[n - 1] - t[0]) / (n - 1) as f64;
+    if interval.is_nan() || interval <= 0.0 {
+        return stance;
+    }
+    // The rest's mean rate is the bias the detector's zero-rate test must not see.
+    let rest = t.partition_point(|&x| x < t[0] + setup.rest_s);
+    let bias = if rest > 0 {
+        [0, 1, 2].map(|k| w[..rest].iter().map(|x| x[k]).sum::<f64>() / rest as f64)
+    } else {
+        [0.0; 3]
+    };
+    let gyro: Vec<[f64; 3]> = w
+        .iter()
+        .map(|x| [x[0] - bias[0], x[1] - bias[1], x[2] - bias[2]])
+        .collect();
+    let noise = ReadingNoise {
+        accel: setup.noise.accel_psd / interval.sqrt(),
+        gyro: setup.noise.gyro_psd / interval.sqrt(),
+    };
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let window = ((STANCE_WINDOW_S / interval).round() as usize).max(3);
+    detect_stance(
+        f,
+        &gyro,
+        setup.gravity_m_s2,
+        noise,
+        window,
+        shoe_threshold(window, STANCE_FALSE_ALARM),
+        &mut stance,
+    );
+    stance
 }
 
 /// Block length of the rest detector, s.
@@ -1450,6 +1521,7 @@ impl FuseSetup {
             rest_s: 0.0,
             detect_rest: false,
             smooth: false,
+            zupt: false,
         }
     }
 }

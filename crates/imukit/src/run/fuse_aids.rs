@@ -8,7 +8,8 @@ use imu_core::fusion::gate::gate_99_9;
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
 use crate::run::fuse::{
-    AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, REST_VELOCITY_SIGMA_M_S, filter_refusal,
+    AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, REST_VELOCITY_SIGMA_M_S,
+    STANCE_VELOCITY_SIGMA_M_S, filter_refusal,
 };
 
 /// The smallest one-sigma the filter is told for an aid (exact simulated readings still need a
@@ -64,6 +65,8 @@ pub(crate) struct AidStreams {
     gate_on: bool,
     /// The end of the rest at the start, s, and one sample's gyroscope noise, rad/s.
     rest: (f64, f64),
+    /// Per IMU sample, whether it is a stance (zero-velocity updates on the move).
+    stance: Vec<bool>,
     next: (usize, usize),
     next_nhc_t: f64,
 }
@@ -130,9 +133,15 @@ impl AidStreams {
             nhc_sigma_m_s: nhc,
             gate_on: setup.gate.is_finite(),
             rest: (span.0 + setup.rest_s, gyro_sample_sigma),
+            stance: Vec::new(),
             next: (0, 0),
             next_nhc_t: span.0,
         })
+    }
+
+    /// The stance samples, by IMU sample index ([`super::fuse::FuseSetup::zupt`]).
+    pub(crate) fn set_stance(&mut self, stance: Vec<bool>) {
+        self.stance = stance;
     }
 
     /// Skips the readings before the filter's first sample at `t_first`.
@@ -164,7 +173,16 @@ impl AidStreams {
         t_s: f64,
         i: usize,
     ) -> Result<()> {
-        if t_s < self.rest.0 {
+        if t_s >= self.rest.0 && self.stance.get(i).copied().unwrap_or(false) {
+            // A stance on the move: the detector is the gate, and the foot is still only to
+            // about a centimetre a second (it rolls and settles).
+            filter
+                .update_zero_velocity(STANCE_VELOCITY_SIGMA_M_S, f64::INFINITY)
+                .map_err(|e| filter_refusal("IMU (stance, zero velocity)", i, e))?;
+            filter
+                .update_zero_rate(self.rest.1, f64::INFINITY)
+                .map_err(|e| filter_refusal("IMU (stance, zero rate)", i, e))?;
+        } else if t_s < self.rest.0 {
             filter
                 .update_zero_velocity(REST_VELOCITY_SIGMA_M_S, self.gate(3))
                 .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;

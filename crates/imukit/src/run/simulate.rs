@@ -480,6 +480,14 @@ impl Scenario {
                 "trajectory (waypoints)",
                 emit,
             ),
+            Trajectory::Walk(w) => motion_chunks(
+                w,
+                AnalyticOptions::default(),
+                t_s,
+                size,
+                "trajectory (walk)",
+                emit,
+            ),
             Trajectory::Samples(path) => path.truth_chunks(size, emit),
             Trajectory::BodyRates(_) => {
                 let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;

@@ -251,16 +251,43 @@ pub enum TrajectorySpec {
     Waypoints(WaypointsSpec),
     /// A built-in scenario's trajectory (and its defaults for every key the file leaves out).
     Builtin(BuiltinSpec),
+    /// A walking foot: stance, swing, at a cadence and stride length.
+    Walk(WalkSpec),
+}
+
+/// `type = "walk"` (see `motion::walk`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkSpec {
+    /// Strides per second (one foot), Hz.
+    pub cadence_hz: f64,
+    /// Distance one stride carries the foot, m.
+    pub stride_m: f64,
+    /// Fraction of a stride the foot stands still (default 0.6).
+    pub stance_fraction: Option<f64>,
+    /// Largest lift of the foot, m (default 0.1).
+    pub lift_m: Option<f64>,
+    /// Largest pitch of the foot, rad (default 0.3).
+    pub foot_pitch_rad: Option<f64>,
+    /// Radius of a circle walked (turning left), m; without it a straight line.
+    pub radius_m: Option<f64>,
+    /// Time standing still before the first stride, s (default 0).
+    pub start_s: Option<f64>,
+    /// Initial heading from the x axis towards y, rad (default 0).
+    pub heading_rad: Option<f64>,
+    /// Start point, navigation frame, m (default the origin).
+    pub start_m: Option<[f64; 3]>,
 }
 
 /// The trajectory types by their `type` name.
-const TRAJECTORY_TYPES: [&str; 6] = [
+const TRAJECTORY_TYPES: [&str; 7] = [
     "expression",
     "samples",
     "track",
     "body-rates",
     "waypoints",
     "builtin",
+    "walk",
 ];
 
 impl<'de> Deserialize<'de> for TrajectorySpec {
@@ -335,6 +362,7 @@ impl TrajectorySpec {
             "body-rates" => Self::BodyRates(BodyRatesSpec::deserialize(keys)?),
             "waypoints" => Self::Waypoints(WaypointsSpec::deserialize(keys)?),
             "builtin" => Self::Builtin(BuiltinSpec::deserialize(keys)?),
+            "walk" => Self::Walk(WalkSpec::deserialize(keys)?),
             other => return Err(D::Error::unknown_variant(other, &TRAJECTORY_TYPES)),
         })
     }
