@@ -267,8 +267,9 @@ pub enum Command {
         /// header stamps.
         #[arg(long)]
         receive_time: bool,
-        /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`).
-        gnss: PathBuf,
+        /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
+        /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
+        gnss: Option<PathBuf>,
         /// The initial state: the first row of this truth file, or of a reference in latitude,
         /// longitude and height or ECEF (docs/earth.md; without an attitude, with --align).
         #[arg(long)]

@@ -349,3 +349,14 @@ def test_smoothing_on_the_wgs84_earth_brings_an_outage_back_to_the_fixes():
     assert rms(smoothed) < 0.5 * rms(filtered), (rms(smoothed), rms(filtered))
     # Smoothed one-sigma no larger than the filter's anywhere (it uses more data).
     assert np.all(smoothed["pos_x_sigma_m"] <= filtered["pos_x_sigma_m"] * (1 + 1e-9) + 1e-12)
+
+
+def test_a_walk_without_fixes_is_navigated_by_its_stances():
+    # examples/walk.toml: 754 m around a circle and back; no GNSS at all, zero-velocity updates.
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[3] / "examples" / "walk.toml"
+    sim = imukit.simulate(str(path))
+    nav = imukit.fuse(sim.imu, None, initial=sim.truth, scenario=str(path), zupt=True, rest_s=10.0)
+    end = np.array([nav[f"pos_{a}_m"][-1] for a in "xyz"])
+    start = np.array([sim.truth[f"pos_{a}_m"][0] for a in "xyz"])
+    assert np.linalg.norm(end - start) < 0.01 * 754.0

@@ -19,7 +19,8 @@ use crate::error::{by_flag, flag};
 /// The command's arguments.
 pub struct Args<'a> {
     pub imu: &'a Path,
-    pub gnss: &'a Path,
+    /// The fixes (`None`: none).
+    pub gnss: Option<&'a Path>,
     pub init: Option<&'a Path>,
     pub align: Option<AlignName>,
     pub scenario: Option<&'a Path>,
@@ -39,11 +40,16 @@ pub struct Args<'a> {
     pub out: &'a Path,
 }
 
+/// The input files whose descriptions say what the data are: the IMU's and the fixes'.
+fn inputs_of<'a>(a: &Args<'a>) -> Vec<&'a Path> {
+    std::iter::once(a.imu).chain(a.gnss).collect()
+}
+
 /// The filter's setup from `--imu PART` and the `--gnss-*` accuracies: the data's frame, Earth
 /// and sign from the input files' descriptions (`--earth` checked against them), the sample
 /// rate from the IMU's times.
 fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<FuseSetup, CliError> {
-    let described = Described::read(&[a.imu, a.gnss])?;
+    let described = Described::read(&inputs_of(a))?;
     let asked = NavAsked {
         earth: a.earth,
         ..NavAsked::default()
@@ -79,7 +85,7 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
         let on_earth = matches!(scenario.earth, imukit::scenario::EarthSetup::Wgs84(_));
         return Ok((scenario.nav_frame, on_earth));
     }
-    let described = Described::read(&[a.imu, a.gnss])?;
+    let described = Described::read(&inputs_of(a))?;
     let frame = described
         .pick("nav_frame", None, |d| d.nav_frame, NavFrameName::default())
         .map_err(by_flag)?;
@@ -90,7 +96,8 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
 }
 
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
-    let mut inputs = vec![("IMU file", a.imu), ("GNSS file", a.gnss)];
+    let mut inputs = vec![("IMU file", a.imu)];
+    inputs.extend(a.gnss.map(|p| ("GNSS file", p)));
     inputs.extend(a.scenario.map(|p| ("--scenario", p)));
     inputs.extend(a.init.map(|p| ("--init file", p)));
     inputs.extend(a.odometer.map(|p| ("--odometer", p)));
@@ -125,7 +132,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             let scenario = ScenarioSpec::from_file(path)?.resolve(base)?;
             // Data described in another frame, on another Earth or with the other sign than the
             // scenario's are not the scenario's data.
-            let described = Described::read(&[a.imu, a.gnss])?;
+            let described = Described::read(&inputs_of(a))?;
             let source = format!("the scenario {}", path.display());
             described.check("nav_frame", scenario.nav_frame, &source, |d| d.nav_frame)?;
             let earth = match scenario.earth {
@@ -154,16 +161,29 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             .into());
         }
     };
-    let gnss = read_table_as(a.gnss, Role::Fixes)?;
-    let gnss = match a.gnss_uere_m {
-        Some(uere) => imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
-            Error::Invalid { message, .. } => Error::Invalid {
-                field: format!("--gnss-uere-m ({})", a.gnss.display()),
-                message,
-            },
-            other => other,
-        })?,
-        None => gnss,
+    let gnss = match a.gnss {
+        Some(path) => read_table_as(path, Role::Fixes)?,
+        // No fixes: a table without columns, which the filter reads as none.
+        None => imukit::Table::default(),
+    };
+    let gnss = match (a.gnss_uere_m, a.gnss) {
+        (Some(uere), Some(path)) => {
+            imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
+                Error::Invalid { message, .. } => Error::Invalid {
+                    field: format!("--gnss-uere-m ({})", path.display()),
+                    message,
+                },
+                other => other,
+            })?
+        }
+        (Some(_), None) => {
+            return Err(Error::Invalid {
+                field: "--gnss-uere-m".into(),
+                message: "needs a GNSS file whose fixes carry an HDOP".into(),
+            }
+            .into());
+        }
+        (None, _) => gnss,
     };
     let odometer = a.odometer.map(read_table).transpose()?;
     let baro = a.baro.map(read_table).transpose()?;
@@ -174,7 +194,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     // The library names its inputs by kind; the user knows them by file.
     let file_of = |context: &str| match context {
         "IMU data" => Some(a.imu),
-        "GNSS data" => Some(a.gnss),
+        "GNSS data" => a.gnss,
         "odometer data" => a.odometer,
         "barometer data" => a.baro,
         _ => None,
@@ -261,7 +281,8 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         crate::report::warn(&format!(
             "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
              time(s), at t = {} s (column {}): its one-sigma understates its error around them",
-            a.gnss.display(),
+            a.gnss
+                .map_or_else(|| "GNSS".into(), |p| p.display().to_string()),
             imukit::run::fuse::MAX_REJECTED_IN_A_ROW,
             summary.resets,
             at.join(", "),

@@ -162,13 +162,13 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         } => {
             attach_map(&imu, map.as_deref())?;
             attach_topics(
-                &[Some(&imu), Some(&gnss), init.as_deref()],
+                &[Some(&imu), gnss.as_deref(), init.as_deref()],
                 &topics,
                 receive_time,
             );
             fuse::run(&fuse::Args {
                 imu: &imu,
-                gnss: &gnss,
+                gnss: gnss.as_deref(),
                 init: init.as_deref(),
                 align,
                 scenario: scenario.as_deref(),

@@ -139,7 +139,7 @@ def compare(truth: TableLike, estimate: TableLike) -> Comparison:
     return Comparison(_table(table), {str(k): float(v) for k, v in dict(summary).items()})
 
 
-def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None,
+def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None,
          initial: Optional[TableLike] = None, align: Optional[str] = None,
          gate: bool = True,
          odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
@@ -190,7 +190,8 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
     ``hdop`` column (HDOP × UERE).
 
     ``zupt=True`` applies zero-velocity (and zero-rate) updates wherever the readings show a
-    stance — a foot-mounted IMU — by the SHOE detector with the part's noise.
+    stance — a foot-mounted IMU — by the SHOE detector with the part's noise; ``gnss=None``
+    runs without fixes.
     ``smooth=True`` returns the forward–backward (Rauch–Tung–Striebel) smoothed estimate instead:
     each sample's best estimate from all the data, with its one-sigma, in the same columns.
 
@@ -224,7 +225,9 @@ def fuse(imu: TableLike, gnss: TableLike, *, scenario: Optional[Union[str, os.Pa
         if t is not None:
             aids.update(zip((f"{name}_columns", f"{name}_values"), _table_args(name, t)))
     start = (None, None) if initial is None else _table_args("initial", initial)
-    table, _, _ = _core.fuse(*_table_args("imu", imu), *_table_args("gnss", gnss), *start,
+    # No fixes: a table without columns (the IMU and the other aids alone, e.g. zupt=True).
+    fixes = ([], np.zeros((0, 0))) if gnss is None else _table_args("gnss", gnss)
+    table, _, _ = _core.fuse(*_table_args("imu", imu), *fixes, *start,
                              source, format=fmt, base_dir=base, gate=bool(gate),
                              align=None if align is None else str(align),
                              nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),

@@ -469,7 +469,8 @@ pub fn gnss_alignment_sigma(v: [f64; 3], setup: &FuseSetup) -> InitialSigma {
     }
 }
 
-/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::scenario::gnss::GNSS_COLUMNS)) from `initial`.
+/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::scenario::gnss::GNSS_COLUMNS)) from `initial`;
+/// a `gnss` table without columns is no fixes (the IMU and the other aids alone).
 ///
 /// # Errors
 /// Missing columns, GNSS times that do not increase or fall outside the IMU's span, the
@@ -665,6 +666,19 @@ impl FusionInputs {
             ));
         }
         let has = |c: &&str| gnss.columns.iter().any(|h| h == c);
+        if gnss.columns.is_empty() {
+            // No fixes at all (a table without columns): the IMU and the other aids alone.
+            return Ok(Self {
+                t,
+                f,
+                w,
+                g_t: Vec::new(),
+                g_p: Vec::new(),
+                g_v: Vec::new(),
+                velocities: FixVelocity::None,
+                accuracy: None,
+            });
+        }
         // Positions only when none of the velocity's columns is there; the horizontal velocity
         // alone when the vertical one is missing.
         let velocities = match (columns[4..6].iter().any(has), has(&columns[6])) {
