@@ -1535,3 +1535,55 @@ fn a_walk_navigated_by_zero_velocity_updates_returns_to_its_start() {
     );
     assert_eq!(false_stance, 0);
 }
+
+/// Each preset in free inertial on the example road after a 20 s alignment at rest (the filter
+/// told of the rest, then no fix at all): its horizontal position error when the car stops at
+/// 170 s, against a navigation engineer's bounds for its grade — a navigation-grade part drifts
+/// metres, a tactical one tens of metres, an industrial one hundreds, a consumer one up to
+/// kilometres, none more. The table in the README is this test's output.
+#[test]
+fn each_presets_free_inertial_drift_is_within_its_grades_bounds() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(dir.join("car_tunnel.toml")).unwrap();
+    eprintln!("| preset | grade | drift after 170 s |\n|---|---|---|");
+    for name in imukit::io::presets::names() {
+        let grade = imukit::io::presets::load(name)
+            .unwrap()
+            .info
+            .get("grade")
+            .cloned()
+            .unwrap_or_default();
+        let bound_m = match grade.as_str() {
+            "ideal" | "navigation" => 10.0,
+            "tactical" => 100.0,
+            "industrial" => 1000.0,
+            _ => 3000.0,
+        };
+        let sc = ScenarioSpec::from_toml(
+            &text.replace("preset = \"stim300\"", &format!("preset = \"{name}\"")),
+            "car_tunnel.toml",
+        )
+        .unwrap()
+        .resolve(&dir)
+        .unwrap();
+        let sim = sc.simulate().unwrap();
+        let setup = FuseSetup {
+            rest_s: 20.0,
+            ..FuseSetup::from_scenario(&sc).unwrap()
+        };
+        let initial = InitialState::from_table(&sim.truth).unwrap();
+        let no_fixes = Table::default();
+        let (nav, _) = fuse(&sim.imu, &no_fixes, &initial, &setup).unwrap();
+        let (p, q) = (
+            rows3(&sim.truth, ["pos_x_m", "pos_y_m", "pos_z_m"]),
+            rows3(&nav, ["pos_x_m", "pos_y_m", "pos_z_m"]),
+        );
+        let last = p.len() - 1;
+        let drift = (p[last][0] - q[last][0]).hypot(p[last][1] - q[last][1]);
+        eprintln!("| {name} | {grade} | {drift:.1} m |");
+        assert!(
+            drift < bound_m,
+            "{name} ({grade}): {drift} m, bound {bound_m} m"
+        );
+    }
+}
