@@ -30,22 +30,17 @@ pub struct ReadingNoise {
 
 /// The number of samples from the first that are still, a whole number of blocks of `window`
 /// samples with the last still block left out (motion may start inside it unseen); 0 when fewer
-/// than two blocks are still or the noise is not positive. `accel` and `gyro` are the three
-/// axes' readings, all of one length.
+/// than two blocks are still or the noise is not positive. `accel` and `gyro` are rows of
+/// readings (the shorter sets the length).
 #[must_use]
 pub fn initial_rest(
-    accel: [&[f64]; 3],
-    gyro: [&[f64]; 3],
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
     noise: ReadingNoise,
     window: usize,
 ) -> usize {
     use statrs::distribution::{ChiSquared, ContinuousCDF};
-    let n = accel
-        .iter()
-        .chain(gyro.iter())
-        .map(|a| a.len())
-        .min()
-        .unwrap_or(0);
+    let n = accel.len().min(gyro.len());
     if window < 2
         || n < 2 * window
         || !(noise.accel > 0.0 && noise.gyro > 0.0)
@@ -57,13 +52,14 @@ pub fn initial_rest(
         return 0;
     };
     let variance_limit = chi.inverse_cdf(1.0 - FALSE_ALARM) / (window - 1) as f64;
-    let axes: [(&[f64], f64); 6] = [
-        (accel[0], noise.accel),
-        (accel[1], noise.accel),
-        (accel[2], noise.accel),
-        (gyro[0], noise.gyro),
-        (gyro[1], noise.gyro),
-        (gyro[2], noise.gyro),
+    // Axis k of the six: the accelerometer's 0–2, the gyroscope's 3–5.
+    let axes: [(&[[f64; 3]], usize, f64); 6] = [
+        (accel, 0, noise.accel),
+        (accel, 1, noise.accel),
+        (accel, 2, noise.accel),
+        (gyro, 0, noise.gyro),
+        (gyro, 1, noise.gyro),
+        (gyro, 2, noise.gyro),
     ];
     let mut reference = [0.0; 6];
     let mut still = 0usize;
@@ -72,10 +68,14 @@ pub fn initial_rest(
         let range = block * window..(block + 1) * window;
         let mut ok = true;
         let mut means = [0.0; 6];
-        for (k, (x, sigma)) in axes.iter().enumerate() {
-            let part = &x[range.clone()];
-            let mean = part.iter().sum::<f64>() / w;
-            let var = part.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (w - 1.0);
+        for (k, &(rows, axis, sigma)) in axes.iter().enumerate() {
+            let part = &rows[range.clone()];
+            let mean = part.iter().map(|r| r[axis]).sum::<f64>() / w;
+            let var = part
+                .iter()
+                .map(|r| (r[axis] - mean) * (r[axis] - mean))
+                .sum::<f64>()
+                / (w - 1.0);
             means[k] = mean;
             if var.partial_cmp(&(sigma * sigma * variance_limit))
                 == Some(core::cmp::Ordering::Greater)

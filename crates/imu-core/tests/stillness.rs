@@ -5,6 +5,15 @@ use imu_core::stillness::{ReadingNoise, initial_rest};
 use rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
+/// Three axes' readings as rows.
+fn rows(x: &[f64], y: &[f64], z: &[f64]) -> Vec<[f64; 3]> {
+    x.iter()
+        .zip(y)
+        .zip(z)
+        .map(|((a, b), c)| [*a, *b, *c])
+        .collect()
+}
+
 fn noisy(n: usize, sigma: f64, offset: f64, seed: u64) -> Vec<f64> {
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
     (0..n)
@@ -35,7 +44,7 @@ fn a_still_log_with_large_biases_is_still_and_a_start_of_motion_is_found() {
         noisy(n, noise.gyro, -0.2, 5),
         noisy(n, noise.gyro, 0.1, 6),
     );
-    let still = initial_rest([&ax, &ay, &az], [&gx, &gy, &gz], noise, 50);
+    let still = initial_rest(&rows(&ax, &ay, &az), &rows(&gx, &gy, &gz), noise, 50);
     // Found within two blocks of the true start (the last still block is left out).
     assert!((1850..=2000).contains(&still), "{still}");
 }
@@ -51,11 +60,16 @@ fn vibration_above_the_noise_is_not_rest() {
     let quiet = noisy(n, noise.accel, 9.81, 8);
     let g = noisy(n, noise.gyro, 0.0, 9);
     assert_eq!(
-        initial_rest([&shaking, &quiet, &quiet], [&g, &g, &g], noise, 50),
+        initial_rest(
+            &rows(&shaking, &quiet, &quiet),
+            &rows(&g, &g, &g),
+            noise,
+            50
+        ),
         0
     );
     assert_eq!(
-        initial_rest([&quiet, &quiet, &quiet], [&g, &g, &g], noise, 1),
+        initial_rest(&rows(&quiet, &quiet, &quiet), &rows(&g, &g, &g), noise, 1),
         0
     );
 }

@@ -1295,16 +1295,11 @@ pub const STANCE_FALSE_ALARM: f64 = 1e-3;
 /// The samples of readings `f`, `w` (specific force and rate, times `t`) that are stances
 /// ([`FuseSetup::zupt`]), as the fusion finds them.
 pub fn stance_samples(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> Vec<bool> {
-    use imu_core::stillness::{ReadingNoise, detect_stance, shoe_threshold};
-    let n = t.len();
-    let mut stance = vec![false; n];
-    if n < 3 {
+    use imu_core::stillness::{detect_stance, shoe_threshold};
+    let mut stance = vec![false; t.len()];
+    let Some((interval, noise)) = reading_noise(t, setup) else {
         return stance;
-    }
-    let interval = (t[n - 1] - t[0]) / (n - 1) as f64;
-    if interval.is_nan() || interval <= 0.0 {
-        return stance;
-    }
+    };
     // The rest's mean rate is the bias the detector's zero-rate test must not see.
     let rest = t.partition_point(|&x| x < t[0] + setup.rest_s);
     let bias = if rest > 0 {
@@ -1316,10 +1311,6 @@ pub fn stance_samples(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSet
         .iter()
         .map(|x| [x[0] - bias[0], x[1] - bias[1], x[2] - bias[2]])
         .collect();
-    let noise = ReadingNoise {
-        accel: setup.noise.accel_psd / interval.sqrt(),
-        gyro: setup.noise.gyro_psd / interval.sqrt(),
-    };
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let window = ((STANCE_WINDOW_S / interval).round() as usize).max(3);
     detect_stance(
@@ -1343,31 +1334,34 @@ pub const REST_START_SPEED_M_S: f64 = 0.1;
 /// The rest at the start of readings `f`, `w` at times `t`, s ([`imu_core::stillness`] with the
 /// part's white noise per sample and blocks of [`REST_WINDOW_S`]).
 fn detected_rest_s(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> f64 {
-    use imu_core::stillness::{ReadingNoise, initial_rest};
+    let Some((interval, noise)) = reading_noise(t, setup) else {
+        return 0.0;
+    };
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let window = ((REST_WINDOW_S / interval).round() as usize).max(2);
+    let still = imu_core::stillness::initial_rest(f, w, noise, window);
+    if still == 0 { 0.0 } else { t[still] - t[0] }
+}
+
+/// The mean interval of the times `t` and the part's white noise over one such interval, the
+/// stillness tests' noise; `None` for fewer than three samples or times that do not advance.
+fn reading_noise(t: &[f64], setup: &FuseSetup) -> Option<(f64, imu_core::stillness::ReadingNoise)> {
     let n = t.len();
     if n < 3 {
-        return 0.0;
+        return None;
     }
     let interval = (t[n - 1] - t[0]) / (n - 1) as f64;
     if interval.is_nan() || interval <= 0.0 {
-        return 0.0;
+        return None;
     }
     let per_sample = |psd: f64| psd / interval.sqrt();
-    let noise = ReadingNoise {
-        accel: per_sample(setup.noise.accel_psd),
-        gyro: per_sample(setup.noise.gyro_psd),
-    };
-    let axis = |v: &[[f64; 3]], k: usize| v.iter().map(|x| x[k]).collect::<Vec<f64>>();
-    let (f_axes, w_axes) = ([0, 1, 2].map(|k| axis(f, k)), [0, 1, 2].map(|k| axis(w, k)));
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let window = ((REST_WINDOW_S / interval).round() as usize).max(2);
-    let still = initial_rest(
-        [&f_axes[0], &f_axes[1], &f_axes[2]],
-        [&w_axes[0], &w_axes[1], &w_axes[2]],
-        noise,
-        window,
-    );
-    if still == 0 { 0.0 } else { t[still] - t[0] }
+    Some((
+        interval,
+        imu_core::stillness::ReadingNoise {
+            accel: per_sample(setup.noise.accel_psd),
+            gyro: per_sample(setup.noise.gyro_psd),
+        },
+    ))
 }
 
 /// The refusal of `setup`'s covariance interval.
