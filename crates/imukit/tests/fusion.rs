@@ -562,8 +562,9 @@ fn heading_is_observable_in_a_turn_and_not_on_a_straight_line_at_constant_speed(
 #[test]
 fn the_biases_of_a_tactical_imu_converge_on_the_road_before_the_tunnel() {
     // STIM300 on the tunnel road, GNSS only: by 115 s each accelerometer and gyroscope bias
-    // estimate is within 3σ of the part's constant bias and its one-sigma is well below its
-    // start (the turns and speed changes make them observable), over five runs. The part's
+    // estimate is within 3σ of the part's constant bias and its one-sigma is below 0.6 of its
+    // start (the turns and speed changes make them observable; the vertical gyroscope's, seen
+    // only through heading in the turns, comes down least, to about half), over five runs. The part's
     // scale-factor and cross-axis errors are set perfect here: acting on gravity and the turns
     // they would add a bias the 15-state filter folds into its estimate (1 mrad of cross-axis
     // error reads as 10 mg on a level road).
@@ -597,7 +598,7 @@ fn the_biases_of_a_tactical_imu_converge_on_the_road_before_the_tunnel() {
                     sigma[i]
                 );
                 assert!(
-                    sigma[i] < 0.5 * sigma[0],
+                    sigma[i] < 0.6 * sigma[0],
                     "run {run}, {sensor} {axis}: σ {} from {}",
                     sigma[i],
                     sigma[0]
@@ -1545,7 +1546,9 @@ fn a_walk_navigated_by_zero_velocity_updates_returns_to_its_start() {
 fn each_presets_free_inertial_drift_is_within_its_grades_bounds() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let text = std::fs::read_to_string(dir.join("car_tunnel.toml")).unwrap();
-    eprintln!("| preset | grade | drift after 170 s |\n|---|---|---|");
+    eprintln!(
+        "| preset | grade | drift after 170 s | not given by its data sheet |\n|---|---|---|---|"
+    );
     for name in imukit::io::presets::names() {
         let grade = imukit::io::presets::load(name)
             .unwrap()
@@ -1580,7 +1583,12 @@ fn each_presets_free_inertial_drift_is_within_its_grades_bounds() {
         );
         let last = p.len() - 1;
         let drift = (p[last][0] - q[last][0]).hypot(p[last][1] - q[last][1]);
-        eprintln!("| {name} | {grade} | {drift:.1} m |");
+        let missing = imukit::io::presets::load(name)
+            .unwrap()
+            .datasheet
+            .map(|d| d.missing_error_terms())
+            .unwrap_or_default();
+        eprintln!("| {name} | {grade} | {drift:.1} m | {missing} |");
         assert!(
             drift < bound_m,
             "{name} ({grade}): {drift} m, bound {bound_m} m"

@@ -19,10 +19,17 @@ pub fn run(
     match name {
         None => {
             for n in presets::names() {
-                let info = presets::load(n)?.info;
-                let grade = info.get("grade").map(String::as_str).unwrap_or("");
-                let source = info.get("source").map(String::as_str).unwrap_or("");
+                let file = presets::load(n)?;
+                let grade = file.info.get("grade").map(String::as_str).unwrap_or("");
+                let source = file.info.get("source").map(String::as_str).unwrap_or("");
                 crate::out_line!("{n:<14} {grade:<11} {source}");
+                let missing = file
+                    .datasheet
+                    .map(|d| d.missing_error_terms())
+                    .unwrap_or_default();
+                if !missing.is_empty() {
+                    crate::out_line!("{:<26} not given: {missing}", "");
+                }
             }
         }
         Some(n) => match format {

@@ -611,6 +611,8 @@ pub struct ParamFile {
     pub present: [bool; 3],
     /// `name`, `grade`, `source` and other descriptive strings from the file.
     pub info: BTreeMap<String, String>,
+    /// The part's data-sheet figures (`[datasheet.<sensor>]`), when the file gives them.
+    pub datasheet: Option<crate::io::datasheet::Datasheet>,
     /// What was skipped in a MATLAB file (keys MATLAB's `loadparams` ignores), for the front end
     /// to show as warnings.
     pub warnings: Vec<String>,
@@ -665,6 +667,11 @@ fn parse_document(
                 skipped,
             )?;
             out.present[i] = true;
+        } else if k == "datasheet" && !matlab {
+            out.datasheet = Some(crate::io::datasheet::Datasheet::parse(
+                v,
+                &format!("{origin}: datasheet"),
+            )?);
         } else if INFO_KEYS.contains(&k.as_str()) {
             out.info.insert(
                 k.clone(),
@@ -677,7 +684,7 @@ fn parse_document(
         } else {
             return Err(invalid(
                 format!("{origin}: {k}"),
-                "unknown key (expected accelerometer, gyroscope, magnetometer, name, grade, source, notes)",
+                "unknown key (expected accelerometer, gyroscope, magnetometer, name, grade, source, notes, datasheet)",
             ));
         }
     }
@@ -741,6 +748,7 @@ pub fn parse_any_document(
             .iter()
             .any(|s| s.key() == k || s.matlab_key() == k)
             || INFO_KEYS.contains(&k)
+            || k == "datasheet"
     };
     if map.keys().all(|k| is_sensor_key(k)) {
         return parse_param_document(doc, origin, profile);

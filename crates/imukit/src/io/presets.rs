@@ -64,3 +64,90 @@ pub fn load(name: &str) -> Result<ParamFile> {
         })?;
     parse_param_document(&doc, &format!("preset {name}"), Profile::Default)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::datasheet::Entry;
+
+    /// Preset `name`'s parameters are its data sheet's statistics: every term of each sensor it
+    /// describes has a figure with its line (converted by the rule of its statistic to the value
+    /// the preset sets) or is marked not given and left ideal.
+    fn figures_are_the_data_sheets(name: &str) {
+        let file = load(name).unwrap();
+        let sheet = file.datasheet.as_ref().expect("a [datasheet] table");
+        let problems = sheet.check(&file.params, file.present);
+        assert!(problems.is_empty(), "{name}: {problems:#?}");
+        for entry in sheet.entries.values() {
+            if let Entry::Given(f) = entry {
+                assert!(
+                    !f.line.trim().is_empty(),
+                    "{name}: a figure without its line"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn mpu_6050_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("mpu-6050");
+    }
+
+    #[test]
+    fn icm_20948_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("icm-20948");
+    }
+
+    #[test]
+    fn icm_42688_p_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("icm-42688-p");
+    }
+
+    #[test]
+    fn adis16465_1_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("adis16465-1");
+    }
+
+    #[test]
+    fn mti_1_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("mti-1");
+    }
+
+    #[test]
+    fn stim300_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("stim300");
+    }
+
+    #[test]
+    fn hg1700_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("hg1700");
+    }
+
+    #[test]
+    fn hg9900_figures_are_its_data_sheets() {
+        figures_are_the_data_sheets("hg9900");
+    }
+
+    #[test]
+    fn every_part_has_figures_and_the_ideal_part_none() {
+        for n in names() {
+            let file = load(n).unwrap();
+            assert_eq!(file.datasheet.is_some(), n != "ideal", "{n}");
+        }
+    }
+
+    /// The check is not vacuous: the STIM300's bias range, put back as its turn-on bias, is
+    /// refused as a bound.
+    #[test]
+    fn a_range_in_place_of_a_one_sigma_bias_is_caught() {
+        let text = text("stim300").unwrap().replace(
+            "constant_bias = { quoted = 0.5, unit = \"°/h\", statistic = \"1-sigma\"",
+            "constant_bias = { quoted = 250, unit = \"°/h\", statistic = \"range\"",
+        );
+        let doc: crate::io::params::ParamValue = toml::from_str(&text).unwrap();
+        let file = parse_param_document(&doc, "test", Profile::Default).unwrap();
+        let problems = file.datasheet.unwrap().check(&file.params, file.present);
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert!(problems[0].contains("a bound, not a 1σ statistic"));
+    }
+}

@@ -292,6 +292,7 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
         present,
         info,
         warnings: Vec::new(),
+        datasheet: None,
     })
 }
 
