@@ -189,8 +189,8 @@ fn grades() -> Vec<(&'static str, [f64; 3])> {
 }
 
 /// 50 runs of 2 h at rest per grade, flicker over 1–1000 s: each coefficient's 95 % interval
-/// holds its true value in at least 90 % of all runs, and in at least 80 % of each grade's (the
-/// intervals rest on normal and χ² approximations, and on the correlation of white noise).
+/// holds its true value in at least 90 % of each grade's runs (with 95 % coverage, 45 or more of
+/// 50 happens with probability 0.96 per coefficient; the seeds are fixed).
 #[test]
 fn intervals_hold_the_truth_for_every_grade() {
     let fs = 20.0;
@@ -201,7 +201,6 @@ fn intervals_hold_the_truth_for_every_grade() {
         NoiseTerm::BiasInstability,
         NoiseTerm::RandomWalk,
     ];
-    let mut pooled = [0usize; 3];
     for (name, truth) in grades() {
         let p = SensorParams {
             noise_density: [truth[0]; 3],
@@ -222,15 +221,8 @@ fn intervals_hold_the_truth_for_every_grade() {
         }
         eprintln!("{name}: intervals held the truth in {held:?} of {runs} runs (N, B, K)");
         for h in held {
-            assert!(h * 10 >= runs as usize * 8, "{name}: {held:?} of {runs}");
+            assert!(h * 10 >= runs as usize * 9, "{name}: {held:?} of {runs}");
         }
-        for (p, h) in pooled.iter_mut().zip(held) {
-            *p += h;
-        }
-    }
-    let total = runs as usize * grades().len();
-    for p in pooled {
-        assert!(p * 10 >= total * 9, "pooled {pooled:?} of {total}");
     }
 }
 
@@ -315,6 +307,66 @@ fn octave_correlation_is_that_of_white_noise_estimators() {
         let rho = cross(&base, &other) / (cross(&base, &base) * cross(&other, &other)).sqrt();
         let model = octave_correlation(r as f64);
         assert!((rho - model).abs() < 2e-3, "r = {r}: {rho} vs {model}");
+    }
+}
+
+/// The correlations the fit assumes for estimates dominated by flicker (`1.4/r`) and by a random
+/// walk (`r^(−0.29)`), against those measured over 200 seeded records of 2 h at 20 Hz: one, two
+/// and three octaves apart, averaged over τ from 0.2 to 51 s (standard error about 0.03 each).
+#[test]
+fn octave_correlations_of_flicker_and_random_walk_are_as_measured() {
+    use imu_core::allan::fit::{Family, family_correlation};
+    let fs = 20.0;
+    let n = (2.0 * 3600.0 * fs) as usize;
+    let runs = 200;
+    for (family, b, k) in [
+        (Family::Flicker, 1e-3, 0.0),
+        (Family::RandomWalk, 0.0, 1e-3),
+    ] {
+        let p = SensorParams {
+            bias_instability: [b; 3],
+            bias_instability_model: BiasInstabilityModel::Flicker {
+                tau_min_s: 0.05,
+                tau_max_s: 1e5,
+            },
+            random_walk: [k; 3],
+            ..SensorParams::default()
+        };
+        let logs: Vec<Vec<f64>> = (0..runs)
+            .map(|seed| {
+                let (_, adev, _) = octaves(&static_axis(&p, n, 5000 + seed, fs), fs);
+                adev.iter().map(|a| (a * a).ln()).collect()
+            })
+            .collect();
+        let m = logs[0].len();
+        let mean: Vec<f64> = (0..m)
+            .map(|i| logs.iter().map(|l| l[i]).sum::<f64>() / runs as f64)
+            .collect();
+        let cov = |i: usize, j: usize| {
+            logs.iter()
+                .map(|l| (l[i] - mean[i]) * (l[j] - mean[j]))
+                .sum::<f64>()
+                / runs as f64
+        };
+        for apart in 1..=3u32 {
+            let at: Vec<usize> = (2..=10).collect();
+            let measured = at
+                .iter()
+                .map(|&i| {
+                    let j = i + apart as usize;
+                    cov(i, j) / (cov(i, i) * cov(j, j)).sqrt()
+                })
+                .sum::<f64>()
+                / at.len() as f64;
+            let model = family_correlation(family, f64::from(2u32.pow(apart)));
+            eprintln!(
+                "{family:?}, {apart} octaves apart: measured {measured:.3}, model {model:.3}"
+            );
+            assert!(
+                (measured - model).abs() < 0.08,
+                "{family:?}, {apart} octaves: measured {measured:.3}, model {model:.3}"
+            );
+        }
     }
 }
 

@@ -261,23 +261,27 @@ impl<B: FilterBuffer> FilterMemory<B> {
 
 /// Designs the flicker cascade: poles and zeros alternate, log-spaced two per decade between
 /// `f_lo = 0.02/τ_max` and `f_hi = min(fs/4, 20/τ_min)` (continuous-time, mapped by `z = e^{sT}`),
-/// so `|H|² ∝ 1/f` in between; the gain makes the two-sided PSD of the output for input `B·n`
+/// so `|H|² ∝ 1/f` in between, and a last pole at `f_hi` ends the band; the gain makes the two-sided PSD of the output for input `B·n`
 /// equal `B²/(2πf)`, whose Allan deviation is `√(2 ln 2/π)·B ≈ 0.664·B` (IEEE 952, Annex C).
 fn flicker<B: FilterBuffer>(tau_min_s: f64, tau_max_s: f64, fs: f64) -> BiasFilter<B> {
     let two_pi = 2.0 * core::f64::consts::PI;
     let f_hi = (fs / 4.0).min(20.0 / tau_min_s);
     let f_lo = (0.02 / tau_max_s).min(f_hi / 10.0);
     let ratio = f_hi / f_lo;
-    let sections = (math::ceil(2.0 * math::ln(ratio) / math::ln(10.0)) as usize)
-        .clamp(1, MAX_FLICKER_SECTIONS);
-    let r = math::powf(ratio, 1.0 / sections as f64);
+    let pairs = (math::ceil(2.0 * math::ln(ratio) / math::ln(10.0)) as usize)
+        .clamp(1, MAX_FLICKER_SECTIONS - 1);
+    let r = math::powf(ratio, 1.0 / pairs as f64);
     let mut zero = [0.0; MAX_FLICKER_SECTIONS];
     let mut pole = [0.0; MAX_FLICKER_SECTIONS];
-    for i in 0..sections {
+    for i in 0..pairs {
         let p = f_lo * math::powf(r, i as f64);
         pole[i] = math::exp(-two_pi * p / fs);
         zero[i] = math::exp(-two_pi * p * math::sqrt(r) / fs);
     }
+    // A last pole at f_hi, with no zero after it: above the band the spectrum falls instead of
+    // flattening into white noise that would add to the part's own.
+    pole[pairs] = math::exp(-two_pi * f_hi / fs);
+    let sections = pairs + 1;
     // |H(e^{jω})|² of the cascade, with 1 − cos ω written as 2 sin²(ω/2) for precision.
     let h2 = |f: f64| {
         let s = math::sin(core::f64::consts::PI * f / fs);
