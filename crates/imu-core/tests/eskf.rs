@@ -268,7 +268,8 @@ fn the_covariance_stays_symmetric_and_positive_definite_for_a_million_steps() {
 
 /// A reset to a fix: the reference point moves to the fix less the lever arm, the velocity to
 /// the fix's, the heading along it; their variances are the fix's and their correlations with
-/// every other state are gone; tilt, biases and their covariance are kept.
+/// every other state are gone; tilt and its covariance are kept, the bias estimates too, but
+/// their uncertainty returns to at least its initial value, uncorrelated.
 #[test]
 fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
     let earth = FlatEarth::<Enu>::new(9.81);
@@ -283,10 +284,29 @@ fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
         gyro_bias_rad_s: [0.0; 3],
     };
     let mut f = Eskf::<FlatEarth<Enu>, BASE_STATES>::new(earth, &start, &SIGMA, NOISE).unwrap();
+    // A second at rest, fixes of the standstill every 0.1 s: the vertical accelerometer bias
+    // is learnt (its variance falls below the initial one).
+    let standstill = GnssFix::<FlatEarth<Enu>> {
+        position: Vec3::new(0.0, 0.0, 0.0),
+        velocity_m_s: Some(Vec3::zeros()),
+        lever_arm_m: Vec3::zeros(),
+        position_sigma_m: [0.5; 3],
+        velocity_sigma_m_s: [0.01; 3],
+        age_s: 0.0,
+    };
     for k in 0..=100 {
         f.propagate(k as f64 / RATE_HZ, [0.0; 3], [0.0, 0.0, 9.81])
             .unwrap();
+        if k % 10 == 0 {
+            f.update_gnss(&standstill, 1e6).unwrap();
+        }
     }
+    let bias_before: Vec<f64> = (9..15).map(|k| f.covariance(k, k)).collect();
+    let initial = [SIGMA.accel_bias_m_s2.powi(2); 3]
+        .into_iter()
+        .chain([SIGMA.gyro_bias_rad_s.powi(2); 3])
+        .collect::<Vec<_>>();
+    assert!(bias_before[2] < 0.5 * initial[2], "{bias_before:?}");
     let tilt_before = f.covariance(6, 6);
     // A fix 40 m north-east with a velocity due north, the antenna 1 m ahead of the reference
     // point (the body's x axis points east at identity attitude in ENU).
@@ -298,22 +318,36 @@ fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
         velocity_sigma_m_s: [0.1, 0.1, 0.2],
         age_s: 0.0,
     };
+    let biases = (f.state().accel_bias_m_s2, f.state().gyro_bias_rad_s);
+    let counts = f.update_counts();
     f.reset_to_gnss(&fix, Some(0.02)).unwrap();
     let s = f.state();
     // The reference point is the antenna less the lever arm, turned by the attitude after the
-    // reset (forward now north): 1 m south of the fix.
+    // reset (forward now north, the tilt the updates left): about 1 m south of the fix.
     let p = s.nav.position.to_array();
-    assert!(
-        (p[0] - 30.0).abs() < 1e-12 && (p[1] - 39.0).abs() < 1e-12 && p[2].abs() < 1e-12,
-        "{p:?}"
-    );
+    let arm = s.nav.attitude.apply(Vec3::new(1.0, 0.0, 0.0)).to_array();
+    for k in 0..3 {
+        let want = [30.0, 40.0, 0.0][k] - arm[k];
+        assert!((p[k] - want).abs() < 1e-12, "{p:?}");
+    }
+    assert!((p[1] - 39.0).abs() < 1e-5, "{p:?}");
+    // The fix's velocity, less the lever arm's turning with the rate the estimated gyroscope
+    // bias leaves (under 1e-6 m/s here).
     let v = s.nav.velocity_m_s.to_array();
-    assert!(v[0].abs() < 1e-12 && (v[1] - 5.0).abs() < 1e-12, "{v:?}");
-    // Heading along the velocity: the body's forward axis now points north.
+    assert!(
+        v[0].abs() < 1e-12 && (v[1] - 5.0).abs() < 1e-6 && v[2].abs() < 1e-6,
+        "{v:?}"
+    );
+    // Heading along the velocity: the body's forward axis, seen from above, now points north.
     let forward = s.nav.attitude.apply(Vec3::new(1.0, 0.0, 0.0)).to_array();
     assert!(
-        forward[0].abs() < 1e-12 && (forward[1] - 1.0).abs() < 1e-12,
+        forward[0].abs() < 1e-12 && (forward[1] - 1.0).abs() < 1e-5,
         "{forward:?}"
+    );
+    assert_eq!(
+        (s.accel_bias_m_s2, s.gyro_bias_rad_s),
+        biases,
+        "bias estimates kept"
     );
     let expected = [1.5, 1.5, 3.0, 0.1, 0.1, 0.2];
     for (k, sigma) in expected.iter().enumerate() {
@@ -326,10 +360,16 @@ fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
     }
     assert!((f.covariance(8, 8) - 0.02 * 0.02).abs() < 1e-18);
     assert_eq!(f.covariance(6, 6), tilt_before, "tilt kept");
-    assert_eq!(s.accel_bias_m_s2, [0.01, 0.0, 0.0], "biases kept");
+    for k in 0..6 {
+        let want = bias_before[k].max(initial[k]);
+        assert_eq!(f.covariance(9 + k, 9 + k), want, "bias {k}");
+        for j in (0..BASE_STATES).filter(|&j| j != 9 + k) {
+            assert_eq!(f.covariance(9 + k, j), 0.0, "bias {k} with {j}");
+        }
+    }
     assert_eq!(
         f.update_counts(),
-        (0, 0),
+        counts,
         "a reset is neither an update nor a rejection"
     );
     // A heading asked for without a horizontal velocity is refused.

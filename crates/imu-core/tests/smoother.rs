@@ -49,7 +49,10 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
     }
     let mut smoothed = vec![ErrorVector::<2>::zeros(); z.len()];
     let mut cov = vec![Covariance::<2>::zeros(); z.len()];
-    rts_backward(&records, &mut smoothed, &mut cov);
+    rts_backward(records.as_slice(), |j, s, p| {
+        smoothed[j] = *s;
+        cov[j] = *p;
+    });
     // Batch: minimise |x_0 − x̄_0|²_{P0⁻¹} + Σ|x_{k+1} − Φx_k|²_{Q⁻¹} + Σ|z_k − x_k,pos|²/r.
     let n = z.len();
     let mut info = DMatrix::<f64>::zeros(2 * n, 2 * n);
@@ -107,8 +110,12 @@ fn a_reset_is_not_crossed() {
     };
     let records = [rec(false, 0.0), rec(true, 3.0), rec(false, 1.0)];
     let mut s = [ErrorVector::<1>::zeros(); 3];
-    let mut c = [Covariance::<1>::zeros(); 3];
-    rts_backward(&records, &mut s, &mut c);
+    let mut visited = Vec::new();
+    rts_backward(records.as_slice(), |j, dx, _| {
+        s[j] = *dx;
+        visited.push(j);
+    });
+    assert_eq!(visited, [2, 1, 0]);
     assert_eq!(s[0][0], 0.0);
     assert!(s[1][0] > 0.0);
 }

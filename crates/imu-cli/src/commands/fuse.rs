@@ -272,12 +272,19 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         let resets = nav
             .column(imukit::run::fuse::RESETS_COLUMN)
             .unwrap_or_default();
-        let at: Vec<String> = resets
+        // The first few times; the column has them all.
+        const SHOWN: usize = 10;
+        let mut at: Vec<String> = resets
             .windows(2)
             .zip(&t[1..])
             .filter(|(r, _)| r[1] > r[0])
             .map(|(_, t)| format!("{t:.2}"))
             .collect();
+        if at.len() > SHOWN {
+            let more = at.len() - SHOWN;
+            at.truncate(SHOWN);
+            at.push(format!("… ({more} more)"));
+        }
         crate::report::warn(&format!(
             "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
              time(s), at t = {} s (column {}): its one-sigma understates its error around them",

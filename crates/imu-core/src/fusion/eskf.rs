@@ -331,6 +331,8 @@ pub struct Eskf<E: EarthModel, const S: usize = BASE_STATES> {
     updates: usize,
     rejected: usize,
     smoothing: Option<SmoothingLog<S>>,
+    /// The biases' initial variances (accelerometer, then gyroscope), which a reset restores.
+    initial_bias_variance: [f64; 6],
 }
 
 impl<E: EarthModel, const S: usize> Eskf<E, S> {
@@ -374,6 +376,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             updates: 0,
             rejected: 0,
             smoothing: None,
+            initial_bias_variance: core::array::from_fn(|k| cov[(9 + k, 9 + k)]),
         })
     }
 
@@ -623,9 +626,12 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     /// arm taken off with the attitude after the reset), and their error covariance the fix's
     /// variances, uncorrelated with every other state. With `heading_sigma_rad` the heading too
     /// turns, so that the body's forward axis points along the fix's horizontal velocity (a
-    /// vehicle moving nose first), its error variance that sigma squared. Tilt, biases and
-    /// sensor errors are kept with their covariance. The reset is neither an update nor a
-    /// rejection in [`Self::update_counts`].
+    /// vehicle moving nose first), its error variance that sigma squared. The biases return to
+    /// their initial uncertainty, uncorrelated (at least; a larger one is kept): fixes rejected
+    /// one after another say the filter was sure of something wrong, and a bias it was sure of
+    /// is the likeliest — kept, a wrong gyroscope bias turns the heading away again and brings
+    /// the next reset. Tilt and sensor errors are kept with their covariance. The reset is
+    /// neither an update nor a rejection in [`Self::update_counts`].
     ///
     /// # Errors
     /// Non-finite input, sigmas that are not positive and finite, a heading asked for without a
@@ -690,6 +696,8 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             log.correction(t, &prior, &dx, true);
         }
         self.inject(&dx, index)?;
+        let bias_variance: [f64; 6] =
+            core::array::from_fn(|k| self.cov[(9 + k, 9 + k)].max(self.initial_bias_variance[k]));
         let mut set = |k: usize, variance: f64| {
             self.cov.row_mut(k).fill(0.0);
             self.cov.column_mut(k).fill(0.0);
@@ -705,6 +713,9 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         }
         if let Some(h) = heading_sigma_rad {
             set(8, h * h);
+        }
+        for (k, variance) in bias_variance.into_iter().enumerate() {
+            set(9 + k, variance);
         }
         Ok(())
     }

@@ -156,26 +156,44 @@ impl<const S: usize> SmoothingLog<S> {
     }
 }
 
-/// The backward pass over `epochs` (in time order): `smoothed[j]` is the smoothed correction to
-/// the filter's corrected state at epoch `j`, `covariance[j]` its covariance. Where the
-/// predicted covariance of the next epoch cannot be inverted, or the next epoch is a reset, the
-/// epoch keeps the filter's estimate.
-///
-/// # Panics
-/// Never; slices of other lengths than `epochs` are filled as far as all three reach.
-pub fn rts_backward<const S: usize>(
-    epochs: &[EpochRecord<S>],
-    smoothed: &mut [ErrorVector<S>],
-    covariance: &mut [Covariance<S>],
+/// Where the backward pass reads the forward filter's epochs from, in time order: a slice of
+/// records, or a store that keeps them packed (symmetric covariances by their upper triangle).
+pub trait Epochs<const S: usize> {
+    /// How many epochs.
+    fn count(&self) -> usize;
+    /// Epoch `j` (`j < count()`).
+    fn record(&self, j: usize) -> EpochRecord<S>;
+}
+
+impl<const S: usize> Epochs<S> for [EpochRecord<S>] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn record(&self, j: usize) -> EpochRecord<S> {
+        self[j]
+    }
+}
+
+/// The backward pass over `epochs`: for each epoch `j`, from the last to the first,
+/// `visit(j, δs_j, P_{j|N})` — the smoothed correction to the filter's corrected state at
+/// epoch `j` and its covariance. Only the pass's running covariance is held, so the caller keeps
+/// what it needs of each (its diagonal, say). Where the predicted covariance of the next epoch
+/// cannot be inverted, or the next epoch is a reset, the epoch keeps the filter's estimate.
+pub fn rts_backward<const S: usize, E: Epochs<S> + ?Sized>(
+    epochs: &E,
+    mut visit: impl FnMut(usize, &ErrorVector<S>, &Covariance<S>),
 ) {
-    let n = epochs.len().min(smoothed.len()).min(covariance.len());
+    let n = epochs.count();
     if n == 0 {
         return;
     }
-    smoothed[n - 1] = ErrorVector::zeros();
-    covariance[n - 1] = epochs[n - 1].posterior;
+    let mut next = epochs.record(n - 1);
+    let mut smoothed = ErrorVector::<S>::zeros();
+    let mut covariance = next.posterior;
+    visit(n - 1, &smoothed, &covariance);
     for j in (0..n - 1).rev() {
-        let (here, next) = (&epochs[j], &epochs[j + 1]);
+        let here = epochs.record(j);
         let gain = if next.reset {
             None
         } else {
@@ -186,14 +204,16 @@ pub fn rts_backward<const S: usize>(
         };
         match gain {
             Some(c) => {
-                smoothed[j] = c * (next.correction + smoothed[j + 1]);
-                let p = here.posterior + c * (covariance[j + 1] - next.prior) * c.transpose();
-                covariance[j] = (p + p.transpose()) * 0.5;
+                smoothed = c * (next.correction + smoothed);
+                let p = here.posterior + c * (covariance - next.prior) * c.transpose();
+                covariance = (p + p.transpose()) * 0.5;
             }
             None => {
-                smoothed[j] = ErrorVector::zeros();
-                covariance[j] = here.posterior;
+                smoothed = ErrorVector::zeros();
+                covariance = here.posterior;
             }
         }
+        visit(j, &smoothed, &covariance);
+        next = here;
     }
 }

@@ -10,7 +10,7 @@
 //! exactly there).
 use imu_core::fusion::align::{self, PartFigures};
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
-use imu_core::fusion::smoother::{Covariance, EpochRecord, ErrorVector, rts_backward};
+use imu_core::fusion::smoother::{ErrorVector, rts_backward};
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfError, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
     SensorErrorEstimate, SensorErrorSigma, corrected_state,
@@ -1092,7 +1092,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         filter
     };
     // What the backward pass needs: the epochs, and each sample's filtered state.
-    let mut epochs = Vec::new();
+    let mut epochs = crate::run::epochs::PackedEpochs::<S>::new();
     let mut filtered: Vec<(EskfState<E>, SensorErrorEstimate, usize)> = Vec::new();
     let lever = Vec3::<Body>::from_array(setup.lever_arm_m);
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
@@ -1153,7 +1153,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         let s = filter.state();
         if setup.smooth {
             while let Some(e) = filter.take_epoch() {
-                epochs.push(e);
+                epochs.push(&e);
             }
             filtered.push((s, filter.sensor_errors(), acceptance.resets));
             continue;
@@ -1170,7 +1170,7 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
     if setup.smooth {
         filter.finish_smoothing();
         while let Some(e) = filter.take_epoch() {
-            epochs.push(e);
+            epochs.push(&e);
         }
         smoothed_rows::<E, S>(
             filter.earth(),
@@ -1232,40 +1232,42 @@ fn push_fused_row<E: NavEarth, const S: usize>(
 /// epochs around it (none across a reset), its one-sigma likewise.
 fn smoothed_rows<E: NavEarth, const S: usize>(
     earth: &E,
-    epochs: &[EpochRecord<S>],
+    epochs: &crate::run::epochs::PackedEpochs<S>,
     filtered: &[(EskfState<E>, SensorErrorEstimate, usize)],
     t: &[f64],
     (table, row): (&mut Table, &mut Vec<f64>),
     origin: &E::Origin,
 ) {
-    let mut smoothed = vec![ErrorVector::<S>::zeros(); epochs.len()];
-    let mut covariance = vec![Covariance::<S>::zeros(); epochs.len()];
-    rts_backward(epochs, &mut smoothed, &mut covariance);
+    let n = epochs.len();
+    let mut smoothed = vec![ErrorVector::<S>::zeros(); n];
+    let mut variance = vec![ErrorVector::<S>::zeros(); n];
+    rts_backward(epochs, |j, dx, p| {
+        smoothed[j] = *dx;
+        variance[j] = p.diagonal();
+    });
     let mut last_yaw = None;
     let mut j = 0;
     for (i, (state, errors, resets)) in filtered.iter().enumerate() {
         let ti = t[i];
-        while j + 1 < epochs.len() && epochs[j + 1].t_s <= ti {
+        while j + 1 < n && epochs.t_s(j + 1) <= ti {
             j += 1;
         }
-        let (dx, var) = match epochs.get(j + 1) {
-            Some(next) if !next.reset && epochs[j].t_s <= ti => {
-                let span = next.t_s - epochs[j].t_s;
-                let w = if span > 0.0 {
-                    (ti - epochs[j].t_s) / span
-                } else {
-                    0.0
-                };
-                let end = next.correction + smoothed[j + 1];
-                (
-                    smoothed[j] * (1.0 - w) + end * w,
-                    covariance[j].diagonal() * (1.0 - w) + covariance[j + 1].diagonal() * w,
-                )
-            }
-            _ => match epochs.get(j) {
-                Some(e) if e.t_s <= ti => (smoothed[j], covariance[j].diagonal()),
-                _ => (ErrorVector::<S>::zeros(), ErrorVector::<S>::zeros()),
-            },
+        let (dx, var) = if j + 1 < n && !epochs.reset(j + 1) && epochs.t_s(j) <= ti {
+            let span = epochs.t_s(j + 1) - epochs.t_s(j);
+            let w = if span > 0.0 {
+                (ti - epochs.t_s(j)) / span
+            } else {
+                0.0
+            };
+            let end = epochs.correction(j + 1) + smoothed[j + 1];
+            (
+                smoothed[j] * (1.0 - w) + end * w,
+                variance[j] * (1.0 - w) + variance[j + 1] * w,
+            )
+        } else if j < n && epochs.t_s(j) <= ti {
+            (smoothed[j], variance[j])
+        } else {
+            (ErrorVector::<S>::zeros(), ErrorVector::<S>::zeros())
         };
         let s = corrected_state(earth, state, dx.as_slice());
         let mut e = *errors;

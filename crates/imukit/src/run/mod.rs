@@ -5,6 +5,7 @@
 pub mod allan;
 pub mod arrays;
 pub mod compare;
+pub mod epochs;
 pub mod fuse;
 mod fuse_aids;
 pub mod identify;
