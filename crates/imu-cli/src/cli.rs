@@ -46,6 +46,31 @@ pub struct FigureArgs {
     pub dpi: Option<f64>,
 }
 
+/// How a vendor's CSV maps to imukit's columns (`--map`), for the commands that read IMU data.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MapArg {
+    /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
+    /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
+    /// axes in the body frame (docs/formats.md).
+    #[arg(long, value_name = "FILE")]
+    pub map: Option<PathBuf>,
+}
+
+/// Which topics of a ROS bag to read and on which clock (`--topic`, `--receive-time`), for every
+/// command that reads tables.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BagArgs {
+    /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
+    /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
+    /// reference's).
+    #[arg(long = "topic", value_name = "NAME")]
+    pub topics: Vec<String>,
+    /// Read a ROS bag's messages at the times the recorder received them, not at their
+    /// header stamps.
+    #[arg(long)]
+    pub receive_time: bool,
+}
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 #[allow(
@@ -97,20 +122,12 @@ pub enum Command {
         /// (`dv_*_m_s`, `dtheta_*_rad`). Planar: CSV (`t_s, accel_x_m_s2, accel_y_m_s2,
         /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
         input: PathBuf,
-        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
-        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
-        /// axes in the body frame (docs/formats.md).
-        #[arg(long, value_name = "FILE")]
-        map: Option<PathBuf>,
-        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
-        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
-        /// reference's).
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them, not at their
-        /// header stamps.
-        #[arg(long)]
-        receive_time: bool,
+        /// How a vendor's CSV maps to imukit's columns.
+        #[command(flatten)]
+        map: MapArg,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// 3D: initial state from the first row of this truth file, or of a reference in
         /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
@@ -203,20 +220,12 @@ pub enum Command {
         /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
         /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
         input: PathBuf,
-        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
-        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
-        /// axes in the body frame (docs/formats.md).
-        #[arg(long, value_name = "FILE")]
-        map: Option<PathBuf>,
-        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
-        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
-        /// reference's).
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them, not at their
-        /// header stamps.
-        #[arg(long)]
-        receive_time: bool,
+        /// How a vendor's CSV maps to imukit's columns.
+        #[command(flatten)]
+        map: MapArg,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// The filter.
         #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
         filter: FilterKind,
@@ -253,20 +262,12 @@ pub enum Command {
     Fuse {
         /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
         imu: PathBuf,
-        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
-        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
-        /// axes in the body frame (docs/formats.md).
-        #[arg(long, value_name = "FILE")]
-        map: Option<PathBuf>,
-        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
-        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
-        /// reference's).
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them, not at their
-        /// header stamps.
-        #[arg(long)]
-        receive_time: bool,
+        /// How a vendor's CSV maps to imukit's columns.
+        #[command(flatten)]
+        map: MapArg,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
         /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
         gnss: Option<PathBuf>,
@@ -392,15 +393,9 @@ pub enum Command {
         truth: PathBuf,
         /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
         estimate: PathBuf,
-        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
-        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
-        /// reference's).
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them, not at their
-        /// header stamps.
-        #[arg(long)]
-        receive_time: bool,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -451,20 +446,12 @@ pub enum Command {
     Allan {
         /// IMU readings CSV (with `t_s`).
         input: PathBuf,
-        /// A column map (TOML) for a vendor's CSV: which of its columns hold the time, the
-        /// accelerometer, the gyroscope and the magnetometer, in which units, and the sensor's
-        /// axes in the body frame (docs/formats.md).
-        #[arg(long, value_name = "FILE")]
-        map: Option<PathBuf>,
-        /// A topic to read from a ROS bag (`.mcap`, `.db3`, `.bag`, a bag folder) that holds
-        /// several that fit; given once per topic the command reads (the IMU's, the fixes', the
-        /// reference's).
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them, not at their
-        /// header stamps.
-        #[arg(long)]
-        receive_time: bool,
+        /// How a vendor's CSV maps to imukit's columns.
+        #[command(flatten)]
+        map: MapArg,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,
@@ -485,15 +472,12 @@ pub enum Command {
     Identify {
         /// The static log (any format imukit reads, with `t_s`).
         input: PathBuf,
-        /// A column map (TOML) for a vendor's CSV (docs/formats.md).
-        #[arg(long, value_name = "FILE")]
-        map: Option<PathBuf>,
-        /// A topic to read from a ROS bag that holds several that fit.
-        #[arg(long = "topic", value_name = "NAME")]
-        topics: Vec<String>,
-        /// Read a ROS bag's messages at the times the recorder received them.
-        #[arg(long)]
-        receive_time: bool,
+        /// How a vendor's CSV maps to imukit's columns.
+        #[command(flatten)]
+        map: MapArg,
+        /// Which topics of a ROS bag, on which clock.
+        #[command(flatten)]
+        bag: BagArgs,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,

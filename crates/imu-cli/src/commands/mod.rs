@@ -68,8 +68,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Integrate {
             input,
             map,
-            topics,
-            receive_time,
+            bag,
             init,
             nav_frame,
             gravity_m_s2,
@@ -92,8 +91,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             height0_m,
             out,
         } => {
-            attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input), init.as_deref()], &topics, receive_time);
+            map.attach(&input)?;
+            bag.attach(&[Some(&input), init.as_deref()]);
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -135,8 +134,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Fuse {
             imu,
             map,
-            topics,
-            receive_time,
+            bag,
             gnss,
             init,
             align,
@@ -160,12 +158,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             zupt,
             out,
         } => {
-            attach_map(&imu, map.as_deref())?;
-            attach_topics(
-                &[Some(&imu), gnss.as_deref(), init.as_deref()],
-                &topics,
-                receive_time,
-            );
+            map.attach(&imu)?;
+            bag.attach(&[Some(&imu), gnss.as_deref(), init.as_deref()]);
             fuse::run(&fuse::Args {
                 imu: &imu,
                 gnss: gnss.as_deref(),
@@ -201,8 +195,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Orient {
             input,
             map,
-            topics,
-            receive_time,
+            bag,
             filter,
             params,
             conventions,
@@ -210,8 +203,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             accel_sign,
             out,
         } => {
-            attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input)], &topics, receive_time);
+            map.attach(&input)?;
+            bag.attach(&[Some(&input)]);
             orient::run(
                 &input,
                 filter,
@@ -225,11 +218,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Compare {
             truth,
             estimate,
-            topics,
-            receive_time,
+            bag,
             out,
         } => {
-            attach_topics(&[Some(&truth), Some(&estimate)], &topics, receive_time);
+            bag.attach(&[Some(&truth), Some(&estimate)]);
             compare::run(&truth, &estimate, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
@@ -241,15 +233,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Allan {
             input,
             map,
-            topics,
-            receive_time,
+            bag,
             columns,
             out,
             plot,
             figure,
         } => {
-            attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input)], &topics, receive_time);
+            map.attach(&input)?;
+            bag.attach(&[Some(&input)]);
             allan::run(
                 &input,
                 &columns,
@@ -261,8 +252,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Identify {
             input,
             map,
-            topics,
-            receive_time,
+            bag,
             columns,
             out,
             params,
@@ -272,8 +262,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             plot,
             figure,
         } => {
-            attach_map(&input, map.as_deref())?;
-            attach_topics(&[Some(&input)], &topics, receive_time);
+            map.attach(&input)?;
+            bag.attach(&[Some(&input)]);
             identify::run(
                 &input,
                 &columns,
@@ -309,33 +299,37 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// Names `topics` (`--topic`) as the ones to read from each of `inputs` that is a bag, at the
-/// recorder's receive times when `receive_time` (`--receive-time`).
-fn attach_topics(inputs: &[Option<&std::path::Path>], topics: &[String], receive_time: bool) {
-    use imukit::io::bag::{Clock, Selection};
-    for input in inputs.iter().flatten() {
-        if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
-            let clock = if receive_time {
-                Clock::Receive
-            } else {
-                Clock::Header
-            };
-            imukit::io::bag::attach(
-                input,
-                Selection {
-                    topics: topics.to_vec(),
-                    clock,
-                },
-            );
+impl crate::cli::BagArgs {
+    /// Names the topics (`--topic`) as the ones to read from each of `inputs` that is a bag, at
+    /// the recorder's receive times with `--receive-time`.
+    fn attach(&self, inputs: &[Option<&std::path::Path>]) {
+        use imukit::io::bag::{Clock, Selection};
+        for input in inputs.iter().flatten() {
+            if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
+                let clock = if self.receive_time {
+                    Clock::Receive
+                } else {
+                    Clock::Header
+                };
+                imukit::io::bag::attach(
+                    input,
+                    Selection {
+                        topics: self.topics.clone(),
+                        clock,
+                    },
+                );
+            }
         }
     }
 }
 
-/// Reads the column map `map` (`--map FILE`) and attaches it to `input`: every reader of the
-/// input then reads it through the map.
-fn attach_map(input: &std::path::Path, map: Option<&std::path::Path>) -> Result<(), CliError> {
-    if let Some(m) = map {
-        imukit::io::column_map::attach(input, imukit::io::column_map::ColumnMap::read(m)?);
+impl crate::cli::MapArg {
+    /// Reads the column map (`--map FILE`) and attaches it to `input`: every reader of the
+    /// input then reads it through the map.
+    fn attach(&self, input: &std::path::Path) -> Result<(), CliError> {
+        if let Some(m) = &self.map {
+            imukit::io::column_map::attach(input, imukit::io::column_map::ColumnMap::read(m)?);
+        }
+        Ok(())
     }
-    Ok(())
 }
