@@ -1595,3 +1595,43 @@ fn each_presets_free_inertial_drift_is_within_its_grades_bounds() {
         );
     }
 }
+
+/// One pass gives both tables: the filtered one is `fuse`'s and the smoothed one `fuse` with
+/// `smooth`'s, value for value (the study compares them without running the filter twice).
+#[test]
+fn the_filtered_and_smoothed_tables_of_one_pass_are_those_of_two() {
+    use imukit::run::fuse::{AidTables, Start, fuse_filtered_and_smoothed, fuse_with};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let sc = imukit::Scenario::from_file(&dir.join("car_tunnel.toml")).unwrap();
+    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    let sim = sc.simulate_run(0).unwrap();
+    let initial = InitialState::from_table(&sim.truth).unwrap();
+    let gnss = sim.gnss.as_ref().unwrap();
+    let run = |setup: &FuseSetup| {
+        fuse_with(
+            &sim.imu,
+            gnss,
+            AidTables::default(),
+            Start::State(&initial),
+            setup,
+        )
+        .unwrap()
+        .0
+    };
+    let filtered = run(&setup);
+    let smoothed = run(&FuseSetup {
+        smooth: true,
+        ..setup
+    });
+    let (f, s, _) = fuse_filtered_and_smoothed(
+        &sim.imu,
+        gnss,
+        AidTables::default(),
+        Start::State(&initial),
+        &setup,
+    )
+    .unwrap();
+    assert_eq!(f, filtered);
+    assert_eq!(s, smoothed);
+    assert_ne!(f, s);
+}

@@ -504,7 +504,7 @@ pub fn fuse_with(
     start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    on_earth(
+    let (table, _, summary) = on_earth(
         setup.nav_frame,
         setup.earth,
         setup.gravity_m_s2,
@@ -514,8 +514,44 @@ pub fn fuse_with(
             aids,
             start,
             setup,
+            keep_filtered: false,
         },
-    )
+    )?;
+    Ok((table, summary))
+}
+
+/// [`fuse_with`] smoothed forward–backward ([`FuseSetup::smooth`] whatever `setup` says), with
+/// the forward filter's own table from the same pass: `(filtered, smoothed, summary)`, for
+/// those who compare the two without running the filter twice.
+///
+/// # Errors
+/// As [`fuse_with`].
+pub fn fuse_filtered_and_smoothed(
+    imu: &Table,
+    gnss: &Table,
+    aids: AidTables<'_>,
+    start: Start<'_>,
+    setup: &FuseSetup,
+) -> Result<(Table, Table, FuseSummary)> {
+    let setup = FuseSetup {
+        smooth: true,
+        ..*setup
+    };
+    let (smoothed, filtered, summary) = on_earth(
+        setup.nav_frame,
+        setup.earth,
+        setup.gravity_m_s2,
+        Fuse {
+            imu,
+            gnss,
+            aids,
+            start,
+            setup: &setup,
+            keep_filtered: true,
+        },
+    )?;
+    let filtered = filtered.ok_or_else(|| invalid("fuse", "the filtered table was not kept"))?;
+    Ok((filtered, smoothed, summary))
 }
 
 /// [`fuse_with`] as an [`EarthJob`].
@@ -525,10 +561,12 @@ struct Fuse<'a> {
     aids: AidTables<'a>,
     start: Start<'a>,
     setup: &'a FuseSetup,
+    /// Smoothing, also write the forward filter's rows into a table of their own.
+    keep_filtered: bool,
 }
 
 impl EarthJob for Fuse<'_> {
-    type Output = Result<(Table, FuseSummary)>;
+    type Output = Result<(Table, Option<Table>, FuseSummary)>;
 
     fn run<E: NavEarth>(self, earth: E) -> Self::Output {
         if self.setup.estimate_sensor_errors {
@@ -850,13 +888,17 @@ impl Acceptance {
 /// The GNSS speed above which a vehicle is not at rest for the static alignment, m/s.
 const STATIC_SPEED_M_S: f64 = 0.5;
 
-fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Table, FuseSummary)> {
+fn fuse_on<E: NavEarth, const S: usize>(
+    earth: E,
+    job: Fuse<'_>,
+) -> Result<(Table, Option<Table>, FuseSummary)> {
     let Fuse {
         imu,
         gnss,
         aids,
         start,
         setup,
+        keep_filtered,
     } = job;
     let [h, _, v] = setup.gnss_position_sigma_m;
     let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT, [h, v])?;
@@ -1110,6 +1152,10 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         columns,
         data: Vec::new(),
     };
+    let mut filtered_table = (setup.smooth && keep_filtered).then(|| Table {
+        columns: table.columns.clone(),
+        data: Vec::new(),
+    });
     let mut acceptance = Acceptance::default();
     let mut last_yaw = None;
     let mut row = Vec::with_capacity(table.columns.len());
@@ -1156,6 +1202,15 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
                 epochs.push(&e);
             }
             filtered.push((s, filter.sensor_errors(), acceptance.resets));
+            if let Some(kept) = filtered_table.as_mut() {
+                push_fused_row(
+                    kept,
+                    &mut row,
+                    (&s, &filter.sensor_errors(), &filter.sigmas()),
+                    (&origin, &mut last_yaw),
+                    acceptance.resets,
+                );
+            }
             continue;
         }
         let sig = filter.sigmas();
@@ -1182,9 +1237,13 @@ fn fuse_on<E: NavEarth, const S: usize>(earth: E, job: Fuse<'_>) -> Result<(Tabl
         );
     }
     table.check_finite("fused navigation")?;
+    if let Some(kept) = &filtered_table {
+        kept.check_finite("fused navigation")?;
+    }
     let (updates, rejected) = filter.update_counts();
     Ok((
         table,
+        filtered_table,
         FuseSummary {
             updates,
             rejected,

@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
-use crate::run::fuse::{AidTables, FuseSetup, Start, fuse_with};
+use crate::run::fuse::{AidTables, FuseSetup, Start, fuse_filtered_and_smoothed, fuse_with};
 use crate::run::navigate::InitialState;
 use crate::scenario::{Scenario, ScenarioSpec};
 
@@ -379,9 +379,16 @@ impl Study {
             odometer: sim.odometer.as_ref().filter(|_| self.odometer),
             baro: sim.baro.as_ref().filter(|_| self.baro),
         };
-        let (nav, resets) = match fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &c.setup)
-        {
-            Ok((nav, summary)) => (nav, summary.resets),
+        // Smoothing, one pass gives the filter's table and the smoothed one.
+        let fused = if self.smooth {
+            fuse_filtered_and_smoothed(&sim.imu, gnss, aids, Start::State(&initial), &c.setup)
+                .map(|(nav, smoothed, summary)| (nav, Some(smoothed), summary))
+        } else {
+            fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &c.setup)
+                .map(|(nav, summary)| (nav, None, summary))
+        };
+        let (nav, smoothed_nav, resets) = match fused {
+            Ok((nav, smoothed, summary)) => (nav, smoothed, summary.resets),
             Err(Error::Diverged { context, message }) => {
                 return Ok(RunOutcome::Diverged(format!(
                     "preset {}, run {run}: {context}: {message}",
@@ -399,16 +406,9 @@ impl Study {
         let (tx, ty) = (col(&sim.truth, "pos_x_m")?, col(&sim.truth, "pos_y_m")?);
         let (sx, sy) = (col(&nav, "pos_x_sigma_m")?, col(&nav, "pos_y_sigma_m")?);
         let (start, end) = self.outage;
-        let smoothed = if self.smooth {
-            let setup = FuseSetup {
-                smooth: true,
-                ..c.setup
-            };
-            let (nav, _) =
-                fuse_with(&sim.imu, gnss, aids, Start::State(&initial), &setup).map_err(named)?;
-            Some((col(&nav, "pos_x_m")?, col(&nav, "pos_y_m")?))
-        } else {
-            None
+        let smoothed = match &smoothed_nav {
+            Some(nav) => Some((col(nav, "pos_x_m")?, col(nav, "pos_y_m")?)),
+            None => None,
         };
         let mut out = OutageRun {
             t_s: Vec::new(),
