@@ -374,7 +374,7 @@ impl Datasheet {
                                 .push(format!("{at}: marked not given, but set to {}", show(&set)));
                         }
                     }
-                    Some(Entry::Given(f)) => match figure_value(f, term) {
+                    Some(Entry::Given(f)) => match f.model_value(term) {
                         Err(e) => problems.push(format!("{at}: {e}")),
                         Ok(want) => {
                             let want = if want.len() == 1 {
@@ -463,7 +463,28 @@ impl Figure {
     /// # Errors
     /// A statistic that cannot state the term (a bound for a spread), an unknown unit.
     pub fn model_value(&self, term: Term) -> std::result::Result<Vec<f64>, String> {
-        figure_value(self, term)
+        term.accepts(self.statistic)
+            .map_err(|why| format!("{} figure: {why}", self.statistic.name()))?;
+        let unit = self.unit.trim().to_lowercase().replace(' ', "");
+        let one = |q: f64| -> std::result::Result<f64, String> {
+            let v = match term {
+                Term::ScaleFactor | Term::Misalignment => percent(q, &unit)?,
+                Term::Resolution => match unit.strip_prefix("lsb/") {
+                    Some(per) => si(1.0 / q, per.trim_matches(|c| c == '(' || c == ')'))?,
+                    None => si(q, &unit)?,
+                },
+                Term::TemperatureScaleFactor if self.span_c.is_some() => percent(q, &unit)?,
+                _ => si(q, &unit)?,
+            };
+            let v = match (term, self.span_c) {
+                (Term::BiasInstability, _) => datasheet_bias_instability(v),
+                (Term::TemperatureBias | Term::TemperatureScaleFactor, Some(span)) => v / span,
+                (_, Some(_)) => return Err("span_c is for temperature figures".into()),
+                _ => v,
+            };
+            Ok(v)
+        };
+        self.quoted.iter().map(|&q| one(q)).collect()
     }
 
     /// Half a unit in the last digit quoted (`0.15` → 0.005, `2` → 0.5): the figure stands for
@@ -479,31 +500,6 @@ impl Figure {
             })
             .fold(0.0, f64::max)
     }
-}
-
-fn figure_value(f: &Figure, term: Term) -> std::result::Result<Vec<f64>, String> {
-    term.accepts(f.statistic)
-        .map_err(|why| format!("{} figure: {why}", f.statistic.name()))?;
-    let unit = f.unit.trim().to_lowercase().replace(' ', "");
-    let one = |q: f64| -> std::result::Result<f64, String> {
-        let v = match term {
-            Term::ScaleFactor | Term::Misalignment => percent(q, &unit)?,
-            Term::Resolution => match unit.strip_prefix("lsb/") {
-                Some(per) => si(1.0 / q, per.trim_matches(|c| c == '(' || c == ')'))?,
-                None => si(q, &unit)?,
-            },
-            Term::TemperatureScaleFactor if f.span_c.is_some() => percent(q, &unit)?,
-            _ => si(q, &unit)?,
-        };
-        let v = match (term, f.span_c) {
-            (Term::BiasInstability, _) => datasheet_bias_instability(v),
-            (Term::TemperatureBias | Term::TemperatureScaleFactor, Some(span)) => v / span,
-            (_, Some(_)) => return Err("span_c is for temperature figures".into()),
-            _ => v,
-        };
-        Ok(v)
-    };
-    f.quoted.iter().map(|&q| one(q)).collect()
 }
 
 fn si(q: f64, unit: &str) -> std::result::Result<f64, String> {

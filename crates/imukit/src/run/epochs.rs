@@ -20,12 +20,7 @@ impl<const S: usize> PackedEpochs<S> {
     /// No epochs yet.
     #[must_use]
     pub fn new() -> Self {
-        Self {
-            times: Vec::new(),
-            resets: Vec::new(),
-            corrections: Vec::new(),
-            matrices: Vec::new(),
-        }
+        Self::default()
     }
 
     /// Appends `record` (after the last).

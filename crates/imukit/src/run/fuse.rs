@@ -504,19 +504,15 @@ pub fn fuse_with(
     start: Start<'_>,
     setup: &FuseSetup,
 ) -> Result<(Table, FuseSummary)> {
-    let (table, _, summary) = on_earth(
-        setup.nav_frame,
-        setup.earth,
-        setup.gravity_m_s2,
-        Fuse {
-            imu,
-            gnss,
-            aids,
-            start,
-            setup,
-            keep_filtered: false,
-        },
-    )?;
+    let (table, _, summary) = Fuse {
+        imu,
+        gnss,
+        aids,
+        start,
+        setup,
+        keep_filtered: false,
+    }
+    .on_its_earth()?;
     Ok((table, summary))
 }
 
@@ -537,19 +533,15 @@ pub fn fuse_filtered_and_smoothed(
         smooth: true,
         ..*setup
     };
-    let (smoothed, filtered, summary) = on_earth(
-        setup.nav_frame,
-        setup.earth,
-        setup.gravity_m_s2,
-        Fuse {
-            imu,
-            gnss,
-            aids,
-            start,
-            setup: &setup,
-            keep_filtered: true,
-        },
-    )?;
+    let (smoothed, filtered, summary) = Fuse {
+        imu,
+        gnss,
+        aids,
+        start,
+        setup: &setup,
+        keep_filtered: true,
+    }
+    .on_its_earth()?;
     let filtered = filtered.ok_or_else(|| invalid("fuse", "the filtered table was not kept"))?;
     Ok((filtered, smoothed, summary))
 }
@@ -563,6 +555,18 @@ struct Fuse<'a> {
     setup: &'a FuseSetup,
     /// Smoothing, also write the forward filter's rows into a table of their own.
     keep_filtered: bool,
+}
+
+impl Fuse<'_> {
+    /// Runs the fusion on the Earth and in the frame its setup names.
+    fn on_its_earth(self) -> Result<(Table, Option<Table>, FuseSummary)> {
+        let (frame, earth, gravity) = (
+            self.setup.nav_frame,
+            self.setup.earth,
+            self.setup.gravity_m_s2,
+        );
+        on_earth(frame, earth, gravity, self)
+    }
 }
 
 impl EarthJob for Fuse<'_> {
@@ -1201,12 +1205,13 @@ fn fuse_on<E: NavEarth, const S: usize>(
             while let Some(e) = filter.take_epoch() {
                 epochs.push(&e);
             }
-            filtered.push((s, filter.sensor_errors(), acceptance.resets));
+            let errors = filter.sensor_errors();
+            filtered.push((s, errors, acceptance.resets));
             if let Some(kept) = filtered_table.as_mut() {
                 push_fused_row(
                     kept,
                     &mut row,
-                    (&s, &filter.sensor_errors(), &filter.sigmas()),
+                    (&s, &errors, &filter.sigmas()),
                     (&origin, &mut last_yaw),
                     acceptance.resets,
                 );
