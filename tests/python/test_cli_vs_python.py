@@ -9,6 +9,8 @@ import pytest
 
 import imukit
 
+_D = imukit._core.DEFAULTS
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -274,9 +276,12 @@ def test_python_and_the_command_line_start_from_the_same_defaults():
         want = py[name].default
         got = cli[name]
         if name in described:
-            # Taken from the input files' descriptions first (docs/formats.md), else the default.
+            # Taken from the tables' descriptions first (docs/formats.md), else the default: in
+            # Python the argument left out (None), on the command line the flag.
+            assert want is None, (name, want)
             assert got.startswith("what the input files' descriptions say, else "), (name, got)
-            got = got.rsplit("else ", 1)[1]
+            got = got.rsplit("else ", 1)[1].removeprefix("the conventions' (").rstrip(")")
+            want = _D[name]
         assert (float(got) == want) if isinstance(want, (int, float)) else (got == want), (name, got, want)
     # The scheme: one default for 3D (`auto`), one for planar (`trapezoid`), named by the library.
     assert py["scheme"].default == imukit._core.DEFAULTS["scheme"] == "auto"
@@ -285,4 +290,5 @@ def test_python_and_the_command_line_start_from_the_same_defaults():
     assert orient["conventions"] == imukit._core.DEFAULTS["conventions"] == "imukit"
     assert orient["filter"] == imukit._core.DEFAULTS["filter"]
     # The orientation filters' frame and sign, unless told, are the conventions': ENU.
-    assert imukit.ImuFilter(100.0).reference_frame == cli["nav_frame"].rsplit("else ", 1)[1] == "ENU"
+    assert imukit.ImuFilter(100.0).reference_frame == _D["nav_frame"] == "ENU"
+    assert cli["nav_frame"].endswith("else the conventions' (ENU)")

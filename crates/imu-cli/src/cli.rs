@@ -56,6 +56,25 @@ pub struct MapArg {
     pub map: Option<PathBuf>,
 }
 
+/// What the data's axes and accelerometer sign are (`--nav-frame`, `--accel-sign`,
+/// `--conventions`), for the commands that navigate: each as given, else what the input files'
+/// descriptions say, else the conventions'.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FrameArgs {
+    /// Navigation frame of the data [default: what the input files' descriptions say, else the
+    /// conventions' (ENU)].
+    #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+    pub nav_frame: Option<NavFrameName>,
+    /// Sign of the accelerometer columns [default: what the input files' descriptions say, else
+    /// the conventions' (specific-force)].
+    #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
+    pub accel_sign: Option<AccelSignName>,
+    /// Conventions for what neither an option nor a description gives: `imukit` (ENU and
+    /// specific force) or `matlab` (NED and MATLAB's accelerometer sign: a MATLAB export).
+    #[arg(long, value_parser = choice::<Conventions>(), ignore_case = true)]
+    pub conventions: Option<Conventions>,
+}
+
 /// Which topics of a ROS bag to read and on which clock (`--topic`, `--receive-time`), for every
 /// command that reads tables.
 #[derive(Debug, Clone, clap::Args)]
@@ -133,18 +152,13 @@ pub enum Command {
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
         #[arg(long)]
         init: Option<PathBuf>,
-        /// 3D: navigation frame of the data [default: what the input files' descriptions say,
-        /// else ENU].
-        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
-        nav_frame: Option<NavFrameName>,
+        /// 3D: the data's frame and accelerometer sign.
+        #[command(flatten)]
+        frame: FrameArgs,
         /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling) [default: what the input
         /// files' descriptions say, else 9.81].
         #[arg(long, alias = "gravity")]
         gravity_m_s2: Option<f64>,
-        /// 3D: sign of the accelerometer columns [default: what the input files' descriptions
-        /// say, else specific-force].
-        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
-        accel_sign: Option<AccelSignName>,
         /// 3D: switch off the coning and sculling corrections (for comparison).
         #[arg(long)]
         no_corrections: bool,
@@ -322,6 +336,9 @@ pub enum Command {
         /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.
         #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
         earth: Option<EarthName>,
+        /// The data's frame and accelerometer sign (with --scenario: checked against it).
+        #[command(flatten)]
+        frame: FrameArgs,
         /// Apply every fix (no chi-square innovation gate).
         #[arg(long)]
         no_gate: bool,

@@ -1382,7 +1382,7 @@ fn fuse_follows_a_gnss_aided_car_and_names_bad_input() {
     assert!(rms < 1.0, "{report}");
     std::fs::remove_file(dir.join("nav.csv")).unwrap();
     for (out, extra, needle) in [
-        ("nav.csv", vec!["--earth", "wgs84"], "is on the flat Earth"),
+        ("nav.csv", vec!["--earth", "wgs84"], "which says flat"),
         ("imu.csv", vec![], "--out"),
     ] {
         let (code, err) = fuse_to(out, &extra);

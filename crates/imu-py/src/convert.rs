@@ -1,6 +1,7 @@
 //! NumPy and Python objects in, library types out, and back: shapes are checked here, once, with
 //! the argument named. Nothing here computes.
 use imukit::Table;
+use imukit::io::description::{Described, Description, Value};
 use imukit::io::params::{MAX_DEPTH, ParamValue, SensorTable};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
@@ -15,6 +16,14 @@ use crate::errors::shape_error;
 
 /// A table for Python: column names and a (rows, columns) array.
 pub(crate) type TableOut<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>);
+
+/// A table for Python with what it holds: column names, a (rows, columns) array and its
+/// description's entries (`imukit.Table.description`).
+pub(crate) type DescribedOut<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>, Bound<'py, PyDict>);
+
+/// The inputs' descriptions as Python hands them over: `(argument, entries)` for each table
+/// argument that carries one.
+pub(crate) type DescribedIn<'py> = Vec<(String, Bound<'py, PyDict>)>;
 
 /// A shape as Python writes it: `(5, 2)`.
 fn shape(s: &[usize]) -> String {
@@ -105,6 +114,78 @@ pub(crate) fn table_out(py: Python<'_>, t: Table) -> PyResult<TableOut<'_>> {
     let shape = (t.rows(), t.columns.len());
     let arr = Array2::from_shape_vec(shape, t.data).map_err(|e| shape_error(e.to_string()))?;
     Ok((t.columns, arr.into_pyarray(py)))
+}
+
+/// A description's entries as a dict (keys without the `imukit.` prefix).
+pub(crate) fn description_dict<'py>(
+    py: Python<'py>,
+    d: &Description,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    if d.is_empty() {
+        return Ok(out);
+    }
+    for (k, v) in d.entries() {
+        match v {
+            Value::Text(s) => out.set_item(k, s)?,
+            Value::Number(x) => out.set_item(k, x)?,
+        }
+    }
+    Ok(out)
+}
+
+/// A library table and its description for Python.
+pub(crate) fn described_out<'py>(
+    py: Python<'py>,
+    t: Table,
+    d: &Description,
+) -> PyResult<DescribedOut<'py>> {
+    let dict = description_dict(py, d)?;
+    let (columns, values) = table_out(py, t)?;
+    Ok((columns, values, dict))
+}
+
+/// One table's description from its entries, each checked as a file's would be; `name` is
+/// the argument.
+pub(crate) fn description_in(name: &str, entries: &Bound<'_, PyDict>) -> PyResult<Description> {
+    let mut pairs = Vec::with_capacity(entries.len());
+    for (k, v) in entries.iter() {
+        let key: String = k.extract().map_err(|_| {
+            PyTypeError::new_err(format!("{name}.description: keys must be strings"))
+        })?;
+        let value = if v.is_instance_of::<PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "{name}.description[{key:?}]: expected a name or a number, got a bool"
+            )));
+        } else if let Ok(x) = v.extract::<f64>()
+            && (v.is_instance_of::<PyFloat>() || v.is_instance_of::<PyInt>())
+        {
+            Value::Number(x)
+        } else if let Ok(text) = v.extract::<String>() {
+            Value::Text(text)
+        } else {
+            return Err(PyTypeError::new_err(format!(
+                "{name}.description[{key:?}]: expected a name or a number, got {}",
+                v.get_type().name()?
+            )));
+        };
+        pairs.push((key, value));
+    }
+    Description::from_entries(
+        pairs.iter().map(|(k, v)| (k.as_str(), v.clone())),
+        &format!("{name}.description"),
+    )
+    .map_err(crate::errors::refused)
+}
+
+/// The descriptions of a job's table arguments, named as messages give them ("the imu
+/// table").
+pub(crate) fn described_in(named: &DescribedIn<'_>) -> PyResult<Described> {
+    let mut out = Vec::with_capacity(named.len());
+    for (name, entries) in named {
+        out.push((format!("the {name} table"), description_in(name, entries)?));
+    }
+    Ok(Described::of(out))
 }
 
 /// A row-major (rows, cols) array from flat data.

@@ -4,19 +4,33 @@ use std::path::Path;
 
 use imukit::Table;
 use imukit::io::column_map::ColumnMap;
-use imukit::io::description::{Description, Value};
+use imukit::io::description::Description;
 use imukit::io::table::{read_table, read_table_through, run_path as run_file};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{TableOut, table_in, table_out};
+use crate::convert::{DescribedOut, described_out, description_dict, description_in, table_in};
 use crate::errors::refused;
 
-/// Every column of an imukit CSV file.
+/// A table read from `path` with what the file says it holds, else what its columns show.
+fn read_out<'py>(py: Python<'py>, path: &str, t: Table) -> PyResult<DescribedOut<'py>> {
+    let d = py
+        .detach(|| Description::read(Path::new(path)))
+        .map_err(refused)?
+        .unwrap_or_default();
+    let d = Description {
+        kind: d.kind.or_else(|| Description::of_columns(&t.columns).kind),
+        ..d
+    };
+    described_out(py, t, &d)
+}
+
+/// Every column of an imukit CSV file, with its description.
 #[pyfunction]
-fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
-    table_out(py, read_table(Path::new(path)).map_err(refused)?)
+fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<DescribedOut<'py>> {
+    let t = read_table(Path::new(path)).map_err(refused)?;
+    read_out(py, path, t)
 }
 
 /// Every column of a table file, its format by its extension (`.parquet`, else CSV); a CSV
@@ -30,7 +44,7 @@ fn read_table_file<'py>(
     map_json: Option<&str>,
     topic: Option<String>,
     receive_time: bool,
-) -> PyResult<TableOut<'py>> {
+) -> PyResult<DescribedOut<'py>> {
     use imukit::io::bag::{Clock, Role, read_on};
     if topic.is_some() || receive_time {
         let clock = if receive_time {
@@ -42,7 +56,7 @@ fn read_table_file<'py>(
         let t = py
             .detach(|| read_on(Path::new(path), clock)?.table_among(&named, &[], Role::Any))
             .map_err(refused)?;
-        return table_out(py, t);
+        return read_out(py, path, t);
     }
     let map = match (map_path, map_json) {
         (Some(p), _) => Some(ColumnMap::read(Path::new(p)).map_err(refused)?),
@@ -55,19 +69,37 @@ fn read_table_file<'py>(
             None => read_table(Path::new(path)),
         })
         .map_err(refused)?;
-    table_out(py, t)
+    match map {
+        // A vendor's file says nothing of itself: what its columns show.
+        Some(_) => {
+            let d = Description::of_columns(&t.columns);
+            described_out(py, t, &d)
+        }
+        None => read_out(py, path, t),
+    }
 }
 
-/// Writes a table in the format its path's extension names (`.parquet`, `.npy`, `.npz`, else CSV), atomically.
+/// Writes a table in the format its path's extension names (`.parquet`, `.npy`, `.npz`, else
+/// CSV), atomically, with its description (`description`'s entries; else what its columns show).
 #[pyfunction]
+#[pyo3(signature = (path, columns, values, description = None))]
 fn write_table_file(
     py: Python<'_>,
     path: &str,
     columns: Vec<String>,
     values: PyReadonlyArray2<'_, f64>,
+    description: Option<Bound<'_, PyDict>>,
 ) -> PyResult<()> {
+    let d = description
+        .map(|d| description_in("table", &d))
+        .transpose()?
+        .filter(|d| !d.is_empty());
     let t: Table = table_in("values", columns, &values)?;
-    py.detach(move || t.write(Path::new(path))).map_err(refused)
+    py.detach(move || match d {
+        Some(d) => t.write_described(Path::new(path), &d),
+        None => t.write(Path::new(path)),
+    })
+    .map_err(refused)
 }
 
 /// Writes a table as an imukit CSV (shortest round-trip numbers, atomically).
@@ -90,14 +122,7 @@ fn read_description<'py>(py: Python<'py>, path: &str) -> PyResult<Option<Bound<'
     let Some(d) = Description::read(Path::new(path)).map_err(refused)? else {
         return Ok(None);
     };
-    let out = PyDict::new(py);
-    for (k, v) in d.entries() {
-        match v {
-            Value::Text(s) => out.set_item(k, s)?,
-            Value::Number(x) => out.set_item(k, x)?,
-        }
-    }
-    Ok(Some(out))
+    description_dict(py, &d).map(Some)
 }
 
 /// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).

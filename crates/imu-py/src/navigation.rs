@@ -6,17 +6,17 @@ use imukit::Table;
 use imukit::choice::Choice;
 use imukit::run::compare as comparison;
 use imukit::run::navigate::{
-    EarthGravityName, InitialState, NavRequest, SchemeName, VerticalName, integrate,
+    InitialState, NavAsked, NavRequest, SchemeName, VerticalName, integrate,
 };
 use imukit::run::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
-use imukit::scenario::{AccelSignName, EarthName, NavFrameName};
 use numpy::PyReadonlyArray1;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    TableOut, check_len, choice, choice_opt, fixed, fixed_opt, non_negative, table_in, table_out,
+    DescribedIn, DescribedOut, TableOut, check_len, choice, choice_opt, described_in,
+    described_out, fixed, fixed_opt, non_negative, table_in, table_out,
 };
 use crate::errors::refused;
 
@@ -82,14 +82,13 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
 #[pyfunction]
 #[pyo3(signature = (columns, values, *, initial_columns = None, initial_values = None, position0_m = None,
                     velocity0_m_s = None, quaternion0 = None, euler0_rad = None,
-                    nav_frame = NavFrameName::default_name(),
-                    gravity_m_s2 = imu_core::DEFAULT_GRAVITY_M_S2, coning = true, sculling = true,
-                    accel_sign = AccelSignName::default_name(), scheme = SchemeName::default_name(),
+                    nav_frame = None, gravity_m_s2 = None, coning = true, sculling = true,
+                    accel_sign = None, scheme = SchemeName::default_name(),
                     substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64,
-                    earth = EarthName::default_name(), vertical = VerticalName::default_name(),
+                    earth = None, vertical = VerticalName::default_name(),
                     baro_time_constant_s = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
-                    earth_gravity = EarthGravityName::default_name(), lat0_deg = None, lon0_deg = None, height0_m = None,
-                    baro_columns = None, baro_values = None))]
+                    earth_gravity = None, lat0_deg = None, lon0_deg = None, height0_m = None,
+                    baro_columns = None, baro_values = None, described = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 fn strapdown<'py>(
     py: Python<'py>,
@@ -101,39 +100,48 @@ fn strapdown<'py>(
     velocity0_m_s: Option<Vec<f64>>,
     quaternion0: Option<Vec<f64>>,
     euler0_rad: Option<Vec<f64>>,
-    nav_frame: &str,
-    gravity_m_s2: f64,
+    nav_frame: Option<&str>,
+    gravity_m_s2: Option<f64>,
     coning: bool,
     sculling: bool,
-    accel_sign: &str,
+    accel_sign: Option<&str>,
     scheme: &str,
     substeps: i64,
-    earth: &str,
+    earth: Option<&str>,
     vertical: &str,
     baro_time_constant_s: f64,
-    earth_gravity: &str,
+    earth_gravity: Option<&str>,
     lat0_deg: Option<f64>,
     lon0_deg: Option<f64>,
     height0_m: Option<f64>,
     baro_columns: Option<Vec<String>>,
     baro_values: Option<PyReadonlyArray2<'py, f64>>,
-) -> PyResult<(TableOut<'py>, Vec<String>)> {
+    described: DescribedIn<'py>,
+) -> PyResult<(DescribedOut<'py>, Vec<String>)> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
+    let asked = NavAsked {
+        nav_frame: choice_opt("nav_frame", nav_frame)?,
+        accel_sign: choice_opt("accel_sign", accel_sign)?,
+        gravity_m_s2,
+        earth: choice_opt("earth", earth)?,
+        earth_gravity: choice_opt("earth_gravity", earth_gravity)?,
+        conventions: None,
+    };
+    let described = described_in(&described)?;
+    // What the tables say they hold fills the settings left out, and refuses an argument that
+    // contradicts it, as the command line does with its files.
     let setup = NavRequest {
-        nav_frame: choice("nav_frame", nav_frame)?,
-        accel_sign: choice("accel_sign", accel_sign)?,
         scheme: choice("scheme", scheme)?,
         substeps,
-        gravity_m_s2,
         coning,
         sculling,
-        earth: choice("earth", earth)?,
         vertical: choice("vertical", vertical)?,
         baro_time_constant_s,
-        earth_gravity: choice("earth_gravity", earth_gravity)?,
         barometer: baro_columns.is_some(),
+        ..NavRequest::default()
     }
-    .setup()
+    .with_described(&asked, &described)
+    .and_then(|r| r.setup())
     .map_err(refused)?;
     let mut imu = table_in("imu", columns, &values)?;
     if let (Some(c), Some(v)) = (baro_columns, &baro_values) {
@@ -150,6 +158,7 @@ fn strapdown<'py>(
         ),
     }
     .and_then(|s| s.with_geodetic0(lat0_deg, lon0_deg, height0_m))
+    .and_then(|s| Ok(s.at_origin(described.origin()?)))
     .map_err(refused)?;
     let out = py
         .detach(|| integrate(&imu, &initial, &setup))
@@ -159,18 +168,24 @@ fn strapdown<'py>(
     let notes = imukit::io::rows::Gaps::of_times(&t, 0)
         .message("imu")
         .into_iter();
-    Ok((table_out(py, out)?, notes.collect()))
+    Ok((
+        described_out(py, out, &setup.description())?,
+        notes.collect(),
+    ))
 }
 
 /// Errors of an estimate against truth: (error table, summary dict).
 #[pyfunction]
+#[pyo3(signature = (truth_columns, truth, estimate_columns, estimate, described = Vec::new()))]
 fn compare<'py>(
     py: Python<'py>,
     truth_columns: Vec<String>,
     truth: PyReadonlyArray2<'py, f64>,
     estimate_columns: Vec<String>,
     estimate: PyReadonlyArray2<'py, f64>,
+    described: DescribedIn<'py>,
 ) -> PyResult<(TableOut<'py>, Bound<'py, PyDict>)> {
+    comparison::check_comparable(&described_in(&described)?).map_err(refused)?;
     let t: Table = table_in("truth", truth_columns, &truth)?;
     let e: Table = table_in("estimate", estimate_columns, &estimate)?;
     let c = py
@@ -195,7 +210,7 @@ fn compare<'py>(
                     gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
                     gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None, gnss_uere_m = None,
                     nav_frame = None, earth = None, earth_gravity = None, accel_sign = None,
-                    gravity_m_s2 = None))]
+                    gravity_m_s2 = None, described = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 fn fuse<'py>(
     py: Python<'py>,
@@ -232,30 +247,28 @@ fn fuse<'py>(
     earth_gravity: Option<&str>,
     accel_sign: Option<&str>,
     gravity_m_s2: Option<f64>,
-) -> PyResult<(TableOut<'py>, usize, usize)> {
+    described: DescribedIn<'py>,
+) -> PyResult<(DescribedOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
     use imukit::run::fuse::{AidTables, FuseRequest, PartModel, fuse_with};
-    use imukit::run::navigate::NavRequest;
     // The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
     // made once per call: its size does not matter).
     #[allow(clippy::large_enum_variant)]
     enum Model {
         Scenario(ScenarioSpec),
-        Part(PartModel, NavRequest, Option<imu_core::AccelSign>),
+        Part(PartModel),
     }
+    let asked = NavAsked {
+        nav_frame: choice_opt("nav_frame", nav_frame)?,
+        accel_sign: choice_opt("accel_sign", accel_sign)?,
+        gravity_m_s2,
+        earth: choice_opt("earth", earth)?,
+        earth_gravity: choice_opt("earth_gravity", earth_gravity)?,
+        conventions: None,
+    };
+    let described = described_in(&described)?;
     let model = match imu_model {
         Some(imu) => {
-            let d = NavRequest::default();
-            let nav = NavRequest {
-                nav_frame: choice_opt("nav_frame", nav_frame)?.unwrap_or(d.nav_frame),
-                earth: choice_opt("earth", earth)?.unwrap_or(d.earth),
-                earth_gravity: choice_opt("earth_gravity", earth_gravity)?
-                    .unwrap_or(d.earth_gravity),
-                gravity_m_s2: gravity_m_s2.unwrap_or(d.gravity_m_s2),
-                ..d
-            };
-            let sign = choice_opt::<imukit::scenario::AccelSignName>("accel_sign", accel_sign)?
-                .map(imu_core::AccelSign::from);
             let gnss = imukit::scenario::gnss::GnssSpec {
                 horizontal_accuracy_m: gnss_horizontal_accuracy_m,
                 vertical_accuracy_m: gnss_vertical_accuracy_m,
@@ -263,7 +276,7 @@ fn fuse<'py>(
                 lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m)?,
                 ..Default::default()
             };
-            Model::Part(PartModel { imu, part, gnss }, nav, sign)
+            Model::Part(PartModel { imu, part, gnss })
         }
         None => Model::Scenario(
             match format {
@@ -305,7 +318,7 @@ fn fuse<'py>(
     let odometer = optional("odometer", odometer_columns, &odometer_values)?;
     let baro = optional("baro", baro_columns, &baro_values)?;
     let base = base_dir.to_string();
-    let (table, summary) = py
+    let (table, summary, description) = py
         .detach(move || {
             let request = FuseRequest {
                 initial: initial.as_ref(),
@@ -320,19 +333,30 @@ fn fuse<'py>(
                 zupt,
             };
             let (setup, start) = match model {
-                Model::Scenario(spec) => request.setup(&spec.resolve(Path::new(&base))?)?,
-                Model::Part(part, nav, sign) => {
-                    request.apply(part.setup_for(&nav.setup()?, sign, &imu)?)?
+                Model::Scenario(spec) => {
+                    let scenario = spec.resolve(Path::new(&base))?;
+                    // Tables or arguments in another frame, on another Earth or with the other
+                    // sign than the scenario's are not the scenario's data.
+                    described.check_fixed(&scenario.description(None), &asked, "the scenario")?;
+                    request.setup(&scenario)?
+                }
+                Model::Part(part) => {
+                    request.apply(part.setup_described(&asked, &described, &imu)?)?
                 }
             };
             let aids = AidTables {
                 odometer: odometer.as_ref(),
                 baro: baro.as_ref(),
             };
-            fuse_with(&imu, &gnss, aids, start, &setup)
+            let description = setup.description();
+            fuse_with(&imu, &gnss, aids, start, &setup).map(|(t, s)| (t, s, description))
         })
         .map_err(refused)?;
-    Ok((table_out(py, table)?, summary.updates, summary.rejected))
+    Ok((
+        described_out(py, table, &description)?,
+        summary.updates,
+        summary.rejected,
+    ))
 }
 
 /// Adds this module's functions.

@@ -21,19 +21,19 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::convert::{
-    TableOut, check_len, choice, fixed, fixed_opt, non_negative, rows, rows_out, table_in,
-    table_out, value_tree, vector,
+    DescribedOut, TableOut, check_len, choice, described_out, description_dict, fixed, fixed_opt,
+    non_negative, rows, rows_out, table_in, table_out, value_tree, vector,
 };
 use crate::errors::{refused, shape_error};
 
 /// Truth (unless left out), IMU and (when the scenario has them) GNSS, barometer and odometer
 /// tables of one run, and the warnings the user should see (the scenario's, the run's).
 type SimulationOut<'py> = (
-    Option<TableOut<'py>>,
-    TableOut<'py>,
-    Option<TableOut<'py>>,
-    Option<TableOut<'py>>,
-    Option<TableOut<'py>>,
+    Option<DescribedOut<'py>>,
+    DescribedOut<'py>,
+    Option<DescribedOut<'py>>,
+    Option<DescribedOut<'py>>,
+    Option<DescribedOut<'py>>,
     Vec<String>,
 );
 
@@ -73,13 +73,19 @@ fn run_spec<'py>(
     let run = run.map(|r| non_negative("run", r)).transpose()?;
     let threads = RunThreads::at_most(threads, "threads").map_err(refused)?;
     let base = base_dir.to_string();
-    let (scenario, shape) = py
+    let (scenario, shape, described) = py
         .detach(move || {
             let sc = spec.resolve(Path::new(&base))?;
             let shape = sc.gathered_shape()?;
-            Ok::<_, imukit::Error>((sc, shape))
+            let described = sc.description(None);
+            Ok::<_, imukit::Error>((sc, shape, described))
         })
         .map_err(refused)?;
+    // Each table is described as the scenario's, of its own kind.
+    let of_kind = |columns: &[String]| imukit::io::description::Description {
+        kind: imukit::io::schema::TableKind::detect(columns),
+        ..described.clone()
+    };
     let truth =
         truth.then(|| PyArray2::<f64>::zeros(py, [shape.rows, shape.truth_columns.len()], false));
     let imu_shape = [shape.rows, shape.imu_columns.len()];
@@ -109,11 +115,23 @@ fn run_spec<'py>(
             .map_err(refused)?
     };
     warnings.extend(aids.report.warnings(sample_rate_hz));
-    let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect();
-    let optional = |t: Option<imukit::Table>| t.map(|t| table_out(py, t)).transpose();
+    let names = |c: Vec<&str>| c.into_iter().map(str::to_string).collect::<Vec<String>>();
+    let optional = |t: Option<imukit::Table>| {
+        t.map(|t| {
+            let d = of_kind(&t.columns);
+            described_out(py, t, &d)
+        })
+        .transpose()
+    };
+    let with_description = |columns: Vec<String>, values| {
+        let d = description_dict(py, &of_kind(&columns))?;
+        Ok::<_, PyErr>((columns, values, d))
+    };
     Ok((
-        truth.map(|t| (names(shape.truth_columns), t)),
-        (names(shape.imu_columns), imu),
+        truth
+            .map(|t| with_description(names(shape.truth_columns), t))
+            .transpose()?,
+        with_description(names(shape.imu_columns), imu)?,
         optional(aids.gnss)?,
         optional(aids.baro)?,
         optional(aids.odometer)?,

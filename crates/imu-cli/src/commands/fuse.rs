@@ -2,7 +2,6 @@
 //! library's fuse job with the filter's model from the scenario.
 use std::path::Path;
 
-use imu_core::AccelSign;
 use imukit::io::bag::Role;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
@@ -25,7 +24,8 @@ pub struct Args<'a> {
     pub align: Option<AlignName>,
     pub scenario: Option<&'a Path>,
     pub model: Option<PartModel>,
-    pub earth: Option<EarthName>,
+    /// `--earth`, `--nav-frame`, `--accel-sign`, `--conventions`.
+    pub asked: NavAsked,
     /// `--gnss-uere-m`: the fixes' horizontal accuracy from their HDOP.
     pub gnss_uere_m: Option<f64>,
     pub no_gate: bool,
@@ -46,34 +46,23 @@ fn inputs_of<'a>(a: &Args<'a>) -> Vec<&'a Path> {
 }
 
 /// The filter's setup from `--imu PART` and the `--gnss-*` accuracies: the data's frame, Earth
-/// and sign from the input files' descriptions (`--earth` checked against them), the sample
-/// rate from the IMU's times.
+/// and sign from the options, else the input files' descriptions, the sample rate from the
+/// IMU's times.
 fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<FuseSetup, CliError> {
     let described = Described::read(&inputs_of(a))?;
-    let asked = NavAsked {
-        earth: a.earth,
-        ..NavAsked::default()
-    };
-    let nav = NavRequest::default()
-        .with_described(&asked, &described)
-        .map_err(by_flag)?
-        .setup()
-        .map_err(by_flag)?;
-    let sign = described
-        .known("accel_sign", None, |d| d.accel_sign)
-        .map_err(by_flag)?
-        .map(AccelSign::from);
-    Ok(model.setup_for(&nav, sign, imu).map_err(|e| match e {
-        Error::Invalid { field, message } if field == "IMU data" => Error::Invalid {
-            field: a.imu.display().to_string(),
-            message,
-        },
-        Error::Invalid { field, message } => Error::Invalid {
-            field: field.replace("gnss.", "--gnss-").replace('_', "-"),
-            message,
-        },
-        other => by_flag(other),
-    })?)
+    Ok(model
+        .setup_described(&a.asked, &described, imu)
+        .map_err(|e| match e {
+            Error::Invalid { field, message } if field == "IMU data" => Error::Invalid {
+                field: a.imu.display().to_string(),
+                message,
+            },
+            Error::Invalid { field, message } if field.starts_with("gnss.") => Error::Invalid {
+                field: field.replace("gnss.", "--gnss-").replace('_', "-"),
+                message,
+            },
+            other => by_flag(other),
+        })?)
 }
 
 /// The data's navigation frame and whether they are on the WGS-84 Earth: the scenario's, else
@@ -86,13 +75,10 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
         return Ok((scenario.nav_frame, on_earth));
     }
     let described = Described::read(&inputs_of(a))?;
-    let frame = described
-        .pick("nav_frame", None, |d| d.nav_frame, NavFrameName::default())
+    let nav = NavRequest::default()
+        .with_described(&a.asked, &described)
         .map_err(by_flag)?;
-    let earth = described
-        .pick("earth", a.earth, |d| d.earth, EarthName::Flat)
-        .map_err(by_flag)?;
-    Ok((frame, earth == EarthName::Wgs84))
+    Ok((nav.nav_frame, nav.earth == EarthName::Wgs84))
 }
 
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
@@ -116,7 +102,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let request = FuseRequest {
         initial: initial.as_ref(),
         align: a.align,
-        earth: a.earth,
+        earth: a.asked.earth,
         gate: !a.no_gate,
         nhc_sigma_m_s: a.nhc,
         covariance_interval_s: a.covariance_interval_s,
@@ -134,12 +120,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             // scenario's are not the scenario's data.
             let described = Described::read(&inputs_of(a))?;
             let source = format!("the scenario {}", path.display());
-            described.check("nav_frame", scenario.nav_frame, &source, |d| d.nav_frame)?;
-            let earth = match scenario.earth {
-                imukit::scenario::EarthSetup::Flat => EarthName::Flat,
-                imukit::scenario::EarthSetup::Wgs84(_) => EarthName::Wgs84,
-            };
-            described.check("earth", earth, &source, |d| d.earth)?;
+            described
+                .check_fixed(&scenario.description(None), &a.asked, &source)
+                .map_err(by_flag)?;
             request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.
                 Error::Invalid { field, message } if field == "earth" => Error::Invalid {
@@ -228,7 +211,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         },
         other => other,
     })?;
-    nav.write(a.out)?;
+    nav.write_described(a.out, &setup.description())?;
     let t = imu.column("t_s").unwrap_or_default();
     if let Some(m) = Gaps::of_times(&t, 2).message(&a.imu.display().to_string()) {
         crate::report::warn(&m);

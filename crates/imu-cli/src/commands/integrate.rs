@@ -143,7 +143,25 @@ pub fn three_d(
             let attitude = o.euler0.map(|_| "--euler0-rad").ok_or("--euler0-rad");
             start_from(p, setup.nav_frame, setup.earth.is_some(), attitude)?
         }
-        None => InitialState::default(),
+        None => {
+            // A start nobody gave is said, not silently taken.
+            let assumed: Vec<&str> = [
+                (c.position0.is_none(), "at the origin"),
+                (c.velocity0.is_none(), "at rest"),
+                (o.euler0.is_none(), "level with heading 0"),
+            ]
+            .into_iter()
+            .filter_map(|(left_out, what)| left_out.then_some(what))
+            .collect();
+            if !assumed.is_empty() {
+                crate::note!(
+                    "imukit: no --init: the integration starts {} (give --init TRUTH, or \
+                     --position0-m, --velocity0-m-s, --euler0-rad)",
+                    assumed.join(", ")
+                );
+            }
+            InitialState::default()
+        }
     };
     if let Some(p) = c.position0 {
         initial.position_m = vector("--position0-m", Some(p), [0.0; 3])?;

@@ -70,9 +70,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             map,
             bag,
             init,
-            nav_frame,
+            frame,
             gravity_m_s2,
-            accel_sign,
             no_corrections,
             euler0,
             planar,
@@ -116,11 +115,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     ..NavRequest::default()
                 };
                 let asked = NavAsked {
-                    nav_frame,
-                    accel_sign,
+                    nav_frame: frame.nav_frame,
+                    accel_sign: frame.accel_sign,
                     gravity_m_s2,
                     earth,
                     earth_gravity,
+                    conventions: frame.conventions,
                 };
                 let opts = integrate::Options3d {
                     init: init.as_deref(),
@@ -147,6 +147,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             gnss_lever_arm_m,
             gnss_uere_m,
             earth,
+            frame,
             no_gate,
             odometer,
             baro,
@@ -178,7 +179,13 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     },
                 }),
                 gnss_uere_m,
-                earth,
+                asked: imukit::run::navigate::NavAsked {
+                    nav_frame: frame.nav_frame,
+                    accel_sign: frame.accel_sign,
+                    earth,
+                    conventions: frame.conventions,
+                    ..Default::default()
+                },
                 no_gate,
                 odometer: odometer.as_deref(),
                 baro: baro.as_deref(),

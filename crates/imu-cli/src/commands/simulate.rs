@@ -3,7 +3,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imukit::ScenarioSpec;
-use imukit::io::output::check_outputs;
+use imukit::io::output::{check_outputs, create_folder_within};
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
@@ -179,10 +179,6 @@ pub fn euroc(
         .into());
     }
     let run_threads = RunThreads::at_most(threads, "--threads")?;
-    let (imu, truth) = (
-        out.join("mav0/imu0/data.csv"),
-        out.join("mav0/state_groundtruth_estimate0/data.csv"),
-    );
     let spec = ScenarioSpec::from_file(scenario)?;
     let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let files = spec.input_files(base);
@@ -192,12 +188,12 @@ pub fn euroc(
     for w in &sc.warnings {
         crate::report::warn(w);
     }
-    for dir in [&imu, &truth].into_iter().filter_map(|p| p.parent()) {
-        std::fs::create_dir_all(dir).map_err(|source| imukit::Error::Io {
-            path: dir.into(),
-            source,
-        })?;
-    }
+    // The folders under DIR are made here, following no link planted inside DIR.
+    let (imu, truth) = (
+        create_folder_within(out, Path::new("mav0/imu0"), "--out")?.join("data.csv"),
+        create_folder_within(out, Path::new("mav0/state_groundtruth_estimate0"), "--out")?
+            .join("data.csv"),
+    );
     check_outputs(
         &inputs,
         &[("--out", imu.as_path()), ("--out", truth.as_path())],

@@ -5,8 +5,12 @@ import numpy as np
 import numpy.typing as npt
 
 _Table = tuple[list[str], npt.NDArray[np.float64]]
+#: A table with its description's entries.
+_Described = tuple[list[str], npt.NDArray[np.float64], dict[str, Union[str, float]]]
+#: The descriptions of a job's table arguments: (argument, entries).
+_DescribedIn = Sequence[tuple[str, dict[str, Union[str, float]]]]
 #: A run's tables: truth (None when not kept), IMU, and the GNSS, barometer and odometer ones.
-_Simulation = tuple[Optional[_Table], _Table, Optional[_Table], Optional[_Table], Optional[_Table], list[str]]
+_Simulation = tuple[Optional[_Described], _Described, Optional[_Described], Optional[_Described], Optional[_Described], list[str]]
 
 __version__: str
 DEFAULTS: dict[str, str | int | float | bool]
@@ -230,23 +234,24 @@ def strapdown(
     velocity0_m_s: Optional[Sequence[float]] = None,
     quaternion0: Optional[Sequence[float]] = None,
     euler0_rad: Optional[Sequence[float]] = None,
-    nav_frame: str = ...,
-    gravity_m_s2: float = ...,
+    nav_frame: Optional[str] = None,
+    gravity_m_s2: Optional[float] = None,
     coning: bool = True,
     sculling: bool = True,
-    accel_sign: str = ...,
+    accel_sign: Optional[str] = None,
     scheme: str = ...,
     substeps: int = ...,
-    earth: str = ...,
+    earth: Optional[str] = None,
     vertical: str = ...,
     baro_time_constant_s: float = ...,
-    earth_gravity: str = ...,
+    earth_gravity: Optional[str] = None,
     lat0_deg: Optional[float] = None,
     lon0_deg: Optional[float] = None,
     height0_m: Optional[float] = None,
     baro_columns: Optional[Sequence[str]] = None,
     baro_values: Optional[npt.NDArray[np.float64]] = None,
-) -> tuple[_Table, list[str]]: ...
+    described: _DescribedIn = ...,
+) -> tuple[_Described, list[str]]: ...
 def fuse(
     imu_columns: Sequence[str],
     imu_values: npt.NDArray[np.float64],
@@ -282,12 +287,14 @@ def fuse(
     earth_gravity: Optional[str] = None,
     accel_sign: Optional[str] = None,
     gravity_m_s2: Optional[float] = None,
-) -> tuple[_Table, int, int]: ...
+    described: _DescribedIn = ...,
+) -> tuple[_Described, int, int]: ...
 def compare(
     truth_columns: Sequence[str],
     truth: npt.NDArray[np.float64],
     estimate_columns: Sequence[str],
     estimate: npt.NDArray[np.float64],
+    described: _DescribedIn = ...,
 ) -> tuple[_Table, dict[str, float]]: ...
 def truth_from_body_rates(
     t_s: npt.NDArray[np.float64],
@@ -309,7 +316,7 @@ def truth_from_waypoints(
     nav_frame: str = ...,
 ) -> _Table: ...
 def cli_main(argv: Sequence[str]) -> int: ...
-def read_table_file(path: str, map_path: Optional[str] = None, map_json: Optional[str] = None, topic: Optional[str] = None, receive_time: bool = False) -> _Table: ...
+def read_table_file(path: str, map_path: Optional[str] = None, map_json: Optional[str] = None, topic: Optional[str] = None, receive_time: bool = False) -> _Described: ...
 def read_description(path: str) -> Optional[dict[str, Union[str, float]]]: ...
 def write_run(
     path: str,
@@ -321,8 +328,8 @@ def write_run(
     origin: str,
     base_dir: str,
 ) -> None: ...
-def write_table_file(path: str, columns: Sequence[str], values: npt.NDArray[np.float64]) -> None: ...
-def read_csv(path: str) -> _Table: ...
+def write_table_file(path: str, columns: Sequence[str], values: npt.NDArray[np.float64], description: Optional[dict[str, Union[str, float]]] = None) -> None: ...
+def read_csv(path: str) -> _Described: ...
 def table_kind(columns: list[str]) -> Optional[str]: ...
 def figure_panels(kind: str) -> list[tuple[str, str, float, list[tuple[str, str]], list[tuple[str, int]]]]: ...
 def frame_plan(t_s: npt.NDArray[np.float64], fps: float, speed: Optional[float] = None) -> tuple[list[int], float]: ...

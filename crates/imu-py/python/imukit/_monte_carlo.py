@@ -23,18 +23,20 @@ from ._warning import _emit
 @dataclass(frozen=True, repr=False)
 class MonteCarlo:
     """Gathered Monte Carlo results: ``imu[k]`` is run ``runs[k]`` with columns ``columns``
-    (shape (runs, samples, columns)); ``truth`` is common to every run."""
+    (shape (runs, samples, columns)); ``truth`` is common to every run, and so is
+    ``description``, what every run's readings hold (:attr:`imukit.Table.description`)."""
 
     runs: np.ndarray
     columns: tuple
     imu: np.ndarray
     truth: Any  # imukit.Table
+    description: Any = None  # a mapping
 
     def run(self, k: int) -> Any:
-        """Run ``runs[k]``'s readings as an :class:`imukit.Table`."""
+        """Run ``runs[k]``'s readings as an :class:`imukit.Table`, with their description."""
         from ._table import Table
 
-        return Table(self.columns, self.imu[k])
+        return Table(self.columns, self.imu[k], self.description)
 
     def __repr__(self) -> str:
         n, samples, columns = self.imu.shape
@@ -155,7 +157,8 @@ def monte_carlo(
         return [path for path, _ in results]
     from . import Table
 
-    columns = tuple(results[0][0][0])
-    imu = gathered if client is None else np.stack([values for (_, values), _ in results])
-    truth_columns, truth_values = results[0][1]  # run 0 kept its truth table
-    return MonteCarlo(runs=np.array(ids), columns=columns, imu=imu, truth=Table(truth_columns, truth_values))
+    columns, _, description = results[0][0]
+    imu = gathered if client is None else np.stack([values for (_, values, _), _ in results])
+    truth = Table(*results[0][1])  # run 0 kept its truth table
+    return MonteCarlo(runs=np.array(ids), columns=tuple(columns), imu=imu, truth=truth,
+                      description=description)

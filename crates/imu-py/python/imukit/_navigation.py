@@ -11,8 +11,7 @@ from . import _core
 from ._warning import _emit
 from ._core import ImuError
 from ._convert import _f64, _table_args, _times
-from ._table import Table, TableLike, _table
-from ._truth import DEFAULT_GRAVITY_M_S2
+from ._table import Table, TableLike, _described, _table
 
 _D = _core.DEFAULTS  # the library's request defaults, shared with the command line
 
@@ -50,22 +49,27 @@ def strapdown(
     imu: TableLike,
     *,
     initial: Optional[Union[TableLike, Mapping[str, Any]]] = None,
-    nav_frame: str = _D["nav_frame"],
-    gravity_m_s2: float = DEFAULT_GRAVITY_M_S2,
+    nav_frame: Optional[str] = None,
+    gravity_m_s2: Optional[float] = None,
     coning: bool = _D["coning"],
     sculling: bool = _D["sculling"],
-    accel_sign: str = _D["accel_sign"],
+    accel_sign: Optional[str] = None,
     scheme: str = _D["scheme"],
     substeps: int = _D["substeps"],
-    earth: str = _D["earth"],
+    earth: Optional[str] = None,
     vertical: str = _D["vertical"],
     baro_time_constant_s: float = _D["baro_time_constant_s"],
-    earth_gravity: str = _D["earth_gravity"],
+    earth_gravity: Optional[str] = None,
     baro: Optional[TableLike] = None,
 ) -> Table:
     """3D strapdown navigation of an IMU table — rates (``accel_*_m_s2``, ``gyro_*_rad_s``) or
     increments (``dv_*_m_s``, ``dtheta_*_rad``) — in a flat-Earth ENU/NED frame, with the exact
     rotation-vector attitude step, two-sample coning and sculling corrections and gravity.
+
+    ``nav_frame`` (``"ENU"``/``"NED"``), ``accel_sign``, ``gravity_m_s2``, ``earth`` and
+    ``earth_gravity`` left out are what the tables' descriptions say (``imu.description``: a
+    simulated or read table knows its frame), else imukit's defaults (ENU, specific force,
+    9.81 m/s², flat); one given that contradicts a description is refused.
 
     ``initial`` is a truth ``Table`` (its first row is used) or a dict with ``position_m``,
     ``velocity_m_s`` and ``quaternion`` (``[w, x, y, z]``) or ``euler_rad`` (``[yaw, pitch, roll]``);
@@ -106,10 +110,12 @@ def strapdown(
         raise TypeError("initial must be a truth Table or a dict")
     nav, notes = _core.strapdown(
         *_table_args("imu", imu), **start,
-        nav_frame=nav_frame, gravity_m_s2=float(gravity_m_s2), coning=bool(coning), sculling=bool(sculling),
+        nav_frame=nav_frame, gravity_m_s2=None if gravity_m_s2 is None else float(gravity_m_s2),
+        coning=bool(coning), sculling=bool(sculling),
         accel_sign=accel_sign, scheme=scheme, substeps=int(substeps), earth=earth, vertical=vertical,
         baro_time_constant_s=float(baro_time_constant_s), earth_gravity=earth_gravity,
-        **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro)))))
+        **({} if baro is None else dict(zip(("baro_columns", "baro_values"), _table_args("baro", baro)))),
+        described=_described(imu=imu, initial=None if isinstance(initial, Mapping) else initial, baro=baro))
     _emit(notes, stacklevel=2)
     return _table(nav)
 
@@ -134,8 +140,10 @@ def compare(truth: TableLike, estimate: TableLike) -> Comparison:
     as ``imukit orient`` writes) gives ``t_s, att_err_rad, yaw_err_rad, pitch_err_rad,
     roll_err_rad``. The dict holds RMS, maximum and final values (``position_rms_m``,
     ``position_max_m``, ``position_final_m``, …, ``attitude_final_rad``; attitude only for
-    orientation estimates)."""
-    table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate))
+    orientation estimates). Tables whose descriptions say different frames or Earths are
+    refused."""
+    table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate),
+                                   described=_described(truth=truth, estimate=estimate))
     return Comparison(_table(table), {str(k): float(v) for k, v in dict(summary).items()})
 
 
@@ -181,8 +189,10 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     file or Kalibr's ``imu.yaml`` — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
     ``gnss_velocity_accuracy_m_s`` and ``gnss_lever_arm_m`` the receiver (MATLAB gpsSensor's
     defaults for those left out); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
-    ``gravity_m_s2`` say what the tables are in (imukit's defaults; the sign by default the part's
-    profile's). The sample rate is the IMU's median.
+    ``gravity_m_s2`` say what the tables are in: left out, what the tables' descriptions say
+    (a simulated or read table knows its frame), else imukit's defaults (the sign the part's
+    profile's). With a scenario, tables or arguments that contradict it are refused. The sample
+    rate is the IMU's median.
 
     Fixes may carry their own accuracy, one-sigma per fix: ``horizontal_accuracy_m`` and
     ``vertical_accuracy_m`` columns (a ROS ``NavSatFix``'s covariance gives them) replace the
@@ -235,7 +245,8 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
                              sensor_errors=None if sensor_errors is None else bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s), smooth=bool(smooth),
                              zupt=bool(zupt),
-                             **aids, **part_keys)
+                             **aids, **part_keys,
+                             described=_described(imu=imu, gnss=gnss, initial=initial, odometer=odometer, baro=baro))
     fused = _table(table)
     resets = fused["gnss_resets"]
     if len(resets) and resets[-1] > 0:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
 import numpy as np
@@ -15,13 +16,21 @@ _SHOWN_COLUMNS = 6
 
 
 class Table:
-    """Named columns over a 2-D float64 array (one row per sample).
+    """Named columns over a 2-D float64 array (one row per sample), and what they hold.
 
     ``table["t_s"]`` is a column (a read-only view), ``table.values`` the whole array,
     ``table.columns`` the names in order, ``len(table)`` the number of rows.
+
+    ``table.description`` says what the table holds, as an imukit file's description does
+    (docs/formats.md): ``kind``, ``nav_frame`` and ``body_frame``, ``earth``, the origin,
+    gravity, ``accel_sign``, the sensor. :func:`simulate`, :func:`read` and every job fill it;
+    every job that takes the table honours it as the command line honours a file's (an argument
+    that contradicts it is refused), and :meth:`write` and :meth:`to_pandas` (as
+    ``DataFrame.attrs["imukit"]``) keep it. A table made from plain columns has none.
     """
 
-    def __init__(self, columns: Sequence[str], values: np.ndarray) -> None:
+    def __init__(self, columns: Sequence[str], values: np.ndarray,
+                 description: Optional[Mapping[str, Any]] = None) -> None:
         values = np.asarray(values, dtype=np.float64)
         if values.ndim != 2 or values.shape[1] != len(columns):
             raise ValueError(f"values must have shape (N, {len(columns)}), got {values.shape}")
@@ -29,6 +38,12 @@ class Table:
         self.columns: tuple = tuple(columns)
         self.values: np.ndarray = values
         self._index = {c: k for k, c in enumerate(self.columns)}
+        self._description = MappingProxyType(dict(description or {}))
+
+    @property
+    def description(self) -> Mapping[str, Any]:
+        """What the table holds (read-only; empty when nothing is known)."""
+        return self._description
 
     def __getitem__(self, name: str) -> np.ndarray:
         try:
@@ -56,9 +71,11 @@ class Table:
     def write(self, path) -> None:
         """Writes the table in the format the path's extension names — Parquet for ``.parquet``,
         NumPy for ``.npy`` (a structured array) and ``.npz`` (an array per column), CSV
-        otherwise — atomically (imukit's own writer, as the command line's)."""
+        otherwise — atomically (imukit's own writer, as the command line's), with its
+        description where the format has room (CSV's first line, Parquet's metadata)."""
         from . import _core
-        _core.write_table_file(str(path), list(self.columns), self.values)
+        _core.write_table_file(str(path), list(self.columns), self.values,
+                               dict(self._description) or None)
 
     @classmethod
     def of(cls, data: TableLike, name: str = "table") -> "Table":
@@ -82,7 +99,8 @@ class Table:
         to_numpy = getattr(data, "to_numpy", None)
         if columns is not None and callable(to_numpy):  # pandas, polars and alike
             names = [c for c in columns]
-            return cls._from_columns(name, {c: data[c] for c in names})
+            table = cls._from_columns(name, {c: data[c] for c in names})
+            return cls(table.columns, table.values, _description_of(data))
         if isinstance(data, Mapping):
             return cls._from_columns(name, data)
         raise TypeError(f"{name} must be an imukit.Table, a pandas or polars DataFrame, a NumPy structured "
@@ -117,7 +135,8 @@ class Table:
     def to_pandas(self, *, copy: bool = True):
         """A pandas ``DataFrame`` of the columns. By default a copy you can change; with
         ``copy=False`` a read-only view of the table's own memory (no copy; a write raises).
-        Needs pandas (``pip install "imukit[pandas]"``).
+        The description goes along as ``df.attrs["imukit"]``, so the frame passed back to imukit
+        is still known to be, say, NED. Needs pandas (``pip install "imukit[pandas]"``).
 
         >>> df = Table(["t_s", "x"], [[0.0, 1.0], [1.0, 2.0]]).to_pandas()
         >>> df.loc[0, "x"] = 5.0
@@ -129,8 +148,12 @@ class Table:
         except ImportError:
             raise ImportError("Table.to_pandas needs pandas (pip install pandas)") from None
         if copy:
-            return pd.DataFrame(np.array(self.values), columns=list(self.columns))
-        return pd.DataFrame(self.values, columns=list(self.columns), copy=False)
+            df = pd.DataFrame(np.array(self.values), columns=list(self.columns))
+        else:
+            df = pd.DataFrame(self.values, columns=list(self.columns), copy=False)
+        if self._description:
+            df.attrs["imukit"] = dict(self._description)
+        return df
 
     def to_polars(self):
         """A polars ``DataFrame`` of the columns. polars keeps each column contiguous, so the
@@ -164,6 +187,22 @@ class Simulation:
                                           ("baro", self.baro), ("odometer", self.odometer)) if v is not None]
         return f"Simulation({', '.join(parts)})"
 
+def _description_of(data: Any) -> dict:
+    """The description a table argument carries: a Table's, or a pandas frame's
+    ``attrs["imukit"]`` (as :meth:`Table.to_pandas` leaves it); else none."""
+    if isinstance(data, Table):
+        return dict(data.description)
+    attrs = getattr(data, "attrs", None)
+    if isinstance(attrs, Mapping) and isinstance(attrs.get("imukit"), Mapping):
+        return dict(attrs["imukit"])
+    return {}
+
+
+def _described(**tables: Any) -> list:
+    """``[(argument, description), …]`` of the table arguments that carry one, for the core."""
+    return [(name, d) for name, t in tables.items() if t is not None for d in [_description_of(t)] if d]
+
+
 def _table(out) -> Table:
-    columns, values = out
-    return Table(columns, values)
+    """A Table from the core's ``(columns, values)`` or ``(columns, values, description)``."""
+    return Table(*out)

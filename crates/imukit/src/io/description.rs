@@ -12,7 +12,7 @@
 //! contradicts it, naming both ([`Described::pick`]); a table without a description keeps the
 //! options' own defaults. Entries that a later version adds are ignored by this one.
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::choice::Choice;
 use crate::error::{Error, Result};
@@ -227,7 +227,7 @@ impl Description {
 
     /// A description from its entries (keys without the prefix), each value checked; `place`
     /// names where they were read (the file and where in it).
-    pub(crate) fn from_entries<'a>(
+    pub fn from_entries<'a>(
         entries: impl IntoIterator<Item = (&'a str, Value)>,
         place: &str,
     ) -> Result<Self> {
@@ -389,7 +389,9 @@ impl Description {
 /// setting is what the user asked for, else what the files say, else the library's default.
 #[derive(Clone, Debug, Default)]
 pub struct Described {
-    files: Vec<(PathBuf, Description)>,
+    /// Each input's name as messages give it (a file's path, "the imu table") and its
+    /// description.
+    files: Vec<(String, Description)>,
 }
 
 impl Described {
@@ -401,10 +403,24 @@ impl Described {
         let mut files = Vec::new();
         for p in paths {
             if let Some(d) = Description::read(p)? {
-                files.push((p.to_path_buf(), d));
+                files.push((p.display().to_string(), d));
             }
         }
         Ok(Self { files })
+    }
+
+    /// The descriptions of inputs held in memory (Python's tables), each with the name
+    /// messages give it (`"the imu table"`); an empty description adds nothing.
+    #[must_use]
+    pub fn of(named: impl IntoIterator<Item = (String, Description)>) -> Self {
+        Self {
+            files: named.into_iter().filter(|(_, d)| !d.is_empty()).collect(),
+        }
+    }
+
+    /// The inputs and their descriptions, with the names messages give them.
+    pub fn inputs(&self) -> impl Iterator<Item = (&str, &Description)> {
+        self.files.iter().map(|(n, d)| (n.as_str(), d))
     }
 
     /// What the files say of one setting, with the file that says it; refused when two of
@@ -413,23 +429,19 @@ impl Described {
         &self,
         field: &str,
         get: impl Fn(&Description) -> Option<T>,
-    ) -> Result<Option<(T, &Path)>> {
-        let mut found: Option<(T, &Path)> = None;
+    ) -> Result<Option<(T, &str)>> {
+        let mut found: Option<(T, &str)> = None;
         for (path, d) in &self.files {
             let Some(v) = get(d) else { continue };
             match found {
                 Some((w, other)) if w != v => {
                     return Err(Error::Invalid {
                         field: field.to_string(),
-                        message: format!(
-                            "the inputs disagree: {} says {w}, {} says {v}",
-                            other.display(),
-                            path.display()
-                        ),
+                        message: format!("the inputs disagree: {other} says {w}, {path} says {v}"),
                     });
                 }
                 Some(_) => {}
-                None => found = Some((v, path)),
+                None => found = Some((v, path.as_str())),
             }
         }
         Ok(found)
@@ -466,8 +478,8 @@ impl Described {
             (Some(a), Some((d, path))) if a != d => Err(Error::Invalid {
                 field: field.to_string(),
                 message: format!(
-                    "{a} contradicts {}, whose description says {d} (leave the option out to use it)",
-                    path.display()
+                    "{a} contradicts {path}, whose description says {d} (leave the option out to \
+                     use it)"
                 ),
             }),
             (Some(a), _) => Ok(Some(a)),
@@ -491,13 +503,51 @@ impl Described {
         match self.agreed(field, get)? {
             Some((d, path)) if d != value => Err(Error::Invalid {
                 field: field.to_string(),
-                message: format!(
-                    "{source} says {value}, the description of {} says {d}",
-                    path.display()
-                ),
+                message: format!("{source} says {value}, the description of {path} says {d}"),
             }),
             _ => Ok(()),
         }
+    }
+
+    /// Refuses inputs, and options the user gave (`asked`), that say another navigation frame,
+    /// Earth or accelerometer sign than `fixed`, the description of what `source` (a scenario
+    /// file, say) makes.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the setting, `source` and both values.
+    pub fn check_fixed(
+        &self,
+        fixed: &Description,
+        asked: &crate::run::navigate::NavAsked,
+        source: &str,
+    ) -> Result<()> {
+        fn option<T: PartialEq + core::fmt::Display>(
+            field: &str,
+            asked: Option<T>,
+            fixed: Option<T>,
+            source: &str,
+        ) -> Result<()> {
+            match (asked, fixed) {
+                (Some(a), Some(f)) if a != f => Err(Error::Invalid {
+                    field: field.to_string(),
+                    message: format!("{a} contradicts {source}, which says {f}"),
+                }),
+                _ => Ok(()),
+            }
+        }
+        option("nav_frame", asked.nav_frame, fixed.nav_frame, source)?;
+        option("earth", asked.earth, fixed.earth, source)?;
+        option("accel_sign", asked.accel_sign, fixed.accel_sign, source)?;
+        if let Some(v) = fixed.nav_frame {
+            self.check("nav_frame", v, source, |d| d.nav_frame)?;
+        }
+        if let Some(v) = fixed.earth {
+            self.check("earth", v, source, |d| d.earth)?;
+        }
+        if let Some(v) = fixed.accel_sign {
+            self.check("accel_sign", v, source, |d| d.accel_sign)?;
+        }
+        Ok(())
     }
 
     /// The origin the files agree on, if any.

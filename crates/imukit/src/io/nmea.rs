@@ -32,13 +32,15 @@ const MAX_LINE_BYTES: u64 = 4096;
 const KNOT_M_S: f64 = 1852.0 / 3600.0;
 
 /// Seconds in a day.
-const DAY_S: f64 = 86_400.0;
+const DAY_NS: i64 = 86_400_000_000_000;
 
 /// One epoch's fix as it is gathered.
 #[derive(Clone, Copy, Debug, Default)]
 struct Epoch {
-    /// UTC time of day, s.
-    time_of_day_s: f64,
+    /// UTC time of day, ns (kept whole: a fix at 0.6 s is read as the double nearest 0.6).
+    time_of_day_ns: i64,
+    /// The line of the sentence that began it.
+    line: usize,
     position: Option<[f64; 3]>,
     /// `GGA`'s horizontal dilution of precision.
     hdop: Option<f64>,
@@ -97,8 +99,39 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 }
                 let altitude = f64::from(g.altitude.unwrap_or(0.0));
                 let separation = f64::from(g.geoid_separation.unwrap_or(0.0));
-                let position = [lat.to_radians(), lon.to_radians(), altitude + separation];
-                let epoch = epoch_at(&mut epochs, seconds_of(time));
+                if !(lat.abs() <= 90.0 && lon.abs() <= 180.0) {
+                    return Err(bad(
+                        line,
+                        format!("GGA: latitude {lat}, longitude {lon} is not a place on the Earth"),
+                    ));
+                }
+                let height = altitude + separation;
+                if height.is_nan() || height.abs() >= MAX_HEIGHT_M {
+                    return Err(bad(
+                        line,
+                        format!(
+                            "GGA: altitude {altitude} m and geoid separation {separation} m is \
+                             not a height within {MAX_HEIGHT_M} m of the Earth"
+                        ),
+                    ));
+                }
+                let position = [lat.to_radians(), lon.to_radians(), height];
+                let at = nanos_of(time);
+                if let Some(last) = epochs.last()
+                    && last.time_of_day_ns == at
+                    && last.position.is_some_and(|p| p != position)
+                {
+                    return Err(bad(
+                        line,
+                        format!(
+                            "GGA: a second fix, elsewhere, at the time of line {} ({} s of the \
+                             day): one fix per time",
+                            last.line,
+                            at as f64 / 1e9
+                        ),
+                    ));
+                }
+                let epoch = epoch_at(&mut epochs, at, line);
                 epoch.position = Some(position);
                 epoch.hdop = g.hdop.map(f64::from).filter(|h| h.is_finite() && *h > 0.0);
             }
@@ -111,7 +144,8 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 if r.status_of_fix == nmea::sentences::rmc::RmcStatusOfFix::Invalid {
                     continue;
                 }
-                epoch_at(&mut epochs, seconds_of(time)).ground = Some(ground(speed, course));
+                let g = ground(speed, course).map_err(|m| bad(line, format!("RMC: {m}")))?;
+                epoch_at(&mut epochs, nanos_of(time), line).ground = Some(g);
             }
             Ok(ParseResult::VTG(v)) => {
                 // No time of its own: the epoch of the sentences before it.
@@ -119,7 +153,8 @@ pub fn read_table(path: &Path) -> Result<Table> {
                     (epochs.last_mut(), v.speed_over_ground, v.true_course)
                     && last.ground.is_none()
                 {
-                    last.ground = Some(ground(speed, course));
+                    last.ground =
+                        Some(ground(speed, course).map_err(|m| bad(line, format!("VTG: {m}")))?);
                 }
             }
             Ok(_) | Err(nmea::Error::Unsupported(_) | nmea::Error::Unknown(_)) => {}
@@ -155,15 +190,18 @@ pub fn read_table(path: &Path) -> Result<Table> {
         columns.push(HDOP_COLUMN);
     }
     let mut table = Table::new(&columns);
-    let (mut day, mut previous) = (0.0, fixes[0].time_of_day_s);
+    let (mut day, mut previous) = (0, fixes[0].time_of_day_ns);
     for e in &fixes {
         // Past midnight: the clock starts again.
-        if e.time_of_day_s < previous - DAY_S / 2.0 {
-            day += DAY_S;
+        if e.time_of_day_ns < previous - DAY_NS / 2 {
+            day += DAY_NS;
         }
-        previous = e.time_of_day_s;
+        previous = e.time_of_day_ns;
         let [lat, lon, h] = e.position.unwrap_or_default();
-        let mut row = vec![day + e.time_of_day_s, lat, lon, h];
+        // One rounding, from whole nanoseconds: 0.6 s is the double nearest 0.6.
+        #[allow(clippy::cast_precision_loss)]
+        let t_s = (day + e.time_of_day_ns) as f64 / 1e9;
+        let mut row = vec![t_s, lat, lon, h];
         if let Some((speed, course)) = e.ground.filter(|_| velocities) {
             row.extend([speed * course.cos(), speed * course.sin()]);
         }
@@ -221,10 +259,11 @@ pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
 }
 
 /// The epoch at time of day `t` (the last one when it is the same time, else a new one).
-fn epoch_at(epochs: &mut Vec<Epoch>, t: f64) -> &mut Epoch {
-    if epochs.last().is_none_or(|e| e.time_of_day_s != t) {
+fn epoch_at(epochs: &mut Vec<Epoch>, t_ns: i64, line: usize) -> &mut Epoch {
+    if epochs.last().is_none_or(|e| e.time_of_day_ns != t_ns) {
         epochs.push(Epoch {
-            time_of_day_s: t,
+            time_of_day_ns: t_ns,
+            line,
             ..Epoch::default()
         });
     }
@@ -233,16 +272,24 @@ fn epoch_at(epochs: &mut Vec<Epoch>, t: f64) -> &mut Epoch {
 }
 
 /// A UTC time of day in seconds.
-fn seconds_of(t: chrono::NaiveTime) -> f64 {
-    f64::from(t.num_seconds_from_midnight()) + f64::from(t.nanosecond()) * 1e-9
+fn nanos_of(t: chrono::NaiveTime) -> i64 {
+    // A leap second's nanoseconds run past 10⁹: they stay within the day.
+    i64::from(t.num_seconds_from_midnight()) * 1_000_000_000 + i64::from(t.nanosecond())
 }
 
-/// Speed (knots) and true course (degrees) as m/s and radians.
-fn ground(speed_knots: f32, course_deg: f32) -> (f64, f64) {
-    (
-        f64::from(speed_knots) * KNOT_M_S,
-        f64::from(course_deg).to_radians(),
-    )
+/// The farthest from the ellipsoid a fix's height may be, m (a receiver on a rocket is within).
+const MAX_HEIGHT_M: f64 = 1.0e7;
+
+/// Speed (knots) and true course (degrees) as m/s and radians; a speed or course that is no
+/// number (`nan`, `inf`, a speed below zero or of `1e308` knots) is refused.
+fn ground(speed_knots: f32, course_deg: f32) -> core::result::Result<(f64, f64), String> {
+    let (speed, course) = (f64::from(speed_knots), f64::from(course_deg));
+    if !(speed.is_finite() && speed >= 0.0 && course.is_finite()) {
+        return Err(format!(
+            "speed {speed_knots} knots, course {course_deg}° is not a motion over the ground"
+        ));
+    }
+    Ok((speed * KNOT_M_S, course.to_radians()))
 }
 
 #[cfg(test)]
@@ -300,6 +347,54 @@ mod tests {
         // 10 knots due east, then 2 knots due south from the VTG.
         assert!(a[4].abs() < 1e-12 && (a[5] - 10.0 * KNOT_M_S).abs() < 1e-5);
         assert!((b[4] + 2.0 * KNOT_M_S).abs() < 1e-5 && b[5].abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_fix_time_is_the_double_nearest_its_stamp_and_numbers_that_are_not_refused() {
+        let dir = tempfile::tempdir().expect("dir");
+        let gga_at = |time: &str, lat: &str, alt: &str| {
+            sentence(&format!(
+                "GPGGA,{time},{lat},N,01131.000,E,1,08,0.9,{alt},M,47.0,M,,"
+            ))
+        };
+        let gga = |time: &str, lat: &str| gga_at(time, lat, "545.4");
+        let t = read_table(&write(
+            &dir,
+            &[gga("000000.60", "4807.038"), gga("000001.70", "4807.038")],
+        ))
+        .expect("read");
+        assert_eq!(t.column("t_s"), Some(vec![0.6, 1.7]));
+        for (lines, needle) in [
+            (
+                vec![gga_at("000000.60", "4807.038", "nan")],
+                "line 1: GGA: altitude NaN m",
+            ),
+            (
+                vec![gga_at("000000.60", "4807.038", "inf")],
+                "line 1: GGA: altitude inf m",
+            ),
+            (
+                vec![gga("000000.60", "9107.038")],
+                "not a place on the Earth",
+            ),
+            (
+                vec![
+                    gga("000000.60", "4807.038"),
+                    sentence("GPRMC,000000.60,A,4807.038,N,01131.000,E,1e308,90.0,230394,003.1,W"),
+                ],
+                "line 2: RMC: speed inf knots",
+            ),
+            (
+                vec![gga("000000.60", "4807.038"), gga("000000.60", "4808.038")],
+                "line 2: GGA: a second fix, elsewhere, at the time of line 1",
+            ),
+        ] {
+            let e = read_table(&write(&dir, &lines)).unwrap_err().to_string();
+            assert!(
+                e.contains("log.nmea") && e.contains(needle),
+                "{needle}: {e}"
+            );
+        }
     }
 
     #[test]

@@ -766,6 +766,63 @@ fn name_unnamed(_file: &File, _folder: &Path, _path: &Path) -> std::io::Result<P
     Err(std::io::Error::other("no unnamed files here"))
 }
 
+/// Makes the folder `root/inner` (each missing level created) for a job's outputs under the
+/// output folder `root`, following no link below `root`: a link planted inside an output folder
+/// (`seq/mav0 -> ../elsewhere`) would send the outputs somewhere the user never named. `root`
+/// itself is the user's to name, link or not.
+///
+/// # Errors
+/// [`Error::Invalid`] naming the link (or the file standing where a folder goes) and `field`;
+/// I/O errors naming the folder.
+pub fn create_folder_within(root: &Path, inner: &Path, field: &str) -> Result<PathBuf> {
+    let io = |path: &Path, source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    std::fs::create_dir_all(root).map_err(|e| io(root, e))?;
+    let mut at = root.to_path_buf();
+    for part in inner.components() {
+        let std::path::Component::Normal(name) = part else {
+            return Err(invalid(
+                field,
+                format!("{} is not a plain folder path", inner.display()),
+            ));
+        };
+        at.push(name);
+        match std::fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{} is a link: imukit writes no output through a link inside an output \
+                         folder (remove it, or name the folder it points to)",
+                        at.display()
+                    ),
+                ));
+            }
+            Ok(m) if m.is_dir() => {}
+            Ok(_) => {
+                return Err(invalid(
+                    field,
+                    format!("{} is a file where a folder goes", at.display()),
+                ));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => match std::fs::create_dir(&at) {
+                Ok(()) => {}
+                // Made by a run beside this one: checked again as a folder.
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    if !std::fs::symlink_metadata(&at).is_ok_and(|m| m.is_dir()) {
+                        return Err(invalid(field, format!("{} is not a folder", at.display())));
+                    }
+                }
+                Err(e) => return Err(io(&at, e)),
+            },
+            Err(e) => return Err(io(&at, e)),
+        }
+    }
+    Ok(at)
+}
+
 /// True for an existing path that is neither a regular file nor a folder: a device such as
 /// `/dev/null`, a FIFO or a socket. Such outputs are written directly. A symbolic link is
 /// written through only where the system keeps its own (`/dev/stdout`, `/dev/fd/1`,
@@ -851,6 +908,38 @@ pub fn check_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Res
 mod tests {
     use super::*;
     use std::io::Read;
+
+    #[cfg(unix)]
+    #[test]
+    fn folders_inside_an_output_folder_are_made_through_no_link() {
+        let dir = tempfile::tempdir().unwrap();
+        let (out, elsewhere) = (dir.path().join("seq"), dir.path().join("elsewhere"));
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::create_dir_all(&elsewhere).unwrap();
+        std::os::unix::fs::symlink(&elsewhere, out.join("mav0")).unwrap();
+        let e = create_folder_within(&out, Path::new("mav0/imu0"), "--out")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--out") && e.contains("mav0 is a link"), "{e}");
+        assert!(!elsewhere.join("imu0").exists());
+        // Without the link the folders are made, and made again without complaint.
+        std::fs::remove_file(out.join("mav0")).unwrap();
+        for _ in 0..2 {
+            let made = create_folder_within(&out, Path::new("mav0/imu0"), "--out").unwrap();
+            assert_eq!(made, out.join("mav0/imu0"));
+            assert!(made.is_dir());
+        }
+        // The output folder itself may be a link the user named.
+        let named = dir.path().join("named");
+        std::os::unix::fs::symlink(&elsewhere, &named).unwrap();
+        create_folder_within(&named, Path::new("mav0"), "--out").unwrap();
+        assert!(elsewhere.join("mav0").is_dir());
+        std::fs::write(out.join("file"), "x").unwrap();
+        let e = create_folder_within(&out, Path::new("file/x"), "--out")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is a file where a folder goes"), "{e}");
+    }
 
     #[test]
     fn an_output_in_a_missing_folder_is_refused_naming_the_file_and_its_folder() {

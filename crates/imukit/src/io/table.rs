@@ -1102,6 +1102,16 @@ impl CsvRows {
                     for (f, c) in terms {
                         v += c * self.number(*f, name, row)?;
                     }
+                    // A finite reading in the file's unit may overflow in SI (1e308 g).
+                    if !v.is_finite() {
+                        let f = terms.first().map_or(0, |(f, _)| *f);
+                        return Err(self.bad(
+                            f,
+                            name,
+                            row,
+                            format!("{v} once in SI units: not a reading"),
+                        ));
+                    }
                     v
                 }
             };

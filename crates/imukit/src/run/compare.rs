@@ -329,6 +329,17 @@ fn next_state(
     Ok(true)
 }
 
+/// Refuses a truth and an estimate whose descriptions say different navigation frames or
+/// Earths: their axes are not compared one by one.
+///
+/// # Errors
+/// [`crate::Error::Invalid`] naming the setting and both inputs.
+pub fn check_comparable(described: &crate::io::description::Described) -> Result<()> {
+    described.known("nav_frame", None, |d| d.nav_frame)?;
+    described.known("earth", None, |d| d.earth)?;
+    Ok(())
+}
+
 /// [`compare`] on two CSV files, streamed; the errors over time go to `out`, which appears only
 /// when complete.
 ///
@@ -345,10 +356,9 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
     {
         return compare_on_earth(truth, estimate, layout, out);
     }
-    // Two tables in different frames or on different Earths are not compared axis by axis.
-    let described = crate::io::description::Described::read(&[truth, estimate])?;
-    described.known("nav_frame", None, |d| d.nav_frame)?;
-    described.known("earth", None, |d| d.earth)?;
+    check_comparable(&crate::io::description::Described::read(&[
+        truth, estimate,
+    ])?)?;
     let header = crate::io::table::read_header(estimate)?;
     let kind = EstimateKind::of(&header)?;
     let sigmas = has_sigmas(&header, kind);

@@ -875,8 +875,9 @@ impl Acceptance {
                 message: format!(
                     "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
                      gate (the last with NIS {:.1} against {gate:.1}) after {MAX_RESETS_IN_A_ROW} \
-                     resets to the fixes: the fixes have jumped, or the IMU is not the one \
-                     described; nothing is written",
+                     resets to the fixes: the fixes have jumped, the data are in another frame \
+                     or with another accelerometer sign than the filter was told (nav_frame, \
+                     accel_sign), or the IMU is not the one described; nothing is written",
                     index + 2,
                     outcome.nis
                 ),
@@ -1704,6 +1705,50 @@ impl PartModel {
             odometer: None,
             baro_sigma_m: None,
         }))
+    }
+}
+
+impl PartModel {
+    /// [`PartModel::setup_for`] on data whose frame, Earth, gravity and accelerometer sign are
+    /// what the user gave (`asked`), else what the inputs' descriptions say (`described`), else
+    /// the conventions asked for, else the library's defaults (the sign: the part's profile's).
+    ///
+    /// # Errors
+    /// An option that contradicts an input's description, or two inputs that disagree (the
+    /// setting named); as [`PartModel::setup_for`].
+    pub fn setup_described(
+        &self,
+        asked: &crate::run::navigate::NavAsked,
+        described: &crate::io::description::Described,
+        imu: &Table,
+    ) -> Result<FuseSetup> {
+        let nav = crate::run::navigate::NavRequest::default()
+            .with_described(asked, described)?
+            .setup()?;
+        self.setup_for(&nav, asked.accel_sign_of(described)?, imu)
+    }
+}
+
+impl FuseSetup {
+    /// What an estimate made with this setup holds ([`crate::io::description::Description`]):
+    /// a fused table in the setup's frame, on its Earth, with its gravity.
+    #[must_use]
+    pub fn description(&self) -> crate::io::description::Description {
+        use crate::io::description::{Description, wgs84_gravity};
+        let (earth, earth_gravity, gravity_m_s2) = match self.earth {
+            None => (EarthName::Flat, None, Some(self.gravity_m_s2)),
+            Some(model) => {
+                let (gravity, g) = wgs84_gravity(model);
+                (EarthName::Wgs84, Some(gravity), g)
+            }
+        };
+        Description {
+            nav_frame: Some(self.nav_frame),
+            earth: Some(earth),
+            earth_gravity,
+            gravity_m_s2,
+            ..Description::of_kind(crate::io::schema::TableKind::Fused)
+        }
     }
 }
 

@@ -595,6 +595,26 @@ pub struct NavAsked {
     pub earth: Option<EarthName>,
     /// Gravity on the WGS-84 Earth.
     pub earth_gravity: Option<EarthGravityName>,
+    /// The conventions that fill the frame and the sign where neither an option nor an input's
+    /// description gives them (`None`: imukit's).
+    pub conventions: Option<crate::run::orient::Conventions>,
+}
+
+impl NavAsked {
+    /// The accelerometer sign of the data: as asked, else the inputs' descriptions', else the
+    /// conventions' (`None`: nothing says; the caller's default applies).
+    ///
+    /// # Errors
+    /// As [`Described::known`].
+    pub fn accel_sign_of(&self, described: &Described) -> Result<Option<AccelSign>> {
+        Ok(described
+            .known("accel_sign", self.accel_sign, |d| d.accel_sign)?
+            .map(AccelSign::from)
+            .or_else(|| {
+                self.conventions
+                    .map(crate::run::orient::Conventions::accel_sign)
+            }))
+    }
 }
 
 /// The baro loop's time constant unless told otherwise, s.
@@ -633,18 +653,19 @@ impl NavRequest {
             check_gravity("gravity_m_s2", g)?;
         }
         let d = Self::default();
+        let conventions = asked.conventions.unwrap_or_default();
         Ok(Self {
             nav_frame: described.pick(
                 "nav_frame",
                 asked.nav_frame,
                 |x| x.nav_frame,
-                d.nav_frame,
+                conventions.nav_frame(),
             )?,
             accel_sign: described.pick(
                 "accel_sign",
                 asked.accel_sign,
                 |x| x.accel_sign,
-                d.accel_sign,
+                conventions.accel_sign_name(),
             )?,
             gravity_m_s2: described.pick(
                 "gravity_m_s2",

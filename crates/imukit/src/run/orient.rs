@@ -192,6 +192,15 @@ impl Conventions {
         }
     }
 
+    /// The accelerometer sign, by its name.
+    #[must_use]
+    pub fn accel_sign_name(self) -> AccelSignName {
+        match self {
+            Self::Imukit => AccelSignName::SpecificForce,
+            Self::Matlab => AccelSignName::Matlab,
+        }
+    }
+
     /// The accelerometer sign.
     #[must_use]
     pub fn accel_sign(self) -> AccelSign {

@@ -261,25 +261,19 @@ pub fn description(path: &Path) -> Result<Option<Description>> {
     if !ext.eq_ignore_ascii_case("mcap") {
         return Ok(None);
     }
-    let (handle, _) = crate::io::open_with_length(&file)?;
-    let options = LinearReaderOptions::default()
-        .with_record_length_limit(RECORD_LIMIT)
-        .with_prevalidate_chunk_crcs(true);
-    let first = crate::io::contained(|| {
-        mcap::io::MessageReader::new_with_options(BufReader::new(handle), options).next()
+    let mut found = None;
+    let read = crate::io::contained(|| {
+        mcap_messages(&file, &mut |channel, _, _, _| {
+            found = Some(channel_description(&file, &channel.metadata));
+            Ok(false)
+        })
     })
     .map_err(|panic| Error::CsvFormat {
         file: file.clone(),
         message: format!("not a readable MCAP file ({panic})"),
     })?;
-    match first {
-        None => Ok(None),
-        Some(Err(e)) => Err(Error::CsvFormat {
-            file,
-            message: format!("not a readable MCAP file: {e}"),
-        }),
-        Some(Ok(message)) => channel_description(&file, &message.channel.metadata),
-    }
+    read?;
+    found.unwrap_or(Ok(None))
 }
 
 /// The storage files of the bag at `path`: the file itself, or a bag folder's `.mcap` or
@@ -437,35 +431,218 @@ fn read_file(path: &Path, contents: &mut Contents) -> Result<()> {
     }
 }
 
-/// Reads an MCAP file (the `mcap` crate's streaming reader).
+/// Reads an MCAP file (the `mcap` crate's sans-I/O reader, each record's lengths checked
+/// before it is parsed).
 fn read_mcap(path: &Path, contents: &mut Contents) -> Result<()> {
-    let (file, _) = crate::io::open_with_length(path)?;
-    let options = LinearReaderOptions::default()
-        .with_record_length_limit(RECORD_LIMIT)
-        .with_prevalidate_chunk_crcs(true);
-    let reader = mcap::io::MessageReader::new_with_options(BufReader::new(file), options);
     let mut first = contents.topics.is_empty();
-    for message in reader {
-        let message = message.map_err(|e| Error::CsvFormat {
-            file: path.into(),
-            message: format!("not a readable MCAP file: {e}"),
-        })?;
-        let channel = &message.channel;
+    mcap_messages(path, &mut |channel, schema, data, log_time| {
         if first {
             first = false;
             contents.description = channel_description(path, &channel.metadata)?;
         }
-        let schema = channel.schema.as_ref().map_or("", |s| s.name.as_str());
         contents.ingest(
             path,
             &channel.topic,
             schema,
             &channel.message_encoding,
-            &message.data,
-            i64::try_from(message.log_time).unwrap_or(i64::MAX),
+            data,
+            i64::try_from(log_time).unwrap_or(i64::MAX),
         )?;
+        Ok(true)
+    })
+}
+
+/// What [`mcap_messages`] calls for each message: `(channel, schema name, data, log time)`,
+/// `false` to stop.
+type McapVisitor<'a> = dyn FnMut(&mcap::records::Channel, &str, &[u8], u64) -> Result<bool> + 'a;
+
+/// Calls `each(channel, schema name, data, log time)` for the messages of the MCAP file at
+/// `path` in file order, until it returns `false`. Every record's strings, maps and byte
+/// fields are checked to fit in the record before the `mcap` crate parses it: a length field
+/// of a damaged file must not make it reserve gigabytes.
+fn mcap_messages(path: &Path, each: &mut McapVisitor<'_>) -> Result<()> {
+    use mcap::records::Record;
+    use mcap::sans_io::{LinearReadEvent, LinearReader};
+    use std::collections::HashMap;
+    use std::io::Read;
+    let bad = |message: String| Error::CsvFormat {
+        file: path.into(),
+        message: format!("not a readable MCAP file: {message}"),
+    };
+    let (mut file, _) = crate::io::open_with_length(path)?;
+    let options = LinearReaderOptions::default()
+        .with_record_length_limit(RECORD_LIMIT)
+        .with_prevalidate_chunk_crcs(true);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut schemas: HashMap<u16, String> = HashMap::new();
+    let mut channels: HashMap<u16, mcap::records::Channel> = HashMap::new();
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|e| bad(e.to_string()))? {
+            LinearReadEvent::ReadRequest(n) => {
+                let got = file.read(reader.insert(n)).map_err(|source| Error::Io {
+                    path: path.into(),
+                    source,
+                })?;
+                reader.notify_read(got);
+            }
+            LinearReadEvent::Record { data, opcode } => {
+                mcap_lengths_fit(opcode, data)
+                    .map_err(|m| bad(format!("record 0x{opcode:02x}: {m}")))?;
+                match mcap::parse_record(opcode, data).map_err(|e| bad(e.to_string()))? {
+                    Record::Schema { header, .. } => {
+                        schemas.insert(header.id, header.name);
+                    }
+                    Record::Channel(c) => {
+                        channels.insert(c.id, c);
+                    }
+                    Record::Message { header, data } => {
+                        let Some(channel) = channels.get(&header.channel_id) else {
+                            return Err(bad(format!(
+                                "a message of channel {} before the channel",
+                                header.channel_id
+                            )));
+                        };
+                        let schema = schemas.get(&channel.schema_id).map_or("", String::as_str);
+                        if !each(channel, schema, &data, header.log_time)? {
+                            return Ok(());
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
     }
     Ok(())
+}
+
+/// Whether the length fields of an MCAP record (`opcode`, its body `data`) fit in the record:
+/// the strings, string maps and prefixed byte fields of each record type, walked field by field
+/// (<https://mcap.dev/spec>). Records of other types have no such field, or none that the
+/// `mcap` crate reserves memory for.
+fn mcap_lengths_fit(opcode: u8, data: &[u8]) -> core::result::Result<(), String> {
+    struct Walk<'a>(&'a [u8]);
+    impl Walk<'_> {
+        fn skip(&mut self, n: u64, what: &str) -> core::result::Result<(), String> {
+            match usize::try_from(n).ok().filter(|n| *n <= self.0.len()) {
+                Some(n) => {
+                    self.0 = &self.0[n..];
+                    Ok(())
+                }
+                None => Err(format!(
+                    "{what} declares {n} bytes where {} are left",
+                    self.0.len()
+                )),
+            }
+        }
+        fn uint(&mut self, width: usize, what: &str) -> core::result::Result<u64, String> {
+            let Some(bytes) = self.0.get(..width) else {
+                return Err(format!("{what} is cut short"));
+            };
+            let mut v = 0u64;
+            for (k, b) in bytes.iter().enumerate() {
+                v |= u64::from(*b) << (8 * k);
+            }
+            self.0 = &self.0[width..];
+            Ok(v)
+        }
+        fn string(&mut self, what: &str) -> core::result::Result<(), String> {
+            let n = self.uint(4, what)?;
+            self.skip(n, what)
+        }
+        fn bytes32(&mut self, what: &str) -> core::result::Result<(), String> {
+            self.string(what)
+        }
+        fn string_map(&mut self, what: &str) -> core::result::Result<(), String> {
+            let n = self.uint(4, what)?;
+            let Some(map) = usize::try_from(n).ok().and_then(|n| self.0.get(..n)) else {
+                return Err(format!(
+                    "{what} declares {n} bytes where {} are left",
+                    self.0.len()
+                ));
+            };
+            let mut inner = Walk(map);
+            while !inner.0.is_empty() {
+                inner.string(&format!("a key of {what}"))?;
+                inner.string(&format!("a value of {what}"))?;
+            }
+            self.0 = &self.0[map.len()..];
+            Ok(())
+        }
+    }
+    let mut w = Walk(data);
+    match opcode {
+        // Header: profile, library.
+        0x01 => {
+            w.string("the profile")?;
+            w.string("the library")
+        }
+        // Schema: id, name, encoding, data.
+        0x03 => {
+            w.uint(2, "the schema id")?;
+            w.string("the schema name")?;
+            w.string("the schema encoding")?;
+            w.bytes32("the schema data")
+        }
+        // Channel: id, schema id, topic, message encoding, metadata.
+        0x04 => {
+            w.uint(2, "the channel id")?;
+            w.uint(2, "the schema id")?;
+            w.string("the topic")?;
+            w.string("the message encoding")?;
+            w.string_map("the channel metadata")
+        }
+        // Chunk: start, end, uncompressed size and CRC, compression, records.
+        0x06 => {
+            w.uint(8, "the start time")?;
+            w.uint(8, "the end time")?;
+            let size = w.uint(8, "the uncompressed size")?;
+            if size > RECORD_LIMIT as u64 {
+                return Err(format!(
+                    "a chunk declares {size} bytes once decompressed, more than the \
+                     {RECORD_LIMIT} imukit reads in one chunk"
+                ));
+            }
+            w.uint(4, "the uncompressed CRC")?;
+            w.string("the compression")?;
+            let n = w.uint(8, "the records' length")?;
+            w.skip(n, "the records")
+        }
+        // Attachment: log and create time, name, media type, data.
+        0x09 => {
+            w.uint(8, "the log time")?;
+            w.uint(8, "the create time")?;
+            w.string("the name")?;
+            w.string("the media type")?;
+            let n = w.uint(8, "the data's length")?;
+            w.skip(n, "the attachment data")
+        }
+        // Attachment index: offset, length, log and create time, data size, name, media type.
+        0x0A => {
+            for what in [
+                "the offset",
+                "the length",
+                "the log time",
+                "the create time",
+                "the size",
+            ] {
+                w.uint(8, what)?;
+            }
+            w.string("the name")?;
+            w.string("the media type")
+        }
+        // Metadata: name, metadata.
+        0x0C => {
+            w.string("the name")?;
+            w.string_map("the metadata")
+        }
+        // Metadata index: offset, length, name.
+        0x0D => {
+            w.uint(8, "the offset")?;
+            w.uint(8, "the length")?;
+            w.string("the name")
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Reads a ROS 1 bag (the `rosbag` crate: chunks decompressed one at a time, messages in
@@ -476,6 +653,7 @@ fn read_ros1(path: &Path, contents: &mut Contents) -> Result<()> {
         file: path.into(),
         message: format!("not a readable ROS 1 bag: {e}"),
     };
+    check_ros1_chunks(path)?;
     let bag = RosBag::new(path).map_err(|source| Error::Io {
         path: path.into(),
         source,
@@ -510,6 +688,96 @@ fn read_ros1(path: &Path, contents: &mut Contents) -> Result<()> {
     Ok(())
 }
 
+/// Walks a ROS 1 bag's records (each a header of `name=value` fields and its data) and
+/// refuses a chunk that declares more than [`RECORD_LIMIT`] bytes once decompressed, or a
+/// record longer than what is left of the file, before the `rosbag` crate reserves what the
+/// chunk declares: a few damaged bytes must not reserve gigabytes.
+fn check_ros1_chunks(path: &Path) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+    let (file, length) = crate::io::open_with_length(path)?;
+    let mut reader = BufReader::new(file);
+    let io = |source| Error::Io {
+        path: path.into(),
+        source,
+    };
+    let bad = |at: u64, message: String| Error::CsvFormat {
+        file: path.into(),
+        message: format!("not a readable ROS 1 bag: the record at byte {at} {message}"),
+    };
+    let mut magic = [0u8; MAGIC.len()];
+    if length < MAGIC.len() as u64 {
+        return Ok(()); // the crate says what is wrong with it
+    }
+    reader.read_exact(&mut magic).map_err(io)?;
+    if magic != MAGIC {
+        return Ok(());
+    }
+    let mut at = MAGIC.len() as u64;
+    let mut word = [0u8; 4];
+    while at + 4 <= length {
+        reader.read_exact(&mut word).map_err(io)?;
+        let header_len = u64::from(u32::from_le_bytes(word));
+        if at + 4 + header_len + 4 > length {
+            return Err(bad(
+                at,
+                format!("declares a {header_len}-byte header past the file's end"),
+            ));
+        }
+        let mut header = vec![0u8; usize::try_from(header_len).unwrap_or(usize::MAX)];
+        reader.read_exact(&mut header).map_err(io)?;
+        reader.read_exact(&mut word).map_err(io)?;
+        let data_len = u64::from(u32::from_le_bytes(word));
+        let data_at = at + 4 + header_len + 4;
+        if data_at + data_len > length {
+            return Err(bad(
+                at,
+                format!("declares {data_len} bytes of data past the file's end"),
+            ));
+        }
+        let (mut op, mut compression, mut size) = (None, None, None);
+        let mut fields = header.as_slice();
+        while fields.len() >= 4 {
+            let n = u32::from_le_bytes([fields[0], fields[1], fields[2], fields[3]]) as usize;
+            let Some(field) = fields.get(4..4 + n) else {
+                break;
+            };
+            if let Some(eq) = field.iter().position(|b| *b == b'=') {
+                let (name, value) = (&field[..eq], &field[eq + 1..]);
+                match name {
+                    b"op" => op = value.first().copied(),
+                    b"compression" => compression = Some(value.to_vec()),
+                    b"size" if value.len() == 4 => {
+                        size = Some(u32::from_le_bytes([value[0], value[1], value[2], value[3]]));
+                    }
+                    _ => {}
+                }
+            }
+            fields = &fields[4 + n..];
+        }
+        if op == Some(0x05)
+            && compression.as_deref() != Some(b"none")
+            && let Some(size) = size
+            && size as usize > RECORD_LIMIT
+        {
+            return Err(bad(
+                at,
+                format!(
+                    "is a chunk declaring {size} bytes once decompressed, more than the \
+                     {RECORD_LIMIT} imukit reads in one chunk"
+                ),
+            ));
+        }
+        reader
+            .seek(SeekFrom::Current(
+                i64::try_from(data_len).unwrap_or(i64::MAX),
+            ))
+            .map_err(io)?;
+        at = data_at + data_len;
+    }
+    Ok(())
+}
+
 /// Reads a ROS 2 bag's sqlite3 storage file (the `rusqlite` crate, the file opened read-only,
 /// messages in stamp order).
 fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
@@ -518,11 +786,46 @@ fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
         file: path.into(),
         message: format!("not a readable ROS 2 sqlite3 bag: {e}"),
     };
+    // Immutable: SQLite takes no lock and makes no side file (`-shm`, `-wal`) beside the bag.
     let db = Connection::open_with_flags(
-        path,
-        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+        sqlite_uri(path),
+        OpenFlags::SQLITE_OPEN_READ_ONLY
+            | OpenFlags::SQLITE_OPEN_NO_MUTEX
+            | OpenFlags::SQLITE_OPEN_URI,
     )
     .map_err(bad)?;
+    // A view or a virtual table computes its rows, and may compute them without end: a bag's
+    // two tables are stored ones.
+    for name in ["topics", "messages"] {
+        let sql: Option<(String, String)> = db
+            .query_row(
+                "SELECT type, COALESCE(sql, '') FROM sqlite_master WHERE name = ?1",
+                [name],
+                |r| Ok((r.get(0)?, r.get(1)?)),
+            )
+            .map(Some)
+            .or_else(|e| match e {
+                rusqlite::Error::QueryReturnedNoRows => Ok(None),
+                other => Err(other),
+            })
+            .map_err(bad)?;
+        let stored = sql.as_ref().is_some_and(|(kind, text)| {
+            kind == "table"
+                && !text
+                    .trim_start()
+                    .to_ascii_uppercase()
+                    .starts_with("CREATE VIRTUAL")
+        });
+        if !stored {
+            return Err(Error::CsvFormat {
+                file: path.into(),
+                message: format!(
+                    "not a ROS 2 sqlite3 bag: its {name} is {} (a bag stores its {name} in a table)",
+                    sql.map_or("missing".to_string(), |(kind, _)| format!("a {kind}"))
+                ),
+            });
+        }
+    }
     let mut topics: BTreeMap<i64, (String, String, String)> = BTreeMap::new();
     {
         let mut query = db
@@ -554,6 +857,22 @@ fn read_sqlite(path: &Path, contents: &mut Contents) -> Result<()> {
         contents.ingest(path, topic, tp, format, data, receive)?;
     }
     Ok(())
+}
+
+/// The SQLite URI that opens `path` read-only as an immutable file (no lock, no side files):
+/// every byte of the path but letters, digits and `/._-~` percent-escaped.
+fn sqlite_uri(path: &Path) -> String {
+    use std::fmt::Write as _;
+    let mut uri = String::from("file:");
+    for b in path.as_os_str().as_encoded_bytes() {
+        if b.is_ascii_alphanumeric() || b"/._-~".contains(b) {
+            uri.push(char::from(*b));
+        } else {
+            let _ = write!(uri, "%{b:02X}");
+        }
+    }
+    uri.push_str("?immutable=1");
+    uri
 }
 
 /// The description in a channel's metadata (`imukit.` keys), if any.
@@ -1360,6 +1679,115 @@ mod tests {
         for (a, b) in fixes.data.iter().zip(&back.data) {
             assert!((a - b).abs() <= 1e-15 * a.abs().max(1.0), "{a} {b}");
         }
+    }
+
+    /// An MCAP file of the magic, a header and one metadata record whose key declares `key_len`
+    /// bytes, then the data end and footer.
+    fn mcap_with_metadata_key(key_len: u32) -> Vec<u8> {
+        fn record(out: &mut Vec<u8>, op: u8, body: &[u8]) {
+            out.push(op);
+            out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+            out.extend_from_slice(body);
+        }
+        let string = |s: &[u8]| [&(s.len() as u32).to_le_bytes()[..], s].concat();
+        let mut out = b"\x89MCAP0\r\n".to_vec();
+        record(&mut out, 0x01, &[string(b"ros2"), string(b"x")].concat());
+        let mut map = key_len.to_le_bytes().to_vec();
+        map.extend_from_slice(b"abc");
+        let body = [string(b"m"), (map.len() as u32).to_le_bytes().to_vec(), map].concat();
+        record(&mut out, 0x0C, &body);
+        record(&mut out, 0x0F, &0u32.to_le_bytes());
+        record(&mut out, 0x02, &[0u8; 20]);
+        out.extend_from_slice(b"\x89MCAP0\r\n");
+        out
+    }
+
+    #[test]
+    fn a_length_that_does_not_fit_its_record_is_refused_before_anything_is_reserved() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("m.mcap");
+        std::fs::write(&p, mcap_with_metadata_key(0xFFFF_0003)).unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("m.mcap") && e.contains("a key of the metadata declares 4294901763 bytes"),
+            "{e}"
+        );
+        // The same record with a key that fits is read (no messages: no topic).
+        std::fs::write(&p, mcap_with_metadata_key(3)).unwrap();
+        let e = read(&p).map(|_| ()).map_err(|e| e.to_string());
+        assert!(
+            e.as_ref()
+                .map_or_else(|m| !m.contains("declares"), |()| true),
+            "{e:?}"
+        );
+        // Each kind of field is walked.
+        assert!(mcap_lengths_fit(0x04, &[0, 0, 0, 0, 9, 0, 0, 0]).is_err());
+        assert!(mcap_lengths_fit(0x01, &[1, 0, 0, 0, b'a', 0, 0, 0, 0]).is_ok());
+        let mut chunk = vec![0u8; 16];
+        chunk.extend_from_slice(&(u64::MAX).to_le_bytes());
+        let e = mcap_lengths_fit(0x06, &chunk).unwrap_err();
+        assert!(e.contains("once decompressed"), "{e}");
+    }
+
+    #[test]
+    fn a_ros1_chunk_declaring_gigabytes_is_refused_before_it_is_decompressed() {
+        fn field(name: &[u8], value: &[u8]) -> Vec<u8> {
+            let f = [name, b"=", value].concat();
+            [(f.len() as u32).to_le_bytes().to_vec(), f].concat()
+        }
+        let header = [
+            field(b"op", &[0x05]),
+            field(b"compression", b"bz2"),
+            field(b"size", &u32::MAX.to_le_bytes()),
+        ]
+        .concat();
+        let mut bag = b"#ROSBAG V2.0\n".to_vec();
+        bag.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        bag.extend_from_slice(&header);
+        bag.extend_from_slice(&4u32.to_le_bytes());
+        bag.extend_from_slice(b"BZh9");
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("b.bag");
+        std::fs::write(&p, &bag).unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("b.bag") && e.contains("at byte 13") && e.contains("4294967295 bytes"),
+            "{e}"
+        );
+        // A record longer than the file is refused as such.
+        bag.truncate(bag.len() - 2);
+        std::fs::write(&p, &bag).unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("past the file's end"), "{e}");
+    }
+
+    #[test]
+    fn a_sqlite_bag_whose_messages_are_a_view_is_refused_and_no_side_file_is_left() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("v.db3");
+        {
+            let db = rusqlite::Connection::open(&p).unwrap();
+            db.execute_batch(
+                "PRAGMA journal_mode=WAL;
+                 CREATE TABLE topics (id INTEGER, name TEXT, type TEXT, serialization_format TEXT);
+                 CREATE VIEW messages AS WITH RECURSIVE n(id) AS (SELECT 1 UNION ALL SELECT id + 1 FROM n)
+                   SELECT 1 AS topic_id, x'00' AS data, id AS timestamp, id FROM n;",
+            )
+            .unwrap();
+        }
+        for side in ["v.db3-shm", "v.db3-wal"] {
+            let _ = std::fs::remove_file(dir.path().join(side));
+        }
+        let e = read(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("v.db3") && e.contains("its messages is a view"),
+            "{e}"
+        );
+        let left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(left, ["v.db3"]);
     }
 
     #[test]
