@@ -18,7 +18,10 @@ long, extreme numbers); extreme numeric options; scenarios and navigation on the
 wrong, or right over damaged sentences) and Kalibr files fed to ``fuse``; crafted binary tables (archives whose members
 lie about their sizes, repeat, fail their CRC or expand like bombs, ``.npy`` headers against their files, Parquet
 footers damaged field by field, a column twice); barometer and odometer files fed to ``integrate`` and ``fuse``;
-output paths that collide with inputs, special files and folders; real signals (SIGINT, SIGTERM, SIGHUP) sent to
+output paths that collide with inputs, special files and folders; crafted bags whose lengths declare gigabytes
+(MCAP strings and maps, ROS 1 chunks, under a 3 GiB address space), a ``.db3`` whose messages are an endless SQL
+view, NMEA fields ``nan``/``inf``/``1e308``, a link planted inside an output folder, outputs named ``.xlsx``,
+``.mat``, ``.db3``…; real signals (SIGINT, SIGTERM, SIGHUP) sent to
 a command at a random moment of its run; two processes writing one output name at once; Python calls with NaN,
 inf, huge and misshapen arguments, empty tables, and tables written under hostile column names. Prints one line
 per class and a closing ``N passed, M failed`` line; exits 1 on any failure.
@@ -95,11 +98,19 @@ class Run:
         self.failures.append(f"{self.name}: {case}: {why}")
 
 
-def run_cli(run: Run, work: Path, args: list, inputs: list, case: str) -> None:
-    """Runs one command in `work` and checks it against every rule."""
+def run_cli(run: Run, work: Path, args: list, inputs: list, case: str, memory_gb: float = 0) -> None:
+    """Runs one command in `work` and checks it against every rule; `memory_gb` caps its address
+    space (an allocation beyond it aborts the process: a failure)."""
     before = {p: digest(work / p) for p in inputs}
+
+    def limit() -> None:
+        import resource
+        cap = int(memory_gb * (1 << 30))
+        resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
+
     try:
-        out = subprocess.run([imukit_bin(), *args], cwd=work, capture_output=True, timeout=TIME_LIMIT_S)
+        out = subprocess.run([imukit_bin(), *args], cwd=work, capture_output=True, timeout=TIME_LIMIT_S,
+                             preexec_fn=limit if memory_gb else None)
     except subprocess.TimeoutExpired:
         run.fail(case, f"no answer within {TIME_LIMIT_S} s: {args}")
         return
@@ -554,6 +565,91 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 run_cli(r, work, args, ["kx.yaml", "ai.csv", "at.csv", "ag.csv"], f"case {k} (kalibr)")
         for n in ("ae.toml", "ai.csv", "at.csv", "ag.csv", "ab.csv", "ao.csv", "ax.csv", "an.csv", "ax.nmea", "kx.yaml"):
             (work / n).unlink(missing_ok=True)
+        runs.append(r)
+
+        r = Run("crafted bags, logs, output folders and names")
+        # Lengths that declare gigabytes, SQL that never ends, numbers that are not numbers, a
+        # link planted inside an output folder, names of formats imukit does not write: each
+        # refused by name, within a 3 GiB address space, the link's target untouched.
+        def mcap_metadata(key_len: int) -> bytes:
+            def record(op: int, body: bytes) -> bytes:
+                return bytes([op]) + struct.pack("<Q", len(body)) + body
+            string = lambda b: struct.pack("<I", len(b)) + b  # noqa: E731
+            entries = struct.pack("<I", key_len) + b"abc"
+            body = string(b"m") + struct.pack("<I", len(entries)) + entries
+            magic = b"\x89MCAP0\r\n"
+            return (magic + record(0x01, string(b"ros2") + string(b"x")) + record(0x0C, body)
+                    + record(0x0F, b"\0" * 4) + record(0x02, b"\0" * 20) + magic)
+
+        def ros1_chunk(size: int) -> bytes:
+            field = lambda n, v: struct.pack("<I", len(n) + 1 + len(v)) + n + b"=" + v  # noqa: E731
+            header = field(b"op", b"\x05") + field(b"compression", b"bz2") + field(b"size", struct.pack("<I", size))
+            return b"#ROSBAG V2.0\n" + struct.pack("<I", len(header)) + header + struct.pack("<I", 4) + b"BZh9"
+
+        def endless_db3(path: Path) -> None:
+            import sqlite3
+            path.unlink(missing_ok=True)
+            with sqlite3.connect(path) as db:
+                db.executescript(
+                    "CREATE TABLE topics (id INTEGER, name TEXT, type TEXT, serialization_format TEXT);"
+                    "INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr');"
+                    "CREATE VIEW messages AS WITH RECURSIVE n(id) AS (SELECT 1 UNION ALL SELECT id + 1 FROM n) "
+                    "SELECT 1 AS topic_id, x'00' AS data, id AS timestamp, id FROM n;")
+            db.close()
+
+        for k in range(per):
+            kind = k % 6
+            if kind == 0:
+                (work / "cx.mcap").write_bytes(mcap_metadata(rng.choice([0xFFFF0003, 2**31, 2**32 - 1, 1 << 29])))
+                run_cli(r, work, [rng.choice(["integrate", "orient", "allan"]), "cx.mcap", "--out", "o.csv"],
+                        ["cx.mcap"], f"case {k} (mcap length)", memory_gb=3)
+            elif kind == 1:
+                (work / "cx.bag").write_bytes(ros1_chunk(rng.choice([2**32 - 1, 1 << 29, 3 << 30])))
+                run_cli(r, work, [rng.choice(["integrate", "orient"]), "cx.bag", "--out", "o.csv"],
+                        ["cx.bag"], f"case {k} (ros 1 chunk)", memory_gb=3)
+            elif kind == 2:
+                endless_db3(work / "cx.db3")
+                run_cli(r, work, ["integrate", "cx.db3", "--out", "o.csv"], ["cx.db3"], f"case {k} (sqlite view)")
+                left = [p.name for p in work.iterdir() if p.name.startswith("cx.db3-")]
+                if left:
+                    r.fail(f"case {k} (sqlite view)", f"side files left: {left}")
+            elif kind == 3:
+                bad = rng.choice(["nan", "inf", "-inf", "1e308"])
+                field = rng.choice(["alt", "speed", "course"])
+                alt, speed, course = (bad if field == f else v for f, v in
+                                      (("alt", "545.4"), ("speed", "10.0"), ("course", "90.0")))
+                def sentence(body: str) -> str:
+                    total = 0
+                    for ch in body.encode():
+                        total ^= ch
+                    return f"${body}*{total:02X}"
+                lines = [sentence(f"GPGGA,000000.60,4807.038,N,01131.000,E,1,08,0.9,{alt},M,47.0,M,,"),
+                         sentence(f"GPRMC,000000.60,A,4807.038,N,01131.000,E,{speed},{course},230394,003.1,W")]
+                (work / "cx.nmea").write_text("\r\n".join(lines) + "\r\n")
+                run_cli(r, work, ["fuse", "imu.csv", "cx.nmea", "--imu", "stim300", "--align", "gnss",
+                                  "--out", "o.csv"], ["cx.nmea", "imu.csv"], f"case {k} (nmea {field} {bad})")
+            elif kind == 4:
+                shutil.rmtree(work / "seq", ignore_errors=True)
+                shutil.rmtree(work / "elsewhere", ignore_errors=True)
+                (work / "elsewhere" / "imu0").mkdir(parents=True)
+                (work / "elsewhere" / "imu0" / "data.csv").write_text("not yours\n")
+                (work / "seq").mkdir()
+                os.symlink(work / "elsewhere", work / "seq" / "mav0")
+                run_cli(r, work, ["simulate", "s.toml", "--layout", "euroc", "--out", "seq"],
+                        ["s.toml", "elsewhere/imu0/data.csv"], f"case {k} (link inside an output folder)")
+            else:
+                name = "o." + rng.choice(["xlsx", "mat", "h5", "db3", "bag", "nmea", "json"])
+                run_cli(r, work, rng.choice([["integrate", "imu.csv", "--out", name],
+                                             ["simulate", "s.toml", "--out", name],
+                                             ["compare", "truth.csv", "truth.csv", "--out", name]]),
+                        ["imu.csv", "s.toml", "truth.csv"], f"case {k} ({name})")
+                if (work / name).exists():
+                    r.fail(f"case {k} ({name})", f"{name} was written")
+                    (work / name).unlink()
+        for n in ("cx.mcap", "cx.bag", "cx.db3", "cx.nmea"):
+            (work / n).unlink(missing_ok=True)
+        shutil.rmtree(work / "seq", ignore_errors=True)
+        shutil.rmtree(work / "elsewhere", ignore_errors=True)
         runs.append(r)
 
         r = Run("signals at a random moment")

@@ -266,7 +266,8 @@ def test_commands_take_a_column_map_and_refuse_a_bad_one_by_name(tmp_path):
     plain = tmp_path / "plain.csv"
     sim.imu.write(plain)
     outs = {}
-    for name, extra in [("vendor", [str(path), "--map", str(map_path)]), ("plain", [str(plain)])]:
+    # The plain file says its frame (the built-in scenario's NED); the vendor's is told.
+    for name, extra in [("vendor", [str(path), "--map", str(map_path), "--nav-frame", "NED"]), ("plain", [str(plain)])]:
         out = tmp_path / f"{name}_orient.csv"
         done = subprocess.run([imukit_bin(), "orient", *extra, "--filter", "ahrsfilter", "--out", str(out)],
                               capture_output=True, text=True)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import imukit
+from imukit import ImuError
 from test_cli_vs_python import ROOT, imukit_bin
 
 PART = ["--imu", "stim300", "--gnss-horizontal-accuracy-m", "1.5", "--gnss-vertical-accuracy-m", "3",
@@ -78,7 +79,11 @@ def test_a_scenario_that_contradicts_the_datas_description_is_refused(drive):
     out = tmp / "never.csv"
     done = fuse(files, out, "--scenario", str(ned))
     assert done.returncode == 65, done.stderr
-    assert f"nav_frame: the scenario {ned} says NED, the description of {files['imu']} says ENU" in done.stderr
+    assert f"--nav-frame: the scenario {ned} says NED, the description of {files['imu']} says ENU" in done.stderr
+    # In Python alike: the tables read back say ENU, the scenario NED.
+    with pytest.raises(ImuError, match="nav_frame: the scenario says NED, the description of the imu table says ENU"):
+        imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]),
+                    scenario=ned)
     assert not out.exists()
 
 

@@ -39,7 +39,8 @@ def test_runs_write_their_readings_into_the_gathered_array():
     whole = imukit.simulate(SCENARIO, run=3)
     assert (rows, tuple(columns)) == (whole.imu.values.shape[0], whole.imu.columns)
     gathered = np.full((2, rows, len(columns)), np.nan)
-    _, (names, filled), *_ = _core.simulate_dict(SCENARIO, run=3, truth=False, imu_out=gathered[1])
+    _, (names, filled, description), *_ = _core.simulate_dict(SCENARIO, run=3, truth=False, imu_out=gathered[1])
+    assert description["kind"] == "readings"
     assert names == list(columns) and np.shares_memory(filled, gathered)
     assert np.array_equal(gathered[1], whole.imu.values) and np.isnan(gathered[0]).all()
     with pytest.raises(ValueError, match=r"imu_out has shape \[400, 10\], the run makes \[401, 10\]"):

@@ -72,6 +72,17 @@ pub fn warn(message: &str) {
     crate::err_line!("imukit: warning: {message}");
 }
 
+/// Warns about IMU readings in `path` that look like a unit slip (g as m/s², °/s as rad/s, ms
+/// as s: [`imukit::io::plausible`]).
+pub fn warn_implausible(path: &std::path::Path) {
+    for w in imukit::io::plausible::file_readings(
+        path,
+        "declare the file's units with --map, docs/formats.md",
+    ) {
+        warn(&w);
+    }
+}
+
 fn line_interval() -> Duration {
     let seconds = std::env::var("IMUKIT_PROGRESS_INTERVAL_S")
         .ok()

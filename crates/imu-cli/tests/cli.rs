@@ -1034,12 +1034,33 @@ fn orient_with_decimation_says_how_many_samples_end_without_an_orientation() {
         .args(["--out", "o.csv"])
         .output()
         .unwrap();
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    assert_eq!(out.status.code(), Some(0), "{stdout}");
-    assert!(stdout.contains(": 16 orientations in o.csv"), "{stdout}");
+    // Notes go to standard error, as every command's do; standard output stays empty.
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(out.stdout.is_empty());
+    assert!(stderr.contains(": 16 orientations in o.csv"), "{stderr}");
     assert!(
-        stdout.contains("the last 2 samples do not fill a block"),
-        "{stdout}"
+        stderr.contains("the last 2 samples do not fill a block"),
+        "{stderr}"
+    );
+    // -q keeps them back.
+    let quiet = imukit()
+        .current_dir(dir)
+        .args([
+            "-q",
+            "orient",
+            "imu.csv",
+            "--filter",
+            "imufilter",
+            "--out",
+            "q.csv",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(quiet.status.code(), Some(0));
+    assert!(
+        quiet.stderr.is_empty() && quiet.stdout.is_empty(),
+        "{quiet:?}"
     );
     let rows = table_text(dir.join("o.csv")).lines().count();
     assert_eq!(rows, 17);

@@ -116,7 +116,7 @@ fn plot(files: &[&str], name: &str) -> ((u32, u32), usize) {
         paths.extend([Path::new("--out"), &out]);
         let o = imukit(&["plot"], &paths);
         ok(&o);
-        assert!(String::from_utf8_lossy(&o.stdout).contains(&out.display().to_string()));
+        assert!(String::from_utf8_lossy(&o.stderr).contains(&out.display().to_string()));
         if ext == "svg" {
             svg = svg_series(&out);
         } else {
@@ -259,7 +259,7 @@ fn gif_animation_has_one_frame_per_twentieth_of_a_second_of_animation() {
     }
     // 1 s of motion at 0.5× real time and 20 frames/s: frames at 0, 1/40 s, …, 1 s.
     assert_eq!(frames, 41);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("41 frames"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("41 frames"));
 }
 
 #[test]

@@ -125,6 +125,22 @@ fn read_description<'py>(py: Python<'py>, path: &str) -> PyResult<Option<Bound<'
     description_dict(py, &d).map(Some)
 }
 
+/// What in IMU readings (`columns`, `values`) read from `source` looks like a unit slip (g as
+/// m/s², °/s as rad/s, ms as s), one sentence each.
+#[pyfunction]
+fn implausible(
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'_, f64>,
+    source: &str,
+) -> PyResult<Vec<String>> {
+    let t = table_in("values", columns, &values)?;
+    Ok(imukit::io::plausible::readings(
+        &t,
+        source,
+        "declare the file's units with map=, docs/formats.md",
+    ))
+}
+
 /// The file of Monte Carlo run `run` of `runs` for the output `out` (`imu.csv` → `imu_run0007.csv`).
 #[pyfunction]
 fn run_path(out: &str, run: u64, runs: u64) -> String {
@@ -139,5 +155,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_table_file, m)?)?;
     m.add_function(wrap_pyfunction!(run_path, m)?)?;
     m.add_function(wrap_pyfunction!(read_description, m)?)?;
+    m.add_function(wrap_pyfunction!(implausible, m)?)?;
     Ok(())
 }

@@ -90,8 +90,13 @@ def test_on_the_wgs84_earth_the_imu_senses_the_earth_and_the_earth_strapdown_und
     _, on_earth = imukit.compare(sim.truth, nav)
     assert on_earth["position_max_m"] < 1e-6
     np.testing.assert_allclose(nav["lat_rad"], sim.truth["lat_rad"], atol=1e-12)
-    flat = imukit.strapdown(sim.imu, initial=sim.truth, nav_frame="NED")
-    _, on_flat = imukit.compare(sim.truth, flat)
+    # The tables say they are on the WGS-84 Earth: a flat mechanization is refused, and runs
+    # on the same numbers without their descriptions.
+    with pytest.raises(imukit.ImuError, match="earth: flat contradicts"):
+        imukit.strapdown(sim.imu, initial=sim.truth, earth="flat")
+    plain = lambda t: imukit.Table(t.columns, t.values)  # noqa: E731
+    flat = imukit.strapdown(plain(sim.imu), initial=plain(sim.truth), nav_frame="NED")
+    _, on_flat = imukit.compare(plain(sim.truth), flat)
     assert on_flat["position_final_m"] > 1000.0  # the flat mechanization ignores the Earth
 
     # A start given by its parts: at rest, level, at 45° N, for an hour with the height held.
@@ -101,8 +106,12 @@ def test_on_the_wgs84_earth_the_imu_senses_the_earth_and_the_earth_strapdown_und
     still = imukit.strapdown(imu, nav_frame="NED", earth="wgs84", vertical="hold",
                              initial={"latitude_deg": 45.0, "longitude_deg": 0.0, "height_m": 0.0})
     assert np.max(np.abs(still["pos_x_m"])) < 1e-6 and np.max(np.abs(still["pos_y_m"])) < 1e-6
+    # Without a start, the described origin is the start (as on the command line) …
+    described = imukit.strapdown(imu, vertical="hold")
+    np.testing.assert_array_equal(described.values, still.values)
+    # … and a table that says nothing of its origin needs one.
     with pytest.raises(ImuError, match="lat_rad, lon_rad, height_m") as e:
-        imukit.strapdown(imu, nav_frame="NED", earth="wgs84")
+        imukit.strapdown(imukit.Table(imu.columns, imu.values), nav_frame="NED", earth="wgs84")
     with pytest.raises(ImuError, match="unknown vertical channel") as e:
         imukit.strapdown(imu, earth="wgs84", vertical="float", initial={"latitude_deg": 0, "longitude_deg": 0, "height_m": 0})
     assert e.value.field == "vertical"

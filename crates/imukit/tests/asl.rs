@@ -167,3 +167,42 @@ fn a_euroc_sequence_reads_back_exactly_and_navigates_as_the_run() {
         worst(&errors)
     );
 }
+
+#[test]
+fn a_sequence_that_crosses_midnight_keeps_one_time_origin() {
+    let dir = tempfile::tempdir().unwrap();
+    let (imu_path, truth_path) = (
+        dir.path().join("mav0/imu0/data.csv"),
+        dir.path().join("mav0/state_groundtruth_estimate0/data.csv"),
+    );
+    // The IMU starts 0.2 s before a UTC midnight, the ground truth 0.5 s after it.
+    let midnight = time_origin_ns(FIRST_NS) + imukit::io::asl::DAY_NS;
+    let imu_ns: Vec<i64> = (0..200)
+        .map(|k| midnight - 200_000_000 + k * 5_000_000)
+        .collect();
+    let truth_ns: Vec<i64> = (0..10)
+        .map(|k| midnight + 500_000_000 + k * 5_000_000)
+        .collect();
+    let zeros = |n: usize, columns: usize| vec![vec![0.0; n]; columns];
+    write_asl(&imu_path, IMU_HEADER, &imu_ns, &zeros(imu_ns.len(), 6), 0);
+    let mut truth_values = zeros(truth_ns.len(), 10);
+    truth_values[3] = vec![1.0; truth_ns.len()]; // q_w
+    write_asl(&truth_path, TRUTH_HEADER, &truth_ns, &truth_values, 6);
+    let imu = read_table(&imu_path).unwrap();
+    let truth = read_table(&truth_path).unwrap();
+    let origin = midnight - imukit::io::asl::DAY_NS;
+    // Both count from the midnight before the sequence's first stamp: 0.7 s apart, as recorded.
+    assert_eq!(
+        imu.column("t_s").unwrap()[0],
+        seconds_after(imu_ns[0], origin)
+    );
+    assert_eq!(
+        truth.column("t_s").unwrap()[0],
+        seconds_after(truth_ns[0], origin)
+    );
+    assert!((truth.column("t_s").unwrap()[0] - imu.column("t_s").unwrap()[0] - 0.7).abs() < 1e-9);
+    // A file alone (outside a sequence's mav0 folder) counts from its own midnight.
+    let alone = dir.path().join("alone.csv");
+    std::fs::copy(&truth_path, &alone).unwrap();
+    assert_eq!(read_table(&alone).unwrap().column("t_s").unwrap()[0], 0.5);
+}

@@ -38,7 +38,7 @@ fn a_single_sided_part_keeps_its_densities_and_its_flicker_gives_the_random_walk
     );
     let yaml = imu.to_yaml();
     assert_eq!(value(&yaml, "update_rate"), 125.0);
-    assert!(yaml.contains("rostopic: /imu0\n"));
+    assert!(yaml.contains("rostopic: \"/imu0\"\n"));
     // Seven significant digits written.
     let written = value(&yaml, "gyroscope_random_walk");
     assert!((written - k).abs() <= 5e-7 * k, "{written:e} against {k:e}");

@@ -700,3 +700,51 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
     assert_eq!(setup.rest_s, 5.0);
     assert!(!setup.detect_rest);
 }
+
+#[test]
+fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
+    use imukit::run::fuse::PartModel;
+    use imukit::run::navigate::NavSetup;
+    use imukit::scenario::gnss::GnssSpec;
+    let part = |gnss: GnssSpec| PartModel {
+        imu: "stim300".into(),
+        part: None,
+        gnss,
+    };
+    for (gnss, field) in [
+        (
+            GnssSpec {
+                velocity_accuracy_m_s: Some(0.0),
+                ..GnssSpec::default()
+            },
+            "gnss.velocity_accuracy_m_s",
+        ),
+        (
+            GnssSpec {
+                horizontal_accuracy_m: Some(-1.0),
+                ..GnssSpec::default()
+            },
+            "gnss.horizontal_accuracy_m",
+        ),
+        (
+            GnssSpec {
+                vertical_accuracy_m: Some(f64::NAN),
+                ..GnssSpec::default()
+            },
+            "gnss.vertical_accuracy_m",
+        ),
+    ] {
+        match part(gnss).setup(&NavSetup::default(), None, 100.0) {
+            Err(Error::Invalid { field: f, message }) => {
+                assert_eq!(f, field);
+                assert!(message.contains("above 0"), "{message}");
+            }
+            other => panic!("{field}: {other:?}"),
+        }
+    }
+    let given = GnssSpec {
+        velocity_accuracy_m_s: Some(0.05),
+        ..GnssSpec::default()
+    };
+    assert!(part(given).setup(&NavSetup::default(), None, 100.0).is_ok());
+}

@@ -20,6 +20,8 @@ pub fn run(
     let mut outputs = vec![("--out", out)];
     outputs.extend(plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
+    imukit::io::output::check_table_outputs(&[("--out", out)])?;
+    crate::report::warn_implausible(input);
     let result = analyse(input, columns)?;
     result.table.write(out)?;
     if let Some(p) = plot {
@@ -54,10 +56,10 @@ pub fn run(
         "(\"<x\": not resolved, below x with 95 % confidence; `imukit identify` says more)"
     );
     if let Some(p) = plot {
-        crate::out_line!("\nFigure written to {}", p.display());
+        crate::note!("imukit: figure written to {}", p.display());
     }
-    crate::out_line!(
-        "\nAllan deviation of {} columns at {} τ values ({} Hz) written to {}",
+    crate::note!(
+        "imukit: Allan deviation of {} columns at {} τ values ({} Hz) written to {}",
         result.noise.len(),
         result.table.rows(),
         result.sample_rate_hz,

@@ -15,6 +15,9 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
         &inputs,
         &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
     )?;
+    imukit::io::output::check_table_outputs(
+        &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
+    )?;
     let c = compare_csv(truth, estimate, out)?;
     crate::out_line!(
         "{:<10} {:>16} {:>16} {:>16}",
@@ -42,7 +45,7 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
     }
     crate::out_line!("({} rows compared)", c.rows());
     if let Some(o) = out {
-        crate::out_line!("\nErrors over time written to {}", o.display());
+        crate::note!("imukit: errors over time written to {}", o.display());
     }
     Ok(())
 }

@@ -89,6 +89,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     inputs.extend(a.odometer.map(|p| ("--odometer", p)));
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
+    imukit::io::output::check_table_outputs(&[("--out", a.out)])?;
     let initial = match a.init {
         Some(init) => {
             let (frame, on_earth) = data_frame(a)?;
@@ -112,6 +113,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         zupt: a.zupt,
     };
     let imu = read_table_as(a.imu, Role::Readings)?;
+    crate::report::warn_implausible(a.imu);
     let (setup, start) = match (a.scenario, &a.model) {
         (Some(path), _) => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));

@@ -35,6 +35,7 @@ pub fn run(
     outputs.extend(to.kalibr.map(|p| ("--kalibr", p)));
     outputs.extend(to.plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
+    crate::report::warn_implausible(input);
     let result = analyse(input, columns)?;
     let source = file_name(input);
     // Everything is computed before anything is written.
@@ -85,8 +86,8 @@ pub fn run(
             );
         }
     }
-    crate::out_line!(
-        "\nAllan curves with 95 % bands and fitted terms of {} columns written to {}",
+    crate::note!(
+        "imukit: Allan curves with 95 % bands and fitted terms of {} columns written to {}",
         result.noise.len(),
         to.out.display()
     );
@@ -96,7 +97,7 @@ pub fn run(
         ("Figure", to.plot),
     ] {
         if let Some(p) = path {
-            crate::out_line!("{what} written to {}", p.display());
+            crate::note!("imukit: {what} written to {}", p.display());
         }
     }
     Ok(())

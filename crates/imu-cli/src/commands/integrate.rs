@@ -63,6 +63,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
         velocity0_m_s: vector("--velocity0-m-s", c.velocity0, [0.0, 0.0])?,
     };
     check_outputs(&[("input", c.input)], &[("--out", c.out)])?;
+    imukit::io::output::check_table_outputs(&[("--out", c.out)])?;
     let samples = read_planar(c.input)?;
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
     let initial = request.initial_state(t0).map_err(by_flag)?;
@@ -123,6 +124,7 @@ pub fn three_d(
     inputs.extend(o.init.map(|p| ("--init file", p)));
     inputs.extend(o.baro.map(|p| ("--baro file", p)));
     check_outputs(&inputs, &[("--out", c.out)])?;
+    imukit::io::output::check_table_outputs(&[("--out", c.out)])?;
     // What the input files say they hold fills the settings left out, and refuses a flag that
     // contradicts it.
     let described = Described::read(
@@ -138,6 +140,7 @@ pub fn three_d(
     .with_described(asked, &described)
     .map_err(by_flag)?;
     let setup = request.setup().map_err(by_flag)?;
+    crate::report::warn_implausible(c.input);
     let mut initial = match o.init {
         Some(p) => {
             let attitude = o.euler0.map(|_| "--euler0-rad").ok_or("--euler0-rad");

@@ -18,6 +18,7 @@ pub fn run(
     out: &Path,
 ) -> Result<(), CliError> {
     check_outputs(&[("input", input)], &[("--out", out)])?;
+    imukit::io::output::check_table_outputs(&[("--out", out)])?;
     // The frame and sign the input says it has, unless the flags say (and do not contradict it).
     let (spec, nav) = OrientRequest {
         filter,
@@ -29,6 +30,7 @@ pub fn run(
     .with_described(&Described::read(&[input])?)
     .map_err(crate::error::by_flag)?
     .resolve();
+    crate::report::warn_implausible(input);
     let s = orient_csv(input, &spec, nav, out)?;
     let rate = (s.sample_rate_hz * 1e6).round() / 1e6;
     let timing = if s.per_sample {
@@ -36,7 +38,7 @@ pub fn run(
     } else {
         format!("at a fixed {rate} Hz (SampleRate)")
     };
-    crate::out_line!(
+    crate::note!(
         "imukit: {} samples, {timing}, through {filter}: {} orientations in {}",
         s.samples,
         s.rows,
@@ -46,7 +48,7 @@ pub fn run(
         crate::report::warn(&m);
     }
     if s.unfinished > 0 {
-        crate::out_line!(
+        crate::note!(
             "imukit: the last {} samples do not fill a block of DecimationFactor samples and \
              give no orientation",
             s.unfinished

@@ -22,7 +22,7 @@ pub fn plot(
     let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
     check_outputs(&inputs, &[("--out", out)])?;
     plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
-    crate::out_line!("Wrote {}", out.display());
+    crate::note!("imukit: wrote {}", out.display());
     Ok(())
 }
 
@@ -62,8 +62,8 @@ pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), Cl
     let table = read_table(truth)?;
     let info = anim::animate(&table, &truth.display().to_string(), out, opts)
         .map_err(crate::plot_by_flag)?;
-    crate::out_line!(
-        "Wrote {} ({} frames at {} frames/s, {}× real time)",
+    crate::note!(
+        "imukit: wrote {} ({} frames at {} frames/s, {}× real time)",
         out.display(),
         info.frames,
         opts.fps,

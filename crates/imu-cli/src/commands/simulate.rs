@@ -3,7 +3,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imukit::ScenarioSpec;
-use imukit::io::output::{check_outputs, create_folder_within};
+use imukit::io::output::{check_outputs, check_table_outputs, create_folder_within};
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
@@ -48,6 +48,7 @@ pub fn run(
     outputs.extend(baro_files.iter().map(|p| ("--baro", p.as_path())));
     outputs.extend(odometer_files.iter().map(|p| ("--odometer", p.as_path())));
     check_outputs(&inputs, &outputs)?;
+    check_table_outputs(&outputs)?;
     let sc = spec.resolve(base)?;
     for w in &sc.warnings {
         crate::report::warn(w);

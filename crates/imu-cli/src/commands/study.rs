@@ -18,6 +18,7 @@ pub fn run(study: &Path, out: &Path, plot: Option<&Path>) -> Result<(), CliError
     let mut outputs = vec![("--out", out)];
     outputs.extend(plot.map(|p| ("--plot", p)));
     check_outputs(&inputs, &outputs)?;
+    imukit::io::output::check_table_outputs(&[("--out", out)])?;
     for line in s.undescribed() {
         crate::report::warn(&format!("the presets are not described alike: {line}"));
     }

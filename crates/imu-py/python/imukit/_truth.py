@@ -79,7 +79,9 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_
     ``nav_msgs/Odometry``, … — as imukit's columns; ``topic`` names it where the bag holds
     several, else its IMU topic is read). Any other extension is refused with the formats read.
     A EuRoC/TUM-VI file (``#timestamp [ns],w_RS_S_x [rad s^-1],…``) is read as imukit's columns
-    by its header.
+    by its header. Readings that look like a unit slip — accelerations whose median magnitude
+    is 1 (g) or 1000 (mg) rather than gravity's 9.81, rates beyond any MEMS gyroscope's, samples
+    a second or more apart — raise an :class:`ImuWarning` naming the likely unit.
 
     ``map`` reads a vendor's CSV through a column map — the path of a TOML map, or the same keys
     as a dict — giving ``t_s`` and the sensors' columns in SI units and body axes
@@ -104,10 +106,14 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_
         return _table(_core.read_table_file(str(path), topic=None if topic is None else str(topic),
                                             receive_time=bool(receive_time)))
     if map is None:
-        return _table(_core.read_table_file(str(path)))
-    if isinstance(map, Mapping):
-        return _table(_core.read_table_file(str(path), map_json=json.dumps(dict(map))))
-    return _table(_core.read_table_file(str(path), map_path=str(map)))
+        table = _table(_core.read_table_file(str(path)))
+    elif isinstance(map, Mapping):
+        table = _table(_core.read_table_file(str(path), map_json=json.dumps(dict(map))))
+    else:
+        table = _table(_core.read_table_file(str(path), map_path=str(map)))
+    # Readings that look like a unit slip (g as m/s², °/s as rad/s, ms as s) are warned about.
+    _emit(_core.implausible(list(table.columns), table.values, str(path)))
+    return table
 
 
 def describe(path: Union[str, os.PathLike]) -> dict[str, Union[str, float]]:

@@ -212,6 +212,44 @@ pub fn time_origin_ns(first_ns: i64) -> i64 {
     first_ns.div_euclid(DAY_NS) * DAY_NS
 }
 
+/// The time origin shared by the files of the EuRoC/TUM-VI sequence that holds `path`
+/// (`…/mav0/<sensor>/data.csv`): the UTC midnight before the earliest first stamp of the
+/// sequence's ASL files, so that the IMU and the ground truth of a recording that crosses
+/// midnight count from one origin. `None` for a file outside such a folder, or when no sibling
+/// gives a stamp (the file's own first stamp then sets it).
+#[must_use]
+pub fn sequence_origin_ns(path: &std::path::Path) -> Option<i64> {
+    let sequence = path.parent()?.parent()?;
+    if sequence.file_name()? != "mav0" {
+        return None;
+    }
+    let mut first: Option<i64> = None;
+    // A sequence has a handful of sensors; a folder of thousands is not one.
+    for entry in std::fs::read_dir(sequence).ok()?.take(64) {
+        let file = entry.ok()?.path().join("data.csv");
+        if let Some(ns) = first_stamp_ns(&file) {
+            first = Some(first.map_or(ns, |f| f.min(ns)));
+        }
+    }
+    first.map(time_origin_ns)
+}
+
+/// The first stamp of the ASL file at `path`, ns: its first data row's first field (`None`
+/// when it is no ASL file or has no row). At most two lines of 64 KiB are read.
+fn first_stamp_ns(path: &std::path::Path) -> Option<i64> {
+    use std::io::{BufRead, Read};
+    let file = std::fs::File::open(path).ok()?;
+    let mut reader = std::io::BufReader::new(file.take(128 * 1024));
+    let mut header = String::new();
+    reader.read_line(&mut header).ok()?;
+    if !is_header(&header) {
+        return None;
+    }
+    let mut row = String::new();
+    reader.read_line(&mut row).ok()?;
+    row.split(',').next()?.trim().parse().ok()
+}
+
 /// `t_s` as an integer-nanosecond stamp (rounded to the nanosecond); `None` when it is not
 /// finite or beyond ±292 years.
 #[must_use]

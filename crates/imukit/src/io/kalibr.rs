@@ -54,6 +54,10 @@ struct Tree {
     open: Vec<Option<OpenMap>>,
     root: Option<Node>,
     refused: Option<String>,
+    /// The line of the event being taken (1-based).
+    line: usize,
+    /// YAML documents begun.
+    documents: usize,
 }
 
 impl Tree {
@@ -68,7 +72,14 @@ impl Tree {
             Some(Some((entries, key))) => match key.take() {
                 Some(k) => entries.push((k, node)),
                 None => match node {
-                    Node::Scalar(k) => *key = Some(k),
+                    Node::Scalar(k) => {
+                        if entries.iter().any(|(e, _)| *e == k) {
+                            let line = self.line;
+                            self.refused
+                                .get_or_insert_with(|| format!("line {line}: key {k} given twice"));
+                        }
+                        *key = Some(k);
+                    }
                     _ => {
                         self.refused
                             .get_or_insert_with(|| "a key that is not a plain name".into());
@@ -83,7 +94,19 @@ impl Tree {
 impl yaml_rust2::parser::MarkedEventReceiver for Tree {
     fn on_event(&mut self, ev: yaml_rust2::Event, mark: yaml_rust2::scanner::Marker) {
         use yaml_rust2::Event;
+        self.line = mark.line();
         match ev {
+            Event::DocumentStart => {
+                self.documents += 1;
+                if self.documents > 1 {
+                    self.refused.get_or_insert_with(|| {
+                        format!(
+                            "line {}: a second YAML document (---): a Kalibr file is one",
+                            mark.line()
+                        )
+                    });
+                }
+            }
             Event::Scalar(text, ..) => self.put(Node::Scalar(text)),
             Event::MappingStart(..) => self.open.push(Some((Vec::new(), None))),
             Event::SequenceStart(..) => self.open.push(None),
@@ -137,7 +160,7 @@ pub fn read(path: &Path) -> Result<KalibrImu> {
         })?;
     let mut tree = Tree::default();
     yaml_rust2::parser::Parser::new_from_str(&text)
-        .load(&mut tree, false)
+        .load(&mut tree, true)
         .map_err(|e| bad(format!("not YAML: {e}")))?;
     if let Some(r) = tree.refused {
         return Err(bad(r));
@@ -377,7 +400,8 @@ random_walk_rad_s_rt_hz = {:e}
     pub fn to_yaml(&self) -> String {
         let mut s = String::from("# Kalibr IMU noise model (imu.yaml), written by imukit");
         if let Some(name) = &self.name {
-            s += &format!(" from {name}");
+            // A comment ends at the line's end: a name's own line breaks are not written.
+            s += &format!(" from {}", name.replace(['\n', '\r'], " "));
         }
         s += "\n# continuous-time, single-sided figures: discrete σ = density·√rate, bias step = \
               random walk/√rate\n";
@@ -390,7 +414,12 @@ random_walk_rad_s_rt_hz = {:e}
             }
         }
         let num = yaml_float;
-        s += &format!("rostopic: {}\n", self.rostopic);
+        // Quoted (a JSON string is a YAML double-quoted scalar): a topic with `: `, `#` or a
+        // line break stays one value.
+        s += &format!(
+            "rostopic: {}\n",
+            serde_json::Value::String(self.rostopic.clone())
+        );
         s += &format!(
             "update_rate: {}  # Hz: the logger's rate (imukit presets … --rate-hz)\n",
             if self.update_rate_hz.fract() == 0.0 && self.update_rate_hz < 1e9 {
@@ -427,6 +456,37 @@ mod tests {
         let path = dir.path().join(name);
         std::fs::write(&path, text).expect("written");
         path
+    }
+
+    #[test]
+    fn a_topic_is_written_quoted_and_a_file_that_says_a_key_twice_is_refused() {
+        let dir = tempfile::tempdir().expect("dir");
+        let file = crate::io::presets::load("stim300").expect("preset");
+        for topic in ["a: b", "/imu # x", "two\nupdate_rate: 1.0", "\"quoted\""] {
+            let written = KalibrImu::from_params(&file, 125.0, topic).expect("kalibr");
+            let path = write(&dir, "imu.yaml", &written.to_yaml());
+            let back = read(&path).expect("read back");
+            assert_eq!(
+                (back.rostopic.as_str(), back.update_rate_hz),
+                (topic, 125.0)
+            );
+        }
+        let good = KalibrImu::from_params(&file, 125.0, "/imu0")
+            .expect("kalibr")
+            .to_yaml();
+        let twice = format!("{good}update_rate: 200.0\n");
+        let e = read(&write(&dir, "twice.yaml", &twice))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("twice.yaml") && e.contains("key update_rate given twice"),
+            "{e}"
+        );
+        let second = format!("{good}---\n{good}");
+        let e = read(&write(&dir, "second.yaml", &second))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a second YAML document"), "{e}");
     }
 
     #[test]

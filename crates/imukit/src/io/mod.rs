@@ -20,6 +20,7 @@ pub mod npz;
 pub mod output;
 pub mod params;
 pub mod parquet;
+pub mod plausible;
 pub mod presets;
 pub mod rows;
 pub mod schema;
@@ -120,6 +121,45 @@ impl TableFormat {
         } else {
             Self::Csv
         }
+    }
+
+    /// The format a table is written in at `path`: CSV (`.csv`, `.txt`, or no extension: a
+    /// device such as `/dev/stdout`), `.parquet`, `.npy`, `.npz`, or a ROS 2 bag as MCAP
+    /// (`.mcap`). Any other name is refused before anything is written, rather than given CSV
+    /// text under a name that promises another format (`.xlsx`, `.mat`, `.h5`), or MCAP bytes
+    /// under a name ROS reads as another storage (`.db3`, `.bag`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming `field` and the path, with the formats written.
+    pub fn written(field: &str, path: &Path) -> crate::Result<Self> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let is = |e: &str| ext.eq_ignore_ascii_case(e);
+        let format = Self::of(path);
+        if is("db3") || is("bag") {
+            return Err(crate::error::invalid(
+                field,
+                format!(
+                    "{}: imukit writes ROS 2 bags as MCAP; name it .mcap (ROS 2 replays it; \
+                     `rosbags-convert` makes a ROS 1 .bag of it)",
+                    path.display()
+                ),
+            ));
+        }
+        let known = matches!(format, Self::Parquet | Self::Npy | Self::Npz | Self::Mcap)
+            || ext.is_empty()
+            || is("csv")
+            || is("txt");
+        if !known {
+            return Err(crate::error::invalid(
+                field,
+                format!(
+                    "{}: .{ext} is not a table format imukit writes (.csv, .parquet, .npy, .npz, \
+                     .mcap)",
+                    path.display()
+                ),
+            ));
+        }
+        Ok(format)
     }
 
     /// The number of a table's first row in the file as errors name it: 2 in a CSV file (its

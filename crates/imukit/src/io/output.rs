@@ -443,7 +443,7 @@ impl AtomicFile {
     pub fn begin_table(&mut self, columns: &[String], description: &Description) -> Result<()> {
         check_column_names(columns, &self.path)?;
         self.columns = columns.to_vec();
-        match TableFormat::of(&self.path) {
+        match TableFormat::written(&self.path.display().to_string(), &self.path)? {
             TableFormat::Parquet => {
                 let writer = self.writer.take().expect("a table is begun once");
                 self.parquet = Some(ParquetSink::create(
@@ -855,6 +855,18 @@ fn identity(path: &Path) -> Option<PathBuf> {
     Some(parent.canonicalize().ok()?.join(path.file_name()?))
 }
 
+/// Refuses table outputs (`(option, path)`) whose names promise a format imukit does not write
+/// ([`TableFormat::written`]), before any work.
+///
+/// # Errors
+/// As [`TableFormat::written`], naming the option.
+pub fn check_table_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
+    for (name, path) in outputs {
+        TableFormat::written(name, path)?;
+    }
+    Ok(())
+}
+
 /// Refuses a job whose outputs would overwrite one of its inputs or each other, before any work:
 /// paths are compared after resolving `.`, `..` and links. Special files (`/dev/null`) may be
 /// given as several outputs. `-` (standard output) is refused with a hint.
@@ -908,6 +920,47 @@ pub fn check_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Res
 mod tests {
     use super::*;
     use std::io::Read;
+
+    #[test]
+    fn a_table_is_written_only_under_a_name_whose_format_it_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let table = Table {
+            columns: vec!["t_s".into()],
+            data: vec![0.0, 1.0],
+        };
+        for (name, needle) in [
+            ("err.xlsx", ".xlsx is not a table format imukit writes"),
+            ("x.mat", ".mat is not a table format"),
+            ("x.h5", ".h5 is not a table format"),
+            ("x.db3", "name it .mcap"),
+            ("x.bag", "name it .mcap"),
+            ("x.nmea", ".nmea is not a table format"),
+        ] {
+            let path = dir.path().join(name);
+            let e = table.write(&path).unwrap_err().to_string();
+            assert!(e.contains(name) && e.contains(needle), "{name}: {e}");
+            assert!(!path.exists(), "{name} was written");
+            assert!(check_table_outputs(&[("--out", &path)]).is_err());
+        }
+        for name in [
+            "t.csv",
+            "t.CSV",
+            "t.txt",
+            "t.parquet",
+            "t.npy",
+            "t.npz",
+            "noext",
+        ] {
+            let path = dir.path().join(name);
+            check_table_outputs(&[("--out", &path)]).unwrap();
+            table.write(&path).unwrap();
+            assert_eq!(
+                crate::io::table::read_table(&path).unwrap().data,
+                table.data,
+                "{name}"
+            );
+        }
+    }
 
     #[cfg(unix)]
     #[test]

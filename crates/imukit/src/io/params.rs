@@ -688,6 +688,14 @@ fn parse_document(
             ));
         }
     }
+    // A data sheet given beside the parameters must say what they are: a range quoted as a
+    // spread, or a figure the parameters do not follow, is refused rather than carried along.
+    if let Some(sheet) = &out.datasheet {
+        let problems = sheet.check(&out.params, out.present);
+        if !problems.is_empty() {
+            return Err(invalid(format!("{origin}: datasheet"), problems.join("; ")));
+        }
+    }
     Ok(out)
 }
 

@@ -145,9 +145,14 @@ mod tests {
             "constant_bias = { quoted = 250, unit = \"°/h\", statistic = \"range\"",
         );
         let doc: crate::io::params::ParamValue = toml::from_str(&text).unwrap();
-        let file = parse_param_document(&doc, "test", Profile::Default).unwrap();
-        let problems = file.datasheet.unwrap().check(&file.params, file.present);
-        assert_eq!(problems.len(), 1, "{problems:?}");
-        assert!(problems[0].contains("a bound, not a 1σ statistic"));
+        // Refused when the file is read, naming the data sheet and the bound.
+        let e = parse_param_document(&doc, "test", Profile::Default)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("test: datasheet") && e.contains("a bound, not a 1σ statistic"),
+            "{e}"
+        );
+        assert_eq!(e.matches("a bound").count(), 1, "{e}");
     }
 }

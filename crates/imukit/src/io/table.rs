@@ -429,11 +429,12 @@ impl Table {
         }
     }
 
-    /// Writes the table in the format its path's extension names ([`TableFormat`]: Parquet
-    /// for `.parquet`, NumPy for `.npy` and `.npz`, CSV otherwise), atomically.
+    /// Writes the table in the format its path's extension names ([`TableFormat::written`]:
+    /// Parquet for `.parquet`, NumPy for `.npy` and `.npz`, a bag for `.mcap`, CSV for `.csv`,
+    /// `.txt` or no extension), atomically.
     ///
     /// # Errors
-    /// A value that is not finite; [`Error::Io`] naming the file.
+    /// A name of another format; a value that is not finite; [`Error::Io`] naming the file.
     pub fn write(&self, path: &Path) -> Result<()> {
         self.write_described(path, &Description::of_columns(&self.columns))
     }
@@ -455,7 +456,7 @@ impl Table {
         } else {
             description
         };
-        match TableFormat::of(path) {
+        match TableFormat::written(&path.display().to_string(), path)? {
             TableFormat::Parquet
             | TableFormat::Npy
             | TableFormat::Npz
@@ -659,6 +660,9 @@ struct Layout {
     file_names: Option<Vec<String>>,
     /// Whether `#` lines are comments (not in an ASL file, whose header starts with `#`).
     comments: bool,
+    /// The time origin its stamps count from when it is fixed before the first row: the
+    /// sequence's, for a file of a EuRoC/TUM-VI sequence ([`crate::io::asl::sequence_origin_ns`]).
+    origin_ns: Option<i64>,
 }
 
 /// The layout of the CSV file at `path`, read through `map` when given, else through the map
@@ -673,6 +677,7 @@ fn csv_layout(path: &Path, map: Option<&ColumnMap>) -> Result<Layout> {
             sources: Some(sources),
             file_names: Some(raw),
             comments: true,
+            origin_ns: None,
         });
     }
     if let Some(line) = asl_header(path)? {
@@ -690,6 +695,7 @@ fn csv_layout(path: &Path, map: Option<&ColumnMap>) -> Result<Layout> {
             sources: Some(sources),
             file_names: Some(crate::io::asl::file_names(&line)),
             comments: false,
+            origin_ns: crate::io::asl::sequence_origin_ns(path),
         });
     }
     Ok(Layout {
@@ -697,6 +703,7 @@ fn csv_layout(path: &Path, map: Option<&ColumnMap>) -> Result<Layout> {
         sources: None,
         file_names: None,
         comments: true,
+        origin_ns: None,
     })
 }
 
@@ -986,12 +993,14 @@ impl CsvRows {
                 sources: None,
                 file_names: None,
                 comments: true,
+                origin_ns: None,
             },
             _ => Layout {
                 names: read_header(path)?,
                 sources: None,
                 file_names: None,
                 comments: true,
+                origin_ns: None,
             },
         };
         let names = layout.names;
@@ -1007,10 +1016,34 @@ impl CsvRows {
             .map(|c| (*c).to_string())
             .collect();
         if !missing.is_empty() {
+            // A header with none of imukit's columns is a vendor's or another program's: its
+            // columns are read through a map.
+            let foreign = layout.sources.is_none()
+                && !names.iter().any(|n| {
+                    crate::io::schema::TableKind::detect(std::slice::from_ref(n)).is_some()
+                        || n == "t_s"
+                        || n.ends_with("_m_s2")
+                        || n.ends_with("_rad_s")
+                        || n.ends_with("_m")
+                });
+            let hint = if foreign && matches!(TableFormat::of(path), TableFormat::Csv) {
+                format!(
+                    "{hint}; the header has none of imukit's columns ({}): read a vendor's CSV \
+                     through a column map, --map FILE (Python: map=), docs/formats.md",
+                    names
+                        .iter()
+                        .take(6)
+                        .map(String::as_str)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            } else {
+                hint.to_string()
+            };
             return Err(Error::MissingColumns {
                 file: path.into(),
                 missing,
-                hint: hint.into(),
+                hint,
             });
         }
         let wanted = required
@@ -1040,7 +1073,7 @@ impl CsvRows {
             wanted,
             comments,
             sources: layout.sources,
-            origin_ns: std::cell::Cell::new(None),
+            origin_ns: std::cell::Cell::new(layout.origin_ns),
             file_names: layout.file_names,
         })
     }

@@ -1688,6 +1688,30 @@ impl PartModel {
         };
         let sensors =
             crate::scenario::sensors::SensorSetup::resolve(&spec, std::path::Path::new("."))?;
+        // A simulated receiver may be exact; a filter told so gates away every real fix.
+        for (field, value) in [
+            (
+                "gnss.horizontal_accuracy_m",
+                self.gnss.horizontal_accuracy_m,
+            ),
+            ("gnss.vertical_accuracy_m", self.gnss.vertical_accuracy_m),
+            (
+                "gnss.velocity_accuracy_m_s",
+                self.gnss.velocity_accuracy_m_s,
+            ),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "must be a one-sigma above 0 for the filter, got {v} (no receiver is \
+                         exact: a filter told so rejects its fixes)"
+                    ),
+                ));
+            }
+        }
         let gnss = self.gnss.params()?;
         Ok(FuseSetup::from_model(&FuseModel {
             nav_frame: nav.nav_frame,

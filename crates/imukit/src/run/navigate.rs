@@ -329,7 +329,7 @@ impl InitialState {
     /// Missing columns, a bad first row (file, row, column), an empty file.
     pub fn from_csv(path: &Path) -> Result<Self> {
         // The state columns after t_s: position, velocity, quaternion.
-        let hint = "the initial state comes from a truth CSV";
+        let hint = "; the initial state comes from a truth CSV";
         let mut columns = STATE_COLUMNS[1..].to_vec();
         let mut rows = CsvRows::open(path, &columns, hint)?;
         // Read with the geodetic position where the table has it (the same table: a bag's

@@ -162,12 +162,12 @@ fn decode_row<W: ros::Wire>(
         MessageType::Imu => {
             let m: ros::Imu<W::Header> = W::parse(data, 1)?;
             let row = [m.linear_acceleration.array(), m.angular_velocity.array()].concat();
-            (m.header.stamp_ns(), row)
+            (m.header.stamp_ns()?, row)
         }
         MessageType::MagneticField => {
             let m: ros::MagneticField<W::Header> = W::parse(data, 1)?;
             (
-                m.header.stamp_ns(),
+                m.header.stamp_ns()?,
                 m.magnetic_field.array().map(|b| b * 1e6).to_vec(),
             )
         }
@@ -191,27 +191,27 @@ fn decode_row<W: ros::Wire>(
                 if h > 0.0 { h } else { -1.0 },
                 if v > 0.0 { v } else { -1.0 },
             ];
-            (m.header.stamp_ns(), row)
+            (m.header.stamp_ns()?, row)
         }
         MessageType::PointStamped => {
             let m: ros::PointStamped<W::Header> = W::parse(data, 1)?;
-            (m.header.stamp_ns(), m.point.array().to_vec())
+            (m.header.stamp_ns()?, m.point.array().to_vec())
         }
         MessageType::TwistStamped => {
             let m: ros::TwistStamped<W::Header> = W::parse(data, 1)?;
-            (m.header.stamp_ns(), m.twist.linear.array().to_vec())
+            (m.header.stamp_ns()?, m.twist.linear.array().to_vec())
         }
         MessageType::Odometry => {
             let m: ros::Odometry<W::Header> = W::parse(data, 2)?;
             let q = m.pose.pose.orientation.wxyz();
             let v = rotate(q, m.twist.twist.linear.array());
             let row = [&m.pose.pose.position.array()[..], &v, &q].concat();
-            (m.header.stamp_ns(), row)
+            (m.header.stamp_ns()?, row)
         }
         MessageType::PoseStamped => {
             let m: ros::PoseStamped<W::Header> = W::parse(data, 1)?;
             let row = [&m.pose.position.array()[..], &m.pose.orientation.wxyz()].concat();
-            (m.header.stamp_ns(), row)
+            (m.header.stamp_ns()?, row)
         }
     }))
 }

@@ -70,18 +70,33 @@ pub struct Header1 {
 /// A message header's stamp, in nanoseconds after the epoch.
 pub trait Stamped {
     /// The stamp, ns.
-    fn stamp_ns(&self) -> i64;
+    ///
+    /// # Errors
+    /// Nanoseconds of 10⁹ or more: not a stamp (taken as they are, they would move the
+    /// reading by whole seconds).
+    fn stamp_ns(&self) -> Result<i64, String>;
+}
+
+/// Refuses nanoseconds that are not below a second.
+fn nanoseconds(ns: u32) -> Result<i64, String> {
+    if i64::from(ns) < SECOND_NS {
+        Ok(i64::from(ns))
+    } else {
+        Err(format!(
+            "the header stamp's nanoseconds, {ns}, are not below 10⁹"
+        ))
+    }
 }
 
 impl Stamped for Header {
-    fn stamp_ns(&self) -> i64 {
-        self.stamp.ns()
+    fn stamp_ns(&self) -> Result<i64, String> {
+        Ok(i64::from(self.stamp.sec) * SECOND_NS + nanoseconds(self.stamp.nanosec)?)
     }
 }
 
 impl Stamped for Header1 {
-    fn stamp_ns(&self) -> i64 {
-        i64::from(self.stamp.secs) * SECOND_NS + i64::from(self.stamp.nsecs)
+    fn stamp_ns(&self) -> Result<i64, String> {
+        Ok(i64::from(self.stamp.secs) * SECOND_NS + nanoseconds(self.stamp.nsecs)?)
     }
 }
 
@@ -592,6 +607,24 @@ mod tests {
         assert_eq!(&bytes[..4], &[0, 1, 0, 0]);
         assert_eq!(bytes.len(), 4 + 8 + 8 + 32 + 3 * 72 + 2 * 24);
         assert_eq!(decode::<Imu<Header>>(&bytes, 1), Ok(m));
+    }
+
+    #[test]
+    fn a_stamp_whose_nanoseconds_reach_a_second_is_refused() {
+        let ros2 = |nanosec| Header {
+            stamp: Time { sec: 3, nanosec },
+            frame_id: String::new(),
+        };
+        let ros1 = |nsecs| Header1 {
+            seq: 0,
+            stamp: Time1 { secs: 3, nsecs },
+            frame_id: String::new(),
+        };
+        assert_eq!(ros2(999_999_999).stamp_ns(), Ok(3_999_999_999));
+        assert_eq!(ros1(5).stamp_ns(), Ok(3_000_000_005));
+        for e in [ros2(1_000_000_000).stamp_ns(), ros1(u32::MAX).stamp_ns()] {
+            assert!(e.unwrap_err().contains("not below 10⁹"));
+        }
     }
 
     #[test]
