@@ -28,6 +28,7 @@ __all__ = [
     "read_csv",
     "read_table_file",
     "read_description",
+    "implausible",
     "write_run",
     "write_table_file",
     "write_csv",
