@@ -113,3 +113,18 @@ def test_a_vendors_header_is_pointed_at_a_column_map(tmp_path, sim):
                            "--out", str(tmp_path / "n.csv")], capture_output=True, text=True)
     assert done.returncode == 65 and "--map" not in done.stderr, done.stderr
     assert "; the initial state comes from a truth CSV" in done.stderr, done.stderr
+
+
+def test_options_that_would_be_ignored_are_refused(tmp_path, sim):
+    csv, parquet = tmp_path / "imu.csv", tmp_path / "imu.parquet"
+    sim.imu.write(csv)
+    sim.imu.write(parquet)
+    map_path = write_map(tmp_path, map_of())
+    for args, needle in [
+        (["integrate", str(parquet), "--map", str(map_path)], "--map: reads a vendor's CSV"),
+        (["integrate", str(csv), "--topic", "/imu"], "--topic: chooses what to read from a ROS bag"),
+        (["allan", str(csv), "--receive-time"], "--receive-time: chooses what to read from a ROS bag"),
+    ]:
+        done = subprocess.run([imukit_bin(), *args, "--out", str(tmp_path / "o.csv")], capture_output=True, text=True)
+        assert done.returncode == 65 and needle in done.stderr, (args, done.stderr)
+        assert not (tmp_path / "o.csv").exists()

@@ -91,7 +91,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             map.attach(&input)?;
-            bag.attach(&[Some(&input), init.as_deref()]);
+            bag.attach(&[Some(&input), init.as_deref()])?;
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -160,7 +160,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             map.attach(&imu)?;
-            bag.attach(&[Some(&imu), gnss.as_deref(), init.as_deref()]);
+            bag.attach(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
             fuse::run(&fuse::Args {
                 imu: &imu,
                 gnss: gnss.as_deref(),
@@ -211,7 +211,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
         } => {
             map.attach(&input)?;
-            bag.attach(&[Some(&input)]);
+            bag.attach(&[Some(&input)])?;
             orient::run(
                 &input,
                 filter,
@@ -228,7 +228,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             bag,
             out,
         } => {
-            bag.attach(&[Some(&truth), Some(&estimate)]);
+            bag.attach(&[Some(&truth), Some(&estimate)])?;
             compare::run(&truth, &estimate, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
@@ -247,7 +247,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             figure,
         } => {
             map.attach(&input)?;
-            bag.attach(&[Some(&input)]);
+            bag.attach(&[Some(&input)])?;
             allan::run(
                 &input,
                 &columns,
@@ -270,7 +270,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             figure,
         } => {
             map.attach(&input)?;
-            bag.attach(&[Some(&input)]);
+            bag.attach(&[Some(&input)])?;
             identify::run(
                 &input,
                 &columns,
@@ -309,8 +309,33 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
 impl crate::cli::BagArgs {
     /// Names the topics (`--topic`) as the ones to read from each of `inputs` that is a bag, at
     /// the recorder's receive times with `--receive-time`.
-    fn attach(&self, inputs: &[Option<&std::path::Path>]) {
+    ///
+    /// # Errors
+    /// `--topic` or `--receive-time` given when no input is a bag: they would be ignored.
+    fn attach(&self, inputs: &[Option<&std::path::Path>]) -> Result<(), CliError> {
         use imukit::io::bag::{Clock, Selection};
+        let is_bag =
+            |p: &&std::path::Path| imukit::io::TableFormat::of(p) == imukit::io::TableFormat::Mcap;
+        if (!self.topics.is_empty() || self.receive_time) && !inputs.iter().flatten().any(is_bag) {
+            let files: Vec<String> = inputs
+                .iter()
+                .flatten()
+                .map(|p| p.display().to_string())
+                .collect();
+            return Err(imukit::Error::Invalid {
+                field: if self.topics.is_empty() {
+                    "--receive-time".into()
+                } else {
+                    "--topic".into()
+                },
+                message: format!(
+                    "chooses what to read from a ROS bag (.mcap, .db3, .bag, a bag's folder); \
+                     none of the inputs is one ({})",
+                    files.join(", ")
+                ),
+            }
+            .into());
+        }
         for input in inputs.iter().flatten() {
             if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
                 let clock = if self.receive_time {
@@ -327,14 +352,30 @@ impl crate::cli::BagArgs {
                 );
             }
         }
+        Ok(())
     }
 }
 
 impl crate::cli::MapArg {
     /// Reads the column map (`--map FILE`) and attaches it to `input`: every reader of the
     /// input then reads it through the map.
+    ///
+    /// # Errors
+    /// An unreadable map; a map given for an input that is not CSV (whose columns are
+    /// imukit's already: the map would be ignored).
     fn attach(&self, input: &std::path::Path) -> Result<(), CliError> {
         if let Some(m) = &self.map {
+            let format = imukit::io::TableFormat::of(input);
+            if format != imukit::io::TableFormat::Csv {
+                return Err(imukit::Error::Invalid {
+                    field: "--map".into(),
+                    message: format!(
+                        "reads a vendor's CSV; {} is not CSV: its columns are imukit's already",
+                        input.display()
+                    ),
+                }
+                .into());
+            }
             imukit::io::column_map::attach(input, imukit::io::column_map::ColumnMap::read(m)?);
         }
         Ok(())
