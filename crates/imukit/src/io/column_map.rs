@@ -242,7 +242,21 @@ impl ColumnMap {
                 field(&columns[1])?,
                 field(&columns[2])?,
             ];
-            used.extend(fields);
+            // One column of the file is one quantity on one axis: read twice, it would be the
+            // same reading on two axes (or the time and a reading) without a word.
+            for (f, name) in fields.iter().zip(columns.iter()) {
+                if used.contains(f) {
+                    return Err(Error::CsvFormat {
+                        file: file.into(),
+                        message: format!(
+                            "the column map {} reads column {name:?} twice: each column of the \
+                             file is one quantity on one axis",
+                            self.origin
+                        ),
+                    });
+                }
+                used.push(*f);
+            }
             for (row, name) in self.rotation.iter().zip(imukit) {
                 names.push((*name).to_string());
                 sources.push(Source::Combination(
@@ -420,5 +434,27 @@ axes = ["x", "-y", "-z"]
             m.contains("v.csv") && m.contains("v.toml names column \"AccZ\""),
             "{m}"
         );
+        // One column read for two axes, or for the time and an axis, is refused.
+        for (twice, column) in [
+            (
+                MAP.replace("\"AccY\", \"AccZ\"", "\"AccY\", \"AccY\""),
+                "AccY",
+            ),
+            (MAP.replace("[\"GyrX\"", "[\"Timestamp\""), "Timestamp"),
+            (MAP.replace("[\"MagX\"", "[\"AccX\""), "AccX"),
+        ] {
+            let map = ColumnMap::from_toml(&twice, "v.toml").unwrap();
+            let m = map
+                .resolve(
+                    &header("Timestamp,AccX,AccY,AccZ,GyrX,GyrY,GyrZ,MagX,MagY,MagZ"),
+                    Path::new("v.csv"),
+                )
+                .unwrap_err()
+                .to_string();
+            assert!(
+                m.contains("v.csv") && m.contains(&format!("reads column \"{column}\" twice")),
+                "{m}"
+            );
+        }
     }
 }
