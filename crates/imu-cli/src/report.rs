@@ -72,13 +72,21 @@ pub fn warn(message: &str) {
     crate::err_line!("imukit: warning: {message}");
 }
 
+/// How a user declares a file's units: the fix every unit-slip warning names.
+const DECLARE_UNITS: &str = "declare the file's units with --map, docs/formats.md";
+
 /// Warns about IMU readings in `path` that look like a unit slip (g as m/s², °/s as rad/s, ms
-/// as s: [`imukit::io::plausible`]).
+/// as s: [`imukit::io::plausible`]), reading its first rows.
 pub fn warn_implausible(path: &std::path::Path) {
-    for w in imukit::io::plausible::file_readings(
-        path,
-        "declare the file's units with --map, docs/formats.md",
-    ) {
+    for w in imukit::io::plausible::file_readings(path, DECLARE_UNITS) {
+        warn(&w);
+    }
+}
+
+/// [`warn_implausible`] on the readings of `path` already in memory (`imu`).
+pub fn warn_implausible_read(imu: &imukit::Table, path: &std::path::Path) {
+    let source = path.display().to_string();
+    for w in imukit::io::plausible::readings(imu, &source, DECLARE_UNITS) {
         warn(&w);
     }
 }

@@ -133,7 +133,24 @@ fn implausible(
     values: PyReadonlyArray2<'_, f64>,
     source: &str,
 ) -> PyResult<Vec<String>> {
-    let t = table_in("values", columns, &values)?;
+    // Only the rows looked at are copied.
+    let v = values.as_array();
+    if v.ncols() != columns.len() {
+        return Err(crate::errors::shape_error(format!(
+            "values has {} columns but {} column names",
+            v.ncols(),
+            columns.len()
+        )));
+    }
+    let t = Table {
+        columns,
+        data: v
+            .rows()
+            .into_iter()
+            .take(imukit::io::plausible::HEAD_ROWS)
+            .flat_map(|r| r.to_vec())
+            .collect(),
+    };
     Ok(imukit::io::plausible::readings(
         &t,
         source,

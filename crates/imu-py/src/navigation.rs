@@ -77,6 +77,24 @@ fn read_planar<'py>(py: Python<'py>, path: &str) -> PyResult<TableOut<'py>> {
     table_out(py, planar::samples_table(&samples))
 }
 
+/// The settings a table's description may fix, as the keywords give them (`None`: left out).
+fn nav_asked(
+    nav_frame: Option<&str>,
+    accel_sign: Option<&str>,
+    gravity_m_s2: Option<f64>,
+    earth: Option<&str>,
+    earth_gravity: Option<&str>,
+) -> PyResult<NavAsked> {
+    Ok(NavAsked {
+        nav_frame: choice_opt("nav_frame", nav_frame)?,
+        accel_sign: choice_opt("accel_sign", accel_sign)?,
+        gravity_m_s2,
+        earth: choice_opt("earth", earth)?,
+        earth_gravity: choice_opt("earth_gravity", earth_gravity)?,
+        conventions: None,
+    })
+}
+
 /// 3D strapdown of an IMU table (rates or increments) from an initial state: the first row of
 /// a truth table (`initial_columns`, `initial_values`) or its parts.
 #[pyfunction]
@@ -119,14 +137,7 @@ fn strapdown<'py>(
     described: DescribedIn<'py>,
 ) -> PyResult<(DescribedOut<'py>, Vec<String>)> {
     let substeps = usize::try_from(non_negative("substeps", substeps)?).unwrap_or(usize::MAX);
-    let asked = NavAsked {
-        nav_frame: choice_opt("nav_frame", nav_frame)?,
-        accel_sign: choice_opt("accel_sign", accel_sign)?,
-        gravity_m_s2,
-        earth: choice_opt("earth", earth)?,
-        earth_gravity: choice_opt("earth_gravity", earth_gravity)?,
-        conventions: None,
-    };
+    let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
     // What the tables say they hold fills the settings left out, and refuses an argument that
     // contradicts it, as the command line does with its files.
@@ -258,14 +269,7 @@ fn fuse<'py>(
         Scenario(ScenarioSpec),
         Part(PartModel),
     }
-    let asked = NavAsked {
-        nav_frame: choice_opt("nav_frame", nav_frame)?,
-        accel_sign: choice_opt("accel_sign", accel_sign)?,
-        gravity_m_s2,
-        earth: choice_opt("earth", earth)?,
-        earth_gravity: choice_opt("earth_gravity", earth_gravity)?,
-        conventions: None,
-    };
+    let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
     let model = match imu_model {
         Some(imu) => {

@@ -113,7 +113,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         zupt: a.zupt,
     };
     let imu = read_table_as(a.imu, Role::Readings)?;
-    crate::report::warn_implausible(a.imu);
+    crate::report::warn_implausible_read(&imu, a.imu);
     let (setup, start) = match (a.scenario, &a.model) {
         (Some(path), _) => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));

@@ -131,6 +131,32 @@ impl Description {
         }
     }
 
+    /// What a navigation estimate of `kind` holds: its frame, its Earth (`earth_gravity`:
+    /// `None` for the flat one, else the WGS-84 gravity model) and the flat Earth's gravity
+    /// `gravity_m_s2`.
+    #[must_use]
+    pub fn of_navigation(
+        kind: TableKind,
+        nav_frame: NavFrameName,
+        earth_gravity: Option<imu_core::earth::GravityModel>,
+        gravity_m_s2: f64,
+    ) -> Self {
+        let (earth, earth_gravity, gravity_m_s2) = match earth_gravity {
+            None => (EarthName::Flat, None, Some(gravity_m_s2)),
+            Some(model) => {
+                let (gravity, g) = wgs84_gravity(model);
+                (EarthName::Wgs84, Some(gravity), g)
+            }
+        };
+        Self {
+            nav_frame: Some(nav_frame),
+            earth: Some(earth),
+            earth_gravity,
+            gravity_m_s2,
+            ..Self::of_kind(kind)
+        }
+    }
+
     /// The same description for a table of another kind.
     #[must_use]
     pub fn with_kind(&self, kind: TableKind) -> Self {

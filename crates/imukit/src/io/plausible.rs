@@ -16,6 +16,9 @@ use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table};
 /// The widest range of a MEMS gyroscope, rad/s (2000 °/s).
 const MAX_MEMS_RATE_RAD_S: f64 = 2000.0 * core::f64::consts::PI / 180.0;
 
+/// The rows looked at, the first of a table or file: enough for a median, little to read.
+pub const HEAD_ROWS: usize = 20_000;
+
 /// The median of `v` (NaN when empty), `v` reordered.
 fn median(v: &mut [f64]) -> f64 {
     if v.is_empty() {
@@ -37,10 +40,20 @@ fn norms(t: &Table, names: &[&str; 3]) -> Option<Vec<f64>> {
 }
 
 /// What looks like a unit slip in the IMU readings `t` read from `source` (a file, a table's
-/// name), each a sentence naming the column, the figure and the likely unit; `fix` is the
-/// option or key that declares units (`--map`, the map's `unit`).
+/// name), on its first [`HEAD_ROWS`] rows, each a sentence naming the column, the figure and
+/// the likely unit; `fix` is the option or key that declares units (`--map`, the map's `unit`).
 #[must_use]
 pub fn readings(t: &Table, source: &str, fix: &str) -> Vec<String> {
+    let head;
+    let t = if t.rows() > HEAD_ROWS {
+        head = Table {
+            columns: t.columns.clone(),
+            data: t.data[..HEAD_ROWS * t.columns.len()].to_vec(),
+        };
+        &head
+    } else {
+        t
+    };
     let mut out = Vec::new();
     if let Some(mut a) = norms(t, &ACCEL_COLUMNS)
         && a.len() >= 2
@@ -97,11 +110,8 @@ pub fn readings(t: &Table, source: &str, fix: &str) -> Vec<String> {
     out
 }
 
-/// The rows [`file_readings`] looks at: enough for a median, little to read.
-const HEAD_ROWS: usize = 20_000;
-
-/// [`readings`] of the IMU file at `path` (through its attached column map, if any), on its
-/// first rows; nothing when it has no IMU columns or cannot be read (the job that reads it says
+/// [`readings`] of the IMU file at `path` (through its attached column map, if any), of which
+/// only the first [`HEAD_ROWS`] rows are read; nothing when it has no IMU columns or cannot be read (the job that reads it says
 /// why).
 #[must_use]
 pub fn file_readings(path: &std::path::Path, fix: &str) -> Vec<String> {

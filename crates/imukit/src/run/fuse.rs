@@ -1758,21 +1758,12 @@ impl FuseSetup {
     /// a fused table in the setup's frame, on its Earth, with its gravity.
     #[must_use]
     pub fn description(&self) -> crate::io::description::Description {
-        use crate::io::description::{Description, wgs84_gravity};
-        let (earth, earth_gravity, gravity_m_s2) = match self.earth {
-            None => (EarthName::Flat, None, Some(self.gravity_m_s2)),
-            Some(model) => {
-                let (gravity, g) = wgs84_gravity(model);
-                (EarthName::Wgs84, Some(gravity), g)
-            }
-        };
-        Description {
-            nav_frame: Some(self.nav_frame),
-            earth: Some(earth),
-            earth_gravity,
-            gravity_m_s2,
-            ..Description::of_kind(crate::io::schema::TableKind::Fused)
-        }
+        crate::io::description::Description::of_navigation(
+            crate::io::schema::TableKind::Fused,
+            self.nav_frame,
+            self.earth,
+            self.gravity_m_s2,
+        )
     }
 }
 

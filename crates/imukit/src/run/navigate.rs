@@ -21,7 +21,7 @@ use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
-use crate::io::description::{Described, Description, Origin, wgs84_gravity};
+use crate::io::description::{Described, Description, Origin};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{Gaps, TimedRows, check_increasing};
 use crate::io::schema::TableKind;
@@ -430,20 +430,12 @@ impl NavSetup {
     /// What a navigation table made with this setup holds ([`Description`]).
     #[must_use]
     pub fn description(&self) -> Description {
-        let (earth, earth_gravity, gravity_m_s2) = match &self.earth {
-            None => (EarthName::Flat, None, Some(self.gravity_m_s2)),
-            Some(e) => {
-                let (gravity, g) = wgs84_gravity(e.gravity);
-                (EarthName::Wgs84, Some(gravity), g)
-            }
-        };
-        Description {
-            nav_frame: Some(self.nav_frame),
-            earth: Some(earth),
-            earth_gravity,
-            gravity_m_s2,
-            ..Description::of_kind(TableKind::Navigation)
-        }
+        Description::of_navigation(
+            TableKind::Navigation,
+            self.nav_frame,
+            self.earth.map(|e| e.gravity),
+            self.gravity_m_s2,
+        )
     }
 }
 

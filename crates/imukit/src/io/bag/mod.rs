@@ -549,9 +549,6 @@ fn mcap_lengths_fit(opcode: u8, data: &[u8]) -> core::result::Result<(), String>
             let n = self.uint(4, what)?;
             self.skip(n, what)
         }
-        fn bytes32(&mut self, what: &str) -> core::result::Result<(), String> {
-            self.string(what)
-        }
         fn string_map(&mut self, what: &str) -> core::result::Result<(), String> {
             let n = self.uint(4, what)?;
             let Some(map) = usize::try_from(n).ok().and_then(|n| self.0.get(..n)) else {
@@ -581,7 +578,7 @@ fn mcap_lengths_fit(opcode: u8, data: &[u8]) -> core::result::Result<(), String>
             w.uint(2, "the schema id")?;
             w.string("the schema name")?;
             w.string("the schema encoding")?;
-            w.bytes32("the schema data")
+            w.string("the schema data") // a u32 length and its bytes, as a string
         }
         // Channel: id, schema id, topic, message encoding, metadata.
         0x04 => {
