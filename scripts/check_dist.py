@@ -71,6 +71,8 @@ def check_sdist(sdist: Path, version: str) -> None:
     for member in needed:
         if f"{top}/{member}" not in names:
             fail(f"{sdist.name}: {member} missing")
+    if f"{top}/crates/imukit/examples/study/tunnel.toml" not in names:
+        fail(f"{sdist.name}: the examples (crates/imukit/examples, built into the library) are missing")
     if not any(n.startswith(f"{top}/crates/imukit/presets/") for n in names):
         fail(f"{sdist.name}: the presets (crates/imukit/presets) are missing")
 

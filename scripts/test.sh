@@ -75,14 +75,18 @@ python -m mypy.stubtest imukit._core
 
 section "Python tests (the installed wheel)"
 python -m pytest -q crates/imu-py/tests tests/python --doctest-glob='*.md' README.md docs
-python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth imukit._table
+python -m pytest -q --doctest-modules --pyargs imukit.plot imukit._monte_carlo imukit._orientation imukit._sensor imukit._truth imukit._table imukit._examples
 
 section "Hostile input (a short seeded run; see tests/fuzz/hostile.py for a long one)"
 python tests/fuzz/hostile.py --cases 400 --seed 1
 
-section "Examples"
+section "Examples (written by the installed wheel into an empty folder: no checkout needed)"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+repo=$PWD
+cd "$out"
+imukit --quiet example all
+diff -r "$repo/examples" examples
 for f in examples/*.toml; do
   name=$(basename "$f" .toml)
   imukit simulate "$f" --out "$out/${name}_imu.csv" --truth "$out/${name}_truth.csv"
@@ -106,6 +110,7 @@ imukit plot "$out/orient_err_ahrsfilter.csv" --out "$out/orient_err.png"
 imukit exercise --out-dir "$out/exercise"
 imukit study examples/study/tunnel.toml --out "$out/tunnel.csv" --plot "$out/tunnel.png"
 imukit study examples/study/tunnel_wheels.toml --out "$out/wheels.csv" --plot "$out/wheels.png"
+cd "$repo"
 
 section "NumPy comparison (agreement checked; the ratios at this small N are not the benchmark)"
 python benches/compare_numpy.py --sizes 1e4

@@ -1,7 +1,7 @@
 """Every example in the README and the topic guides (docs/*.md) runs:
 
 * ```sh blocks run in order, page by page, with bash (-e, -u, pipefail) in a fresh folder that
-  holds a copy of examples/, with `imukit` the command under test (IMUKIT_BIN);
+  holds the examples as `imukit example all` writes them, with `imukit` the command under test (IMUKIT_BIN);
 * ```python blocks without prompts run in order in one namespace per page, in that folder; the
   blocks with `>>>` prompts are doctests (scripts/test.sh passes the pages to pytest's doctest);
 * every Python example passes `mypy --strict` against the installed package;
@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -44,7 +43,10 @@ def imukit_bin() -> str:
 
 @pytest.fixture()
 def workdir(tmp_path):
-    shutil.copytree(ROOT / "examples", tmp_path / "examples")
+    # The examples come from the command under test (`imukit example all`), as a user without a
+    # checkout gets them.
+    subprocess.run([imukit_bin(), "--quiet", "example", "all", "--out-dir", str(tmp_path / "examples")],
+                   check=True)
     bindir = tmp_path / "_bin"
     bindir.mkdir()
     (bindir / "imukit").symlink_to(imukit_bin())

@@ -104,8 +104,9 @@ def test_a_study_from_python_equals_the_cli_on_any_threads_and_on_dask(tmp_path)
         np.sqrt(np.mean(one.table["stim300_rms_error_m"][-1] ** 2)))
     out = tmp_path / "study.csv"
     subprocess.run([imukit_bin(), "study", str(study), "--out", str(out)], check=True, capture_output=True)
-    cli = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert np.array_equal(cli, one.table.values)
+    cli = imukit.read(out)
+    assert cli.columns == one.table.columns and cli.description["kind"] == "study"
+    assert np.array_equal(cli.values, one.table.values)
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:

@@ -532,6 +532,17 @@ pub enum Command {
         #[arg(long, default_value = imukit::scenario::builtin::DEMO)]
         scenario: String,
     },
+    /// Writes shipped examples (scenario files, data, Python scripts) where the guides' commands
+    /// read them (`examples/track.toml`), or lists them. A file already there is left alone if
+    /// it is the shipped one and never overwritten if it differs.
+    Example {
+        /// Examples to write (`all` for every file); none lists them.
+        names: Vec<String>,
+        /// Folder the examples go into, keeping their places in it (`study/tunnel.toml` reads
+        /// `../car_tunnel.toml`).
+        #[arg(long, default_value = imukit::examples::DEFAULT_FOLDER)]
+        out_dir: PathBuf,
+    },
     /// Lists the built-in scenarios, or prints one as an editable scenario file.
     Scenario {
         /// Name of a built-in scenario.

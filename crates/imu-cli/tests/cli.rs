@@ -58,7 +58,10 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
     let dir = dir.path();
     let list = imukit().arg("scenario").output().unwrap();
     let names = String::from_utf8(list.stdout).unwrap();
-    assert_eq!(names.lines().count(), 6);
+    assert_eq!(
+        names.lines().count(),
+        imukit::scenario::builtin::NAMES.len()
+    );
     for name in names.lines() {
         let toml = imukit().args(["scenario", name]).output().unwrap();
         assert!(toml.status.success());
@@ -1524,7 +1527,7 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_filter_reset_to_the_f
     std::fs::write(
         dir.join("study.toml"),
         format!(
-            "scenario = \"{}\"\npresets = [\"mpu-6050\", \"stim300\"]\nruns = 2\n",
+            "scenario = \"{}\"\npresets = [\"mpu-6050\", \"stim300\"]\nruns = 2\nsmooth = true\n",
             scenario.display()
         ),
     )
@@ -1552,13 +1555,28 @@ fn study_compares_presets_through_the_tunnel_and_reports_a_filter_reset_to_the_f
         err.contains("not described alike: mpu-6050: no gyroscope bias drift"),
         "{err}"
     );
-    let header = std::fs::read_to_string(dir.join("t.csv")).unwrap();
-    let header = header.lines().next().unwrap();
+    let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+    let mut lines = text.lines();
+    assert!(
+        lines.next().unwrap().contains("\"kind\": \"study\""),
+        "{text}"
+    );
     assert_eq!(
-        header,
-        "t_s,mpu-6050_rms_error_m,mpu-6050_sigma_m,stim300_rms_error_m,stim300_sigma_m"
+        lines.next().unwrap(),
+        "t_s,mpu-6050_rms_error_m,mpu-6050_sigma_m,mpu-6050_smoothed_rms_error_m,\
+         stim300_rms_error_m,stim300_sigma_m,stim300_smoothed_rms_error_m"
     );
     assert!(std::fs::metadata(dir.join("t.png")).unwrap().len() > 1000);
+    // The table is drawn again by `imukit plot`, recognised as a study (smoothed curves too).
+    let (code, err) = run_in(dir, &["plot", "t.csv", "--out", "again.svg"]);
+    assert_eq!(code, Some(0), "{err}");
+    let svg = std::fs::read_to_string(dir.join("again.svg")).unwrap();
+    assert!(
+        svg.contains("Horizontal position error through the GNSS outage")
+            && svg.contains("dotted: smoothed")
+            && svg.contains("stim300"),
+        "{svg}"
+    );
     // A bad figure name is refused before any run; an output over the study file is refused.
     let (code, err) = run_in(
         dir,

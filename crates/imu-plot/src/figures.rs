@@ -149,6 +149,15 @@ pub fn plot_tables(
     if kind == TableKind::Allan {
         return allan_from_tables(out, &files, &names.join(", "), size);
     }
+    if kind == TableKind::Study {
+        let [(_, table)] = files.as_slice() else {
+            return Err(PlotError::Invalid {
+                field: "plot".into(),
+                message: "an outage study is drawn alone: give one study table".into(),
+            });
+        };
+        return crate::study::study_figure(out, table);
+    }
     let panels: Vec<Panel> = kind
         .panels()
         .iter()

@@ -20,6 +20,9 @@ pub enum TableKind {
     Errors,
     /// An orientation output (`t_s, q_*, yaw_rad, pitch_rad, roll_rad`, from `imukit orient`).
     Orientation,
+    /// An outage study's curves (`t_s, <preset>_rms_error_m, <preset>_sigma_m…`, from
+    /// `imukit study`), drawn on a log axis.
+    Study,
 }
 
 /// Column names for a message: all of them, or the first 20 and how many there are.
@@ -49,6 +52,7 @@ impl TableKind {
             Kind::Allan => Self::Allan,
             Kind::Errors | Kind::OrientationErrors => Self::Errors,
             Kind::Orientation => Self::Orientation,
+            Kind::Study => Self::Study,
             Kind::Gnss | Kind::GnssGeodetic | Kind::Baro | Kind::Odometer => return None,
         })
     }
@@ -63,7 +67,7 @@ impl TableKind {
                 source,
                 format!(
                     "unknown kind of CSV (columns: {}); imukit plots truth, IMU readings, navigation \
-                     output, orientation output, Allan deviation and error tables",
+                     output, orientation output, Allan deviation, error and outage-study tables",
                     shown(columns)
                 ),
             )
@@ -80,6 +84,7 @@ impl TableKind {
             Self::Allan => "Allan deviation",
             Self::Errors => "errors against truth",
             Self::Orientation => "orientation output",
+            Self::Study => "outage study",
         }
     }
 
@@ -93,6 +98,7 @@ impl TableKind {
             Self::Allan => "allan",
             Self::Errors => "errors",
             Self::Orientation => "orientation",
+            Self::Study => "study",
         }
     }
 
@@ -108,6 +114,7 @@ impl TableKind {
             Self::Allan,
             Self::Errors,
             Self::Orientation,
+            Self::Study,
         ]
         .into_iter()
         .find(|k| k.key() == key)
@@ -115,7 +122,7 @@ impl TableKind {
             invalid(
                 "kind",
                 format!(
-                    "unknown kind {key:?}: truth, imu, navigation, orientation, allan or errors"
+                    "unknown kind {key:?}: truth, imu, navigation, orientation, allan, errors or study"
                 ),
             )
         })
@@ -138,7 +145,7 @@ impl TableKind {
     /// attitudes, readings in the body frame it implies), so that its figure names the frame.
     #[must_use]
     pub fn has_frame(self) -> bool {
-        !matches!(self, Self::Allan)
+        !matches!(self, Self::Allan | Self::Study)
     }
 
     /// The time-series panels of the kind's figure (none for Allan tables, drawn on log axes).
@@ -233,7 +240,7 @@ impl TableKind {
                     &[("q_w", "w"), ("q_x", "x"), ("q_y", "y"), ("q_z", "z")].map(own),
                 ),
             ],
-            Self::Allan => Vec::new(),
+            Self::Allan | Self::Study => Vec::new(),
         }
     }
 }

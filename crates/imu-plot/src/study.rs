@@ -1,5 +1,6 @@
 //! The outage-study figure: per IMU preset, the Monte Carlo RMS horizontal position error
-//! through the outage (solid) and the filter's own one-sigma (dashed), log scale.
+//! through the outage (solid), the filter's own one-sigma (dashed) and, for a study run with
+//! smoothing, the smoothed estimate's RMS error (dotted), log scale.
 use std::path::Path;
 
 use imukit::Table;
@@ -9,8 +10,12 @@ use crate::PlotError;
 use crate::allan::log_range;
 use crate::draw::{COLORS, draw_legend, err, key, tick, write_figure};
 
+/// The suffix of a preset's smoothed-error column.
+const SMOOTHED: &str = "_smoothed_rms_error_m";
+
 /// Draws a study table (`t_s`, then per preset `<preset>_rms_error_m` and `<preset>_sigma_m`,
-/// as `imukit::run::study` writes it) into `path` (SVG or PNG).
+/// and `<preset>_smoothed_rms_error_m` with smoothing, as `imukit::run::study` writes it) into
+/// `path` (SVG or PNG).
 ///
 /// # Errors
 /// A table without `t_s` or without a preset's pair of columns, nothing positive to draw, or
@@ -26,6 +31,7 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
     let presets: Vec<&str> = table
         .columns
         .iter()
+        .filter(|c| !c.ends_with(SMOOTHED))
         .filter_map(|c| c.strip_suffix("_rms_error_m"))
         .collect();
     let mut curves = Vec::with_capacity(presets.len());
@@ -35,11 +41,12 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
         let (Some(error), Some(sigma)) = (error, sigma) else {
             return Err(fail(format!("the study table lacks {p}_sigma_m")));
         };
-        curves.push((*p, error, sigma));
+        let smoothed = table.column(&format!("{p}{SMOOTHED}"));
+        curves.push((*p, error, sigma, smoothed));
     }
     let positive = curves
         .iter()
-        .flat_map(|(_, e, s)| e.iter().chain(s))
+        .flat_map(|(_, e, s, m)| e.iter().chain(s).chain(m.iter().flat_map(|m| m.iter())))
         .copied()
         .filter(|v| *v > 0.0 && v.is_finite());
     let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
@@ -63,11 +70,15 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
         chart
             .configure_mesh()
             .x_desc("time since the outage began (s)")
-            .y_desc("m (solid: RMS over runs; dashed: filter's 1σ)")
+            .y_desc(if curves.iter().any(|c| c.3.is_some()) {
+                "m (solid: RMS over runs; dashed: filter's 1σ; dotted: smoothed)"
+            } else {
+                "m (solid: RMS over runs; dashed: filter's 1σ)"
+            })
             .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(err)?;
-        for (k, (name, error, sigma)) in curves.iter().enumerate() {
+        for (k, (name, error, sigma, smoothed)) in curves.iter().enumerate() {
             let color = COLORS[k % COLORS.len()];
             let line = |v: &[f64]| -> Vec<(f64, f64)> {
                 t.iter()
@@ -89,6 +100,16 @@ pub fn study_figure(path: &Path, table: &Table) -> Result<(), PlotError> {
                     color.mix(0.8).stroke_width(2),
                 ))
                 .map_err(err)?;
+            if let Some(smoothed) = smoothed {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        line(smoothed),
+                        2,
+                        4,
+                        color.stroke_width(2),
+                    ))
+                    .map_err(err)?;
+            }
         }
         draw_legend(&mut chart)
     })

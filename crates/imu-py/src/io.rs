@@ -164,6 +164,30 @@ fn run_path(out: &str, run: u64, runs: u64) -> String {
     run_file(Path::new(out), run, runs).display().to_string()
 }
 
+/// The shipped examples: (name, what) of each.
+#[pyfunction]
+fn example_list() -> Vec<(&'static str, &'static str)> {
+    imukit::examples::EXAMPLES
+        .iter()
+        .map(|e| (e.name, e.what))
+        .collect()
+}
+
+/// Writes the examples named under `folder`: (path, written) of each file, `written` false for a
+/// file already there with the shipped text.
+#[pyfunction]
+fn write_examples(names: Vec<String>, folder: &str) -> PyResult<Vec<(String, bool)>> {
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let done = imukit::examples::write(&names, Path::new(folder)).map_err(refused)?;
+    Ok(done
+        .into_iter()
+        .map(|w| {
+            let new = matches!(w, imukit::examples::Written::New(_));
+            (w.path().display().to_string(), new)
+        })
+        .collect())
+}
+
 /// Adds this module's functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
@@ -173,5 +197,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_path, m)?)?;
     m.add_function(wrap_pyfunction!(read_description, m)?)?;
     m.add_function(wrap_pyfunction!(implausible, m)?)?;
+    m.add_function(wrap_pyfunction!(example_list, m)?)?;
+    m.add_function(wrap_pyfunction!(write_examples, m)?)?;
     Ok(())
 }

@@ -20,6 +20,7 @@
 //! | [`io`] | [`Table`] and CSV files (readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
 //! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
 //! | [`sensor`] | the core's sensor types with bias-instability filters on the heap (any length, as MATLAB) |
+//! | [`examples`] | the shipped examples (scenario files, data, Python scripts), written where the docs' commands read them |
 //! | [`choice`] | options chosen by name ([`choice::Choice`]): the names, the default, the refusal |
 //! | [`error`] | [`Error`]: what went wrong and where |
 //!
@@ -92,6 +93,7 @@
 #![forbid(unsafe_code)]
 pub mod choice;
 pub mod error;
+pub mod examples;
 pub mod io;
 pub mod motion;
 pub mod run;

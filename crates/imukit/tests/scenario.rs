@@ -370,3 +370,48 @@ fn body_rate_scenarios_reproduce_matlabs_platform_from_formulas_and_files() {
         "{e}"
     );
 }
+
+/// The built-in with GNSS: the car stands 20 s (a rest a filter can use), drives its loop back
+/// to the start, and its receiver gives 5 Hz fixes except in the 15 s outage.
+#[test]
+fn gnss_car_stands_drives_its_loop_and_loses_its_fixes() {
+    let sim = builtin::spec("gnss-car")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+        .simulate()
+        .unwrap();
+    let t = sim.truth.column("t_s").unwrap();
+    let (x, y) = (
+        sim.truth.column("pos_x_m").unwrap(),
+        sim.truth.column("pos_y_m").unwrap(),
+    );
+    let vx = sim.truth.column("vel_x_m_s").unwrap();
+    let n = t.len() - 1;
+    // 789 m of track: 20 s standing, two 10 s ramps at 1 m/s², the rest at 10 m/s.
+    let length = 600.0 + 60.0 * std::f64::consts::PI;
+    let duration = 20.0 + 20.0 + (length - 100.0) / 10.0;
+    assert!(
+        (t[n] - duration).abs() <= 0.01,
+        "within a sample: {} vs {duration}",
+        t[n]
+    );
+    assert!(
+        x[n].hypot(y[n]) < 1e-6,
+        "the loop closes: {} {}",
+        x[n],
+        y[n]
+    );
+    for k in 0..2000 {
+        assert!(x[k] == 0.0 && y[k] == 0.0 && vx[k] == 0.0, "row {k}");
+    }
+    assert!(vx[2100] > 0.9, "moving after the wait: {}", vx[2100]);
+    let gnss = sim.gnss.as_ref().expect("the receiver's fixes");
+    let tg = gnss.column("t_s").unwrap();
+    assert!(
+        tg.iter().all(|&s| !(60.0..75.0).contains(&s)),
+        "no fix in the outage"
+    );
+    let before = tg.iter().filter(|&&s| s < 60.0).count();
+    assert_eq!(before, 300, "5 Hz from t = 0");
+}

@@ -2,6 +2,7 @@
 mod allan;
 mod compare;
 mod demo;
+mod example;
 mod exercise;
 mod fuse;
 mod identify;
@@ -54,6 +55,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
+        Command::Example { names, out_dir } => example::run(&names, &out_dir),
         Command::Presets {
             name,
             params,

@@ -76,6 +76,8 @@ __all__ = [
     "truth_from_waypoints",
     "builtin_names",
     "builtin_toml",
+    "example_list",
+    "write_examples",
 ]
 
 DEFAULT_GRAVITY_M_S2: float
@@ -160,6 +162,8 @@ def quaternion_to_dcm(quaternion: npt.NDArray[np.float64]) -> npt.NDArray[np.flo
 def dcm_to_quaternion(dcm: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def builtin_names() -> list[str]: ...
 def builtin_toml(name: str) -> str: ...
+def example_list() -> list[tuple[str, str]]: ...
+def write_examples(names: list[str], folder: str) -> list[tuple[str, bool]]: ...
 
 @final
 class ImuSensor:

@@ -69,12 +69,12 @@ def _load(items: Sequence[TableOrPath], labels: Optional[Sequence[str]]) -> list
 
 def kind(table: Table, source: str = "table") -> str:
     """The kind of an imukit table from its columns: ``truth``, ``imu``, ``navigation``,
-    ``orientation``, ``allan`` or ``errors``; :class:`ImuError` for anything else."""
+    ``orientation``, ``allan``, ``errors`` or ``study``; :class:`ImuError` for anything else."""
     k = _core.table_kind(list(table.columns))
     if k is None:
         raise ImuError(
             f"{source}: unknown kind of table (columns: {', '.join(table.columns)}); imukit plots truth, "
-            "IMU readings, navigation output, orientation output, Allan deviation and error tables"
+            "IMU readings, navigation output, orientation output, Allan deviation, error and outage-study tables"
         )
     return k
 
@@ -167,6 +167,29 @@ def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = No
     return ax.figure
 
 
+def _study(table: Table, size_in: Optional[Tuple[float, float]], dpi: Optional[float]) -> Any:
+    """An outage study's figure, as ``imukit plot study.csv`` draws it: per preset the RMS error
+    (solid), the filter's one-sigma (dashed) and the smoothed error (dotted), log scale."""
+    plt = _pyplot()
+    fig = plt.figure(figsize=size_in or (9.0, 6.0), dpi=dpi, layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    t = table["t_s"]
+    presets = [c[: -len("_rms_error_m")] for c in table.columns
+               if c.endswith("_rms_error_m") and not c.endswith("_smoothed_rms_error_m")]
+    for k, preset in enumerate(presets):
+        colour = f"C{k}"
+        ax.semilogy(t, table[f"{preset}_rms_error_m"], "-", color=colour, label=preset)
+        ax.semilogy(t, table[f"{preset}_sigma_m"], "--", color=colour)
+        if f"{preset}_smoothed_rms_error_m" in table:
+            ax.semilogy(t, table[f"{preset}_smoothed_rms_error_m"], ":", color=colour)
+    ax.set_xlabel("time since the outage began (s)")
+    ax.set_ylabel("m (solid: RMS over runs; dashed: filter's 1σ; dotted: smoothed)")
+    ax.set_title("Horizontal position error through the GNSS outage")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig
+
+
 def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = _D["nav_frame"],
            size_in: Optional[Tuple[float, float]] = None, dpi: Optional[float] = None) -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
@@ -180,6 +203,10 @@ def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_fra
         if len(loaded) > 1:
             raise ImuError("overlay Allan curves by passing tau_s and a (T, k) adev to allan()")
         return allan(loaded[0][1], labels=None)
+    if k == "study":
+        if len(loaded) > 1:
+            raise ImuError("an outage study is drawn alone: give one study table")
+        return _study(loaded[0][1], size_in, dpi)
     panels = [p for p in _core.figure_panels(k)
               if any(c in t for _, t in loaded for c, _ in p[3])]
     with_path = k in ("truth", "navigation")

@@ -50,6 +50,9 @@ pub enum TableKind {
     Baro,
     /// Odometer readings ([`ODOMETER_COLUMNS`]).
     Odometer,
+    /// An outage study's curves (`t_s`, then per preset `<preset>_rms_error_m`,
+    /// `<preset>_sigma_m` and with smoothing `<preset>_smoothed_rms_error_m`; `run::study`).
+    Study,
 }
 
 impl Choice for TableKind {
@@ -69,6 +72,7 @@ impl Choice for TableKind {
         ("gnss-geodetic", Self::GnssGeodetic),
         ("baro", Self::Baro),
         ("odometer", Self::Odometer),
+        ("study", Self::Study),
     ];
 }
 
@@ -98,6 +102,7 @@ impl TableKind {
             Self::GnssGeodetic => &GNSS_EARTH_COLUMNS,
             Self::Baro => &BARO_COLUMNS,
             Self::Odometer => &ODOMETER_COLUMNS,
+            Self::Study => &TIME,
         }
     }
 
@@ -117,7 +122,7 @@ impl TableKind {
             Self::GnssGeodetic => &["lat_rad", "vel_n_m_s"],
             Self::Baro => &["baro_height_m"],
             Self::Odometer => &["speed_m_s"],
-            Self::Readings | Self::PlanarReadings | Self::Allan => &[],
+            Self::Readings | Self::PlanarReadings | Self::Allan | Self::Study => &[],
         }
     }
 
@@ -131,6 +136,24 @@ impl TableKind {
         let has = |c: &str| columns.iter().any(|h| h.as_ref() == c);
         if has("tau_s") && columns.iter().any(|c| c.as_ref().starts_with("adev_")) {
             return Some(Self::Allan);
+        }
+        // A study: time, and for each preset its error and the filter's one-sigma, nothing else.
+        let preset_of = |c: &str| {
+            c.strip_suffix("_smoothed_rms_error_m")
+                .or_else(|| c.strip_suffix("_rms_error_m"))
+                .or_else(|| c.strip_suffix("_sigma_m"))
+                .map(str::to_owned)
+        };
+        let rest = columns.iter().filter(|c| c.as_ref() != "t_s");
+        if has("t_s")
+            && columns.len() >= 3
+            && rest.clone().all(|c| preset_of(c.as_ref()).is_some())
+            && rest.clone().all(|c| {
+                let p = preset_of(c.as_ref()).unwrap_or_default();
+                has(&format!("{p}_rms_error_m")) && has(&format!("{p}_sigma_m"))
+            })
+        {
+            return Some(Self::Study);
         }
         let by_signature = [
             Self::Truth,
@@ -188,6 +211,33 @@ impl TableKind {
 mod tests {
     use super::*;
 
+    /// An outage study's table is told apart by its per-preset pairs, smoothed or not.
+    #[test]
+    fn a_study_is_recognised_by_its_preset_pairs() {
+        let study = [
+            "t_s",
+            "a_rms_error_m",
+            "a_sigma_m",
+            "b-2_rms_error_m",
+            "b-2_sigma_m",
+        ];
+        assert_eq!(TableKind::detect(&study), Some(TableKind::Study));
+        let smoothed = [
+            "t_s",
+            "a_rms_error_m",
+            "a_sigma_m",
+            "a_smoothed_rms_error_m",
+        ];
+        assert_eq!(TableKind::detect(&smoothed), Some(TableKind::Study));
+        assert_eq!(TableKind::detect(&["t_s", "a_rms_error_m"]), None);
+        assert_eq!(
+            TableKind::detect(&["t_s", "a_rms_error_m", "b_sigma_m"]),
+            None
+        );
+        let fused: Vec<&str> = FUSE_COLUMNS.to_vec();
+        assert_eq!(TableKind::detect(&fused), Some(TableKind::Fused));
+    }
+
     #[test]
     fn every_kind_is_recognised_by_its_own_columns() {
         for (name, kind) in TableKind::NAMES {
@@ -195,6 +245,7 @@ mod tests {
             match kind {
                 TableKind::Readings => columns.extend(GYRO_COLUMNS),
                 TableKind::Allan => columns.push("adev_gyro_x_rad_s"),
+                TableKind::Study => columns.extend(["stim300_rms_error_m", "stim300_sigma_m"]),
                 _ => {}
             }
             assert_eq!(TableKind::detect(&columns), Some(*kind), "{name}");

@@ -7,6 +7,7 @@
 //! | `rounded-rectangle` | 1 m × 1 m square with 0.1 m corner radius at 0.8 m/s, 2 kHz, one lap | the MATLAB trajectory tool, "Abgerundetes Viereck" |
 //! | `static` | level IMU at rest, 100 Hz, 10 s | — |
 //! | `platform-turn` | NED platform turning 360° in 4 s, then 360° in 2 s, 100 Hz, 600 samples | MATLAB's imuSensor page |
+//! | `gnss-car` | a car with a consumer IMU (ICM-42688-P preset) and a 5 Hz GNSS receiver: stands 20 s, then drives a 789 m loop of straights and quarter turns at up to 10 m/s, fixes lost for 15 s from t = 60 s; 100 Hz | — (the scenario of `imukit fuse`) |
 //! | `cart` | planar cart on a closed rail (20 m straights, 5 m half turns to the left) from [100, 100], starting and stopping at rest (2 m/s, 0.5 m/s²), 50 Hz | the planar cart exercise's exercise |
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_PI_2;
@@ -18,13 +19,14 @@ use crate::scenario::{
 };
 
 /// Names of the built-in scenarios.
-pub const NAMES: [&str; 6] = [
+pub const NAMES: [&str; 7] = [
     "figure8",
     "tilted-circle",
     "rounded-rectangle",
     "static",
     "platform-turn",
     "cart",
+    "gnss-car",
 ];
 
 /// The default scenario of `imukit demo`.
@@ -162,6 +164,51 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
                 }),
             );
             s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
+            s
+        }
+        "gnss-car" => {
+            let quarter = Segment::Arc {
+                arc_radius_m: 30.0,
+                arc_angle_rad: FRAC_PI_2,
+            };
+            let long = Segment::Straight { straight_m: 200.0 };
+            let short = Segment::Straight { straight_m: 100.0 };
+            let mut s = base(
+                100.0,
+                None,
+                TrajectorySpec::Track(TrackSpec {
+                    start_m: [0.0, 0.0, 0.0],
+                    heading_rad: 0.0,
+                    speed_m_s: 10.0,
+                    accel_m_s2: Some(1.0),
+                    segments: vec![
+                        Segment::Wait { wait_s: 20.0 },
+                        long,
+                        quarter,
+                        short,
+                        quarter,
+                        long,
+                        quarter,
+                        short,
+                        quarter,
+                    ],
+                }),
+            );
+            s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
+            s.imu.preset = Some("icm-42688-p".into());
+            s.imu.seed = Some(1);
+            s.gnss = Some(crate::scenario::gnss::GnssSpec {
+                rate_hz: Some(5.0),
+                horizontal_accuracy_m: Some(1.5),
+                vertical_accuracy_m: Some(3.0),
+                velocity_accuracy_m_s: Some(0.1),
+                decay_factor: Some(0.0),
+                outages: vec![crate::scenario::gnss::OutageSpec {
+                    start_s: 60.0,
+                    duration_s: 15.0,
+                }],
+                ..Default::default()
+            });
             s
         }
         _ => {
