@@ -148,3 +148,18 @@ def test_integrate_without_a_start_says_what_it_assumed(ned, tmp_path):
     r = subprocess.run([imukit_bin(), "integrate", str(imu), "--euler0-rad", "0", "0", "0",
                         "--out", str(tmp_path / "nav.csv")], capture_output=True, text=True, check=True)
     assert "at the origin, at rest (give" in r.stderr, r.stderr
+
+
+def test_figures_draw_a_described_ned_truth_as_ned():
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    import imukit.plot
+    sim = imukit.simulate({"duration_s": 2.0, "trajectory": {"type": "builtin", "name": "platform-turn"}})
+    assert sim.truth.description["nav_frame"] == "NED"
+    fig = imukit.plot.figure(sim.truth)
+    assert fig._suptitle.get_text().endswith("— NED")
+    with pytest.raises(imukit.ImuError, match="nav_frame: ENU contradicts"):
+        imukit.plot.figure(sim.truth, nav_frame="ENU")
+    with pytest.raises(imukit.ImuError, match="nav_frame: ENU contradicts"):
+        imukit.plot.animate(sim.truth, nav_frame="ENU")

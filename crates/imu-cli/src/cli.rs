@@ -90,6 +90,22 @@ pub struct BagArgs {
     pub receive_time: bool,
 }
 
+/// How a written ROS 2 bag names its IMU and when it starts (`--out NAME.mcap`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BagOutArgs {
+    /// The IMU's topic in a bag written (`--out NAME.mcap`; default /imu; the magnetometer's is
+    /// TOPIC/mag).
+    #[arg(long, value_name = "TOPIC")]
+    pub bag_topic: Option<String>,
+    /// The frame id of the IMU's messages in a bag written (default imu_link).
+    #[arg(long, value_name = "FRAME")]
+    pub bag_frame_id: Option<String>,
+    /// The stamp of time 0 in a bag written, seconds since 1970-01-01 UTC (default 0: a
+    /// simulated run's stamps start in 1970), such as 1700000000.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    pub bag_start_s: Option<f64>,
+}
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 #[allow(
@@ -102,7 +118,8 @@ pub enum Command {
     Simulate {
         /// The scenario file.
         scenario: PathBuf,
-        /// Where to write the IMU readings (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+        /// Where to write the IMU readings (CSV, or by extension `.parquet`, `.npy`, `.npz`; a
+        /// ROS 2 bag `.mcap` holds the truth and the fixes too).
         #[arg(long)]
         out: PathBuf,
         /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`).
@@ -134,6 +151,9 @@ pub enum Command {
         /// the ASL layout (nanosecond stamps; docs/formats.md).
         #[arg(long, value_parser = ["euroc"])]
         layout: Option<String>,
+        /// A bag's IMU topic, frame id and start stamp.
+        #[command(flatten)]
+        bag_out: BagOutArgs,
     },
     /// Strapdown navigation (3D) or planar dead reckoning (`--planar`) of IMU data.
     Integrate {
@@ -558,9 +578,10 @@ pub enum Command {
         /// The figure file (`.svg` or `.png`).
         #[arg(long)]
         out: PathBuf,
-        /// Navigation frame of the positions (NED paths are drawn east, north, up).
-        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
-        nav_frame: NavFrameName,
+        /// Navigation frame of the positions (NED paths are drawn east, north, up; default:
+        /// what the files' descriptions say, else ENU).
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+        nav_frame: Option<NavFrameName>,
         /// Size and resolution.
         #[command(flatten)]
         figure: FigureArgs,
@@ -586,9 +607,10 @@ pub enum Command {
         /// Seconds of motion per second of animation (default: the animation lasts 4 to 12 s).
         #[arg(long)]
         speed: Option<f64>,
-        /// Navigation frame of the truth (NED is drawn turned so that up is up).
-        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true, default_value_t)]
-        nav_frame: NavFrameName,
+        /// Navigation frame of the truth (NED is drawn turned so that up is up; default: what
+        /// the file's description says, else ENU).
+        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+        nav_frame: Option<NavFrameName>,
     },
     /// Prints a shell's completion script for imukit to standard output.
     Completions {

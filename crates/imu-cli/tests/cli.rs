@@ -2082,3 +2082,103 @@ fn fuse_without_fixes_navigates_a_walk_by_its_stances() {
         .sqrt();
     assert!(error < 7.54, "{error} m from the start after 754 m");
 }
+
+/// A bag's topic, frame id and start stamp are options of a bag output only, checked by name.
+#[test]
+fn bag_options_apply_to_a_bag_and_are_checked() {
+    let dir = temp_dir("bag-options");
+    let dir = dir.path();
+    std::fs::write(
+        dir.join("s.toml"),
+        "rate_hz = 100.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(
+        dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "run.mcap",
+            "--bag-topic",
+            "/sensors/imu",
+            "--bag-frame-id",
+            "imu",
+            "--bag-start-s",
+            "1700000000",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(
+        dir,
+        &[
+            "integrate",
+            "run.mcap",
+            "--topic",
+            "/sensors/imu",
+            "--out",
+            "nav.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    for (args, needle) in [
+        (
+            &["--out", "run.csv", "--bag-topic", "/x"][..],
+            "--bag-topic: applies to a ROS 2 bag",
+        ),
+        (
+            &["--out", "b.mcap", "--bag-topic", "imu"][..],
+            "--bag-topic: \"imu\" is not a ROS 2 topic name",
+        ),
+        (
+            &["--out", "b.mcap", "--bag-frame-id", "my frame"][..],
+            "--bag-frame-id:",
+        ),
+        (
+            &["--out", "b.mcap", "--bag-start-s", "-5"][..],
+            "--bag-start-s: -5 is not a ROS time stamp",
+        ),
+    ] {
+        let mut all = vec!["simulate", "s.toml"];
+        all.extend_from_slice(args);
+        let (code, err) = run_in(dir, &all);
+        assert_eq!(code, Some(65), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!dir.join("run.csv").exists() && !dir.join("b.mcap").exists());
+    }
+}
+
+/// The Allan deviation takes samples as evenly spaced: times that go back are refused by row,
+/// and a gap is said (for `identify` too, which reads the log the same way).
+#[test]
+fn allan_refuses_times_that_go_back_and_warns_of_gaps() {
+    let dir = temp_dir("allan-times");
+    let dir = dir.path();
+    let mut text = String::from("t_s,gyro_x_rad_s\n");
+    for k in (0..3000).filter(|k| !(1000..1500).contains(k)) {
+        let noise = ((k * 7919) % 1000) as f64 * 1e-6 - 5e-4;
+        text += &format!("{},{noise}\n", f64::from(k) * 0.01);
+    }
+    std::fs::write(dir.join("gap.csv"), text).unwrap();
+    for command in ["allan", "identify"] {
+        let (code, err) = run_in(dir, &[command, "gap.csv", "--out", "a.csv"]);
+        assert_eq!(code, Some(0), "{command}: {err}");
+        assert!(
+            err.contains("gap.csv: 1 interval(s) longer than 2.5 median intervals")
+                && err.contains("after row 1001"),
+            "{command}: {err}"
+        );
+    }
+    std::fs::write(
+        dir.join("back.csv"),
+        "t_s,gyro_x_rad_s\n0,0\n0.01,0\n0.005,0\n0.02,0\n",
+    )
+    .unwrap();
+    let (code, err) = run_in(dir, &["allan", "back.csv", "--out", "b.csv"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("back.csv: time at row 4 does not increase"),
+        "{err}"
+    );
+    assert!(!dir.join("b.csv").exists());
+}

@@ -150,6 +150,27 @@ fn imu_readings_have_accelerometer_gyroscope_and_magnetometer() {
     assert_eq!(plot(&["imu.csv"], "imu"), ((560, 40 + 960), 3 * 3));
 }
 
+/// A log stamped from UTC midnight (the EuRoC layout's times): the time axis is drawn less a
+/// round offset that its label names, and no two tick labels are alike.
+#[test]
+fn stamps_far_from_zero_get_an_offset_and_distinct_ticks() {
+    let log = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../imukit/examples/data/euroc/mav0/imu0/data.csv");
+    let out = data().join("stamped.svg");
+    ok(&imukit(&["plot"], &[&log, Path::new("--out"), &out]));
+    let texts = svg_texts(&out);
+    assert!(texts.iter().any(|t| t == "t − 68570 (s)"), "{texts:?}");
+    let ticks: Vec<&String> = texts
+        .iter()
+        .filter(|t| !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || c == '.'))
+        .collect();
+    assert!(
+        ticks.iter().any(|t| *t == "10") && ticks.iter().any(|t| *t == "15"),
+        "{ticks:?}"
+    );
+    assert!(!ticks.iter().any(|t| t.starts_with("685")), "{ticks:?}");
+}
+
 #[test]
 fn errors_have_position_velocity_and_attitude_panels() {
     assert_eq!(
@@ -494,8 +515,9 @@ fn figures_are_titled_with_their_files_and_frame_and_take_a_size_and_resolution(
     ok(&o);
     assert_eq!(png_size(&out), (1200, 750));
     let svg = d.join("titled.svg");
+    // The frame is the files' (their descriptions say ENU), named in the title.
     ok(&imukit(
-        &["plot", "--nav-frame", "NED"],
+        &["plot"],
         &[
             &d.join("truth.csv"),
             &d.join("nav.csv"),
@@ -507,7 +529,7 @@ fn figures_are_titled_with_their_files_and_frame_and_take_a_size_and_resolution(
     assert!(
         texts
             .iter()
-            .any(|t| t == "truth.csv, nav.csv (truth) — NED"),
+            .any(|t| t == "truth.csv, nav.csv (truth) — ENU"),
         "{texts:?}"
     );
     // No tick reads -0 or carries a needless exponent.
@@ -548,5 +570,60 @@ fn figures_are_titled_with_their_files_and_frame_and_take_a_size_and_resolution(
             String::from_utf8_lossy(&o.stderr)
         );
         assert!(!d.join("refused.png").exists());
+    }
+}
+
+/// A NED truth is drawn as NED without the flag (its description says so), and a flag that
+/// contradicts the file is refused, for the figure and the animation.
+#[test]
+fn the_frame_comes_from_the_description() {
+    let d = data();
+    let scenario = d.join("turn.toml");
+    std::fs::write(
+        &scenario,
+        "duration_s = 2.0\n[trajectory]\ntype = \"builtin\"\nname = \"platform-turn\"\n",
+    )
+    .unwrap();
+    let (imu, truth) = (d.join("turn_imu.csv"), d.join("turn_truth.csv"));
+    ok(&imukit(
+        &["simulate"],
+        &[
+            &scenario,
+            Path::new("--out"),
+            &imu,
+            Path::new("--truth"),
+            &truth,
+        ],
+    ));
+    let out = d.join("turn.svg");
+    ok(&imukit(&["plot"], &[&truth, Path::new("--out"), &out]));
+    assert!(
+        svg_texts(&out).iter().any(|t| t.ends_with("— NED")),
+        "{:?}",
+        svg_texts(&out)
+    );
+    for command in ["plot", "animate"] {
+        let wrong = d.join(if command == "plot" {
+            "wrong.svg"
+        } else {
+            "wrong.gif"
+        });
+        let o = imukit(
+            &[command],
+            &[
+                &truth,
+                Path::new("--out"),
+                &wrong,
+                Path::new("--nav-frame"),
+                Path::new("ENU"),
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(65), "{command}: {err}");
+        assert!(
+            err.contains("--nav-frame: ENU contradicts") && err.contains("says NED"),
+            "{command}: {err}"
+        );
+        assert!(!wrong.exists());
     }
 }

@@ -77,6 +77,30 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// The offset drawn values of an axis from `lo` to `hi` are shown less: 0 unless they are a
+/// hundred spans or more from zero (four significant digits would then label two ticks alike),
+/// else the values rounded down to the power of ten at or above the span.
+#[must_use]
+pub fn axis_offset(lo: f64, hi: f64) -> f64 {
+    let span = hi - lo;
+    if !(span > 0.0 && span.is_finite()) || lo.abs().max(hi.abs()) < 100.0 * span {
+        return 0.0;
+    }
+    let step = 10f64.powf(span.log10().ceil());
+    (lo / step).floor() * step
+}
+
+/// An axis label for values drawn less `offset`: `t (s)` becomes `t − 68500 (s)`.
+fn offset_label(label: &str, offset: f64) -> String {
+    if offset == 0.0 {
+        return label.to_string();
+    }
+    match label.rsplit_once(" (") {
+        Some((name, unit)) => format!("{name} − {offset} ({unit}"),
+        None => format!("{label} − {offset}"),
+    }
+}
+
 /// Draws a time-series panel into `area`.
 pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> Result<(), String> {
     let all: Vec<(f64, f64)> = panel
@@ -86,6 +110,14 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         .collect();
     let (x0, x1) = range(all.iter().map(|p| p.0));
     let (y0, y1) = range(all.iter().map(|p| p.1));
+    // Values far from zero for their span (a log stamped from midnight or the epoch) are drawn
+    // less a round offset, which the axis label names: else the ticks read 68580, 68580, ….
+    let (dx, dy) = (axis_offset(x0, x1), axis_offset(y0, y1));
+    let (x0, x1, y0, y1) = (x0 - dx, x1 - dx, y0 - dy, y1 - dy);
+    let (x_label, y_label) = (
+        offset_label(&panel.x_label, dx),
+        offset_label(&panel.y_label, dy),
+    );
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 16))
         .margin(8)
@@ -95,8 +127,8 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc(panel.x_label.as_str())
-        .y_desc(panel.y_label.as_str())
+        .x_desc(x_label.as_str())
+        .y_desc(y_label.as_str())
         .label_style(("sans-serif", 11))
         .x_label_formatter(&|v| tick_on(*v, x1 - x0))
         .y_label_formatter(&|v| tick_on(*v, y1 - y0))
@@ -104,13 +136,8 @@ pub fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel) -> R
         .map_err(err)?;
     for s in &panel.series {
         let color = COLORS[s.color % COLORS.len()];
-        draw_line(
-            &mut chart,
-            thin(finite(&s.points)),
-            color,
-            s.style,
-            &s.label,
-        )?;
+        let shifted: Vec<(f64, f64)> = s.points.iter().map(|&(x, y)| (x - dx, y - dy)).collect();
+        draw_line(&mut chart, thin(finite(&shifted)), color, s.style, &s.label)?;
     }
     draw_legend(&mut chart)
 }
@@ -286,6 +313,25 @@ pub fn trajectories_figure(path: &Path, title: &str, traces: &[Trace]) -> Result
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn an_axis_far_from_zero_is_drawn_less_a_round_offset() {
+        // Midnight-stamped seconds: over 6.6 s less a multiple of 10, over 16.6 s of 100.
+        assert_eq!(axis_offset(68_579.2, 68_585.8), 68_570.0);
+        assert_eq!(axis_offset(68_579.2, 68_595.8), 68_500.0);
+        // Epoch seconds over 100 s, and a span of an hour.
+        assert_eq!(axis_offset(1.7e9 + 12.0, 1.7e9 + 90.0), 1.7e9);
+        assert_eq!(axis_offset(1.7e9 + 12.0, 1.7e9 + 3600.0), 1.7e9);
+        // Near zero, or far from it for its span but under a hundred spans: no offset.
+        assert_eq!(axis_offset(0.0, 60.0), 0.0);
+        assert_eq!(axis_offset(-5.0, 5.0), 0.0);
+        assert_eq!(axis_offset(900.0, 1000.0), 0.0);
+        assert_eq!(axis_offset(3.0, 3.0), 0.0);
+        assert_eq!(offset_label("t (s)", 68_570.0), "t − 68570 (s)");
+        assert_eq!(offset_label("x", 100.0), "x − 100");
+        assert_eq!(offset_label("t (s)", 0.0), "t (s)");
+    }
+
     use super::*;
 
     #[test]

@@ -177,7 +177,11 @@ def test_orientation_outputs_and_their_errors_have_their_panels():
 
 
 def test_a_figure_takes_a_size_and_resolution_and_is_titled_with_its_tables_and_frame(sim):
-    fig = ip.figure(sim.truth, size_in=(8.0, 5.0), dpi=150, nav_frame="NED", labels=["truth"])
+    # The frame is the table's own (its description says ENU), named in the title.
+    fig = ip.figure(sim.truth, size_in=(8.0, 5.0), dpi=150, labels=["truth"])
     assert tuple(fig.get_size_inches()) == (8.0, 5.0)
     assert fig.dpi == 150
-    assert fig._suptitle.get_text() == "truth (truth) — NED"
+    assert fig._suptitle.get_text() == "truth (truth) — ENU"
+    # A plain array's frame is the argument's.
+    plain = imukit.Table(sim.truth.columns, sim.truth.values)
+    assert ip.figure(plain, nav_frame="NED", labels=["t"])._suptitle.get_text() == "t (truth) — NED"

@@ -98,7 +98,25 @@ pub(crate) fn analyse(input: &Path, columns: &[String]) -> Result<AllanResult, C
         ""
     };
     let data = read_columns(input, &required, hint)?;
-    let rate = mean_rate(data.get("t_s"))?;
+    let t = data.get("t_s");
+    // The Allan deviation takes the samples as evenly spaced: times that go back are refused
+    // by row, and gaps are said (the clusters that span them are not the sensor's noise).
+    imukit::io::rows::check_increasing(t, &input.display().to_string(), 2)?;
+    let gaps = imukit::io::rows::Gaps::of_times(t, 2);
+    if gaps.count > 0 {
+        crate::report::warn(&format!(
+            "{}: {} interval(s) longer than {} median intervals ({} s), the longest {} s after \
+             row {}: the Allan deviation takes the samples as evenly spaced, so its clusters \
+             across the gaps are not the sensor's noise (cut the log at the gaps)",
+            input.display(),
+            gaps.count,
+            imukit::io::rows::MAX_GAP_FACTOR,
+            (gaps.median_s * 1e6).round() / 1e6,
+            (gaps.longest_s * 1e6).round() / 1e6,
+            gaps.longest_after_row
+        ));
+    }
+    let rate = mean_rate(t)?;
     let series: Vec<(String, Vec<f64>)> = chosen
         .iter()
         .map(|c| (c.clone(), data.get(c).to_vec()))

@@ -37,17 +37,22 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             runs,
             threads,
             layout,
+            bag_out,
         } => {
+            let bag = simulate::bag_options(&bag_out, &out, layout.is_some())?;
             if layout.is_some() {
                 simulate::euroc(&scenario, &out, truth.as_deref(), runs, threads)
             } else {
                 simulate::run(
                     &scenario,
-                    &out,
-                    truth.as_deref(),
-                    gnss.as_deref(),
-                    baro.as_deref(),
-                    odometer.as_deref(),
+                    &simulate::Outputs {
+                        out: &out,
+                        truth: truth.as_deref(),
+                        gnss: gnss.as_deref(),
+                        baro: baro.as_deref(),
+                        odometer: odometer.as_deref(),
+                        bag: bag.as_ref(),
+                    },
                     runs,
                     threads,
                 )
@@ -302,6 +307,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             speed,
             nav_frame,
         } => {
+            let nav_frame = plot::described_frame(&[truth.as_path()], nav_frame)?;
             let opts = plot::options(body.as_deref(), lever_arm.as_deref(), fps, speed, nav_frame);
             plot::animate(&truth, &out, &opts)
         }

@@ -3,6 +3,7 @@ use std::path::{Path, PathBuf};
 
 use imu_plot::animate::{self as anim, AnimateOptions};
 use imu_plot::{FigureSize, plot_files};
+use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::table::read_table;
 
@@ -12,15 +13,31 @@ use super::CliError;
 use crate::cli::FigureArgs;
 use crate::plot_by_flag;
 
+/// The frame positions are drawn in: `--nav-frame`, else what the files' descriptions say,
+/// else ENU; a flag or a file that contradicts another is refused.
+pub fn described_frame(
+    files: &[&Path],
+    asked: Option<NavFrameName>,
+) -> Result<NavFrameName, CliError> {
+    Ok(Described::read(files)?.pick(
+        "--nav-frame",
+        asked,
+        |d| d.nav_frame,
+        NavFrameName::default(),
+    )?)
+}
+
 pub fn plot(
     files: &[PathBuf],
     out: &Path,
-    nav_frame: NavFrameName,
+    nav_frame: Option<NavFrameName>,
     size: FigureSize,
 ) -> Result<(), CliError> {
     imu_plot::check_figure_path(out)?;
     let inputs: Vec<(&str, &Path)> = files.iter().map(|f| ("input", f.as_path())).collect();
     check_outputs(&inputs, &[("--out", out)])?;
+    let paths: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    let nav_frame = described_frame(&paths, nav_frame)?;
     plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
     crate::note!("imukit: wrote {}", out.display());
     Ok(())

@@ -3,6 +3,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imukit::ScenarioSpec;
+use imukit::io::TableFormat;
+use imukit::io::bag::BagOptions;
 use imukit::io::output::{check_outputs, check_table_outputs, create_folder_within};
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
@@ -11,19 +13,71 @@ use imukit::scenario::report::RunReport;
 use rayon::prelude::*;
 
 use super::CliError;
+use crate::cli::BagOutArgs;
 
-// The command's own arguments, one by one, as the command line gives them.
-#[allow(clippy::too_many_arguments)]
+/// The files `simulate` writes, and a bag's options.
+pub struct Outputs<'a> {
+    pub out: &'a Path,
+    pub truth: Option<&'a Path>,
+    pub gnss: Option<&'a Path>,
+    pub baro: Option<&'a Path>,
+    pub odometer: Option<&'a Path>,
+    pub bag: Option<&'a BagOptions>,
+}
+
+/// The bag options given (`None` when none is), refused unless `--out` names a bag.
+pub fn bag_options(
+    args: &BagOutArgs,
+    out: &Path,
+    layout: bool,
+) -> Result<Option<BagOptions>, CliError> {
+    let given = [
+        ("--bag-topic", args.bag_topic.is_some()),
+        ("--bag-frame-id", args.bag_frame_id.is_some()),
+        ("--bag-start-s", args.bag_start_s.is_some()),
+    ];
+    let Some((flag, _)) = given.iter().find(|(_, g)| *g) else {
+        return Ok(None);
+    };
+    if layout || TableFormat::of(out) != TableFormat::Mcap {
+        return Err(imukit::Error::Invalid {
+            field: (*flag).into(),
+            message: format!(
+                "applies to a ROS 2 bag written by --out NAME.mcap, not to {}",
+                out.display()
+            ),
+        }
+        .into());
+    }
+    let options = BagOptions::new(
+        args.bag_topic.as_deref(),
+        args.bag_frame_id.as_deref(),
+        args.bag_start_s,
+    )
+    .map_err(|e| match e {
+        imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
+            field: format!("--{}", field.replace('_', "-")),
+            message,
+        },
+        other => other,
+    })?;
+    Ok(Some(options))
+}
+
 pub fn run(
     scenario: &Path,
-    out: &Path,
-    truth: Option<&Path>,
-    gnss: Option<&Path>,
-    baro: Option<&Path>,
-    odometer: Option<&Path>,
+    o: &Outputs<'_>,
     runs: Option<u64>,
     threads: Option<i64>,
 ) -> Result<(), CliError> {
+    let Outputs {
+        out,
+        truth,
+        gnss,
+        baro,
+        odometer,
+        bag,
+    } = *o;
     // One run's stages, or the runs at a time: refused before anything is read if below 1.
     let run_threads = RunThreads::at_most(threads, "--threads")?;
     let spec = ScenarioSpec::from_file(scenario)?;
@@ -65,6 +119,7 @@ pub fn run(
             odometer,
             description: &description,
             asl: false,
+            bag,
         };
         let report = sc
             .stream_to_files(None, run_threads, &outputs)
@@ -126,6 +181,7 @@ pub fn run(
                         odometer: odometer_file.as_deref(),
                         description: &description,
                         asl: false,
+                        bag,
                     },
                 )?;
                 if let Ok(mut m) = merged.lock() {

@@ -92,6 +92,23 @@ def _kinds(tables: list) -> str:
     return first
 
 
+def _frame(loaded: Sequence[Tuple[str, Table]], nav_frame: Optional[str]) -> str:
+    """The frame positions are drawn in: ``nav_frame``, else what the tables' descriptions say,
+    else the default; an argument or a table that contradicts another is refused (as ``imukit
+    plot`` does with files)."""
+    said = [(name, str(t.description["nav_frame"]).upper()) for name, t in loaded
+            if t.description.get("nav_frame")]
+    for (a, fa), (b, fb) in zip(said, said[1:]):
+        if fa != fb:
+            raise ImuError(f"nav_frame: the tables disagree: {a} says {fa}, {b} says {fb}")
+    if nav_frame is None:
+        return said[0][1] if said else _D["nav_frame"]
+    if said and nav_frame.upper() != said[0][1]:
+        raise ImuError(f"nav_frame: {nav_frame} contradicts {said[0][0]}, whose description says "
+                       f"{said[0][1]} (leave the argument out to use it)")
+    return nav_frame
+
+
 def _points(t: Table, nav_frame: str = _D["nav_frame"]) -> np.ndarray:
     """Positions (N, 3) in east, north, up (NED ones turned as ``imukit plot`` turns them)."""
     z = t["pos_z_m"] if "pos_z_m" in t else np.zeros(len(t))
@@ -100,11 +117,13 @@ def _points(t: Table, nav_frame: str = _D["nav_frame"]) -> np.ndarray:
 
 
 def trajectory(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, ax: Any = None,
-               nav_frame: str = _D["nav_frame"]) -> Any:
+               nav_frame: Optional[str] = None) -> Any:
     """Paths of truth or navigation tables (``pos_*_m``): seen from above with equal scales when
-    they stay in a plane, in 3D otherwise; start ● and end ✕ marked; ``nav_frame="NED"`` paths
-    are drawn east, north, up. Returns the figure."""
+    they stay in a plane, in 3D otherwise; start ● and end ✕ marked; NED paths (``nav_frame``,
+    by default what the tables' descriptions say, else ENU) are drawn east, north, up. Returns
+    the figure."""
     loaded = _load(tables, labels)
+    nav_frame = _frame(loaded, nav_frame)
     paths = [(name, _points(t, nav_frame)) for name, t in loaded]
     three_d = _core.leaves_plane(np.ascontiguousarray(np.vstack([p for _, p in paths])))
     if ax is None:
@@ -190,14 +209,16 @@ def _study(table: Table, size_in: Optional[Tuple[float, float]], dpi: Optional[f
     return fig
 
 
-def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: str = _D["nav_frame"],
+def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_frame: Optional[str] = None,
            size_in: Optional[Tuple[float, float]] = None, dpi: Optional[float] = None) -> Any:
     """The default figure of imukit tables or CSV files of one kind (or truth and navigation
     output together): the trajectory and the time-series panels of ``imukit plot``, later tables
-    dashed, dotted, …; ``nav_frame="NED"`` paths are drawn east, north, up. ``size_in`` (width,
+    dashed, dotted, …; NED paths (``nav_frame``, by default what the tables' descriptions say,
+    else ENU) are drawn east, north, up. ``size_in`` (width,
     height in inches) and ``dpi`` as ``imukit plot --size --dpi``; the title names the tables,
     their kind and the frame. Returns the figure."""
     loaded = _load(tables, labels)
+    nav_frame = _frame(loaded, nav_frame)
     k = _kinds(loaded)
     if k == "allan":
         if len(loaded) > 1:
@@ -247,19 +268,21 @@ def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_fra
 
 def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
             lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = 20.0,
-            speed: Optional[float] = None, nav_frame: str = _D["nav_frame"]) -> Any:
+            speed: Optional[float] = None, nav_frame: Optional[str] = None) -> Any:
     """The body moving along its path, as ``imukit animate`` draws it: a box of ``body_m``
     (length, width, height along body x, y, z; by default a tenth of the path's extent long)
     turned by the truth's attitude, its nose face red, the reference point (yellow) and the IMU
     point at ``lever_arm_m`` (violet), the trail blue. ``fps`` frames per second, ``speed``
-    seconds of motion per second (by default the animation lasts 4 to 12 s). A ``nav_frame="NED"``
-    truth is drawn turned into east, north, up (the body axes stay those of the data).
+    seconds of motion per second (by default the animation lasts 4 to 12 s). A NED truth
+    (``nav_frame``, by default what its description says, else ENU) is drawn turned into east,
+    north, up (the body axes stay those of the data).
 
     Returns a ``matplotlib.animation.FuncAnimation``; ``anim.save("body.gif", writer="pillow")``
     writes it."""
     from matplotlib.animation import FuncAnimation
 
     (name, t), = _load([truth], None)
+    nav_frame = _frame([(name, t)], nav_frame)
     for c in ("t_s", "pos_x_m", "pos_y_m", "pos_z_m", "q_w", "q_x", "q_y", "q_z"):
         if c not in t:
             raise ImuError(f"{name}: no {c} column: animate needs a truth table (t_s, pos_*_m, q_*)")

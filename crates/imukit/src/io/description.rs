@@ -112,6 +112,69 @@ fn body_frame(nav: NavFrameName) -> &'static str {
 }
 
 impl Description {
+    /// The first setting (frame, Earth, origin, gravity, accelerometer sign) that `self` and
+    /// `other` both state and state differently, as `nav_frame NED, not ENU`; `None` when they
+    /// agree on every setting both state. The kind, sensor and scenario text are not settings.
+    #[must_use]
+    pub fn contradiction(&self, other: &Self) -> Option<String> {
+        fn differ<T: PartialEq + core::fmt::Debug>(
+            name: &str,
+            a: Option<&T>,
+            b: Option<&T>,
+            show: impl Fn(&T) -> String,
+        ) -> Option<String> {
+            match (a, b) {
+                (Some(a), Some(b)) if a != b => {
+                    Some(format!("{name} {}, not {}", show(b), show(a)))
+                }
+                _ => None,
+            }
+        }
+        differ(
+            "nav_frame",
+            self.nav_frame.as_ref(),
+            other.nav_frame.as_ref(),
+            ToString::to_string,
+        )
+        .or_else(|| {
+            differ(
+                "earth",
+                self.earth.as_ref(),
+                other.earth.as_ref(),
+                ToString::to_string,
+            )
+        })
+        .or_else(|| {
+            differ(
+                "accel_sign",
+                self.accel_sign.as_ref(),
+                other.accel_sign.as_ref(),
+                ToString::to_string,
+            )
+        })
+        .or_else(|| {
+            differ(
+                "gravity_m_s2",
+                self.gravity_m_s2.as_ref(),
+                other.gravity_m_s2.as_ref(),
+                ToString::to_string,
+            )
+        })
+        .or_else(|| {
+            differ(
+                "earth_gravity",
+                self.earth_gravity.as_ref(),
+                other.earth_gravity.as_ref(),
+                ToString::to_string,
+            )
+        })
+        .or_else(|| {
+            differ("origin", self.origin.as_ref(), other.origin.as_ref(), |o| {
+                format!("{}° {}° {} m", o.latitude_deg, o.longitude_deg, o.height_m)
+            })
+        })
+    }
+
     /// A description of a table of `kind` and nothing else.
     #[must_use]
     pub fn of_kind(kind: TableKind) -> Self {
@@ -411,6 +474,36 @@ impl Description {
     }
 }
 
+/// Refuses a file whose description names a kind of table its columns are not (a description
+/// copied onto other data, or edited by hand): its settings would then be taken for data they
+/// do not describe. A file whose header cannot be read is left to its reader.
+fn check_kind(path: &Path, d: &Description) -> Result<()> {
+    let Some(said) = d.kind else {
+        return Ok(());
+    };
+    let Ok(header) = crate::io::table::read_header(path) else {
+        return Ok(());
+    };
+    let Some(found) = TableKind::detect(&header) else {
+        return Ok(());
+    };
+    let alike = |a: TableKind, b: TableKind| {
+        use TableKind::{Fused, Navigation, PlanarReadings, Readings};
+        a == b || matches!((a, b), (Navigation, Fused) | (Readings, PlanarReadings))
+    };
+    if alike(said, found) || alike(found, said) {
+        return Ok(());
+    }
+    Err(Error::CsvFormat {
+        file: path.into(),
+        message: format!(
+            "its description says it holds {said} but its columns are those of {found}: the \
+             description belongs to other data (remove the `# imukit:` line, or write the table \
+             again)"
+        ),
+    })
+}
+
 /// The descriptions of a job's input files, which together fix the settings they give: each
 /// setting is what the user asked for, else what the files say, else the library's default.
 #[derive(Clone, Debug, Default)]
@@ -429,6 +522,7 @@ impl Described {
         let mut files = Vec::new();
         for p in paths {
             if let Some(d) = Description::read(p)? {
+                check_kind(p, &d)?;
                 files.push((p.display().to_string(), d));
             }
         }
@@ -587,6 +681,38 @@ impl Described {
 
 #[cfg(test)]
 mod tests {
+
+    /// A description copied onto data of another kind is refused by name; a matching one is read.
+    #[test]
+    fn a_description_of_another_kind_of_table_is_refused() {
+        let dir = tempfile::tempdir().expect("dir");
+        let wrong = dir.path().join("imu.csv");
+        std::fs::write(
+            &wrong,
+            "# imukit: {\"kind\": \"truth\", \"nav_frame\": \"NED\"}\n\
+             t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n\
+             0,0,0,-9.8,0,0,0\n",
+        )
+        .expect("written");
+        let e = Described::read(&[wrong.as_path()])
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            e.contains("imu.csv")
+                && e.contains("says it holds truth but its columns are those of readings"),
+            "{e}"
+        );
+        let right = dir.path().join("ok.csv");
+        std::fs::write(
+            &right,
+            "# imukit: {\"kind\": \"readings\", \"nav_frame\": \"NED\"}\n\
+             t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n\
+             0,0,0,-9.8,0,0,0\n",
+        )
+        .expect("written");
+        assert!(Described::read(&[right.as_path()]).is_ok());
+    }
+
     use super::*;
 
     fn full() -> Description {

@@ -15,7 +15,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
 use crate::io::asl::AslWriter;
-use crate::io::bag::BagWriter;
+use crate::io::bag::{BagOptions, BagWriter};
 use crate::io::description::Description;
 use crate::io::npy::NpySink;
 use crate::io::npz::NpzSink;
@@ -510,11 +510,24 @@ impl AtomicFile {
     /// # Errors
     /// The bag writer's refusal, naming the file.
     pub fn begin_bag(&mut self, description: &Description) -> Result<()> {
+        self.begin_bag_with(description, &BagOptions::default())
+    }
+
+    /// [`Self::begin_bag`] with the IMU's topic, frame id and start stamp as `options` say.
+    ///
+    /// # Errors
+    /// The bag writer's refusal, naming the file.
+    pub fn begin_bag_with(
+        &mut self,
+        description: &Description,
+        options: &BagOptions,
+    ) -> Result<()> {
         let writer = self.writer.take().expect("a bag is begun once");
         self.bag = Some(BagWriter::create(
             writer,
             &self.path.display().to_string(),
             description,
+            options,
         )?);
         Ok(())
     }

@@ -6,11 +6,123 @@
 //! [`MAX_GAP_FACTOR`] median intervals is a *gap*: it is bridged like any other (the strapdown
 //! and the filters carry their state across it), and counted and reported ([`Gaps`]) so that a
 //! user knows the data had holes. Nothing is refused for jitter or gaps.
+//!
+//! A [`TimeWindow`] keeps the rows of a stretch of a log (`--start-s`, `--end-s`), counted in
+//! seconds from the first sample of the command's first input, so that the same numbers cut
+//! every file of one run (the fixes, the reference) at the same instants.
 use std::collections::VecDeque;
 use std::path::Path;
 
 use crate::error::{Result, invalid};
-use crate::io::table::CsvRows;
+use crate::io::table::{CsvRows, Table};
+
+/// A stretch of a run: from `start_s` to `end_s` seconds after the first sample of the run's
+/// first input (either end open when `None`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TimeWindow {
+    /// Seconds after the first sample where the stretch begins (≥ 0).
+    pub start_s: Option<f64>,
+    /// Seconds after the first sample where it ends (> `start_s`).
+    pub end_s: Option<f64>,
+}
+
+impl TimeWindow {
+    /// The window, checked: finite, `start_s ≥ 0`, `end_s > start_s` (and > 0).
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] naming `start_s` or `end_s`.
+    pub fn new(start_s: Option<f64>, end_s: Option<f64>) -> Result<Self> {
+        if let Some(s) = start_s
+            && !(s.is_finite() && s >= 0.0)
+        {
+            return Err(invalid(
+                "start_s",
+                format!("must be a finite number of seconds ≥ 0 after the first sample, got {s}"),
+            ));
+        }
+        let after = start_s.unwrap_or(0.0);
+        if let Some(e) = end_s
+            && !(e.is_finite() && e > after)
+        {
+            return Err(invalid(
+                "end_s",
+                format!("must be a finite number of seconds after the start ({after} s), got {e}"),
+            ));
+        }
+        Ok(Self { start_s, end_s })
+    }
+
+    /// True when the window keeps every row.
+    #[must_use]
+    pub fn is_whole(&self) -> bool {
+        self.start_s.is_none() && self.end_s.is_none()
+    }
+
+    /// The rows of `table` whose `t_s` lies in the window, its seconds counted from `t0` (the
+    /// first sample of the run's first input, [`Self::first_time`]); the table itself when the
+    /// window is whole.
+    ///
+    /// # Errors
+    /// A table without `t_s`, or with fewer than `at_least` rows in the window, naming `source`
+    /// and the window.
+    pub fn apply(&self, table: Table, t0: f64, source: &str, at_least: usize) -> Result<Table> {
+        if self.is_whole() {
+            return Ok(table);
+        }
+        let Some(k) = table.columns.iter().position(|c| c == "t_s") else {
+            return Err(invalid(
+                source,
+                "has no t_s column to cut a time window from",
+            ));
+        };
+        let (lo, hi) = (
+            t0 + self.start_s.unwrap_or(0.0),
+            self.end_s.map_or(f64::INFINITY, |e| t0 + e),
+        );
+        let width = table.columns.len();
+        let mut kept = Table {
+            columns: table.columns.clone(),
+            data: Vec::new(),
+        };
+        for row in table.data.chunks_exact(width) {
+            if row[k] >= lo && row[k] <= hi {
+                kept.data.extend_from_slice(row);
+            }
+        }
+        if kept.rows() < at_least {
+            return Err(invalid(
+                source,
+                format!(
+                    "{} row(s) of {} lie in the window {} (seconds after the first sample, \
+                     t_s = {t0}); at least {at_least} needed",
+                    kept.rows(),
+                    table.rows(),
+                    self.describe()
+                ),
+            ));
+        }
+        Ok(kept)
+    }
+
+    /// The first `t_s` of `table`, the origin of the window's seconds.
+    ///
+    /// # Errors
+    /// A table without `t_s` or rows, naming `source`.
+    pub fn first_time(table: &Table, source: &str) -> Result<f64> {
+        let k = table.columns.iter().position(|c| c == "t_s");
+        k.and_then(|k| table.data.get(k).copied())
+            .ok_or_else(|| invalid(source, "has no t_s column or no rows"))
+    }
+
+    /// The window as `[10 s, 60 s]`.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let end = self
+            .end_s
+            .map_or_else(|| "the end".to_string(), |e| format!("{e} s"));
+        format!("[{} s, {end}]", self.start_s.unwrap_or(0.0))
+    }
+}
 
 /// Intervals longer than this many median intervals count as gaps in the data.
 pub const MAX_GAP_FACTOR: f64 = 2.5;
@@ -265,5 +377,77 @@ impl TimedRows {
         }
         self.previous_t = Some(t);
         Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn log() -> Table {
+        let mut t = Table::new(&["t_s", "x"]);
+        for k in 0..100 {
+            let time = 25_600.0 + f64::from(k) * 0.1;
+            t.push_row(&[time, f64::from(k)]);
+        }
+        t
+    }
+
+    #[test]
+    fn a_window_keeps_the_rows_of_its_stretch_counted_from_the_first_sample() {
+        let t = log();
+        let t0 = TimeWindow::first_time(&t, "log.csv").expect("a time");
+        assert_eq!(t0, 25_600.0);
+        let w = TimeWindow::new(Some(2.0), Some(5.0)).expect("valid");
+        let kept = w.apply(t.clone(), t0, "log.csv", 2).expect("rows");
+        let x = kept.column("x").expect("x");
+        // 25 602.0 is 25 600 + 20 × 0.1 to within a rounding: the rows from 20 or 21 to 50.
+        assert!(x[0] == 20.0 || x[0] == 21.0, "{}", x[0]);
+        assert!(x[x.len() - 1] == 50.0 || x[x.len() - 1] == 49.0);
+        let tail = TimeWindow::new(Some(9.45), None)
+            .expect("valid")
+            .apply(t.clone(), t0, "log.csv", 2)
+            .expect("rows");
+        assert_eq!(tail.column("x").expect("x"), [95.0, 96.0, 97.0, 98.0, 99.0]);
+        let whole = TimeWindow::default()
+            .apply(t.clone(), t0, "log.csv", 2)
+            .expect("rows");
+        assert_eq!(whole, t);
+        // Another file of the run, cut at the same instants.
+        let mut fixes = Table::new(&["t_s", "y"]);
+        for k in 0..10 {
+            fixes.push_row(&[25_600.0 + f64::from(k), 0.0]);
+        }
+        let cut = w.apply(fixes, t0, "gnss.csv", 1).expect("fixes");
+        assert_eq!(
+            cut.column("t_s").expect("t"),
+            [25_602.0, 25_603.0, 25_604.0, 25_605.0]
+        );
+    }
+
+    #[test]
+    fn a_window_is_checked_and_an_empty_one_named() {
+        for (start, end, field) in [
+            (Some(-1.0), None, "start_s"),
+            (Some(f64::NAN), None, "start_s"),
+            (Some(5.0), Some(5.0), "end_s"),
+            (None, Some(0.0), "end_s"),
+            (None, Some(f64::INFINITY), "end_s"),
+        ] {
+            let e = TimeWindow::new(start, end)
+                .expect_err("refused")
+                .to_string();
+            assert!(e.starts_with(field), "{e}");
+        }
+        let e = TimeWindow::new(Some(50.0), None)
+            .expect("valid")
+            .apply(log(), 25_600.0, "log.csv", 2)
+            .expect_err("empty")
+            .to_string();
+        assert!(
+            e.contains("log.csv")
+                && e.contains("0 row(s) of 100 lie in the window [50 s, the end]"),
+            "{e}"
+        );
     }
 }

@@ -18,6 +18,7 @@ use imu_core::{Enu, NavFrame, Ned, Truth};
 
 use crate::error::Result;
 use crate::io::TableFormat;
+use crate::io::bag::BagOptions;
 use crate::io::description::Description;
 use crate::io::output::AtomicFile;
 use crate::io::schema::TableKind;
@@ -106,6 +107,8 @@ pub struct StreamOutputs<'a> {
     /// The IMU readings and the truth in the ASL layout of a EuRoC sequence
     /// ([`crate::io::asl`]) instead of imukit's tables.
     pub asl: bool,
+    /// A bag's IMU topic, frame id and start stamp (`None`: `/imu`, `imu_link`, 0 s).
+    pub bag: Option<&'a BagOptions>,
 }
 
 /// An empty description, for outputs that say nothing beyond their kind.
@@ -131,6 +134,7 @@ impl Default for StreamOutputs<'_> {
             odometer: None,
             description: &NO_DESCRIPTION,
             asl: false,
+            bag: None,
         }
     }
 }
@@ -205,7 +209,7 @@ impl Scenario {
             }
         }
         let open = |p: Option<&Path>, asl: bool| {
-            p.map(|p| TableSink::create(p, outputs.description, asl))
+            p.map(|p| TableSink::create(p, outputs.description, asl, outputs.bag))
                 .transpose()
         };
         let (mut imu, mut truth) = (
@@ -510,10 +514,17 @@ struct TableSink {
     started: bool,
     /// In the ASL layout ([`AtomicFile::begin_asl`]).
     asl: bool,
+    /// A bag's options.
+    bag: BagOptions,
 }
 
 impl TableSink {
-    fn create(path: &Path, description: &Description, asl: bool) -> Result<Self> {
+    fn create(
+        path: &Path,
+        description: &Description,
+        asl: bool,
+        bag: Option<&BagOptions>,
+    ) -> Result<Self> {
         let format = TableFormat::of(path);
         Ok(Self {
             file: AtomicFile::create(path)?,
@@ -523,6 +534,7 @@ impl TableSink {
             description: description.clone(),
             started: false,
             asl,
+            bag: bag.cloned().unwrap_or_default(),
         })
     }
 
@@ -561,7 +573,7 @@ impl TableSink {
             if let [only] = tables {
                 description.kind = TableKind::detect(&only.columns);
             }
-            self.file.begin_bag(&description)?;
+            self.file.begin_bag_with(&description, &self.bag)?;
             self.started = true;
         }
         self.file.write_bag(tables)

@@ -35,19 +35,18 @@
 //! FLU bodies: a NED run is written as it is (its description says so).
 pub mod ros;
 mod storage;
+mod writer;
+pub use writer::{BagOptions, BagWriter};
 
 use storage::{mcap_messages, read_mcap, read_ros1, read_sqlite};
 
 use std::collections::BTreeMap;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use crate::error::{Error, Result};
-use crate::io::asl::{seconds_after, stamp_ns, time_origin_ns};
+use crate::io::asl::{seconds_after, time_origin_ns};
 use crate::io::description::Description;
-use crate::io::output::OutputFile;
-use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Table};
 use crate::run::fuse::FIX_ACCURACY_COLUMNS;
 use crate::run::navigate::GEODETIC_COLUMNS;
@@ -750,343 +749,10 @@ pub fn column_names(path: &Path, wanted: &[&str]) -> Result<Vec<String>> {
     Ok(read_table(path, wanted)?.columns)
 }
 
-/// A topic being written: its channel and what it holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stream {
-    Imu,
-    Mag,
-    Truth,
-    TruthFix,
-    Estimate,
-    Fix,
-    Position,
-    Velocity,
-}
-
-impl Stream {
-    fn topic(self) -> &'static str {
-        match self {
-            Self::Imu => "/imu",
-            Self::Mag => "/imu/mag",
-            Self::Truth => "/ground_truth",
-            Self::TruthFix => "/ground_truth/fix",
-            Self::Estimate => "/odometry",
-            Self::Fix => "/gnss/fix",
-            Self::Position => "/gnss/position",
-            Self::Velocity => "/gnss/vel",
-        }
-    }
-
-    fn message_type(self) -> MessageType {
-        match self {
-            Self::Imu => MessageType::Imu,
-            Self::Mag => MessageType::MagneticField,
-            Self::Truth | Self::Estimate => MessageType::Odometry,
-            Self::Fix | Self::TruthFix => MessageType::NavSatFix,
-            Self::Position => MessageType::PointStamped,
-            Self::Velocity => MessageType::TwistStamped,
-        }
-    }
-
-    /// The frame its header names.
-    fn frame(self) -> &'static str {
-        match self {
-            Self::Imu | Self::Mag => "imu_link",
-            Self::Truth | Self::Estimate | Self::Position => "map",
-            Self::Fix | Self::Velocity => "gnss",
-            Self::TruthFix => "base_link",
-        }
-    }
-}
-
-/// A fix at latitude, longitude (rad) and height (m), its accuracy not given.
-fn nav_sat_fix(header: ros::Header, [lat, lon, height]: [f64; 3]) -> ros::NavSatFix {
-    ros::NavSatFix {
-        header,
-        status: ros::NavSatStatus {
-            status: 0,
-            service: ros::SERVICE_GPS,
-        },
-        latitude: lat.to_degrees(),
-        longitude: lon.to_degrees(),
-        altitude: height,
-        position_covariance: [0.0; 9],
-        position_covariance_type: ros::COVARIANCE_TYPE_UNKNOWN,
-    }
-}
-
-/// A ROS 2 bag (one MCAP file) being written from imukit's tables.
-pub struct BagWriter {
-    writer: mcap::Writer<BufWriter<OutputFile>>,
-    name: String,
-    metadata: BTreeMap<String, String>,
-    channels: Vec<(Stream, u16)>,
-    sequence: u32,
-    /// Poses are an estimate (`/odometry`), not the truth (`/ground_truth`).
-    estimate: bool,
-}
-
-impl core::fmt::Debug for BagWriter {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("BagWriter")
-            .field("name", &self.name)
-            .finish()
-    }
-}
-
-/// Finds the columns `names` in `columns`.
-fn find<const N: usize>(columns: &[String], names: [&str; N]) -> Option<[usize; N]> {
-    let mut out = [0; N];
-    for (slot, name) in out.iter_mut().zip(names) {
-        *slot = columns.iter().position(|c| c == name)?;
-    }
-    Some(out)
-}
-
-impl BagWriter {
-    /// Starts a bag on `writer` (the file named `name` in messages), each channel carrying
-    /// `description`; poses go to `/odometry` when its kind is an estimate (strapdown or fused),
-    /// else to `/ground_truth`.
-    ///
-    /// # Errors
-    /// The MCAP writer's refusal, naming the file.
-    pub fn create(
-        writer: BufWriter<OutputFile>,
-        name: &str,
-        description: &Description,
-    ) -> Result<Self> {
-        let mut d = description.clone();
-        let estimate = matches!(d.kind, Some(TableKind::Navigation | TableKind::Fused));
-        d.kind = None;
-        let writer = mcap::WriteOptions::new()
-            .profile("ros2")
-            .library(format!("imukit {}", env!("CARGO_PKG_VERSION")))
-            .create(writer)
-            .map_err(|e| Self::error_of(name, &e))?;
-        Ok(Self {
-            writer,
-            name: name.to_string(),
-            metadata: d.metadata().into_iter().collect(),
-            channels: Vec::new(),
-            sequence: 0,
-            estimate,
-        })
-    }
-
-    fn error_of(name: &str, e: &mcap::McapError) -> Error {
-        Error::CsvFormat {
-            file: name.into(),
-            message: format!("writing the bag: {e}"),
-        }
-    }
-
-    fn channel(&mut self, stream: Stream) -> Result<u16> {
-        if let Some((_, id)) = self.channels.iter().find(|(s, _)| *s == stream) {
-            return Ok(*id);
-        }
-        let kind = stream.message_type();
-        let name = self.name.clone();
-        let schema = self
-            .writer
-            .add_schema(kind.name(), "ros2msg", kind.schema().as_bytes())
-            .map_err(|e| Self::error_of(&name, &e))?;
-        let id = self
-            .writer
-            .add_channel(schema, stream.topic(), "cdr", &self.metadata)
-            .map_err(|e| Self::error_of(&name, &e))?;
-        self.channels.push((stream, id));
-        Ok(id)
-    }
-
-    /// Writes `tables` (IMU rates, truth or GNSS fixes, each known by its columns) as their
-    /// topics' messages, in stamp order (equal stamps in the tables' order).
-    ///
-    /// # Errors
-    /// A table a bag has no topic for; a time stamp outside a ROS stamp's range (before 1970
-    /// or after 2038); the writer's refusal.
-    pub fn write(&mut self, tables: &[&Table]) -> Result<()> {
-        // (stamp, stream, payload) of every message of the tables.
-        let mut messages: Vec<(i64, Stream, Vec<u8>)> = Vec::new();
-        for table in tables {
-            self.messages_of(table, &mut messages)?;
-        }
-        messages.sort_by_key(|(ns, _, _)| *ns);
-        for (ns, stream, data) in messages {
-            let channel_id = self.channel(stream)?;
-            self.sequence = self.sequence.wrapping_add(1);
-            let time = u64::try_from(ns).unwrap_or(0);
-            let header = mcap::records::MessageHeader {
-                channel_id,
-                sequence: self.sequence,
-                log_time: time,
-                publish_time: time,
-            };
-            let name = self.name.clone();
-            self.writer
-                .write_to_known_channel(&header, &data)
-                .map_err(|e| Self::error_of(&name, &e))?;
-        }
-        Ok(())
-    }
-
-    /// Appends the messages of `table` to `messages`.
-    #[allow(clippy::too_many_lines)]
-    fn messages_of(&self, table: &Table, messages: &mut Vec<(i64, Stream, Vec<u8>)>) -> Result<()> {
-        let c = &table.columns;
-        let width = c.len().max(1);
-        let header = |stamp: ros::Time, stream: Stream| ros::Header {
-            stamp,
-            frame_id: stream.frame().into(),
-        };
-        let v3 = |row: &[f64], at: [usize; 3]| ros::Vector3::of(at.map(|k| row[k]));
-        let Some([t]) = find(c, ["t_s"]) else {
-            return Err(self.unwritable(c));
-        };
-        let imu = find(c, ACCEL_COLUMNS).zip(find(c, GYRO_COLUMNS));
-        let mag = find(c, MAG_COLUMNS);
-        let position = find(c, Position::Plane.columns());
-        let position_velocity = find(c, Velocity::Nav.columns());
-        let truth = position
-            .zip(position_velocity)
-            .zip(find(c, QUATERNION_COLUMNS));
-        // Fixes: a position, and where the table has them a velocity and each fix's accuracy.
-        let fix = find(c, GEODETIC_COLUMNS);
-        let fix_velocity = find(c, Velocity::Ned.columns());
-        let accuracy = find(c, FIX_ACCURACY_COLUMNS);
-        for (k, row) in table.data.chunks_exact(width).enumerate() {
-            let ns = stamp_ns(row[t]).filter(|&ns| ros::Time::from_ns(ns).is_some());
-            let Some(ns) = ns else {
-                return Err(Error::CsvFormat {
-                    file: self.name.clone().into(),
-                    message: format!(
-                        "row {}: t_s = {} is outside a ROS time stamp's range (1970 to 2038)",
-                        k + 1,
-                        row[t]
-                    ),
-                });
-            };
-            let stamp = ros::Time::from_ns(ns).unwrap_or_default();
-            if let Some((a, g)) = imu {
-                let m = ros::Imu {
-                    header: header(stamp, Stream::Imu),
-                    orientation: ros::Quaternion::default(),
-                    orientation_covariance: ros::UNKNOWN_COVARIANCE,
-                    angular_velocity: v3(row, g),
-                    angular_velocity_covariance: [0.0; 9],
-                    linear_acceleration: v3(row, a),
-                    linear_acceleration_covariance: [0.0; 9],
-                };
-                messages.push((ns, Stream::Imu, ros::encode(&m)));
-                if let Some(b) = mag {
-                    let m = ros::MagneticField {
-                        header: header(stamp, Stream::Mag),
-                        magnetic_field: ros::Vector3::of(b.map(|k| row[k] / 1e6)),
-                        magnetic_field_covariance: [0.0; 9],
-                    };
-                    messages.push((ns, Stream::Mag, ros::encode(&m)));
-                }
-            } else if let Some(((p, v), q)) = truth {
-                let q = q.map(|k| row[k]);
-                let conj = [q[0], -q[1], -q[2], -q[3]];
-                let m = ros::Odometry {
-                    header: header(stamp, Stream::Truth),
-                    child_frame_id: "base_link".into(),
-                    pose: ros::PoseWithCovariance {
-                        pose: ros::Pose {
-                            position: v3(row, p),
-                            orientation: ros::Quaternion::of_wxyz(q),
-                        },
-                        covariance: ros::Covariance6::default(),
-                    },
-                    twist: ros::TwistWithCovariance {
-                        twist: ros::Twist {
-                            linear: ros::Vector3::of(rotate(conj, v.map(|k| row[k]))),
-                            angular: find(c, ["omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"])
-                                .map_or_else(ros::Vector3::default, |w| v3(row, w)),
-                        },
-                        covariance: ros::Covariance6::default(),
-                    },
-                };
-                let stream = if self.estimate {
-                    Stream::Estimate
-                } else {
-                    Stream::Truth
-                };
-                messages.push((ns, stream, ros::encode(&m)));
-                // On the WGS-84 Earth, the reference point's latitude, longitude and height.
-                if let (Some(llh), false) = (fix, self.estimate) {
-                    let m = nav_sat_fix(header(stamp, Stream::TruthFix), llh.map(|k| row[k]));
-                    messages.push((ns, Stream::TruthFix, ros::encode(&m)));
-                }
-            } else if let Some(llh) = fix {
-                let mut m = nav_sat_fix(header(stamp, Stream::Fix), llh.map(|k| row[k]));
-                if let Some([h, v]) = accuracy.map(|a| a.map(|k| row[k])) {
-                    // East, north, up variances.
-                    let (h2, v2) = (h * h, v * v);
-                    m.position_covariance = [h2, 0.0, 0.0, 0.0, h2, 0.0, 0.0, 0.0, v2];
-                    m.position_covariance_type = ros::COVARIANCE_TYPE_DIAGONAL_KNOWN;
-                }
-                messages.push((ns, Stream::Fix, ros::encode(&m)));
-                if let Some(ned) = fix_velocity {
-                    let [n, e, d] = ned.map(|k| row[k]);
-                    let m = ros::TwistStamped {
-                        header: header(stamp, Stream::Velocity),
-                        twist: ros::Twist {
-                            linear: ros::Vector3::of([e, n, -d]),
-                            angular: ros::Vector3::default(),
-                        },
-                    };
-                    messages.push((ns, Stream::Velocity, ros::encode(&m)));
-                }
-            } else if let Some(p) = position {
-                let m = ros::PointStamped {
-                    header: header(stamp, Stream::Position),
-                    point: v3(row, p),
-                };
-                messages.push((ns, Stream::Position, ros::encode(&m)));
-                if let Some(v) = position_velocity {
-                    let m = ros::TwistStamped {
-                        header: header(stamp, Stream::Velocity),
-                        twist: ros::Twist {
-                            linear: v3(row, v),
-                            angular: ros::Vector3::default(),
-                        },
-                    };
-                    messages.push((ns, Stream::Velocity, ros::encode(&m)));
-                }
-            } else {
-                return Err(self.unwritable(c));
-            }
-        }
-        Ok(())
-    }
-
-    fn unwritable(&self, columns: &[String]) -> Error {
-        Error::CsvFormat {
-            file: self.name.clone().into(),
-            message: format!(
-                "a bag holds IMU rates, a truth or GNSS fixes; not a table of {}",
-                columns.join(", ")
-            ),
-        }
-    }
-
-    /// Writes the bag's summary and gives back the file's writer.
-    ///
-    /// # Errors
-    /// The writer's refusal.
-    pub fn finish(mut self) -> Result<BufWriter<OutputFile>> {
-        let name = self.name.clone();
-        self.writer
-            .finish()
-            .map_err(|e| Self::error_of(&name, &e))?;
-        Ok(self.writer.into_inner())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::asl::stamp_ns;
     use crate::io::table::Table;
 
     fn write_bag(path: &Path, tables: &[&Table], description: &Description) {
@@ -1375,6 +1041,53 @@ mod tests {
         write_bag(&path, &[&readings(3, false)], &d);
         let back = read(&path).expect("read").description.expect("described");
         assert_eq!(back.nav_frame, d.nav_frame);
+    }
+
+    /// Two topics of one bag described in different frames are not read as one run.
+    #[test]
+    fn topics_described_in_two_frames_are_refused() {
+        let dir = tempfile::tempdir().expect("dir");
+        let path = dir.path().join("mixed.mcap");
+        let file = std::io::BufWriter::new(std::fs::File::create(&path).expect("file"));
+        let mut w = mcap::WriteOptions::new()
+            .profile("ros2")
+            .create(file)
+            .expect("writer");
+        let kind = ros::MessageType::Imu;
+        let schema = w
+            .add_schema(kind.name(), "ros2msg", kind.schema().as_bytes())
+            .expect("schema");
+        for (k, (topic, frame)) in [("/imu", "ENU"), ("/imu2", "NED")].into_iter().enumerate() {
+            let meta = BTreeMap::from([("imukit.nav_frame".to_string(), frame.to_string())]);
+            let channel = w.add_channel(schema, topic, "cdr", &meta).expect("channel");
+            let m = ros::Imu {
+                header: ros::Header {
+                    stamp: ros::Time::from_ns(1_000 + k as i64).expect("stamp"),
+                    frame_id: "imu_link".into(),
+                },
+                orientation: ros::Quaternion::default(),
+                orientation_covariance: ros::UNKNOWN_COVARIANCE,
+                angular_velocity: ros::Vector3::default(),
+                angular_velocity_covariance: [0.0; 9],
+                linear_acceleration: ros::Vector3::of([0.0, 0.0, 9.8]),
+                linear_acceleration_covariance: [0.0; 9],
+            };
+            let header = mcap::records::MessageHeader {
+                channel_id: channel,
+                sequence: 1,
+                log_time: 1_000 + k as u64,
+                publish_time: 1_000 + k as u64,
+            };
+            w.write_to_known_channel(&header, &ros::encode(&m))
+                .expect("message");
+        }
+        w.finish().expect("finished");
+        drop(w);
+        let e = read(&path).map(|_| ()).expect_err("refused").to_string();
+        assert!(
+            e.contains("topic /imu2 is described with nav_frame NED, not ENU (topic /imu's)"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -15,10 +15,31 @@ use crate::error::{Error, Result};
 /// before it is parsed).
 pub(super) fn read_mcap(path: &Path, contents: &mut Contents) -> Result<()> {
     let mut first = contents.topics.is_empty();
+    // Every channel's description, checked once: the topics of one bag share one frame.
+    let mut checked: Vec<u16> = Vec::new();
+    let mut first_topic = String::new();
     mcap_messages(path, &mut |channel, schema, data, log_time| {
         if first {
             first = false;
             contents.description = channel_description(path, &channel.metadata)?;
+            first_topic.clone_from(&channel.topic);
+            checked.push(channel.id);
+        } else if !checked.contains(&channel.id) {
+            checked.push(channel.id);
+            let this = channel_description(path, &channel.metadata)?;
+            if let (Some(a), Some(b)) = (&contents.description, &this)
+                && let Some(what) = a.contradiction(b)
+            {
+                return Err(Error::CsvFormat {
+                    file: path.into(),
+                    message: format!(
+                        "topic {} is described with {what} (topic {first_topic}'s): the \
+                         topics of one bag are read as one run in one frame (split the \
+                         bag, or write its topics alike)",
+                        channel.topic,
+                    ),
+                });
+            }
         }
         contents.ingest(
             path,
@@ -41,7 +62,7 @@ pub(super) type McapVisitor<'a> =
 /// `path` in file order, until it returns `false`. Every record's strings, maps and byte
 /// fields are checked to fit in the record before the `mcap` crate parses it: a length field
 /// of a damaged file must not make it reserve gigabytes.
-pub(super) fn mcap_messages(path: &Path, each: &mut McapVisitor<'_>) -> Result<()> {
+pub(in crate::io::bag) fn mcap_messages(path: &Path, each: &mut McapVisitor<'_>) -> Result<()> {
     use mcap::records::Record;
     use mcap::sans_io::{LinearReadEvent, LinearReader};
     use std::collections::HashMap;
