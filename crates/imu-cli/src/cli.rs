@@ -90,6 +90,18 @@ pub struct BagArgs {
     pub receive_time: bool,
 }
 
+/// The stretch of a run a command reads (`--start-s`, `--end-s`).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct WindowArgs {
+    /// Read from this many seconds after the first sample of the (first) input; every input
+    /// of the command is cut at the same instants.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    pub start_s: Option<f64>,
+    /// Read up to this many seconds after the first sample of the (first) input.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    pub end_s: Option<f64>,
+}
+
 /// How a written ROS 2 bag names its IMU and when it starts (`--out NAME.mcap`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct BagOutArgs {
@@ -167,6 +179,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// 3D: initial state from the first row of this truth file, or of a reference in
         /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
         /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
@@ -260,6 +275,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// The filter.
         #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
         filter: FilterKind,
@@ -302,6 +320,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
         /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
         gnss: Option<PathBuf>,
@@ -433,6 +454,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -489,6 +513,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,
@@ -515,6 +542,9 @@ pub enum Command {
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
         bag: BagArgs,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// Columns to analyse (default: every gyro and accel column present).
         #[arg(long = "column")]
         columns: Vec<String>,
@@ -575,6 +605,9 @@ pub enum Command {
         /// The CSV files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// The stretch of the run to read.
+        #[command(flatten)]
+        window: WindowArgs,
         /// The figure file (`.svg` or `.png`).
         #[arg(long)]
         out: PathBuf,

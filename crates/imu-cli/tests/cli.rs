@@ -2182,3 +2182,136 @@ fn allan_refuses_times_that_go_back_and_warns_of_gaps() {
     );
     assert!(!dir.join("b.csv").exists());
 }
+
+/// `--start-s` and `--end-s` cut every input of a command at the same instants, counted from
+/// the first sample: a windowed integration starts from the reference's row where the window
+/// starts and is the integration of those rows alone.
+#[test]
+fn a_time_window_cuts_every_input_at_the_same_instants() {
+    let dir = temp_dir("window");
+    let dir = dir.path();
+    let toml = imukit()
+        .current_dir(dir)
+        .args(["scenario", "gnss-car"])
+        .output()
+        .unwrap();
+    std::fs::write(dir.join("car.toml"), toml.stdout).unwrap();
+    let (code, err) = run_in(
+        dir,
+        &[
+            "simulate",
+            "car.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(
+        dir,
+        &[
+            "integrate",
+            "imu.csv",
+            "--init",
+            "truth.csv",
+            "--start-s",
+            "30",
+            "--end-s",
+            "40",
+            "--out",
+            "nav.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let rows = |name: &str| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(dir.join(name))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("t_s"))
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let (nav, truth) = (rows("nav.csv"), rows("truth.csv"));
+    assert_eq!(nav.len(), 1001, "30 s to 40 s at 100 Hz");
+    assert_eq!((nav[0][0], nav[1000][0]), (30.0, 40.0));
+    // The start is the truth's row at 30 s: position, velocity and attitude as they are.
+    let at30 = truth.iter().find(|r| r[0] == 30.0).unwrap();
+    assert_eq!(nav[0][1..7], at30[1..7], "position and velocity");
+    assert_eq!(nav[0][7..11], at30[10..14], "attitude");
+    // Compared over the same window: the same 1001 rows, and a consumer part's drift in 10 s.
+    let out = imukit()
+        .current_dir(dir)
+        .args([
+            "compare",
+            "truth.csv",
+            "nav.csv",
+            "--start-s",
+            "30",
+            "--end-s",
+            "40",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("(1001 rows compared)"), "{text}");
+    // Fused over a stretch: the fixes are cut there too, and the estimate starts at 25 s.
+    let (code, err) = run_in(
+        dir,
+        &[
+            "fuse",
+            "imu.csv",
+            "gnss.csv",
+            "--init",
+            "truth.csv",
+            "--scenario",
+            "car.toml",
+            "--start-s",
+            "25",
+            "--end-s",
+            "50",
+            "--out",
+            "fused.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let fused = rows("fused.csv");
+    assert_eq!((fused[0][0], fused[fused.len() - 1][0]), (25.0, 50.0));
+    // The fixes of 25 s to 50 s at 5 Hz, both ends included.
+    assert!(err.contains("2501 samples fused with 126 updates"), "{err}");
+    // An empty window, and a window the wrong way round, are refused by name.
+    for (args, needle) in [
+        (
+            &["integrate", "imu.csv", "--start-s", "500", "--out", "x.csv"][..],
+            "no row lies in the window [500 s, the end]",
+        ),
+        (
+            &["orient", "imu.csv", "--start-s", "500", "--out", "x.csv"][..],
+            "no row lies in the window [500 s, the end]",
+        ),
+        (
+            &["allan", "imu.csv", "--start-s", "500", "--out", "x.csv"][..],
+            "0 row(s) lie in the window [500 s, the end]",
+        ),
+        (
+            &[
+                "integrate",
+                "imu.csv",
+                "--start-s",
+                "5",
+                "--end-s",
+                "2",
+                "--out",
+                "x.csv",
+            ][..],
+            "--end-s: must be a finite number of seconds after the start (5 s)",
+        ),
+    ] {
+        let (code, err) = run_in(dir, args);
+        assert_eq!(code, Some(65), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!dir.join("x.csv").exists());
+    }
+}

@@ -66,7 +66,7 @@
 //! sim.truth.write_csv(&dir.join("truth.csv"))?;
 //!
 //! let initial = InitialState::from_csv(&dir.join("truth.csv"))?;
-//! let nav = integrate_csv(&dir.join("imu.csv"), &initial, &NavSetup::default(), &dir.join("nav.csv"))?;
+//! let nav = integrate_csv(&dir.join("imu.csv"), &initial, &NavSetup::default(), Default::default(), &dir.join("nav.csv"))?;
 //! assert_eq!(nav.rows, sim.truth.rows());
 //! # std::fs::remove_dir_all(&dir).ok();
 //! # Ok::<(), imukit::Error>(())

@@ -227,7 +227,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         };
         let (input, out) = (dir.join("imu.csv"), dir.join("nav.csv"));
         sim.imu.write_csv(&input).unwrap();
-        let summary = integrate_csv(&input, &init, &setup, &out).unwrap();
+        let summary = integrate_csv(&input, &init, &setup, Default::default(), &out).unwrap();
         let whole = integrate(&sim.imu, &init, &setup).unwrap();
         let streamed = imukit::io::table::read_table(&out).unwrap();
         assert_eq!(summary.rows, whole.rows());
@@ -249,7 +249,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         let (input, out) = (dir.join("short.csv"), dir.join("short_nav.csv"));
         short.write_csv(&input).unwrap();
         match (
-            integrate_csv(&input, &init, &setup, &out),
+            integrate_csv(&input, &init, &setup, Default::default(), &out),
             integrate(&short, &init, &setup),
         ) {
             (Ok(summary), Ok(whole)) => {
@@ -281,8 +281,14 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
     }
     let (input, out) = (dir.join("gappy.csv"), dir.join("gappy_nav.csv"));
     gappy.write_csv(&input).unwrap();
-    let summary =
-        integrate_csv(&input, &InitialState::default(), &NavSetup::default(), &out).unwrap();
+    let summary = integrate_csv(
+        &input,
+        &InitialState::default(),
+        &NavSetup::default(),
+        Default::default(),
+        &out,
+    )
+    .unwrap();
     assert_eq!(
         (summary.gaps.count, summary.gaps.longest_after_row),
         (1, 3001)

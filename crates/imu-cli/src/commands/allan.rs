@@ -6,10 +6,12 @@ use imukit::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;
+use imukit::io::rows::TimeWindow;
 
 pub fn run(
     input: &Path,
     columns: &[String],
+    window: TimeWindow,
     out: &Path,
     plot: Option<&Path>,
     size: imu_plot::FigureSize,
@@ -22,7 +24,7 @@ pub fn run(
     check_outputs(&[("input", input)], &outputs)?;
     imukit::io::output::check_table_outputs(&[("--out", out)])?;
     crate::report::warn_implausible(input);
-    let result = analyse(input, columns)?;
+    let result = analyse(input, columns, window)?;
     result.table.write(out)?;
     if let Some(p) = plot {
         imu_plot::allan_figure(p, &result, &file_name(input), size)?;
@@ -78,7 +80,11 @@ pub(crate) fn file_name(input: &Path) -> String {
 
 /// Reads `columns` (default: every gyro and accel column) and `t_s` of `input` and computes
 /// their Allan curves and noise terms; errors name the file and column.
-pub(crate) fn analyse(input: &Path, columns: &[String]) -> Result<AllanResult, CliError> {
+pub(crate) fn analyse(
+    input: &Path,
+    columns: &[String],
+    window: TimeWindow,
+) -> Result<AllanResult, CliError> {
     let header = read_header(input)?;
     let chosen: Vec<String> = if columns.is_empty() {
         GYRO_COLUMNS
@@ -98,7 +104,32 @@ pub(crate) fn analyse(input: &Path, columns: &[String]) -> Result<AllanResult, C
         ""
     };
     let data = read_columns(input, &required, hint)?;
-    let t = data.get("t_s");
+    // The window's rows: the times are checked in order below, so they are a run of rows.
+    let all_t = data.get("t_s");
+    let rows = match (window.is_whole(), all_t.first()) {
+        (false, Some(&t0)) => {
+            let lo = t0 + window.start_s.unwrap_or(0.0);
+            let hi = window.end_s.map_or(f64::INFINITY, |e| t0 + e);
+            imukit::io::rows::check_increasing(all_t, &input.display().to_string(), 2)?;
+            let from = all_t.partition_point(|&t| t < lo);
+            let to = all_t.partition_point(|&t| t <= hi);
+            if to < from + 2 {
+                return Err(imukit::Error::Invalid {
+                    field: input.display().to_string(),
+                    message: format!(
+                        "{} row(s) lie in the window {} (seconds after the first sample); at \
+                         least 2 needed",
+                        to.saturating_sub(from),
+                        window.describe()
+                    ),
+                }
+                .into());
+            }
+            from..to
+        }
+        _ => 0..all_t.len(),
+    };
+    let t = &all_t[rows.clone()];
     // The Allan deviation takes the samples as evenly spaced: times that go back are refused
     // by row, and gaps are said (the clusters that span them are not the sensor's noise).
     imukit::io::rows::check_increasing(t, &input.display().to_string(), 2)?;
@@ -119,7 +150,7 @@ pub(crate) fn analyse(input: &Path, columns: &[String]) -> Result<AllanResult, C
     let rate = mean_rate(t)?;
     let series: Vec<(String, Vec<f64>)> = chosen
         .iter()
-        .map(|c| (c.clone(), data.get(c).to_vec()))
+        .map(|c| (c.clone(), data.get(c)[rows.clone()].to_vec()))
         .collect();
     // The library names the column; the file is named here.
     let in_file = |column: String| format!("{}, column {column}", input.display());

@@ -4,12 +4,18 @@ use std::path::Path;
 
 use imu_core::orientation::DistanceStats;
 use imukit::io::output::check_outputs;
-use imukit::run::compare::compare_csv;
+use imukit::io::rows::TimeWindow;
+use imukit::run::compare::compare_csv_within;
 
 use super::CliError;
 
 /// Streams both files (memory does not grow with them).
-pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliError> {
+pub fn run(
+    truth: &Path,
+    estimate: &Path,
+    window: TimeWindow,
+    out: Option<&Path>,
+) -> Result<(), CliError> {
     let inputs = [("truth file", truth), ("estimate file", estimate)];
     check_outputs(
         &inputs,
@@ -18,7 +24,7 @@ pub fn run(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<(), CliE
     imukit::io::output::check_table_outputs(
         &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
     )?;
-    let c = compare_csv(truth, estimate, out)?;
+    let c = compare_csv_within(truth, estimate, window, out)?;
     crate::out_line!(
         "{:<10} {:>16} {:>16} {:>16}",
         "error",

@@ -5,7 +5,7 @@ use std::path::Path;
 use imukit::io::bag::Role;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
-use imukit::io::rows::Gaps;
+use imukit::io::rows::{Gaps, TimeWindow};
 use imukit::io::table::{read_table, read_table_as};
 use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
 use imukit::run::navigate::{NavAsked, NavRequest};
@@ -37,6 +37,8 @@ pub struct Args<'a> {
     pub rest_s: Option<f64>,
     pub smooth: bool,
     pub zupt: bool,
+    /// `--start-s`, `--end-s`: every input is cut at the same instants.
+    pub window: TimeWindow,
     pub out: &'a Path,
 }
 
@@ -90,11 +92,21 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
     imukit::io::output::check_table_outputs(&[("--out", a.out)])?;
+    let imu = read_table_as(a.imu, Role::Readings)?;
+    // The window's seconds count from the IMU's first sample; every input is cut there.
+    let t0 = TimeWindow::first_time(&imu, &a.imu.display().to_string())?;
+    let cut = |table: imukit::Table, path: &Path, at_least: usize| {
+        a.window
+            .apply(table, t0, &path.display().to_string(), at_least)
+    };
+    let imu = cut(imu, a.imu, 2)?;
     let initial = match a.init {
         Some(init) => {
             let (frame, on_earth) = data_frame(a)?;
             let attitude = a.align.is_some().then_some("--align");
-            let s = super::integrate::start_from(init, frame, on_earth, attitude.ok_or("--align"))?;
+            let at = a.window.start_s.map(|s| t0 + s);
+            let s =
+                super::integrate::start_from(init, frame, on_earth, attitude.ok_or("--align"), at)?;
             s.check(&format!("{}, row 2", init.display()))?;
             Some(s)
         }
@@ -112,7 +124,6 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         smooth: a.smooth,
         zupt: a.zupt,
     };
-    let imu = read_table_as(a.imu, Role::Readings)?;
     crate::report::warn_implausible_read(&imu, a.imu);
     let (setup, start) = match (a.scenario, &a.model) {
         (Some(path), _) => {
@@ -147,7 +158,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
     };
     let gnss = match a.gnss {
-        Some(path) => read_table_as(path, Role::Fixes)?,
+        Some(path) => cut(read_table_as(path, Role::Fixes)?, path, 0)?,
         // No fixes: a table without columns, which the filter reads as none.
         None => imukit::Table::default(),
     };
@@ -170,8 +181,8 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         (None, _) => gnss,
     };
-    let odometer = a.odometer.map(read_table).transpose()?;
-    let baro = a.baro.map(read_table).transpose()?;
+    let odometer = a.odometer.map(|p| cut(read_table(p)?, p, 0)).transpose()?;
+    let baro = a.baro.map(|p| cut(read_table(p)?, p, 0)).transpose()?;
     let aids = AidTables {
         odometer: odometer.as_ref(),
         baro: baro.as_ref(),

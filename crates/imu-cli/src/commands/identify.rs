@@ -10,6 +10,7 @@ use imukit::run::identify::{
 
 use super::CliError;
 use super::allan::{analyse, file_name};
+use imukit::io::rows::TimeWindow;
 
 /// Where `identify` writes, besides the curve.
 pub struct Outputs<'a> {
@@ -24,6 +25,7 @@ pub struct Outputs<'a> {
 pub fn run(
     input: &Path,
     columns: &[String],
+    window: TimeWindow,
     to: &Outputs<'_>,
     size: imu_plot::FigureSize,
 ) -> Result<(), CliError> {
@@ -36,7 +38,7 @@ pub fn run(
     outputs.extend(to.plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
     crate::report::warn_implausible(input);
-    let result = analyse(input, columns)?;
+    let result = analyse(input, columns, window)?;
     let source = file_name(input);
     // Everything is computed before anything is written.
     let file = param_file(&result, &source);

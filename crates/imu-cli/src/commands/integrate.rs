@@ -7,7 +7,7 @@ use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
-use imukit::io::rows::Gaps;
+use imukit::io::rows::{Gaps, TimeWindow};
 use imukit::run::navigate::{InitialState, NavAsked, NavRequest, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
@@ -18,6 +18,8 @@ use crate::{CliError, by_flag};
 pub struct Common<'a> {
     pub input: &'a Path,
     pub out: &'a Path,
+    /// `--start-s`, `--end-s`.
+    pub window: TimeWindow,
     pub position0: Option<&'a [f64]>,
     pub velocity0: Option<&'a [f64]>,
 }
@@ -64,7 +66,25 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
     };
     check_outputs(&[("input", c.input)], &[("--out", c.out)])?;
     imukit::io::output::check_table_outputs(&[("--out", c.out)])?;
-    let samples = read_planar(c.input)?;
+    let mut samples = read_planar(c.input)?;
+    if !c.window.is_whole() {
+        let first = samples.first().map_or(0.0, |x| x.t_s);
+        let (lo, hi) = (
+            first + c.window.start_s.unwrap_or(0.0),
+            c.window.end_s.map_or(f64::INFINITY, |e| first + e),
+        );
+        samples.retain(|x| x.t_s >= lo && x.t_s <= hi);
+        if samples.is_empty() {
+            return Err(Error::Invalid {
+                field: c.input.display().to_string(),
+                message: format!(
+                    "no sample lies in the window {} (seconds after the first sample)",
+                    c.window.describe()
+                ),
+            }
+            .into());
+        }
+    }
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
     let initial = request.initial_state(t0).map_err(by_flag)?;
     let nav = integrate(&samples, scheme, initial).map_err(|e| Error::Invalid {
@@ -88,8 +108,9 @@ pub(crate) fn start_from(
     frame: imukit::scenario::NavFrameName,
     on_earth: bool,
     attitude: Result<&str, &str>,
+    at_s: Option<f64>,
 ) -> Result<InitialState, CliError> {
-    let (initial, given) = InitialState::from_reference(path, frame)?;
+    let (initial, given) = InitialState::from_reference_at(path, frame, at_s)?;
     if given.on_earth && !on_earth {
         return Err(Error::Invalid {
             field: "--init".into(),
@@ -144,7 +165,12 @@ pub fn three_d(
     let mut initial = match o.init {
         Some(p) => {
             let attitude = o.euler0.map(|_| "--euler0-rad").ok_or("--euler0-rad");
-            start_from(p, setup.nav_frame, setup.earth.is_some(), attitude)?
+            // With a window, the start is the reference's row where the window starts.
+            let at = match c.window.start_s {
+                Some(s) => Some(TimeWindow::first_time_in(c.input)? + s),
+                None => None,
+            };
+            start_from(p, setup.nav_frame, setup.earth.is_some(), attitude, at)?
         }
         None => {
             // A start nobody gave is said, not silently taken.
@@ -196,6 +222,9 @@ pub fn three_d(
     if let Some(baro) = o.baro {
         // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
         let imu = imukit::run::navigate::read_whole(c.input)?;
+        let source = c.input.display().to_string();
+        let t0 = TimeWindow::first_time(&imu, &source)?;
+        let imu = c.window.apply(imu, t0, &source, 1)?;
         let readings = imukit::io::table::read_table(baro)?;
         let joined =
             imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| match e {
@@ -221,13 +250,14 @@ pub fn three_d(
         return Ok(());
     }
     // Streamed: memory does not grow with the input file.
-    let summary = integrate_csv(c.input, &initial, &setup, c.out).map_err(|e| match e {
-        Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
-            field: c.input.display().to_string(),
-            message: e.to_string(),
-        },
-        other => other,
-    })?;
+    let summary =
+        integrate_csv(c.input, &initial, &setup, c.window, c.out).map_err(|e| match e {
+            Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
+                field: c.input.display().to_string(),
+                message: e.to_string(),
+            },
+            other => other,
+        })?;
     if let Some(m) = summary.gaps.message(&c.input.display().to_string()) {
         crate::report::warn(&m);
     }

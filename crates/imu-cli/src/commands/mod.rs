@@ -16,6 +16,7 @@ mod simulate;
 mod study;
 
 use imukit::choice::Choice;
+use imukit::io::rows::TimeWindow;
 use imukit::run::navigate::{NavAsked, NavRequest, SchemeName};
 
 use crate::CliError;
@@ -96,12 +97,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             lon0_deg,
             height0_m,
             out,
+            window,
         } => {
             map.attach(&input)?;
             bag.attach(&[Some(&input), init.as_deref()])?;
             let common = integrate::Common {
                 input: &input,
                 out: &out,
+                window: window.window()?,
                 position0: position0.as_deref(),
                 velocity0: velocity0.as_deref(),
             };
@@ -165,6 +168,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             smooth,
             zupt,
             out,
+            window,
         } => {
             map.attach(&imu)?;
             bag.attach(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
@@ -202,6 +206,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 rest_s,
                 smooth,
                 zupt,
+                window: window.window()?,
                 out: &out,
             })
         }
@@ -216,27 +221,30 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             nav_frame,
             accel_sign,
             out,
+            window,
         } => {
             map.attach(&input)?;
             bag.attach(&[Some(&input)])?;
-            orient::run(
-                &input,
+            orient::run(&orient::Args {
+                input: &input,
                 filter,
-                &params,
+                params: &params,
                 conventions,
                 nav_frame,
                 accel_sign,
-                &out,
-            )
+                window: window.window()?,
+                out: &out,
+            })
         }
         Command::Compare {
             truth,
             estimate,
             bag,
             out,
+            window,
         } => {
             bag.attach(&[Some(&truth), Some(&estimate)])?;
-            compare::run(&truth, &estimate, out.as_deref())
+            compare::run(&truth, &estimate, window.window()?, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {
@@ -252,12 +260,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             plot,
             figure,
+            window,
         } => {
             map.attach(&input)?;
             bag.attach(&[Some(&input)])?;
             allan::run(
                 &input,
                 &columns,
+                window.window()?,
                 &out,
                 plot.as_deref(),
                 plot::figure_size(&figure)?,
@@ -275,12 +285,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             kalibr_topic,
             plot,
             figure,
+            window,
         } => {
             map.attach(&input)?;
             bag.attach(&[Some(&input)])?;
             identify::run(
                 &input,
                 &columns,
+                window.window()?,
                 &identify::Outputs {
                     out: &out,
                     params: params.as_deref(),
@@ -294,10 +306,17 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Plot {
             files,
+            window,
             out,
             nav_frame,
             figure,
-        } => plot::plot(&files, &out, nav_frame, plot::figure_size(&figure)?),
+        } => plot::plot(
+            &files,
+            &out,
+            nav_frame,
+            window.window()?,
+            plot::figure_size(&figure)?,
+        ),
         Command::Animate {
             truth,
             out,
@@ -311,6 +330,24 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let opts = plot::options(body.as_deref(), lever_arm.as_deref(), fps, speed, nav_frame);
             plot::animate(&truth, &out, &opts)
         }
+    }
+}
+
+impl crate::cli::WindowArgs {
+    /// The window asked for, checked; refusals name the flag.
+    ///
+    /// # Errors
+    /// As [`TimeWindow::new`], naming `--start-s` or `--end-s`.
+    pub fn window(&self) -> Result<TimeWindow, CliError> {
+        TimeWindow::new(self.start_s, self.end_s)
+            .map_err(|e| match e {
+                imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
+                    field: format!("--{}", field.replace('_', "-")),
+                    message,
+                },
+                other => other,
+            })
+            .map_err(CliError::from)
     }
 }
 

@@ -3,20 +3,37 @@ use std::path::Path;
 
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
+use imukit::io::rows::TimeWindow;
 use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
 use imukit::scenario::{AccelSignName, NavFrameName};
 
 use crate::CliError;
 
-pub fn run(
-    input: &Path,
-    filter: FilterKind,
-    params: &[String],
-    conventions: Conventions,
-    nav_frame: Option<NavFrameName>,
-    accel_sign: Option<AccelSignName>,
-    out: &Path,
-) -> Result<(), CliError> {
+/// The command's arguments.
+pub struct Args<'a> {
+    pub input: &'a Path,
+    pub filter: FilterKind,
+    /// `--param KEY=VALUE`.
+    pub params: &'a [String],
+    pub conventions: Conventions,
+    pub nav_frame: Option<NavFrameName>,
+    pub accel_sign: Option<AccelSignName>,
+    /// `--start-s`, `--end-s`.
+    pub window: TimeWindow,
+    pub out: &'a Path,
+}
+
+pub fn run(a: &Args<'_>) -> Result<(), CliError> {
+    let Args {
+        input,
+        filter,
+        params,
+        conventions,
+        nav_frame,
+        accel_sign,
+        window,
+        out,
+    } = *a;
     check_outputs(&[("input", input)], &[("--out", out)])?;
     imukit::io::output::check_table_outputs(&[("--out", out)])?;
     // The frame and sign the input says it has, unless the flags say (and do not contradict it).
@@ -31,7 +48,7 @@ pub fn run(
     .map_err(crate::error::by_flag)?
     .resolve();
     crate::report::warn_implausible(input);
-    let s = orient_csv(input, &spec, nav, out)?;
+    let s = orient_csv(input, &spec, nav, window, out)?;
     let rate = (s.sample_rate_hz * 1e6).round() / 1e6;
     let timing = if s.per_sample {
         format!("each over its own interval (median rate {rate} Hz)")

@@ -5,6 +5,7 @@ use imu_plot::animate::{self as anim, AnimateOptions};
 use imu_plot::{FigureSize, plot_files};
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
+use imukit::io::rows::TimeWindow;
 use imukit::io::table::read_table;
 
 use imukit::scenario::NavFrameName;
@@ -31,6 +32,7 @@ pub fn plot(
     files: &[PathBuf],
     out: &Path,
     nav_frame: Option<NavFrameName>,
+    window: TimeWindow,
     size: FigureSize,
 ) -> Result<(), CliError> {
     imu_plot::check_figure_path(out)?;
@@ -38,7 +40,23 @@ pub fn plot(
     check_outputs(&inputs, &[("--out", out)])?;
     let paths: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     let nav_frame = described_frame(&paths, nav_frame)?;
-    plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
+    if window.is_whole() {
+        plot_files(files, out, nav_frame == NavFrameName::NED, size)?;
+    } else {
+        // Every file cut at the same instants, counted from the first file's first sample.
+        let mut tables = Vec::with_capacity(files.len());
+        let mut t0 = None;
+        for f in files {
+            let table = read_table(f)?;
+            let name = f.display().to_string();
+            let origin = match t0 {
+                Some(t) => t,
+                None => *t0.insert(TimeWindow::first_time(&table, &name)?),
+            };
+            tables.push((f.clone(), window.apply(table, origin, &name, 1)?));
+        }
+        imu_plot::plot_tables(&tables, out, nav_frame == NavFrameName::NED, size)?;
+    }
     crate::note!("imukit: wrote {}", out.display());
     Ok(())
 }

@@ -114,6 +114,23 @@ impl TimeWindow {
             .ok_or_else(|| invalid(source, "has no t_s column or no rows"))
     }
 
+    /// The first `t_s` of the file at `path` (its first row alone is read), the origin of the
+    /// window's seconds for a command whose first input is that file.
+    ///
+    /// # Errors
+    /// Missing `t_s`, a bad first row, a file without rows.
+    pub fn first_time_in(path: &Path) -> Result<f64> {
+        let mut rows = CsvRows::open(path, &["t_s"], "")?;
+        let mut t = [0.0];
+        match rows.next_row(&mut t)? {
+            Some(_) => Ok(t[0]),
+            None => Err(crate::Error::CsvFormat {
+                file: path.into(),
+                message: "no data rows after the header".into(),
+            }),
+        }
+    }
+
     /// The window as `[10 s, 60 s]`.
     #[must_use]
     pub fn describe(&self) -> String {
@@ -291,6 +308,15 @@ pub(crate) struct TimedRows {
     interval: Option<f64>,
     gaps: Gaps,
     taken: usize,
+    /// The rows given: from `window.0` to `window.1` (absolute times), the others skipped.
+    window: (f64, f64),
+    /// The window as the user gave it, and the file, for the message when it holds no row.
+    asked: TimeWindow,
+    path: std::path::PathBuf,
+    given: usize,
+    /// The time of the last row skipped before the window (for the order check).
+    skipped_t: Option<f64>,
+    width: usize,
 }
 
 impl TimedRows {
@@ -325,12 +351,59 @@ impl TimedRows {
             interval: None,
             gaps: Gaps::against(median.unwrap_or(0.0)),
             taken: 0,
+            window: (f64::NEG_INFINITY, f64::INFINITY),
+            asked: TimeWindow::default(),
+            path: path.into(),
+            given: 0,
+            skipped_t: None,
+            width: columns.len(),
         })
     }
 
-    /// The first row's time, s.
-    pub(crate) fn first_time(&self) -> f64 {
-        self.first_t
+    /// Gives only the rows of `window` (its seconds counted from this file's first row): the
+    /// rows before it are read, checked in order and skipped, and the file ends with it.
+    pub(crate) fn within(mut self, window: TimeWindow) -> Self {
+        if !window.is_whole() {
+            self.window = (
+                self.first_t + window.start_s.unwrap_or(0.0),
+                window.end_s.map_or(f64::INFINITY, |e| self.first_t + e),
+            );
+            self.asked = window;
+        }
+        self
+    }
+
+    /// The time of the first row given, s: the file's first row, or the first in the window
+    /// ([`Self::within`]; the rows before it are read, checked in order and skipped).
+    ///
+    /// # Errors
+    /// Bad cells, times that do not increase, a window that holds no row.
+    pub(crate) fn start_time(&mut self) -> Result<f64> {
+        loop {
+            if self.ahead.is_empty() {
+                let mut row = vec![0.0; self.width];
+                if self.rows.next_row(&mut row)?.is_none() {
+                    self.ended()?;
+                    return Ok(self.first_t);
+                }
+                self.ahead.push_back(row);
+            }
+            let t = self.ahead[0][0];
+            if let Some(p) = self.skipped_t
+                && t <= p
+            {
+                return Err(not_increasing("IMU data", self.taken + 2));
+            }
+            if t >= self.window.0 {
+                if t > self.window.1 {
+                    self.ended()?;
+                }
+                return Ok(t);
+            }
+            self.skipped_t = Some(t);
+            self.ahead.pop_front();
+            self.taken += 1;
+        }
     }
 
     /// The median interval of the look-ahead rows, s (`None` for a single row).
@@ -358,25 +431,53 @@ impl TimedRows {
     /// # Errors
     /// Bad cells, times that do not increase (rows named).
     pub(crate) fn next_row(&mut self, row: &mut [f64]) -> Result<bool> {
-        match self.ahead.pop_front() {
-            Some(r) => row.copy_from_slice(&r),
-            None => {
-                if self.rows.next_row(row)?.is_none() {
-                    return Ok(false);
+        loop {
+            match self.ahead.pop_front() {
+                Some(r) => row.copy_from_slice(&r),
+                None => {
+                    if self.rows.next_row(row)?.is_none() {
+                        return self.ended();
+                    }
                 }
             }
-        }
-        self.taken += 1;
-        let (t, line) = (row[0], self.last_row());
-        if let Some(p) = self.previous_t {
-            if t <= p {
+            self.taken += 1;
+            let (t, line) = (row[0], self.last_row());
+            if let Some(p) = self.previous_t.or(self.skipped_t)
+                && t <= p
+            {
                 return Err(not_increasing("IMU data", line));
             }
-            self.gaps.note(t - p, line - 1);
-            self.interval = Some(t - p);
+            if t > self.window.1 {
+                return self.ended();
+            }
+            if t < self.window.0 {
+                // Before the window: checked in order, then skipped as if not in the file.
+                self.skipped_t = Some(t);
+                continue;
+            }
+            if let Some(p) = self.previous_t {
+                self.gaps.note(t - p, line - 1);
+                self.interval = Some(t - p);
+            }
+            self.previous_t = Some(t);
+            self.given += 1;
+            return Ok(true);
         }
-        self.previous_t = Some(t);
-        Ok(true)
+    }
+
+    /// The end of the rows given; refused when a window held none.
+    fn ended(&mut self) -> Result<bool> {
+        if self.given == 0 && !self.asked.is_whole() {
+            return Err(crate::Error::CsvFormat {
+                file: self.path.clone(),
+                message: format!(
+                    "no row lies in the window {} (seconds after the first sample, t_s = {})",
+                    self.asked.describe(),
+                    self.first_t
+                ),
+            });
+        }
+        Ok(false)
     }
 }
 

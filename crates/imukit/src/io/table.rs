@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use imu_core::sensor::ImuReading;
 use imu_core::{NavFrame, Truth};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, invalid};
 use crate::io::TableFormat;
 use crate::io::column_map::{ColumnMap, Source, TimeUnit};
 use crate::io::description::Description;
@@ -956,9 +956,34 @@ pub struct CsvRows {
     origin_ns: std::cell::Cell<Option<i64>>,
     /// The file's own column names, by field, for messages.
     file_names: Option<Vec<String>>,
+    /// Rows given only from `.1` to `.2` in the time column `.0` ([`CsvRows::within`]).
+    window: Option<(usize, f64, f64)>,
 }
 
 impl CsvRows {
+    /// Gives only the rows whose `t_s` (a column asked for) lies in `window`, its seconds
+    /// counted from `t0`: the rows before it are skipped, and the rows end after it.
+    ///
+    /// # Errors
+    /// `t_s` not among the columns asked for.
+    pub fn within(mut self, window: crate::io::rows::TimeWindow, t0: f64) -> Result<Self> {
+        if window.is_whole() {
+            return Ok(self);
+        }
+        let Some(k) = self.wanted.iter().position(|(_, name)| name == "t_s") else {
+            return Err(invalid(
+                self.path.display().to_string(),
+                "has no t_s column to cut a time window from",
+            ));
+        };
+        self.window = Some((
+            k,
+            t0 + window.start_s.unwrap_or(0.0),
+            window.end_s.map_or(f64::INFINITY, |e| t0 + e),
+        ));
+        Ok(self)
+    }
+
     /// Opens `path` and checks that its header has every column of `required`.
     ///
     /// # Errors
@@ -1075,6 +1100,7 @@ impl CsvRows {
             sources: layout.sources,
             origin_ns: std::cell::Cell::new(layout.origin_ns),
             file_names: layout.file_names,
+            window: None,
         })
     }
 
@@ -1090,6 +1116,21 @@ impl CsvRows {
     /// # Errors
     /// Values that are not finite numbers (file, row, column), malformed rows.
     pub fn next_row(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
+        loop {
+            let row = self.next_row_any(out)?;
+            let (Some(line), Some((k, lo, hi))) = (row, self.window) else {
+                return Ok(row);
+            };
+            match out.get(k) {
+                Some(&t) if t < lo => {}
+                Some(&t) if t > hi => return Ok(None),
+                _ => return Ok(Some(line)),
+            }
+        }
+    }
+
+    /// The next row, whatever its time.
+    fn next_row_any(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
         let reader = match &mut self.reader {
             RowSource::Csv(r) => r,
             RowSource::Parquet(rows) => return rows.next_row(&self.wanted, out),

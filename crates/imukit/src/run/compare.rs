@@ -15,6 +15,7 @@ use imu_core::{Body, Ecef, Enu, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
 use crate::io::output::AtomicFile;
+use crate::io::rows::TimeWindow;
 use crate::io::table::{CsvRows, Table};
 use crate::run::fuse::SIGMA_COLUMNS;
 use crate::run::navigate::{GEODETIC_COLUMNS, STATE_COLUMNS};
@@ -346,6 +347,25 @@ pub fn check_comparable(described: &crate::io::description::Described) -> Result
 /// # Errors
 /// As [`compare`], CSV errors naming file, row and column, and I/O errors.
 pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+    compare_csv_within(truth, estimate, TimeWindow::default(), out)
+}
+
+/// [`compare_csv`] over the rows of `window` alone, its seconds counted from the truth's first
+/// sample (both files cut at the same instants).
+///
+/// # Errors
+/// As [`compare_csv`].
+pub fn compare_csv_within(
+    truth: &Path,
+    estimate: &Path,
+    window: TimeWindow,
+    out: Option<&Path>,
+) -> Result<ErrorSummary> {
+    let t0 = if window.is_whole() {
+        0.0
+    } else {
+        TimeWindow::first_time_in(truth)?
+    };
     // A reference on the Earth (latitude, longitude, height or ECEF, without imukit's plane
     // coordinates) is compared in the Earth's terms.
     let truth_header = crate::io::table::read_header(truth)?;
@@ -354,7 +374,7 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
         Ok(EstimateKind::Navigation)
     ) && let Some(layout) = Layout::on_earth(&truth_header)
     {
-        return compare_on_earth(truth, estimate, layout, out);
+        return compare_on_earth(truth, estimate, layout, (window, t0), out);
     }
     check_comparable(&crate::io::description::Described::read(&[
         truth, estimate,
@@ -375,8 +395,8 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
         EstimateKind::Navigation => "; the truth needs t_s, pos_*, vel_*, q_*",
         EstimateKind::Orientation => "; the truth needs t_s, q_w, q_x, q_y, q_z",
     };
-    let mut truth_rows = CsvRows::open(truth, wanted, hint)?;
-    let mut estimate_rows = CsvRows::open(estimate, &estimate_wanted, "")?;
+    let mut truth_rows = CsvRows::open(truth, wanted, hint)?.within(window, t0)?;
+    let mut estimate_rows = CsvRows::open(estimate, &estimate_wanted, "")?.within(window, t0)?;
     let (mut truth_buffer, mut estimate_buffer) =
         (vec![0.0; wanted.len()], vec![0.0; estimate_wanted.len()]);
     let mut file = out.map(AtomicFile::create).transpose()?;
@@ -424,6 +444,7 @@ fn compare_on_earth(
     truth: &Path,
     estimate: &Path,
     layout: Layout,
+    (window, t0): (TimeWindow, f64),
     out: Option<&Path>,
 ) -> Result<ErrorSummary> {
     let frame_of = |p: &Path| -> Result<NavFrameName> {
@@ -450,8 +471,8 @@ fn compare_on_earth(
         attitude: layout.attitude && own.attitude,
     };
     let (truth_columns, estimate_columns) = (layout.columns(), own.columns());
-    let mut truth_rows = CsvRows::open(truth, &truth_columns, "")?;
-    let mut estimate_rows = CsvRows::open(estimate, &estimate_columns, "")?;
+    let mut truth_rows = CsvRows::open(truth, &truth_columns, "")?.within(window, t0)?;
+    let mut estimate_rows = CsvRows::open(estimate, &estimate_columns, "")?.within(window, t0)?;
     let (mut truth_buffer, mut estimate_buffer) = (
         vec![0.0; truth_columns.len()],
         vec![0.0; estimate_columns.len()],

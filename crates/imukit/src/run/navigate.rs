@@ -23,7 +23,7 @@ use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::description::{Described, Description, Origin};
 use crate::io::output::AtomicFile;
-use crate::io::rows::{Gaps, TimedRows, check_increasing};
+use crate::io::rows::{Gaps, TimeWindow, TimedRows, check_increasing};
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
@@ -261,6 +261,19 @@ impl InitialState {
     /// # Errors
     /// As [`Self::from_csv`]; a first row that names no point on the Earth.
     pub fn from_reference(path: &Path, frame: NavFrameName) -> Result<(Self, Given)> {
+        Self::from_reference_at(path, frame, None)
+    }
+
+    /// [`Self::from_reference`] at the first row at or after `at_s` (s, the file's own times;
+    /// `None`: its first row): the start of a stretch of a run (`--start-s`).
+    ///
+    /// # Errors
+    /// As [`Self::from_reference`]; no row at or after `at_s`.
+    pub fn from_reference_at(
+        path: &Path,
+        frame: NavFrameName,
+        at_s: Option<f64>,
+    ) -> Result<(Self, Given)> {
         use crate::run::reference::{Layout, Position, VelocitySource, ecef, ned_of_difference};
         let header = crate::io::table::read_header(path)?;
         let plane = Layout::of(&header, &[Position::Plane]);
@@ -268,7 +281,7 @@ impl InitialState {
             // imukit's own tables (plane coordinates, velocity and attitude) start as they did.
             !plane.is_some_and(|p| p.velocity == Some(Velocity::Nav) && p.attitude)
         }) else {
-            return Ok((Self::from_csv(path)?, Given::FULL));
+            return Ok((Self::from_csv_at(path, at_s)?, Given::FULL));
         };
         let own = crate::io::description::Description::read(path)?
             .and_then(|d| d.nav_frame)
@@ -288,10 +301,20 @@ impl InitialState {
                 )
             })
         };
-        let Some(first) = read(&mut rows)? else {
+        let mut first = read(&mut rows)?;
+        while let (Some(row), Some(at)) = (&first, at_s) {
+            if row.t_s >= at {
+                break;
+            }
+            first = read(&mut rows)?;
+        }
+        let Some(first) = first else {
             return Err(crate::Error::CsvFormat {
                 file: path.into(),
-                message: "no data rows after the header".into(),
+                message: at_s.map_or_else(
+                    || "no data rows after the header".into(),
+                    |at| format!("no row at or after t_s = {at}, where the run's window starts"),
+                ),
             });
         };
         let (velocity_ned, source) = match first.velocity_ned {
@@ -328,9 +351,17 @@ impl InitialState {
     /// # Errors
     /// Missing columns, a bad first row (file, row, column), an empty file.
     pub fn from_csv(path: &Path) -> Result<Self> {
-        // The state columns after t_s: position, velocity, quaternion.
+        Self::from_csv_at(path, None)
+    }
+
+    /// [`Self::from_csv`] at the first row at or after `at_s` (s; `None`: the first row).
+    ///
+    /// # Errors
+    /// As [`Self::from_csv`]; no row at or after `at_s`.
+    pub fn from_csv_at(path: &Path, at_s: Option<f64>) -> Result<Self> {
+        // The state columns: time, position, velocity, quaternion.
         let hint = "; the initial state comes from a truth CSV";
-        let mut columns = STATE_COLUMNS[1..].to_vec();
+        let mut columns = STATE_COLUMNS[..].to_vec();
         let mut rows = CsvRows::open(path, &columns, hint)?;
         // Read with the geodetic position where the table has it (the same table: a bag's
         // topic chosen once for all of them).
@@ -342,14 +373,25 @@ impl InitialState {
             columns.extend(GEODETIC_COLUMNS);
             rows = CsvRows::open(path, &columns, hint)?;
         }
-        let mut r = [0.0; 13];
-        if rows.next_row(&mut r[..columns.len()])?.is_none() {
-            return Err(crate::Error::CsvFormat {
-                file: path.into(),
-                message: "no data rows after the header".into(),
-            });
+        let mut row = [0.0; 14];
+        loop {
+            if rows.next_row(&mut row[..columns.len()])?.is_none() {
+                return Err(crate::Error::CsvFormat {
+                    file: path.into(),
+                    message: at_s.map_or_else(
+                        || "no data rows after the header".into(),
+                        |at| {
+                            format!("no row at or after t_s = {at}, where the run's window starts")
+                        },
+                    ),
+                });
+            }
+            if at_s.is_none_or(|at| row[0] >= at) {
+                break;
+            }
         }
-        let geodetic = (columns.len() == 13).then_some(Geodetic {
+        let r = &row[1..];
+        let geodetic = (columns.len() == 14).then_some(Geodetic {
             latitude_rad: r[10],
             longitude_rad: r[11],
             height_m: r[12],
@@ -911,14 +953,17 @@ pub struct NavSummary {
 /// against the median interval of the first [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows
 /// and reported in the summary.
 /// The baro-damped vertical channel reads the file whole (within the memory budget of
-/// [`read_whole`]). `out` appears only when complete.
+/// [`read_whole`]). `out` appears only when complete. Only the rows of `window` are integrated,
+/// from `initial` at the first of them.
 ///
 /// # Errors
-/// As [`integrate`], CSV errors naming file, row and column, and I/O errors.
+/// As [`integrate`], CSV errors naming file, row and column, a window that holds no row, and
+/// I/O errors.
 pub fn integrate_csv(
     input: &Path,
     initial: &InitialState,
     setup: &NavSetup,
+    window: TimeWindow,
     out: &Path,
 ) -> Result<NavSummary> {
     if let Some(EarthNav {
@@ -927,6 +972,8 @@ pub fn integrate_csv(
     }) = setup.earth
     {
         let imu = read_whole(input)?;
+        let t0 = TimeWindow::first_time(&imu, &input.display().to_string())?;
+        let imu = window.apply(imu, t0, &input.display().to_string(), 1)?;
         let nav = integrate(&imu, initial, setup)?;
         let rates = ACCEL_COLUMNS
             .iter()
@@ -949,6 +996,7 @@ pub fn integrate_csv(
             input,
             initial,
             setup,
+            window,
             out,
         },
     )
@@ -1145,6 +1193,7 @@ struct IntegrateCsv<'a> {
     input: &'a Path,
     initial: &'a InitialState,
     setup: &'a NavSetup,
+    window: TimeWindow,
     out: &'a Path,
 }
 
@@ -1156,6 +1205,7 @@ impl EarthJob for IntegrateCsv<'_> {
             input,
             initial,
             setup,
+            window,
             out,
         } = self;
         let options = strapdown_options(setup);
@@ -1172,8 +1222,9 @@ impl EarthJob for IntegrateCsv<'_> {
         let mut columns = vec!["t_s"];
         columns.extend(force);
         columns.extend(turn);
-        let mut rows = TimedRows::open(input, &columns, "")?;
-        let (s0, origin) = nav_earth::start::<E>(initial, rows.first_time())?;
+        let mut rows = TimedRows::open(input, &columns, "")?.within(window);
+        let start = rows.start_time()?;
+        let (s0, origin) = nav_earth::start::<E>(initial, start)?;
         let failed = |source: StrapdownError| crate::Error::Strapdown {
             context: "initial state".into(),
             source,

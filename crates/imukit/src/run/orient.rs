@@ -13,7 +13,7 @@ use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::description::{Described, Description};
 use crate::io::output::AtomicFile;
-use crate::io::rows::{Gaps, SampleClock, TimedRows};
+use crate::io::rows::{Gaps, SampleClock, TimeWindow, TimedRows};
 use crate::io::schema::TableKind;
 use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
@@ -603,7 +603,7 @@ pub struct OrientSummary {
 /// The sample rate is `SampleRate` if set, else the median interval of the first
 /// [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
 /// that may use one, whether the file has `mag_*` columns (`spec.magnetometer` is set
-/// accordingly).
+/// accordingly). Only the rows of `window` are filtered.
 ///
 /// # Errors
 /// Missing columns, bad cells (file, row, column), times that do not increase, the filter's
@@ -612,11 +612,12 @@ pub fn orient_csv(
     input: &Path,
     spec: &FilterSpec,
     nav: NavFrameName,
+    window: TimeWindow,
     out: &Path,
 ) -> Result<OrientSummary> {
     match nav {
-        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, nav, out),
-        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, nav, out),
+        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, nav, window, out),
+        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, nav, window, out),
     }
 }
 
@@ -624,6 +625,7 @@ fn orient_csv_in<N: NavFrame>(
     input: &Path,
     spec: &FilterSpec,
     nav: NavFrameName,
+    window: TimeWindow,
     out: &Path,
 ) -> Result<OrientSummary> {
     let header = crate::io::table::read_header(input)?;
@@ -663,7 +665,7 @@ fn orient_csv_in<N: NavFrame>(
         if gyro { ", gyro_*" } else { "" },
         if spec.magnetometer { ", mag_*" } else { "" }
     );
-    let mut rows = TimedRows::open(input, &columns, &hint)?;
+    let mut rows = TimedRows::open(input, &columns, &hint)?.within(window);
     let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
     let rate = spec.sample_rate_hz(data_rate)?;
     let per_sample = spec.fixed_rate_hz()?.is_none();
