@@ -21,7 +21,9 @@ footers damaged field by field, a column twice); barometer and odometer files fe
 output paths that collide with inputs, special files and folders; crafted bags whose lengths declare gigabytes
 (MCAP strings and maps, ROS 1 chunks, under a 3 GiB address space), a ``.db3`` whose messages are an endless SQL
 view, NMEA fields ``nan``/``inf``/``1e308``, a link planted inside an output folder, outputs named ``.xlsx``,
-``.mat``, ``.db3``…; real signals (SIGINT, SIGTERM, SIGHUP) sent to
+``.mat``, ``.db3``…; time windows at extreme values, shipped examples written into a folder
+with a link or a file planted in it, hostile bag topic and frame names and start stamps, track
+waits at extreme values; real signals (SIGINT, SIGTERM, SIGHUP) sent to
 a command at a random moment of its run; two processes writing one output name at once; Python calls with NaN,
 inf, huge and misshapen arguments, empty tables, and tables written under hostile column names. Prints one line
 per class and a closing ``N passed, M failed`` line; exits 1 on any failure.
@@ -649,6 +651,66 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
         for n in ("cx.mcap", "cx.bag", "cx.db3", "cx.nmea"):
             (work / n).unlink(missing_ok=True)
         shutil.rmtree(work / "seq", ignore_errors=True)
+        shutil.rmtree(work / "elsewhere", ignore_errors=True)
+        runs.append(r)
+
+        r = Run("time windows, shipped examples, bag names and track waits")
+        (work / "elsewhere").mkdir(exist_ok=True)
+        (work / "elsewhere" / "keep.txt").write_text("not yours")
+        hostile_names = ["", "/", "//imu", "/imu/", "imu", "/imu data", "/2x", "/a\nb", "/" + "a" * 5000,
+                         "/ok/topic", "frame", "../x", "imu_link", "é", "/imu\x00"]
+        for k in range(per):
+            kind = rng.choice(["window", "example", "bag", "wait"])
+            if kind == "window":
+                start, end = rng.choice(EXTREMES + ["0.2", "10"]), rng.choice(EXTREMES + ["0.3", "1e3"])
+                flags = rng.choice([["--start-s", start], ["--end-s", end], ["--start-s", start, "--end-s", end]])
+                args = rng.choice([["integrate", "imu.csv", "--init", "truth.csv", "--out", "o.csv"],
+                                   ["orient", "imu.csv", "--out", "o.csv"],
+                                   ["allan", "imu.csv", "--out", "o.csv"],
+                                   ["compare", "truth.csv", "truth.csv", "--out", "o.csv"],
+                                   ["plot", "truth.csv", "--out", "o.svg"]])
+                run_cli(r, work, [*args, *flags], ["imu.csv", "truth.csv"], f"case {k} (window)")
+                (work / "o.svg").unlink(missing_ok=True)
+            elif kind == "example":
+                ex = work / "ex"
+                shutil.rmtree(ex, ignore_errors=True)
+                ex.mkdir()
+                plant = rng.choice(["link", "file", "edited", "none"])
+                if plant == "link":
+                    os.symlink(work / "elsewhere", ex / rng.choice(["study", "data"]))
+                elif plant == "file":
+                    (ex / rng.choice(["study", "data"])).write_text("a file where a folder goes")
+                elif plant == "edited":
+                    (ex / "car_tunnel.toml").write_text("# mine")
+                name = rng.choice(["all", "study/tunnel", "data/euroc", "samples", "car_tunnel", "../x", "",
+                                   "/etc/passwd", "study/../../x", "a" * 3000, "track.toml"])
+                run_cli(r, work, ["example", name, "--out-dir", "ex"], ["imu.csv"], f"case {k} (example {plant})")
+                if sorted(p.name for p in (work / "elsewhere").iterdir()) != ["keep.txt"]:
+                    r.fail(f"case {k} (example {plant})", "wrote through a link planted in the examples folder")
+                if plant == "edited" and (ex / "car_tunnel.toml").read_text() != "# mine":
+                    r.fail(f"case {k} (example edited)", "an edited example was overwritten")
+                shutil.rmtree(ex, ignore_errors=True)
+            elif kind == "bag":
+                flags = rng.choice([["--bag-topic", rng.choice(hostile_names)],
+                                    ["--bag-frame-id", rng.choice(hostile_names)],
+                                    ["--bag-start-s", rng.choice(EXTREMES + ["1700000000", "2147483647", "2147483648"])]])
+                out = rng.choice(["o.mcap", "o.csv"])
+                try:
+                    run_cli(r, work, ["simulate", "s.toml", "--out", out, *flags], ["s.toml"], f"case {k} (bag)")
+                except ValueError:  # a NUL in an argument: the OS refuses it before imukit runs
+                    r.passed += 1
+                (work / "o.mcap").unlink(missing_ok=True)
+            else:
+                wait = rng.choice(EXTREMES + ["20", "1e6"])
+                where = rng.choice(["first", "middle", "last", "only"])
+                segs = {"first": f"{{ wait_s = {wait} }}, {{ straight_m = 5 }}",
+                        "middle": f"{{ straight_m = 5 }}, {{ wait_s = {wait} }}, {{ straight_m = 5 }}",
+                        "last": f"{{ straight_m = 5 }}, {{ wait_s = {wait} }}",
+                        "only": f"{{ wait_s = {wait} }}"}[where]
+                accel = rng.choice(["accel_m_s2 = 1.0\n", ""])
+                (work / "w.toml").write_text(f'rate_hz = 20.0\n[trajectory]\ntype = "track"\nspeed_m_s = 2.0\n'
+                                             f'{accel}segments = [{segs}]\n')
+                run_cli(r, work, ["simulate", "w.toml", "--out", "o.csv"], ["w.toml"], f"case {k} (wait {wait})")
         shutil.rmtree(work / "elsewhere", ignore_errors=True)
         runs.append(r)
 
