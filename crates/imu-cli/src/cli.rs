@@ -289,6 +289,10 @@ pub enum Command {
         /// MATLAB's filters do.
         #[arg(long = "param", value_name = "KEY=VALUE")]
         params: Vec<String>,
+        /// Run a 9-axis file as 6D: its magnetometer columns are ignored (the filters that may
+        /// use a magnetometer use one when the file has it).
+        #[arg(long)]
+        no_mag: bool,
         /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
         /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
         /// override either, and so does what the input's description says.
@@ -624,6 +628,9 @@ pub enum Command {
     Animate {
         /// Truth CSV (`t_s, pos_*_m, q_*`, as `imukit simulate --truth` writes).
         truth: PathBuf,
+        /// The stretch of the run to animate.
+        #[command(flatten)]
+        window: WindowArgs,
         /// The animation file: `.gif`, or `.html` (a self-contained page, no network needed).
         #[arg(long)]
         out: PathBuf,

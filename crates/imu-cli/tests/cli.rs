@@ -2315,3 +2315,118 @@ fn a_time_window_cuts_every_input_at_the_same_instants() {
         assert!(!dir.join("x.csv").exists());
     }
 }
+
+/// A 9-axis file runs as 6D with `--no-mag` (the heading then comes from the gyroscopes alone);
+/// a filter that ignores a magnetometer the file has says so; a filter that needs one says what
+/// to use instead; an unknown setting is named before its value is read.
+#[test]
+fn orient_says_what_it_does_with_the_magnetometer() {
+    let dir = temp_dir("orient-mag");
+    let dir = dir.path();
+    let scenario = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/matlab_orientation.toml");
+    std::fs::copy(&scenario, dir.join("m.toml")).unwrap();
+    let (code, err) = run_in(dir, &["simulate", "m.toml", "--out", "nine.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    let text = std::fs::read_to_string(dir.join("nine.csv")).unwrap();
+    // The same readings without the magnetometer columns: a 6-axis file.
+    let mut six = String::new();
+    for line in text.lines() {
+        if line.starts_with('#') {
+            six += line;
+        } else {
+            six += &line.split(',').take(7).collect::<Vec<_>>().join(",");
+        }
+        six.push('\n');
+    }
+    std::fs::write(dir.join("six.csv"), six).unwrap();
+    // The robust filter with --no-mag on the 9-axis file is the robust filter on the 6-axis one.
+    let (code, err) = run_in(dir, &["orient", "nine.csv", "--no-mag", "--out", "a.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = run_in(dir, &["orient", "six.csv", "--out", "b.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    let body = |name: &str| -> Vec<String> {
+        std::fs::read_to_string(dir.join(name))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(str::to_owned)
+            .collect()
+    };
+    assert_eq!(body("a.csv"), body("b.csv"));
+    let (code, err) = run_in(dir, &["orient", "nine.csv", "--out", "c.csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_ne!(
+        body("a.csv"),
+        body("c.csv"),
+        "without --no-mag the magnetometer is used"
+    );
+    for (args, code_wanted, needle) in [
+        (
+            &[
+                "orient",
+                "nine.csv",
+                "--filter",
+                "imufilter",
+                "--out",
+                "x.csv",
+            ][..],
+            0,
+            "the imufilter filter uses no magnetometer: the file's mag_* columns are ignored",
+        ),
+        (
+            &[
+                "orient",
+                "nine.csv",
+                "--filter",
+                "ahrsfilter",
+                "--no-mag",
+                "--out",
+                "x.csv",
+            ][..],
+            65,
+            "--no-mag: the ahrsfilter filter needs a magnetometer; for 6D use robust",
+        ),
+        (
+            &[
+                "orient", "six.csv", "--filter", "ecompass", "--out", "x.csv",
+            ][..],
+            65,
+            "the ecompass filter needs a magnetometer and this file has none",
+        ),
+        (
+            &[
+                "orient",
+                "six.csv",
+                "--filter",
+                "madgwick",
+                "--param",
+                "Bta=false",
+                "--out",
+                "x.csv",
+            ][..],
+            65,
+            "Bta: unknown setting for madgwick; known: SampleRate, Beta",
+        ),
+    ] {
+        let (code, err) = run_in(dir, args);
+        assert_eq!(code, Some(code_wanted), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        let _ = std::fs::remove_file(dir.join("x.csv"));
+    }
+    // With --no-mag, imufilter on the 9-axis file says nothing: 6D is what was asked.
+    let (code, err) = run_in(
+        dir,
+        &[
+            "orient",
+            "nine.csv",
+            "--filter",
+            "imufilter",
+            "--no-mag",
+            "--out",
+            "x.csv",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+}

@@ -54,6 +54,7 @@ impl PyOrientationFilter {
             nav_frame: choice_opt("reference_frame", reference_frame)?,
             accel_sign: choice_opt("accel_sign", accel_sign)?,
             settings,
+            use_magnetometer: magnetometer,
         };
         let (mut spec, nav) = request.resolve();
         let kind = spec.kind;

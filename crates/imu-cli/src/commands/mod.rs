@@ -217,6 +217,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             bag,
             filter,
             params,
+            no_mag,
             conventions,
             nav_frame,
             accel_sign,
@@ -229,6 +230,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 input: &input,
                 filter,
                 params: &params,
+                no_mag,
                 conventions,
                 nav_frame,
                 accel_sign,
@@ -319,6 +321,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         ),
         Command::Animate {
             truth,
+            window,
             out,
             body,
             lever_arm,
@@ -328,7 +331,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         } => {
             let nav_frame = plot::described_frame(&[truth.as_path()], nav_frame)?;
             let opts = plot::options(body.as_deref(), lever_arm.as_deref(), fps, speed, nav_frame);
-            plot::animate(&truth, &out, &opts)
+            plot::animate(&truth, &out, window.window()?, &opts)
         }
     }
 }

@@ -15,6 +15,8 @@ pub struct Args<'a> {
     pub filter: FilterKind,
     /// `--param KEY=VALUE`.
     pub params: &'a [String],
+    /// `--no-mag`: a 9-axis file run as 6D.
+    pub no_mag: bool,
     pub conventions: Conventions,
     pub nav_frame: Option<NavFrameName>,
     pub accel_sign: Option<AccelSignName>,
@@ -28,6 +30,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         input,
         filter,
         params,
+        no_mag,
         conventions,
         nav_frame,
         accel_sign,
@@ -42,13 +45,25 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         conventions,
         nav_frame,
         accel_sign,
-        settings: FilterSpec::parse_settings(params)?,
+        settings: FilterSpec::parse_settings(filter, params)?,
+        use_magnetometer: !no_mag,
     }
     .with_described(&Described::read(&[input])?)
     .map_err(crate::error::by_flag)?
     .resolve();
     crate::report::warn_implausible(input);
-    let s = orient_csv(input, &spec, nav, window, out)?;
+    let s = orient_csv(input, &spec, nav, window, out).map_err(|e| match e {
+        imukit::Error::Invalid { field, message } if field == "use_magnetometer" => {
+            imukit::Error::Invalid {
+                field: "--no-mag".into(),
+                message,
+            }
+        }
+        other => other,
+    })?;
+    for w in &s.warnings {
+        crate::report::warn(w);
+    }
     let rate = (s.sample_rate_hz * 1e6).round() / 1e6;
     let timing = if s.per_sample {
         format!("each over its own interval (median rate {rate} Hz)")

@@ -91,10 +91,18 @@ pub fn options(
     }
 }
 
-pub fn animate(truth: &Path, out: &Path, opts: &AnimateOptions) -> Result<(), CliError> {
+pub fn animate(
+    truth: &Path,
+    out: &Path,
+    window: TimeWindow,
+    opts: &AnimateOptions,
+) -> Result<(), CliError> {
     anim::check_animation_path(out)?;
     check_outputs(&[("truth file", truth)], &[("--out", out)])?;
     let table = read_table(truth)?;
+    let name = truth.display().to_string();
+    let t0 = TimeWindow::first_time(&table, &name)?;
+    let table = window.apply(table, t0, &name, 2)?;
     let info = anim::animate(&table, &truth.display().to_string(), out, opts)
         .map_err(crate::plot_by_flag)?;
     crate::note!(

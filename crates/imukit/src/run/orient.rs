@@ -240,6 +240,9 @@ pub struct OrientRequest {
     pub accel_sign: Option<AccelSignName>,
     /// `(name, value)` settings.
     pub settings: Vec<(String, f64)>,
+    /// `false`: a 9-axis input run as 6D, its magnetometer columns ignored (`--no-mag`); `true`
+    /// (the default): the magnetometer used when the filter may use one and the input has it.
+    pub use_magnetometer: bool,
 }
 
 impl OrientRequest {
@@ -264,9 +267,30 @@ impl OrientRequest {
         let (nav, sign) = frame_and_sign(self.conventions, self.nav_frame, self.accel_sign);
         let mut spec = FilterSpec::new(self.filter, sign);
         spec.settings.clone_from(&self.settings);
+        spec.use_magnetometer = self.use_magnetometer;
         (spec, nav)
     }
 }
+
+/// The refusal of a setting `kind` does not have, listing those it has.
+fn unknown_setting(kind: FilterKind, name: &str) -> crate::Error {
+    let known = kind.settings();
+    invalid(
+        name,
+        format!(
+            "unknown setting for {}; known: {}",
+            kind.name(),
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        ),
+    )
+}
+
+/// The filters that run without a magnetometer, for messages.
+const SIX_AXIS_FILTERS: &str = "robust, imufilter, madgwick, mahony or complementary";
 
 /// A filter to build: which, with which sensors and accelerometer sign, and its settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -277,6 +301,8 @@ pub struct FilterSpec {
     pub accel_sign: AccelSign,
     /// Whether magnetometer readings are fed (for the filters that may use one).
     pub magnetometer: bool,
+    /// `false`: magnetometer columns of the input are ignored (6D from a 9-axis file).
+    pub use_magnetometer: bool,
     /// `(name, value)` settings (see [`FilterKind::settings`]).
     pub settings: Vec<(String, f64)>,
     /// The diagonal of InitialProcessNoise (9 or 12 values), replacing the default.
@@ -298,6 +324,7 @@ impl FilterSpec {
             kind,
             accel_sign,
             magnetometer: kind.magnetometer().unwrap_or(false),
+            use_magnetometer: true,
             settings: Vec::new(),
             initial_process_noise: None,
         }
@@ -307,17 +334,24 @@ impl FilterSpec {
     ///
     /// # Errors
     /// A setting without `=`, or a value that is not a number.
-    pub fn parse_settings(pairs: &[String]) -> Result<Vec<(String, f64)>> {
+    pub fn parse_settings(kind: FilterKind, pairs: &[String]) -> Result<Vec<(String, f64)>> {
+        let known = kind.settings();
         pairs
             .iter()
             .map(|p| {
                 let (k, v) = p
                     .split_once('=')
                     .ok_or_else(|| invalid("--param", format!("{p:?} is not key=value")))?;
-                let value: f64 = v.trim().parse().map_err(|_| {
-                    invalid("--param", format!("{}: {v:?} is not a number", k.trim()))
-                })?;
-                Ok((k.trim().to_string(), value))
+                let k = k.trim();
+                // The key first: a setting the filter does not have is the mistake to name.
+                if !known.iter().any(|n| key(n) == key(k)) {
+                    return Err(unknown_setting(kind, k));
+                }
+                let value: f64 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| invalid("--param", format!("{k}: {v:?} is not a number")))?;
+                Ok((k.to_string(), value))
             })
             .collect()
     }
@@ -327,18 +361,7 @@ impl FilterSpec {
         let known = self.kind.settings();
         for (k, _) in &self.settings {
             if !known.iter().any(|n| key(n) == key(k)) {
-                let filter = self.kind.name();
-                return Err(invalid(
-                    k.as_str(),
-                    format!(
-                        "unknown setting for {filter}; known: {}",
-                        if known.is_empty() {
-                            "none".to_string()
-                        } else {
-                            known.join(", ")
-                        }
-                    ),
-                ));
+                return Err(unknown_setting(self.kind, k));
             }
         }
         Ok(self
@@ -580,7 +603,7 @@ pub fn orient_row<N: NavFrame>(
 }
 
 /// What [`orient_csv`] wrote.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct OrientSummary {
     /// Rows read.
     pub samples: usize,
@@ -596,6 +619,8 @@ pub struct OrientSummary {
     pub per_sample: bool,
     /// The gaps in the sample times, integrated across.
     pub gaps: Gaps,
+    /// What the user should know about the run (a magnetometer the filter ignores).
+    pub warnings: Vec<String>,
 }
 
 /// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
@@ -634,20 +659,50 @@ fn orient_csv_in<N: NavFrame>(
     // A filter that may use a magnetometer uses one when the file has it; a file with only some
     // of the mag_* columns is a mistake to name, not a reason to drop the magnetometer silently.
     let some_mag = MAG_COLUMNS.iter().any(|c| header.iter().any(|h| h == c));
-    spec.magnetometer = spec.kind.magnetometer().unwrap_or(some_mag);
+    let name = spec.kind.name();
+    let mut warnings = Vec::new();
+    spec.magnetometer = match (spec.kind.magnetometer(), spec.use_magnetometer) {
+        (Some(true), false) => {
+            return Err(invalid(
+                "use_magnetometer",
+                format!("the {name} filter needs a magnetometer; for 6D use {SIX_AXIS_FILTERS}"),
+            ));
+        }
+        (Some(true), true) => true,
+        (Some(false), _) => {
+            if some_mag && spec.use_magnetometer {
+                warnings.push(format!(
+                    "{}: the {name} filter uses no magnetometer: the file's mag_* columns are \
+                     ignored and the heading is not held (robust, ahrsfilter, madgwick, mahony \
+                     and complementary use them; --no-mag says you mean 6D)",
+                    input.display()
+                ));
+            }
+            false
+        }
+        (None, use_it) => some_mag && use_it,
+    };
     if spec.magnetometer && !has(&MAG_COLUMNS) {
         let missing = MAG_COLUMNS
             .iter()
             .filter(|c| !header.iter().any(|h| h == *c))
             .map(|c| (*c).to_string())
             .collect();
+        let hint = if some_mag {
+            format!(
+                "; the {name} filter uses all three magnetometer columns when the file has any \
+                 (--no-mag ignores them)"
+            )
+        } else {
+            format!(
+                "; the {name} filter needs a magnetometer and this file has none: for 6D use \
+                 {SIX_AXIS_FILTERS}"
+            )
+        };
         return Err(crate::Error::MissingColumns {
             file: input.into(),
             missing,
-            hint: format!(
-                "; the {} filter uses all three magnetometer columns when the file has any",
-                spec.kind.name()
-            ),
+            hint,
         });
     }
     let gyro = spec.kind != FilterKind::Ecompass;
@@ -725,6 +780,7 @@ fn orient_csv_in<N: NavFrame>(
         sample_rate_hz: rate,
         per_sample,
         gaps: rows.gaps(),
+        warnings,
     })
 }
 
