@@ -73,7 +73,7 @@ pub struct Example {
     pub files: &'static [&'static str],
 }
 
-/// The name that asks for every file ([`write`]).
+/// The name that asks for every file ([`write()`]).
 pub const ALL: &str = "all";
 
 /// The folder examples are written into unless another is named: the one the README's and the
@@ -239,7 +239,7 @@ fn file(path: &str) -> Option<&'static ExampleFile> {
     FILES.iter().find(|f| f.path == path)
 }
 
-/// What [`write`] did with one file.
+/// What [`write()`] did with one file.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Written {
     /// Written at this path.
