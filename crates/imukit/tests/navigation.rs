@@ -79,7 +79,7 @@ fn compare_reports_zero_against_itself_and_refuses_times_outside_the_truth() {
         shifted.data[r * w] += 20.0;
     }
     let e = compare(&sim.truth, &shifted).unwrap_err().to_string();
-    assert!(e.contains("outside the truth"), "{e}");
+    assert!(e.contains("(row 2) is after the truth's last, 10 s"), "{e}");
     let e = integrate(
         &imukit::Table::new(&["t_s", "accel_x_m_s2"]),
         &InitialState::default(),
@@ -373,10 +373,10 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
     std::fs::remove_file(&out).unwrap();
     for (times, needle) in [
         (vec![0.5, 0.4], "row 3) goes back"),
-        (vec![-0.1], "(row 2) is outside the truth's 0…"),
+        (vec![-0.1], "(row 2) is before the truth's first, 0 s"),
         (
             vec![1.0, last + 0.01],
-            "(row 3) is outside the truth's 0…19.90",
+            "(row 3) is after the truth's last, 19.9",
         ),
     ] {
         linear_states(&times, [0.0; 3]).write_csv(&ep).unwrap();

@@ -619,15 +619,19 @@ fn compare_rows(
                 truth_ended = true;
             }
         }
-        if t < t0 - 1e-9 || (truth_ended && t > b[0] + 1e-9) {
-            let end = if truth_ended {
-                format!("{} s", b[0])
-            } else {
-                "…".into()
-            };
+        if t < t0 - 1e-9 {
             return Err(invalid(
                 estimate_name,
-                format!("estimate time {t} s (row {row}) is outside the truth's {t0}…{end}"),
+                format!("estimate time {t} s (row {row}) is before the truth's first, {t0} s"),
+            ));
+        }
+        if truth_ended && t > b[0] + 1e-9 {
+            return Err(invalid(
+                estimate_name,
+                format!(
+                    "estimate time {t} s (row {row}) is after the truth's last, {} s",
+                    b[0]
+                ),
             ));
         }
         let w = if b[0] == a[0] {
