@@ -34,10 +34,11 @@ impl CliError {
 }
 
 /// The request fields whose flag is not the field's name with `-` for `_`.
-const FLAGS: [(&str, &str); 3] = [
+const FLAGS: [(&str, &str); 4] = [
     ("initial", "--init"),
     ("nhc_sigma_m_s", "--nhc"),
     ("gate", "--no-gate"),
+    ("use_magnetometer", "--no-mag"),
 ];
 
 /// The flag that sets a library request field: the table `FLAGS`, else the field's name with `-` for

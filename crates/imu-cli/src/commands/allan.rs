@@ -108,8 +108,7 @@ pub(crate) fn analyse(
     let all_t = data.get("t_s");
     let rows = match (window.is_whole(), all_t.first()) {
         (false, Some(&t0)) => {
-            let lo = t0 + window.start_s.unwrap_or(0.0);
-            let hi = window.end_s.map_or(f64::INFINITY, |e| t0 + e);
+            let (lo, hi) = window.bounds(t0);
             imukit::io::rows::check_increasing(all_t, &input.display().to_string(), 2)?;
             let from = all_t.partition_point(|&t| t < lo);
             let to = all_t.partition_point(|&t| t <= hi);

@@ -69,10 +69,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
     let mut samples = read_planar(c.input)?;
     if !c.window.is_whole() {
         let first = samples.first().map_or(0.0, |x| x.t_s);
-        let (lo, hi) = (
-            first + c.window.start_s.unwrap_or(0.0),
-            c.window.end_s.map_or(f64::INFINITY, |e| first + e),
-        );
+        let (lo, hi) = c.window.bounds(first);
         samples.retain(|x| x.t_s >= lo && x.t_s <= hi);
         if samples.is_empty() {
             return Err(Error::Invalid {

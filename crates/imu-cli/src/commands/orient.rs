@@ -53,11 +53,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     .resolve();
     crate::report::warn_implausible(input);
     let s = orient_csv(input, &spec, nav, window, out).map_err(|e| match e {
-        imukit::Error::Invalid { field, message } if field == "use_magnetometer" => {
-            imukit::Error::Invalid {
-                field: "--no-mag".into(),
-                message,
-            }
+        // The request's own field; other refusals name the file.
+        imukit::Error::Invalid { ref field, .. } if field == "use_magnetometer" => {
+            crate::error::by_flag(e)
         }
         other => other,
     })?;

@@ -54,13 +54,7 @@ pub fn bag_options(
         args.bag_frame_id.as_deref(),
         args.bag_start_s,
     )
-    .map_err(|e| match e {
-        imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
-            field: format!("--{}", field.replace('_', "-")),
-            message,
-        },
-        other => other,
-    })?;
+    .map_err(crate::error::by_flag)?;
     Ok(Some(options))
 }
 

@@ -12,6 +12,7 @@ pub mod asl;
 pub mod bag;
 pub mod column_map;
 pub mod datasheet;
+pub mod described;
 pub mod description;
 pub mod kalibr;
 pub mod nmea;

@@ -75,10 +75,7 @@ impl TimeWindow {
                 "has no t_s column to cut a time window from",
             ));
         };
-        let (lo, hi) = (
-            t0 + self.start_s.unwrap_or(0.0),
-            self.end_s.map_or(f64::INFINITY, |e| t0 + e),
-        );
+        let (lo, hi) = self.bounds(t0);
         let width = table.columns.len();
         let mut kept = Table {
             columns: table.columns.clone(),
@@ -102,6 +99,16 @@ impl TimeWindow {
             ));
         }
         Ok(kept)
+    }
+
+    /// The window's ends as times, its seconds counted from `t0`: `(t0 + start, t0 + end)`,
+    /// the start `t0` and the end +∞ when not given.
+    #[must_use]
+    pub fn bounds(&self, t0: f64) -> (f64, f64) {
+        (
+            t0 + self.start_s.unwrap_or(0.0),
+            self.end_s.map_or(f64::INFINITY, |e| t0 + e),
+        )
     }
 
     /// The first `t_s` of `table`, the origin of the window's seconds.
@@ -364,10 +371,7 @@ impl TimedRows {
     /// rows before it are read, checked in order and skipped, and the file ends with it.
     pub(crate) fn within(mut self, window: TimeWindow) -> Self {
         if !window.is_whole() {
-            self.window = (
-                self.first_t + window.start_s.unwrap_or(0.0),
-                window.end_s.map_or(f64::INFINITY, |e| self.first_t + e),
-            );
+            self.window = window.bounds(self.first_t);
             self.asked = window;
         }
         self

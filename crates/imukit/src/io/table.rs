@@ -976,11 +976,8 @@ impl CsvRows {
                 "has no t_s column to cut a time window from",
             ));
         };
-        self.window = Some((
-            k,
-            t0 + window.start_s.unwrap_or(0.0),
-            window.end_s.map_or(f64::INFINITY, |e| t0 + e),
-        ));
+        let (lo, hi) = window.bounds(t0);
+        self.window = Some((k, lo, hi));
         Ok(self)
     }
 
