@@ -347,9 +347,8 @@ def write_readme(path: Path, lines: list) -> None:
         pass
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     command = "python benches/compare_numpy.py " + " ".join(sys.argv[1:])
-    text = (
-        "# Benchmarks\n\n"
-        "Written by `benches/compare_numpy.py --write-readme benches/README.md`; rerun it to replace this page.\n\n"
+    body = (
+        "## Speed beside NumPy\n\n"
         f"- machine: {cpu}, {cores} cores, {platform.system()} {platform.release()}, Python {platform.python_version()}\n"
         f"- date: {time.strftime('%Y-%m-%d', time.gmtime())}\n"
         f"- command: `{command}`\n\n"
@@ -357,7 +356,10 @@ def write_readme(path: Path, lines: list) -> None:
         "(`cargo bench -p imu-benches`) print their own figures.\n\n"
         "```text\n" + "\n".join(lines) + "\n```\n"
     )
-    path.write_text(text)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from readme_section import replace_section
+
+    replace_section(path, "compare_numpy", body)
 
 
 def main() -> None:

@@ -262,9 +262,11 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Orientation from IMU readings by a filter: `robust` (imukit's own, the default: bias
-    /// learnt at rest only, rejected readings flagged), `imufilter` and `ahrsfilter` (MATLAB's
-    /// Kalman filters), `ecompass`, `madgwick`, `mahony` or `complementary`.
+    /// Orientation from IMU readings by a filter: `robust` (imukit's own, the default:
+    /// inclination from the accelerometer low-passed in an almost inertial frame, heading from
+    /// the magnetometer unless a magnet is near, gyroscope bias learnt at rest and in motion),
+    /// `imufilter` and `ahrsfilter` (MATLAB's Kalman filters), `ecompass`, `madgwick`, `mahony`
+    /// or `complementary`.
     Orient {
         /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
         /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
@@ -293,6 +295,11 @@ pub enum Command {
         /// use a magnetometer use one when the file has it).
         #[arg(long)]
         no_mag: bool,
+        /// Smooth the whole run after the fact (robust only): the filter forward, then backward
+        /// from where it ended, and the mean of the two (the heading, with a magnetometer, the
+        /// forward pass's). For logs processed offline; the file is read whole.
+        #[arg(long)]
+        smooth: bool,
         /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
         /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
         /// override either, and so does what the input's description says.

@@ -145,10 +145,8 @@ fn the_bias_stays_sane_the_tilt_holds_and_the_flags_fire() {
         "attitude error {}°",
         worst_heading.to_degrees()
     );
-    assert!(
-        rejected_shaking * 2 >= shaking,
-        "{rejected_shaking}/{shaking}"
-    );
+    // Shaking back and forth at 2 Hz averages out in the low-pass: not a sustained acceleration.
+    assert_eq!(rejected_shaking, 0, "{shaking} shaking samples");
     assert_eq!(rejected_still, 0);
     assert!(flagged * 10 >= disturbed * 9, "{flagged}/{disturbed}");
     assert!(rest_seen > 2000);

@@ -2,7 +2,7 @@
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
 use imu_core::{Enu, Ned};
 use imukit::io::rows::SampleClock;
-use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows};
+use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows, smooth_rows};
 use imukit::scenario::NavFrameName;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -27,6 +27,8 @@ pub(crate) struct PyOrientationFilter {
     magnetometer: bool,
     /// The robust filter's bias and flags of the last call's estimates (empty for the others).
     last_status: Vec<[f64; 6]>,
+    /// Each call is a whole run, smoothed (the robust filter only).
+    smooth: bool,
 }
 
 type Estimates<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
@@ -36,7 +38,7 @@ impl PyOrientationFilter {
     #[new]
     #[pyo3(signature = (kind, *, sample_rate, conventions = None, reference_frame = None,
                         accel_sign = None, magnetometer = false, settings = Vec::new(),
-                        initial_process_noise = None))]
+                        initial_process_noise = None, smooth = false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         kind: &str,
@@ -47,6 +49,7 @@ impl PyOrientationFilter {
         magnetometer: bool,
         settings: Vec<(String, f64)>,
         initial_process_noise: Option<Vec<f64>>,
+        smooth: bool,
     ) -> PyResult<Self> {
         let request = OrientRequest {
             filter: choice("kind", kind)?,
@@ -55,9 +58,15 @@ impl PyOrientationFilter {
             accel_sign: choice_opt("accel_sign", accel_sign)?,
             settings,
             use_magnetometer: magnetometer,
+            smooth,
         };
         let (mut spec, nav) = request.resolve();
         let kind = spec.kind;
+        if smooth && kind != FilterKind::Robust {
+            return Err(PyValueError::new_err(format!(
+                "smooth: only the robust filter smooths, not {kind}"
+            )));
+        }
         spec.magnetometer = kind.magnetometer().unwrap_or(magnetometer);
         spec.initial_process_noise = initial_process_noise;
         let filter = match nav {
@@ -70,6 +79,7 @@ impl PyOrientationFilter {
             gyroscope: kind != FilterKind::Ecompass,
             magnetometer: spec.magnetometer,
             last_status: Vec::new(),
+            smooth,
         })
     }
 
@@ -105,9 +115,15 @@ impl PyOrientationFilter {
             }
             (None, false) => None,
         };
-        let (filter, clock) = (&mut self.filter, &mut self.clock);
+        let (filter, clock, smooth) = (&mut self.filter, &mut self.clock, self.smooth);
         let out = py
             .detach(|| match filter {
+                Filter::Enu(AnyFilter::Robust(r)) if smooth => {
+                    smooth_rows::<Enu>(*r.params(), a, g.unwrap_or_default(), m, t.as_deref())
+                }
+                Filter::Ned(AnyFilter::Robust(r)) if smooth => {
+                    smooth_rows::<Ned>(*r.params(), a, g.unwrap_or_default(), m, t.as_deref())
+                }
                 Filter::Enu(f) => run_rows(f, clock, a, g, m, t.as_deref()),
                 Filter::Ned(f) => run_rows(f, clock, a, g, m, t.as_deref()),
             })

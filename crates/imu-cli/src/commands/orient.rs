@@ -17,6 +17,8 @@ pub struct Args<'a> {
     pub params: &'a [String],
     /// `--no-mag`: a 9-axis file run as 6D.
     pub no_mag: bool,
+    /// `--smooth`: the whole run smoothed (robust only).
+    pub smooth: bool,
     pub conventions: Conventions,
     pub nav_frame: Option<NavFrameName>,
     pub accel_sign: Option<AccelSignName>,
@@ -31,6 +33,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         filter,
         params,
         no_mag,
+        smooth,
         conventions,
         nav_frame,
         accel_sign,
@@ -47,6 +50,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         accel_sign,
         settings: FilterSpec::parse_settings(filter, params)?,
         use_magnetometer: !no_mag,
+        smooth,
     }
     .with_described(&Described::read(&[input])?)
     .map_err(crate::error::by_flag)?
@@ -54,7 +58,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     crate::report::warn_implausible(input);
     let s = orient_csv(input, &spec, nav, window, out).map_err(|e| match e {
         // The request's own field; other refusals name the file.
-        imukit::Error::Invalid { ref field, .. } if field == "use_magnetometer" => {
+        imukit::Error::Invalid { ref field, .. }
+            if field == "use_magnetometer" || field == "smooth" =>
+        {
             crate::error::by_flag(e)
         }
         other => other,
@@ -69,8 +75,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         format!("at a fixed {rate} Hz (SampleRate)")
     };
     crate::note!(
-        "imukit: {} samples, {timing}, through {filter}: {} orientations in {}",
+        "imukit: {} samples, {timing}, through {filter}{}: {} orientations in {}",
         s.samples,
+        if smooth { " (smoothed)" } else { "" },
         s.rows,
         out.display()
     );

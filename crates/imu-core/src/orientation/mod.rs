@@ -1,6 +1,6 @@
 //! Orientation from IMU readings: the e-compass, Kalman filters equivalent in structure to
 //! MATLAB's `imufilter` and `ahrsfilter`, the complementary, Madgwick and Mahony filters, and
-//! imukit's own [`robust`] filter (bias learnt at rest only, rejections flagged),
+//! imukit's own [`robust`] filter (inclination, heading and bias each from its own evidence, with a smoother for whole logs),
 //! all behind one per-sample trait ([`OrientationFilter`]); and the quaternion distance that
 //! judges them against truth ([`metrics`]).
 //!

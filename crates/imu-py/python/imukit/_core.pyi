@@ -363,6 +363,7 @@ class OrientationFilter:
         magnetometer: bool = False,
         settings: Sequence[tuple[str, float]] = ...,
         initial_process_noise: Optional[Sequence[float]] = None,
+        smooth: bool = False,
     ) -> OrientationFilter: ...
     def step(
         self,

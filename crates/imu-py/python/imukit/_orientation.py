@@ -76,7 +76,7 @@ class _Filter:
 
     def __init__(self, sample_rate: float, conventions: Optional[str], reference_frame: Optional[str],
                  accel_sign: Optional[str], magnetometer: bool, settings: dict, orientation_format: str,
-                 initial_process_noise=None) -> None:
+                 initial_process_noise=None, smooth: bool = False) -> None:
         if orientation_format not in ("quaternion", "rotmat"):
             raise ValueError(f'orientation_format must be "quaternion" or "rotmat", got {orientation_format!r}')
         self.orientation_format = orientation_format
@@ -86,7 +86,7 @@ class _Filter:
             self._kind, sample_rate=self.sample_rate, conventions=conventions, reference_frame=reference_frame,
             accel_sign=accel_sign,
             magnetometer=magnetometer, settings=[(k, float(v)) for k, v in settings.items()],
-            initial_process_noise=initial_process_noise)
+            initial_process_noise=initial_process_noise, smooth=smooth)
 
     def _run(self, accel, gyro, mag, t_s, return_angular_velocity: bool):
         a = _rows("accel", accel)
@@ -230,28 +230,47 @@ class MadgwickFilter(_SimpleFilter):
 
 
 class RobustFilter(_SimpleFilter):
-    """imukit's own attitude (and, with ``has_magnetometer=True``, heading) filter, made for real
-    motion: the gyroscope bias is learnt only at rest, accelerometer readings that are not gravity
-    (linear acceleration) and magnetometer readings that are not the Earth's field (a magnet
-    nearby) are rejected and flagged. ``status`` holds, for the last call's estimates, the bias
+    """imukit's own attitude (and, with ``has_magnetometer=True``, heading) filter, the default of
+    ``imukit orient``: the gyroscope's integral, an inclination correction from the accelerometer
+    low-passed in an almost inertial frame (slowed while the body accelerates hard for long), a
+    heading correction from the magnetometer (held while a magnet is near), and a gyroscope bias
+    learnt at rest and in motion. ``status`` holds, for the last call's estimates, the bias
     estimate (rad/s) and the flags: a dict of ``gyro_bias`` (M, 3), ``at_rest``,
-    ``accel_rejected`` and ``mag_disturbed`` (M,) booleans. Settings (times in s, angles in rad):
-    ``accelerometer_time_constant`` 3, ``magnetometer_time_constant`` 9, ``bias_time_constant``
-    3, and the rest as ``imukit orient --filter robust --param`` names them."""
+    ``accel_rejected`` (correction slowed) and ``mag_disturbed`` (M,) booleans.
+
+    ``accelerometer_time_constant`` and ``magnetometer_time_constant`` (s) are the two a user
+    tunes; ``settings`` takes any other by the name ``imukit orient --filter robust --param``
+    uses (angles in rad, times in s). Unset, each is the library's default.
+
+    ``smooth=True`` is for logs processed after the fact (``imukit orient --smooth``): each call
+    is a whole run, filtered forward, then backward from where the forward pass ended, and the
+    two averaged; nothing carries over between calls.
+
+    >>> import numpy as np
+    >>> t = np.arange(500) / 100.0
+    >>> gyro = np.column_stack([np.zeros(500), np.zeros(500), np.full(500, 0.2)])   # 0.2 rad/s yaw
+    >>> q = RobustFilter(100.0, smooth=True)(np.tile([0.0, 0.0, 9.81], (500, 1)), gyro, t_s=t)
+    >>> yaw = 2 * np.arctan2(q[:, 3], q[:, 0])
+    >>> bool(abs((yaw[-1] - yaw[0]) - 0.2 * 4.99) < 1e-6)
+    True
+    """
 
     _kind = "robust"
 
     def __init__(self, sample_rate: float = 100.0, *, has_magnetometer: bool = False,
-                 accelerometer_time_constant: float = 3.0, magnetometer_time_constant: float = 9.0,
-                 bias_time_constant: float = 3.0, settings: Optional[dict] = None,
+                 accelerometer_time_constant: Optional[float] = None,
+                 magnetometer_time_constant: Optional[float] = None, settings: Optional[dict] = None,
                  conventions: Optional[str] = None, reference_frame: Optional[str] = None,
-                 orientation_format: str = "quaternion", accel_sign: Optional[str] = None) -> None:
-        all_settings = dict(AccelerometerTimeConstant=accelerometer_time_constant,
-                            MagnetometerTimeConstant=magnetometer_time_constant,
-                            BiasTimeConstant=bias_time_constant)
+                 orientation_format: str = "quaternion", accel_sign: Optional[str] = None,
+                 smooth: bool = False) -> None:
+        all_settings = {}
+        if accelerometer_time_constant is not None:
+            all_settings["AccelerometerTimeConstant"] = accelerometer_time_constant
+        if magnetometer_time_constant is not None:
+            all_settings["MagnetometerTimeConstant"] = magnetometer_time_constant
         all_settings.update(settings or {})
         super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer,
-                         all_settings, orientation_format)
+                         all_settings, orientation_format, smooth=smooth)
 
     @property
     def status(self) -> dict:

@@ -1,22 +1,15 @@
 //! Orientation filters by name with `key=value` settings, run over IMU CSV files (streamed) —
 //! the layer under `imukit orient` and the Python filter classes. The filters themselves are
 //! the core's ([`imu_core::orientation`]).
-use std::path::Path;
-
 use imu_core::orientation::{
     Complementary, Ecompass, Estimate, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
     OrientError, OrientationFilter, RobustFilter, RobustParams, RobustStatus,
 };
-use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
+use imu_core::{AccelSign, NavFrame};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
-use crate::io::description::{Described, Description};
-use crate::io::output::AtomicFile;
-use crate::io::rows::{Gaps, SampleClock, TimeWindow, TimedRows};
-use crate::io::schema::TableKind;
-use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
-use crate::run::navigate::euler_unwrapped;
+use crate::io::description::Described;
 use crate::scenario::{AccelSignName, NavFrameName};
 
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
@@ -61,9 +54,9 @@ pub fn robust_row(s: &RobustStatus) -> [f64; 6] {
 /// The filters, by name.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FilterKind {
-    /// imukit's own filter, the default: gyroscope bias learnt at rest only, accelerometer and
-    /// magnetometer readings that are not gravity and north rejected and flagged
-    /// (`imu_core::orientation::robust`).
+    /// imukit's own filter, the default: inclination from the accelerometer low-passed in an
+    /// almost inertial frame, heading from the magnetometer unless a magnet is near, gyroscope
+    /// bias learnt at rest and in motion (`imu_core::orientation::robust`).
     #[default]
     Robust,
     /// MATLAB `imufilter`: accelerometer + gyroscope Kalman filter.
@@ -116,29 +109,10 @@ impl FilterKind {
             Self::Madgwick => vec!["SampleRate", "Beta"],
             Self::Mahony => vec!["SampleRate", "Kp", "Ki"],
             Self::Complementary => vec!["SampleRate", "AccelerometerGain", "MagnetometerGain"],
-            Self::Robust => ROBUST_SETTINGS.to_vec(),
+            Self::Robust => RobustParams::setting_names().to_vec(),
         }
     }
 }
-
-/// Settings of the robust filter (`RobustParams`; angles in rad, times in s).
-const ROBUST_SETTINGS: [&str; 15] = [
-    "SampleRate",
-    "Gravity",
-    "AccelerometerTimeConstant",
-    "MagnetometerTimeConstant",
-    "RestTimeConstant",
-    "RestGyroscopeThreshold",
-    "RestAccelerometerThreshold",
-    "RestMinimumTime",
-    "BiasTimeConstant",
-    "AccelerationRejection",
-    "AccelerationRejectionAngle",
-    "RecoveryTime",
-    "MagneticRejection",
-    "DipRejection",
-    "MagneticRecoveryTime",
-];
 
 /// Settings of both Kalman filters.
 const KALMAN_SETTINGS: [&str; 9] = [
@@ -243,6 +217,9 @@ pub struct OrientRequest {
     /// `false`: a 9-axis input run as 6D, its magnetometer columns ignored (`--no-mag`); `true`
     /// (the default): the magnetometer used when the filter may use one and the input has it.
     pub use_magnetometer: bool,
+    /// The whole run smoothed after the fact (the robust filter's forward and backward passes,
+    /// `imu_core::orientation::robust::smooth`), not filtered as it comes.
+    pub smooth: bool,
 }
 
 impl OrientRequest {
@@ -268,6 +245,7 @@ impl OrientRequest {
         let mut spec = FilterSpec::new(self.filter, sign);
         spec.settings.clone_from(&self.settings);
         spec.use_magnetometer = self.use_magnetometer;
+        spec.smooth = self.smooth;
         (spec, nav)
     }
 }
@@ -307,6 +285,8 @@ pub struct FilterSpec {
     pub settings: Vec<(String, f64)>,
     /// The diagonal of InitialProcessNoise (9 or 12 values), replacing the default.
     pub initial_process_noise: Option<Vec<f64>>,
+    /// Smooth the whole run (the robust filter only).
+    pub smooth: bool,
 }
 
 fn key(name: &str) -> String {
@@ -327,6 +307,7 @@ impl FilterSpec {
             use_magnetometer: true,
             settings: Vec::new(),
             initial_process_noise: None,
+            smooth: false,
         }
     }
 
@@ -490,22 +471,10 @@ impl FilterSpec {
                     magnetometer: mag,
                     ..RobustParams::default()
                 };
-                for (name, field) in [
-                    ("Gravity", &mut p.gravity_m_s2),
-                    ("AccelerometerTimeConstant", &mut p.tau_accel_s),
-                    ("MagnetometerTimeConstant", &mut p.tau_mag_s),
-                    ("RestTimeConstant", &mut p.rest_tau_s),
-                    ("RestGyroscopeThreshold", &mut p.rest_gyro_rad_s),
-                    ("RestAccelerometerThreshold", &mut p.rest_accel_m_s2),
-                    ("RestMinimumTime", &mut p.rest_min_s),
-                    ("BiasTimeConstant", &mut p.bias_tau_s),
-                    ("AccelerationRejection", &mut p.accel_rejection_g),
-                    ("AccelerationRejectionAngle", &mut p.accel_rejection_rad),
-                    ("RecoveryTime", &mut p.recovery_s),
-                    ("MagneticRejection", &mut p.mag_rejection),
-                    ("DipRejection", &mut p.dip_rejection_rad),
-                    ("MagneticRecoveryTime", &mut p.mag_recovery_s),
-                ] {
+                for (name, field) in p.settings_mut() {
+                    if name == "SampleRate" {
+                        continue; // the filter's rate, set above
+                    }
                     if let Some(v) = self.setting(name)? {
                         *field = v;
                     }
@@ -590,360 +559,8 @@ impl<N: NavFrame> OrientationFilter<N> for AnyFilter<N> {
     }
 }
 
-/// One orientation output row in [`ORIENT_COLUMNS`] order (yaw unwrapped against `last_yaw`).
-#[must_use]
-pub fn orient_row<N: NavFrame>(
-    t_s: f64,
-    q: &Rotation<Body, N>,
-    last_yaw: &mut Option<f64>,
-) -> [f64; 8] {
-    let [w, x, y, z] = q.to_wxyz();
-    let e = euler_unwrapped(q, last_yaw);
-    [t_s, w, x, y, z, e.yaw_rad, e.pitch_rad, e.roll_rad]
-}
+mod csv;
+mod rows;
 
-/// What [`orient_csv`] wrote.
-#[derive(Clone, Debug, PartialEq)]
-pub struct OrientSummary {
-    /// Rows read.
-    pub samples: usize,
-    /// Rows written (fewer with decimation).
-    pub rows: usize,
-    /// Samples at the end that do not fill a decimation block, so give no estimate (0 without
-    /// decimation; MATLAB's filters refuse such a call, a file is read whole instead).
-    pub unfinished: usize,
-    /// The sample rate: the `SampleRate` setting, or the median rate of the file, Hz.
-    pub sample_rate_hz: f64,
-    /// Whether each sample was integrated over its own interval (no `SampleRate` setting) or
-    /// at the fixed `SampleRate`, as MATLAB's filters do.
-    pub per_sample: bool,
-    /// The gaps in the sample times, integrated across.
-    pub gaps: Gaps,
-    /// What the user should know about the run (a magnetometer the filter ignores).
-    pub warnings: Vec<String>,
-}
-
-/// Runs the filter `spec` over the IMU CSV `input` (`accel_*`, `gyro_*` and, when used,
-/// `mag_*` columns) into `out` ([`ORIENT_COLUMNS`]), streamed; `out` appears only when complete.
-/// The sample rate is `SampleRate` if set, else the median interval of the first
-/// [`GAP_WINDOW`](crate::io::rows::GAP_WINDOW) rows'. Whether the magnetometer is used follows the filter, or for those
-/// that may use one, whether the file has `mag_*` columns (`spec.magnetometer` is set
-/// accordingly). Only the rows of `window` are filtered.
-///
-/// # Errors
-/// Missing columns, bad cells (file, row, column), times that do not increase, the filter's
-/// refusals with the row, I/O errors.
-pub fn orient_csv(
-    input: &Path,
-    spec: &FilterSpec,
-    nav: NavFrameName,
-    window: TimeWindow,
-    out: &Path,
-) -> Result<OrientSummary> {
-    match nav {
-        NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, nav, window, out),
-        NavFrameName::NED => orient_csv_in::<Ned>(input, spec, nav, window, out),
-    }
-}
-
-fn orient_csv_in<N: NavFrame>(
-    input: &Path,
-    spec: &FilterSpec,
-    nav: NavFrameName,
-    window: TimeWindow,
-    out: &Path,
-) -> Result<OrientSummary> {
-    let header = crate::io::table::read_header(input)?;
-    let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
-    let mut spec = spec.clone();
-    // A filter that may use a magnetometer uses one when the file has it; a file with only some
-    // of the mag_* columns is a mistake to name, not a reason to drop the magnetometer silently.
-    let some_mag = MAG_COLUMNS.iter().any(|c| header.iter().any(|h| h == c));
-    let name = spec.kind.name();
-    let mut warnings = Vec::new();
-    spec.magnetometer = match (spec.kind.magnetometer(), spec.use_magnetometer) {
-        (Some(true), false) => {
-            return Err(invalid(
-                "use_magnetometer",
-                format!("the {name} filter needs a magnetometer; for 6D use {SIX_AXIS_FILTERS}"),
-            ));
-        }
-        (Some(true), true) => true,
-        (Some(false), _) => {
-            if some_mag && spec.use_magnetometer {
-                warnings.push(format!(
-                    "{}: the {name} filter uses no magnetometer: the file's mag_* columns are \
-                     ignored and the heading is not held (robust, ahrsfilter, madgwick, mahony \
-                     and complementary use them; --no-mag says you mean 6D)",
-                    input.display()
-                ));
-            }
-            false
-        }
-        (None, use_it) => some_mag && use_it,
-    };
-    if spec.magnetometer && !has(&MAG_COLUMNS) {
-        let missing = MAG_COLUMNS
-            .iter()
-            .filter(|c| !header.iter().any(|h| h == *c))
-            .map(|c| (*c).to_string())
-            .collect();
-        let hint = if some_mag {
-            format!(
-                "; the {name} filter uses all three magnetometer columns when the file has any \
-                 (--no-mag ignores them)"
-            )
-        } else {
-            format!(
-                "; the {name} filter needs a magnetometer and this file has none: for 6D use \
-                 {SIX_AXIS_FILTERS}"
-            )
-        };
-        return Err(crate::Error::MissingColumns {
-            file: input.into(),
-            missing,
-            hint,
-        });
-    }
-    let gyro = spec.kind != FilterKind::Ecompass;
-    let mut columns = vec!["t_s"];
-    columns.extend(ACCEL_COLUMNS);
-    if gyro {
-        columns.extend(GYRO_COLUMNS);
-    }
-    if spec.magnetometer {
-        columns.extend(MAG_COLUMNS);
-    }
-    let hint = format!(
-        "; the {} filter needs t_s, accel_*{}{}",
-        spec.kind.name(),
-        if gyro { ", gyro_*" } else { "" },
-        if spec.magnetometer { ", mag_*" } else { "" }
-    );
-    let mut rows = TimedRows::open(input, &columns, &hint)?.within(window);
-    let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
-    let rate = spec.sample_rate_hz(data_rate)?;
-    let per_sample = spec.fixed_rate_hz()?.is_none();
-    if !(rate.is_finite() && rate > 0.0) {
-        return Err(invalid(
-            "SampleRate",
-            "cannot be taken from a single row: give SampleRate=…",
-        ));
-    }
-    let mut filter = spec.build::<N>(rate)?;
-    let mut file = AtomicFile::create(out)?;
-    let robust = spec.kind == FilterKind::Robust;
-    let out_columns: Vec<String> = ORIENT_COLUMNS
-        .iter()
-        .chain(if robust { &ROBUST_COLUMNS[..] } else { &[] })
-        .map(|c| (*c).to_string())
-        .collect();
-    file.begin_table(
-        &out_columns,
-        &Description {
-            nav_frame: Some(nav),
-            ..Description::of_kind(TableKind::Orientation)
-        },
-    )?;
-    let (mut samples, mut written, mut last_yaw) = (0usize, 0usize, None);
-    let mut r = vec![0.0; columns.len()];
-    while rows.next_row(&mut r)? {
-        let three = |k: usize| [r[k], r[k + 1], r[k + 2]];
-        let sample = FilterInput {
-            accel_m_s2: three(1),
-            gyro_rad_s: if gyro { three(4) } else { [0.0; 3] },
-            mag_ut: if spec.magnetometer {
-                three(if gyro { 7 } else { 4 })
-            } else {
-                [0.0; 3]
-            },
-            interval_s: rows.interval().filter(|_| per_sample),
-        };
-        let estimate = filter
-            .update(&sample)
-            .map_err(|e| invalid("IMU data", format!("row {}: {e}", rows.last_row())))?;
-        if let Some(est) = estimate {
-            let row = orient_row(r[0], &est.orientation, &mut last_yaw);
-            match filter.status() {
-                Some(status) => file.write_row(&[&row[..], &robust_row(&status)].concat())?,
-                None => file.write_row(&row)?,
-            }
-            written += 1;
-        }
-        samples += 1;
-    }
-    file.commit()?;
-    Ok(OrientSummary {
-        samples,
-        rows: written,
-        unfinished: samples - written * filter.decimation(),
-        sample_rate_hz: rate,
-        per_sample,
-        gaps: rows.gaps(),
-        warnings,
-    })
-}
-
-/// Estimates of a batch: `q_nb` (w, x, y, z) and the bias-corrected body rate per estimate.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Estimates {
-    /// Orientations, one per estimate.
-    pub quaternions: Vec<[f64; 4]>,
-    /// Angular velocities, rad/s.
-    pub angular_velocity_rad_s: Vec<[f64; 3]>,
-    /// The robust filter's bias and flags per estimate ([`ROBUST_COLUMNS`]); empty for the
-    /// others.
-    pub status: Vec<[f64; 6]>,
-}
-
-/// Runs `filter` over rows of readings given as flat slices (three values per row):
-/// accelerometer, gyroscope and magnetometer (`None` for sensors the filter does not use), and
-/// their times `t_s` when known: each sample is then integrated over its own interval, the
-/// first from the last time `clock` holds (else at the filter's sample rate).
-/// The filter and the clock carry their state into the next call, so a run in chunks equals a
-/// run whole; on an error both are left as they were before the call. As in MATLAB's `imufilter` and
-/// `ahrsfilter`, each call takes whole decimation blocks: the row count must be a multiple of
-/// the `DecimationFactor`.
-///
-/// # Errors
-/// Slices of different lengths, a row count that is not a multiple of the decimation factor,
-/// times that are not finite or do not increase, the filter's refusals naming the row index
-/// (non-finite readings among them), and estimates that are not finite.
-pub fn run_rows<N: NavFrame>(
-    filter: &mut AnyFilter<N>,
-    clock: &mut SampleClock,
-    accel: &[f64],
-    gyro: Option<&[f64]>,
-    mag: Option<&[f64]>,
-    t_s: Option<&[f64]>,
-) -> Result<Estimates> {
-    let n = accel.len() / 3;
-    if let Some(t) = t_s.filter(|t| t.len() != n) {
-        return Err(invalid(
-            "t_s",
-            format!("has {} times, the accelerometer {n} rows", t.len()),
-        ));
-    }
-    let intervals = t_s.map(|t| clock.intervals(t)).transpose()?;
-    for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
-        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
-            return Err(invalid(
-                name,
-                format!("has {} rows, the accelerometer {n}", s.len() / 3),
-            ));
-        }
-    }
-    let decimation = filter.decimation();
-    if !n.is_multiple_of(decimation) {
-        return Err(invalid(
-            "readings",
-            format!(
-                "{n} rows is not a multiple of DecimationFactor = {decimation} (each call takes \
-                 whole blocks of {decimation} samples, as MATLAB's imufilter and ahrsfilter do)"
-            ),
-        ));
-    }
-    let mut working = *filter;
-    let mut out = Estimates::default();
-    let three = |s: Option<&[f64]>, i: usize| {
-        s.map_or([0.0; 3], |s| [s[3 * i], s[3 * i + 1], s[3 * i + 2]])
-    };
-    for i in 0..n {
-        let input = FilterInput {
-            accel_m_s2: three(Some(accel), i),
-            gyro_rad_s: three(gyro, i),
-            mag_ut: three(mag, i),
-            interval_s: intervals.as_ref().and_then(|d| d[i]),
-        };
-        let estimate = working
-            .update(&input)
-            .map_err(|e| invalid("readings", format!("row {i}: {e}")))?;
-        if let Some(e) = estimate {
-            let (q, w) = (e.orientation.to_wxyz(), e.angular_velocity_rad_s);
-            if !q.iter().chain(&w).all(|v| v.is_finite()) {
-                return Err(invalid(
-                    "readings",
-                    format!(
-                        "row {i}: the estimate is not finite (readings too large for the filter, \
-                         or a sample rate too small)"
-                    ),
-                ));
-            }
-            out.quaternions.push(q);
-            out.angular_velocity_rad_s.push(w);
-            if let Some(status) = working.status() {
-                out.status.push(robust_row(&status));
-            }
-        }
-    }
-    *filter = working;
-    clock.advance(t_s);
-    Ok(out)
-}
-
-/// The e-compass of each row: accelerometer and magnetometer rows (three values each, flat) in
-/// frame `nav`, with the accelerometer sign `accel_sign`; four values `q_nb` per row.
-///
-/// # Errors
-/// Slices of different lengths; a row the e-compass refuses (parallel or zero vectors), named
-/// by its index.
-pub fn ecompass_rows(
-    accel: &[f64],
-    mag: &[f64],
-    accel_sign: AccelSign,
-    nav: NavFrameName,
-) -> Result<Vec<f64>> {
-    fn rows<N: NavFrame>(a: &[f64], m: &[f64], s: AccelSign) -> Result<Vec<f64>> {
-        let mut out = Vec::with_capacity(a.len() / 3 * 4);
-        for (i, (a, m)) in a.chunks_exact(3).zip(m.chunks_exact(3)).enumerate() {
-            let q = imu_core::orientation::ecompass::<N>([a[0], a[1], a[2]], [m[0], m[1], m[2]], s)
-                .map_err(|source| crate::Error::Orientation {
-                    context: format!("row {i}"),
-                    source,
-                })?;
-            out.extend(q.to_wxyz());
-        }
-        Ok(out)
-    }
-    if accel.len() != mag.len() {
-        return Err(invalid(
-            "mag",
-            format!("has {} rows, accel {}", mag.len() / 3, accel.len() / 3),
-        ));
-    }
-    match nav {
-        NavFrameName::ENU => rows::<Enu>(accel, mag, accel_sign),
-        NavFrameName::NED => rows::<Ned>(accel, mag, accel_sign),
-    }
-}
-
-/// The quaternion distance (rad) between the rows of two flat lists of quaternions
-/// `[w, x, y, z]` (four values per row).
-///
-/// # Errors
-/// Lists of different lengths; a quaternion of zero norm or not finite, named `q1[i]`/`q2[i]`.
-pub fn quaternion_distances(q1: &[f64], q2: &[f64]) -> Result<Vec<f64>> {
-    if q1.len() != q2.len() {
-        return Err(invalid(
-            "q2",
-            format!("has {} rows, q1 {}", q2.len() / 4, q1.len() / 4),
-        ));
-    }
-    let rotation = |c: &[f64], name: &str, i: usize| {
-        Rotation::<Body, Enu>::from_wxyz([c[0], c[1], c[2], c[3]]).ok_or_else(|| {
-            crate::Error::BadQuaternion {
-                field: format!("{name}[{i}]"),
-            }
-        })
-    };
-    q1.chunks_exact(4)
-        .zip(q2.chunks_exact(4))
-        .enumerate()
-        .map(|(i, (a, b))| {
-            Ok(imu_core::orientation::quaternion_distance(
-                &rotation(a, "q1", i)?,
-                &rotation(b, "q2", i)?,
-            ))
-        })
-        .collect()
-}
+pub use csv::{OrientSummary, orient_csv, orient_row};
+pub use rows::{Estimates, ecompass_rows, quaternion_distances, run_rows, smooth_rows};
