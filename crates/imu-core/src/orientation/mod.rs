@@ -1,7 +1,7 @@
 //! Orientation from IMU readings: the e-compass, Kalman filters equivalent in structure to
 //! MATLAB's `imufilter` and `ahrsfilter`, the complementary, Madgwick and Mahony filters, and
-//! imukit's own [`robust`] filter (inclination, heading and bias each from its own evidence, with a smoother for whole logs),
-//! all behind one per-sample trait ([`OrientationFilter`]); and the quaternion distance that
+//! imukit's own [`robust`] filter (inclination, heading and bias each from its own evidence,
+//! with a smoother for whole logs), all behind one per-sample trait ([`OrientationFilter`]); and the quaternion distance that
 //! judges them against truth ([`metrics`]).
 //!
 //! Conventions (docs/design.md §2): the estimate is `q_nb`, the rotation from the body to the
