@@ -1,6 +1,8 @@
-//! Throughput (samples/s) of every orientation filter on a static, gently noisy IMU: the
-//! Kalman filters (imufilter and ahrsfilter), the e-compass, Madgwick, Mahony and the
-//! complementary filter (with a magnetometer where they take one); 1 sample and 10⁵ samples.
+//! Throughput (samples/s) of every orientation filter on a static, gently noisy IMU: imukit's
+//! robust filter (6D and 9D), the Kalman filters (imufilter and ahrsfilter), the e-compass,
+//! Madgwick, Mahony and the complementary filter (with a magnetometer where they take one);
+//! 1 sample and 10⁵ samples. `benches/broad/broad.py --speed` times the robust filter beside
+//! VQF's C++ core through both Python packages.
 //!
 //! Run: `cargo bench -p imu-benches --bench orientation`.
 #![allow(missing_docs)]
@@ -8,7 +10,7 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_core::orientation::{
     Complementary, Ecompass, FilterInput, KalmanFilter, KalmanParams, Madgwick, Mahony,
-    OrientationFilter,
+    OrientationFilter, RobustFilter, RobustParams,
 };
 use imu_core::sensor::{NoiseSource, SeededNormals};
 use imu_core::{AccelSign, Ned};
@@ -46,6 +48,14 @@ fn bench<F: OrientationFilter<Ned> + Clone>(c: &mut Criterion, name: &str, filte
 
 fn filters(c: &mut Criterion) {
     let sign = AccelSign::Matlab;
+    for (name, magnetometer) in [("robust_6d", false), ("robust_9d", true)] {
+        let params = RobustParams {
+            accel_sign: sign,
+            magnetometer,
+            ..RobustParams::default()
+        };
+        bench(c, name, RobustFilter::new(params).unwrap());
+    }
     let p = KalmanParams::default();
     bench(c, "imufilter", KalmanFilter::<Ned>::imu(p).unwrap());
     bench(c, "ahrsfilter", KalmanFilter::<Ned>::ahrs(p).unwrap());

@@ -246,6 +246,38 @@ def table(results: dict, names: list[str], trials: list[str], groups: dict) -> l
     return lines
 
 
+def speed(paths: list[Path]) -> list[str]:
+    """Per-sample update time of imukit's default filter and of VQF's C++ core, each run over a
+    whole trial in one call (a native loop on both sides), best of five, 6D and 9D."""
+    import imukit
+
+    d = load_trial(paths[0])
+    n = len(d["imu_gyr"])
+    rows = []
+    for mag in (False, True):
+        def ours():
+            f = imukit.RobustFilter(sample_rate=d["rate"], has_magnetometer=mag)
+            f(d["imu_acc"], d["imu_gyr"], d["imu_mag"] if mag else None)
+
+        def theirs():
+            from vqf import VQF
+
+            VQF(1.0 / d["rate"]).updateBatch(d["imu_gyr"], d["imu_acc"], d["imu_mag"] if mag else None)
+
+        cells = []
+        for fn in (ours, theirs):
+            best = float("inf")
+            for _ in range(5):
+                t0 = time.perf_counter()
+                fn()
+                best = min(best, time.perf_counter() - t0)
+            cells.append(best / n * 1e9)
+        rows.append(f"| {'9D' if mag else '6D'} | {cells[0]:.0f} | {cells[1]:.0f} |")
+    return [f"Per-sample update time, ns ({n} samples of {paths[0].stem}, one call each, best of 5; "
+            "VQF through its Python package's batch call to its C++ core):", "",
+            "| | imukit robust | VQF 2.1.2 (C++) |", "|---|---|---|"] + rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, required=True,
@@ -255,6 +287,8 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=len(__import__("os").sched_getaffinity(0)))
     parser.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
                         help="settings of imukit's robust filter (as `imukit orient --param` takes them)")
+    parser.add_argument("--speed", action="store_true",
+                        help="also time the default filter beside VQF's C++ core (per-sample update)")
     parser.add_argument("--per-trial", action="store_true", help="also print each trial's 6D/9D total RMSE")
     parser.add_argument("--write-readme", type=Path, metavar="PATH",
                         help="also write the table as the BROAD section of PATH (benches/README.md)")
@@ -279,6 +313,8 @@ def main() -> None:
             print(t, "  ".join(f"{n}: {results[t][(n, '6D')]['total']:.2f}/{results[t][(n, '9D')]['total']:.2f}"
                                for n in names))
     lines = table(results, names, trials, groups_of(args.data, trials))
+    if args.speed:
+        lines += [""] + speed(paths)
     print("\n".join(lines))
     if args.write_readme:
         from readme_section import replace_section
@@ -294,7 +330,8 @@ def main() -> None:
         body = ("## Orientation on BROAD\n\n"
                 f"- data: BROAD (Laidig et al., Data 2021, CC BY 4.0), {len(trials)} of its 39 trials\n"
                 f"- versions: {', '.join(versions)}; Python {platform.python_version()}\n"
-                f"- command: `python benches/broad/broad.py --data BROAD --write-readme {args.write_readme}`\n\n"
+                f"- command: `python benches/broad/broad.py --data BROAD{' --speed' if args.speed else ''} "
+                f"--write-readme {args.write_readme}` (BROAD: a local copy of its data_hdf5 or data_mat folder)\n\n"
                 + "\n".join(lines) + "\n")
         replace_section(args.write_readme, "broad", body)
 

@@ -460,7 +460,10 @@ pub enum Command {
         /// lon_rad, height_m`, `lat_deg, lon_deg, height_m` or `ecef_*_m`, with velocity and
         /// attitude where it has them): errors then north, east, down (docs/earth.md).
         truth: PathBuf,
-        /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`).
+        /// Estimate CSV: navigation (`imukit integrate`) or orientation (`imukit orient`). An
+        /// orientation estimate is scored as orientation benchmarks do: the error's heading and
+        /// inclination parts beside its angle; rows where the reference has no value (empty or
+        /// NaN quaternion cells, a gap in its times) or no time are skipped and counted.
         estimate: PathBuf,
         /// Which topics of a ROS bag, on which clock.
         #[command(flatten)]
@@ -471,6 +474,10 @@ pub enum Command {
         /// Where to write the errors over time (CSV, or by extension `.parquet`, `.npy`, `.npz`).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Orientation estimates: remove one constant heading offset (the circular mean of the
+        /// heading error) before scoring — a 6D estimate's heading is arbitrary.
+        #[arg(long)]
+        align_heading: bool,
     },
     /// The planar cart exercise end to end: the built-in cart's clean and erroneous `.dat` files,
     /// dead-reckoned with both schemes, and a plot of the trajectories (start and end marked).

@@ -187,7 +187,8 @@ fn strapdown<'py>(
 
 /// Errors of an estimate against truth: (error table, summary dict).
 #[pyfunction]
-#[pyo3(signature = (truth_columns, truth, estimate_columns, estimate, described = Vec::new()))]
+#[pyo3(signature = (truth_columns, truth, estimate_columns, estimate, described = Vec::new(),
+                    align_heading = false))]
 fn compare<'py>(
     py: Python<'py>,
     truth_columns: Vec<String>,
@@ -195,12 +196,15 @@ fn compare<'py>(
     estimate_columns: Vec<String>,
     estimate: PyReadonlyArray2<'py, f64>,
     described: DescribedIn<'py>,
+    align_heading: bool,
 ) -> PyResult<(TableOut<'py>, Bound<'py, PyDict>)> {
     comparison::check_comparable(&described_in(&described)?).map_err(refused)?;
     let t: Table = table_in("truth", truth_columns, &truth)?;
     let e: Table = table_in("estimate", estimate_columns, &estimate)?;
     let c = py
-        .detach(move || comparison::compare(&t, &e))
+        .detach(move || {
+            comparison::compare_with(&t, &e, comparison::CompareOptions { align_heading })
+        })
         .map_err(refused)?;
     let d = PyDict::new(py);
     for (name, value) in c.summary.entries() {

@@ -157,8 +157,15 @@ def test_quaternion_distance_and_compare_of_an_orientation_output():
     est_q = imukit.euler_to_quaternion(e + [0.01, 0.0, 0.0])
     estimate = imukit.Table(["t_s", "q_w", "q_x", "q_y", "q_z"], np.column_stack([t, est_q]))
     errors, summary = imukit.compare(truth, estimate)
-    assert list(errors.columns) == ["t_s", "att_err_rad", "yaw_err_rad", "pitch_err_rad", "roll_err_rad"]
+    assert list(errors.columns) == ["t_s", "att_err_rad", "heading_err_rad", "inclination_err_rad",
+                                    "yaw_err_rad", "pitch_err_rad", "roll_err_rad"]
     np.testing.assert_allclose(errors["yaw_err_rad"], 0.01, atol=1e-9)
+    # A yaw error is all heading: BROAD's split of the error rotation.
+    np.testing.assert_allclose(errors["heading_err_rad"], 0.01, atol=1e-9)
+    np.testing.assert_allclose(errors["inclination_err_rad"], 0.0, atol=1e-7)
+    np.testing.assert_allclose(summary["heading_offset_rad"], 0.01, atol=1e-9)
+    aligned = imukit.compare(truth, estimate, align_heading=True).summary
+    assert aligned["attitude_rms_rad"] < 1e-7 and aligned["skipped_rows"] == 0
     np.testing.assert_allclose(summary["attitude_rms_rad"], 0.01, atol=1e-9)
     assert "position_rms_m" not in summary and summary["attitude_max_rad"] >= summary["attitude_rms_rad"]
 

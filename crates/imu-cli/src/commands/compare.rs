@@ -5,7 +5,7 @@ use std::path::Path;
 use imu_core::orientation::DistanceStats;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
-use imukit::run::compare::compare_csv_within;
+use imukit::run::compare::{CompareOptions, compare_csv_with};
 
 use super::CliError;
 
@@ -14,6 +14,7 @@ pub fn run(
     truth: &Path,
     estimate: &Path,
     window: TimeWindow,
+    options: CompareOptions,
     out: Option<&Path>,
 ) -> Result<(), CliError> {
     let inputs = [("truth file", truth), ("estimate file", estimate)];
@@ -24,7 +25,7 @@ pub fn run(
     imukit::io::output::check_table_outputs(
         &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
     )?;
-    let c = compare_csv_within(truth, estimate, window, out)?;
+    let c = compare_csv_with(truth, estimate, window, options, out)?;
     crate::out_line!(
         "{:<10} {:>16} {:>16} {:>16}",
         "error",
@@ -49,7 +50,28 @@ pub fn run(
     if let Some(a) = &c.attitude {
         line("attitude", a, 1f64.to_degrees(), "deg");
     }
+    if let Some(h) = &c.heading {
+        line("heading", h, 1f64.to_degrees(), "deg");
+    }
+    if let Some(i) = &c.inclination {
+        line("incl.", i, 1f64.to_degrees(), "deg");
+    }
     crate::out_line!("({} rows compared)", c.rows());
+    if let Some(offset) = c.heading_offset_rad
+        && options.align_heading
+    {
+        crate::out_line!(
+            "(a constant heading offset of {:.4} deg removed)",
+            offset.to_degrees()
+        );
+    }
+    if c.skipped > 0 {
+        crate::report::warn(&format!(
+            "{}: {} estimate rows skipped: the reference has no value or no time there",
+            estimate.display(),
+            c.skipped
+        ));
+    }
     if let Some(o) = out {
         crate::note!("imukit: errors over time written to {}", o.display());
     }

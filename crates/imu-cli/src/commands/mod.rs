@@ -246,9 +246,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             bag,
             out,
             window,
+            align_heading,
         } => {
             bag.attach(&[Some(&truth), Some(&estimate)])?;
-            compare::run(&truth, &estimate, window.window()?, out.as_deref())
+            let options = imukit::run::compare::CompareOptions { align_heading };
+            compare::run(&truth, &estimate, window.window()?, options, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
         Command::Convert { value, unit } => {

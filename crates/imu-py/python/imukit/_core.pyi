@@ -300,6 +300,7 @@ def compare(
     estimate_columns: Sequence[str],
     estimate: npt.NDArray[np.float64],
     described: _DescribedIn = ...,
+    align_heading: bool = False,
 ) -> tuple[_Table, dict[str, float]]: ...
 def truth_from_body_rates(
     t_s: npt.NDArray[np.float64],

@@ -131,19 +131,25 @@ class Comparison(NamedTuple):
         return f"Comparison(errors={self.errors!r}, summary={{{shown}}})"
 
 
-def compare(truth: TableLike, estimate: TableLike) -> Comparison:
+def compare(truth: TableLike, estimate: TableLike, *, align_heading: bool = False) -> Comparison:
     """Errors of an estimate against truth on the estimate's times: a :class:`Comparison`
     ``(errors, summary)``.
 
     A navigation estimate (``t_s, pos_*, vel_*, q_*``) gives the Table ``t_s, pos_err_*_m,
     pos_err_m, vel_err_*_m_s, att_err_rad``; an orientation estimate (``t_s, q_w, q_x, q_y, q_z``,
-    as ``imukit orient`` writes) gives ``t_s, att_err_rad, yaw_err_rad, pitch_err_rad,
-    roll_err_rad``. The dict holds RMS, maximum and final values (``position_rms_m``,
-    ``position_max_m``, ``position_final_m``, …, ``attitude_final_rad``; attitude only for
-    orientation estimates). Tables whose descriptions say different frames or Earths are
+    as ``imukit orient`` writes) gives ``t_s, att_err_rad, heading_err_rad, inclination_err_rad,
+    yaw_err_rad, pitch_err_rad, roll_err_rad`` — scored as orientation benchmarks do (BROAD's
+    metric): the error rotation's heading and inclination parts beside its angle; rows where the
+    reference has no value (NaN quaternion, a gap in its times) or no time are skipped and counted
+    (``skipped_rows``). ``align_heading=True`` removes one constant heading offset first (a 6D
+    estimate's heading is arbitrary; ``heading_offset_rad`` says how much). The dict holds RMS,
+    maximum and final values (``position_rms_m``, ``position_max_m``, ``position_final_m``, …,
+    ``attitude_final_rad``, ``heading_rms_rad``, ``inclination_rms_rad``; position and velocity
+    only for navigation estimates). Tables whose descriptions say different frames or Earths are
     refused."""
     table, summary = _core.compare(*_table_args("truth", truth), *_table_args("estimate", estimate),
-                                   described=_described(truth=truth, estimate=estimate))
+                                   described=_described(truth=truth, estimate=estimate),
+                                   align_heading=align_heading)
     return Comparison(_table(table), {str(k): float(v) for k, v in dict(summary).items()})
 
 

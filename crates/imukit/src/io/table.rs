@@ -958,9 +958,25 @@ pub struct CsvRows {
     file_names: Option<Vec<String>>,
     /// Rows given only from `.1` to `.2` in the time column `.0` ([`CsvRows::within`]).
     window: Option<(usize, f64, f64)>,
+    /// Per requested column: an empty or NaN cell is a missing value, given as NaN
+    /// ([`CsvRows::allowing_missing`]).
+    missing_ok: Vec<bool>,
 }
 
 impl CsvRows {
+    /// Takes an empty cell or `NaN` in the requested columns `names` as a missing value, given
+    /// as NaN (a reference that lost track for a while), instead of refusing it. Infinite values
+    /// are still refused. CSV only: the binary formats' readers refuse a missing value.
+    #[must_use]
+    pub fn allowing_missing(mut self, names: &[&str]) -> Self {
+        self.missing_ok = self
+            .wanted
+            .iter()
+            .map(|(_, name)| names.contains(&name.as_str()))
+            .collect();
+        self
+    }
+
     /// Gives only the rows whose `t_s` (a column asked for) lies in `window`, its seconds
     /// counted from `t0`: the rows before it are skipped, and the rows end after it.
     ///
@@ -1098,6 +1114,7 @@ impl CsvRows {
             origin_ns: std::cell::Cell::new(layout.origin_ns),
             file_names: layout.file_names,
             window: None,
+            missing_ok: Vec::new(),
         })
     }
 
@@ -1153,8 +1170,11 @@ impl CsvRows {
             .record
             .position()
             .map_or(0, |p| (p.line() as usize).saturating_sub(self.comments));
-        for ((k, name), slot) in self.wanted.iter().zip(out.iter_mut()) {
+        for (i, ((k, name), slot)) in self.wanted.iter().zip(out.iter_mut()).enumerate() {
+            let missing_ok = self.missing_ok.get(i).copied().unwrap_or(false);
             *slot = match self.sources.as_ref().map(|s| &s[*k]) {
+                None if missing_ok => self.number_or_missing(*k, name, row)?,
+                Some(Source::Field(f)) if missing_ok => self.number_or_missing(*f, name, row)?,
                 None => self.number(*k, name, row)?,
                 Some(Source::Field(f)) => self.number(*f, name, row)?,
                 Some(Source::Time(f, unit)) => {
@@ -1212,6 +1232,16 @@ impl CsvRows {
             let lossy = String::from_utf8_lossy(field);
             self.bad(f, name, row, format!("not a number: \"{}\"", lossy.trim()))
         })
+    }
+
+    /// Field `f` of the current record as a finite number, or NaN for an empty or NaN cell.
+    fn number_or_missing(&self, f: usize, name: &str, row: usize) -> Result<f64> {
+        let text = self.text(f, name, row)?;
+        if text.is_empty() || text.eq_ignore_ascii_case("nan") {
+            Ok(f64::NAN)
+        } else {
+            self.number(f, name, row)
+        }
     }
 
     /// Field `f` of the current record as a finite number.

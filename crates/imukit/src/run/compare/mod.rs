@@ -4,9 +4,14 @@
 //!
 //! Two kinds of estimate: a navigation output (`t_s`, `pos_*`, `vel_*`, `q_*`; errors in
 //! [`ERROR_COLUMNS`]) and an orientation output (`t_s`, `q_*` only, as `imukit orient` writes;
-//! errors in [`ORIENTATION_ERROR_COLUMNS`]: the quaternion distance and the z-y-x Euler angle
-//! differences, wrapped to (−π, π]). Both stream: rows are read in time order, and memory
-//! does not grow with the files.
+//! errors in [`ORIENTATION_ERROR_COLUMNS`]: the quaternion distance, its heading and
+//! inclination parts, and the z-y-x Euler angle differences, wrapped to (−π, π]; scored as
+//! orientation benchmarks do, [`orientation`]). Both stream: rows are read in time order, and
+//! memory does not grow with the files.
+mod orientation;
+
+pub use orientation::heading_inclination;
+
 use std::path::Path;
 
 use imu_core::earth::Geodetic;
@@ -50,10 +55,13 @@ pub const EARTH_ERROR_COLUMNS: [&str; 9] = [
     "att_err_rad",
 ];
 
-/// Error columns of an orientation estimate (estimate − truth for the angles).
-pub const ORIENTATION_ERROR_COLUMNS: [&str; 5] = [
+/// Error columns of an orientation estimate: the error rotation's angle and its heading and
+/// inclination parts ([`heading_inclination`]), estimate − truth for the Euler angles.
+pub const ORIENTATION_ERROR_COLUMNS: [&str; 7] = [
     "t_s",
     "att_err_rad",
+    "heading_err_rad",
+    "inclination_err_rad",
     "yaw_err_rad",
     "pitch_err_rad",
     "roll_err_rad",
@@ -113,14 +121,34 @@ pub struct ErrorSummary {
     pub velocity: Option<DistanceStats>,
     /// Attitude error angle (quaternion distance), rad (`None`: a reference without one).
     pub attitude: Option<DistanceStats>,
+    /// Orientation estimates: the heading part of the error angle, rad.
+    pub heading: Option<DistanceStats>,
+    /// Orientation estimates: the inclination part of the error angle, rad.
+    pub inclination: Option<DistanceStats>,
+    /// Orientation estimates: the constant heading offset removed (`--align-heading`), else
+    /// the circular mean of the signed heading error, rad.
+    pub heading_offset_rad: Option<f64>,
+    /// Estimate rows not scored: outside the reference's times, or where it has a hole
+    /// (orientation estimates; navigation estimates refuse such rows).
+    pub skipped: usize,
     /// Rows compared.
     pub rows: usize,
 }
 
+/// How to compare.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CompareOptions {
+    /// Orientation estimates: remove one constant heading offset first (a 6D estimate, whose
+    /// heading is arbitrary).
+    pub align_heading: bool,
+}
+
 impl ErrorSummary {
     /// Every figure by name with its unit: `position_rms_m`, `position_max_m`,
-    /// `position_final_m`, the same for `velocity` (`_m_s`) and `attitude` (`_rad`); position and
-    /// velocity only for navigation estimates, each only where the reference has it.
+    /// `position_final_m`, the same for `velocity` (`_m_s`), `attitude`, `heading` and
+    /// `inclination` (`_rad`); position and velocity only for navigation estimates, heading and
+    /// inclination (with `heading_offset_rad` and `skipped_rows`) only for orientation ones,
+    /// each only where the reference has it.
     #[must_use]
     pub fn entries(&self) -> Vec<(String, f64)> {
         let mut out = Vec::new();
@@ -137,6 +165,18 @@ impl ErrorSummary {
         }
         if let Some(a) = &self.attitude {
             put("attitude", "rad", a);
+        }
+        if let Some(h) = &self.heading {
+            put("heading", "rad", h);
+        }
+        if let Some(i) = &self.inclination {
+            put("inclination", "rad", i);
+        }
+        if let Some(o) = self.heading_offset_rad {
+            out.push(("heading_offset_rad".to_string(), o));
+        }
+        if self.kind == EstimateKind::Orientation {
+            out.push(("skipped_rows".to_string(), self.skipped as f64));
         }
         out
     }
@@ -245,8 +285,49 @@ fn push_sigmas(row: &mut Vec<f64>, sigmas: &[f64; SIGMA_COLUMNS.len()]) {
 /// Missing columns; truth or estimate times that do not increase (or are not finite); estimate
 /// times outside the truth's span; zero quaternions.
 pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
+    compare_with(truth, estimate, CompareOptions::default())
+}
+
+/// [`compare`] with `options`. A navigation estimate and its truth must be finite throughout;
+/// an orientation reference may have holes (NaN quaternions), which are skipped.
+///
+/// # Errors
+/// As [`compare`].
+pub fn compare_with(
+    truth: &Table,
+    estimate: &Table,
+    options: CompareOptions,
+) -> Result<Comparison> {
     let kind = EstimateKind::of(&estimate.columns)?;
     check_truth(&truth.columns, kind)?;
+    estimate.check_finite("estimate")?;
+    if kind == EstimateKind::Orientation {
+        if let Some(t) = truth.column("t_s") {
+            crate::io::table::check_finite(&["t_s"], &t, "truth")?;
+        }
+        let mut table = Table::new(kind.error_columns());
+        let score = |align: Option<f64>, table: &mut Table| {
+            let (mut tr, mut er) = (state_rows(truth, kind), state_rows(estimate, kind));
+            orientation::compare_orientation_rows(
+                ["truth", "estimate"],
+                |row| Ok(tr.next().map(|r| *row = r).is_some()),
+                |row| Ok(er.next().map(|r| *row = r).is_some()),
+                align,
+                |e| {
+                    table.push_row(e);
+                    Ok(())
+                },
+            )
+        };
+        let summary = if options.align_heading {
+            let offset = score(None, &mut Table::new(kind.error_columns()))?.heading_offset_rad;
+            score(offset, &mut table)?
+        } else {
+            score(None, &mut table)?
+        };
+        return Ok(Comparison { table, summary });
+    }
+    truth.check_finite("truth")?;
     let (mut tr, mut er) = (state_rows(truth, kind), state_rows(estimate, kind));
     let sigmas: Vec<Vec<f64>> = if has_sigmas(&estimate.columns, kind) {
         SIGMA_COLUMNS
@@ -259,7 +340,6 @@ pub fn compare(truth: &Table, estimate: &Table) -> Result<Comparison> {
     let mut table = Table::new(&output_columns(kind, !sigmas.is_empty()));
     let mut out = Vec::with_capacity(table.columns.len());
     let summary = compare_rows(
-        kind,
         Parts::PLANE,
         ["truth", "estimate"],
         |row| Ok(tr.next().map(|r| *row = r).is_some()),
@@ -361,6 +441,21 @@ pub fn compare_csv_within(
     window: TimeWindow,
     out: Option<&Path>,
 ) -> Result<ErrorSummary> {
+    compare_csv_with(truth, estimate, window, CompareOptions::default(), out)
+}
+
+/// [`compare_csv_within`] with `options`; an orientation reference may have holes (empty or
+/// NaN quaternion cells), which are skipped. Aligning the heading reads both files twice.
+///
+/// # Errors
+/// As [`compare_csv`].
+pub fn compare_csv_with(
+    truth: &Path,
+    estimate: &Path,
+    window: TimeWindow,
+    options: CompareOptions,
+    out: Option<&Path>,
+) -> Result<ErrorSummary> {
     let t0 = if window.is_whole() {
         0.0
     } else {
@@ -395,6 +490,36 @@ pub fn compare_csv_within(
         EstimateKind::Navigation => "; the truth needs t_s, pos_*, vel_*, q_*",
         EstimateKind::Orientation => "; the truth needs t_s, q_w, q_x, q_y, q_z",
     };
+    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
+    if kind == EstimateKind::Orientation {
+        let score = |align: Option<f64>, file: Option<&mut AtomicFile>| {
+            let mut truth_rows = CsvRows::open(truth, wanted, hint)?
+                .allowing_missing(&ORIENTATION_COLUMNS[1..])
+                .within(window, t0)?;
+            let mut estimate_rows = CsvRows::open(estimate, wanted, "")?.within(window, t0)?;
+            let (mut tb, mut eb) = (vec![0.0; wanted.len()], vec![0.0; wanted.len()]);
+            let mut file = file;
+            orientation::compare_orientation_rows(
+                [&truth_name, &estimate_name],
+                |row| next_state(&mut truth_rows, &mut tb, kind, row),
+                |row| next_state(&mut estimate_rows, &mut eb, kind, row),
+                align,
+                |e| file.as_mut().map_or(Ok(()), |f| f.write_row(e)),
+            )
+        };
+        let offset = if options.align_heading {
+            score(None, None)?.heading_offset_rad
+        } else {
+            None
+        };
+        let mut file = out.map(AtomicFile::create).transpose()?;
+        if let Some(f) = file.as_mut() {
+            f.write_header(kind.error_columns())?;
+        }
+        let summary = score(offset, file.as_mut())?;
+        file.map_or(Ok(()), AtomicFile::commit)?;
+        return Ok(summary);
+    }
     let mut truth_rows = CsvRows::open(truth, wanted, hint)?.within(window, t0)?;
     let mut estimate_rows = CsvRows::open(estimate, &estimate_wanted, "")?.within(window, t0)?;
     let (mut truth_buffer, mut estimate_buffer) =
@@ -406,9 +531,7 @@ pub fn compare_csv_within(
     // The estimate row's sigmas, handed from the reader to the writer.
     let row_sigmas = std::cell::Cell::new([0.0; SIGMA_COLUMNS.len()]);
     let mut out_row = Vec::new();
-    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
     let summary = compare_rows(
-        kind,
         Parts::PLANE,
         [&truth_name, &estimate_name],
         |row| next_state(&mut truth_rows, &mut truth_buffer, kind, row),
@@ -511,7 +634,6 @@ fn compare_on_earth(
         f.write_header(&parts.columns())?;
     }
     let summary = compare_rows(
-        EstimateKind::Navigation,
         parts,
         [&truth_name, &estimate_name],
         |row| {
@@ -547,11 +669,11 @@ fn angle_difference(a: f64, b: f64) -> f64 {
     if d > std::f64::consts::PI { d - tau } else { d }
 }
 
-/// The comparison of two row streams in time order: for each estimate row the truth rows that
+/// The comparison of two navigation row streams in time order (orientation estimates are scored
+/// by [`orientation`]): for each estimate row the truth rows that
 /// bracket its time (a single-row truth brackets with itself; times past the last truth row
 /// but within 1e-9 s use the last two), errors handed to `sink`.
 fn compare_rows(
-    kind: EstimateKind,
     parts: Parts,
     names: [&str; 2],
     mut read_truth: impl FnMut(&mut StateRow) -> Result<bool>,
@@ -640,8 +762,7 @@ fn compare_rows(
             ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
         };
         let q = |r: &StateRow| Rotation::<Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
-        let attitude = parts.attitude || kind == EstimateKind::Orientation;
-        let (qe, qt, angle) = if attitude {
+        let angle = if parts.attitude {
             let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
                 return Err(invalid(
                     "compare",
@@ -653,53 +774,39 @@ fn compare_rows(
             );
             let angle = quaternion_distance(&qe, &qt);
             att.push(angle);
-            (qe, qt, angle)
+            angle
         } else {
-            (Rotation::identity(), Rotation::identity(), 0.0)
+            0.0
         };
-        match kind {
-            EstimateKind::Navigation => {
-                let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
-                let mut dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
-                if parts.earth {
-                    let point = Vec3::<Ecef>::from_array([lerp(1), lerp(2), lerp(3)]);
-                    let at = Geodetic::from_ecef(point).ok_or_else(|| {
-                        invalid(
-                            truth_name,
-                            format!("no point on the Earth near estimate row {row}"),
-                        )
-                    })?;
-                    dp = ned_of_difference(&at, dp);
-                }
-                let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
-                let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let np = norm(&dp);
-                pos.push(np);
-                let mut out = [0.0; 9];
-                out[..5].copy_from_slice(&[t, dp[0], dp[1], dp[2], np]);
-                let mut width = 5;
-                if parts.velocity {
-                    vel.push(norm(&dv));
-                    out[5..8].copy_from_slice(&dv);
-                    width = 8;
-                }
-                if parts.attitude {
-                    out[width] = angle;
-                    width += 1;
-                }
-                sink(&out[..width])?;
-            }
-            EstimateKind::Orientation => {
-                let (ee, et) = (qe.to_euler(), qt.to_euler());
-                sink(&[
-                    t,
-                    angle,
-                    angle_difference(ee.yaw_rad, et.yaw_rad),
-                    angle_difference(ee.pitch_rad, et.pitch_rad),
-                    angle_difference(ee.roll_rad, et.roll_rad),
-                ])?;
-            }
+        let lerp = |c: usize| a[c] + w * (b[c] - a[c]);
+        let mut dp: [f64; 3] = std::array::from_fn(|j| e[1 + j] - lerp(1 + j));
+        if parts.earth {
+            let point = Vec3::<Ecef>::from_array([lerp(1), lerp(2), lerp(3)]);
+            let at = Geodetic::from_ecef(point).ok_or_else(|| {
+                invalid(
+                    truth_name,
+                    format!("no point on the Earth near estimate row {row}"),
+                )
+            })?;
+            dp = ned_of_difference(&at, dp);
         }
+        let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
+        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let np = norm(&dp);
+        pos.push(np);
+        let mut out = [0.0; 9];
+        out[..5].copy_from_slice(&[t, dp[0], dp[1], dp[2], np]);
+        let mut width = 5;
+        if parts.velocity {
+            vel.push(norm(&dv));
+            out[5..8].copy_from_slice(&dv);
+            width = 8;
+        }
+        if parts.attitude {
+            out[width] = angle;
+            width += 1;
+        }
+        sink(&out[..width])?;
     }
     if rows == 0 {
         return Err(invalid("compare", "empty table"));
@@ -707,12 +814,15 @@ fn compare_rows(
     // The truth rows past the last estimate are read too: a truth file is refused whole or not
     // at all.
     while !truth_ended && truth(&mut next)? {}
-    let navigation = kind == EstimateKind::Navigation;
     Ok(ErrorSummary {
-        kind,
-        position: navigation.then_some(pos),
-        velocity: (navigation && parts.velocity).then_some(vel),
-        attitude: (!navigation || parts.attitude).then_some(att),
+        kind: EstimateKind::Navigation,
+        position: Some(pos),
+        velocity: parts.velocity.then_some(vel),
+        attitude: parts.attitude.then_some(att),
+        heading: None,
+        inclination: None,
+        heading_offset_rad: None,
+        skipped: 0,
         rows,
     })
 }
