@@ -6,7 +6,7 @@
 //! [`ERROR_COLUMNS`]) and an orientation output (`t_s`, `q_*` only, as `imukit orient` writes;
 //! errors in [`ORIENTATION_ERROR_COLUMNS`]: the quaternion distance, its heading and
 //! inclination parts, and the z-y-x Euler angle differences, wrapped to (−π, π]; scored as
-//! orientation benchmarks do, [`orientation`]). Both stream: rows are read in time order, and
+//! orientation benchmarks do, [`heading_inclination`]). Both stream: rows are read in time order, and
 //! memory does not grow with the files.
 mod orientation;
 
@@ -670,7 +670,7 @@ fn angle_difference(a: f64, b: f64) -> f64 {
 }
 
 /// The comparison of two navigation row streams in time order (orientation estimates are scored
-/// by [`orientation`]): for each estimate row the truth rows that
+/// by the `orientation` module): for each estimate row the truth rows that
 /// bracket its time (a single-row truth brackets with itself; times past the last truth row
 /// but within 1e-9 s use the last two), errors handed to `sink`.
 fn compare_rows(
