@@ -219,9 +219,10 @@ def groups_of(folder: Path, trials: list[str]) -> dict:
 def table(results: dict, names: list[str], trials: list[str], groups: dict) -> list[str]:
     lines = [f"{len(trials)} BROAD trials; RMSE in degrees over the motion phases, mean over trials "
              "(6D: one constant heading offset per trial removed)", ""]
+    peer = "VQF (causal)" if "VQF (causal)" in names else None
     lines.append("| filter | 6D total | 6D heading | 6D inclination | 9D total | 9D heading | 9D inclination "
-                 "| worst 6D / 9D trial |")
-    lines.append("|---|---|---|---|---|---|---|---|")
+                 "| worst 6D / 9D trial |" + (" trials > VQF + 2° (6D / 9D) |" if peer else ""))
+    lines.append("|---|---|---|---|---|---|---|---|" + ("---|" if peer else ""))
     for name in names:
         row = [name]
         worst = []
@@ -230,6 +231,10 @@ def table(results: dict, names: list[str], trials: list[str], groups: dict) -> l
                 row.append(f"{np.mean([results[t][(name, dim)][k] for t in trials]):.3f}")
             worst.append(f"{max(results[t][(name, dim)]['total'] for t in trials):.2f}")
         row.append(" / ".join(worst))
+        if peer:
+            row.append(" / ".join(
+                str(sum(results[t][(name, dim)]["total"] > results[t][(peer, dim)]["total"] + 2.0 for t in trials))
+                for dim in ("6D", "9D")))
         lines.append("| " + " | ".join(row) + " |")
     if groups:
         lines += ["", "Total RMSE by BROAD group (6D / 9D), degrees:", ""]

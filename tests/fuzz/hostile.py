@@ -317,9 +317,11 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 "s.toml": ["simulate", bad.name, "--out", "o.csv"],
                 "imu.csv": rng.choice([["integrate", bad.name, "--out", "o.csv"],
                                        ["orient", bad.name, "--out", "o.csv"],
+                                       ["orient", bad.name, "--smooth", "--out", "o.csv"],
                                        ["allan", bad.name, "--out", "o.csv"],
                                        ["plot", bad.name, "--out", "o.svg"]]),
                 "truth.csv": rng.choice([["compare", bad.name, "truth.csv"], ["plot", bad.name, "--out", "o.svg"],
+                                         ["compare", bad.name, "truth.csv", "--align-heading"],
                                          ["animate", bad.name, "--out", "o.html"]]),
                 "p.json": ["simulate", "ps.toml", "--out", "o.csv"],
                 "allan.csv": ["plot", bad.name, "--out", rng.choice(["o.svg", "o.png"])],
@@ -353,6 +355,10 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 ["convert", x(), rng.choice(["°/h", "°/√h", "mg", "µg/√Hz", "furlong"])],
                 ["orient", "imu.csv", "--param", f"GyroscopeNoise={x()}", "--out", "o.csv"],
                 ["orient", "imu.csv", "--filter", "madgwick", "--param", f"Beta={x()}", "--out", "o.csv"],
+                ["orient", "imu.csv", "--smooth", "--param",
+                 rng.choice(["AccelerometerTimeConstant", "AccelerationThreshold", "AccelerationSustainedTime",
+                             "BiasForgettingTime", "MagneticRejectionFactor", "BiasSigmaMotion"]) + f"={x()}",
+                 "--out", "o.csv"],
             ])
             run_cli(r, work, args, ["imu.csv", "truth.csv"], f"case {k}")
             for leftover in ("o.html", "o.gif"):
@@ -701,7 +707,7 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                     r.passed += 1
                 (work / "o.mcap").unlink(missing_ok=True)
             else:
-                wait = rng.choice(EXTREMES + ["20", "1e6"])
+                wait = rng.choice(EXTREMES + ["20", "3600"])
                 where = rng.choice(["first", "middle", "last", "only"])
                 segs = {"first": f"{{ wait_s = {wait} }}, {{ straight_m = 5 }}",
                         "middle": f"{{ straight_m = 5 }}, {{ wait_s = {wait} }}, {{ straight_m = 5 }}",

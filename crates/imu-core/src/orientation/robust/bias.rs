@@ -125,8 +125,13 @@ impl BiasEstimate {
             return;
         };
         let k = self.p * h.transpose() * s_inv;
-        self.bias += k * e;
-        self.p -= k * h * self.p;
-        self.bias = self.bias.map(|x| x.clamp(-clip, clip));
+        let bias = (self.bias + k * e).map(|x| x.clamp(-clip, clip));
+        let cov = self.p - k * h * self.p;
+        // Settings at the edge of their range (a forgetting time of 1e308 s makes the process
+        // noise underflow) must not turn the estimate into NaN: such an update is left out.
+        if bias.iter().chain(cov.iter()).all(|v| v.is_finite()) {
+            self.bias = bias;
+            self.p = cov;
+        }
     }
 }

@@ -46,20 +46,21 @@ impl MagneticTest {
     }
 
     /// One reading of magnitude `norm` (µT) and dip `dip` (rad, down positive), with the body
-    /// turning at `rate_rad_s`; returns the factor (0 to 1) on the heading correction's gain.
+    /// turning at `rate_rad_s`; `k_ref` is `1 − e^(−Δt/mag_reference_tau_s)`. Returns the
+    /// factor (0 to 1) on the heading correction's gain.
     pub(crate) fn step(
         &mut self,
         p: &RobustParams,
         norm: f64,
         dip: f64,
         rate_rad_s: f64,
+        k_ref: f64,
         dt_s: f64,
     ) -> f64 {
         let [norm, dip] = self.current.step([norm, dip], dt_s);
         let close = |(n, d): (f64, f64)| {
             math::abs(norm - n) < p.mag_rejection * n && math::abs(dip - d) < p.dip_rejection_rad
         };
-        let k_ref = 1.0 - math::exp(-dt_s / p.mag_reference_tau_s);
         match self.reference {
             Some(r) if close(r) => {
                 self.undisturbed_s += dt_s;

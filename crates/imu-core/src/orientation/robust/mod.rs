@@ -257,6 +257,33 @@ pub struct RobustStatus {
     pub mag_disturbed: bool,
 }
 
+/// The first-order gains of an interval: `1 − e^(−Δt/τ)` for the heading and the magnetic
+/// reference, kept while the interval stays (the exponential is the costliest step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Gains {
+    dt_s: f64,
+    heading: f64,
+    mag_reference: f64,
+}
+
+impl Gains {
+    fn new(p: &RobustParams, dt_s: f64) -> Self {
+        Self {
+            dt_s,
+            heading: 1.0 - math::exp(-dt_s / p.tau_mag_s),
+            mag_reference: 1.0 - math::exp(-dt_s / p.mag_reference_tau_s),
+        }
+    }
+
+    /// The gains for `dt_s` (recomputed when it changes by more than 1e-6 of itself).
+    fn at(&mut self, p: &RobustParams, dt_s: f64) -> Self {
+        if math::abs(dt_s - self.dt_s) > 1e-6 * self.dt_s {
+            *self = Self::new(p, dt_s);
+        }
+        *self
+    }
+}
+
 /// A stretch of readings whose magnitude is off gravity.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Excursion {
@@ -283,6 +310,7 @@ struct State {
     gravity_m_s2: f64,
     excursion: Option<Excursion>,
     waited: bool,
+    gains: Gains,
     bias: BiasEstimate,
     magnetic: MagneticTest,
     mag_samples: f64,
@@ -374,6 +402,7 @@ impl RobustFilter {
             gravity_m_s2: p.gravity_m_s2,
             excursion: None,
             waited: false,
+            gains: Gains::new(p, dt),
             bias: BiasEstimate::new(p, dt),
             magnetic: MagneticTest::new(p, dt),
             mag_samples: 1.0,
@@ -400,7 +429,9 @@ impl RobustFilter {
         s.rest_s = if steady { s.rest_s + dt } else { 0.0 };
         status.at_rest = s.rest_s >= p.rest_min_s;
         // Gyroscope integration.
-        s.q_gyro *= UnitQuaternion::from_scaled_axis((w - s.bias.bias()) * dt);
+        s.q_gyro = UnitQuaternion::new_normalize(
+            (s.q_gyro * UnitQuaternion::from_scaled_axis((w - s.bias.bias()) * dt)).into_inner(),
+        );
         // How much this reading is gravity: its magnitude against gravity's (learnt at rest).
         // (Only near the nominal value: a steady push also looks like rest.)
         let at_rest_norm = accel_lp.norm();
@@ -410,9 +441,55 @@ impl RobustFilter {
             let k = dt / (p.rest_tau_s + dt);
             s.gravity_m_s2 += k * (at_rest_norm - s.gravity_m_s2);
         }
-        // A sustained excursion of the magnitude off gravity (a turn, a long push): once it has
-        // lasted `accel_sustained_s`, undo what it did to the inclination and bias, and leave
-        // the accelerometer out until the magnitude is back.
+        let (rejected, waiting) = Self::watch_acceleration(p, s, down, dt);
+        status.accel_rejected = rejected;
+        // Inclination: the gravity reading low-passed in the almost inertial frame (while
+        // rejected, the gravity the estimate already has, which moves nothing).
+        let input = if rejected {
+            (s.q_incl.inverse() * Vector3::z()) * s.gravity_m_s2
+        } else {
+            s.q_gyro * down
+        };
+        let lp = Vector3::from(s.accel_lp.step(input.into(), dt));
+        let in_level = s.q_incl * lp;
+        let rotation = toward_down(&in_level);
+        // Its rotation vector, to second order (what the bias estimate reads as a rate).
+        let correction = Vector3::new(2.0 * rotation.i, 2.0 * rotation.j, 0.0);
+        let catching_up = s.waited;
+        s.waited = waiting;
+        if !waiting {
+            // Renormalised, so that rounding never accumulates over a long run.
+            s.q_incl = UnitQuaternion::new_normalize((rotation * s.q_incl).into_inner());
+        }
+        // Bias: from the rest, or from the corrections while the accelerometer is trusted.
+        let q6 = s.q_incl * s.q_gyro;
+        let evidence = if status.at_rest {
+            BiasEvidence::Rest(gyro_lp)
+        } else if rejected || waiting || catching_up || p.bias_sigma_motion_rad_s == 0.0 {
+            BiasEvidence::None
+        } else {
+            BiasEvidence::Motion(correction)
+        };
+        s.bias
+            .update(p, q6.to_rotation_matrix().matrix(), evidence, dt);
+        // Heading from magnetic north.
+        if p.magnetometer && m.norm() > 0.0 {
+            status.mag_disturbed = Self::correct_heading(p, s, &q6, m, gyro_lp.norm(), dt);
+        }
+        status.gyro_bias_rad_s = s.bias.bias().into();
+        status
+    }
+
+    /// The acceleration test (see the module documentation): a sustained excursion of the
+    /// magnitude off gravity (a turn, a long push), once it has lasted `accel_sustained_s` and
+    /// held steady, has what it did to the inclination and bias undone, and the accelerometer is
+    /// left out until the magnitude is back. Returns (rejected, waiting).
+    fn watch_acceleration(
+        p: &RobustParams,
+        s: &mut State,
+        down: &Vector3<f64>,
+        dt: f64,
+    ) -> (bool, bool) {
         let deviation = down.norm() / s.gravity_m_s2 - 1.0;
         let off = math::abs(deviation) > p.accel_threshold_g;
         match (&mut s.excursion, off) {
@@ -450,73 +527,61 @@ impl RobustFilter {
         let waiting = s
             .excursion
             .is_some_and(|e| !e.sustained && e.duration_s < p.accel_sustained_s);
-        status.accel_rejected = rejected;
-        // Inclination: the gravity reading low-passed in the almost inertial frame (while
-        // rejected, the gravity the estimate already has, which moves nothing).
-        let input = if rejected {
-            (s.q_incl.inverse() * Vector3::z()) * s.gravity_m_s2
-        } else {
-            s.q_gyro * down
-        };
-        let lp = Vector3::from(s.accel_lp.step(input.into(), dt));
-        let in_level = s.q_incl * lp;
-        let correction = if in_level.norm() > 0.0 {
-            let d = in_level.normalize();
-            let axis = d.cross(&Vector3::z());
-            let sin = axis.norm();
-            if sin > 0.0 {
-                axis * (math::atan2(sin, d.z) / sin)
-            } else if d.z < 0.0 {
-                Vector3::x() * core::f64::consts::PI
-            } else {
-                Vector3::zeros()
-            }
-        } else {
-            Vector3::zeros()
-        };
-        let catching_up = s.waited;
-        s.waited = waiting;
-        if !waiting {
-            s.q_incl = UnitQuaternion::from_scaled_axis(correction) * s.q_incl;
-        }
-        // Bias: from the rest, or from the corrections while the accelerometer is trusted.
-        let q6 = s.q_incl * s.q_gyro;
-        let evidence = if status.at_rest {
-            BiasEvidence::Rest(gyro_lp)
-        } else if rejected || waiting || catching_up || p.bias_sigma_motion_rad_s == 0.0 {
-            BiasEvidence::None
-        } else {
-            BiasEvidence::Motion(correction)
-        };
-        s.bias
-            .update(p, q6.to_rotation_matrix().matrix(), evidence, dt);
-        // Heading from magnetic north.
-        if p.magnetometer && m.norm() > 0.0 {
-            let level = q6 * m;
-            let horizontal = math::hypot(level.x, level.y);
-            let factor = s.magnetic.step(
-                p,
-                level.norm(),
-                math::atan2(level.z, horizontal),
-                gyro_lp.norm(),
-                dt,
-            );
-            status.mag_disturbed = s.magnetic.disturbed();
-            if horizontal > 0.0 {
-                let target = -math::atan2(level.y, level.x);
-                let error = wrap(target - s.heading_rad);
-                let mut k = (1.0 - math::exp(-dt / p.tau_mag_s)) * factor;
-                // The mean of the readings so far while that is faster than the time constant.
-                if s.elapsed_s < p.tau_mag_s {
-                    s.mag_samples += 1.0;
-                    k = k.max(1.0 / s.mag_samples);
-                }
-                s.heading_rad = wrap(s.heading_rad + k * error);
-            }
-        }
-        status.gyro_bias_rad_s = s.bias.bias().into();
-        status
+        (rejected, waiting)
     }
+
+    /// Turns the heading towards magnetic north seen in the level frame `q6`; returns whether
+    /// the field is disturbed.
+    fn correct_heading(
+        p: &RobustParams,
+        s: &mut State,
+        q6: &UnitQuaternion<f64>,
+        m: &Vector3<f64>,
+        rate_rad_s: f64,
+        dt: f64,
+    ) -> bool {
+        let level = q6 * m;
+        let horizontal = math::hypot(level.x, level.y);
+        let gains = s.gains.at(p, dt);
+        let factor = s.magnetic.step(
+            p,
+            level.norm(),
+            math::atan2(level.z, horizontal),
+            rate_rad_s,
+            gains.mag_reference,
+            dt,
+        );
+        if horizontal > 0.0 {
+            let target = -math::atan2(level.y, level.x);
+            let error = wrap(target - s.heading_rad);
+            let mut k = gains.heading * factor;
+            // The mean of the readings so far while that is faster than the time constant.
+            if s.elapsed_s < p.tau_mag_s {
+                s.mag_samples += 1.0;
+                k = k.max(1.0 / s.mag_samples);
+            }
+            s.heading_rad = wrap(s.heading_rad + k * error);
+        }
+        s.magnetic.disturbed()
+    }
+}
+
+/// The rotation taking the direction of `v` to down (NED +z), from the direction alone (no
+/// trigonometry): `w = cos(θ/2) = √((1 + d_z)/2)`, vector `(d_y, −d_x, 0)/(2w)`; half a turn
+/// about x for `v` pointing up, none for a zero `v`.
+fn toward_down(v: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let norm = v.norm();
+    if norm <= 0.0 {
+        return UnitQuaternion::identity();
+    }
+    let d = v / norm;
+    let w = math::sqrt(0.5 * (1.0 + d.z));
+    let q = if w > 1e-6 {
+        nalgebra::Quaternion::new(w, 0.5 * d.y / w, -0.5 * d.x / w, 0.0)
+    } else {
+        nalgebra::Quaternion::new(0.0, 1.0, 0.0, 0.0)
+    };
+    UnitQuaternion::new_unchecked(q)
 }
 
 /// The NED yaw of a NED-internal `q_nb`.

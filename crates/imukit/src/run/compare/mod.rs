@@ -8,6 +8,7 @@
 //! inclination parts, and the z-y-x Euler angle differences, wrapped to (−π, π]; scored as
 //! orientation benchmarks do, [`heading_inclination`]). Both stream: rows are read in time order, and
 //! memory does not grow with the files.
+mod earth;
 mod orientation;
 
 pub use orientation::heading_inclination;
@@ -23,9 +24,8 @@ use crate::io::output::AtomicFile;
 use crate::io::rows::TimeWindow;
 use crate::io::table::{CsvRows, Table};
 use crate::run::fuse::SIGMA_COLUMNS;
-use crate::run::navigate::{GEODETIC_COLUMNS, STATE_COLUMNS};
-use crate::run::reference::{Layout, Position, ecef, ned_of_difference};
-use crate::scenario::NavFrameName;
+use crate::run::navigate::STATE_COLUMNS;
+use crate::run::reference::{Layout, ned_of_difference};
 
 /// Error columns of a navigation estimate.
 pub const ERROR_COLUMNS: [&str; 9] = [
@@ -469,7 +469,7 @@ pub fn compare_csv_with(
         Ok(EstimateKind::Navigation)
     ) && let Some(layout) = Layout::on_earth(&truth_header)
     {
-        return compare_on_earth(truth, estimate, layout, (window, t0), out);
+        return earth::compare_on_earth(truth, estimate, layout, (window, t0), out);
     }
     check_comparable(&crate::io::description::Described::read(&[
         truth, estimate,
@@ -554,109 +554,6 @@ pub fn compare_csv_with(
             Some(f) => f.write_row(e),
             None => Ok(()),
         },
-    )?;
-    file.map_or(Ok(()), AtomicFile::commit)?;
-    Ok(summary)
-}
-
-/// [`compare_csv`] of an estimate on the WGS-84 Earth against a reference whose position is
-/// on the Earth (`layout`): ECEF points, errors north, east, down at the reference point;
-/// velocities and attitudes where both have them, each table's in its own frame (its
-/// description's, else ENU).
-fn compare_on_earth(
-    truth: &Path,
-    estimate: &Path,
-    layout: Layout,
-    (window, t0): (TimeWindow, f64),
-    out: Option<&Path>,
-) -> Result<ErrorSummary> {
-    let frame_of = |p: &Path| -> Result<NavFrameName> {
-        Ok(crate::io::description::Description::read(p)?
-            .and_then(|d| d.nav_frame)
-            .unwrap_or_default())
-    };
-    let (truth_frame, estimate_frame) = (frame_of(truth)?, frame_of(estimate)?);
-    let header = crate::io::table::read_header(estimate)?;
-    let own = Layout::of(&header, &[Position::GeodeticRad]).ok_or_else(|| {
-        invalid(
-            estimate.display().to_string(),
-            format!(
-                "the reference {} gives positions on the Earth: the estimate needs {} (an \
-                 estimate on the WGS-84 Earth, as integrate and fuse write it)",
-                truth.display(),
-                GEODETIC_COLUMNS.join(", ")
-            ),
-        )
-    })?;
-    let parts = Parts {
-        earth: true,
-        velocity: layout.velocity.is_some() && own.velocity.is_some(),
-        attitude: layout.attitude && own.attitude,
-    };
-    let (truth_columns, estimate_columns) = (layout.columns(), own.columns());
-    let mut truth_rows = CsvRows::open(truth, &truth_columns, "")?.within(window, t0)?;
-    let mut estimate_rows = CsvRows::open(estimate, &estimate_columns, "")?.within(window, t0)?;
-    let (mut truth_buffer, mut estimate_buffer) = (
-        vec![0.0; truth_columns.len()],
-        vec![0.0; estimate_columns.len()],
-    );
-    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
-    // A row of the Earth's terms as a state row: ECEF, NED velocity, FRD-to-NED attitude.
-    let next = |rows: &mut CsvRows,
-                buffer: &mut [f64],
-                layout: &Layout,
-                frame: NavFrameName,
-                name: &str,
-                state: &mut StateRow|
-     -> Result<bool> {
-        let Some(line) = rows.next_row(buffer)? else {
-            return Ok(false);
-        };
-        let r = layout.earth_row(buffer, frame).ok_or_else(|| {
-            invalid(
-                format!("{name}, row {line}"),
-                "not a point on the Earth (a latitude beyond ±90°), or a quaternion of zero norm",
-            )
-        })?;
-        *state = [0.0; 11];
-        state[0] = r.t_s;
-        state[1..4].copy_from_slice(&ecef(&r.position));
-        if let Some(v) = r.velocity_ned {
-            state[4..7].copy_from_slice(&v);
-        }
-        if let Some(q) = r.attitude {
-            state[7..].copy_from_slice(&q);
-        }
-        Ok(true)
-    };
-    let mut file = out.map(AtomicFile::create).transpose()?;
-    if let Some(f) = file.as_mut() {
-        f.write_header(&parts.columns())?;
-    }
-    let summary = compare_rows(
-        parts,
-        [&truth_name, &estimate_name],
-        |row| {
-            next(
-                &mut truth_rows,
-                &mut truth_buffer,
-                &layout,
-                truth_frame,
-                &truth_name,
-                row,
-            )
-        },
-        |row| {
-            next(
-                &mut estimate_rows,
-                &mut estimate_buffer,
-                &own,
-                estimate_frame,
-                &estimate_name,
-                row,
-            )
-        },
-        |e| file.as_mut().map_or(Ok(()), |f| f.write_row(e)),
     )?;
     file.map_or(Ok(()), AtomicFile::commit)?;
     Ok(summary)

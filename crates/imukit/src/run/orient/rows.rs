@@ -70,7 +70,16 @@ pub fn run_rows<N: NavFrame>(
         ));
     }
     let mut working = *filter;
-    let mut out = Estimates::default();
+    let estimates = n / decimation;
+    let mut out = Estimates {
+        quaternions: Vec::with_capacity(estimates),
+        angular_velocity_rad_s: Vec::with_capacity(estimates),
+        status: Vec::with_capacity(if working.status().is_some() {
+            estimates
+        } else {
+            0
+        }),
+    };
     let three = |s: Option<&[f64]>, i: usize| {
         s.map_or([0.0; 3], |s| [s[3 * i], s[3 * i + 1], s[3 * i + 2]])
     };
