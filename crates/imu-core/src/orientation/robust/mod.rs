@@ -473,7 +473,7 @@ impl RobustFilter {
         s.bias
             .update(p, q6.to_rotation_matrix().matrix(), evidence, dt);
         // Heading from magnetic north.
-        if p.magnetometer && m.norm() > 0.0 {
+        if p.magnetometer && (m.x != 0.0 || m.y != 0.0 || m.z != 0.0) {
             status.mag_disturbed = Self::correct_heading(p, s, &q6, m, gyro_lp.norm(), dt);
         }
         status.gyro_bias_rad_s = s.bias.bias().into();
@@ -541,7 +541,8 @@ impl RobustFilter {
         dt: f64,
     ) -> bool {
         let level = q6 * m;
-        let horizontal = math::hypot(level.x, level.y);
+        // µT readings: no overflow to guard against with `hypot` (a non-finite one is refused).
+        let horizontal = math::sqrt(level.x * level.x + level.y * level.y);
         let gains = s.gains.at(p, dt);
         let factor = s.magnetic.step(
             p,
@@ -592,7 +593,8 @@ fn yaw_of(q: &UnitQuaternion<f64>) -> f64 {
 
 /// A rotation by `angle` about the NED vertical (down).
 fn rotate_z(angle: f64) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_scaled_axis(Vector3::z() * angle)
+    let (s, c) = math::sin_cos(0.5 * angle);
+    UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(c, 0.0, 0.0, s))
 }
 
 /// An angle in (−π, π].
