@@ -1,7 +1,7 @@
 //! An orientation filter over an IMU file, streamed into an orientation table (`imukit orient`).
 use std::path::Path;
 
-use imu_core::orientation::{Estimate, FilterInput, OrientationFilter, RobustStatus};
+use imu_core::orientation::{FilterInput, OrientationFilter};
 use imu_core::{Body, Enu, NavFrame, Ned, Rotation};
 
 use super::{
@@ -237,15 +237,7 @@ fn write_smoothed<N: NavFrame>(
         return Err(invalid("smooth", "only the robust filter smooths a run"));
     };
     let inputs: Vec<FilterInput> = run.iter().map(|(_, s)| *s).collect();
-    let blank = (
-        Estimate {
-            orientation: Rotation::<Body, N>::identity(),
-            angular_velocity_rad_s: [0.0; 3],
-        },
-        RobustStatus::default(),
-    );
-    let mut smoothed = vec![blank; inputs.len()];
-    imu_core::orientation::robust::smooth(*robust.params(), &inputs, &mut smoothed)
+    let smoothed = super::rows::smooth_inputs::<N>(*robust.params(), &inputs)
         .map_err(|(i, e)| invalid("IMU data", format!("sample {}: {e}", i + 1)))?;
     let mut last_yaw = None;
     for ((t, _), (estimate, status)) in run.iter().zip(&smoothed) {

@@ -1,7 +1,7 @@
 //! Orientation filters over readings in memory (the Python filter classes): a batch at a time
 //! with state carried between calls, or a whole run smoothed.
 use imu_core::orientation::{
-    Estimate, FilterInput, OrientationFilter, RobustParams, RobustStatus, robust,
+    Estimate, FilterInput, OrientError, OrientationFilter, RobustParams, RobustStatus, robust,
 };
 use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
@@ -43,22 +43,8 @@ pub fn run_rows<N: NavFrame>(
     mag: Option<&[f64]>,
     t_s: Option<&[f64]>,
 ) -> Result<Estimates> {
-    let n = accel.len() / 3;
-    if let Some(t) = t_s.filter(|t| t.len() != n) {
-        return Err(invalid(
-            "t_s",
-            format!("has {} times, the accelerometer {n} rows", t.len()),
-        ));
-    }
+    let n = rows_of(accel, gyro, mag, t_s)?;
     let intervals = t_s.map(|t| clock.intervals(t)).transpose()?;
-    for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
-        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
-            return Err(invalid(
-                name,
-                format!("has {} rows, the accelerometer {n}", s.len() / 3),
-            ));
-        }
-    }
     let decimation = filter.decimation();
     if !n.is_multiple_of(decimation) {
         return Err(invalid(
@@ -196,21 +182,7 @@ pub fn smooth_rows<N: NavFrame>(
     mag: Option<&[f64]>,
     t_s: Option<&[f64]>,
 ) -> Result<Estimates> {
-    let n = accel.len() / 3;
-    if let Some(t) = t_s.filter(|t| t.len() != n) {
-        return Err(invalid(
-            "t_s",
-            format!("has {} times, the accelerometer {n} rows", t.len()),
-        ));
-    }
-    for (name, s) in [("gyroscope", Some(gyro)), ("magnetometer", mag)] {
-        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
-            return Err(invalid(
-                name,
-                format!("has {} rows, the accelerometer {n}", s.len() / 3),
-            ));
-        }
-    }
+    let n = rows_of(accel, Some(gyro), mag, t_s)?;
     let intervals = t_s
         .map(|t| SampleClock::default().intervals(t))
         .transpose()?;
@@ -223,15 +195,7 @@ pub fn smooth_rows<N: NavFrame>(
             interval_s: intervals.as_ref().and_then(|d| d[i]),
         })
         .collect();
-    let blank = (
-        Estimate {
-            orientation: Rotation::<Body, N>::identity(),
-            angular_velocity_rad_s: [0.0; 3],
-        },
-        RobustStatus::default(),
-    );
-    let mut smoothed = vec![blank; n];
-    robust::smooth(params, &inputs, &mut smoothed)
+    let smoothed = smooth_inputs::<N>(params, &inputs)
         .map_err(|(i, e)| invalid("readings", format!("row {i}: {e}")))?;
     let mut out = Estimates::default();
     for (i, (e, status)) in smoothed.iter().enumerate() {
@@ -247,4 +211,51 @@ pub fn smooth_rows<N: NavFrame>(
         out.status.push(robust_row(status));
     }
     Ok(out)
+}
+
+/// The rows of readings given as flat slices (three values per row), checked to agree in
+/// length with the times.
+fn rows_of(
+    accel: &[f64],
+    gyro: Option<&[f64]>,
+    mag: Option<&[f64]>,
+    t_s: Option<&[f64]>,
+) -> Result<usize> {
+    let n = accel.len() / 3;
+    if let Some(t) = t_s.filter(|t| t.len() != n) {
+        return Err(invalid(
+            "t_s",
+            format!("has {} times, the accelerometer {n} rows", t.len()),
+        ));
+    }
+    for (name, s) in [("gyroscope", gyro), ("magnetometer", mag)] {
+        if let Some(s) = s.filter(|s| s.len() != accel.len()) {
+            return Err(invalid(
+                name,
+                format!("has {} rows, the accelerometer {n}", s.len() / 3),
+            ));
+        }
+    }
+    Ok(n)
+}
+
+/// One smoothed sample: the estimate and the filter's status.
+pub(super) type Smoothed<N> = (Estimate<N>, RobustStatus);
+
+/// The robust filter with `params` smoothed over `inputs`: an estimate and status per input;
+/// the index of a refused sample otherwise.
+pub(super) fn smooth_inputs<N: NavFrame>(
+    params: RobustParams,
+    inputs: &[FilterInput],
+) -> std::result::Result<Vec<Smoothed<N>>, (usize, OrientError)> {
+    let blank = (
+        Estimate {
+            orientation: Rotation::<Body, N>::identity(),
+            angular_velocity_rad_s: [0.0; 3],
+        },
+        RobustStatus::default(),
+    );
+    let mut smoothed = vec![blank; inputs.len()];
+    robust::smooth(params, inputs, &mut smoothed)?;
+    Ok(smoothed)
 }
