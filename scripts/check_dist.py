@@ -65,7 +65,7 @@ def check_sdist(sdist: Path, version: str) -> None:
     with tarfile.open(sdist) as t:
         names = set(t.getnames())
     needed = ["Cargo.toml", "Cargo.lock", "pyproject.toml", "LICENSE-MIT", "LICENSE-APACHE", "NOTICE.md",
-              "crates/imu-core/src/lib.rs", "crates/imukit/src/lib.rs", "crates/imu-plot/src/lib.rs",
+              "crates/imu-core/src/lib.rs", "crates/imu-io/src/lib.rs", "crates/imukit/src/lib.rs", "crates/imu-plot/src/lib.rs",
               "crates/imu-cli/src/lib.rs", "crates/imu-py/src/lib.rs", "python/_imukit_cli/__init__.py",
               "python/imukit/__init__.py"]
     for member in needed:
@@ -73,8 +73,8 @@ def check_sdist(sdist: Path, version: str) -> None:
             fail(f"{sdist.name}: {member} missing")
     if f"{top}/crates/imukit/examples/study/tunnel.toml" not in names:
         fail(f"{sdist.name}: the examples (crates/imukit/examples, built into the library) are missing")
-    if not any(n.startswith(f"{top}/crates/imukit/presets/") for n in names):
-        fail(f"{sdist.name}: the presets (crates/imukit/presets) are missing")
+    if not any(n.startswith(f"{top}/crates/imu-io/presets/") for n in names):
+        fail(f"{sdist.name}: the presets (crates/imu-io/presets) are missing")
 
 
 def main() -> None:

@@ -20,9 +20,10 @@ python -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" "zig
 
 section "Format and lints"
 cargo fmt --all -- --check
+python3 scripts/check_layers.py   # no room of the library imports a room above its own
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
-RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imukit -p imu-plot -p imu-cli   # doc links resolve
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imu-io -p imukit -p imu-plot -p imu-cli   # doc links resolve
 
 section "Heap-free core: builds without std, never names alloc or std, no std-only dependency"
 cargo build --quiet -p imu-core --no-default-features --features libm

@@ -4,10 +4,11 @@ use std::path::PathBuf;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
 use imukit::choice::Choice;
+use imukit::io::conventions::EarthGravityName;
+use imukit::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use imukit::run::fuse::AlignName;
-use imukit::run::navigate::{EarthGravityName, VerticalName};
+use imukit::run::navigate::VerticalName;
 use imukit::run::orient::{Conventions, FilterKind};
-use imukit::scenario::{AccelSignName, EarthName, NavFrameName};
 
 /// A flag that takes one of a library choice's names (any case): the names for help and
 /// completion, the library's value.

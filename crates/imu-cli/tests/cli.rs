@@ -624,7 +624,7 @@ fn a_duplicated_column_or_a_missing_position_is_refused_not_a_panic() {
     assert!(!dir.join("a.csv").exists());
     // A truth table without pos_y_m: the trajectory panel cannot be drawn.
     let truth = dir.join("truth.csv");
-    let columns: Vec<&str> = imukit::io::table::TRUTH_COLUMNS
+    let columns: Vec<&str> = imukit::io::columns::TRUTH_COLUMNS
         .iter()
         .copied()
         .filter(|c| *c != "pos_y_m")

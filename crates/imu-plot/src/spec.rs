@@ -417,33 +417,33 @@ mod tests {
         let of =
             |c: &[&str]| TableKind::detect(&c.iter().map(|s| s.to_string()).collect::<Vec<_>>());
         assert_eq!(
-            of(&imukit::io::table::TRUTH_COLUMNS),
+            of(&imukit::io::columns::TRUTH_COLUMNS),
             Some(TableKind::Truth)
         );
         assert_eq!(
-            of(&imukit::run::navigate::NAV_COLUMNS),
+            of(&imukit::io::columns::NAV_COLUMNS),
             Some(TableKind::Navigation)
         );
         assert_eq!(
-            of(&imukit::run::fuse::FUSE_COLUMNS),
+            of(&imukit::io::columns::FUSE_COLUMNS),
             Some(TableKind::Navigation)
         );
         assert_eq!(
-            of(&imukit::run::planar::PLANAR_NAV_COLUMNS),
+            of(&imukit::io::columns::PLANAR_NAV_COLUMNS),
             Some(TableKind::Navigation)
         );
         assert_eq!(
-            of(&imukit::run::compare::ERROR_COLUMNS),
+            of(&imukit::io::columns::ERROR_COLUMNS),
             Some(TableKind::Errors)
         );
         assert_eq!(
-            of(&imukit::run::orient::ORIENT_COLUMNS),
+            of(&imukit::io::columns::ORIENT_COLUMNS),
             Some(TableKind::Orientation)
         );
         assert_eq!(k("t_s,dv_x_m_s,dtheta_x_rad"), Some(TableKind::Imu));
         assert_eq!(k("tau_s,adev_gyro_x_rad_s"), Some(TableKind::Allan));
         // GNSS fixes are a kind of table, not one imukit draws.
-        assert_eq!(of(&imukit::scenario::gnss::GNSS_COLUMNS), None);
+        assert_eq!(of(&imukit::io::columns::GNSS_COLUMNS), None);
         assert_eq!(k("a,b"), None);
         let e = TableKind::of(&cols("a,b"), "f.csv")
             .unwrap_err()

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 
 use crate::convert::{check_len, choice, fixed, rows, rows_out};
 use crate::errors::{refused, refused_figure, shape_error};
-use imukit::scenario::NavFrameName;
+use imukit::io::conventions::NavFrameName;
 
 /// The kind key of a table with these columns (`truth`, `imu`, `navigation`, `allan`,
 /// `errors`), or `None`.

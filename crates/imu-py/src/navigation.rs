@@ -345,7 +345,11 @@ fn fuse<'py>(
                     let scenario = spec.resolve(Path::new(&base))?;
                     // Tables or arguments in another frame, on another Earth or with the other
                     // sign than the scenario's are not the scenario's data.
-                    described.check_fixed(&scenario.description(None), &asked, "the scenario")?;
+                    described.check_fixed(
+                        &scenario.description(None),
+                        &asked.as_description(),
+                        "the scenario",
+                    )?;
                     request.setup(&scenario)?
                 }
                 Model::Part(part) => {

@@ -1,9 +1,9 @@
 //! Orientation estimation for Python: the e-compass, every filter behind one class, and the
 //! quaternion distance (the Python classes `imukit.ImuFilter`, `AhrsFilter`, … wrap these).
 use imu_core::{Enu, Ned};
+use imukit::io::conventions::NavFrameName;
 use imukit::io::rows::SampleClock;
 use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows, smooth_rows};
-use imukit::scenario::NavFrameName;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

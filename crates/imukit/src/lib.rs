@@ -1,9 +1,10 @@
 //! # imukit — the library behind the `imukit` command and the Python package
 //!
 //! The std layer a Rust program embeds: scenario files, exact and sampled motions, sensor setups,
-//! CSV tables, and the jobs (simulate, navigate, orient, compare, Allan) the command line and
-//! Python run. The numerics are in [`core`] (`imu-core`: `no_std`, no heap); this crate parses,
-//! resolves, checks every input once, converts units and reads and writes files.
+//! and the jobs (simulate, navigate, fuse, orient, compare, identify, Allan) the command line and
+//! Python run. The numerics are in [`core`] (`imu-core`: `no_std`, no heap), files and formats in
+//! [`io`] (`imu-io`, which knows no job); this crate parses, resolves, checks every input once and
+//! runs the jobs.
 //!
 //! Conventions (the whole contract is in `docs/design.md` §2): SI units with the unit in every
 //! boundary name; navigation frame ENU (default) or NED, flat Earth; body frame FLU under ENU,
@@ -17,12 +18,13 @@
 //! |---|---|
 //! | [`scenario`] | the scenario file as written ([`ScenarioSpec`]), its resolution into a runnable [`Scenario`], built-ins, sensor setups, Monte Carlo perturbations |
 //! | [`motion`] | motions: formula strings with exact derivatives, Rust functions over dual numbers, tracks, waypoints, samples, body rates |
-//! | [`io`] | [`Table`] and CSV files (readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
+//! | [`io`] | the `imu-io` crate: [`Table`], every column set, the formats (CSV, Parquet, NumPy, bags, NMEA; readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
 //! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
-//! | [`sensor`] | the core's sensor types with bias-instability filters on the heap (any length, as MATLAB) |
 //! | [`examples`] | the shipped examples (scenario files, data, Python scripts), written where the docs' commands read them |
-//! | [`choice`] | options chosen by name ([`choice::Choice`]): the names, the default, the refusal |
-//! | [`error`] | [`Error`]: what went wrong and where |
+//!
+//! From `imu-io`, also at this crate's root: [`choice`] (options chosen by name), [`error`]
+//! ([`Error`]: what went wrong and where) and [`sensor`] (the core's sensor types with
+//! bias-instability filters on the heap).
 //!
 //! ## Simulate a scenario
 //!
@@ -91,14 +93,13 @@
 //! # Ok::<(), imukit::Error>(())
 //! ```
 #![forbid(unsafe_code)]
-pub mod choice;
-pub mod error;
 pub mod examples;
-pub mod io;
 pub mod motion;
 pub mod run;
 pub mod scenario;
-pub mod sensor;
+
+pub use imu_io as io;
+pub use imu_io::{choice, error, sensor};
 
 pub use error::{Error, Result};
 pub use imu_core as core;

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use imu_core::earth::wgs84::OMEGA_IE_RAD_S;
 use imu_core::earth::{Geodetic, normal_gravity_m_s2};
-use imukit::scenario::earth::EARTH_TRUTH_COLUMNS;
+use imukit::io::columns::EARTH_TRUTH_COLUMNS;
 use imukit::{Error, ScenarioSpec, Simulation};
 
 fn run(text: &str) -> Result<Simulation, Error> {

@@ -12,9 +12,9 @@ use imu_core::fusion::{
 use imu_core::sensor::{NoiseSource, SeededNormals};
 use imu_core::strapdown::NavState;
 use imu_core::{Body, Enu, Rotation, Vec3};
+use imukit::io::conventions::NavFrameName;
 use imukit::run::fuse::{FuseSetup, fuse};
 use imukit::run::navigate::InitialState;
-use imukit::scenario::NavFrameName;
 use imukit::{ScenarioSpec, Simulation, Table};
 
 /// A car-like manoeuvre: a 60 m circle at 8–12 m/s with a gentle hill, nose along the path.

@@ -3,9 +3,9 @@ use std::path::Path;
 
 use imu_core::AccelSign;
 use imukit::ScenarioSpec;
+use imukit::io::conventions::NavFrameName;
 use imukit::run::compare::compare;
 use imukit::run::navigate::{InitialState, NavSetup, integrate};
-use imukit::scenario::NavFrameName;
 
 fn scenario(extra_imu: &str, frame: &str) -> imukit::Simulation {
     let text = format!(
@@ -301,7 +301,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
 /// A state table on `times` with position `[t, 2t, 0] + offset`, velocity `[1, 2, 0]` and a yaw
 /// of `0.1 t` (the quaternion interpolates exactly by slerp).
 fn linear_states(times: &[f64], offset: [f64; 3]) -> imukit::Table {
-    let mut t = imukit::Table::new(imukit::run::navigate::STATE_COLUMNS);
+    let mut t = imukit::Table::new(imukit::io::columns::STATE_COLUMNS);
     for &s in times {
         let h = 0.05 * s;
         t.push_row(&[

@@ -4,14 +4,15 @@ use std::path::Path;
 
 use imu_core::strapdown::planar::PlanarScheme;
 use imukit::choice::Choice;
+use imukit::io::conventions::EarthGravityName;
+use imukit::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use imukit::io::table::ImuKind;
 use imukit::run::navigate::{
-    DEFAULT_RK4_SUBSTEPS, EarthGravityName, NavRequest, NavScheme, SchemeName, VerticalName,
+    DEFAULT_RK4_SUBSTEPS, NavRequest, NavScheme, SchemeName, VerticalName,
 };
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest};
 use imukit::scenario::sensors::TemperatureSpec;
 use imukit::scenario::spec::{Formula, TrajectorySpec};
-use imukit::scenario::{AccelSignName, EarthName, NavFrameName};
 use imukit::{Error, ScenarioSpec};
 
 #[test]

@@ -1,7 +1,9 @@
 //! Scenario files end to end: parsing, built-ins, samples files, and the errors users meet.
 use std::path::Path;
 
-use imukit::io::table::{TRUTH_COLUMNS, read_columns};
+use imukit::io::columns::TRUTH_COLUMNS;
+
+use imukit::io::table::read_columns;
 use imukit::scenario::builtin;
 use imukit::{Error, Scenario, ScenarioSpec, Table};
 

@@ -1,8 +1,10 @@
 //! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
 use std::path::Path;
 
+use imukit::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS};
+
 use imukit::io::output::check_outputs;
-use imukit::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, read_columns, read_header};
+use imukit::io::table::{read_columns, read_header};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;

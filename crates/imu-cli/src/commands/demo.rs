@@ -8,8 +8,8 @@ use imukit::scenario::builtin;
 use super::CliError;
 use imu_plot::animate::{AnimateOptions, animate};
 use imu_plot::{FigureSize, plot_tables};
+use imukit::io::conventions::NavFrameName;
 use imukit::io::output::write_atomically;
-use imukit::scenario::NavFrameName;
 use std::io::Write as _;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {

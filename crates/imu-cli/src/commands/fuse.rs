@@ -3,13 +3,13 @@
 use std::path::Path;
 
 use imukit::io::bag::Role;
+use imukit::io::conventions::{EarthName, NavFrameName};
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::{Gaps, TimeWindow};
 use imukit::io::table::{read_table, read_table_as};
 use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
 use imukit::run::navigate::{NavAsked, NavRequest};
-use imukit::scenario::{EarthName, NavFrameName};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
@@ -134,7 +134,11 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
             let described = Described::read(&inputs_of(a))?;
             let source = format!("the scenario {}", path.display());
             described
-                .check_fixed(&scenario.description(None), &a.asked, &source)
+                .check_fixed(
+                    &scenario.description(None),
+                    &a.asked.as_description(),
+                    &source,
+                )
                 .map_err(by_flag)?;
             request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.

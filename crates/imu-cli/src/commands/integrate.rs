@@ -102,7 +102,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
 /// file or from the option `attitude` names (`Ok`: given, `Err`: the option to ask for).
 pub(crate) fn start_from(
     path: &Path,
-    frame: imukit::scenario::NavFrameName,
+    frame: imukit::io::conventions::NavFrameName,
     on_earth: bool,
     attitude: Result<&str, &str>,
     at_s: Option<f64>,

@@ -1,11 +1,11 @@
 //! `imukit orient IMU.csv --filter NAME [--param KEY=VALUE …] --out ORIENT.csv`.
 use std::path::Path;
 
+use imukit::io::conventions::{AccelSignName, NavFrameName};
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
 use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
-use imukit::scenario::{AccelSignName, NavFrameName};
 
 use crate::CliError;
 

@@ -8,7 +8,7 @@ use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
 use imukit::io::table::read_table;
 
-use imukit::scenario::NavFrameName;
+use imukit::io::conventions::NavFrameName;
 
 use super::CliError;
 use crate::cli::FigureArgs;

@@ -12,10 +12,10 @@ use num_dual::DualNum;
 use std::cell::RefCell;
 use std::sync::OnceLock;
 
+use crate::io::conventions::NavFrameName;
 use crate::motion::analytic::{Motion, MotionPoint, Scalar, atan2, dual_derivatives};
 use crate::motion::compiled::{Order, Program, Row, Scratch};
 use crate::motion::expr::Expr;
-use crate::scenario::NavFrameName;
 
 /// Attitude of an expression motion.
 #[derive(Clone, Debug)]

@@ -1,5 +1,7 @@
 //! The array-level API behind the Python functions: plain slices in, [`Table`]s out, with errors
 //! that name the argument and index.
+use crate::io::columns::TRUTH_COLUMNS;
+use crate::io::conventions::{AccelSignName, NavFrameName};
 use crate::motion::analytic::AnalyticOptions;
 use imu_core::ideal::at_lever_arm;
 use imu_core::kinematics::sampled::SampledOptions;
@@ -8,11 +10,11 @@ use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::ImuKind;
-use crate::io::table::{TRUTH_COLUMNS, Table};
+use crate::io::table::Table;
 use crate::motion::{SampledAttitudeData, SampledPath, Trajectory};
 use crate::run::simulate::motion_chunks;
 use crate::scenario::resolve::finite_vec;
-use crate::scenario::{AccelSignName, ExpressionSpec, ImuSetup, NavFrameName};
+use crate::scenario::{ExpressionSpec, ImuSetup};
 
 fn in_frame<T>(nav: NavFrameName, enu: impl FnOnce() -> T, ned: impl FnOnce() -> T) -> T {
     match nav {
@@ -86,7 +88,7 @@ pub fn truth_from_arrays_into(
     nav: NavFrameName,
     out: &mut [f64],
 ) -> Result<()> {
-    const WIDTH: usize = crate::io::table::TRUTH_COLUMNS.len();
+    const WIDTH: usize = crate::io::columns::TRUTH_COLUMNS.len();
     if out.len() != t_s.len() * WIDTH {
         return Err(invalid(
             "output",

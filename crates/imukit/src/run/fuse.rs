@@ -8,6 +8,7 @@
 //! WGS-84 `lat_rad, lon_rad, height_m`, one row per IMU sample. A fix is applied at the first IMU
 //! sample at or after its stamp (fixes are taken at IMU samples in imukit's simulations, so
 //! exactly there).
+use crate::io::columns::{FIX_ACCURACY_COLUMNS, FUSE_COLUMNS};
 use imu_core::fusion::align::{self, PartFigures};
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::smoother::{ErrorVector, rts_backward};
@@ -18,48 +19,15 @@ use imu_core::fusion::{
 use imu_core::strapdown::NavState;
 use imu_core::{AccelSign, Body, Vec3};
 
+use crate::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS, NAV_COLUMNS};
+
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Error, Result, invalid};
-use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, Table, concat_columns};
+use crate::io::conventions::{EarthName, NavFrameName};
+use crate::io::table::Table;
 use crate::run::fuse_aids::AidStreams;
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
-use crate::run::navigate::{InitialState, NAV_COLUMNS};
-use crate::scenario::{EarthName, NavFrameName};
-
-/// The one-sigma columns of a fused estimate: position, velocity and attitude error, axes of
-/// the navigation frame. `imukit compare` carries them into the errors, which `imukit plot`
-/// draws against ±3σ.
-pub const SIGMA_COLUMNS: [&str; 9] = [
-    "pos_x_sigma_m",
-    "pos_y_sigma_m",
-    "pos_z_sigma_m",
-    "vel_x_sigma_m_s",
-    "vel_y_sigma_m_s",
-    "vel_z_sigma_m_s",
-    "att_x_sigma_rad",
-    "att_y_sigma_rad",
-    "att_z_sigma_rad",
-];
-
-/// Columns of a fused estimate: [`NAV_COLUMNS`], [`SIGMA_COLUMNS`], the bias estimates (body
-/// frame) and their one-sigma.
-pub const FUSE_COLUMNS: [&str; 35] = concat_columns(
-    concat_columns::<14, 9, 23>(NAV_COLUMNS, SIGMA_COLUMNS),
-    [
-        "accel_bias_x_m_s2",
-        "accel_bias_y_m_s2",
-        "accel_bias_z_m_s2",
-        "gyro_bias_x_rad_s",
-        "gyro_bias_y_rad_s",
-        "gyro_bias_z_rad_s",
-        "accel_bias_x_sigma_m_s2",
-        "accel_bias_y_sigma_m_s2",
-        "accel_bias_z_sigma_m_s2",
-        "gyro_bias_x_sigma_rad_s",
-        "gyro_bias_y_sigma_rad_s",
-        "gyro_bias_z_sigma_rad_s",
-    ],
-);
+use crate::run::navigate::InitialState;
 
 /// The columns a fused estimate gains when the filter estimates the IMU's scale-factor,
 /// misalignment and g-sensitivity errors ([`FuseSetup::estimate_sensor_errors`]): for the
@@ -119,7 +87,7 @@ pub struct FuseSetup {
     /// Navigation frame of the tables.
     pub nav_frame: NavFrameName,
     /// `None`: the flat Earth; on the WGS-84 Earth its gravity model (the fixes are then
-    /// geodetic, see [`GNSS_EARTH_COLUMNS`](crate::scenario::gnss::GNSS_EARTH_COLUMNS)).
+    /// geodetic, see [`GNSS_EARTH_COLUMNS`](crate::io::columns::GNSS_EARTH_COLUMNS)).
     pub earth: Option<imu_core::earth::GravityModel>,
     /// Sign of the accelerometer columns.
     pub accel_sign: AccelSign,
@@ -469,7 +437,7 @@ pub fn gnss_alignment_sigma(v: [f64; 3], setup: &FuseSetup) -> InitialSigma {
     }
 }
 
-/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::scenario::gnss::GNSS_COLUMNS)) from `initial`;
+/// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::io::columns::GNSS_COLUMNS)) from `initial`;
 /// a `gnss` table without columns is no fixes (the IMU and the other aids alone).
 ///
 /// # Errors
@@ -671,11 +639,6 @@ enum FixVelocity {
 
 /// The one-sigma given to a vertical velocity the fixes do not know, m/s: no information.
 const UNKNOWN_VELOCITY_SIGMA_M_S: f64 = 1e4;
-
-/// A fix table's own accuracy per fix (what a receiver reports: a `NavSatFix` covariance, an
-/// NMEA HDOP times a UERE), one-sigma per horizontal axis and vertically, m; where a table has
-/// them (either alone, or both) they replace the setup's for that fix.
-pub const FIX_ACCURACY_COLUMNS: [&str; 2] = ["horizontal_accuracy_m", "vertical_accuracy_m"];
 
 impl FusionInputs {
     /// Reads `imu` (rates) and `gnss` (`columns`: `t_s`, three position and three velocity

@@ -8,9 +8,9 @@ use imu_core::strapdown::NavState;
 use imu_core::{Body, Ecef, Enu, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
-use crate::run::navigate::{GEODETIC_COLUMNS, InitialState, NAV_COLUMNS, euler_unwrapped};
-use crate::scenario::NavFrameName;
-use crate::scenario::gnss::{GNSS_COLUMNS, GNSS_EARTH_COLUMNS};
+use crate::io::columns::{GEODETIC_COLUMNS, GNSS_COLUMNS, GNSS_EARTH_COLUMNS, NAV_COLUMNS};
+use crate::io::conventions::NavFrameName;
+use crate::run::navigate::{InitialState, euler_unwrapped};
 
 /// The widest navigation row: [`NAV_COLUMNS`] and a geodetic position.
 pub(crate) const MAX_NAV_WIDTH: usize = NAV_COLUMNS.len() + GEODETIC_COLUMNS.len();

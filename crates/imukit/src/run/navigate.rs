@@ -8,6 +8,8 @@
 //! then in the tangent plane at the origin of the starting truth, velocity and attitude in the
 //! local-level frame at each position). Both Earths run in the data's own frame through
 //! `run::nav_earth`.
+use crate::io::columns::{GEODETIC_COLUMNS, STATE_COLUMNS};
+use crate::io::conventions::EarthGravityName;
 use imu_core::strapdown::rk4::{NODES, RateWindow, window_start};
 use std::collections::VecDeque;
 use std::path::Path;
@@ -19,42 +21,21 @@ use imu_core::strapdown::{
 };
 use imu_core::{AccelSign, Enu, EulerZyx, NavFrame, Rotation};
 
+use crate::io::columns::{
+    ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Position, Velocity,
+};
+
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
+use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use crate::io::description::{Described, Description, Origin};
 use crate::io::output::AtomicFile;
 use crate::io::rows::{Gaps, TimeWindow, TimedRows, check_increasing};
 use crate::io::schema::TableKind;
-use crate::io::table::{ACCEL_COLUMNS, CsvRows, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, Table};
+use crate::io::table::{CsvRows, Table};
 use crate::run::nav_earth::{self, EarthJob, NavEarth, on_earth};
-use crate::run::reference::{Given, Velocity};
+use crate::run::reference::Given;
 use crate::scenario::resolve::{check_gravity, finite_vec};
-use crate::scenario::{AccelSignName, EarthName, NavFrameName};
-
-/// Navigation output columns.
-pub const NAV_COLUMNS: [&str; 14] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "pos_z_m",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "vel_z_m_s",
-    "q_w",
-    "q_x",
-    "q_y",
-    "q_z",
-    "yaw_rad",
-    "pitch_rad",
-    "roll_rad",
-];
-
-/// The geodetic columns of truth and navigation on the WGS-84 Earth.
-pub const GEODETIC_COLUMNS: [&str; 3] = ["lat_rad", "lon_rad", "height_m"];
-
-/// Columns [`compare`](crate::run::compare::compare) reads from truth and estimate: the navigation columns up to the
-/// quaternion.
-pub const STATE_COLUMNS: &[&str] = NAV_COLUMNS.split_at(11).0;
 
 /// The initial state of a 3D integration, frame-free (default: at rest at the origin, level).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -274,7 +255,7 @@ impl InitialState {
         frame: NavFrameName,
         at_s: Option<f64>,
     ) -> Result<(Self, Given)> {
-        use crate::run::reference::{Layout, Position, VelocitySource, ecef, ned_of_difference};
+        use crate::run::reference::{Layout, VelocitySource, ecef, ned_of_difference};
         let header = crate::io::table::read_header(path)?;
         let plane = Layout::of(&header, &[Position::Plane]);
         let Some(layout) = Layout::on_earth(&header).filter(|_| {
@@ -562,23 +543,7 @@ impl Choice for VerticalName {
     ];
 }
 
-/// Gravity on the WGS-84 Earth by name.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum EarthGravityName {
-    /// WGS-84 normal gravity at the position (the default).
-    #[default]
-    Normal,
-    /// A constant magnitude ([`NavRequest::gravity_m_s2`]) along the local vertical.
-    Constant,
-}
-
-impl Choice for EarthGravityName {
-    const WHAT: &'static str = "gravity model";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("normal", Self::Normal), ("constant", Self::Constant)];
-}
-
-display_as_name!(SchemeName, VerticalName, EarthGravityName);
+display_as_name!(SchemeName, VerticalName);
 
 /// A 3D integration as a front end states it; checked once, in [`NavRequest::setup`], whose
 /// errors name the fields as written here (`substeps`, `gravity_m_s2`, `vertical`,
@@ -635,6 +600,20 @@ pub struct NavAsked {
 }
 
 impl NavAsked {
+    /// The options as a description of the data ([`Described::check_fixed`] compares them with
+    /// the inputs' and a scenario's).
+    #[must_use]
+    pub fn as_description(&self) -> Description {
+        Description {
+            nav_frame: self.nav_frame,
+            earth: self.earth,
+            gravity_m_s2: self.gravity_m_s2,
+            earth_gravity: self.earth_gravity,
+            accel_sign: self.accel_sign,
+            ..Description::default()
+        }
+    }
+
     /// The accelerometer sign of the data: as asked, else the inputs' descriptions', else the
     /// conventions' (`None`: nothing says; the caller's default applies).
     ///
@@ -1003,7 +982,7 @@ pub fn integrate_csv(
 }
 
 /// Reads an IMU CSV file whole, refused before reading when it could exceed the memory budget
-/// of [`check_in_memory`](crate::scenario::check_in_memory) with what the navigation keeps per
+/// of [`check_in_memory`](crate::io::memory::check_in_memory) with what the navigation keeps per
 /// sample.
 ///
 /// # Errors
@@ -1018,7 +997,7 @@ pub fn read_whole(input: &Path) -> Result<Table> {
     // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
     // numbers per row come out (the states and the table).
     let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
-    crate::scenario::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
+    crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
     crate::io::table::read_table(input)
 }
 

@@ -3,30 +3,15 @@
 //! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
 //! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
+use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
 
-use crate::choice::Choice;
 use crate::error::{Error, Result, invalid};
 use crate::io::output::write_atomically;
 use crate::io::table::{Table, read_columns, write_rows};
 use crate::scenario::resolve::finite_vec;
-
-/// Planar IMU columns of a CSV file.
-pub const PLANAR_COLUMNS: [&str; 4] = ["t_s", "accel_x_m_s2", "accel_y_m_s2", "gyro_z_rad_s"];
-
-/// Columns of planar navigation output.
-pub const PLANAR_NAV_COLUMNS: [&str; 8] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "yaw_rad",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "body_vel_x_m_s",
-    "body_vel_y_m_s",
-];
 
 fn is_dat(path: &Path, first_line: &str) -> bool {
     path.extension()
@@ -163,12 +148,6 @@ pub fn samples_table(samples: &[PlanarSample]) -> Table {
 /// The exercise's start position X₀, m (the default of `imukit integrate --planar` and Python's
 /// `planar_dead_reckon`).
 pub const EXERCISE_POSITION0_M: [f64; 2] = [100.0, 100.0];
-
-impl Choice for PlanarScheme {
-    const WHAT: &'static str = "scheme";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("trapezoid", Self::Trapezoid), ("exercise", Self::Exercise)];
-}
 
 /// A planar dead reckoning as a front end states it; checked once, in [`PlanarRequest::run`].
 /// Errors name the fields as written here (`position0_m`, `heading0_rad`, `velocity0_m_s`).

@@ -7,88 +7,11 @@
 //! their difference turned into north, east and down at the reference point; velocities in
 //! north, east, down; attitudes as the turn from forward-right-down body axes to the local
 //! north-east-down frame, whatever frame each table was written in.
-use imu_core::earth::{Geodetic, MAX_LATITUDE_RAD};
+use crate::io::columns::{Position, QUATERNION_COLUMNS, Velocity};
+use imu_core::earth::Geodetic;
 use imu_core::{Body, Ecef, Enu, Frd, NavFrame, Ned, Rotation, Vec3};
 
-use crate::run::navigate::GEODETIC_COLUMNS;
-use crate::scenario::NavFrameName;
-
-/// How a reference gives its position.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Position {
-    /// imukit's tangent-plane coordinates `pos_x_m, pos_y_m, pos_z_m`.
-    Plane,
-    /// `lat_rad, lon_rad, height_m` (WGS-84, height above the ellipsoid).
-    GeodeticRad,
-    /// `lat_deg, lon_deg, height_m`.
-    GeodeticDeg,
-    /// `ecef_x_m, ecef_y_m, ecef_z_m`.
-    Ecef,
-}
-
-impl Position {
-    /// Every form, in the order a table is recognised by.
-    pub const ALL: [Self; 4] = [
-        Self::Plane,
-        Self::GeodeticRad,
-        Self::GeodeticDeg,
-        Self::Ecef,
-    ];
-
-    /// Its columns.
-    #[must_use]
-    pub const fn columns(self) -> [&'static str; 3] {
-        match self {
-            Self::Plane => ["pos_x_m", "pos_y_m", "pos_z_m"],
-            Self::GeodeticRad => GEODETIC_COLUMNS,
-            Self::GeodeticDeg => ["lat_deg", "lon_deg", "height_m"],
-            Self::Ecef => ["ecef_x_m", "ecef_y_m", "ecef_z_m"],
-        }
-    }
-
-    /// The point `values` (its columns' values) on the Earth; `None` for plane coordinates and
-    /// for values that name no point (a latitude beyond ±90°, not finite).
-    #[must_use]
-    pub fn geodetic(self, [a, b, c]: [f64; 3]) -> Option<Geodetic> {
-        let g = match self {
-            Self::Plane => return None,
-            Self::GeodeticRad => Geodetic {
-                latitude_rad: a,
-                longitude_rad: b,
-                height_m: c,
-            },
-            Self::GeodeticDeg => Geodetic::from_degrees(a, b, c),
-            Self::Ecef => Geodetic::from_ecef(Vec3::from_array([a, b, c]))?,
-        };
-        (g.latitude_rad.abs() <= MAX_LATITUDE_RAD
-            && g.longitude_rad.is_finite()
-            && g.height_m.is_finite())
-        .then_some(g)
-    }
-}
-
-/// How a reference gives its velocity.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Velocity {
-    /// `vel_x_m_s, vel_y_m_s, vel_z_m_s` in the table's navigation axes.
-    Nav,
-    /// `vel_n_m_s, vel_e_m_s, vel_d_m_s`.
-    Ned,
-}
-
-impl Velocity {
-    /// Its columns.
-    #[must_use]
-    pub const fn columns(self) -> [&'static str; 3] {
-        match self {
-            Self::Nav => ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"],
-            Self::Ned => ["vel_n_m_s", "vel_e_m_s", "vel_d_m_s"],
-        }
-    }
-}
-
-/// The attitude columns.
-pub const QUATERNION_COLUMNS: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
+use crate::io::conventions::NavFrameName;
 
 /// What a reference table holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

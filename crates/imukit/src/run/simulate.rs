@@ -11,6 +11,8 @@
 //! chunk ahead on a second thread ([`crate::run::pipeline`]); the numbers do not change.
 use std::path::Path;
 
+use crate::io::conventions::NavFrameName;
+
 use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, DERIVATIVE_CHUNK, Motion};
 use imu_core::kinematics::sampled::backfill_standstill;
 use imu_core::sensor::ImuReading;
@@ -26,7 +28,7 @@ use crate::io::table::{ImuOutput, Table, check_finite_from};
 use crate::motion::{Trajectory, with_time};
 use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
 use crate::scenario::report::RunReport;
-use crate::scenario::{NavFrameName, SampleTimes, Scenario};
+use crate::scenario::{SampleTimes, Scenario};
 
 /// Samples per streamed chunk, at most.
 pub const STREAM_CHUNK: usize = 4096;
@@ -320,7 +322,7 @@ impl Scenario {
         let imu_columns = self.imu.output.columns(self.imu.kind);
         let bytes_per_sample =
             core::mem::size_of::<f64>() * (truth_columns.len() + imu_columns.len());
-        crate::scenario::check_in_memory(rows, bytes_per_sample, "duration_s")?;
+        crate::io::memory::check_in_memory(rows, bytes_per_sample, "duration_s")?;
         Ok(GatheredShape {
             rows,
             truth_columns,

@@ -12,11 +12,11 @@
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_PI_2;
 
+use crate::io::conventions::NavFrameName;
+
 use crate::error::{Result, invalid};
 use crate::motion::track::Segment;
-use crate::scenario::{
-    ExpressionSpec, Formula, ImuSpec, NavFrameName, ScenarioSpec, TrackSpec, TrajectorySpec,
-};
+use crate::scenario::{ExpressionSpec, Formula, ImuSpec, ScenarioSpec, TrackSpec, TrajectorySpec};
 
 /// Names of the built-in scenarios.
 pub const NAMES: [&str; 7] = [

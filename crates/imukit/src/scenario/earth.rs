@@ -10,18 +10,16 @@
 //! ground velocity in the local-level frame at the position and the derivative of its
 //! components, the attitude is relative to that frame, `omega_*` is the attitude rate
 //! `ω_nb^b`; `lat_rad, lon_rad, height_m` and `ecef_*_m` are added.
+use crate::io::columns::EARTH_TRUTH_COLUMNS;
 use imu_core::earth::ideal::EcefKinematics;
 use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel, MagneticModel};
 use imu_core::ideal::IdealReading;
 use imu_core::{Body, Ecef, EulerZyx, NavFrame, Ned, Rotation, Truth, Vec3};
 
-use crate::error::{Result, invalid};
-use crate::io::table::{TRUTH_COLUMNS, Table, truth_row};
+use crate::io::columns::TRUTH_COLUMNS;
 
-/// The truth columns added on the WGS-84 Earth, after [`crate::io::table::TRUTH_COLUMNS`].
-pub const EARTH_TRUTH_COLUMNS: [&str; 6] = [
-    "lat_rad", "lon_rad", "height_m", "ecef_x_m", "ecef_y_m", "ecef_z_m",
-];
+use crate::error::{Result, invalid};
+use crate::io::table::{Table, truth_row};
 
 /// The Earth a scenario runs on.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -139,16 +137,16 @@ impl TangentPlane {
     pub fn plane_coordinates(
         &self,
         p: &Geodetic,
-        frame: crate::scenario::NavFrameName,
+        frame: crate::io::conventions::NavFrameName,
     ) -> [f64; 3] {
         let d = p.to_ecef() - self.origin.to_ecef();
         match frame {
-            crate::scenario::NavFrameName::ENU => self
+            crate::io::conventions::NavFrameName::ENU => self
                 .plane_to_ecef::<imu_core::Enu>()
                 .inverse()
                 .apply(d)
                 .to_array(),
-            crate::scenario::NavFrameName::NED => self
+            crate::io::conventions::NavFrameName::NED => self
                 .plane_to_ecef::<imu_core::Ned>()
                 .inverse()
                 .apply(d)
@@ -166,11 +164,11 @@ impl TangentPlane {
     pub fn place_samples(
         &self,
         path: &mut crate::motion::SampledPath,
-        frame: crate::scenario::NavFrameName,
+        frame: crate::io::conventions::NavFrameName,
     ) -> Result<()> {
         match frame {
-            crate::scenario::NavFrameName::ENU => self.place_in::<imu_core::Enu>(path),
-            crate::scenario::NavFrameName::NED => self.place_in::<imu_core::Ned>(path),
+            crate::io::conventions::NavFrameName::ENU => self.place_in::<imu_core::Enu>(path),
+            crate::io::conventions::NavFrameName::NED => self.place_in::<imu_core::Ned>(path),
         }
     }
 
@@ -318,7 +316,7 @@ impl TangentPlane {
     }
 }
 
-/// A chunk of truth on the Earth as a table: [`crate::io::table::TRUTH_COLUMNS`] of the local
+/// A chunk of truth on the Earth as a table: [`crate::io::columns::TRUTH_COLUMNS`] of the local
 /// samples, then [`EARTH_TRUTH_COLUMNS`].
 #[must_use]
 pub fn earth_truth_table<N: NavFrame>(local: &[Truth<N>], earth: &[EarthTruth]) -> Table {

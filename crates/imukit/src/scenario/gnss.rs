@@ -5,6 +5,7 @@
 //! Output ([`GNSS_COLUMNS`] on the flat Earth, [`GNSS_EARTH_COLUMNS`] on WGS-84): the stamp
 //! time, the position (navigation-frame metres, or latitude, longitude, height) and the ground
 //! velocity (navigation-frame axes, or north, east, down).
+use crate::io::columns::{GNSS_COLUMNS, GNSS_EARTH_COLUMNS};
 use imu_core::aiding::{GnssModel, GnssParams, GnssState, PositionNoise};
 use imu_core::earth::{EarthTruth, Geodetic};
 use imu_core::sensor::SeededNormals;
@@ -13,28 +14,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
-
-/// GNSS columns on the flat Earth.
-pub const GNSS_COLUMNS: [&str; 7] = [
-    "t_s",
-    "pos_x_m",
-    "pos_y_m",
-    "pos_z_m",
-    "vel_x_m_s",
-    "vel_y_m_s",
-    "vel_z_m_s",
-];
-
-/// GNSS columns on the WGS-84 Earth.
-pub const GNSS_EARTH_COLUMNS: [&str; 7] = [
-    "t_s",
-    "lat_rad",
-    "lon_rad",
-    "height_m",
-    "vel_n_m_s",
-    "vel_e_m_s",
-    "vel_d_m_s",
-];
 
 /// The noise stream of the GNSS receiver (the IMU's is stream 0).
 const GNSS_STREAM: u64 = 1;

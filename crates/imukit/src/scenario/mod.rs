@@ -32,11 +32,12 @@ pub mod times;
 pub use earth::{EarthSetup, TangentPlane};
 pub use imu::{ImuSetup, ReadingStream};
 pub use spec::{
-    AccelSignName, BodyRatesSpec, BuiltinSpec, EarthName, ExpressionSpec, Formula, ImuSpec,
-    NavFrameName, SamplesSpec, ScenarioSpec, TrackSpec, TrajectorySpec, WaypointsSpec,
+    BodyRatesSpec, BuiltinSpec, ExpressionSpec, Formula, ImuSpec, SamplesSpec, ScenarioSpec,
+    TrackSpec, TrajectorySpec, WaypointsSpec,
 };
-pub use times::{SampleTimes, check_in_memory, regular_times, sample_times};
+pub use times::{SampleTimes, regular_times, sample_times};
 
+use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use std::path::Path;
 
 use imu_core::sensor::ImuReading;
@@ -100,16 +101,16 @@ pub(crate) struct Stretch {
 /// Truth and ideal IMU readings of a scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
-    /// Truth, [`crate::io::table::TRUTH_COLUMNS`].
+    /// Truth, [`crate::io::columns::TRUTH_COLUMNS`].
     pub truth: Table,
     /// IMU readings, columns per [`ImuKind::columns`](crate::io::table::ImuKind::columns).
     pub imu: Table,
-    /// GNSS fixes ([`gnss::GNSS_COLUMNS`] or, on the WGS-84 Earth,
-    /// [`gnss::GNSS_EARTH_COLUMNS`]), when the scenario has a receiver.
+    /// GNSS fixes ([`crate::io::columns::GNSS_COLUMNS`] or, on the WGS-84 Earth,
+    /// [`crate::io::columns::GNSS_EARTH_COLUMNS`]), when the scenario has a receiver.
     pub gnss: Option<Table>,
-    /// Barometer readings ([`aids::BARO_COLUMNS`]), when the scenario has one.
+    /// Barometer readings ([`crate::io::columns::BARO_COLUMNS`]), when the scenario has one.
     pub baro: Option<Table>,
-    /// Odometer readings ([`aids::ODOMETER_COLUMNS`]), when the scenario has one.
+    /// Odometer readings ([`crate::io::columns::ODOMETER_COLUMNS`]), when the scenario has one.
     pub odometer: Option<Table>,
 }
 
@@ -176,7 +177,11 @@ impl Scenario {
     }
 
     fn simulate_in<N: NavFrame>(&self, run: Option<u64>) -> Result<Simulation> {
-        check_in_memory(self.t_s.len(), IN_MEMORY_BYTES_PER_SAMPLE, "duration_s")?;
+        crate::io::memory::check_in_memory(
+            self.t_s.len(),
+            IN_MEMORY_BYTES_PER_SAMPLE,
+            "duration_s",
+        )?;
         let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
         let mut sensors =
             self.imu

@@ -1,6 +1,7 @@
 //! From a scenario as written ([`super::spec`]) to a runnable [`Scenario`]: built-ins merged,
 //! defaults filled, formulas parsed, files read, every value checked once.
 
+use crate::io::conventions::{EarthName, NavFrameName};
 use std::path::{Path, PathBuf};
 
 use imu_core::AccelSign;
@@ -18,11 +19,12 @@ use crate::motion::{BodyRatesData, SampledPath, Trajectory};
 use crate::scenario::builtin;
 use crate::scenario::report;
 
+use crate::io::memory::check_in_memory;
 use crate::scenario::earth::MagneticEnvironment;
 use crate::scenario::earth::{EarthSetup, TangentPlane};
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
-use crate::scenario::times::{SampleTimes, check_in_memory, regular_times};
+use crate::scenario::times::{SampleTimes, regular_times};
 use crate::scenario::{ImuSetup, Scenario};
 use imu_core::earth::{Geodetic, GravityModel, MagneticModel};
 

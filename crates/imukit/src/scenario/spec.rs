@@ -1,13 +1,12 @@
 //! The scenario file's vocabulary: what a user writes in TOML, JSON or a Python dict, before
 //! defaults and files are resolved ([`super::resolve`]).
 
+use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use imu_core::AccelSign;
 use serde::{Deserialize, Serialize};
 
-use crate::choice::{Choice, display_as_name};
 use crate::error::{Error, Result, invalid};
 use crate::io::params::Profile;
 use crate::io::params::SensorTable;
@@ -18,51 +17,6 @@ use crate::motion::track::Segment;
 use crate::motion::{ExpressionAttitude, ExpressionMotion};
 use crate::scenario::perturb::PerturbationSpec;
 use crate::scenario::sensors::TemperatureSpec;
-
-/// The navigation frame, by name.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum NavFrameName {
-    /// East-North-Up (default).
-    #[default]
-    #[serde(alias = "enu")]
-    ENU,
-    /// North-East-Down.
-    #[serde(alias = "ned")]
-    NED,
-}
-
-impl Choice for NavFrameName {
-    const WHAT: &'static str = "navigation frame";
-    const NAMES: &'static [(&'static str, Self)] = &[("ENU", Self::ENU), ("NED", Self::NED)];
-}
-
-/// Accelerometer sign convention, by name.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AccelSignName {
-    /// Specific force (default).
-    #[default]
-    SpecificForce,
-    /// MATLAB imuSensor's gravity-minus-acceleration.
-    Matlab,
-}
-
-impl Choice for AccelSignName {
-    const WHAT: &'static str = "accelerometer sign";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("specific-force", Self::SpecificForce),
-        ("matlab", Self::Matlab),
-    ];
-}
-
-impl From<AccelSignName> for AccelSign {
-    fn from(s: AccelSignName) -> Self {
-        match s {
-            AccelSignName::SpecificForce => Self::SpecificForce,
-            AccelSignName::Matlab => Self::Matlab,
-        }
-    }
-}
 
 /// A formula, or a plain number where a formula is expected.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -149,7 +103,7 @@ impl Formula {
         };
         Expr::parse(&text, constants).map_err(|source| Error::Expression {
             field: field.into(),
-            source,
+            source: Box::new(source),
         })
     }
 }
@@ -194,24 +148,6 @@ pub struct ScenarioSpec {
     /// A wheel odometer.
     pub odometer: Option<crate::scenario::aids::OdometerSpec>,
 }
-
-/// The Earth model of a scenario.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum EarthName {
-    /// Flat, non-rotating, constant gravity (the default).
-    #[default]
-    Flat,
-    /// The rotating WGS-84 ellipsoid with normal gravity.
-    Wgs84,
-}
-
-impl Choice for EarthName {
-    const WHAT: &'static str = "Earth model";
-    const NAMES: &'static [(&'static str, Self)] = &[("flat", Self::Flat), ("wgs84", Self::Wgs84)];
-}
-
-display_as_name!(NavFrameName, AccelSignName, EarthName);
 
 /// A magnetic field model by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -4,12 +4,12 @@ use std::path::Path;
 
 use super::{ErrorSummary, Parts, StateRow, compare_rows};
 use crate::error::{Result, invalid};
+use crate::io::columns::{GEODETIC_COLUMNS, Position};
+use crate::io::conventions::NavFrameName;
 use crate::io::output::AtomicFile;
 use crate::io::rows::TimeWindow;
 use crate::io::table::CsvRows;
-use crate::run::navigate::GEODETIC_COLUMNS;
-use crate::run::reference::{Layout, Position, ecef};
-use crate::scenario::NavFrameName;
+use crate::run::reference::{Layout, ecef};
 
 /// [`compare_csv`] of an estimate on the WGS-84 Earth against a reference whose position is
 /// on the Earth (`layout`): ECEF points, errors north, east, down at the reference point;

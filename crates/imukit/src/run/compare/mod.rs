@@ -13,6 +13,9 @@ mod orientation;
 
 pub use orientation::heading_inclination;
 
+use crate::io::columns::{
+    EARTH_ERROR_COLUMNS, ERROR_COLUMNS, ORIENTATION_COLUMNS, ORIENTATION_ERROR_COLUMNS,
+};
 use std::path::Path;
 
 use imu_core::earth::Geodetic;
@@ -20,55 +23,11 @@ use imu_core::orientation::{DistanceStats, quaternion_distance};
 use imu_core::{Body, Ecef, Enu, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
+use crate::io::columns::{SIGMA_COLUMNS, STATE_COLUMNS};
 use crate::io::output::AtomicFile;
 use crate::io::rows::TimeWindow;
 use crate::io::table::{CsvRows, Table};
-use crate::run::fuse::SIGMA_COLUMNS;
-use crate::run::navigate::STATE_COLUMNS;
 use crate::run::reference::{Layout, ned_of_difference};
-
-/// Error columns of a navigation estimate.
-pub const ERROR_COLUMNS: [&str; 9] = [
-    "t_s",
-    "pos_err_x_m",
-    "pos_err_y_m",
-    "pos_err_z_m",
-    "pos_err_m",
-    "vel_err_x_m_s",
-    "vel_err_y_m_s",
-    "vel_err_z_m_s",
-    "att_err_rad",
-];
-
-/// Error columns of a navigation estimate against a reference on the Earth (latitude,
-/// longitude and height, or ECEF): north, east, down at the reference point. A reference
-/// without a velocity or an attitude gives no `vel_err_*` or `att_err_rad`.
-pub const EARTH_ERROR_COLUMNS: [&str; 9] = [
-    "t_s",
-    "pos_err_n_m",
-    "pos_err_e_m",
-    "pos_err_d_m",
-    "pos_err_m",
-    "vel_err_n_m_s",
-    "vel_err_e_m_s",
-    "vel_err_d_m_s",
-    "att_err_rad",
-];
-
-/// Error columns of an orientation estimate: the error rotation's angle and its heading and
-/// inclination parts ([`heading_inclination`]), estimate − truth for the Euler angles.
-pub const ORIENTATION_ERROR_COLUMNS: [&str; 7] = [
-    "t_s",
-    "att_err_rad",
-    "heading_err_rad",
-    "inclination_err_rad",
-    "yaw_err_rad",
-    "pitch_err_rad",
-    "roll_err_rad",
-];
-
-/// The columns an orientation estimate needs.
-pub const ORIENTATION_COLUMNS: [&str; 5] = ["t_s", "q_w", "q_x", "q_y", "q_z"];
 
 /// What kind of estimate a table or file holds, judged by its columns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

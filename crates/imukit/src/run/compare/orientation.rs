@@ -45,7 +45,7 @@ fn about_vertical(angle: f64) -> UnitQuaternion<f64> {
 /// each estimate row against the slerp of the reference rows that bracket it, skipped where
 /// the reference has no value, a gap, or no time (see the module documentation); the heading
 /// offset `align_rad` removed from every estimate first. Error rows
-/// ([`super::ORIENTATION_ERROR_COLUMNS`]) go to `sink`.
+/// ([`crate::io::columns::ORIENTATION_ERROR_COLUMNS`]) go to `sink`.
 pub(super) fn compare_orientation_rows(
     names: [&str; 2],
     mut read_truth: impl FnMut(&mut StateRow) -> Result<bool>,

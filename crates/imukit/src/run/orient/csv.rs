@@ -1,21 +1,20 @@
 //! An orientation filter over an IMU file, streamed into an orientation table (`imukit orient`).
+use crate::io::columns::{ORIENT_COLUMNS, ROBUST_COLUMNS};
 use std::path::Path;
 
 use imu_core::orientation::{FilterInput, OrientationFilter};
 use imu_core::{Body, Enu, NavFrame, Ned, Rotation};
 
-use super::{
-    AnyFilter, FilterKind, FilterSpec, ORIENT_COLUMNS, ROBUST_COLUMNS, SIX_AXIS_FILTERS, robust_row,
-};
+use super::{AnyFilter, FilterKind, FilterSpec, SIX_AXIS_FILTERS, robust_row};
 use crate::choice::Choice;
 use crate::error::{Result, invalid};
+use crate::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
+use crate::io::conventions::NavFrameName;
 use crate::io::description::Description;
 use crate::io::output::AtomicFile;
 use crate::io::rows::{Gaps, TimeWindow, TimedRows};
 use crate::io::schema::TableKind;
-use crate::io::table::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::run::navigate::euler_unwrapped;
-use crate::scenario::NavFrameName;
 
 /// One orientation output row in [`ORIENT_COLUMNS`] order (yaw unwrapped against `last_yaw`).
 #[must_use]

@@ -9,34 +9,10 @@ use imu_core::{AccelSign, NavFrame};
 
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
+use crate::io::conventions::{AccelSignName, NavFrameName};
 use crate::io::description::Described;
-use crate::scenario::{AccelSignName, NavFrameName};
 
-/// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
-/// unwrapped).
-pub const ORIENT_COLUMNS: [&str; 8] = [
-    "t_s",
-    "q_w",
-    "q_x",
-    "q_y",
-    "q_z",
-    "yaw_rad",
-    "pitch_rad",
-    "roll_rad",
-];
-
-/// What the robust filter adds to [`ORIENT_COLUMNS`]: its gyroscope bias estimate and its
-/// flags (1 or 0): at rest (the bias was learnt), accelerometer rejected, magnetic disturbance.
-pub const ROBUST_COLUMNS: [&str; 6] = [
-    "gyro_bias_x_rad_s",
-    "gyro_bias_y_rad_s",
-    "gyro_bias_z_rad_s",
-    "at_rest",
-    "accel_rejected",
-    "mag_disturbed",
-];
-
-/// The robust filter's status as the values of [`ROBUST_COLUMNS`].
+/// The robust filter's status as the values of [`crate::io::columns::ROBUST_COLUMNS`].
 #[must_use]
 pub fn robust_row(s: &RobustStatus) -> [f64; 6] {
     let flag = |b: bool| if b { 1.0 } else { 0.0 };

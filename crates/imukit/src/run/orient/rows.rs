@@ -7,8 +7,8 @@ use imu_core::{AccelSign, Body, Enu, NavFrame, Ned, Rotation};
 
 use super::{AnyFilter, robust_row};
 use crate::error::{Result, invalid};
+use crate::io::conventions::NavFrameName;
 use crate::io::rows::SampleClock;
-use crate::scenario::NavFrameName;
 
 /// Estimates of a batch: `q_nb` (w, x, y, z) and the bias-corrected body rate per estimate.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -17,7 +17,7 @@ pub struct Estimates {
     pub quaternions: Vec<[f64; 4]>,
     /// Angular velocities, rad/s.
     pub angular_velocity_rad_s: Vec<[f64; 3]>,
-    /// The robust filter's bias and flags per estimate ([`super::ROBUST_COLUMNS`]); empty for the
+    /// The robust filter's bias and flags per estimate ([`crate::io::columns::ROBUST_COLUMNS`]); empty for the
     /// others.
     pub status: Vec<[f64; 6]>,
 }

@@ -1,0 +1,306 @@
+//! The one error type of the std layer: every variant says what and where.
+use std::path::PathBuf;
+
+use imu_core::KinematicsError;
+use imu_core::allan::AllanError;
+use imu_core::fusion::EskfError;
+use imu_core::fusion::align::AlignError;
+use imu_core::orientation::OrientError;
+use imu_core::sensor::{ImuParamError, ParamError};
+use imu_core::strapdown::StrapdownError;
+use imu_core::strapdown::planar::PlanarError;
+
+/// Why a scenario could not be read or run.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// A scenario file (TOML or JSON) that does not parse or has wrong keys or values.
+    #[error("{origin}: {message}")]
+    Scenario {
+        /// The file, or "scenario" for an in-memory one.
+        origin: String,
+        /// The parser's message (it names the key and, for files, the line).
+        message: String,
+    },
+    /// A scenario (a Python dict, a JSON file) whose value at `field` does not fit its key.
+    #[error("{origin}: {field}: {message}")]
+    ScenarioKey {
+        /// What the scenario is, e.g. "scenario dict".
+        origin: String,
+        /// Dotted key path, e.g. `imu.seed`; empty for the whole scenario.
+        field: String,
+        /// What does not fit.
+        message: String,
+    },
+    /// A scenario key with an invalid value.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// Dotted key, e.g. `trajectory.order`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An option given a name it does not take (see [`crate::choice::Choice`]).
+    #[error("{field}: unknown {what} \"{value}\" ({})", choices.join(", "))]
+    UnknownChoice {
+        /// The request field, e.g. `nav_frame`.
+        field: String,
+        /// What is chosen, e.g. "navigation frame".
+        what: &'static str,
+        /// The name given.
+        value: String,
+        /// The names it takes.
+        choices: Vec<&'static str>,
+    },
+    /// The Kalman filter refused its settings or a sample (not a divergence: see
+    /// [`Error::Diverged`]).
+    #[error("{context}: {}{source}", row.map(|r| format!("row {r}: ")).unwrap_or_default())]
+    Filter {
+        /// The input or setting, e.g. `IMU data`, `sensor_error_sigma`.
+        context: String,
+        /// The 1-based row of the input (the header is row 1), when a sample was refused.
+        row: Option<usize>,
+        /// The core's error.
+        source: EskfError,
+    },
+    /// A static alignment that could not be made.
+    #[error("{field}: \"static\": {source}{}", align_hint(source))]
+    Align {
+        /// The request field, `align`.
+        field: String,
+        /// The core's error.
+        source: AlignError,
+    },
+    /// A Kalman filter that lost its measurements (its covariance no longer positive definite,
+    /// or fixes rejected one after another): the estimate is not written.
+    #[error("{context}: {message}")]
+    Diverged {
+        /// The input and row where it was noticed, e.g. `GNSS data`.
+        context: String,
+        /// What happened.
+        message: String,
+    },
+    /// An expression that does not parse.
+    #[error("{field}: {source}")]
+    Expression {
+        /// Dotted key of the expression, e.g. `trajectory.position_m[1]`.
+        field: String,
+        /// The parse error with its column (imukit's expression parser's).
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// A bad value in a CSV file.
+    #[error("{}, row {row}, column {column}: {message}", file.display())]
+    CsvValue {
+        /// The file.
+        file: PathBuf,
+        /// 1-based line number (the header is row 1).
+        row: usize,
+        /// Column name.
+        column: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A CSV file that is malformed (unequal row lengths, truncated, not UTF-8, empty).
+    #[error("{}: {message}", file.display())]
+    CsvFormat {
+        /// The file.
+        file: PathBuf,
+        /// What is wrong (with its row where known).
+        message: String,
+    },
+    /// Required CSV columns are absent.
+    #[error("{}: missing column(s) {}{hint}", file.display(), missing.join(", "))]
+    MissingColumns {
+        /// The file.
+        file: PathBuf,
+        /// Column names not found in the header.
+        missing: Vec<String>,
+        /// What else would do.
+        hint: String,
+    },
+    /// A result that is not a finite number: refused at the boundary, never written.
+    #[error(
+        "{what}, row {row}, column {column}: the result is {value}, not a finite number (an input or parameter is too large for it); nothing was written"
+    )]
+    NotFinite {
+        /// The output (file or table).
+        what: String,
+        /// 1-based row (the header is row 1).
+        row: usize,
+        /// The column.
+        column: String,
+        /// The value (inf or NaN).
+        value: f64,
+    },
+    /// A quaternion of zero norm or not finite, where an attitude was expected.
+    #[error("{field} has zero norm or is not finite")]
+    BadQuaternion {
+        /// The argument and index, e.g. `quaternion[3]`.
+        field: String,
+    },
+    /// A sensor parameter the core refused.
+    #[error("{context}: {source}")]
+    Param {
+        /// The parameter table, e.g. `imu.gyroscope`.
+        context: String,
+        /// The core's error, naming the parameter.
+        source: ParamError,
+    },
+    /// A sensor parameter refused at the sample rate of a model.
+    #[error("{context}: {source}")]
+    ImuParam {
+        /// The IMU, e.g. `imu`.
+        context: String,
+        /// The core's error, naming the sensor and the parameter.
+        source: ImuParamError,
+    },
+    /// The 3D strapdown refused the data.
+    #[error("{context}: {source}")]
+    Strapdown {
+        /// The data, e.g. `IMU data`.
+        context: String,
+        /// The core's error, with its sample.
+        source: StrapdownError,
+    },
+    /// Planar dead reckoning refused the data.
+    #[error("{context}: {source}")]
+    Planar {
+        /// The data, e.g. `planar IMU`.
+        context: String,
+        /// The core's error, with its sample.
+        source: PlanarError,
+    },
+    /// An orientation filter refused its settings or data.
+    #[error("{context}: {source}")]
+    Orientation {
+        /// The filter or the data.
+        context: String,
+        /// The core's error.
+        source: OrientError,
+    },
+    /// The Allan deviation refused a column.
+    #[error("{context}: {source}")]
+    Allan {
+        /// The column.
+        context: String,
+        /// The core's error.
+        source: AllanError,
+    },
+    /// The kinematics refused the input.
+    #[error("{context}: {source}")]
+    Kinematics {
+        /// Where (file or trajectory), and the time of the sample when known.
+        context: String,
+        /// The core's error, with its sample index.
+        source: KinematicsError,
+    },
+}
+
+/// Where an error points, as far as it knows: the scenario key or argument (`field`), the file,
+/// the 1-based row (the header is row 1) and the column. Front ends show it to programs (Python's
+/// `ImuError.field`, `.file`, `.row`, `.column`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Location {
+    /// Dotted key or argument name, e.g. `imu.gyroscope.noise_density`.
+    pub field: Option<String>,
+    /// The file.
+    pub file: Option<PathBuf>,
+    /// The row in the file.
+    pub row: Option<usize>,
+    /// The column name.
+    pub column: Option<String>,
+}
+
+impl Error {
+    /// Where the error points.
+    #[must_use]
+    pub fn location(&self) -> Location {
+        let field = |f: &str| Location {
+            field: Some(f.to_string()),
+            ..Location::default()
+        };
+        let file = |f: &std::path::Path| Location {
+            file: Some(f.to_path_buf()),
+            ..Location::default()
+        };
+        match self {
+            Self::Io { path, .. } => file(path),
+            Self::Scenario { .. } => Location::default(),
+            Self::Invalid { field: f, .. }
+            | Self::ScenarioKey { field: f, .. }
+            | Self::UnknownChoice { field: f, .. }
+            | Self::Align { field: f, .. }
+            | Self::Expression { field: f, .. }
+            | Self::BadQuaternion { field: f }
+            | Self::Diverged { context: f, .. } => field(f),
+            Self::CsvValue {
+                file: f,
+                row,
+                column,
+                ..
+            } => Location {
+                file: Some(f.clone()),
+                row: Some(*row),
+                column: Some(column.clone()),
+                field: None,
+            },
+            Self::CsvFormat { file: f, .. } => file(f),
+            Self::Filter { context, row, .. } => Location {
+                row: *row,
+                ..field(context)
+            },
+            Self::NotFinite {
+                what, row, column, ..
+            } => Location {
+                field: Some(what.clone()),
+                row: Some(*row),
+                column: Some(column.clone()),
+                file: None,
+            },
+            Self::MissingColumns {
+                file: f, missing, ..
+            } => Location {
+                column: missing.first().cloned(),
+                ..file(f)
+            },
+            Self::Param { context, source } => field(&format!("{context}.{}", source.field())),
+            Self::ImuParam { context, source } => field(&format!(
+                "{context}.{}.{}",
+                source.sensor,
+                source.source.field()
+            )),
+            Self::Kinematics { context, .. }
+            | Self::Strapdown { context, .. }
+            | Self::Planar { context, .. }
+            | Self::Orientation { context, .. }
+            | Self::Allan { context, .. } => field(context),
+        }
+    }
+}
+
+/// What to do instead when a static alignment fails.
+fn align_hint(e: &AlignError) -> &'static str {
+    match e {
+        AlignError::NoNorth { .. } => "; use \"gnss\" or give the initial state",
+        AlignError::NotAtRest { .. } => "",
+    }
+}
+
+/// Result with [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// [`Error::Invalid`]: the value of `field` (a key, an option, an argument) is wrong, `message`
+/// says why.
+pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Error {
+    Error::Invalid {
+        field: field.into(),
+        message: message.into(),
+    }
+}
