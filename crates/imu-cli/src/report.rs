@@ -77,8 +77,8 @@ const DECLARE_UNITS: &str = "declare the file's units with --map, docs/formats.m
 
 /// Warns about IMU readings in `path` that look like a unit slip (g as m/s², °/s as rad/s, ms
 /// as s: [`imukit::io::plausible`]), reading its first rows.
-pub fn warn_implausible(path: &std::path::Path) {
-    for w in imukit::io::plausible::file_readings(path, DECLARE_UNITS) {
+pub fn warn_implausible(input: &imukit::io::Input) {
+    for w in imukit::io::plausible::file_readings(input, DECLARE_UNITS) {
         warn(&w);
     }
 }

@@ -18,11 +18,10 @@
 //!
 //! A map is read ([`ColumnMap::read`]) and resolved against a file's header
 //! ([`ColumnMap::resolve`]); the table reader then gives the file's rows as imukit's columns
-//! (`t_s`, `accel_x_m_s2`, …), the file's other columns under their own names. The command line
-//! attaches a map to its input (`--map FILE`, [`attach`]); Python's `imukit.read(path, map=…)`
-//! reads through one.
-use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+//! (`t_s`, `accel_x_m_s2`, …), the file's other columns under their own names. A map travels
+//! with its file as one argument, [`crate::Input::with_map`]: the command line's `--map FILE`,
+//! Python's `imukit.read(path, map=…)`.
+use std::path::Path;
 
 use serde::Deserialize;
 
@@ -329,36 +328,6 @@ fn check_rotation(r: &[[f64; 3]; 3]) -> std::result::Result<(), String> {
         return Err("is a reflection (determinant −1), not a rotation: flip one more axis".into());
     }
     Ok(())
-}
-
-/// Maps attached to input files, by path.
-static ATTACHED: Mutex<Vec<(PathBuf, Arc<ColumnMap>)>> = Mutex::new(Vec::new());
-
-/// Attaches `map` to the file at `path`: from now on in this process, every reader of that
-/// file reads it through the map (the command line's `--map`).
-pub fn attach(path: &Path, map: ColumnMap) {
-    let key = identity(path);
-    let mut all = ATTACHED
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    all.retain(|(p, _)| *p != key);
-    all.push((key, Arc::new(map)));
-}
-
-/// The map attached to `path`, if any.
-pub(crate) fn attached(path: &Path) -> Option<Arc<ColumnMap>> {
-    let key = identity(path);
-    ATTACHED
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-        .iter()
-        .find(|(p, _)| *p == key)
-        .map(|(_, m)| Arc::clone(m))
-}
-
-/// One name per file: canonical where it exists.
-fn identity(path: &Path) -> PathBuf {
-    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
 }
 
 #[cfg(test)]

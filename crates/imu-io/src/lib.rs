@@ -6,7 +6,8 @@
 //! chosen by its path's extension ([`TableFormat`]): CSV, the EuRoC/TUM-VI ASL layout read by its
 //! header ([`asl`]), a vendor's CSV through a column map ([`column_map`]), Parquet
 //! ([`parquet`]), NumPy `.npy` and `.npz` ([`npy`], [`npz`]), the topics of a ROS bag ([`bag`]),
-//! NMEA logs ([`nmea`]); outputs that leave no partial file ([`output`]); the time-checked row
+//! NMEA logs ([`nmea`]); a file to read with how to read it ([`Input`]: its column map, a bag's
+//! topics and clock); outputs that leave no partial file ([`output`]); the time-checked row
 //! reader of IMU files ([`rows`]); the part files: parameter files ([`params`]), data sheets
 //! ([`datasheet`]), Kalibr's ([`kalibr`]), the built-in presets of real parts ([`presets`]),
 //! datasheet units ([`units`]); typed values read from a tree of them ([`value_tree`]: a Python
@@ -27,6 +28,7 @@ pub mod conventions;
 pub mod datasheet;
 pub mod described;
 pub mod description;
+pub mod input;
 pub mod kalibr;
 pub mod memory;
 pub mod nmea;
@@ -44,6 +46,7 @@ pub mod units;
 pub mod value_tree;
 
 pub use error::{Error, Result};
+pub use input::Input;
 pub use table::Table;
 
 use std::cell::Cell;

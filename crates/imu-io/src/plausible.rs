@@ -111,12 +111,13 @@ pub fn readings(t: &Table, source: &str, fix: &str) -> Vec<String> {
     out
 }
 
-/// [`readings`] of the IMU file at `path` (through its attached column map, if any), of which
+/// [`readings`] of the IMU file `input` (through its column map, if it has one), of which
 /// only the first [`HEAD_ROWS`] rows are read; nothing when it has no IMU columns or cannot be read (the job that reads it says
 /// why).
 #[must_use]
-pub fn file_readings(path: &std::path::Path, fix: &str) -> Vec<String> {
-    let Ok(header) = crate::table::read_header(path) else {
+pub fn file_readings(input: impl Into<crate::Input>, fix: &str) -> Vec<String> {
+    let input = input.into();
+    let Ok(header) = crate::table::read_header(&input) else {
         return Vec::new();
     };
     let names: Vec<&str> = std::iter::once("t_s")
@@ -124,7 +125,7 @@ pub fn file_readings(path: &std::path::Path, fix: &str) -> Vec<String> {
         .chain(GYRO_COLUMNS)
         .filter(|c| header.iter().any(|h| h == c))
         .collect();
-    let Ok(mut rows) = crate::table::CsvRows::open(path, &names, "") else {
+    let Ok(mut rows) = crate::table::CsvRows::open(&input, &names, "") else {
         return Vec::new();
     };
     let mut head = Table::new(&names);
@@ -135,7 +136,7 @@ pub fn file_readings(path: &std::path::Path, fix: &str) -> Vec<String> {
             _ => break,
         }
     }
-    readings(&head, &path.display().to_string(), fix)
+    readings(&head, &input.path().display().to_string(), fix)
 }
 
 #[cfg(test)]

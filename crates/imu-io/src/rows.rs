@@ -11,7 +11,6 @@
 //! seconds from the first sample of the command's first input, so that the same numbers cut
 //! every file of one run (the fixes, the reference) at the same instants.
 use std::collections::VecDeque;
-use std::path::Path;
 
 use crate::error::{Result, invalid};
 use crate::table::{CsvRows, Table};
@@ -126,8 +125,10 @@ impl TimeWindow {
     ///
     /// # Errors
     /// Missing `t_s`, a bad first row, a file without rows.
-    pub fn first_time_in(path: &Path) -> Result<f64> {
-        let mut rows = CsvRows::open(path, &["t_s"], "")?;
+    pub fn first_time_in(input: impl Into<crate::Input>) -> Result<f64> {
+        let input = input.into();
+        let path = input.path();
+        let mut rows = CsvRows::open(&input, &["t_s"], "")?;
         let mut t = [0.0];
         match rows.next_row(&mut t)? {
             Some(_) => Ok(t[0]),
@@ -327,12 +328,14 @@ pub struct TimedRows {
 }
 
 impl TimedRows {
-    /// Opens `path` for `columns` (`t_s` first) and reads the look-ahead.
+    /// Opens `input` for `columns` (`t_s` first) and reads the look-ahead.
     ///
     /// # Errors
     /// Missing columns (with `hint`), bad cells, a file without data rows.
-    pub fn open(path: &Path, columns: &[&str], hint: &str) -> Result<Self> {
-        let mut rows = CsvRows::open(path, columns, hint)?;
+    pub fn open(input: impl Into<crate::Input>, columns: &[&str], hint: &str) -> Result<Self> {
+        let input = input.into();
+        let path = input.path();
+        let mut rows = CsvRows::open(&input, columns, hint)?;
         let mut row = vec![0.0; columns.len()];
         let mut ahead = VecDeque::with_capacity(GAP_WINDOW + 1);
         while ahead.len() <= GAP_WINDOW && rows.next_row(&mut row)?.is_some() {

@@ -18,6 +18,7 @@ use crate::TableFormat;
 use crate::column_map::{ColumnMap, Source, TimeUnit};
 use crate::description::Description;
 use crate::error::{Error, Result, invalid};
+use crate::input::Input;
 use crate::output::write_atomically;
 
 /// What the accelerometer and gyroscope columns hold.
@@ -583,19 +584,21 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
 ///
 /// # Errors
 /// Unreadable or empty file, a column name that appears twice.
-pub fn read_header(path: &Path) -> Result<Vec<String>> {
+pub fn read_header(input: impl Into<Input>) -> Result<Vec<String>> {
+    let input = input.into();
+    let path = input.path();
     match TableFormat::of(path) {
         TableFormat::Parquet => crate::parquet::column_names(path),
         TableFormat::Npy => crate::npy::column_names(path),
         TableFormat::Npz => crate::npz::column_names(path),
-        TableFormat::Mcap => crate::bag::column_names(path, &[]),
+        TableFormat::Mcap => crate::bag::column_names(&input, &[]),
         TableFormat::Nmea => Ok(crate::nmea::read_table(path)?.columns),
-        TableFormat::Csv => Ok(csv_layout(path, None)?.names),
+        TableFormat::Csv => Ok(csv_layout(path, input.map())?.names),
     }
 }
 
 /// How a CSV file's fields become a table's columns: as they are, through the ASL layout its
-/// header announces ([`crate::asl`]), or through the column map attached to it
+/// header announces ([`crate::asl`]), or through the column map it is read with
 /// ([`crate::column_map`]).
 struct Layout {
     /// The table's column names.
@@ -611,11 +614,9 @@ struct Layout {
     origin_ns: Option<i64>,
 }
 
-/// The layout of the CSV file at `path`, read through `map` when given, else through the map
-/// attached to it, else by its header.
+/// The layout of the CSV file at `path`, read through `map` when given, else by its header.
 fn csv_layout(path: &Path, map: Option<&ColumnMap>) -> Result<Layout> {
-    let attached = crate::column_map::attached(path);
-    if let Some(map) = map.or(attached.as_deref()) {
+    if let Some(map) = map {
         let raw = plain_header(path)?;
         let (names, sources) = map.resolve(&raw, path)?;
         return Ok(Layout {
@@ -777,51 +778,45 @@ fn csv_error_after(path: &Path, e: &csv::Error, comments: usize) -> Error {
 }
 
 /// Reads every column of a table file in the format its extension names ([`TableFormat`]):
-/// Parquet, `.npy`, `.npz`, else CSV with a header row.
+/// Parquet, `.npy`, `.npz`, else CSV with a header row (through the input's column map when it
+/// has one: `t_s` and the sensors' columns in SI and body axes, then its other columns).
 ///
 /// # Errors
-/// As [`read_columns`]: values that are not finite numbers, malformed or empty files.
-pub fn read_table(path: &Path) -> Result<Table> {
+/// As [`read_columns`]: values that are not finite numbers, malformed or empty files; a column
+/// the map names that the file lacks.
+pub fn read_table(input: impl Into<Input>) -> Result<Table> {
+    let input = input.into();
+    let path = input.path();
     match TableFormat::of(path) {
         TableFormat::Parquet => return crate::parquet::read_table(path),
         TableFormat::Npz => return crate::npz::read_table(path),
-        TableFormat::Mcap => return crate::bag::read_table(path, &[]),
+        TableFormat::Mcap => return crate::bag::read_table(&input, &[]),
         TableFormat::Nmea => return crate::nmea::read_table(path),
         TableFormat::Npy | TableFormat::Csv => {}
     }
-    let header = read_header(path)?;
+    let header = read_header(&input)?;
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
-    read_table_columns(path, &names, "")
+    read_table_columns(&input, &names, "")
 }
 
 /// [`read_table`], a bag's topic chosen among those of `role` (other formats hold one table).
 ///
 /// # Errors
 /// As [`read_table`].
-pub fn read_table_as(path: &Path, role: crate::bag::Role) -> Result<Table> {
-    match TableFormat::of(path) {
-        TableFormat::Mcap => crate::bag::read_table_as(path, role),
-        _ => read_table(path),
+pub fn read_table_as(input: impl Into<Input>, role: crate::bag::Role) -> Result<Table> {
+    let input = input.into();
+    match TableFormat::of(input.path()) {
+        TableFormat::Mcap => crate::bag::read_table_as(&input, role),
+        _ => read_table(input),
     }
-}
-
-/// Reads every column a vendor's CSV file gives through the column `map` ([`ColumnMap`]):
-/// `t_s` and the sensors' columns in SI and body axes, then its other columns.
-///
-/// # Errors
-/// As [`read_table`], and a column the map names that the file lacks.
-pub fn read_table_through(path: &Path, map: &ColumnMap) -> Result<Table> {
-    let names = csv_layout(path, Some(map))?.names;
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    whole_table(CsvRows::open_through(path, &names, "", Some(map))?, &names)
 }
 
 /// Reads the named columns of a CSV file as a table with those columns, in that order.
 ///
 /// # Errors
 /// As [`read_columns`].
-pub fn read_table_columns(path: &Path, names: &[&str], hint: &str) -> Result<Table> {
-    whole_table(CsvRows::open(path, names, hint)?, names)
+pub fn read_table_columns(input: impl Into<Input>, names: &[&str], hint: &str) -> Result<Table> {
+    whole_table(CsvRows::open(input, names, hint)?, names)
 }
 
 /// Every row of `rows` (opened for `names`) as a table, refused when there is none.
@@ -845,8 +840,8 @@ fn whole_table(mut rows: CsvRows, names: &[&str]) -> Result<Table> {
 /// # Errors
 /// Missing columns (all named at once, with `hint`), values that are not finite numbers (file,
 /// row, column), malformed or empty files.
-pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvColumns> {
-    let mut rows = CsvRows::open(path, required, hint)?;
+pub fn read_columns(input: impl Into<Input>, required: &[&str], hint: &str) -> Result<CsvColumns> {
+    let mut rows = CsvRows::open(input, required, hint)?;
     let header: HashMap<String, usize> = rows
         .names
         .iter()
@@ -862,12 +857,12 @@ pub fn read_columns(path: &Path, required: &[&str], hint: &str) -> Result<CsvCol
     }
     if values.iter().all(Vec::is_empty) {
         return Err(Error::CsvFormat {
-            file: path.into(),
+            file: rows.path,
             message: "no data rows after the header".into(),
         });
     }
     Ok(CsvColumns {
-        file: path.into(),
+        file: rows.path,
         header,
         values,
     })
@@ -943,32 +938,23 @@ impl CsvRows {
         Ok(self)
     }
 
-    /// Opens `path` and checks that its header has every column of `required`.
+    /// Opens `input` and checks that its header has every column of `required`; a CSV file is
+    /// read through the input's column map when it has one (a vendor's columns and units).
     ///
     /// # Errors
-    /// Missing columns (all named at once, with `hint`), unreadable or empty files.
-    pub fn open(path: &Path, required: &[&str], hint: &str) -> Result<Self> {
-        Self::open_through(path, required, hint, None)
-    }
-
-    /// [`CsvRows::open`], the CSV file read through `map` (a vendor's columns and units).
-    ///
-    /// # Errors
-    /// As [`CsvRows::open`], and a column the map names that the file lacks.
-    pub fn open_through(
-        path: &Path,
-        required: &[&str],
-        hint: &str,
-        map: Option<&ColumnMap>,
-    ) -> Result<Self> {
+    /// Missing columns (all named at once, with `hint`), unreadable or empty files; a column the
+    /// map names that the file lacks.
+    pub fn open(input: impl Into<Input>, required: &[&str], hint: &str) -> Result<Self> {
+        let input = input.into();
+        let path = input.path();
         // A bag's topic is chosen by the columns asked for, and read whole; an NMEA log too.
         let whole = match TableFormat::of(path) {
-            TableFormat::Mcap => Some(crate::bag::read_table(path, required)?),
+            TableFormat::Mcap => Some(crate::bag::read_table(&input, required)?),
             TableFormat::Nmea => Some(crate::nmea::read_table(path)?),
             _ => None,
         };
         let layout = match TableFormat::of(path) {
-            TableFormat::Csv => csv_layout(path, map)?,
+            TableFormat::Csv => csv_layout(path, input.map())?,
             TableFormat::Mcap | TableFormat::Nmea => Layout {
                 names: whole
                     .as_ref()

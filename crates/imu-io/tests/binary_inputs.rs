@@ -478,5 +478,5 @@ fn a_table_too_wide_for_a_npy_header_is_refused_and_written_in_the_formats_that_
     let mut narrow = Table::new(&fits);
     narrow.push_row(&vec![2.0; 300]);
     narrow.write(&d.join("narrow.npy")).unwrap();
-    assert_eq!(read_table(&d.join("narrow.npy")).unwrap(), narrow);
+    assert_eq!(read_table(d.join("narrow.npy")).unwrap(), narrow);
 }

@@ -3,9 +3,10 @@
 use std::path::Path;
 
 use imukit::Table;
+use imukit::io::Input;
 use imukit::io::column_map::ColumnMap;
 use imukit::io::description::Description;
-use imukit::io::table::{read_table, read_table_through, run_path as run_file};
+use imukit::io::table::{read_table, run_path as run_file};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -45,37 +46,35 @@ fn read_table_file<'py>(
     topic: Option<String>,
     receive_time: bool,
 ) -> PyResult<DescribedOut<'py>> {
-    use imukit::io::bag::{Clock, Role, read_on};
+    use imukit::io::bag::{Clock, Selection};
+    let mut input = Input::new(path);
     if topic.is_some() || receive_time {
         let clock = if receive_time {
             Clock::Receive
         } else {
             Clock::Header
         };
-        let named: Vec<String> = topic.into_iter().collect();
-        let t = py
-            .detach(|| read_on(Path::new(path), clock)?.table_among(&named, &[], Role::Any))
-            .map_err(refused)?;
-        return read_out(py, path, t);
+        input = input.with_selection(Selection {
+            topics: topic.into_iter().collect(),
+            clock,
+        });
     }
     let map = match (map_path, map_json) {
         (Some(p), _) => Some(ColumnMap::read(Path::new(p)).map_err(refused)?),
         (None, Some(text)) => Some(ColumnMap::from_json(text, "map").map_err(refused)?),
         (None, None) => None,
     };
-    let t = py
-        .detach(|| match &map {
-            Some(m) => read_table_through(Path::new(path), m),
-            None => read_table(Path::new(path)),
-        })
-        .map_err(refused)?;
-    match map {
+    let mapped = map.is_some();
+    if let Some(m) = map {
+        input = input.with_map(m);
+    }
+    let t = py.detach(|| read_table(&input)).map_err(refused)?;
+    if mapped {
         // A vendor's file says nothing of itself: what its columns show.
-        Some(_) => {
-            let d = Description::of_columns(&t.columns);
-            described_out(py, t, &d)
-        }
-        None => read_out(py, path, t),
+        let d = Description::of_columns(&t.columns);
+        described_out(py, t, &d)
+    } else {
+        read_out(py, path, t)
     }
 }
 

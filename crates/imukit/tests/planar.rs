@@ -84,13 +84,13 @@ fn dat_files_round_trip_and_bad_lines_are_named() {
     write_dat(&path, &samples).unwrap();
     assert_eq!(read_planar(&path).unwrap(), samples);
     std::fs::write(dir.join("bad.dat"), "0 0 0 0\n0.1 0 0\n").unwrap();
-    let e = read_planar(&dir.join("bad.dat")).unwrap_err().to_string();
+    let e = read_planar(dir.join("bad.dat")).unwrap_err().to_string();
     assert!(
         e.contains("bad.dat") && e.contains("line 2") && e.contains("expected 4 columns"),
         "{e}"
     );
     std::fs::write(dir.join("nan.dat"), "# t ax ay wz\n0 0 0 0\n0.1 0 x 0\n").unwrap();
-    let e = read_planar(&dir.join("nan.dat")).unwrap_err().to_string();
+    let e = read_planar(dir.join("nan.dat")).unwrap_err().to_string();
     assert!(
         e.contains("line 3") && e.contains("column 3") && e.contains("\"x\""),
         "{e}"
@@ -101,11 +101,11 @@ fn dat_files_round_trip_and_bad_lines_are_named() {
     )
     .unwrap();
     assert_eq!(
-        read_planar(&dir.join("imu.csv")).unwrap()[0].gyro_z_rad_s,
+        read_planar(dir.join("imu.csv")).unwrap()[0].gyro_z_rad_s,
         3.0
     );
     std::fs::write(dir.join("cols.csv"), "t_s,accel_x_m_s2\n0,1\n").unwrap();
-    let e = read_planar(&dir.join("cols.csv")).unwrap_err().to_string();
+    let e = read_planar(dir.join("cols.csv")).unwrap_err().to_string();
     assert!(
         e.contains("missing column(s) accel_y_m_s2, gyro_z_rad_s"),
         "{e}"

@@ -8,16 +8,18 @@ use imukit::io::table::{read_columns, read_header};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;
+use imukit::io::Input;
 use imukit::io::rows::TimeWindow;
 
 pub fn run(
-    input: &Path,
+    source: &Input,
     columns: &[String],
     window: TimeWindow,
     out: &Path,
     plot: Option<&Path>,
     size: imu_plot::FigureSize,
 ) -> Result<(), CliError> {
+    let input = source.path();
     if let Some(p) = plot {
         imu_plot::check_figure_path(p)?;
     }
@@ -25,8 +27,8 @@ pub fn run(
     outputs.extend(plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
     imukit::io::output::check_table_outputs(&[("--out", out)])?;
-    crate::report::warn_implausible(input);
-    let result = analyse(input, columns, window)?;
+    crate::report::warn_implausible(source);
+    let result = analyse(source, columns, window)?;
     result.table.write(out)?;
     if let Some(p) = plot {
         imu_plot::allan_figure(p, &result, &file_name(input), size)?;
@@ -83,11 +85,12 @@ pub(crate) fn file_name(input: &Path) -> String {
 /// Reads `columns` (default: every gyro and accel column) and `t_s` of `input` and computes
 /// their Allan curves and noise terms; errors name the file and column.
 pub(crate) fn analyse(
-    input: &Path,
+    source: &Input,
     columns: &[String],
     window: TimeWindow,
 ) -> Result<AllanResult, CliError> {
-    let header = read_header(input)?;
+    let input = source.path();
+    let header = read_header(source)?;
     let chosen: Vec<String> = if columns.is_empty() {
         GYRO_COLUMNS
             .iter()
@@ -105,7 +108,7 @@ pub(crate) fn analyse(
     } else {
         ""
     };
-    let data = read_columns(input, &required, hint)?;
+    let data = read_columns(source, &required, hint)?;
     // The window's rows: the times are checked in order below, so they are a run of rows.
     let all_t = data.get("t_s");
     let rows = match (window.is_whole(), all_t.first()) {

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use imu_core::orientation::DistanceStats;
+use imukit::io::Input;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
 use imukit::run::compare::{CompareOptions, compare_csv_with};
@@ -11,12 +12,13 @@ use super::CliError;
 
 /// Streams both files (memory does not grow with them).
 pub fn run(
-    truth: &Path,
-    estimate: &Path,
+    truth_source: &Input,
+    estimate_source: &Input,
     window: TimeWindow,
     options: CompareOptions,
     out: Option<&Path>,
 ) -> Result<(), CliError> {
+    let (truth, estimate) = (truth_source.path(), estimate_source.path());
     let inputs = [("truth file", truth), ("estimate file", estimate)];
     check_outputs(
         &inputs,
@@ -25,7 +27,7 @@ pub fn run(
     imukit::io::output::check_table_outputs(
         &out.map(|o| ("--out", o)).into_iter().collect::<Vec<_>>(),
     )?;
-    let c = compare_csv_with(truth, estimate, window, options, out)?;
+    let c = compare_csv_with(truth_source, estimate_source, window, options, out)?;
     crate::out_line!(
         "{:<10} {:>16} {:>16} {:>16}",
         "error",

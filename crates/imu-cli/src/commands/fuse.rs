@@ -2,6 +2,7 @@
 //! library's fuse job with the filter's model from the scenario.
 use std::path::Path;
 
+use imukit::io::Input;
 use imukit::io::bag::Role;
 use imukit::io::conventions::{EarthName, NavFrameName};
 use imukit::io::description::Described;
@@ -17,10 +18,10 @@ use crate::error::{by_flag, flag};
 
 /// The command's arguments.
 pub struct Args<'a> {
-    pub imu: &'a Path,
+    pub imu: &'a Input,
     /// The fixes (`None`: none).
-    pub gnss: Option<&'a Path>,
-    pub init: Option<&'a Path>,
+    pub gnss: Option<&'a Input>,
+    pub init: Option<&'a Input>,
     pub align: Option<AlignName>,
     pub scenario: Option<&'a Path>,
     pub model: Option<PartModel>,
@@ -44,7 +45,9 @@ pub struct Args<'a> {
 
 /// The input files whose descriptions say what the data are: the IMU's and the fixes'.
 fn inputs_of<'a>(a: &Args<'a>) -> Vec<&'a Path> {
-    std::iter::once(a.imu).chain(a.gnss).collect()
+    std::iter::once(a.imu.path())
+        .chain(a.gnss.map(Input::path))
+        .collect()
 }
 
 /// The filter's setup from `--imu PART` and the `--gnss-*` accuracies: the data's frame, Earth
@@ -84,10 +87,10 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
 }
 
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
-    let mut inputs = vec![("IMU file", a.imu)];
-    inputs.extend(a.gnss.map(|p| ("GNSS file", p)));
+    let mut inputs = vec![("IMU file", a.imu.path())];
+    inputs.extend(a.gnss.map(|p| ("GNSS file", p.path())));
     inputs.extend(a.scenario.map(|p| ("--scenario", p)));
-    inputs.extend(a.init.map(|p| ("--init file", p)));
+    inputs.extend(a.init.map(|p| ("--init file", p.path())));
     inputs.extend(a.odometer.map(|p| ("--odometer", p)));
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
@@ -193,8 +196,8 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     };
     // The library names its inputs by kind; the user knows them by file.
     let file_of = |context: &str| match context {
-        "IMU data" => Some(a.imu),
-        "GNSS data" => a.gnss,
+        "IMU data" => Some(a.imu.path()),
+        "GNSS data" => a.gnss.map(Input::path),
         "odometer data" => a.odometer,
         "barometer data" => a.baro,
         _ => None,

@@ -10,6 +10,7 @@ use imukit::run::identify::{
 
 use super::CliError;
 use super::allan::{analyse, file_name};
+use imukit::io::Input;
 use imukit::io::rows::TimeWindow;
 
 /// Where `identify` writes, besides the curve.
@@ -23,12 +24,13 @@ pub struct Outputs<'a> {
 }
 
 pub fn run(
-    input: &Path,
+    source: &Input,
     columns: &[String],
     window: TimeWindow,
     to: &Outputs<'_>,
     size: imu_plot::FigureSize,
 ) -> Result<(), CliError> {
+    let input = source.path();
     if let Some(p) = to.plot {
         imu_plot::check_figure_path(p)?;
     }
@@ -37,8 +39,8 @@ pub fn run(
     outputs.extend(to.kalibr.map(|p| ("--kalibr", p)));
     outputs.extend(to.plot.map(|p| ("--plot", p)));
     check_outputs(&[("input", input)], &outputs)?;
-    crate::report::warn_implausible(input);
-    let result = analyse(input, columns, window)?;
+    crate::report::warn_implausible(source);
+    let result = analyse(source, columns, window)?;
     let source = file_name(input);
     // Everything is computed before anything is written.
     let file = param_file(&result, &source);

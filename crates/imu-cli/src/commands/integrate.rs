@@ -5,6 +5,7 @@ use std::path::Path;
 use imu_core::EulerZyx;
 use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
+use imukit::io::Input;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::{Gaps, TimeWindow};
@@ -16,7 +17,7 @@ use crate::{CliError, by_flag};
 
 /// Arguments shared by the planar and the 3D integration.
 pub struct Common<'a> {
-    pub input: &'a Path,
+    pub input: &'a Input,
     pub out: &'a Path,
     /// `--start-s`, `--end-s`.
     pub window: TimeWindow,
@@ -26,7 +27,7 @@ pub struct Common<'a> {
 
 /// 3D options besides the library's request.
 pub struct Options3d<'a> {
-    pub init: Option<&'a Path>,
+    pub init: Option<&'a Input>,
     pub euler0: Option<&'a [f64]>,
     /// `--baro FILE`.
     pub baro: Option<&'a Path>,
@@ -101,7 +102,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
 /// (latitude, longitude and height, or ECEF) needs the WGS-84 Earth, and an attitude from the
 /// file or from the option `attitude` names (`Ok`: given, `Err`: the option to ask for).
 pub(crate) fn start_from(
-    path: &Path,
+    path: &Input,
     frame: imukit::io::conventions::NavFrameName,
     on_earth: bool,
     attitude: Result<&str, &str>,
@@ -138,15 +139,15 @@ pub fn three_d(
     request: &NavRequest,
     asked: &NavAsked,
 ) -> Result<(), CliError> {
-    let mut inputs = vec![("input", c.input)];
-    inputs.extend(o.init.map(|p| ("--init file", p)));
+    let mut inputs = vec![("input", c.input.path())];
+    inputs.extend(o.init.map(|p| ("--init file", p.path())));
     inputs.extend(o.baro.map(|p| ("--baro file", p)));
     check_outputs(&inputs, &[("--out", c.out)])?;
     imukit::io::output::check_table_outputs(&[("--out", c.out)])?;
     // What the input files say they hold fills the settings left out, and refuses a flag that
     // contradicts it.
     let described = Described::read(
-        &[Some(c.input), o.init]
+        &[Some(c.input.path()), o.init.map(Input::path)]
             .into_iter()
             .flatten()
             .collect::<Vec<_>>(),

@@ -16,6 +16,8 @@ mod simulate;
 mod study;
 
 use imukit::choice::Choice;
+use imukit::io::Input;
+use imukit::io::bag::{Clock, Selection};
 use imukit::io::rows::TimeWindow;
 use imukit::run::navigate::{NavAsked, NavRequest, SchemeName};
 
@@ -99,8 +101,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             window,
         } => {
-            map.attach(&input)?;
-            bag.attach(&[Some(&input), init.as_deref()])?;
+            let mapped = map.input(&input)?;
+            bag.check(&[Some(&input), init.as_deref()])?;
+            let input = bag.input(mapped);
+            let init = init.map(|p| bag.input(Input::new(p)));
             let common = integrate::Common {
                 input: &input,
                 out: &out,
@@ -133,7 +137,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     conventions: frame.conventions,
                 };
                 let opts = integrate::Options3d {
-                    init: init.as_deref(),
+                    init: init.as_ref(),
                     euler0: euler0.as_deref(),
                     baro: baro.as_deref(),
                     geodetic0: (lat0_deg, lon0_deg, height0_m),
@@ -170,12 +174,15 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             window,
         } => {
-            map.attach(&imu)?;
-            bag.attach(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
+            let mapped = map.input(&imu)?;
+            bag.check(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
+            let imu = bag.input(mapped);
+            let gnss = gnss.map(|p| bag.input(Input::new(p)));
+            let init = init.map(|p| bag.input(Input::new(p)));
             fuse::run(&fuse::Args {
                 imu: &imu,
-                gnss: gnss.as_deref(),
-                init: init.as_deref(),
+                gnss: gnss.as_ref(),
+                init: init.as_ref(),
                 align,
                 scenario: scenario.as_deref(),
                 model: imu_model.map(|imu| imukit::run::fuse::PartModel {
@@ -225,8 +232,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             out,
             window,
         } => {
-            map.attach(&input)?;
-            bag.attach(&[Some(&input)])?;
+            let mapped = map.input(&input)?;
+            bag.check(&[Some(&input)])?;
+            let input = bag.input(mapped);
             orient::run(&orient::Args {
                 input: &input,
                 filter,
@@ -248,7 +256,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             window,
             align_heading,
         } => {
-            bag.attach(&[Some(&truth), Some(&estimate)])?;
+            bag.check(&[Some(&truth), Some(&estimate)])?;
+            let (truth, estimate) = (
+                bag.input(Input::new(truth)),
+                bag.input(Input::new(estimate)),
+            );
             let options = imukit::run::compare::CompareOptions { align_heading };
             compare::run(&truth, &estimate, window.window()?, options, out.as_deref())
         }
@@ -268,8 +280,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             figure,
             window,
         } => {
-            map.attach(&input)?;
-            bag.attach(&[Some(&input)])?;
+            let mapped = map.input(&input)?;
+            bag.check(&[Some(&input)])?;
+            let input = bag.input(mapped);
             allan::run(
                 &input,
                 &columns,
@@ -293,8 +306,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             figure,
             window,
         } => {
-            map.attach(&input)?;
-            bag.attach(&[Some(&input)])?;
+            let mapped = map.input(&input)?;
+            bag.check(&[Some(&input)])?;
+            let input = bag.input(mapped);
             identify::run(
                 &input,
                 &columns,
@@ -353,16 +367,15 @@ impl crate::cli::WindowArgs {
 }
 
 impl crate::cli::BagArgs {
-    /// Names the topics (`--topic`) as the ones to read from each of `inputs` that is a bag, at
-    /// the recorder's receive times with `--receive-time`.
+    /// Refuses `--topic` or `--receive-time` when none of `inputs` is a bag: they would be
+    /// ignored.
     ///
     /// # Errors
-    /// `--topic` or `--receive-time` given when no input is a bag: they would be ignored.
-    fn attach(&self, inputs: &[Option<&std::path::Path>]) -> Result<(), CliError> {
-        use imukit::io::bag::{Clock, Selection};
-        let is_bag =
-            |p: &&std::path::Path| imukit::io::TableFormat::of(p) == imukit::io::TableFormat::Mcap;
-        if (!self.topics.is_empty() || self.receive_time) && !inputs.iter().flatten().any(is_bag) {
+    /// As said, naming the flag and the inputs.
+    fn check(&self, inputs: &[Option<&std::path::Path>]) -> Result<(), CliError> {
+        if (!self.topics.is_empty() || self.receive_time)
+            && !inputs.iter().flatten().any(|p| is_bag(p))
+        {
             let files: Vec<String> = inputs
                 .iter()
                 .flatten()
@@ -382,48 +395,53 @@ impl crate::cli::BagArgs {
             }
             .into());
         }
-        for input in inputs.iter().flatten() {
-            if imukit::io::TableFormat::of(input) == imukit::io::TableFormat::Mcap {
-                let clock = if self.receive_time {
-                    Clock::Receive
-                } else {
-                    Clock::Header
-                };
-                imukit::io::bag::attach(
-                    input,
-                    Selection {
-                        topics: self.topics.clone(),
-                        clock,
-                    },
-                );
-            }
-        }
         Ok(())
+    }
+
+    /// `input`, read with the topics (`--topic`) and at the recorder's receive times
+    /// (`--receive-time`) asked for when it is a bag.
+    fn input(&self, input: Input) -> Input {
+        if !is_bag(input.path()) {
+            return input;
+        }
+        let clock = if self.receive_time {
+            Clock::Receive
+        } else {
+            Clock::Header
+        };
+        input.with_selection(Selection {
+            topics: self.topics.clone(),
+            clock,
+        })
     }
 }
 
+/// Whether `path` names a ROS bag (a file or a bag's folder).
+fn is_bag(path: &std::path::Path) -> bool {
+    imukit::io::TableFormat::of(path) == imukit::io::TableFormat::Mcap
+}
+
 impl crate::cli::MapArg {
-    /// Reads the column map (`--map FILE`) and attaches it to `input`: every reader of the
-    /// input then reads it through the map.
+    /// `input`, read through the column map (`--map FILE`) when one is given.
     ///
     /// # Errors
     /// An unreadable map; a map given for an input that is not CSV (whose columns are
     /// imukit's already: the map would be ignored).
-    fn attach(&self, input: &std::path::Path) -> Result<(), CliError> {
-        if let Some(m) = &self.map {
-            let format = imukit::io::TableFormat::of(input);
-            if format != imukit::io::TableFormat::Csv {
-                return Err(imukit::Error::Invalid {
-                    field: "--map".into(),
-                    message: format!(
-                        "reads a vendor's CSV; {} is not CSV: its columns are imukit's already",
-                        input.display()
-                    ),
-                }
-                .into());
+    fn input(&self, input: &std::path::Path) -> Result<Input, CliError> {
+        let Some(m) = &self.map else {
+            return Ok(Input::new(input));
+        };
+        let format = imukit::io::TableFormat::of(input);
+        if format != imukit::io::TableFormat::Csv {
+            return Err(imukit::Error::Invalid {
+                field: "--map".into(),
+                message: format!(
+                    "reads a vendor's CSV; {} is not CSV: its columns are imukit's already",
+                    input.display()
+                ),
             }
-            imukit::io::column_map::attach(input, imukit::io::column_map::ColumnMap::read(m)?);
+            .into());
         }
-        Ok(())
+        Ok(Input::new(input).with_map(imukit::io::column_map::ColumnMap::read(m)?))
     }
 }

@@ -1,6 +1,7 @@
 //! `imukit orient IMU.csv --filter NAME [--param KEY=VALUE …] --out ORIENT.csv`.
 use std::path::Path;
 
+use imukit::io::Input;
 use imukit::io::conventions::{AccelSignName, NavFrameName};
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
@@ -11,7 +12,7 @@ use crate::CliError;
 
 /// The command's arguments.
 pub struct Args<'a> {
-    pub input: &'a Path,
+    pub input: &'a Input,
     pub filter: FilterKind,
     /// `--param KEY=VALUE`.
     pub params: &'a [String],

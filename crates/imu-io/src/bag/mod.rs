@@ -20,8 +20,8 @@
 //! the nanosecond). A fix without a fix (`status` −1) is left out.
 //!
 //! **Choosing a topic.** A reader asks for the columns it needs; the topics whose table has
-//! them are the candidates, narrowed to those named with [`attach_topics`] (`--topic`,
-//! Python's `topic=`). One candidate is read; none or several is an error that lists the
+//! them are the candidates, narrowed to those the input's [`Selection`] names (`--topic`,
+//! Python's `topic=`; [`crate::Input::with_selection`]). One candidate is read; none or several is an error that lists the
 //! bag's topics. A topic merged into another (a magnetometer into its IMU) is a candidate only
 //! when named.
 //!
@@ -42,7 +42,6 @@ use storage::{mcap_messages, read_mcap, read_ros1, read_sqlite};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use crate::asl::{seconds_after, time_origin_ns};
 use crate::columns::{
@@ -51,6 +50,7 @@ use crate::columns::{
 };
 use crate::description::Description;
 use crate::error::{Error, Result};
+use crate::input::Input;
 use crate::table::Table;
 use ros::MessageType;
 
@@ -103,6 +103,8 @@ pub struct Contents {
     values: usize,
     /// Whose stamps the rows carry.
     clock: Clock,
+    /// The topics to choose among (all when empty).
+    named: Vec<String>,
 }
 
 /// Which time a message of a bag is read at.
@@ -223,22 +225,17 @@ fn decode_row<W: ros::Wire>(
 /// An unreadable or damaged file (a truncated one included), a message that is not what its
 /// schema names, a value that is not finite, a topic of a known type in another encoding than
 /// CDR — each naming the file and the topic; more rows than fit in memory.
-pub fn read(path: &Path) -> Result<Contents> {
-    read_on(path, attached(path).clock)
-}
-
-/// [`read`] with the stamps of `clock` instead of those attached to the bag.
-///
-/// # Errors
-/// As [`read`].
-pub fn read_on(path: &Path, clock: Clock) -> Result<Contents> {
+pub fn read(input: impl Into<Input>) -> Result<Contents> {
+    let input = input.into();
+    let path = input.path();
     let mut contents = Contents {
         path: path.into(),
         topics: Vec::new(),
         decoded: Vec::new(),
         description: None,
         values: 0,
-        clock,
+        clock: input.selection().clock,
+        named: input.selection().topics.clone(),
     };
     for file in storage_files(path)? {
         read_file(&file, &mut contents)?;
@@ -477,44 +474,6 @@ pub struct Selection {
     pub clock: Clock,
 }
 
-/// The selection attached to each bag.
-static SELECTIONS: Mutex<Vec<(PathBuf, Selection)>> = Mutex::new(Vec::new());
-
-/// Attaches `selection` to the bag at `path`: from now on in this process, a reader of that bag
-/// chooses among its topics only, at its clock.
-pub fn attach(path: &Path, selection: Selection) {
-    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut all = SELECTIONS
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    all.retain(|(p, _)| *p != key);
-    if selection != Selection::default() {
-        all.push((key, selection));
-    }
-}
-
-/// Names the topics to read from the bag at `path` ([`attach`] with the header clock).
-pub fn attach_topics(path: &Path, topics: Vec<String>) {
-    attach(
-        path,
-        Selection {
-            topics,
-            clock: Clock::Header,
-        },
-    );
-}
-
-fn attached(path: &Path) -> Selection {
-    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    SELECTIONS
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-        .iter()
-        .find(|(p, _)| *p == key)
-        .map(|(_, s)| s.clone())
-        .unwrap_or_default()
-}
-
 impl Contents {
     /// The time origin: the UTC midnight before the earliest stamp of any topic read.
     fn origin_ns(&self) -> i64 {
@@ -600,7 +559,7 @@ impl Contents {
     }
 
     /// The table of the one topic that gives every column of `wanted` (all topics' when it is
-    /// empty), among the topics named with [`attach_topics`] when any are.
+    /// empty), among the topics the input's selection names when it names any.
     ///
     /// # Errors
     /// No such topic, or several, naming the file and listing its topics; a named topic the
@@ -616,11 +575,11 @@ impl Contents {
     /// # Errors
     /// As [`Contents::table`].
     pub fn table_as(&self, wanted: &[&str], role: Role) -> Result<Table> {
-        self.table_among(&attached(&self.path).topics, wanted, role)
+        self.table_among(&self.named, wanted, role)
     }
 
-    /// [`Contents::table_as`] among the topics `named` (all when empty) instead of those
-    /// attached to the bag.
+    /// [`Contents::table_as`] among the topics `named` (all when empty) instead of those the
+    /// input's selection names.
     ///
     /// # Errors
     /// As [`Contents::table`].
@@ -730,24 +689,24 @@ impl Role {
 ///
 /// # Errors
 /// As [`read`] and [`Contents::table`].
-pub fn read_table(path: &Path, wanted: &[&str]) -> Result<Table> {
-    read(path)?.table(wanted)
+pub fn read_table(input: impl Into<Input>, wanted: &[&str]) -> Result<Table> {
+    read(input)?.table(wanted)
 }
 
 /// The table of the bag at `path` of `role` ([`Contents::table_as`]).
 ///
 /// # Errors
 /// As [`read`] and [`Contents::table`].
-pub fn read_table_as(path: &Path, role: Role) -> Result<Table> {
-    read(path)?.table_as(&[], role)
+pub fn read_table_as(input: impl Into<Input>, role: Role) -> Result<Table> {
+    read(input)?.table_as(&[], role)
 }
 
 /// The names of the columns [`read_table`] gives for `wanted`.
 ///
 /// # Errors
 /// As [`read_table`].
-pub fn column_names(path: &Path, wanted: &[&str]) -> Result<Vec<String>> {
-    Ok(read_table(path, wanted)?.columns)
+pub fn column_names(input: impl Into<Input>, wanted: &[&str]) -> Result<Vec<String>> {
+    Ok(read_table(input, wanted)?.columns)
 }
 
 #[cfg(test)]
@@ -813,16 +772,24 @@ mod tests {
             }
         }
         // The magnetometer alone, when named.
-        attach_topics(&path, vec!["/imu/mag".into()]);
-        let mag = read_table(&path, &[]).expect("named");
+        let named = |topic: &str| {
+            Input::new(&path).with_selection(Selection {
+                topics: vec![topic.into()],
+                clock: Clock::Header,
+            })
+        };
+        let mag = read_table(named("/imu/mag"), &[]).expect("named");
         assert_eq!(mag.columns, ["t_s", "mag_x_ut", "mag_y_ut", "mag_z_ut"]);
-        attach_topics(&path, vec!["/nope".into()]);
-        let e = read_table(&path, &[]).unwrap_err().to_string();
+        let e = read_table(named("/nope"), &[]).unwrap_err().to_string();
         assert!(
             e.contains("no topic /nope") && e.contains("/imu (sensor_msgs/msg/Imu, 250 messages)"),
             "{e}"
         );
-        attach_topics(&path, Vec::new());
+        // The path alone is read as it is, whatever another reader named.
+        assert_eq!(
+            read_table(&path, &[]).expect("the IMU").columns,
+            imu.columns
+        );
     }
 
     #[test]

@@ -8,6 +8,7 @@
 //! then in the tangent plane at the origin of the starting truth, velocity and attitude in the
 //! local-level frame at each position). Both Earths run in the data's own frame through
 //! `run::nav_earth`.
+use crate::io::Input;
 use crate::io::columns::{GEODETIC_COLUMNS, STATE_COLUMNS};
 use crate::io::conventions::EarthGravityName;
 use imu_core::strapdown::rk4::{NODES, RateWindow, window_start};
@@ -241,8 +242,8 @@ impl InitialState {
     ///
     /// # Errors
     /// As [`Self::from_csv`]; a first row that names no point on the Earth.
-    pub fn from_reference(path: &Path, frame: NavFrameName) -> Result<(Self, Given)> {
-        Self::from_reference_at(path, frame, None)
+    pub fn from_reference(input: impl Into<Input>, frame: NavFrameName) -> Result<(Self, Given)> {
+        Self::from_reference_at(input, frame, None)
     }
 
     /// [`Self::from_reference`] at the first row at or after `at_s` (s, the file's own times;
@@ -251,12 +252,14 @@ impl InitialState {
     /// # Errors
     /// As [`Self::from_reference`]; no row at or after `at_s`.
     pub fn from_reference_at(
-        path: &Path,
+        input: impl Into<Input>,
         frame: NavFrameName,
         at_s: Option<f64>,
     ) -> Result<(Self, Given)> {
         use crate::run::reference::{Layout, VelocitySource, ecef, ned_of_difference};
-        let header = crate::io::table::read_header(path)?;
+        let input = input.into();
+        let path = input.path();
+        let header = crate::io::table::read_header(&input)?;
         let plane = Layout::of(&header, &[Position::Plane]);
         let Some(layout) = Layout::on_earth(&header).filter(|_| {
             // imukit's own tables (plane coordinates, velocity and attitude) start as they did.
@@ -331,19 +334,21 @@ impl InitialState {
     ///
     /// # Errors
     /// Missing columns, a bad first row (file, row, column), an empty file.
-    pub fn from_csv(path: &Path) -> Result<Self> {
-        Self::from_csv_at(path, None)
+    pub fn from_csv(input: impl Into<Input>) -> Result<Self> {
+        Self::from_csv_at(input, None)
     }
 
     /// [`Self::from_csv`] at the first row at or after `at_s` (s; `None`: the first row).
     ///
     /// # Errors
     /// As [`Self::from_csv`]; no row at or after `at_s`.
-    pub fn from_csv_at(path: &Path, at_s: Option<f64>) -> Result<Self> {
+    pub fn from_csv_at(input: impl Into<Input>, at_s: Option<f64>) -> Result<Self> {
         // The state columns: time, position, velocity, quaternion.
         let hint = "; the initial state comes from a truth CSV";
+        let input = input.into();
+        let path = input.path();
         let mut columns = STATE_COLUMNS[..].to_vec();
-        let mut rows = CsvRows::open(path, &columns, hint)?;
+        let mut rows = CsvRows::open(&input, &columns, hint)?;
         // Read with the geodetic position where the table has it (the same table: a bag's
         // topic chosen once for all of them).
         let header = rows.columns();
@@ -352,7 +357,7 @@ impl InitialState {
             .all(|c| header.iter().any(|h| h == c))
         {
             columns.extend(GEODETIC_COLUMNS);
-            rows = CsvRows::open(path, &columns, hint)?;
+            rows = CsvRows::open(&input, &columns, hint)?;
         }
         let mut row = [0.0; 14];
         loop {
@@ -939,20 +944,21 @@ pub struct NavSummary {
 /// As [`integrate`], CSV errors naming file, row and column, a window that holds no row, and
 /// I/O errors.
 pub fn integrate_csv(
-    input: &Path,
+    input: impl Into<Input>,
     initial: &InitialState,
     setup: &NavSetup,
     window: TimeWindow,
     out: &Path,
 ) -> Result<NavSummary> {
+    let input = &input.into();
     if let Some(EarthNav {
         vertical: VerticalChannel::Baro { .. },
         ..
     }) = setup.earth
     {
         let imu = read_whole(input)?;
-        let t0 = TimeWindow::first_time(&imu, &input.display().to_string())?;
-        let imu = window.apply(imu, t0, &input.display().to_string(), 1)?;
+        let t0 = TimeWindow::first_time(&imu, &input.path().display().to_string())?;
+        let imu = window.apply(imu, t0, &input.path().display().to_string(), 1)?;
         let nav = integrate(&imu, initial, setup)?;
         let rates = ACCEL_COLUMNS
             .iter()
@@ -987,10 +993,11 @@ pub fn integrate_csv(
 ///
 /// # Errors
 /// The budget, and the reader's errors naming file, row and column.
-pub fn read_whole(input: &Path) -> Result<Table> {
-    let bytes = std::fs::metadata(input)
+pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
+    let input = input.into();
+    let bytes = std::fs::metadata(input.path())
         .map_err(|source| crate::Error::Io {
-            path: input.into(),
+            path: input.path().into(),
             source,
         })?
         .len();
@@ -1169,7 +1176,7 @@ fn window(held: &VecDeque<[f64; 7]>, offset: usize) -> RateWindow {
 
 /// [`integrate_csv`] as an [`EarthJob`].
 struct IntegrateCsv<'a> {
-    input: &'a Path,
+    input: &'a Input,
     initial: &'a InitialState,
     setup: &'a NavSetup,
     window: TimeWindow,

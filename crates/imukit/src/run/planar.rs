@@ -3,6 +3,7 @@
 //! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
 //! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
+use crate::io::Input;
 use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use std::path::Path;
 
@@ -28,14 +29,16 @@ fn is_dat(path: &Path, first_line: &str) -> bool {
 /// # Errors
 /// Unreadable files, missing columns, a `.dat` line with the wrong number of columns or a value
 /// that is not a finite number (file and line named).
-pub fn read_planar(path: &Path) -> Result<Vec<PlanarSample>> {
+pub fn read_planar(input: impl Into<Input>) -> Result<Vec<PlanarSample>> {
+    let input = input.into();
+    let path = input.path();
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
         path: path.into(),
         source,
     })?;
     let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
     if !is_dat(path, first) {
-        let cols = read_columns(path, &PLANAR_COLUMNS, "")?;
+        let cols = read_columns(&input, &PLANAR_COLUMNS, "")?;
         let (t, ax, ay, wz) = (
             cols.get("t_s"),
             cols.get("accel_x_m_s2"),

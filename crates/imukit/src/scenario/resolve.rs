@@ -535,7 +535,7 @@ fn body_rates(
             "omega_y_rad_s",
             "omega_z_rad_s",
         ];
-        let cols = read_columns(&base_dir.join(file), &COLS, "")?;
+        let cols = read_columns(base_dir.join(file), &COLS, "")?;
         let n = cols.rows();
         let g = |c: usize, i: usize| cols.get(COLS[c])[i];
         data.accel_body_m_s2 = (0..n).map(|i| [g(1, i), g(2, i), g(3, i)]).collect();

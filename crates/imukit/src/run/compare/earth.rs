@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::{ErrorSummary, Parts, StateRow, compare_rows};
 use crate::error::{Result, invalid};
+use crate::io::Input;
 use crate::io::columns::{GEODETIC_COLUMNS, Position};
 use crate::io::conventions::NavFrameName;
 use crate::io::output::AtomicFile;
@@ -16,8 +17,8 @@ use crate::run::reference::{Layout, ecef};
 /// velocities and attitudes where both have them, each table's in its own frame (its
 /// description's, else ENU).
 pub(super) fn compare_on_earth(
-    truth: &Path,
-    estimate: &Path,
+    truth: &Input,
+    estimate: &Input,
     layout: Layout,
     (window, t0): (TimeWindow, f64),
     out: Option<&Path>,
@@ -27,15 +28,15 @@ pub(super) fn compare_on_earth(
             .and_then(|d| d.nav_frame)
             .unwrap_or_default())
     };
-    let (truth_frame, estimate_frame) = (frame_of(truth)?, frame_of(estimate)?);
+    let (truth_frame, estimate_frame) = (frame_of(truth.path())?, frame_of(estimate.path())?);
     let header = crate::io::table::read_header(estimate)?;
     let own = Layout::of(&header, &[Position::GeodeticRad]).ok_or_else(|| {
         invalid(
-            estimate.display().to_string(),
+            estimate.path().display().to_string(),
             format!(
                 "the reference {} gives positions on the Earth: the estimate needs {} (an \
                  estimate on the WGS-84 Earth, as integrate and fuse write it)",
-                truth.display(),
+                truth.path().display(),
                 GEODETIC_COLUMNS.join(", ")
             ),
         )
@@ -52,7 +53,10 @@ pub(super) fn compare_on_earth(
         vec![0.0; truth_columns.len()],
         vec![0.0; estimate_columns.len()],
     );
-    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
+    let (truth_name, estimate_name) = (
+        truth.path().display().to_string(),
+        estimate.path().display().to_string(),
+    );
     // A row of the Earth's terms as a state row: ECEF, NED velocity, FRD-to-NED attitude.
     let next = |rows: &mut CsvRows,
                 buffer: &mut [f64],

@@ -13,6 +13,7 @@ mod orientation;
 
 pub use orientation::heading_inclination;
 
+use crate::io::Input;
 use crate::io::columns::{
     EARTH_ERROR_COLUMNS, ERROR_COLUMNS, ORIENTATION_COLUMNS, ORIENTATION_ERROR_COLUMNS,
 };
@@ -385,7 +386,11 @@ pub fn check_comparable(described: &crate::io::description::Described) -> Result
 ///
 /// # Errors
 /// As [`compare`], CSV errors naming file, row and column, and I/O errors.
-pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<ErrorSummary> {
+pub fn compare_csv(
+    truth: impl Into<Input>,
+    estimate: impl Into<Input>,
+    out: Option<&Path>,
+) -> Result<ErrorSummary> {
     compare_csv_within(truth, estimate, TimeWindow::default(), out)
 }
 
@@ -395,8 +400,8 @@ pub fn compare_csv(truth: &Path, estimate: &Path, out: Option<&Path>) -> Result<
 /// # Errors
 /// As [`compare_csv`].
 pub fn compare_csv_within(
-    truth: &Path,
-    estimate: &Path,
+    truth: impl Into<Input>,
+    estimate: impl Into<Input>,
     window: TimeWindow,
     out: Option<&Path>,
 ) -> Result<ErrorSummary> {
@@ -409,12 +414,13 @@ pub fn compare_csv_within(
 /// # Errors
 /// As [`compare_csv`].
 pub fn compare_csv_with(
-    truth: &Path,
-    estimate: &Path,
+    truth: impl Into<Input>,
+    estimate: impl Into<Input>,
     window: TimeWindow,
     options: CompareOptions,
     out: Option<&Path>,
 ) -> Result<ErrorSummary> {
+    let (truth, estimate) = (&truth.into(), &estimate.into());
     let t0 = if window.is_whole() {
         0.0
     } else {
@@ -431,7 +437,8 @@ pub fn compare_csv_with(
         return earth::compare_on_earth(truth, estimate, layout, (window, t0), out);
     }
     check_comparable(&crate::io::description::Described::read(&[
-        truth, estimate,
+        truth.path(),
+        estimate.path(),
     ])?)?;
     let header = crate::io::table::read_header(estimate)?;
     let kind = EstimateKind::of(&header)?;
@@ -449,7 +456,10 @@ pub fn compare_csv_with(
         EstimateKind::Navigation => "; the truth needs t_s, pos_*, vel_*, q_*",
         EstimateKind::Orientation => "; the truth needs t_s, q_w, q_x, q_y, q_z",
     };
-    let (truth_name, estimate_name) = (truth.display().to_string(), estimate.display().to_string());
+    let (truth_name, estimate_name) = (
+        truth.path().display().to_string(),
+        estimate.path().display().to_string(),
+    );
     if kind == EstimateKind::Orientation {
         let score = |align: Option<f64>, file: Option<&mut AtomicFile>| {
             let mut truth_rows = CsvRows::open(truth, wanted, hint)?

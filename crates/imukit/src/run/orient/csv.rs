@@ -1,4 +1,5 @@
 //! An orientation filter over an IMU file, streamed into an orientation table (`imukit orient`).
+use crate::io::Input;
 use crate::io::columns::{ORIENT_COLUMNS, ROBUST_COLUMNS};
 use std::path::Path;
 
@@ -60,12 +61,13 @@ pub struct OrientSummary {
 /// Missing columns, bad cells (file, row, column), times that do not increase, the filter's
 /// refusals with the row, I/O errors.
 pub fn orient_csv(
-    input: &Path,
+    input: impl Into<Input>,
     spec: &FilterSpec,
     nav: NavFrameName,
     window: TimeWindow,
     out: &Path,
 ) -> Result<OrientSummary> {
+    let input = &input.into();
     match nav {
         NavFrameName::ENU => orient_csv_in::<Enu>(input, spec, nav, window, out),
         NavFrameName::NED => orient_csv_in::<Ned>(input, spec, nav, window, out),
@@ -73,7 +75,7 @@ pub fn orient_csv(
 }
 
 fn orient_csv_in<N: NavFrame>(
-    input: &Path,
+    input: &Input,
     spec: &FilterSpec,
     nav: NavFrameName,
     window: TimeWindow,
@@ -101,7 +103,7 @@ fn orient_csv_in<N: NavFrame>(
                     "{}: the {name} filter uses no magnetometer: the file's mag_* columns are \
                      ignored and the heading is not held (robust, ahrsfilter, madgwick, mahony \
                      and complementary use them; --no-mag says you mean 6D)",
-                    input.display()
+                    input.path().display()
                 ));
             }
             false
@@ -126,7 +128,7 @@ fn orient_csv_in<N: NavFrame>(
             )
         };
         return Err(crate::Error::MissingColumns {
-            file: input.into(),
+            file: input.path().into(),
             missing,
             hint,
         });
