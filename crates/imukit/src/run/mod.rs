@@ -7,7 +7,6 @@ pub mod arrays;
 pub mod compare;
 pub mod epochs;
 pub mod fuse;
-mod fuse_aids;
 pub mod identify;
 pub mod imu_sensor;
 pub(crate) mod nav_earth;

@@ -1023,7 +1023,7 @@ pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
         return Err(invalid("IMU data", "has no rows"));
     };
     // The same rule as the fusion's aids: finite, increasing, within the IMU's span.
-    let (tb, hb) = crate::run::fuse_aids::aid_series(baro, "barometer", BARO_COLUMN, (t0, t1))?;
+    let (tb, hb) = crate::run::fuse::aids::aid_series(baro, "barometer", BARO_COLUMN, (t0, t1))?;
     if tb.is_empty() {
         return Err(invalid("barometer data", "has no readings"));
     }

@@ -1,0 +1,273 @@
+//! What a fusion reads, checked: the IMU's times and rates, the fixes' stamps, positions,
+//! velocities and own accuracies, and the fixes in the filter's terms.
+use imu_core::Vec3;
+
+use super::start::ALIGN_MIN_SPEED_M_S;
+use crate::error::{Result, invalid};
+use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GYRO_COLUMNS};
+use crate::io::table::Table;
+use crate::run::nav_earth::NavEarth;
+
+/// GNSS stamps: finite, increasing, inside the IMU's span `[t0, t1]` (the row named), and not
+/// more frequent on average than the IMU's `samples` (fixes are applied at IMU samples).
+fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<()> {
+    for (k, &tk) in g_t.iter().enumerate() {
+        if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
+            return Err(invalid(
+                "GNSS data",
+                format!("row {}: times must be finite and increase", k + 2),
+            ));
+        }
+        if tk < t0 || tk > t1 {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    if let (Some(&first), Some(&last)) = (g_t.first(), g_t.last())
+        && g_t.len() > 1
+        && samples > 1
+    {
+        let (fix_dt, imu_dt) = (
+            (last - first) / (g_t.len() - 1) as f64,
+            (t1 - t0) / (samples - 1) as f64,
+        );
+        if fix_dt < imu_dt {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "fixes come every {fix_dt} s, more often than the IMU's samples (every \
+                     {imu_dt} s): the filter applies fixes at IMU samples, so the IMU must be the \
+                     faster sensor"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// What a fusion reads: IMU times and rates (the frame's body convention, as in the table),
+/// GNSS stamps, positions (three columns) and velocities, checked.
+pub(super) struct FusionInputs {
+    pub(super) t: Vec<f64>,
+    pub(super) f: Vec<[f64; 3]>,
+    pub(super) w: Vec<[f64; 3]>,
+    pub(super) g_t: Vec<f64>,
+    pub(super) g_p: Vec<[f64; 3]>,
+    /// The fixes' velocities (zeros where they have none).
+    pub(super) g_v: Vec<[f64; 3]>,
+    /// What the fixes give of their velocity.
+    pub(super) velocities: FixVelocity,
+    /// Each fix's own horizontal and vertical one-sigma ([`FIX_ACCURACY_COLUMNS`]), if the
+    /// table gives them.
+    pub(super) accuracy: Option<Vec<[f64; 2]>>,
+}
+
+/// What a table of fixes gives of the velocity, by its columns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum FixVelocity {
+    /// No velocity column: positions only (a `NavSatFix`, an NMEA `GGA`).
+    None,
+    /// The two horizontal columns only (NMEA's speed and course over ground): the vertical one
+    /// is not known.
+    Horizontal,
+    /// All three.
+    Full,
+}
+
+/// The one-sigma given to a vertical velocity the fixes do not know, m/s: no information.
+pub(super) const UNKNOWN_VELOCITY_SIGMA_M_S: f64 = 1e4;
+
+impl FusionInputs {
+    /// Reads `imu` (rates) and `gnss` (`columns`: `t_s`, three position and three velocity
+    /// columns, the velocity's optional, or its vertical one alone; `hint` follows the list of
+    /// missing ones)
+    /// and checks the stamps ([`check_fix_times`]).
+    ///
+    /// # Errors
+    /// Missing columns, named; the stamps' refusals.
+    pub(super) fn read(
+        imu: &Table,
+        gnss: &Table,
+        columns: &[&str; 7],
+        hint: &str,
+        accuracy: [f64; 2],
+    ) -> Result<Self> {
+        let t = imu
+            .column("t_s")
+            .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+        let (Some(f), Some(w)) = (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS)) else {
+            return Err(invalid(
+                "IMU data",
+                "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
+            ));
+        };
+        if t.len() < 2 {
+            return Err(invalid(
+                "IMU data",
+                format!("{} rows: fusion needs at least two samples", t.len()),
+            ));
+        }
+        let has = |c: &&str| gnss.columns.iter().any(|h| h == c);
+        if gnss.columns.is_empty() {
+            // No fixes at all (a table without columns): the IMU and the other aids alone.
+            return Ok(Self {
+                t,
+                f,
+                w,
+                g_t: Vec::new(),
+                g_p: Vec::new(),
+                g_v: Vec::new(),
+                velocities: FixVelocity::None,
+                accuracy: None,
+            });
+        }
+        // Positions only when none of the velocity's columns is there; the horizontal velocity
+        // alone when the vertical one is missing.
+        let velocities = match (columns[4..6].iter().any(has), has(&columns[6])) {
+            (false, false) => FixVelocity::None,
+            (true, false) => FixVelocity::Horizontal,
+            _ => FixVelocity::Full,
+        };
+        let needed = match velocities {
+            FixVelocity::None => &columns[..4],
+            FixVelocity::Horizontal => &columns[..6],
+            FixVelocity::Full => &columns[..],
+        };
+        let missing: Vec<&str> = needed.iter().copied().filter(|c| !has(c)).collect();
+        if !missing.is_empty() {
+            return Err(invalid(
+                "GNSS data",
+                format!("missing column(s) {}{hint}", missing.join(", ")),
+            ));
+        }
+        let g_t = gnss.column("t_s").unwrap_or_default();
+        let g_p = gnss
+            .triples(&[columns[1], columns[2], columns[3]])
+            .unwrap_or_default();
+        let g_v = match velocities {
+            FixVelocity::Full => gnss.triples(&[columns[4], columns[5], columns[6]]),
+            FixVelocity::Horizontal => gnss
+                .column(columns[4])
+                .zip(gnss.column(columns[5]))
+                .map(|(a, b)| a.into_iter().zip(b).map(|(x, y)| [x, y, 0.0]).collect()),
+            FixVelocity::None => None,
+        }
+        .unwrap_or_else(|| vec![[0.0; 3]; g_t.len()]);
+        check_fix_times(&g_t, (t[0], t[t.len() - 1]), t.len())?;
+        let accuracy = fix_accuracy(gnss, accuracy)?;
+        Ok(Self {
+            t,
+            f,
+            w,
+            g_t,
+            g_p,
+            g_v,
+            velocities,
+            accuracy,
+        })
+    }
+
+    /// The IMU's span `[t₀, t₁]`, s.
+    pub(super) fn span(&self) -> (f64, f64) {
+        (self.t[0], self.t[self.t.len() - 1])
+    }
+
+    /// For the alignment from GNSS: the first fix `k` at [`ALIGN_MIN_SPEED_M_S`] or more, the
+    /// IMU sample `i0` it is applied at, and its age there (latency included), s.
+    ///
+    /// # Errors
+    /// No fix that fast.
+    pub(super) fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
+        if self.velocities == FixVelocity::None {
+            return Err(invalid(
+                "GNSS data",
+                "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
+                 GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
+            ));
+        }
+        let k = self
+            .g_v
+            .iter()
+            .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
+            .ok_or_else(|| {
+                invalid(
+                    "GNSS data",
+                    format!(
+                        "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
+                         heading cannot be taken from GNSS velocity (give the initial state \
+                         instead)"
+                    ),
+                )
+            })?;
+        let t = &self.t;
+        let i0 = t.partition_point(|&ti| ti < self.g_t[k]).min(t.len() - 1);
+        Ok((k, i0, t[i0] - self.g_t[k] + latency_s))
+    }
+}
+
+/// A fix table's own accuracy ([`FIX_ACCURACY_COLUMNS`]; where one of the two is missing,
+/// `setup`'s for it), each value a positive finite number; `None` without either column.
+///
+/// # Errors
+/// A value that is not positive and finite (its row).
+fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 2]>>> {
+    let columns = FIX_ACCURACY_COLUMNS.map(|c| gnss.column(c));
+    if columns.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    let rows = gnss.rows();
+    let [h, v] = [0, 1].map(|k| columns[k].clone().unwrap_or_else(|| vec![setup[k]; rows]));
+    for (k, (a, b)) in h.iter().zip(&v).enumerate() {
+        if !(a.is_finite() && b.is_finite() && *a > 0.0 && *b > 0.0) {
+            return Err(invalid(
+                "GNSS data",
+                format!(
+                    "row {}: the fix's accuracy must be positive and finite, got {a} m and {b} m",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok(Some(h.into_iter().zip(v).map(|(a, b)| [a, b]).collect()))
+}
+
+/// The fixes in the filter's terms: positions on its Earth, velocities in its frame.
+pub(super) struct Fixes<E: NavEarth> {
+    /// Each fix's position.
+    pub(super) position: Vec<E::Position>,
+    /// Each fix's velocity (zero where the table has none).
+    pub(super) velocity: Vec<Vec3<E::Frame>>,
+}
+
+impl<E: NavEarth> Fixes<E> {
+    /// The fixes of `inputs`.
+    ///
+    /// # Errors
+    /// A position outside the Earth's domain (its row).
+    pub(super) fn of(inputs: &FusionInputs) -> Result<Self> {
+        let position = inputs
+            .g_p
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                E::fix_position(p).ok_or_else(|| {
+                    invalid(
+                        "GNSS data",
+                        format!(
+                            "row {}: the latitude must be within ±89.9° and the longitude and \
+                             height finite",
+                            k + 2
+                        ),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let velocity = inputs.g_v.iter().map(|&v| E::fix_velocity(v)).collect();
+        Ok(Self { position, velocity })
+    }
+}

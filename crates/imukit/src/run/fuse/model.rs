@@ -1,0 +1,160 @@
+//! What the filter's model is made of, from a scenario or stated apart from any: a part by a
+//! preset's name or a parameter file, the receiver's accuracies.
+use imu_core::AccelSign;
+
+use super::{FuseSetup, OdometerModel};
+use crate::error::{Result, invalid};
+use crate::io::conventions::NavFrameName;
+use crate::io::table::Table;
+
+/// What the filter's model is made of, from a scenario ([`FuseSetup::from_scenario`]) or
+/// stated apart from any ([`PartModel`]): the data's frame, Earth, gravity and accelerometer
+/// sign, the part's error figures at the data's sample rate, and the aids' accuracies.
+#[derive(Clone, Copy, Debug)]
+pub struct FuseModel<'a> {
+    /// Navigation frame of the tables.
+    pub nav_frame: NavFrameName,
+    /// `None`: the flat Earth; on the WGS-84 Earth its gravity model.
+    pub earth: Option<imu_core::earth::GravityModel>,
+    /// Sign of the accelerometer columns.
+    pub accel_sign: AccelSign,
+    /// Gravity magnitude, m/s².
+    pub gravity_m_s2: f64,
+    /// The part's error figures.
+    pub imu: &'a crate::io::params::ImuParams,
+    /// The data's sample rate, Hz (a double-sided density's bandwidth).
+    pub sample_rate_hz: f64,
+    /// The receiver's accuracies and noise model.
+    pub gnss: &'a imu_core::aiding::GnssParams,
+    /// Antenna lever arm, body frame, m.
+    pub lever_arm_m: [f64; 3],
+    /// The receiver's latency, s.
+    pub gnss_latency_s: f64,
+    /// The odometer's model (`None`: none).
+    pub odometer: Option<OdometerModel>,
+    /// The barometer's one-sigma, m (`None`: none).
+    pub baro_sigma_m: Option<f64>,
+}
+
+/// The filter's model apart from any scenario: the part by a preset's name or a parameter
+/// file (`imukit fuse --imu stim300`, `--imu part.toml`), the GNSS receiver as `[gnss]` keys
+/// (`--gnss-horizontal-accuracy-m` …; MATLAB's defaults for the rest), the data's frame and
+/// Earth from the inputs' descriptions ([`PartModel::setup`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PartModel {
+    /// A preset's name, or the path of a parameter file (imukit TOML, MATLAB JSON).
+    pub imu: String,
+    /// The part in a MATLAB file of several.
+    pub part: Option<String>,
+    /// The receiver (its rate is not used).
+    pub gnss: crate::scenario::gnss::GnssSpec,
+}
+
+impl PartModel {
+    /// [`PartModel::setup`] for the IMU table `imu`, at its median sample rate.
+    ///
+    /// # Errors
+    /// As [`PartModel::setup`]; fewer than two samples with increasing times.
+    pub fn setup_for(
+        &self,
+        nav: &crate::run::navigate::NavSetup,
+        accel_sign: Option<AccelSign>,
+        imu: &Table,
+    ) -> Result<FuseSetup> {
+        let t = imu.column("t_s").unwrap_or_default();
+        let median = crate::io::rows::Gaps::of_times(&t, 0).median_s;
+        if median.is_nan() || median <= 0.0 {
+            return Err(invalid(
+                "IMU data",
+                "needs at least two samples with increasing t_s (the sample rate sets the noise)",
+            ));
+        }
+        self.setup(nav, accel_sign, 1.0 / median)
+    }
+
+    /// The filter's setup for data in the frame, Earth and sign of `nav` (the accelerometer
+    /// sign, when `accel_sign` is `None`, the part's profile's) sampled at `sample_rate_hz`.
+    ///
+    /// # Errors
+    /// An unknown preset, an unreadable or invalid parameter file, GNSS keys out of range (named
+    /// `gnss.…`).
+    pub fn setup(
+        &self,
+        nav: &crate::run::navigate::NavSetup,
+        accel_sign: Option<AccelSign>,
+        sample_rate_hz: f64,
+    ) -> Result<FuseSetup> {
+        let path = std::path::Path::new(&self.imu);
+        let is_file = path.extension().is_some() || path.exists();
+        let spec = crate::scenario::ImuSpec {
+            preset: (!is_file).then(|| self.imu.clone()),
+            params: is_file.then(|| path.to_path_buf()),
+            part: self.part.clone(),
+            ..crate::scenario::ImuSpec::default()
+        };
+        let sensors =
+            crate::scenario::sensors::SensorSetup::resolve(&spec, std::path::Path::new("."))?;
+        // A simulated receiver may be exact; a filter told so gates away every real fix.
+        for (field, value) in [
+            (
+                "gnss.horizontal_accuracy_m",
+                self.gnss.horizontal_accuracy_m,
+            ),
+            ("gnss.vertical_accuracy_m", self.gnss.vertical_accuracy_m),
+            (
+                "gnss.velocity_accuracy_m_s",
+                self.gnss.velocity_accuracy_m_s,
+            ),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "must be a one-sigma above 0 for the filter, got {v} (no receiver is \
+                         exact: a filter told so rejects its fixes)"
+                    ),
+                ));
+            }
+        }
+        let gnss = self.gnss.params()?;
+        Ok(FuseSetup::from_model(&FuseModel {
+            nav_frame: nav.nav_frame,
+            earth: nav.earth.map(|e| e.gravity),
+            accel_sign: accel_sign.unwrap_or(sensors.profile.accel_sign()),
+            gravity_m_s2: nav.gravity_m_s2,
+            imu: &sensors.params,
+            sample_rate_hz,
+            gnss: &gnss,
+            lever_arm_m: crate::scenario::resolve::finite_vec(
+                "gnss.lever_arm_m",
+                self.gnss.lever_arm_m.unwrap_or([0.0; 3]),
+            )?,
+            gnss_latency_s: self.gnss.latency_s.unwrap_or(0.0),
+            odometer: None,
+            baro_sigma_m: None,
+        }))
+    }
+}
+
+impl PartModel {
+    /// [`PartModel::setup_for`] on data whose frame, Earth, gravity and accelerometer sign are
+    /// what the user gave (`asked`), else what the inputs' descriptions say (`described`), else
+    /// the conventions asked for, else the library's defaults (the sign: the part's profile's).
+    ///
+    /// # Errors
+    /// An option that contradicts an input's description, or two inputs that disagree (the
+    /// setting named); as [`PartModel::setup_for`].
+    pub fn setup_described(
+        &self,
+        asked: &crate::run::navigate::NavAsked,
+        described: &crate::io::description::Described,
+        imu: &Table,
+    ) -> Result<FuseSetup> {
+        let nav = crate::run::navigate::NavRequest::default()
+            .with_described(asked, described)?
+            .setup()?;
+        self.setup_for(&nav, asked.accel_sign_of(described)?, imu)
+    }
+}
