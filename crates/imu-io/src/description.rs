@@ -16,11 +16,10 @@ use std::path::Path;
 
 use crate::TableFormat;
 use crate::choice::Choice;
+use crate::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
 use crate::error::{Error, Result};
 use crate::schema::TableKind;
 
-use crate::conventions::EarthGravityName;
-use crate::conventions::{AccelSignName, EarthName, NavFrameName};
 pub use crate::described::Described;
 
 /// The prefix of every entry's key in Parquet metadata.

@@ -26,10 +26,11 @@
 //! refused.
 use std::path::Path;
 
-use crate::error::{Error, Result};
-use crate::params::{ParamFile, Sensor};
 use imu_core::allan::BIAS_INSTABILITY_FACTOR;
 use imu_core::sensor::{BiasInstabilityModel, FilterBuffer, NoiseType, SensorParams};
+
+use crate::error::{Error, Result};
+use crate::params::{ParamFile, Sensor};
 
 /// The longest Kalibr file read, bytes (Kalibr's own are a few hundred).
 const MAX_YAML_BYTES: u64 = 64 * 1024;

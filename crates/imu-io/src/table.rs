@@ -3,9 +3,6 @@
 //! A [`Table`] is named columns over row-major `f64` data. CSV output uses shortest round-trip
 //! formatting (`zmij`), so a written file reads back bit for bit, and is written to a temporary file
 //! that is renamed into place only when complete.
-use crate::columns::{
-    ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, TRUTH_COLUMNS,
-};
 use std::collections::HashMap;
 use std::fs::File;
 use std::io::Write;
@@ -16,6 +13,9 @@ use imu_core::{NavFrame, Truth};
 
 use crate::TableFormat;
 use crate::column_map::{ColumnMap, Source, TimeUnit};
+use crate::columns::{
+    ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, TRUTH_COLUMNS,
+};
 use crate::description::Description;
 use crate::error::{Error, Result, invalid};
 use crate::input::Input;

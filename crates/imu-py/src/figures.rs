@@ -3,12 +3,12 @@
 //! NED data into east-north-up. Python draws them with matplotlib (`imukit.plot`).
 use imu_plot::scene::{BOX_EDGES, BOX_NOSE, box_corners_m, point_enu, pose_enu};
 use imu_plot::spec::{self, TableKind};
+use imukit::io::conventions::NavFrameName;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{check_len, choice, fixed, rows, rows_out};
 use crate::errors::{refused, refused_figure, shape_error};
-use imukit::io::conventions::NavFrameName;
 
 /// The kind key of a table with these columns (`truth`, `imu`, `navigation`, `allan`,
 /// `errors`), or `None`.

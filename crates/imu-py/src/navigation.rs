@@ -9,8 +9,7 @@ use imukit::run::navigate::{
     InitialState, NavAsked, NavRequest, SchemeName, VerticalName, integrate,
 };
 use imukit::run::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
-use numpy::PyReadonlyArray1;
-use numpy::PyReadonlyArray2;
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

@@ -3,14 +3,16 @@
 use imu_core::{Enu, Ned};
 use imukit::io::conventions::NavFrameName;
 use imukit::io::rows::SampleClock;
-use imukit::run::orient::{AnyFilter, FilterKind, OrientRequest, run_rows, smooth_rows};
+use imukit::run::orient::{
+    AnyFilter, FilterKind, OrientRequest, ecompass_rows, frame_and_sign, quaternion_distances,
+    run_rows, smooth_rows,
+};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::convert::{array2, choice, choice_opt, flat_rows, vector};
 use crate::errors::refused;
-use imukit::run::orient::{ecompass_rows, frame_and_sign, quaternion_distances};
 
 /// The nav-frame generic filter.
 enum Filter {

@@ -4,8 +4,7 @@ use std::path::Path;
 
 use imu_core::strapdown::planar::PlanarScheme;
 use imukit::choice::Choice;
-use imukit::io::conventions::EarthGravityName;
-use imukit::io::conventions::{AccelSignName, EarthName, NavFrameName};
+use imukit::io::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
 use imukit::io::table::ImuKind;
 use imukit::run::navigate::{
     DEFAULT_RK4_SUBSTEPS, NavRequest, NavScheme, SchemeName, VerticalName,

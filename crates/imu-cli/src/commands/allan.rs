@@ -1,15 +1,14 @@
 //! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
 use std::path::Path;
 
+use imukit::io::Input;
 use imukit::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS};
-
 use imukit::io::output::check_outputs;
+use imukit::io::rows::TimeWindow;
 use imukit::io::table::{read_columns, read_header};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;
-use imukit::io::Input;
-use imukit::io::rows::TimeWindow;
 
 pub fn run(
     source: &Input,

@@ -1,16 +1,16 @@
 //! `imukit demo`: the built-in default scenario, end to end, into a folder.
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::Path;
 
+use imu_plot::animate::{AnimateOptions, animate};
+use imu_plot::{FigureSize, plot_tables};
 use imukit::Simulation;
+use imukit::io::conventions::NavFrameName;
+use imukit::io::output::write_atomically;
 use imukit::scenario::builtin;
 
 use super::CliError;
-use imu_plot::animate::{AnimateOptions, animate};
-use imu_plot::{FigureSize, plot_tables};
-use imukit::io::conventions::NavFrameName;
-use imukit::io::output::write_atomically;
-use std::io::Write as _;
 
 pub fn run(out_dir: &Path, name: &str) -> Result<(), CliError> {
     let io = |source| CliError::Io {

@@ -2,16 +2,16 @@
 use std::io::Write;
 use std::path::Path;
 
+use imukit::io::Input;
 use imukit::io::output::{check_outputs, write_atomically};
 use imukit::io::params::to_toml;
+use imukit::io::rows::TimeWindow;
 use imukit::run::identify::{
     column_header, curve_table, filter_noise, kalibr, param_file, term_rows,
 };
 
 use super::CliError;
 use super::allan::{analyse, file_name};
-use imukit::io::Input;
-use imukit::io::rows::TimeWindow;
 
 /// Where `identify` writes, besides the curve.
 pub struct Outputs<'a> {

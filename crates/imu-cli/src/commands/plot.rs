@@ -3,12 +3,11 @@ use std::path::{Path, PathBuf};
 
 use imu_plot::animate::{self as anim, AnimateOptions};
 use imu_plot::{FigureSize, plot_files};
+use imukit::io::conventions::NavFrameName;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
 use imukit::io::table::read_table;
-
-use imukit::io::conventions::NavFrameName;
 
 use super::CliError;
 use crate::cli::FigureArgs;

@@ -3,14 +3,13 @@
 //! level, carried into the tangent plane of the scenario's origin exactly (the ellipsoid's
 //! formulas evaluated over dual numbers).
 
+use std::cell::RefCell;
+use std::sync::OnceLock;
+
 use imu_core::earth::Geodetic;
 use imu_core::earth::wgs84::{A_M, E2};
 use imu_core::{Ecef, NavFrame, Rotation};
-
 use num_dual::DualNum;
-
-use std::cell::RefCell;
-use std::sync::OnceLock;
 
 use crate::io::conventions::NavFrameName;
 use crate::motion::analytic::{Motion, MotionPoint, Scalar, atan2, dual_derivatives};

@@ -1,16 +1,15 @@
 //! The array-level API behind the Python functions: plain slices in, [`Table`]s out, with errors
 //! that name the argument and index.
-use crate::io::columns::TRUTH_COLUMNS;
-use crate::io::conventions::{AccelSignName, NavFrameName};
-use crate::motion::analytic::AnalyticOptions;
 use imu_core::ideal::at_lever_arm;
 use imu_core::kinematics::sampled::SampledOptions;
 use imu_core::kinematics::tangent::tangent_series;
 use imu_core::{Body, Enu, EulerZyx, IdealReading, NavFrame, Ned, Rotation, Truth, Vec3};
 
 use crate::error::{Error, Result, invalid};
-use crate::io::table::ImuKind;
-use crate::io::table::Table;
+use crate::io::columns::TRUTH_COLUMNS;
+use crate::io::conventions::{AccelSignName, NavFrameName};
+use crate::io::table::{ImuKind, Table};
+use crate::motion::analytic::AnalyticOptions;
 use crate::motion::{SampledAttitudeData, SampledPath, Trajectory};
 use crate::run::simulate::motion_chunks;
 use crate::scenario::resolve::finite_vec;

@@ -4,17 +4,16 @@
 //! stream (so a run in chunks equals the run whole). Python's `imukit.ImuSensor` is this object.
 use std::path::Path;
 
-use crate::io::conventions::{AccelSignName, NavFrameName};
-
-use crate::sensor::{ImuModel, ImuState};
 use imu_core::sensor::{SeededNormals, Temperatures};
 use imu_core::{AccelSign, Body, DEFAULT_GRAVITY_M_S2, Enu, NavFrame, Ned, Rotation, Vec3};
 
 use crate::error::{Result, invalid};
+use crate::io::conventions::{AccelSignName, NavFrameName};
 use crate::io::params::Profile;
 use crate::io::table::{ImuKind, check_finite};
 use crate::scenario::sensors::SensorSetup;
 use crate::scenario::{ImuSetup, ImuSpec};
+use crate::sensor::{ImuModel, ImuState};
 
 /// An imuSensor as MATLAB's constructor states it; checked once, in [`ImuSensor::new`]. Errors
 /// name MATLAB's (Python's) argument names: `imu_type`, `reference_frame`, `profile`,

@@ -3,13 +3,13 @@
 //! Planar IMU data: CSV with `t_s, accel_x_m_s2, accel_y_m_s2, gyro_z_rad_s` (extra columns
 //! ignored, so a full imukit IMU CSV works), or the exercise's whitespace-separated `.dat` files
 //! with the columns t, a_x, a_y, ω_z in that order (lines starting with `#` or `%` skipped).
-use crate::io::Input;
-use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
 
 use crate::error::{Error, Result, invalid};
+use crate::io::Input;
+use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use crate::io::output::write_atomically;
 use crate::io::table::{Table, read_columns, write_rows};
 use crate::scenario::resolve::finite_vec;

@@ -7,10 +7,10 @@
 //! their difference turned into north, east and down at the reference point; velocities in
 //! north, east, down; attitudes as the turn from forward-right-down body axes to the local
 //! north-east-down frame, whatever frame each table was written in.
-use crate::io::columns::{Position, QUATERNION_COLUMNS, Velocity};
 use imu_core::earth::Geodetic;
 use imu_core::{Body, Ecef, Enu, Frd, NavFrame, Ned, Rotation, Vec3};
 
+use crate::io::columns::{Position, QUATERNION_COLUMNS, Velocity};
 use crate::io::conventions::NavFrameName;
 
 /// What a reference table holds.

@@ -11,9 +11,6 @@
 //! chunk ahead on a second thread ([`crate::run::pipeline`]); the numbers do not change.
 use std::path::Path;
 
-use crate::io::conventions::NavFrameName;
-
-use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, DERIVATIVE_CHUNK, Motion};
 use imu_core::kinematics::sampled::backfill_standstill;
 use imu_core::sensor::ImuReading;
 use imu_core::{Enu, NavFrame, Ned, Truth};
@@ -21,10 +18,12 @@ use imu_core::{Enu, NavFrame, Ned, Truth};
 use crate::error::Result;
 use crate::io::TableFormat;
 use crate::io::bag::BagOptions;
+use crate::io::conventions::NavFrameName;
 use crate::io::description::Description;
 use crate::io::output::AtomicFile;
 use crate::io::schema::TableKind;
 use crate::io::table::{ImuOutput, Table, check_finite_from};
+use crate::motion::analytic::{AnalyticOptions, AnalyticStepper, DERIVATIVE_CHUNK, Motion};
 use crate::motion::{Trajectory, with_time};
 use crate::run::pipeline::{RunThreads, Stage, run_in_stages};
 use crate::scenario::report::RunReport;

@@ -2,13 +2,13 @@
 //! `rate_hz` (a divisor of the scenario's rate, so at IMU samples) of the height (up: ENU `z`,
 //! −NED `z`, or the WGS-84 height) and of the body's forward speed, with a constant error and
 //! white noise ([`imu_core::aiding::SimpleAid`]), each on its own seeded stream.
-use crate::io::columns::{BARO_COLUMNS, ODOMETER_COLUMNS};
 use imu_core::aiding::SimpleAid;
 use imu_core::sensor::SeededNormals;
 use imu_core::{NavFrame, Truth};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
+use crate::io::columns::{BARO_COLUMNS, ODOMETER_COLUMNS};
 use crate::io::table::Table;
 
 /// Noise streams (the IMU's is 0, the GNSS receiver's 1).

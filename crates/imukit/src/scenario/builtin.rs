@@ -12,9 +12,8 @@
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_PI_2;
 
-use crate::io::conventions::NavFrameName;
-
 use crate::error::{Result, invalid};
+use crate::io::conventions::NavFrameName;
 use crate::motion::track::Segment;
 use crate::scenario::{ExpressionSpec, Formula, ImuSpec, ScenarioSpec, TrackSpec, TrajectorySpec};
 

@@ -10,15 +10,13 @@
 //! ground velocity in the local-level frame at the position and the derivative of its
 //! components, the attitude is relative to that frame, `omega_*` is the attitude rate
 //! `ω_nb^b`; `lat_rad, lon_rad, height_m` and `ecef_*_m` are added.
-use crate::io::columns::EARTH_TRUTH_COLUMNS;
 use imu_core::earth::ideal::EcefKinematics;
 use imu_core::earth::{EarthMount, EarthTruth, Geodetic, GravityModel, MagneticModel};
 use imu_core::ideal::IdealReading;
 use imu_core::{Body, Ecef, EulerZyx, NavFrame, Ned, Rotation, Truth, Vec3};
 
-use crate::io::columns::TRUTH_COLUMNS;
-
 use crate::error::{Result, invalid};
+use crate::io::columns::{EARTH_TRUTH_COLUMNS, TRUTH_COLUMNS};
 use crate::io::table::{Table, truth_row};
 
 /// The Earth a scenario runs on.

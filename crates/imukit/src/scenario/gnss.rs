@@ -5,7 +5,6 @@
 //! Output ([`GNSS_COLUMNS`] on the flat Earth, [`GNSS_EARTH_COLUMNS`] on WGS-84): the stamp
 //! time, the position (navigation-frame metres, or latitude, longitude, height) and the ground
 //! velocity (navigation-frame axes, or north, east, down).
-use crate::io::columns::{GNSS_COLUMNS, GNSS_EARTH_COLUMNS};
 use imu_core::aiding::{GnssModel, GnssParams, GnssState, PositionNoise};
 use imu_core::earth::{EarthTruth, Geodetic};
 use imu_core::sensor::SeededNormals;
@@ -13,6 +12,7 @@ use imu_core::{Body, NavFrame, Ned, Truth, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
+use crate::io::columns::{GNSS_COLUMNS, GNSS_EARTH_COLUMNS};
 use crate::io::table::Table;
 
 /// The noise stream of the GNSS receiver (the IMU's is stream 0).

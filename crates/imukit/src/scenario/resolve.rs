@@ -1,13 +1,15 @@
 //! From a scenario as written ([`super::spec`]) to a runnable [`Scenario`]: built-ins merged,
 //! defaults filled, formulas parsed, files read, every value checked once.
 
-use crate::io::conventions::{EarthName, NavFrameName};
 use std::path::{Path, PathBuf};
 
 use imu_core::AccelSign;
+use imu_core::earth::{Geodetic, GravityModel, MagneticModel};
 use imu_core::kinematics::tangent::DEFAULT_MIN_SPEED_M_S;
 
 use crate::error::{Error, Result, invalid};
+use crate::io::conventions::{EarthName, NavFrameName};
+use crate::io::memory::check_in_memory;
 use crate::io::params::ParamValue;
 use crate::io::table::read_columns;
 use crate::motion::analytic::AnalyticOptions;
@@ -16,17 +18,11 @@ use crate::motion::expression::GeodeticPlane;
 use crate::motion::track::{SpeedProfile, Track};
 use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
-use crate::scenario::builtin;
-use crate::scenario::report;
-
-use crate::io::memory::check_in_memory;
-use crate::scenario::earth::MagneticEnvironment;
-use crate::scenario::earth::{EarthSetup, TangentPlane};
+use crate::scenario::earth::{EarthSetup, MagneticEnvironment, TangentPlane};
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
 use crate::scenario::times::{SampleTimes, regular_times};
-use crate::scenario::{ImuSetup, Scenario};
-use imu_core::earth::{Geodetic, GravityModel, MagneticModel};
+use crate::scenario::{ImuSetup, Scenario, builtin, report};
 
 impl ScenarioSpec {
     /// Parses TOML text; `origin` names the file in messages.

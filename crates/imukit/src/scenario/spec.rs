@@ -1,15 +1,14 @@
 //! The scenario file's vocabulary: what a user writes in TOML, JSON or a Python dict, before
 //! defaults and files are resolved ([`super::resolve`]).
 
-use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
-use crate::io::params::Profile;
-use crate::io::params::SensorTable;
+use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
+use crate::io::params::{Profile, SensorTable};
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::motion::expr::Expr;
 use crate::motion::expression::GeodeticPlane;

@@ -1,6 +1,4 @@
 //! An orientation filter over an IMU file, streamed into an orientation table (`imukit orient`).
-use crate::io::Input;
-use crate::io::columns::{ORIENT_COLUMNS, ROBUST_COLUMNS};
 use std::path::Path;
 
 use imu_core::orientation::{FilterInput, OrientationFilter};
@@ -9,7 +7,10 @@ use imu_core::{Body, Enu, NavFrame, Ned, Rotation};
 use super::{AnyFilter, FilterKind, FilterSpec, SIX_AXIS_FILTERS, robust_row};
 use crate::choice::Choice;
 use crate::error::{Result, invalid};
-use crate::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
+use crate::io::Input;
+use crate::io::columns::{
+    ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, ORIENT_COLUMNS, ROBUST_COLUMNS,
+};
 use crate::io::conventions::NavFrameName;
 use crate::io::description::Description;
 use crate::io::output::AtomicFile;
