@@ -28,8 +28,8 @@ fn bench(c: &mut Criterion) {
             odometer,
             baro: false,
             nhc_sigma_m_s: odometer.then_some(0.05),
-            sensor_errors: full,
-            rest_s: if full { 20.0 } else { 0.0 },
+            sensor_errors: Some(full),
+            rest_s: Some(if full { 20.0 } else { 0.0 }),
             smooth,
             draw_parts: true,
         };

@@ -577,7 +577,7 @@ pub enum Command {
         #[arg(long, value_name = "FILE")]
         kalibr: Option<PathBuf>,
         /// Factor on the Kalibr file's densities (stated in the file).
-        #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+        #[arg(long, default_value_t = imukit::io::kalibr::DEFAULT_INFLATION, value_name = "FACTOR")]
         kalibr_inflation: f64,
         /// The IMU topic written in the Kalibr file.
         #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC, value_name = "TOPIC")]
@@ -656,7 +656,7 @@ pub enum Command {
         #[arg(long = "lever-arm-m", alias = "lever-arm", num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
         lever_arm: Option<Vec<f64>>,
         /// Frames per second.
-        #[arg(long, default_value_t = 20.0)]
+        #[arg(long, default_value_t = imu_plot::spec::DEFAULT_FPS)]
         fps: f64,
         /// Seconds of motion per second of animation (default: the animation lasts 4 to 12 s).
         #[arg(long)]

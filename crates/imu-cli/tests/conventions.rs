@@ -171,3 +171,58 @@ fn progress_goes_to_a_log_as_lines_and_quiet_silences_it() {
     assert!(quiet.status.success());
     assert_eq!(String::from_utf8(quiet.stderr).unwrap(), "");
 }
+
+/// The numbers `imukit fuse --help` states are the library's defaults: a change in the library
+/// that the help text does not follow fails here.
+#[test]
+fn fuse_help_states_the_librarys_numbers() {
+    use imukit::run::fuse::{
+        ALIGN_MIN_SPEED_M_S, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S,
+        G_SENSITIVITY_STATES_FROM, NHC_RATE_HZ, REST_WINDOW_S, SENSOR_ERROR_STATES_FROM,
+        STATIC_ALIGN_S,
+    };
+    let out = imukit().args(["fuse", "--help"]).output().unwrap();
+    // Lines are wrapped to the terminal: compare with single spaces.
+    let help = String::from_utf8(out.stdout)
+        .unwrap()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    for stated in [
+        format!("first fix at {ALIGN_MIN_SPEED_M_S} m/s or more"),
+        format!("over the first {STATIC_ALIGN_S} s"),
+        format!("{DEFAULT_NHC_SIGMA_M_S} when given without a value"),
+        format!("at {NHC_RATE_HZ} Hz"),
+        format!("default {DEFAULT_COVARIANCE_INTERVAL_S})"),
+        format!("reach {} %", SENSOR_ERROR_STATES_FROM * 100.0),
+        format!("(or {G_SENSITIVITY_STATES_FROM:e} (rad/s)/(m/s²)"),
+        format!("blocks of {REST_WINDOW_S} s"),
+    ] {
+        assert!(
+            help.contains(&stated),
+            "`imukit fuse --help` should say {stated:?}: {help}"
+        );
+    }
+}
+
+/// `--nhc` alone turns the constraints on with the library's one-sigma.
+#[test]
+fn nhc_alone_is_the_librarys_default() {
+    use clap::Parser;
+    use imu_cli::cli::{Cli, Command};
+    let cli = Cli::try_parse_from([
+        "imukit",
+        "fuse",
+        "imu.csv",
+        "--scenario",
+        "s.toml",
+        "--nhc",
+        "--out",
+        "o.csv",
+    ])
+    .unwrap();
+    let Command::Fuse { nhc, .. } = cli.command else {
+        panic!("not fuse")
+    };
+    assert_eq!(nhc, Some(imukit::run::fuse::DEFAULT_NHC_SIGMA_M_S));
+}

@@ -238,6 +238,9 @@ pub fn read(path: &Path) -> Result<KalibrImu> {
 /// The topic written when none is given: imukit's IMU topic in a ROS bag.
 pub const DEFAULT_TOPIC: &str = "/imu";
 
+/// The factor on the densities written when none is given: the identified figures as they are.
+pub const DEFAULT_INFLATION: f64 = 1.0;
+
 /// The rate written when none is given, Hz (Kalibr's own example file's); the rate is the
 /// logger's, so a user sets it.
 pub const DEFAULT_RATE_HZ: f64 = 200.0;

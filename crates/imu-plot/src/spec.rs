@@ -341,6 +341,9 @@ pub struct FramePlan {
 /// The most frames an animation may have (at 20 frames/s, over eight minutes).
 pub const MAX_FRAMES: usize = 10_000;
 
+/// Frames per second of an animation unless told (`imukit animate --fps`, Python's `fps=`).
+pub const DEFAULT_FPS: f64 = 20.0;
+
 /// Plans an animation of samples at times `t_s` (finite, increasing): frames every
 /// `speed / fps` seconds of motion from the first to the last sample. Without a `speed` the
 /// animation lasts between 4 and 12 s: real time for motions of that length, slow motion for

@@ -30,5 +30,42 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     d.set_item("imu_type", ImuKind::default_name())?;
     d.set_item("kalibr_rate_hz", imukit::io::kalibr::DEFAULT_RATE_HZ)?;
     d.set_item("kalibr_topic", imukit::io::kalibr::DEFAULT_TOPIC)?;
+    d.set_item("kalibr_inflation", imukit::io::kalibr::DEFAULT_INFLATION)?;
+    d.set_item("animation_fps", imu_plot::spec::DEFAULT_FPS)?;
+    d.set_item(
+        "planar_position0_m",
+        imukit::run::planar::EXERCISE_POSITION0_M.to_vec(),
+    )?;
+    d.set_item(
+        "finite_difference_order",
+        imukit::core::kinematics::finite_diff::DEFAULT_ORDER,
+    )?;
+    // Each orientation filter's settings by MATLAB name, as the library builds them (a filter
+    // with a magnetometer where it takes one; Madgwick's gain without).
+    let filters = PyDict::new(m.py());
+    for (name, kind) in FilterKind::NAMES {
+        let settings = PyDict::new(m.py());
+        let magnetometer = kind.magnetometer().unwrap_or(false);
+        for (setting, value) in kind.setting_defaults(magnetometer) {
+            settings.set_item(setting, value)?;
+        }
+        filters.set_item(*name, settings)?;
+    }
+    d.set_item("filters", filters)?;
+    // MATLAB imuSensor's defaults, as the library's request states them.
+    let s = imukit::run::imu_sensor::ImuSensorRequest::default();
+    let sensor = PyDict::new(m.py());
+    sensor.set_item("imu_type", s.imu_type.name())?;
+    sensor.set_item("reference_frame", s.reference_frame.name())?;
+    sensor.set_item("sample_rate", s.sample_rate_hz)?;
+    sensor.set_item("temperature", s.temperature_c)?;
+    sensor.set_item("profile", s.profile.name())?;
+    d.set_item("imu_sensor", sensor)?;
+    d.set_item(
+        "initial_process_noise",
+        imukit::core::orientation::KalmanParams::default()
+            .initial_process_noise
+            .to_vec(),
+    )?;
     m.add("DEFAULTS", d)
 }

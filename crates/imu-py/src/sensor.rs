@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    check_len, choice, choice_opt, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table,
+    check_len, choice_opt, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table,
 };
 use crate::errors::{refused, shape_error};
 
@@ -28,31 +28,34 @@ struct PyImuSensor(ImuSensor);
 #[pymethods]
 impl PyImuSensor {
     #[new]
-    #[pyo3(signature = (imu_type = "accel-gyro", *, reference_frame = "NED", sample_rate = 100.0, temperature = 25.0,
+    #[pyo3(signature = (imu_type = None, *, reference_frame = None, sample_rate = None, temperature = None,
                         magnetic_field = None, accelerometer = None, gyroscope = None, magnetometer = None,
-                        preset = None, seed = 0, profile = "matlab", accel_sign = None))]
+                        preset = None, seed = 0, profile = None, accel_sign = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        imu_type: &str,
-        reference_frame: &str,
-        sample_rate: f64,
-        temperature: f64,
+        imu_type: Option<&str>,
+        reference_frame: Option<&str>,
+        sample_rate: Option<f64>,
+        temperature: Option<f64>,
         magnetic_field: Option<Vec<f64>>,
         accelerometer: Option<&Bound<'_, PyAny>>,
         gyroscope: Option<&Bound<'_, PyAny>>,
         magnetometer: Option<&Bound<'_, PyAny>>,
         preset: Option<String>,
         seed: i64,
-        profile: &str,
+        profile: Option<&str>,
         accel_sign: Option<&str>,
     ) -> PyResult<Self> {
+        // What is left out is MATLAB's default, as the library states it.
+        let d = ImuSensorRequest::default();
         let request = ImuSensorRequest {
-            imu_type: choice("imu_type", imu_type)?,
-            reference_frame: choice("reference_frame", reference_frame)?,
-            sample_rate_hz: sample_rate,
-            temperature_c: temperature,
+            imu_type: choice_opt("imu_type", imu_type)?.unwrap_or(d.imu_type),
+            reference_frame: choice_opt("reference_frame", reference_frame)?
+                .unwrap_or(d.reference_frame),
+            sample_rate_hz: sample_rate.unwrap_or(d.sample_rate_hz),
+            temperature_c: temperature.unwrap_or(d.temperature_c),
             magnetic_field_ut: fixed_opt::<3>("magnetic_field", magnetic_field)?,
-            profile: choice("profile", profile)?,
+            profile: choice_opt("profile", profile)?.unwrap_or(d.profile),
             accel_sign: choice_opt("accel_sign", accel_sign)?,
             params: ImuSpec {
                 preset,
@@ -185,7 +188,7 @@ fn allan_deviation<'py>(
 /// unit, datasheet_unit, datasheet_factor)`; `reduced_chi2` per column; `params_toml` (None
 /// without gyroscope or accelerometer columns) and `kalibr_yaml` (None without both).
 #[pyfunction]
-#[pyo3(signature = (x, sample_rate_hz, names, source, *, kalibr_inflation = 1.0, kalibr_topic = imukit::io::kalibr::DEFAULT_TOPIC))]
+#[pyo3(signature = (x, sample_rate_hz, names, source, *, kalibr_inflation = imukit::io::kalibr::DEFAULT_INFLATION, kalibr_topic = imukit::io::kalibr::DEFAULT_TOPIC))]
 fn identify<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,

@@ -748,3 +748,45 @@ fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
     };
     assert!(part(given).setup(&NavSetup::default(), None, 100.0).is_ok());
 }
+
+/// Every setting an orientation filter takes has its default in one table
+/// ([`FilterKind::setting_defaults`]), and a filter given those defaults by name is the filter
+/// built without them.
+#[test]
+fn each_filter_setting_has_one_default_and_stating_it_changes_nothing() {
+    use imukit::choice::Choice;
+    use imukit::run::orient::{FilterKind, FilterSpec};
+    for (name, kind) in FilterKind::NAMES {
+        for magnetometer in [false, true] {
+            if kind.magnetometer().is_some_and(|m| m != magnetometer) {
+                continue;
+            }
+            let defaults = kind.setting_defaults(magnetometer);
+            let mut named: Vec<&str> = defaults.iter().map(|(n, _)| *n).collect();
+            let mut takes = kind.settings();
+            named.sort_unstable();
+            takes.sort_unstable();
+            assert_eq!(
+                named, takes,
+                "{name}: a default for every setting, and no other"
+            );
+            let plain = FilterSpec {
+                magnetometer,
+                ..FilterSpec::new(*kind, imu_core::AccelSign::SpecificForce)
+            };
+            let stated = FilterSpec {
+                settings: defaults
+                    .iter()
+                    .map(|(n, v)| ((*n).to_string(), *v))
+                    .collect(),
+                ..plain.clone()
+            };
+            let rate = kind.setting_defaults(magnetometer)[0].1;
+            assert_eq!(
+                format!("{:?}", plain.build::<imu_core::Enu>(rate).unwrap()),
+                format!("{:?}", stated.build::<imu_core::Enu>(rate).unwrap()),
+                "{name}, magnetometer {magnetometer}"
+            );
+        }
+    }
+}

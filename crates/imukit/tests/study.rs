@@ -23,8 +23,8 @@ fn study_smoothed(presets: &[&str], runs: u64, smooth: bool) -> Study {
         odometer: false,
         baro: false,
         nhc_sigma_m_s: None,
-        sensor_errors: true,
-        rest_s: 20.0,
+        sensor_errors: Some(true),
+        rest_s: Some(20.0),
         smooth,
         draw_parts: true,
     };
@@ -183,8 +183,8 @@ fn an_odometer_and_the_vehicle_constraints_shrink_the_drift_through_the_tunnel()
             odometer: wheels,
             baro: false,
             nhc_sigma_m_s: wheels.then_some(0.05),
-            sensor_errors: true,
-            rest_s: 20.0,
+            sensor_errors: Some(true),
+            rest_s: Some(20.0),
             smooth: false,
             draw_parts: true,
         };
@@ -223,4 +223,52 @@ fn parts_not_described_alike_are_named_before_the_study_runs() {
     }
     // Parts described alike (neither gives any of the terms): nothing to say.
     assert!(study(&["ideal", "icm-42688-p"], 2).undescribed().is_empty());
+}
+
+/// A study sets each preset's filter up as `imukit fuse` does with the same scenario and
+/// options: the same request ([`StudySpec::request`]) through the same policy, also for what a
+/// study file leaves out (the sensor-error states when the part warrants them, the rest found
+/// in the readings).
+#[test]
+fn a_study_sets_the_filter_up_as_fuse_does() {
+    use imukit::ScenarioSpec;
+    use imukit::run::fuse::FuseRequest;
+    use imukit::run::navigate::InitialState;
+    let presets = ["mpu-6050", "stim300"];
+    let spec = StudySpec {
+        scenario: "car_tunnel.toml".into(),
+        presets: presets.iter().map(|p| p.to_string()).collect(),
+        runs: 2,
+        odometer: false,
+        baro: false,
+        nhc_sigma_m_s: Some(0.05),
+        sensor_errors: None,
+        rest_s: None,
+        smooth: false,
+        draw_parts: true,
+    };
+    let s = Study::new(&spec, &examples(), "test study").unwrap();
+    let initial = InitialState::default();
+    let asked_of_fuse = FuseRequest {
+        initial: Some(&initial),
+        nhc_sigma_m_s: Some(0.05),
+        ..FuseRequest::default()
+    };
+    let mut seen = 0;
+    for (preset, setup) in s.setups() {
+        let mut scenario = ScenarioSpec::from_file(&examples().join("car_tunnel.toml")).unwrap();
+        scenario.imu.preset = Some(preset.to_string());
+        let scenario = scenario.resolve(&examples()).unwrap();
+        let (fused, _) = asked_of_fuse.setup(&scenario).unwrap();
+        assert_eq!(*setup, fused, "{preset}");
+        assert!(
+            setup.detect_rest,
+            "{preset}: the rest is found, as fuse finds it"
+        );
+        seen += 1;
+    }
+    assert_eq!(seen, presets.len());
+    // The consumer part's figures warrant the sensor-error states; the tactical part's do not.
+    let full: Vec<bool> = s.setups().map(|(_, s)| s.estimate_sensor_errors).collect();
+    assert_eq!(full, [true, false]);
 }

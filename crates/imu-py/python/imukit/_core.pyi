@@ -13,7 +13,7 @@ _DescribedIn = Sequence[tuple[str, dict[str, Union[str, float]]]]
 _Simulation = tuple[Optional[_Described], _Described, Optional[_Described], Optional[_Described], Optional[_Described], list[str]]
 
 __version__: str
-DEFAULTS: dict[str, str | int | float | bool]
+DEFAULTS: dict[str, Any]
 
 __all__ = [
     "cli_main",
@@ -169,18 +169,18 @@ def write_examples(names: list[str], folder: str) -> list[tuple[str, bool]]: ...
 class ImuSensor:
     def __new__(
         cls,
-        imu_type: str = "accel-gyro",
+        imu_type: Optional[str] = None,
         *,
-        reference_frame: str = "NED",
-        sample_rate: float = 100.0,
-        temperature: float = 25.0,
+        reference_frame: Optional[str] = None,
+        sample_rate: Optional[float] = None,
+        temperature: Optional[float] = None,
         magnetic_field: Optional[Sequence[float]] = None,
         accelerometer: Optional[dict[str, Any]] = None,
         gyroscope: Optional[dict[str, Any]] = None,
         magnetometer: Optional[dict[str, Any]] = None,
         preset: Optional[str] = None,
         seed: int = 0,
-        profile: str = "matlab",
+        profile: Optional[str] = None,
         accel_sign: Optional[str] = None,
     ) -> ImuSensor: ...
     def step(

@@ -23,7 +23,7 @@ def planar_dead_reckon(
     gyro_z_rad_s,
     *,
     scheme: str = _D["planar_scheme"],
-    position0_m: Sequence[float] = (100.0, 100.0),
+    position0_m: Sequence[float] = tuple(_D["planar_position0_m"]),
     heading0_rad: float = 0.0,
     velocity0_m_s: Sequence[float] = (0.0, 0.0),
 ) -> Table:

@@ -18,7 +18,10 @@ import numpy as np
 
 from . import _core
 
-_IPN_DIAG = np.repeat([6.092348396e-06, 7.6154354947e-05, 0.00962361, 0.6], 3)
+# The library's defaults (`imukit._core.DEFAULTS`): each filter's settings by MATLAB name.
+_F = _core.DEFAULTS["filters"]
+_IMU, _AHRS = _F["imufilter"], _F["ahrsfilter"]
+_IPN_DIAG = np.array(_core.DEFAULTS["initial_process_noise"])
 
 
 def _rows(name: str, x, n: Optional[int] = None) -> np.ndarray:
@@ -136,11 +139,14 @@ class ImuFilter(_Filter):
     _states = 9
     DEFAULT_INITIAL_PROCESS_NOISE = np.diag(_IPN_DIAG[:9])
 
-    def __init__(self, sample_rate: float = 100.0, *, conventions: Optional[str] = None,
-                 reference_frame: Optional[str] = None, decimation_factor: int = 1,
-                 accelerometer_noise: float = 0.00019247, gyroscope_noise: float = 9.1385e-5,
-                 gyroscope_drift_noise: float = 3.0462e-13, linear_acceleration_noise: float = 0.0096236,
-                 linear_acceleration_decay_factor: float = 0.5, initial_process_noise=None,
+    def __init__(self, sample_rate: float = _IMU["SampleRate"], *, conventions: Optional[str] = None,
+                 reference_frame: Optional[str] = None, decimation_factor: int = int(_IMU["DecimationFactor"]),
+                 accelerometer_noise: float = _IMU["AccelerometerNoise"],
+                 gyroscope_noise: float = _IMU["GyroscopeNoise"],
+                 gyroscope_drift_noise: float = _IMU["GyroscopeDriftNoise"],
+                 linear_acceleration_noise: float = _IMU["LinearAccelerationNoise"],
+                 linear_acceleration_decay_factor: float = _IMU["LinearAccelerationDecayFactor"],
+                 initial_process_noise=None,
                  orientation_format: str = "quaternion", accel_sign: Optional[str] = None, **magnetic) -> None:
         settings = dict(DecimationFactor=decimation_factor, AccelerometerNoise=accelerometer_noise,
                         GyroscopeNoise=gyroscope_noise, GyroscopeDriftNoise=gyroscope_drift_noise,
@@ -174,9 +180,12 @@ class AhrsFilter(ImuFilter):
     _states = 12
     DEFAULT_INITIAL_PROCESS_NOISE = np.diag(_IPN_DIAG)
 
-    def __init__(self, sample_rate: float = 100.0, *, magnetometer_noise: float = 0.1,
-                 magnetic_disturbance_noise: float = 0.5, magnetic_disturbance_decay_factor: float = 0.5,
-                 expected_magnetic_field_strength: float = 50.0, **kwargs) -> None:
+    def __init__(self, sample_rate: float = _AHRS["SampleRate"], *,
+                 magnetometer_noise: float = _AHRS["MagnetometerNoise"],
+                 magnetic_disturbance_noise: float = _AHRS["MagneticDisturbanceNoise"],
+                 magnetic_disturbance_decay_factor: float = _AHRS["MagneticDisturbanceDecayFactor"],
+                 expected_magnetic_field_strength: float = _AHRS["ExpectedMagneticFieldStrength"],
+                 **kwargs) -> None:
         super().__init__(sample_rate, MagnetometerNoise=magnetometer_noise,
                          MagneticDisturbanceNoise=magnetic_disturbance_noise,
                          MagneticDisturbanceDecayFactor=magnetic_disturbance_decay_factor,
@@ -206,8 +215,9 @@ class ComplementaryFilter(_SimpleFilter):
 
     _kind = "complementary"
 
-    def __init__(self, sample_rate: float = 100.0, *, accelerometer_gain: float = 0.01,
-                 magnetometer_gain: float = 0.01, has_magnetometer: bool = True, conventions: Optional[str] = None,
+    def __init__(self, sample_rate: float = _F["complementary"]["SampleRate"], *,
+                 accelerometer_gain: float = _F["complementary"]["AccelerometerGain"],
+                 magnetometer_gain: float = _F["complementary"]["MagnetometerGain"], has_magnetometer: bool = True, conventions: Optional[str] = None,
                  reference_frame: Optional[str] = None, orientation_format: str = "quaternion",
                  accel_sign: Optional[str] = None) -> None:
         super().__init__(sample_rate, conventions, reference_frame, accel_sign, has_magnetometer,
@@ -221,7 +231,7 @@ class MadgwickFilter(_SimpleFilter):
 
     _kind = "madgwick"
 
-    def __init__(self, sample_rate: float = 100.0, *, beta: Optional[float] = None, has_magnetometer: bool = False,
+    def __init__(self, sample_rate: float = _F["madgwick"]["SampleRate"], *, beta: Optional[float] = None, has_magnetometer: bool = False,
                  conventions: Optional[str] = None, reference_frame: Optional[str] = None,
                  orientation_format: str = "quaternion", accel_sign: Optional[str] = None) -> None:
         settings = {} if beta is None else dict(Beta=beta)
@@ -257,7 +267,7 @@ class RobustFilter(_SimpleFilter):
 
     _kind = "robust"
 
-    def __init__(self, sample_rate: float = 100.0, *, has_magnetometer: bool = False,
+    def __init__(self, sample_rate: float = _F["robust"]["SampleRate"], *, has_magnetometer: bool = False,
                  accelerometer_time_constant: Optional[float] = None,
                  magnetometer_time_constant: Optional[float] = None, settings: Optional[dict] = None,
                  conventions: Optional[str] = None, reference_frame: Optional[str] = None,
@@ -291,7 +301,8 @@ class MahonyFilter(_SimpleFilter):
 
     _kind = "mahony"
 
-    def __init__(self, sample_rate: float = 100.0, *, kp: float = 1.0, ki: float = 0.3,
+    def __init__(self, sample_rate: float = _F["mahony"]["SampleRate"], *, kp: float = _F["mahony"]["Kp"],
+                 ki: float = _F["mahony"]["Ki"],
                  has_magnetometer: bool = False, conventions: Optional[str] = None,
                  reference_frame: Optional[str] = None, orientation_format: str = "quaternion",
                  accel_sign: Optional[str] = None) -> None:

@@ -12,6 +12,8 @@ import numpy as np
 from . import _core
 from ._convert import _out, _rows
 
+_S = _core.DEFAULTS["imu_sensor"]  # MATLAB imuSensor's defaults, as the library states them
+
 
 def _matlab_name(field: str) -> str:
     """MATLAB's property name of a parameter field: ``noise_density`` → ``NoiseDensity``."""
@@ -105,18 +107,18 @@ class ImuSensor:
 
     def __init__(
         self,
-        imu_type: str = "accel-gyro",
+        imu_type: str = _S["imu_type"],
         *,
-        reference_frame: str = "NED",
-        sample_rate: float = 100.0,
-        temperature: float = 25.0,
+        reference_frame: str = _S["reference_frame"],
+        sample_rate: float = _S["sample_rate"],
+        temperature: float = _S["temperature"],
         magnetic_field: Optional[Sequence[float]] = None,
         accelerometer: Optional[Union[Mapping[str, Any], "AccelParams"]] = None,
         gyroscope: Optional[Union[Mapping[str, Any], "GyroParams"]] = None,
         magnetometer: Optional[Union[Mapping[str, Any], "MagParams"]] = None,
         preset: Optional[str] = None,
         seed: int = 0,
-        profile: str = "matlab",
+        profile: str = _S["profile"],
         accel_sign: Optional[str] = None,
     ) -> None:
         self._imu = _core.ImuSensor(
@@ -224,8 +226,8 @@ class Identification:
         return f"Identification({len(self.columns)} columns, {resolved} of {len(self.terms)} terms resolved)"
 
 
-def identify(data, sample_rate_hz: Optional[float] = None, *, columns=None, kalibr_inflation: float = 1.0,
-             kalibr_topic: str = "/imu", **read_options) -> "Identification":
+def identify(data, sample_rate_hz: Optional[float] = None, *, columns=None, kalibr_inflation: float = _core.DEFAULTS["kalibr_inflation"],
+             kalibr_topic: str = _core.DEFAULTS["kalibr_topic"], **read_options) -> "Identification":
     """Noise identification of a static log, as ``imukit identify`` does it.
 
     ``data`` is a path (any format :func:`imukit.read` takes; ``read_options`` such as ``map=`` or

@@ -196,7 +196,7 @@ def truth_from_samples(
     euler_rad=None,
     quaternion=None,
     attitude: Optional[str] = None,
-    order: int = 6,
+    order: int = _D["finite_difference_order"],
     nav_frame: str = _D["nav_frame"],
     min_speed_m_s: Optional[float] = None,
 ) -> Table:

@@ -267,7 +267,7 @@ def figure(*tables: TableOrPath, labels: Optional[Sequence[str]] = None, nav_fra
 
 
 def animate(truth: TableLike, *, body_m: Optional[Sequence[float]] = None,
-            lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = 20.0,
+            lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0), fps: float = _D["animation_fps"],
             speed: Optional[float] = None, nav_frame: Optional[str] = None) -> Any:
     """The body moving along its path, as ``imukit animate`` draws it: a box of ``body_m``
     (length, width, height along body x, y, z; by default a tenth of the path's extent long)

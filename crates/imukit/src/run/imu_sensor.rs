@@ -39,6 +39,23 @@ pub struct ImuSensorRequest {
     pub params: ImuSpec,
 }
 
+impl Default for ImuSensorRequest {
+    /// MATLAB imuSensor's defaults: accelerometer and gyroscope, NED, 100 Hz, 25 °C, MATLAB's
+    /// profile, ideal sensors.
+    fn default() -> Self {
+        Self {
+            imu_type: ImuKind::AccelGyro,
+            reference_frame: NavFrameName::NED,
+            sample_rate_hz: 100.0,
+            temperature_c: 25.0,
+            magnetic_field_ut: None,
+            profile: Profile::Matlab,
+            accel_sign: None,
+            params: ImuSpec::default(),
+        }
+    }
+}
+
 /// The orientation of each sample as a caller hands it over.
 #[derive(Clone, Copy, Debug)]
 pub enum Orientation<'a> {

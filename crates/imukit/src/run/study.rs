@@ -14,7 +14,9 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
-use crate::run::fuse::{AidTables, FuseSetup, Start, fuse_filtered_and_smoothed, fuse_with};
+use crate::run::fuse::{
+    AidTables, FuseRequest, FuseSetup, Start, fuse_filtered_and_smoothed, fuse_with,
+};
 use crate::run::navigate::InitialState;
 use crate::scenario::{Scenario, ScenarioSpec};
 
@@ -42,13 +44,13 @@ pub struct StudySpec {
     /// The non-holonomic constraints of a ground vehicle, one-sigma m/s (off when absent).
     pub nhc_sigma_m_s: Option<f64>,
     /// The filter also estimates each IMU's scale-factor, misalignment and g-sensitivity errors
-    /// (36 states; see [`FuseSetup::estimate_sensor_errors`]).
-    #[serde(default)]
-    pub sensor_errors: bool,
+    /// (36 states; see [`FuseSetup::estimate_sensor_errors`]); absent: as `imukit fuse` does,
+    /// when the part's figures warrant it.
+    pub sensor_errors: Option<bool>,
     /// The vehicle stands still for the first this many seconds, and the filter is told so
-    /// (see [`FuseSetup::rest_s`]); 0 when absent.
-    #[serde(default)]
-    pub rest_s: f64,
+    /// (see [`FuseSetup::rest_s`]); absent: as `imukit fuse` does, the rest found in the
+    /// readings.
+    pub rest_s: Option<f64>,
     /// Also smooth each run forward–backward ([`FuseSetup::smooth`]) and report the smoothed
     /// error beside the filter's.
     #[serde(default)]
@@ -60,6 +62,20 @@ pub struct StudySpec {
     /// figures in every run (MATLAB's fixed parameters).
     #[serde(default = "drawn")]
     pub draw_parts: bool,
+}
+
+impl StudySpec {
+    /// The fusion each run asks for, as `imukit fuse` would be asked (the start is each run's
+    /// truth); smoothing is asked of each run apart ([`StudySpec::smooth`]).
+    #[must_use]
+    pub fn request(&self) -> FuseRequest<'static> {
+        FuseRequest {
+            nhc_sigma_m_s: self.nhc_sigma_m_s,
+            sensor_errors: self.sensor_errors,
+            rest_s: self.rest_s,
+            ..FuseRequest::default()
+        }
+    }
 }
 
 fn drawn() -> bool {
@@ -174,10 +190,12 @@ impl Study {
                 format!("must be a finite number > 0 (m/s), got {c}"),
             ));
         }
-        if !(spec.rest_s.is_finite() && spec.rest_s >= 0.0) {
+        if let Some(r) = spec.rest_s
+            && !(r.is_finite() && r >= 0.0)
+        {
             return Err(invalid(
                 key("rest_s"),
-                format!("must be a finite number ≥ 0 (s), got {}", spec.rest_s),
+                format!("must be a finite number ≥ 0 (s), got {r}"),
             ));
         }
         if spec.presets.is_empty() {
@@ -209,11 +227,10 @@ impl Study {
                 .resolve(scenario_dir)
                 .map_err(|e| invalid(key(&format!("presets[{i}]")), e.to_string()))?;
             scenario.imu.sensors.draw_parts = spec.draw_parts;
-            let mut setup = FuseSetup::from_scenario(&scenario)?;
-            setup.aiding.nhc_sigma_m_s = spec.nhc_sigma_m_s;
-            setup.estimate_sensor_errors = spec.sensor_errors;
-            setup.rest_s = spec.rest_s;
-            setup.smooth = false;
+            // The filter `imukit fuse` sets up for the same scenario and options.
+            let setup = spec
+                .request()
+                .policy(FuseSetup::from_scenario(&scenario)?)?;
             cases.push(Case {
                 preset: preset.clone(),
                 scenario,
@@ -280,6 +297,11 @@ impl Study {
     #[must_use]
     pub fn input_files(&self) -> &[(&'static str, PathBuf)] {
         &self.input_files
+    }
+
+    /// Each preset's filter setup, in the study's order.
+    pub fn setups(&self) -> impl Iterator<Item = (&str, &FuseSetup)> {
+        self.cases.iter().map(|c| (c.preset.as_str(), &c.setup))
     }
 
     /// The presets, in the study's order.

@@ -35,7 +35,7 @@ pub use recovery::{MAX_REJECTED_IN_A_ROW, MAX_RESETS_IN_A_ROW};
 pub use request::{AlignName, FuseRequest, STATIC_ALIGN_S, Start};
 pub use rows::{RESETS_COLUMN, sensor_error_columns};
 pub use setup::{
-    AidingSetup, CHI2_99_9_6DOF, DEFAULT_COVARIANCE_INTERVAL_S, FuseSetup,
+    AidingSetup, CHI2_99_9_6DOF, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S, FuseSetup,
     G_SENSITIVITY_STATES_FROM, MIN_G_SENSITIVITY_SIGMA, MIN_SENSOR_ERROR_SIGMA, NHC_RATE_HZ,
     OdometerModel, REST_VELOCITY_SIGMA_M_S, SENSOR_ERROR_STATES_FROM,
 };

@@ -130,8 +130,17 @@ impl<'a> FuseRequest<'a> {
     /// # Errors
     /// Both starts or neither (field `initial`), an Earth other than the model's (field
     /// `earth`).
-    pub fn apply(&self, mut setup: FuseSetup) -> Result<(FuseSetup, Start<'a>)> {
-        let start = match (self.initial, self.align) {
+    pub fn apply(&self, setup: FuseSetup) -> Result<(FuseSetup, Start<'a>)> {
+        let start = self.start()?;
+        Ok((self.policy(setup)?, start))
+    }
+
+    /// Where the filter starts: the initial state or the alignment asked for.
+    ///
+    /// # Errors
+    /// Both or neither (field `initial`).
+    pub fn start(&self) -> Result<Start<'a>> {
+        Ok(match (self.initial, self.align) {
             (Some(s), None) => Start::State(s),
             (None, Some(a)) => a.into(),
             (Some(_), Some(_)) => {
@@ -147,7 +156,17 @@ impl<'a> FuseRequest<'a> {
                      \"gnss\"",
                 ));
             }
-        };
+        })
+    }
+
+    /// This request's policy (everything but the start) applied to the filter's model `setup`:
+    /// the gate, the constraints, the covariance interval, the sensor-error states, the rest,
+    /// smoothing and stances. Every front end (the command line, Python, `study`) sets the
+    /// filter up through it, so that the same request gives the same filter.
+    ///
+    /// # Errors
+    /// An Earth other than the model's (field `earth`).
+    pub fn policy(&self, mut setup: FuseSetup) -> Result<FuseSetup> {
         let earth = if setup.earth.is_some() {
             EarthName::Wgs84
         } else {
@@ -183,6 +202,6 @@ impl<'a> FuseRequest<'a> {
         }
         setup.smooth = self.smooth;
         setup.zupt = self.zupt;
-        Ok((setup, start))
+        Ok(setup)
     }
 }

@@ -112,6 +112,10 @@ pub const MIN_G_SENSITIVITY_SIGMA: f64 = 1e-6;
 /// One-sigma of the zero-velocity update at rest, m/s.
 pub const REST_VELOCITY_SIGMA_M_S: f64 = 1e-3;
 
+/// The non-holonomic constraints' one-sigma when a front end turns them on without one, m/s
+/// (`--nhc` alone): a car's sideways and vertical body velocity, slip and suspension included.
+pub const DEFAULT_NHC_SIGMA_M_S: f64 = 0.1;
+
 /// Rate of the non-holonomic constraints when no odometer paces them, Hz.
 pub const NHC_RATE_HZ: f64 = 10.0;
 

@@ -90,6 +90,89 @@ impl FilterKind {
     }
 }
 
+impl FilterKind {
+    /// Each setting's default, with a magnetometer or without (Madgwick's gain depends on it):
+    /// the one place the filters, the command line and Python take them from. `SampleRate` is
+    /// the rate of a filter built without data (MATLAB's 100 Hz; the command line runs at the
+    /// data's own rate unless given one).
+    #[must_use]
+    pub fn setting_defaults(self, magnetometer: bool) -> Vec<(&'static str, f64)> {
+        let k = KalmanParams::default();
+        let rate = ("SampleRate", k.sample_rate_hz);
+        match self {
+            Self::ImuFilter | Self::AhrsFilter => {
+                #[allow(clippy::cast_precision_loss)]
+                let mut d = vec![
+                    rate,
+                    ("DecimationFactor", k.decimation as f64),
+                    ("AccelerometerNoise", k.accelerometer_noise),
+                    ("GyroscopeNoise", k.gyroscope_noise),
+                    ("GyroscopeDriftNoise", k.gyroscope_drift_noise),
+                    ("LinearAccelerationNoise", k.linear_acceleration_noise),
+                    ("LinearAccelerationDecayFactor", k.linear_acceleration_decay),
+                    ("InitialProcessNoiseScale", 1.0),
+                    ("Gravity", k.gravity_m_s2),
+                ];
+                if self == Self::AhrsFilter {
+                    d.extend([
+                        ("MagnetometerNoise", k.magnetometer_noise),
+                        ("MagneticDisturbanceNoise", k.magnetic_disturbance_noise),
+                        (
+                            "MagneticDisturbanceDecayFactor",
+                            k.magnetic_disturbance_decay,
+                        ),
+                        (
+                            "ExpectedMagneticFieldStrength",
+                            k.expected_magnetic_field_ut,
+                        ),
+                    ]);
+                }
+                d
+            }
+            Self::Ecompass => vec![rate],
+            Self::Madgwick => vec![
+                rate,
+                (
+                    "Beta",
+                    if magnetometer {
+                        MADGWICK_BETA_9D
+                    } else {
+                        MADGWICK_BETA_6D
+                    },
+                ),
+            ],
+            Self::Mahony => vec![rate, ("Kp", MAHONY_KP), ("Ki", MAHONY_KI)],
+            Self::Complementary => vec![
+                rate,
+                ("AccelerometerGain", COMPLEMENTARY_GAIN),
+                ("MagnetometerGain", COMPLEMENTARY_GAIN),
+            ],
+            Self::Robust => {
+                let mut p = RobustParams::default();
+                p.settings_mut()
+                    .into_iter()
+                    .map(|(name, v)| (name, *v))
+                    .collect()
+            }
+        }
+    }
+}
+
+/// Madgwick's gain without a magnetometer, rad/s (his paper's 6-axis figure).
+pub const MADGWICK_BETA_6D: f64 = 0.033;
+
+/// Madgwick's gain with a magnetometer, rad/s (his paper's 9-axis figure).
+pub const MADGWICK_BETA_9D: f64 = 0.041;
+
+/// Mahony's proportional gain (ahrs' default).
+pub const MAHONY_KP: f64 = 1.0;
+
+/// Mahony's integral gain (ahrs' default).
+pub const MAHONY_KI: f64 = 0.3;
+
+/// MATLAB `complementaryFilter`'s accelerometer and magnetometer gain.
+pub const COMPLEMENTARY_GAIN: f64 = 0.01;
+
 /// Settings of both Kalman filters.
 const KALMAN_SETTINGS: [&str; 9] = [
     "SampleRate",
@@ -430,14 +513,16 @@ impl FilterSpec {
             }
             FilterKind::Ecompass => AnyFilter::Ecompass(Ecompass { accel_sign: sign }),
             FilterKind::Madgwick => {
-                let beta = self
-                    .setting("Beta")?
-                    .unwrap_or(if mag { 0.041 } else { 0.033 });
+                let beta = self.setting("Beta")?.unwrap_or(if mag {
+                    MADGWICK_BETA_9D
+                } else {
+                    MADGWICK_BETA_6D
+                });
                 AnyFilter::Madgwick(Madgwick::new(rate, beta, mag, sign).map_err(refused)?)
             }
             FilterKind::Mahony => {
-                let kp = self.setting("Kp")?.unwrap_or(1.0);
-                let ki = self.setting("Ki")?.unwrap_or(0.3);
+                let kp = self.setting("Kp")?.unwrap_or(MAHONY_KP);
+                let ki = self.setting("Ki")?.unwrap_or(MAHONY_KI);
                 AnyFilter::Mahony(Mahony::new(rate, kp, ki, mag, sign).map_err(refused)?)
             }
             FilterKind::Robust => {
@@ -458,8 +543,12 @@ impl FilterSpec {
                 AnyFilter::Robust(RobustFilter::new(p).map_err(refused)?)
             }
             FilterKind::Complementary => {
-                let ka = self.setting("AccelerometerGain")?.unwrap_or(0.01);
-                let km = self.setting("MagnetometerGain")?.unwrap_or(0.01);
+                let ka = self
+                    .setting("AccelerometerGain")?
+                    .unwrap_or(COMPLEMENTARY_GAIN);
+                let km = self
+                    .setting("MagnetometerGain")?
+                    .unwrap_or(COMPLEMENTARY_GAIN);
                 AnyFilter::Complementary(
                     Complementary::new(rate, ka, km, mag, sign).map_err(refused)?,
                 )
