@@ -1,4 +1,4 @@
-//! The CSV schema (docs/design.md §7) and column tables shared by the CLI and Python.
+//! The CSV schema (docs/design.md §3) and column tables shared by the CLI and Python.
 //!
 //! A [`Table`] is named columns over row-major `f64` data. CSV output uses shortest round-trip
 //! formatting (`zmij`), so a written file reads back bit for bit, and is written to a temporary file

@@ -24,7 +24,7 @@ use pyo3::prelude::*;
 /// call of 4 096 samples in the kernel, 1.83 ms a call against 1.18 ms with mimalloc (10⁴
 /// samples: 3.30 → 2.80 ms; 10⁵ and more unchanged). NumPy's arrays keep NumPy's allocator. The
 /// command line keeps the system's: one run a process, its buffers reused from chunk to chunk;
-/// mimalloc there doubled the streaming commands' peak memory (docs/design.md §7).
+/// mimalloc there doubled the streaming commands' peak memory (docs/design.md §1).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -1,5 +1,5 @@
 """Closing the loop: exact truth → ideal IMU → strapdown → errors, on the figure-8
-(1 kHz, 30 s, reference point), with docs/design.md §6's coning/sculling scheme (second order) and the
+(1 kHz, 30 s, reference point), with docs/models.md §4's coning/sculling scheme (second order) and the
 fourth-order RK4 scheme.
 
 Run: python examples/navigation_round_trip.py [--figures DIR]

@@ -90,7 +90,7 @@ fn gyro_bias_gives_about_g_b_t_cubed_over_six() {
     );
 }
 
-// Classic coning: q(t) = [cos(a/2), 0, sin(a/2)cos Ωt, sin(a/2) sin Ωt] (docs/design.md §6).
+// Classic coning: q(t) = [cos(a/2), 0, sin(a/2)cos Ωt, sin(a/2) sin Ωt] (docs/models.md §4).
 const CONE_A: f64 = 0.1;
 const CONE_W: f64 = 2.0 * std::f64::consts::PI * 5.0;
 

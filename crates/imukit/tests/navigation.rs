@@ -391,7 +391,7 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
 fn the_default_scheme_is_the_best_for_rate_samples_on_a_coning_motion() {
     use imu_core::{Body, Enu, Rotation, Vec3};
     use imukit::run::navigate::{NavRequest, NavScheme, SchemeName};
-    // Classic coning (docs/design.md §6): a 5° cone at 2 Hz, 200 Hz rate samples, 30 s, at rest.
+    // Classic coning (docs/models.md §4): a 5° cone at 2 Hz, 200 Hz rate samples, 30 s, at rest.
     let (a, w) = (5f64.to_radians(), 2.0 * std::f64::consts::TAU);
     let attitude = |t: f64| {
         let (s, c) = (a / 2.0).sin_cos();

@@ -286,7 +286,7 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
     /// the same order: the generator's loop and the model's then each run on their own. That
     /// took the formula job from Python from about 195 to 175–180 ns a sample; the model alone
     /// (`--bench sensor`, `many` against one `measure` a sample) runs the same either way
-    /// (design §4). When every sensor is present the block's normals are one run of the stream,
+    /// (models §2). When every sensor is present the block's normals are one run of the stream,
     /// drawn by one [`NoiseSource::fill_standard_normal`] call (4–8 % faster than a call a number).
     /// The block's normals live on the stack (1.7 KB). On an x86-64 CPU with AVX2
     /// the loop runs a copy compiled for it, with the same numbers ([`crate::cpu`]).

@@ -1,4 +1,4 @@
-//! Sensor error models: MATLAB `imuSensor` parity, then beyond (docs/design.md §4).
+//! Sensor error models: MATLAB `imuSensor` parity, then beyond (docs/models.md §2).
 //!
 //! Per sensor and sample, with `u` the ideal input in the sensor frame:
 //! 1. bulk `B = (M/100)·u + ConstantBias` (AxesMisalignment `M` in percent);

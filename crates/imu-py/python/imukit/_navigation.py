@@ -77,8 +77,8 @@ def strapdown(
     roll_rad``.
 
     ``scheme="auto"`` (default) takes the best scheme for the input: ``"rk4"`` for rates, ``"coning"``
-    for increments or when ``coning``/``sculling`` are switched off. ``"coning"`` (docs/design.md
-    §6, second order; rates or increments) or ``"rk4"``
+    for increments or when ``coning``/``sculling`` are switched off. ``"coning"`` (docs/models.md
+    §4, second order; rates or increments) or ``"rk4"``
     (fourth order: RK4 with ``substeps`` per interval on quintic-interpolated rates; rates only).
 
     ``earth="wgs84"`` navigates on the rotating WGS-84 Earth (Earth rate, transport rate, Coriolis,

@@ -5,8 +5,8 @@
 //! Each stage runs on one thread and keeps its order, so the numbers are those of a single
 //! thread bit for bit: the truth is the same function of the sample times, the sensors draw
 //! their noise in sample order from the same stream, and the files get the same rows in the same
-//! order. What changes is the wall-clock time, when cores are free (see docs/design.md §1 and §8
-//! for the figures).
+//! order. What changes is the wall-clock time, when cores are free (see docs/design.md §1, and
+//! benches/README.md for the figures).
 //!
 //! Memory stays flat: at most two finished chunks wait between two stages, and their buffers go
 //! back to the producer to be refilled.

@@ -14,7 +14,7 @@ use crate::scenario::resolve::check_gravity;
 /// The 3D integration scheme.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NavScheme {
-    /// docs/design.md §6: exact rotation-vector step, two-sample coning and sculling, trapezoidal
+    /// docs/models.md §4: exact rotation-vector step, two-sample coning and sculling, trapezoidal
     /// position; rates or increments; second order.
     #[default]
     ConingSculling,
