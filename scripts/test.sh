@@ -25,6 +25,10 @@ cargo clippy --workspace --all-targets --quiet -- -D warnings
 check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imu-io -p imukit -p imu-plot -p imu-cli   # doc links resolve
 
+section "Files and formats without the heavy ones: imu-io builds, lints and refuses them by name"
+cargo clippy --quiet -p imu-io --no-default-features --lib -- -D warnings
+cargo test --quiet -p imu-io --no-default-features --lib
+
 section "Heap-free core: builds without std, never names alloc or std, no std-only dependency"
 cargo build --quiet -p imu-core --no-default-features --features libm
 # A bare-metal target has no std and no allocator: the core must build there.

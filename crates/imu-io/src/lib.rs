@@ -15,6 +15,10 @@
 //! [`Error`], that names file, row, column or key.
 //!
 //! It imports nothing of the jobs (`imukit`), so the arrows between the two point one way.
+//!
+//! The heavy formats are cargo features, all on by default: `parquet`, `bags` (ROS bags) and
+//! `nmea`. An embedder that leaves one out keeps every other format, and a file of the missing
+//! one is refused by name.
 #![forbid(unsafe_code)]
 pub mod choice;
 pub mod error;
@@ -36,6 +40,10 @@ pub mod npy;
 pub mod npz;
 pub mod output;
 pub mod params;
+#[cfg(feature = "parquet")]
+pub mod parquet;
+#[cfg(not(feature = "parquet"))]
+#[path = "parquet_off.rs"]
 pub mod parquet;
 pub mod plausible;
 pub mod presets;
@@ -76,6 +84,7 @@ thread_local! {
 /// Runs `read`, a panic inside it returned as its message instead of unwinding further, and
 /// printed by no panic hook: for third-party readers that may still panic on a damaged file
 /// where imukit's own checks did not foresee it. A last line of defence, not a way of reading.
+#[cfg_attr(not(any(feature = "parquet", feature = "bags")), allow(dead_code))]
 pub(crate) fn contained<T>(read: impl FnOnce() -> T) -> std::result::Result<T, String> {
     static QUIET: Once = Once::new();
     QUIET.call_once(|| {

@@ -8,7 +8,8 @@ use std::path::Path;
 
 use mcap::sans_io::LinearReaderOptions;
 
-use super::{Contents, RECORD_LIMIT, channel_description};
+use super::Contents;
+use super::read::{RECORD_LIMIT, channel_description};
 use crate::error::{Error, Result};
 
 /// Reads an MCAP file (the `mcap` crate's sans-I/O reader, each record's lengths checked

@@ -5,102 +5,19 @@
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 
+use super::BagOptions;
+use super::decode::rotate;
 use super::ros::{self, MessageType};
-use super::rotate;
 use crate::asl::stamp_ns;
 use crate::columns::{
     ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GEODETIC_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Position,
     QUATERNION_COLUMNS, Velocity,
 };
 use crate::description::Description;
-use crate::error::{Error, Result, invalid};
+use crate::error::{Error, Result};
 use crate::output::OutputFile;
 use crate::schema::TableKind;
 use crate::table::Table;
-
-/// What a bag's IMU is called and when it starts: its topic (the magnetometer's is
-/// `<topic>/mag`), the frame id its headers name, and the stamp of time 0 (a simulated run
-/// starts at 0 s, which is 1970 as a ROS stamp).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct BagOptions {
-    /// The IMU's topic (`/imu`).
-    pub imu_topic: String,
-    /// The frame id of the IMU's and magnetometer's headers (`imu_link`).
-    pub imu_frame_id: String,
-    /// The stamp of a table's time 0, ns since the Unix epoch (0).
-    pub start_ns: i64,
-}
-
-impl Default for BagOptions {
-    fn default() -> Self {
-        Self {
-            imu_topic: "/imu".into(),
-            imu_frame_id: "imu_link".into(),
-            start_ns: 0,
-        }
-    }
-}
-
-impl BagOptions {
-    /// The options given, the defaults for those left out, each checked: a topic is a ROS 2
-    /// name (`/` then letters, digits, `_` and `/`, no `//`, not ending in `/`), a frame id is
-    /// a non-empty name of the same characters, and the start is a time in seconds since the
-    /// Unix epoch within a ROS stamp's range.
-    ///
-    /// # Errors
-    /// [`Error::Invalid`] naming `bag_topic`, `bag_frame_id` or `bag_start_s` and the rule.
-    pub fn new(topic: Option<&str>, frame_id: Option<&str>, start_s: Option<f64>) -> Result<Self> {
-        let mut o = Self::default();
-        let plain = |s: &str| {
-            s.chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/')
-        };
-        if let Some(t) = topic {
-            let well_formed = t.starts_with('/')
-                && t.len() > 1
-                && !t.ends_with('/')
-                && !t.contains("//")
-                && plain(t)
-                && t.split('/')
-                    .skip(1)
-                    .all(|part| !part.starts_with(|c: char| c.is_ascii_digit()));
-            if !well_formed {
-                return Err(invalid(
-                    "bag_topic",
-                    format!(
-                        "{t:?} is not a ROS 2 topic name: `/` then letters, digits, `_` and `/` \
-                         (no `//`, no part starting with a digit, no `/` at the end), such as /imu/data"
-                    ),
-                ));
-            }
-            o.imu_topic = t.to_string();
-        }
-        if let Some(f) = frame_id {
-            if f.is_empty() || !plain(f) {
-                return Err(invalid(
-                    "bag_frame_id",
-                    format!(
-                        "{f:?} is not a frame id: letters, digits, `_` and `/`, such as imu_link"
-                    ),
-                ));
-            }
-            o.imu_frame_id = f.to_string();
-        }
-        if let Some(s) = start_s {
-            let ns = stamp_ns(s).filter(|&ns| ns >= 0 && ros::Time::from_ns(ns).is_some());
-            o.start_ns = ns.ok_or_else(|| {
-                invalid(
-                    "bag_start_s",
-                    format!(
-                        "{s} is not a ROS time stamp: seconds since 1970-01-01 UTC, from 0 to \
-                         2147483647 (2038), such as 1700000000"
-                    ),
-                )
-            })?;
-        }
-        Ok(o)
-    }
-}
 
 /// A topic being written: its channel and what it holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -509,7 +426,8 @@ mod tests {
         assert!((t[49] - t[0] - 0.49).abs() < 1e-9, "{}", t[49] - t[0]);
         let mut frames = Vec::new();
         super::super::storage::mcap_messages(&path, &mut |channel, _, data, log_time| {
-            let header: ros::Header = ros::decode(data, 1).map_err(|e| invalid("test", e))?;
+            let header: ros::Header =
+                ros::decode(data, 1).map_err(|e| crate::error::invalid("test", e))?;
             frames.push((
                 channel.topic.clone(),
                 header.frame_id,

@@ -1,26 +1,11 @@
-//! NMEA 0183 logs (`.nmea`) read as GNSS fixes: `GGA` for the position, `RMC` or `VTG` for the
-//! ground velocity, each sentence's checksum checked (the `nmea` crate parses them).
-//!
-//! One fix per epoch (a `GGA` and the `RMC` of the same time, a `VTG` after them): `t_s`,
-//! `lat_rad`, `lon_rad`, `height_m` — the ellipsoidal height, `GGA`'s altitude above the geoid
-//! plus its geoid separation — and, when every fix has a speed and a course, `vel_n_m_s` and
-//! `vel_e_m_s` (NMEA gives no vertical speed: the filter takes such fixes' velocity as
-//! horizontal only; without velocities the fixes are positions only and it updates on those),
-//! and `hdop` when every `GGA` gives it ([`with_uere`] turns it into each fix's horizontal
-//! accuracy).
-//! Epochs without a fix (`GGA` quality 0) are left out; an `RMC` marked void gives no velocity.
-//!
-//! `t_s` is the UTC time of day counted from the midnight before the first fix (the rule of
-//! [`crate::asl`]), a day added each time the clock passes midnight. Other sentences
-//! (`GSV`, `GSA`, a vendor's) are skipped; text before a sentence's `$` on its line (a logger's
-//! own stamp) is ignored. A bad checksum, or a `GGA`, `RMC` or `VTG` that does not parse, is
-//! refused naming the file and its line.
+//! NMEA 0183 sentences read as one fix per epoch (the `nmea` crate).
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 use chrono::Timelike;
 use nmea::ParseResult;
 
+use super::HDOP_COLUMN;
 use crate::columns::GNSS_EARTH_COLUMNS;
 use crate::error::{Error, Result};
 use crate::table::Table;
@@ -213,51 +198,6 @@ pub fn read_table(path: &Path) -> Result<Table> {
     Ok(table)
 }
 
-/// The column of `GGA`'s horizontal dilution of precision.
-pub const HDOP_COLUMN: &str = "hdop";
-
-/// `fixes` with a `horizontal_accuracy_m` column of their `hdop` times the user-equivalent
-/// range error `uere_m` (one-sigma, m): the horizontal accuracy a receiver's geometry gives.
-///
-/// # Errors
-/// A `uere_m` that is not positive and finite; fixes without `hdop`.
-pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
-    if !(uere_m.is_finite() && uere_m > 0.0) {
-        return Err(crate::error::invalid(
-            "gnss_uere_m",
-            format!("must be a positive number of metres, got {uere_m}"),
-        ));
-    }
-    let Some(hdop) = fixes.column(HDOP_COLUMN) else {
-        return Err(crate::error::invalid(
-            "gnss_uere_m",
-            "the fixes have no hdop column (an NMEA log's GGA gives it) to scale",
-        ));
-    };
-    let name = crate::columns::FIX_ACCURACY_COLUMNS[0];
-    let mut columns: Vec<&str> = fixes
-        .columns
-        .iter()
-        .map(String::as_str)
-        .filter(|c| *c != name)
-        .collect();
-    columns.push(name);
-    let mut out = Table::new(&columns);
-    let index: Vec<usize> = columns[..columns.len() - 1]
-        .iter()
-        .filter_map(|c| fixes.columns.iter().position(|h| h == c))
-        .collect();
-    let width = fixes.columns.len().max(1);
-    let mut row = Vec::with_capacity(columns.len());
-    for (r, h) in fixes.data.chunks_exact(width).zip(hdop) {
-        row.clear();
-        row.extend(index.iter().map(|&k| r[k]));
-        row.push(h * uere_m);
-        out.push_row(&row);
-    }
-    Ok(out)
-}
-
 /// The epoch at time of day `t` (the last one when it is the same time, else a new one).
 fn epoch_at(epochs: &mut Vec<Epoch>, t_ns: i64, line: usize) -> &mut Epoch {
     if epochs.last().is_none_or(|e| e.time_of_day_ns != t_ns) {
@@ -295,6 +235,7 @@ fn ground(speed_knots: f32, course_deg: f32) -> core::result::Result<(f64, f64),
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nmea::with_uere;
 
     /// `body` with its checksum (the XOR of the characters between `$` and `*`).
     fn sentence(body: &str) -> String {
