@@ -83,7 +83,7 @@ fn every_builtin_printed_as_toml_simulates_to_the_same_numbers() {
             .simulate()
             .unwrap();
         let reread =
-            imukit::io::table::read_columns(&out, &["accel_x_m_s2", "gyro_z_rad_s"], "").unwrap();
+            imukit::io::read::read_columns(&out, &["accel_x_m_s2", "gyro_z_rad_s"], "").unwrap();
         assert_eq!(
             reread.get("accel_x_m_s2"),
             direct.imu.column("accel_x_m_s2").unwrap().as_slice(),
@@ -167,7 +167,7 @@ fn exercise_writes_the_datasets_trajectories_and_figure() {
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.matches("<polyline").count() >= 5, "five trajectories");
     // The clean data through the default scheme closes the lap near the start.
-    let nav = imukit::io::table::read_columns(
+    let nav = imukit::io::read::read_columns(
         dir.join("inertial_data_trapezoid.csv"),
         &["pos_x_m", "pos_y_m"],
         "",
@@ -281,7 +281,7 @@ fn simulate_integrate_compare_closes_the_loop() {
         "{report}"
     );
     let err =
-        imukit::io::table::read_columns(dir.join("err.csv"), &["pos_err_m", "att_err_rad"], "")
+        imukit::io::read::read_columns(dir.join("err.csv"), &["pos_err_m", "att_err_rad"], "")
             .unwrap();
     let last = |c: &str| *err.get(c).last().unwrap();
     assert!(
@@ -304,7 +304,7 @@ fn simulate_integrate_compare_closes_the_loop() {
         "nav4.csv",
     ]);
     run(&["compare", "truth.csv", "nav4.csv", "--out", "err4.csv"]);
-    let err4 = imukit::io::table::read_columns(dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
+    let err4 = imukit::io::read::read_columns(dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
     assert!(*err4.get("pos_err_m").last().unwrap() < 1e-6);
     // The files say what they hold (NED, flat Earth, gravity, sign), so no flag is needed: the
     // same numbers as with the flag, from CSV and from Parquet alike.

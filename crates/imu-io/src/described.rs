@@ -14,7 +14,7 @@ fn check_kind(path: &Path, d: &Description) -> Result<()> {
     let Some(said) = d.kind else {
         return Ok(());
     };
-    let Ok(header) = crate::table::read_header(path) else {
+    let Ok(header) = crate::read::read_header(path) else {
         return Ok(());
     };
     let Some(found) = TableKind::detect(&header) else {

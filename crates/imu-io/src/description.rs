@@ -572,13 +572,13 @@ mod tests {
             .csv_line()
             .unwrap();
         std::fs::write(&csv, format!("{line}\nt_s,gyro_x_rad_s\n0.0,1.0\n0.1,x\n")).unwrap();
-        let mut rows = crate::table::CsvRows::open(&csv, &["t_s", "gyro_x_rad_s"], "").unwrap();
+        let mut rows = crate::read::CsvRows::open(&csv, &["t_s", "gyro_x_rad_s"], "").unwrap();
         let mut r = [0.0; 2];
         assert_eq!(rows.next_row(&mut r).unwrap(), Some(2));
         let e = rows.next_row(&mut r).unwrap_err().to_string();
         assert!(e.contains("row 3") && e.contains("gyro_x_rad_s"), "{e}");
         std::fs::write(&csv, format!("{line}\nt_s,gyro_x_rad_s\n0.0,1.0\n0.1\n")).unwrap();
-        let mut rows = crate::table::CsvRows::open(&csv, &["t_s"], "").unwrap();
+        let mut rows = crate::read::CsvRows::open(&csv, &["t_s"], "").unwrap();
         rows.next_row(&mut r[..1]).unwrap();
         let e = rows.next_row(&mut r[..1]).unwrap_err().to_string();
         assert!(e.contains("row 3 has 1 fields"), "{e}");

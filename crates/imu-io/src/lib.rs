@@ -47,6 +47,7 @@ pub mod parquet;
 pub mod parquet;
 pub mod plausible;
 pub mod presets;
+pub mod read;
 pub mod rows;
 pub mod schema;
 pub mod table;

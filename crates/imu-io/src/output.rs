@@ -975,7 +975,7 @@ mod tests {
             }
             table.write(&path).unwrap();
             assert_eq!(
-                crate::table::read_table(&path).unwrap().data,
+                crate::read::read_table(&path).unwrap().data,
                 table.data,
                 "{name}"
             );

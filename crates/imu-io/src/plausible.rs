@@ -117,7 +117,7 @@ pub fn readings(t: &Table, source: &str, fix: &str) -> Vec<String> {
 #[must_use]
 pub fn file_readings(input: impl Into<crate::Input>, fix: &str) -> Vec<String> {
     let input = input.into();
-    let Ok(header) = crate::table::read_header(&input) else {
+    let Ok(header) = crate::read::read_header(&input) else {
         return Vec::new();
     };
     let names: Vec<&str> = std::iter::once("t_s")
@@ -125,7 +125,7 @@ pub fn file_readings(input: impl Into<crate::Input>, fix: &str) -> Vec<String> {
         .chain(GYRO_COLUMNS)
         .filter(|c| header.iter().any(|h| h == c))
         .collect();
-    let Ok(mut rows) = crate::table::CsvRows::open(&input, &names, "") else {
+    let Ok(mut rows) = crate::read::CsvRows::open(&input, &names, "") else {
         return Vec::new();
     };
     let mut head = Table::new(&names);

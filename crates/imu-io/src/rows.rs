@@ -13,7 +13,8 @@
 use std::collections::VecDeque;
 
 use crate::error::{Result, invalid};
-use crate::table::{CsvRows, Table};
+use crate::read::CsvRows;
+use crate::table::Table;
 
 /// A stretch of a run: from `start_s` to `end_s` seconds after the first sample of the run's
 /// first input (either end open when `None`).

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use imu_io::Table;
-use imu_io::table::read_table;
+use imu_io::read::read_table;
 
 fn scratch(name: &str) -> tempfile::TempDir {
     tempfile::Builder::new()
@@ -337,7 +337,7 @@ fn damaged_parquet_metadata_is_refused_naming_the_file_never_a_panic() {
         let e = refused(&p);
         assert!(e.contains(name) && e.contains(want), "{name}: {e}");
         // The row reader (what the commands stream with) refuses it too.
-        let rows = imu_io::table::CsvRows::open(&p, &["t_s"], "").and_then(|mut r| {
+        let rows = imu_io::read::CsvRows::open(&p, &["t_s"], "").and_then(|mut r| {
             let mut out = [0.0];
             while r.next_row(&mut out)?.is_some() {}
             Ok(())
@@ -376,7 +376,7 @@ fn a_page_whose_header_says_dictionary_without_a_dictionary_is_an_error_not_a_pa
         e.contains("dictionary.parquet") && e.contains("damaged file"),
         "{e}"
     );
-    let rows = imu_io::table::CsvRows::open(&p, &["t_s"], "").and_then(|mut r| {
+    let rows = imu_io::read::CsvRows::open(&p, &["t_s"], "").and_then(|mut r| {
         let mut out = [0.0];
         while r.next_row(&mut out)?.is_some() {}
         Ok(())
@@ -413,7 +413,7 @@ fn a_column_named_twice_is_refused_in_every_format_read() {
         e.contains("twice.parquet") && e.contains("column t_s appears twice"),
         "{e}"
     );
-    assert!(imu_io::table::read_header(&p).is_err());
+    assert!(imu_io::read::read_header(&p).is_err());
     let csv = d.join("twice.csv");
     std::fs::write(&csv, "t_s,x,t_s\n0,1,2\n").unwrap();
     assert!(refused(&csv).contains("appears twice"));

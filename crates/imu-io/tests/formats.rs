@@ -37,9 +37,9 @@ fn parquet_tables_round_trip_bit_for_bit_across_row_groups() {
             .all(|(a, b)| a.to_bits() == b.to_bits())
     );
     // The table readers of every command take it as they take CSV.
-    let picked = imu_io::table::read_table_columns(&path, &["y", "t_s"], "").unwrap();
+    let picked = imu_io::read::read_table_columns(&path, &["y", "t_s"], "").unwrap();
     assert_eq!(picked.column("y").unwrap()[7], t.column("y").unwrap()[7]);
-    let e = imu_io::table::read_table_columns(&path, &["z"], "")
+    let e = imu_io::read::read_table_columns(&path, &["z"], "")
         .unwrap_err()
         .to_string();
     assert!(
@@ -122,15 +122,15 @@ fn npy_tables_round_trip_bit_for_bit_and_read_like_csv() {
     );
     // Records follow the header, 8 bytes a field.
     assert_eq!(bytes.len() % 64, (t.data.len() * 8) % 64);
-    let back = imu_io::table::read_table(&path).unwrap();
+    let back = imu_io::read::read_table(&path).unwrap();
     assert_eq!(back.columns, t.columns);
     assert!(same_bits(&back.data, &t.data));
-    let picked = imu_io::table::read_table_columns(&path, &["y", "t_s"], "").unwrap();
+    let picked = imu_io::read::read_table_columns(&path, &["y", "t_s"], "").unwrap();
     assert!(same_bits(
         &picked.column("y").unwrap(),
         &t.column("y").unwrap()
     ));
-    let e = imu_io::table::read_table_columns(&path, &["z"], "")
+    let e = imu_io::read::read_table_columns(&path, &["z"], "")
         .unwrap_err()
         .to_string();
     assert!(
@@ -150,7 +150,7 @@ fn a_bad_npy_file_is_refused_saying_what_and_where() {
     let err = |name: &str, content: &[u8]| {
         let p = d.join(name);
         std::fs::write(&p, content).unwrap();
-        imu_io::table::read_table(&p).unwrap_err().to_string()
+        imu_io::read::read_table(&p).unwrap_err().to_string()
     };
     // Cut short, or longer than its header says: what the header gives against what the file
     // holds, before a row is read.
@@ -223,10 +223,10 @@ fn npz_archives_round_trip_bit_for_bit_across_blocks() {
     }
     let path = d.join("t.npz");
     t.write(&path).unwrap();
-    let back = imu_io::table::read_table(&path).unwrap();
+    let back = imu_io::read::read_table(&path).unwrap();
     assert_eq!(back.columns, t.columns);
     assert!(same_bits(&back.data, &t.data));
-    let picked = imu_io::table::read_table_columns(&path, &["c39", "c0"], "").unwrap();
+    let picked = imu_io::read::read_table_columns(&path, &["c39", "c0"], "").unwrap();
     assert!(same_bits(
         &picked.column("c39").unwrap(),
         &t.column("c39").unwrap()
@@ -250,7 +250,7 @@ fn a_bad_npz_archive_is_refused_saying_what_and_where() {
     let err = |name: &str, content: &[u8]| {
         let p = d.join(name);
         std::fs::write(&p, content).unwrap();
-        imu_io::table::read_table(&p).unwrap_err().to_string()
+        imu_io::read::read_table(&p).unwrap_err().to_string()
     };
     let e = err("cut.npz", &bytes[..bytes.len() / 2]);
     assert!(e.contains("cut.npz") && e.contains(".npz"), "{e}");
@@ -299,7 +299,7 @@ fn a_bad_npz_archive_is_refused_saying_what_and_where() {
             zip.write_all(&buf).unwrap();
         }
         zip.finish().unwrap();
-        imu_io::table::read_table(&p).unwrap_err().to_string()
+        imu_io::read::read_table(&p).unwrap_err().to_string()
     };
     let e = npz(
         "nan2.npz",

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use imu_io::Input;
 use imu_io::column_map::ColumnMap;
-use imu_io::table::{read_header, read_table};
+use imu_io::read::{read_header, read_table};
 
 const MAP: &str = r#"
 time = { column = "Timestamp", unit = "ms" }

@@ -1,7 +1,6 @@
 //! `imukit plot`: default figures for every kind of imukit CSV, several files overlaid.
 use std::path::{Path, PathBuf};
 
-use crate::spec::{PanelSpec, TableKind};
 use imukit::Table;
 use imukit::run::allan::AllanResult;
 
@@ -9,6 +8,7 @@ use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, i
 use crate::PlotError;
 use crate::allan::allan_figure;
 use crate::draw::{FigureSize, err};
+use crate::spec::{PanelSpec, TableKind};
 
 fn stem(p: &Path) -> String {
     p.file_stem().map_or_else(
@@ -91,7 +91,7 @@ pub fn plot_files(
     }
     let tables = paths
         .iter()
-        .map(|p| Ok((p.clone(), imukit::io::table::read_table(p)?)))
+        .map(|p| Ok((p.clone(), imukit::io::read::read_table(p)?)))
         .collect::<Result<Vec<_>, PlotError>>()?;
     plot_tables(&tables, out, ned, size)
 }

@@ -77,7 +77,7 @@
 //! ## Read a CSV file
 //!
 //! ```
-//! use imukit::io::table::read_table;
+//! use imukit::io::read::read_table;
 //! use imukit::Table;
 //!
 //! let path = std::env::temp_dir().join(format!("imukit-doc-read-{}.csv", std::process::id()));

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use imukit::ScenarioSpec;
 use imukit::io::asl::{seconds_after, time_origin_ns};
-use imukit::io::table::read_table;
+use imukit::io::read::read_table;
 use imukit::run::compare::compare;
 use imukit::run::navigate::{InitialState, NavSetup, integrate};
 

@@ -141,7 +141,7 @@ fn the_streamed_file_equals_the_in_memory_table_and_runs_differ() {
         },
     )
     .unwrap();
-    let from_file = imukit::io::table::read_table(&gnss).unwrap();
+    let from_file = imukit::io::read::read_table(&gnss).unwrap();
     let in_memory = sc.simulate().unwrap().gnss.unwrap();
     assert_eq!(from_file.columns, in_memory.columns);
     assert_eq!(from_file.data, in_memory.data);

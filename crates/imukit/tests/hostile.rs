@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use imukit::io::params::{Profile, read_param_file};
-use imukit::io::table::read_table;
+use imukit::io::read::read_table;
 use imukit::motion::expr::Expr;
 use imukit::run::allan::allan;
 use imukit::run::navigate::{InitialState, NavSetup, integrate};

@@ -229,7 +229,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         sim.imu.write_csv(&input).unwrap();
         let summary = integrate_csv(&input, &init, &setup, Default::default(), &out).unwrap();
         let whole = integrate(&sim.imu, &init, &setup).unwrap();
-        let streamed = imukit::io::table::read_table(&out).unwrap();
+        let streamed = imukit::io::read::read_table(&out).unwrap();
         assert_eq!(summary.rows, whole.rows());
         assert!(
             streamed == whole,
@@ -255,7 +255,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
             (Ok(summary), Ok(whole)) => {
                 assert_eq!(summary.rows, rows);
                 assert!(
-                    imukit::io::table::read_table(&out).unwrap() == whole,
+                    imukit::io::read::read_table(&out).unwrap() == whole,
                     "{rows} rows"
                 );
             }
@@ -294,7 +294,7 @@ fn a_streamed_file_integrates_to_the_numbers_of_the_whole_table() {
         (1, 3001)
     );
     let whole = integrate(&gappy, &InitialState::default(), &NavSetup::default()).unwrap();
-    assert!(imukit::io::table::read_table(&out).unwrap() == whole);
+    assert!(imukit::io::read::read_table(&out).unwrap() == whole);
     let _ = std::fs::remove_dir_all(dir);
 }
 
@@ -357,7 +357,7 @@ fn compare_brackets_each_estimate_time_and_streams_files_to_the_same_numbers() {
     estimate.write_csv(&ep).unwrap();
     let s = compare_csv(&tp, &ep, Some(&out)).unwrap();
     assert_eq!(s, c.summary);
-    assert!(imukit::io::table::read_table(&out).unwrap() == c.table);
+    assert!(imukit::io::read::read_table(&out).unwrap() == c.table);
     // A single-row truth compares only at its own time.
     let one = linear_states(&[1.0], [0.0; 3]);
     assert_eq!(

@@ -212,7 +212,7 @@ fn a_bad_csv_cell_is_located_by_file_row_and_column() {
     let dir = dir.path();
     let path = dir.join("bad.csv");
     std::fs::write(&path, "t_s,gyro_z_rad_s\n0,0.1\n0.01,oops\n").unwrap();
-    let e = imukit::io::table::read_table(&path).unwrap_err();
+    let e = imukit::io::read::read_table(&path).unwrap_err();
     let at = e.location();
     assert_eq!(at.file.as_deref(), Some(path.as_path()));
     assert_eq!(at.row, Some(3));
@@ -234,8 +234,8 @@ fn a_column_named_twice_is_refused_with_both_places() {
     )
     .unwrap();
     for e in [
-        imukit::io::table::read_table(&path).unwrap_err(),
-        imukit::io::table::read_columns(&path, &["t_s", "gyro_x_rad_s"], "")
+        imukit::io::read::read_table(&path).unwrap_err(),
+        imukit::io::read::read_columns(&path, &["t_s", "gyro_x_rad_s"], "")
             .map(|_| ())
             .unwrap_err(),
     ] {

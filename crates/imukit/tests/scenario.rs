@@ -2,7 +2,7 @@
 use std::path::Path;
 
 use imukit::io::columns::TRUTH_COLUMNS;
-use imukit::io::table::read_columns;
+use imukit::io::read::read_columns;
 use imukit::scenario::builtin;
 use imukit::{Error, Scenario, ScenarioSpec, Table};
 

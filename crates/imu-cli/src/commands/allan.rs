@@ -4,8 +4,8 @@ use std::path::Path;
 use imukit::io::Input;
 use imukit::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS};
 use imukit::io::output::check_outputs;
+use imukit::io::read::{read_columns, read_header};
 use imukit::io::rows::TimeWindow;
-use imukit::io::table::{read_columns, read_header};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;

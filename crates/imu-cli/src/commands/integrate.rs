@@ -223,7 +223,7 @@ pub fn three_d(
         let source = c.input.display().to_string();
         let t0 = TimeWindow::first_time(&imu, &source)?;
         let imu = c.window.apply(imu, t0, &source, 1)?;
-        let readings = imukit::io::table::read_table(baro)?;
+        let readings = imukit::io::read::read_table(baro)?;
         let joined =
             imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| match e {
                 Error::Invalid { field, message } if field == "barometer data" => Error::Invalid {

@@ -6,8 +6,8 @@ use imu_plot::{FigureSize, plot_files};
 use imukit::io::conventions::NavFrameName;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
+use imukit::io::read::read_table;
 use imukit::io::rows::TimeWindow;
-use imukit::io::table::read_table;
 
 use super::CliError;
 use crate::cli::FigureArgs;

@@ -278,7 +278,7 @@ mod without {
 mod refused {
     #[test]
     fn a_bag_is_refused_by_name() {
-        let e = crate::table::read_table(std::path::Path::new("run.mcap"))
+        let e = crate::read::read_table(std::path::Path::new("run.mcap"))
             .unwrap_err()
             .to_string();
         assert!(

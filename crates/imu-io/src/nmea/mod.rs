@@ -88,7 +88,7 @@ pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
 mod refused {
     #[test]
     fn a_log_is_refused_by_name() {
-        let e = crate::table::read_table(std::path::Path::new("fixes.nmea"))
+        let e = crate::read::read_table(std::path::Path::new("fixes.nmea"))
             .unwrap_err()
             .to_string();
         assert!(

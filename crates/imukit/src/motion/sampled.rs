@@ -9,7 +9,7 @@ use imu_core::kinematics::sampled::{
 use imu_core::{EulerZyx, KinematicsError, NavFrame, Truth};
 
 use crate::error::{Error, Result};
-use crate::io::table::{CsvRows, read_header};
+use crate::io::read::{CsvRows, read_header};
 
 /// Attitude of a sampled path, owned.
 #[derive(Clone, Debug)]

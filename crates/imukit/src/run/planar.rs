@@ -11,7 +11,8 @@ use crate::error::{Error, Result, invalid};
 use crate::io::Input;
 use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use crate::io::output::write_atomically;
-use crate::io::table::{Table, read_columns, write_rows};
+use crate::io::read::read_columns;
+use crate::io::table::{Table, write_rows};
 use crate::scenario::resolve::finite_vec;
 
 fn is_dat(path: &Path, first_line: &str) -> bool {

@@ -11,7 +11,7 @@ use crate::error::{Error, Result, invalid};
 use crate::io::conventions::{EarthName, NavFrameName};
 use crate::io::memory::check_in_memory;
 use crate::io::params::ParamValue;
-use crate::io::table::read_columns;
+use crate::io::read::read_columns;
 use crate::motion::analytic::AnalyticOptions;
 use crate::motion::expr::Expr;
 use crate::motion::expression::GeodeticPlane;

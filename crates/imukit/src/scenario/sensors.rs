@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, invalid};
 use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor, read_param_file};
 use crate::io::presets;
-use crate::io::table::read_columns;
+use crate::io::read::read_columns;
 use crate::scenario::perturb::Perturbation;
 use crate::scenario::resolve::check_temperature;
 use crate::scenario::spec::{ImuSpec, NumberOrText, number_or_text};
@@ -102,7 +102,7 @@ impl Temperature {
     /// # Errors
     /// Missing columns, bad values, times that do not increase.
     pub fn from_csv(path: &Path) -> Result<Self> {
-        let header = crate::io::table::read_header(path)?;
+        let header = crate::io::read::read_header(path)?;
         let has = |c: &str| header.iter().any(|h| h == c);
         let per = [
             "accel_temperature_c",

@@ -8,8 +8,8 @@ use crate::io::Input;
 use crate::io::columns::{GEODETIC_COLUMNS, Position};
 use crate::io::conventions::NavFrameName;
 use crate::io::output::AtomicFile;
+use crate::io::read::CsvRows;
 use crate::io::rows::TimeWindow;
-use crate::io::table::CsvRows;
 use crate::run::reference::{Layout, ecef};
 
 /// [`compare_csv`] of an estimate on the WGS-84 Earth against a reference whose position is
@@ -29,7 +29,7 @@ pub(super) fn compare_on_earth(
             .unwrap_or_default())
     };
     let (truth_frame, estimate_frame) = (frame_of(truth.path())?, frame_of(estimate.path())?);
-    let header = crate::io::table::read_header(estimate)?;
+    let header = crate::io::read::read_header(estimate)?;
     let own = Layout::of(&header, &[Position::GeodeticRad]).ok_or_else(|| {
         invalid(
             estimate.path().display().to_string(),

@@ -13,6 +13,8 @@ mod orientation;
 
 pub use orientation::heading_inclination;
 
+use crate::io::read::CsvRows;
+
 use crate::io::Input;
 use crate::io::columns::{
     EARTH_ERROR_COLUMNS, ERROR_COLUMNS, ORIENTATION_COLUMNS, ORIENTATION_ERROR_COLUMNS,
@@ -27,7 +29,7 @@ use crate::error::{Result, invalid};
 use crate::io::columns::{SIGMA_COLUMNS, STATE_COLUMNS};
 use crate::io::output::AtomicFile;
 use crate::io::rows::TimeWindow;
-use crate::io::table::{CsvRows, Table};
+use crate::io::table::Table;
 use crate::run::reference::{Layout, ned_of_difference};
 
 /// What kind of estimate a table or file holds, judged by its columns.
@@ -428,7 +430,7 @@ pub fn compare_csv_with(
     };
     // A reference on the Earth (latitude, longitude, height or ECEF, without imukit's plane
     // coordinates) is compared in the Earth's terms.
-    let truth_header = crate::io::table::read_header(truth)?;
+    let truth_header = crate::io::read::read_header(truth)?;
     if !matches!(
         EstimateKind::of(&truth_header),
         Ok(EstimateKind::Navigation)
@@ -440,7 +442,7 @@ pub fn compare_csv_with(
         truth.path(),
         estimate.path(),
     ])?)?;
-    let header = crate::io::table::read_header(estimate)?;
+    let header = crate::io::read::read_header(estimate)?;
     let kind = EstimateKind::of(&header)?;
     let sigmas = has_sigmas(&header, kind);
     let wanted: &[&str] = match kind {

@@ -7,7 +7,8 @@ use crate::io::Input;
 use crate::io::columns::{GEODETIC_COLUMNS, Position, STATE_COLUMNS, Velocity};
 use crate::io::conventions::NavFrameName;
 use crate::io::description::Origin;
-use crate::io::table::{CsvRows, Table};
+use crate::io::read::CsvRows;
+use crate::io::table::Table;
 use crate::run::reference::Given;
 use crate::scenario::resolve::finite_vec;
 
@@ -232,7 +233,7 @@ impl InitialState {
         use crate::run::reference::{Layout, VelocitySource, ecef, ned_of_difference};
         let input = input.into();
         let path = input.path();
-        let header = crate::io::table::read_header(&input)?;
+        let header = crate::io::read::read_header(&input)?;
         let plane = Layout::of(&header, &[Position::Plane]);
         let Some(layout) = Layout::on_earth(&header).filter(|_| {
             // imukit's own tables (plane coordinates, velocity and attitude) start as they did.

@@ -109,7 +109,7 @@ pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
     // numbers per row come out (the states and the table).
     let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
     crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
-    crate::io::table::read_table(input)
+    crate::io::read::read_table(input)
 }
 
 /// `imu` with a [`BARO_COLUMN`] taken from barometer readings `baro` (`t_s, baro_height_m`,
@@ -297,7 +297,7 @@ impl EarthJob for IntegrateCsv<'_> {
             out,
         } = self;
         let options = strapdown_options(setup);
-        let header = crate::io::table::read_header(input)?;
+        let header = crate::io::read::read_header(input)?;
         let has_all = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
         let rates = has_all(&ACCEL_COLUMNS) && has_all(&GYRO_COLUMNS);
         let (force, turn) = if rates {

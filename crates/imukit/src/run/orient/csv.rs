@@ -82,7 +82,7 @@ fn orient_csv_in<N: NavFrame>(
     window: TimeWindow,
     out: &Path,
 ) -> Result<OrientSummary> {
-    let header = crate::io::table::read_header(input)?;
+    let header = crate::io::read::read_header(input)?;
     let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
     let mut spec = spec.clone();
     // A filter that may use a magnetometer uses one when the file has it; a file with only some
