@@ -264,7 +264,7 @@ fn fuse<'py>(
     described: DescribedIn<'py>,
 ) -> PyResult<(DescribedOut<'py>, usize, usize)> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{AidTables, FuseRequest, PartModel, fuse_with};
+    use imukit::run::fuse::{AidTables, FuseRequest, Part, PartModel, Start, fuse_with};
     // The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
     // made once per call: its size does not matter).
     #[allow(clippy::large_enum_variant)]
@@ -283,7 +283,11 @@ fn fuse<'py>(
                 lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m)?,
                 ..Default::default()
             };
-            Model::Part(PartModel { imu, part, gnss })
+            Model::Part(PartModel {
+                imu: Part::named(&imu),
+                part,
+                gnss,
+            })
         }
         None => Model::Scenario(
             match format {
@@ -328,8 +332,7 @@ fn fuse<'py>(
     let (table, summary, description) = py
         .detach(move || {
             let request = FuseRequest {
-                initial: initial.as_ref(),
-                align,
+                start: Start::of(initial.as_ref(), align)?,
                 earth: None,
                 gate,
                 nhc_sigma_m_s,

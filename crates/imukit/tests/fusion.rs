@@ -13,7 +13,7 @@ use imu_core::sensor::{NoiseSource, SeededNormals};
 use imu_core::strapdown::NavState;
 use imu_core::{Body, Enu, Rotation, Vec3};
 use imukit::io::conventions::NavFrameName;
-use imukit::run::fuse::{FuseSetup, fuse};
+use imukit::run::fuse::{FuseSetup, Gate, fuse};
 use imukit::run::navigate::InitialState;
 use imukit::{ScenarioSpec, Simulation, Table};
 
@@ -75,7 +75,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         lever_arm_m: [0.0; 3],
         gnss_latency_s: 0.0,
         part_bias: [1e-3, 1e-5],
-        gate: f64::INFINITY,
+        gate: Gate::Off,
         aiding: Default::default(),
         covariance_interval_s: 0.0,
         estimate_sensor_errors: false,
@@ -452,7 +452,7 @@ fn fixes_stamped_late_are_compared_with_the_state_back_then() {
         .unwrap();
     let mut setup = FuseSetup::from_scenario(&sc).unwrap();
     assert_eq!(setup.gnss_latency_s, 0.2);
-    setup.gate = f64::INFINITY;
+    setup.gate = Gate::Off;
     let initial = InitialState::from_table(&sim.truth).unwrap();
     let rms_horizontal = |setup: &FuseSetup| {
         let (nav, _) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, setup).unwrap();
@@ -720,7 +720,7 @@ fn on_the_earth_ideal_sensors_and_exact_fixes_reproduce_the_truth() {
             .unwrap();
         let mut setup = FuseSetup::from_scenario(&sc).unwrap();
         assert!(setup.earth.is_some());
-        setup.gate = f64::INFINITY;
+        setup.gate = Gate::Off;
         let initial = InitialState::from_table(&sim.truth).unwrap();
         let (nav, summary) = fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &setup).unwrap();
         assert_eq!(summary.updates, 201);

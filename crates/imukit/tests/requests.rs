@@ -654,35 +654,31 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
     let field = |r: FuseRequest<'_>| r.setup(&scenario).unwrap_err().location().field;
     // A start: the truth row or an alignment, exactly one.
     assert_eq!(field(d).as_deref(), Some("initial"));
-    let both = FuseRequest {
-        initial: Some(&initial),
-        align: Some(AlignName::Gnss),
-        ..d
-    };
-    assert_eq!(field(both).as_deref(), Some("initial"));
+    let both = Start::of(Some(&initial), Some(AlignName::Gnss)).unwrap_err();
+    assert_eq!(both.location().field.as_deref(), Some("initial"));
     // The scenario decides the Earth.
     let wgs84 = FuseRequest {
-        align: Some(AlignName::Gnss),
+        start: Some(Start::AlignGnss),
         earth: Some(EarthName::Wgs84),
         ..d
     };
     assert_eq!(field(wgs84).as_deref(), Some("earth"));
     let (setup, start) = FuseRequest {
-        align: Some(AlignName::Static),
+        start: Some(AlignName::Static.into()),
         earth: Some(EarthName::Flat),
         ..d
     }
     .setup(&scenario)
     .unwrap();
     assert!(matches!(start, Start::AlignStatic { .. }));
-    assert!(setup.gate.is_finite());
+    assert!(setup.gate.is_on());
     assert_eq!(setup.covariance_interval_s, DEFAULT_COVARIANCE_INTERVAL_S);
     // Not told: the sensor errors as the part warrants, the rest found in the readings.
     assert_eq!(setup.estimate_sensor_errors, setup.warrants_sensor_errors());
     assert!(setup.detect_rest);
     assert_eq!(setup.aiding.nhc_sigma_m_s, None);
     let (setup, start) = FuseRequest {
-        initial: Some(&initial),
+        start: Some(Start::State(&initial)),
         gate: false,
         nhc_sigma_m_s: Some(0.2),
         covariance_interval_s: Some(0.0),
@@ -693,7 +689,7 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
     .setup(&scenario)
     .unwrap();
     assert_eq!(start, Start::State(&initial));
-    assert_eq!(setup.gate, f64::INFINITY);
+    assert_eq!(setup.gate, imukit::run::fuse::Gate::Off);
     assert_eq!(setup.aiding.nhc_sigma_m_s, Some(0.2));
     assert_eq!(setup.covariance_interval_s, 0.0);
     assert!(setup.estimate_sensor_errors);
@@ -707,7 +703,7 @@ fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
     use imukit::run::navigate::NavSetup;
     use imukit::scenario::gnss::GnssSpec;
     let part = |gnss: GnssSpec| PartModel {
-        imu: "stim300".into(),
+        imu: imukit::run::fuse::Part::Preset("stim300".into()),
         part: None,
         gnss,
     };

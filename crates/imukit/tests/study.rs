@@ -250,7 +250,7 @@ fn a_study_sets_the_filter_up_as_fuse_does() {
     let s = Study::new(&spec, &examples(), "test study").unwrap();
     let initial = InitialState::default();
     let asked_of_fuse = FuseRequest {
-        initial: Some(&initial),
+        start: Some(imukit::run::fuse::Start::State(&initial)),
         nhc_sigma_m_s: Some(0.05),
         ..FuseRequest::default()
     };

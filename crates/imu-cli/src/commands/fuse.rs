@@ -9,7 +9,9 @@ use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::read::{read_table, read_table_as};
 use imukit::io::rows::{Gaps, TimeWindow};
-use imukit::run::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, fuse_with};
+use imukit::run::fuse::{
+    AidTables, AlignName, FuseRequest, FuseSetup, PartModel, Start, fuse_with,
+};
 use imukit::run::navigate::{NavAsked, NavRequest};
 use imukit::{Error, ScenarioSpec};
 
@@ -116,8 +118,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         None => None,
     };
     let request = FuseRequest {
-        initial: initial.as_ref(),
-        align: a.align,
+        start: Start::of(initial.as_ref(), a.align).map_err(by_flag)?,
         earth: a.asked.earth,
         gate: !a.no_gate,
         nhc_sigma_m_s: a.nhc,

@@ -186,7 +186,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 align,
                 scenario: scenario.as_deref(),
                 model: imu_model.map(|imu| imukit::run::fuse::PartModel {
-                    imu,
+                    imu: imukit::run::fuse::Part::named(&imu),
                     part,
                     gnss: imukit::scenario::gnss::GnssSpec {
                         horizontal_accuracy_m: gnss_horizontal_accuracy_m,

@@ -131,7 +131,7 @@ impl AidStreams {
             }),
             baro_sigma_m: setup.aiding.baro_sigma_m.unwrap_or(1.0).max(MIN_SIGMA),
             nhc_sigma_m_s: nhc,
-            gate_on: setup.gate.is_finite(),
+            gate_on: setup.gate.is_on(),
             rest: (span.0 + setup.rest_s, gyro_sample_sigma),
             stance: Vec::new(),
             next: (0, 0),

@@ -226,7 +226,8 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,
         };
-        if acceptance.count(filter.update_gnss(&fix, setup.gate), k, setup.gate)? {
+        let gate = setup.gate.threshold();
+        if acceptance.count(filter.update_gnss(&fix, gate), k, gate)? {
             let heading = fix.velocity_m_s.and_then(|v| {
                 let speed = v.x().hypot(v.y());
                 (speed >= ALIGN_MIN_SPEED_M_S).then(|| {

@@ -29,14 +29,14 @@ pub use detect::{
     REST_START_SPEED_M_S, REST_WINDOW_S, STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S,
     STANCE_WINDOW_S, stance_samples,
 };
-pub use model::{FuseModel, PartModel};
+pub use model::{FuseModel, Part, PartModel};
 pub(crate) use recovery::filter_refusal;
 pub use recovery::{MAX_REJECTED_IN_A_ROW, MAX_RESETS_IN_A_ROW};
 pub use request::{AlignName, FuseRequest, STATIC_ALIGN_S, Start};
 pub use rows::{RESETS_COLUMN, sensor_error_columns};
 pub use setup::{
     AidingSetup, CHI2_99_9_6DOF, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S, FuseSetup,
-    G_SENSITIVITY_STATES_FROM, MIN_G_SENSITIVITY_SIGMA, MIN_SENSOR_ERROR_SIGMA, NHC_RATE_HZ,
+    G_SENSITIVITY_STATES_FROM, Gate, MIN_G_SENSITIVITY_SIGMA, MIN_SENSOR_ERROR_SIGMA, NHC_RATE_HZ,
     OdometerModel, REST_VELOCITY_SIGMA_M_S, SENSOR_ERROR_STATES_FROM,
 };
 pub use smooth::SMOOTHING_GAP_S;

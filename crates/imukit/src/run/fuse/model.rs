@@ -36,14 +36,43 @@ pub struct FuseModel<'a> {
     pub baro_sigma_m: Option<f64>,
 }
 
+/// A part: a built-in preset by its name, or a parameter file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// A preset's name (`imukit presets`).
+    Preset(String),
+    /// A parameter file (imukit TOML or JSON, MATLAB `loadparams` JSON).
+    File(std::path::PathBuf),
+}
+
+impl Default for Part {
+    fn default() -> Self {
+        Self::Preset(String::new())
+    }
+}
+
+impl Part {
+    /// What a front end's one argument names (`--imu PRESET|FILE`, Python's `imu=`): a file when
+    /// it has an extension or exists, else a preset's name.
+    #[must_use]
+    pub fn named(name: &str) -> Self {
+        let path = std::path::Path::new(name);
+        if path.extension().is_some() || path.exists() {
+            Self::File(path.to_path_buf())
+        } else {
+            Self::Preset(name.to_string())
+        }
+    }
+}
+
 /// The filter's model apart from any scenario: the part by a preset's name or a parameter
 /// file (`imukit fuse --imu stim300`, `--imu part.toml`), the GNSS receiver as `[gnss]` keys
 /// (`--gnss-horizontal-accuracy-m` …; MATLAB's defaults for the rest), the data's frame and
 /// Earth from the inputs' descriptions ([`PartModel::setup`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PartModel {
-    /// A preset's name, or the path of a parameter file (imukit TOML, MATLAB JSON).
-    pub imu: String,
+    /// The part.
+    pub imu: Part,
     /// The part in a MATLAB file of several.
     pub part: Option<String>,
     /// The receiver (its rate is not used).
@@ -84,11 +113,13 @@ impl PartModel {
         accel_sign: Option<AccelSign>,
         sample_rate_hz: f64,
     ) -> Result<FuseSetup> {
-        let path = std::path::Path::new(&self.imu);
-        let is_file = path.extension().is_some() || path.exists();
+        let (preset, params) = match &self.imu {
+            Part::Preset(name) => (Some(name.clone()), None),
+            Part::File(path) => (None, Some(path.clone())),
+        };
         let spec = crate::scenario::ImuSpec {
-            preset: (!is_file).then(|| self.imu.clone()),
-            params: is_file.then(|| path.to_path_buf()),
+            preset,
+            params,
             part: self.part.clone(),
             ..crate::scenario::ImuSpec::default()
         };

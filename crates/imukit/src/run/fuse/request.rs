@@ -1,6 +1,6 @@
 //! A fusion as a front end states it ([`FuseRequest`]) and where the filter starts
 //! ([`Start`]).
-use super::FuseSetup;
+use super::{FuseSetup, Gate};
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::conventions::EarthName;
@@ -47,6 +47,24 @@ impl Choice for AlignName {
 
 display_as_name!(AlignName);
 
+impl<'a> Start<'a> {
+    /// The start a front end's two options give (`--init`/`--align`, Python's `initial=`/
+    /// `align=`): the truth row or the alignment; `None` for neither.
+    ///
+    /// # Errors
+    /// Both (field `initial`).
+    pub fn of(initial: Option<&'a InitialState>, align: Option<AlignName>) -> Result<Option<Self>> {
+        match (initial, align) {
+            (Some(_), Some(_)) => Err(invalid(
+                "initial",
+                "give the initial state or an alignment, not both",
+            )),
+            (Some(s), None) => Ok(Some(Self::State(s))),
+            (None, a) => Ok(a.map(Self::from)),
+        }
+    }
+}
+
 impl From<AlignName> for Start<'_> {
     fn from(a: AlignName) -> Self {
         match a {
@@ -64,10 +82,9 @@ impl From<AlignName> for Start<'_> {
 /// [`Default`] is every front end's default.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FuseRequest<'a> {
-    /// Where the filter starts: a truth row…
-    pub initial: Option<&'a InitialState>,
-    /// …or an alignment (exactly one of the two).
-    pub align: Option<AlignName>,
+    /// Where the filter starts: a truth row or an alignment ([`Start::of`] turns a front end's
+    /// two options into one).
+    pub start: Option<Start<'a>>,
     /// The Earth the user expects; the scenario decides, so a different one is refused.
     pub earth: Option<EarthName>,
     /// The innovation gate ([`FuseSetup::gate`]) on.
@@ -90,8 +107,7 @@ pub struct FuseRequest<'a> {
 impl Default for FuseRequest<'_> {
     fn default() -> Self {
         Self {
-            initial: None,
-            align: None,
+            start: None,
             earth: None,
             gate: true,
             nhc_sigma_m_s: None,
@@ -135,27 +151,17 @@ impl<'a> FuseRequest<'a> {
         Ok((self.policy(setup)?, start))
     }
 
-    /// Where the filter starts: the initial state or the alignment asked for.
+    /// Where the filter starts.
     ///
     /// # Errors
-    /// Both or neither (field `initial`).
+    /// No start (field `initial`).
     pub fn start(&self) -> Result<Start<'a>> {
-        Ok(match (self.initial, self.align) {
-            (Some(s), None) => Start::State(s),
-            (None, Some(a)) => a.into(),
-            (Some(_), Some(_)) => {
-                return Err(invalid(
-                    "initial",
-                    "give the initial state or an alignment, not both",
-                ));
-            }
-            (None, None) => {
-                return Err(invalid(
-                    "initial",
-                    "the filter needs a start: the initial state (a truth row) or the alignment \
-                     \"gnss\"",
-                ));
-            }
+        self.start.ok_or_else(|| {
+            invalid(
+                "initial",
+                "the filter needs a start: the initial state (a truth row) or the alignment \
+                 \"gnss\"",
+            )
         })
     }
 
@@ -184,7 +190,7 @@ impl<'a> FuseRequest<'a> {
             ));
         }
         if !self.gate {
-            setup.gate = f64::INFINITY;
+            setup.gate = Gate::Off;
         }
         setup.aiding.nhc_sigma_m_s = self.nhc_sigma_m_s;
         if let Some(s) = self.covariance_interval_s {

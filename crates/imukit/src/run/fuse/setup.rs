@@ -39,8 +39,8 @@ pub struct FuseSetup {
     /// The receiver's latency, s: a fix stamped `t` was valid at `t − latency` (`[gnss]
     /// latency_s`); the filter compares it with its state predicted back that far.
     pub gnss_latency_s: f64,
-    /// Innovation gate: NIS above this chi-square value is rejected (`f64::INFINITY`: off).
-    pub gate: f64,
+    /// The innovation gate of the fixes.
+    pub gate: Gate,
     /// Ground-vehicle and barometer aiding (all off by default).
     pub aiding: AidingSetup,
     /// Estimate the IMU's scale-factor, misalignment and g-sensitivity errors: 36 error states
@@ -71,6 +71,34 @@ pub struct FuseSetup {
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
     pub covariance_interval_s: f64,
+}
+
+/// Which fixes the filter takes: all, or those whose normalised innovation squared (NIS) is
+/// within a chi-square value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gate {
+    /// Every fix is applied.
+    Off,
+    /// A fix whose NIS exceeds this value is rejected (and counted).
+    ChiSquare(f64),
+}
+
+impl Gate {
+    /// The NIS above which a fix is rejected (infinite when the gate is off: the core filter's
+    /// way of saying so).
+    #[must_use]
+    pub fn threshold(self) -> f64 {
+        match self {
+            Self::Off => f64::INFINITY,
+            Self::ChiSquare(x) => x,
+        }
+    }
+
+    /// Whether fixes (and aid readings) are gated at all.
+    #[must_use]
+    pub fn is_on(self) -> bool {
+        matches!(self, Self::ChiSquare(_))
+    }
 }
 
 /// The covariance interval [`FuseSetup::from_scenario`] chooses, s: 20 Hz, four times less
@@ -265,7 +293,7 @@ impl FuseSetup {
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: m.lever_arm_m,
             gnss_latency_s: m.gnss_latency_s,
-            gate: CHI2_99_9_6DOF,
+            gate: Gate::ChiSquare(CHI2_99_9_6DOF),
             aiding: AidingSetup {
                 odometer: m.odometer,
                 nhc_sigma_m_s: None,
