@@ -2,7 +2,7 @@
 
 use imu_core::trig;
 
-use super::jets::{Arithmetic, func1, func2, powf, powi};
+use super::jets::{Arithmetic, add, func1, func2, neg, powf, powi, sub};
 use super::{Arith, CHUNK, Jet, Op, Side};
 use crate::motion::expr::{CmpOp, Func1};
 
@@ -189,16 +189,4 @@ fn compare(c: CmpOp, x: f64, y: f64) -> bool {
         CmpOp::Eq => x == y,
         CmpOp::Ne => x != y,
     }
-}
-
-pub(super) fn neg(x: Jet) -> Jet {
-    x.map(|v| -v)
-}
-
-pub(super) fn add(x: Jet, y: Jet) -> Jet {
-    [x[0] + y[0], x[1] + y[1], x[2] + y[2], x[3] + y[3]]
-}
-
-pub(super) fn sub(x: Jet, y: Jet) -> Jet {
-    [x[0] - y[0], x[1] - y[1], x[2] - y[2], x[3] - y[3]]
 }

@@ -2,7 +2,6 @@
 //! products, quotients and chain rule, powers, and the functions a formula may call.
 
 use super::Jet;
-use super::interpret::{add, neg};
 use crate::motion::expr::{Func1, Func2};
 
 /// Products, quotients and the chain rule of one kind of dual number.
@@ -238,4 +237,17 @@ pub(super) fn func2<A: Arithmetic>(f: Func2, x: Jet, y: Jet) -> Jet {
             }
         }
     }
+}
+
+/// The jets' sums and negation, component by component (the same for every kind of dual number).
+pub(super) fn neg(x: Jet) -> Jet {
+    x.map(|v| -v)
+}
+
+pub(super) fn add(x: Jet, y: Jet) -> Jet {
+    [x[0] + y[0], x[1] + y[1], x[2] + y[2], x[3] + y[3]]
+}
+
+pub(super) fn sub(x: Jet, y: Jet) -> Jet {
+    [x[0] - y[0], x[1] - y[1], x[2] - y[2], x[3] - y[3]]
 }

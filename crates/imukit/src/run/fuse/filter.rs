@@ -3,7 +3,7 @@
 //! propagated with the fixes and aid readings due by then, the rows written (forward, or
 //! smoothed after a backward pass).
 use imu_core::fusion::{Eskf, EskfError, EskfState, FULL_STATES, GnssFix, SensorErrorEstimate};
-use imu_core::{AccelSign, Body, Vec3};
+use imu_core::{Body, Vec3};
 
 use super::detect::{REST_START_SPEED_M_S, detected_rest_s, stance_samples};
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
@@ -49,7 +49,11 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let mut next_fix = begin.next_fix;
     for (i, &ti) in t.iter().enumerate().skip(begin.first) {
         filter
-            .propagate(ti, inputs.w[i], inputs.f[i].map(|x| accel_sign(setup) * x))
+            .propagate(
+                ti,
+                inputs.w[i],
+                inputs.f[i].map(|x| setup.specific_force_factor() * x),
+            )
             .map_err(|e| filter_error("IMU data", e))?;
         apply_fixes(
             &mut filter,
@@ -135,14 +139,6 @@ fn mark_stances(aids: &mut AidStreams, inputs: &FusionInputs, setup: &FuseSetup)
     let count = stance.iter().filter(|s| **s).count();
     aids.set_stance(stance);
     count
-}
-
-/// The factor that turns the accelerometer columns into specific force.
-pub(super) fn accel_sign(setup: &FuseSetup) -> f64 {
-    match setup.accel_sign {
-        AccelSign::SpecificForce => 1.0,
-        AccelSign::Matlab => -1.0,
-    }
 }
 
 /// The filter's refusal of `context` (a setting or the IMU data), without a row.

@@ -2,7 +2,6 @@
 //! velocities and own accuracies, and the fixes in the filter's terms.
 use imu_core::Vec3;
 
-use super::start::ALIGN_MIN_SPEED_M_S;
 use crate::error::{Result, invalid};
 use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GYRO_COLUMNS};
 use crate::io::table::Table;
@@ -175,38 +174,6 @@ impl FusionInputs {
     /// The IMU's span `[t₀, t₁]`, s.
     pub(super) fn span(&self) -> (f64, f64) {
         (self.t[0], self.t[self.t.len() - 1])
-    }
-
-    /// For the alignment from GNSS: the first fix `k` at [`ALIGN_MIN_SPEED_M_S`] or more, the
-    /// IMU sample `i0` it is applied at, and its age there (latency included), s.
-    ///
-    /// # Errors
-    /// No fix that fast.
-    pub(super) fn first_fix_at_speed(&self, latency_s: f64) -> Result<(usize, usize, f64)> {
-        if self.velocities == FixVelocity::None {
-            return Err(invalid(
-                "GNSS data",
-                "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
-                 GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
-            ));
-        }
-        let k = self
-            .g_v
-            .iter()
-            .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
-            .ok_or_else(|| {
-                invalid(
-                    "GNSS data",
-                    format!(
-                        "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
-                         heading cannot be taken from GNSS velocity (give the initial state \
-                         instead)"
-                    ),
-                )
-            })?;
-        let t = &self.t;
-        let i0 = t.partition_point(|&ti| ti < self.g_t[k]).min(t.len() - 1);
-        Ok((k, i0, t[i0] - self.g_t[k] + latency_s))
     }
 }
 

@@ -190,6 +190,16 @@ pub const SENSOR_ERROR_STATES_FROM: f64 = 5e-3;
 pub const G_SENSITIVITY_STATES_FROM: f64 = 1e-5;
 
 impl FuseSetup {
+    /// The factor that turns the accelerometer columns into specific force (−1 for MATLAB's
+    /// sign).
+    #[must_use]
+    pub fn specific_force_factor(&self) -> f64 {
+        match self.accel_sign {
+            AccelSign::SpecificForce => 1.0,
+            AccelSign::Matlab => -1.0,
+        }
+    }
+
     /// Whether the part's scale-factor, misalignment or g-sensitivity figures are large enough
     /// ([`SENSOR_ERROR_STATES_FROM`], [`G_SENSITIVITY_STATES_FROM`]) that the filter should
     /// estimate them: what `fuse` does when not told.

@@ -6,8 +6,7 @@ use imu_core::fusion::InitialSigma;
 use imu_core::fusion::align::{self, PartFigures};
 use imu_core::strapdown::NavState;
 
-use super::filter::accel_sign;
-use super::inputs::{Fixes, FusionInputs};
+use super::inputs::{FixVelocity, Fixes, FusionInputs};
 use super::{FuseSetup, Start};
 use crate::error::{Error, Result, invalid};
 use crate::run::nav_earth::{self, NavEarth};
@@ -178,7 +177,7 @@ fn at_rest<E: NavEarth>(
     let aligned = align::at_rest(
         earth,
         &position,
-        mean(&inputs.f, accel_sign(setup)),
+        mean(&inputs.f, setup.specific_force_factor()),
         mean(&inputs.w, 1.0),
         t[i0] - t0,
         &part,
@@ -227,7 +226,7 @@ fn from_gnss<E: NavEarth>(
     inputs: &FusionInputs,
     fixes: &Fixes<E>,
 ) -> Result<Begin<E>> {
-    let (k, i0, age) = inputs.first_fix_at_speed(setup.gnss_latency_s)?;
+    let (k, i0, age) = first_fix_at_speed(inputs, setup.gnss_latency_s)?;
     let v = fixes.velocity[k];
     // The fix was valid `age` before sample i0: moved on by its velocity.
     let position = E::position(earth.offset(&E::coordinates(&fixes.position[k]), &(v * age)));
@@ -243,4 +242,36 @@ fn from_gnss<E: NavEarth>(
         sigma: gnss_alignment_sigma(v.to_array(), setup),
         next_fix: k + 1,
     })
+}
+
+/// For the alignment from GNSS: the first fix `k` of `inputs` at [`ALIGN_MIN_SPEED_M_S`] or
+/// more, the IMU sample `i0` it is applied at, and its age there (latency included), s.
+///
+/// # Errors
+/// No fix that fast.
+fn first_fix_at_speed(inputs: &FusionInputs, latency_s: f64) -> Result<(usize, usize, f64)> {
+    if inputs.velocities == FixVelocity::None {
+        return Err(invalid(
+            "GNSS data",
+            "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
+             GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
+        ));
+    }
+    let k = inputs
+        .g_v
+        .iter()
+        .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
+        .ok_or_else(|| {
+            invalid(
+                "GNSS data",
+                format!(
+                    "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
+                     heading cannot be taken from GNSS velocity (give the initial state \
+                     instead)"
+                ),
+            )
+        })?;
+    let t = &inputs.t;
+    let i0 = t.partition_point(|&ti| ti < inputs.g_t[k]).min(t.len() - 1);
+    Ok((k, i0, t[i0] - inputs.g_t[k] + latency_s))
 }
