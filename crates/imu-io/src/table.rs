@@ -256,6 +256,7 @@ impl Table {
     }
     /// Number of rows.
     #[must_use]
+    #[inline]
     pub fn rows(&self) -> usize {
         if self.columns.is_empty() {
             0
@@ -276,7 +277,9 @@ impl Table {
                 .collect(),
         )
     }
-    /// Appends one row (its length must equal the number of columns).
+    /// Appends one row (its length must equal the number of columns). Inlined: the jobs of
+    /// `imukit` append a row per sample from another crate.
+    #[inline]
     pub fn push_row(&mut self, row: &[f64]) {
         debug_assert_eq!(row.len(), self.columns.len());
         self.data.extend_from_slice(row);
