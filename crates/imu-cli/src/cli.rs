@@ -2,7 +2,7 @@
 use std::path::PathBuf;
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use imukit::choice::Choice;
 use imukit::io::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
 use imukit::run::fuse::AlignName;
@@ -127,315 +127,20 @@ pub struct BagOutArgs {
 pub enum Command {
     /// Truth kinematics and IMU readings of a scenario file (TOML or JSON): ideal, or through the
     /// scenario's sensor error model (`[imu]`: noise, biases, scale factors, presets).
-    Simulate {
-        /// The scenario file.
-        scenario: PathBuf,
-        /// Where to write the IMU readings (CSV, or by extension `.parquet`, `.npy`, `.npz`; a
-        /// ROS 2 bag `.mcap` holds the truth and the fixes too).
-        #[arg(long)]
-        out: PathBuf,
-        /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        truth: Option<PathBuf>,
-        /// Where to write the GNSS fixes of the scenario's `[gnss]` receiver (CSV; with --runs,
-        /// one per run like the IMU readings).
-        #[arg(long)]
-        gnss: Option<PathBuf>,
-        /// Where to write the readings of the scenario's `[baro]` barometer (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        baro: Option<PathBuf>,
-        /// Where to write the readings of the scenario's `[odometer]` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        odometer: Option<PathBuf>,
-        /// Monte Carlo: this many runs, in parallel on all cores, one output per run
-        /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
-        #[arg(long)]
-        runs: Option<u64>,
-        /// Use at most this many threads (default: every core this process may use). A single
-        /// run uses up to three (by default from 1 537 samples, four chunks): the truth, the
-        /// sensors and the files, each a chunk ahead of the next; on two, CSV is written on its
-        /// own thread, binary files beside the sensors. With --runs, this many runs go at a
-        /// time. The numbers are the same however many.
-        #[arg(long, allow_hyphen_values = true)]
-        threads: Option<i64>,
-        /// `euroc`: write the run as a EuRoC sequence, `--out` its folder: the readings in
-        /// `mav0/imu0/data.csv` and the truth in `mav0/state_groundtruth_estimate0/data.csv`, in
-        /// the ASL layout (nanosecond stamps; docs/formats.md).
-        #[arg(long, value_parser = ["euroc"])]
-        layout: Option<String>,
-        /// A bag's IMU topic, frame id and start stamp.
-        #[command(flatten)]
-        bag_out: BagOutArgs,
-    },
+    Simulate(SimulateArgs),
     /// Strapdown navigation (3D) or planar dead reckoning (`--planar`) of IMU data.
-    Integrate {
-        /// IMU data. 3D: CSV with rates (`accel_*_m_s2`, `gyro_*_rad_s`) or increments
-        /// (`dv_*_m_s`, `dtheta_*_rad`). Planar: CSV (`t_s, accel_x_m_s2, accel_y_m_s2,
-        /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
-        input: PathBuf,
-        /// How a vendor's CSV maps to imukit's columns.
-        #[command(flatten)]
-        map: MapArg,
-        /// Which topics of a ROS bag, on which clock.
-        #[command(flatten)]
-        bag: BagArgs,
-        /// The stretch of the run to read.
-        #[command(flatten)]
-        window: WindowArgs,
-        /// 3D: initial state from the first row of this truth file, or of a reference in
-        /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
-        /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
-        #[arg(long)]
-        init: Option<PathBuf>,
-        /// 3D: the data's frame and accelerometer sign.
-        #[command(flatten)]
-        frame: FrameArgs,
-        /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling) [default: what the input
-        /// files' descriptions say, else 9.81].
-        #[arg(long, alias = "gravity")]
-        gravity_m_s2: Option<f64>,
-        /// 3D: switch off the coning and sculling corrections (for comparison).
-        #[arg(long)]
-        no_corrections: bool,
-        /// 3D: initial attitude yaw, pitch, roll, rad.
-        #[arg(long = "euler0-rad", alias = "euler0", num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_hyphen_values = true)]
-        euler0: Option<Vec<f64>>,
-        /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
-        #[arg(long)]
-        planar: bool,
-        /// Planar: `trapezoid` (default) or `exercise` (the planar cart exercise's rules). 3D: `auto`
-        /// (default: `rk4` for rates, `coning` for increments or with --no-corrections), `coning`
-        /// (coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
-        #[arg(long)]
-        scheme: Option<String>,
-        /// 3D `rk4`: RK4 steps per sample interval.
-        #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
-        substeps: usize,
-        /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
-        #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_hyphen_values = true)]
-        position0: Option<Vec<f64>>,
-        /// Planar: initial heading, rad from nav X, counter-clockwise.
-        #[arg(
-            long = "heading0-rad",
-            alias = "heading0",
-            default_value_t = 0.0,
-            allow_hyphen_values = true
-        )]
-        heading0: f64,
-        /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
-        #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_hyphen_values = true)]
-        velocity0: Option<Vec<f64>>,
-        /// 3D: the Earth: `flat` (non-rotating, constant gravity) or `wgs84` (the
-        /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
-        /// needs a geodetic position, from an --init truth file of a `wgs84` scenario or
-        /// --lat0-deg/--lon0-deg/--height0-m). Writes lat_rad, lon_rad, height_m beside the
-        /// local columns [default: what the input files' descriptions say, else flat].
-        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
-        earth: Option<EarthName>,
-        /// 3D, `--earth wgs84`: the vertical channel: `free` (unstable, as physics says),
-        /// `hold` (height and vertical velocity held) or `baro` (a third-order loop on the IMU
-        /// file's `baro_height_m` column).
-        #[arg(long, value_parser = choice::<VerticalName>(), ignore_case = true, default_value_t)]
-        vertical: VerticalName,
-        /// 3D, `--vertical baro`: the loop's time constant, s.
-        #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
-        baro_time_constant_s: f64,
-        /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
-        /// (--gravity-m-s2) [default: what the input files' descriptions say, else normal].
-        #[arg(long, value_parser = choice::<EarthGravityName>(), ignore_case = true)]
-        earth_gravity: Option<EarthGravityName>,
-        /// 3D, `--vertical baro`: barometer readings (`t_s, baro_height_m`, as `imukit simulate
-        /// --baro` writes) instead of a `baro_height_m` column in the IMU file.
-        #[arg(long)]
-        baro: Option<PathBuf>,
-        /// 3D, `--earth wgs84`: the starting latitude, degrees (with --lon0-deg and
-        /// --height0-m; instead of, or over, the --init file's).
-        #[arg(long, allow_hyphen_values = true)]
-        lat0_deg: Option<f64>,
-        /// 3D, `--earth wgs84`: the starting longitude, degrees.
-        #[arg(long, allow_hyphen_values = true)]
-        lon0_deg: Option<f64>,
-        /// 3D, `--earth wgs84`: the starting height above the WGS-84 ellipsoid, m.
-        #[arg(long, allow_hyphen_values = true)]
-        height0_m: Option<f64>,
-        /// Where to write the trajectory (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Integrate(IntegrateArgs),
     /// Orientation from IMU readings by a filter: `robust` (imukit's own, the default:
     /// inclination from the accelerometer low-passed in an almost inertial frame, heading from
     /// the magnetometer unless a magnet is near, gyroscope bias learnt at rest and in motion),
     /// `imufilter` and `ahrsfilter` (MATLAB's Kalman filters), `ecompass`, `madgwick`, `mahony`
     /// or `complementary`.
-    Orient {
-        /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
-        /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
-        input: PathBuf,
-        /// How a vendor's CSV maps to imukit's columns.
-        #[command(flatten)]
-        map: MapArg,
-        /// Which topics of a ROS bag, on which clock.
-        #[command(flatten)]
-        bag: BagArgs,
-        /// The stretch of the run to read.
-        #[command(flatten)]
-        window: WindowArgs,
-        /// The filter.
-        #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
-        filter: FilterKind,
-        /// A filter setting, `KEY=VALUE`, repeatable: MATLAB's property names
-        /// (`GyroscopeNoise=7.6154e-7`, `DecimationFactor=2`, `InitialProcessNoiseScale=10`,
-        /// `SampleRate=100`; `Beta` for madgwick, `Kp`/`Ki` for mahony, `AccelerometerGain`/
-        /// `MagnetometerGain` for complementary). Each sample is integrated over its own
-        /// interval from `t_s`; `SampleRate=…` runs the filter at that fixed rate instead, as
-        /// MATLAB's filters do.
-        #[arg(long = "param", value_name = "KEY=VALUE")]
-        params: Vec<String>,
-        /// Run a 9-axis file as 6D: its magnetometer columns are ignored (the filters that may
-        /// use a magnetometer use one when the file has it).
-        #[arg(long)]
-        no_mag: bool,
-        /// Smooth the whole run after the fact (robust only): the filter forward, then backward
-        /// from where it ended, and the mean of the two (the heading, with a magnetometer, the
-        /// forward pass's). For logs processed offline; the file is read whole.
-        #[arg(long)]
-        smooth: bool,
-        /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
-        /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
-        /// override either, and so does what the input's description says.
-        #[arg(long, value_parser = choice::<Conventions>(), ignore_case = true, default_value_t)]
-        conventions: Conventions,
-        /// Navigation frame of the estimate (default: the input's description's, else the
-        /// conventions').
-        #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
-        nav_frame: Option<NavFrameName>,
-        /// Sign of the accelerometer columns (default: the input's description's, else the
-        /// conventions').
-        #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
-        accel_sign: Option<AccelSignName>,
-        /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,
-        /// roll_rad`).
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Orient(OrientArgs),
     /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states) over IMU rates
     /// and GNSS fixes, the filter's model taken from the scenario that made them (`[imu]` errors,
     /// `[gnss]` accuracy and lever arm); writes the navigation columns, their one-sigma and the
     /// bias estimates with their one-sigma.
-    Fuse {
-        /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
-        imu: PathBuf,
-        /// How a vendor's CSV maps to imukit's columns.
-        #[command(flatten)]
-        map: MapArg,
-        /// Which topics of a ROS bag, on which clock.
-        #[command(flatten)]
-        bag: BagArgs,
-        /// The stretch of the run to read.
-        #[command(flatten)]
-        window: WindowArgs,
-        /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
-        /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
-        gnss: Option<PathBuf>,
-        /// The initial state: the first row of this truth file, or of a reference in latitude,
-        /// longitude and height or ECEF (docs/earth.md; without an attitude, with --align).
-        #[arg(long)]
-        init: Option<PathBuf>,
-        /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
-        /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); `static` (WGS-84
-        /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s. The
-        /// estimate begins there.
-        #[arg(long, value_parser = choice::<AlignName>(), ignore_case = true)]
-        align: Option<AlignName>,
-        /// The scenario whose `[imu]` and `[gnss]` describe the data's errors (or: --imu and
-        /// the --gnss-* accuracies).
-        #[arg(
-            long,
-            required_unless_present = "imu_model",
-            conflicts_with = "imu_model"
-        )]
-        scenario: Option<PathBuf>,
-        /// The IMU part, instead of a scenario: a preset's name (`imukit presets`) or a parameter
-        /// file (imukit TOML, MATLAB JSON). The data's frame, Earth and accelerometer sign come
-        /// from the input files' descriptions (else ENU, flat, specific force).
-        #[arg(long = "imu", value_name = "PRESET|FILE")]
-        imu_model: Option<String>,
-        /// With --imu: the part in a MATLAB parameter file of several.
-        #[arg(long, requires = "imu_model")]
-        part: Option<String>,
-        /// With --imu: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
-        /// when left out).
-        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
-        gnss_horizontal_accuracy_m: Option<f64>,
-        /// With --imu: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
-        /// left out).
-        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
-        gnss_vertical_accuracy_m: Option<f64>,
-        /// With --imu: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
-        /// when left out).
-        #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
-        gnss_velocity_accuracy_m_s: Option<f64>,
-        /// With --imu: the antenna's position from the IMU, body frame, m.
-        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
-              requires = "imu_model")]
-        gnss_lever_arm_m: Option<Vec<f64>>,
-        /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
-        /// user-equivalent range error, m (one-sigma).
-        #[arg(long, allow_hyphen_values = true)]
-        gnss_uere_m: Option<f64>,
-        /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
-        /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
-        /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.
-        #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
-        earth: Option<EarthName>,
-        /// The data's frame and accelerometer sign (with --scenario: checked against it).
-        #[command(flatten)]
-        frame: FrameArgs,
-        /// Apply every fix (no chi-square innovation gate).
-        #[arg(long)]
-        no_gate: bool,
-        /// Odometer readings (`t_s, speed_m_s`, from `imukit simulate --odometer`); the
-        /// scenario's `[odometer]` gives their accuracy.
-        #[arg(long)]
-        odometer: Option<PathBuf>,
-        /// Barometer readings (`t_s, baro_height_m`, from `imukit simulate --baro`); the
-        /// scenario's `[baro]` gives their accuracy.
-        #[arg(long)]
-        baro: Option<PathBuf>,
-        /// Non-holonomic constraints of a ground vehicle: no sideways or vertical body velocity,
-        /// within this one-sigma (m/s; 0.1 when given without a value), with each odometer
-        /// reading or at 10 Hz.
-        #[arg(long, value_name = "SIGMA_M_S", num_args = 0..=1, default_missing_value = "0.1")]
-        nhc: Option<f64>,
-        /// Propagate the covariance once per this interval and at every update, s (0: every IMU
-        /// sample; default 0.05).
-        #[arg(long)]
-        covariance_interval_s: Option<f64>,
-        /// Estimate the IMU's scale-factor, misalignment and g-sensitivity errors (36 error states
-        /// instead of 15; their one-sigma at the start from the part's `axes_misalignment_pct`
-        /// and `acceleration_bias`); the estimate gains their columns. Default: when the part's
-        /// figures reach 0.5 % (or 1e-5 (rad/s)/(m/s²) of g-sensitivity); `--sensor-errors`
-        /// alone is `true`.
-        #[arg(long, value_name = "true|false", num_args = 0..=1, default_missing_value = "true")]
-        sensor_errors: Option<bool>,
-        /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
-        /// zero-rate updates at every sample there calibrate the gyroscope biases. Default: the
-        /// rest found in the readings (blocks of 0.5 s whose spread and mean stay within the
-        /// part's noise); 0: none.
-        #[arg(long, value_name = "SECONDS")]
-        rest_s: Option<f64>,
-        /// Smooth the estimate forward–backward (Rauch–Tung–Striebel over the filter): each
-        /// sample's best estimate from all the data, before and after it, with its one-sigma.
-        #[arg(long)]
-        smooth: bool,
-        /// Zero-velocity updates wherever the readings show a stance (a foot-mounted IMU: the
-        /// SHOE detector with the part's noise), zero velocity and zero rate at each.
-        #[arg(long)]
-        zupt: bool,
-        /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Fuse(FuseArgs),
     /// Which IMU bridges a GNSS outage: a scenario with `[[gnss.outages]]` simulated with each
     /// IMU preset over seeded Monte Carlo runs (all cores; each run a part of the preset's type)
     /// and fused with its GNSS; writes, per preset and time into the first outage, the RMS
@@ -522,73 +227,12 @@ pub enum Command {
     },
     /// Allan deviation of IMU columns (octave τ) with white noise N, bias instability B and
     /// random walk K fitted (a term not resolved shows as its bound).
-    Allan {
-        /// IMU readings CSV (with `t_s`).
-        input: PathBuf,
-        /// How a vendor's CSV maps to imukit's columns.
-        #[command(flatten)]
-        map: MapArg,
-        /// Which topics of a ROS bag, on which clock.
-        #[command(flatten)]
-        bag: BagArgs,
-        /// The stretch of the run to read.
-        #[command(flatten)]
-        window: WindowArgs,
-        /// Columns to analyse (default: every gyro and accel column present).
-        #[arg(long = "column")]
-        columns: Vec<String>,
-        /// Where to write `tau_s, adev_<column>…` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        out: PathBuf,
-        /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// The figure's size and resolution.
-        #[command(flatten)]
-        figure: FigureArgs,
-    },
+    Allan(AllanArgs),
     /// Noise identification of a static log: Allan curves with 95 % bands, the noise terms
     /// (quantisation, white noise, bias instability, rate random walk, rate ramp) each with its
     /// 95 % interval or, not resolved, its bound and the record that would resolve it; an imukit
     /// parameter file, a Kalibr imu.yaml, the fusion filter's noise.
-    Identify {
-        /// The static log (any format imukit reads, with `t_s`).
-        input: PathBuf,
-        /// How a vendor's CSV maps to imukit's columns.
-        #[command(flatten)]
-        map: MapArg,
-        /// Which topics of a ROS bag, on which clock.
-        #[command(flatten)]
-        bag: BagArgs,
-        /// The stretch of the run to read.
-        #[command(flatten)]
-        window: WindowArgs,
-        /// Columns to analyse (default: every gyro and accel column present).
-        #[arg(long = "column")]
-        columns: Vec<String>,
-        /// Where to write `tau_s` and per column `adev_`, `lower95_`, `upper95_`, `edf_`, `fit_`
-        /// (CSV, or by extension `.parquet`, `.npy`, `.npz`).
-        #[arg(long)]
-        out: PathBuf,
-        /// Also write the identified part as an imukit parameter file (TOML) for `--imu`.
-        #[arg(long, value_name = "FILE")]
-        params: Option<PathBuf>,
-        /// Also write the identified part as Kalibr's imu.yaml.
-        #[arg(long, value_name = "FILE")]
-        kalibr: Option<PathBuf>,
-        /// Factor on the Kalibr file's densities (stated in the file).
-        #[arg(long, default_value_t = imukit::io::kalibr::DEFAULT_INFLATION, value_name = "FACTOR")]
-        kalibr_inflation: f64,
-        /// The IMU topic written in the Kalibr file.
-        #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC, value_name = "TOPIC")]
-        kalibr_topic: String,
-        /// Also draw the curves, their bands and the fitted terms (`.svg` or `.png`).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// The figure's size and resolution.
-        #[command(flatten)]
-        figure: FigureArgs,
-    },
+    Identify(IdentifyArgs),
     /// Runs a built-in scenario (default: the figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
     /// and a summary into a folder.
@@ -680,6 +324,386 @@ pub enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+}
+
+/// The arguments of `imukit simulate`.
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Where to write the IMU readings (CSV, or by extension `.parquet`, `.npy`, `.npz`; a
+    /// ROS 2 bag `.mcap` holds the truth and the fixes too).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// Where to write the GNSS fixes of the scenario's `[gnss]` receiver (CSV; with --runs,
+    /// one per run like the IMU readings).
+    #[arg(long)]
+    pub gnss: Option<PathBuf>,
+    /// Where to write the readings of the scenario's `[baro]` barometer (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub baro: Option<PathBuf>,
+    /// Where to write the readings of the scenario's `[odometer]` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub odometer: Option<PathBuf>,
+    /// Monte Carlo: this many runs, in parallel on all cores, one output per run
+    /// (`IMU_run0000.csv`, …); run r draws its noise from (seed, r).
+    #[arg(long)]
+    pub runs: Option<u64>,
+    /// Use at most this many threads (default: every core this process may use). A single
+    /// run uses up to three (by default from 1 537 samples, four chunks): the truth, the
+    /// sensors and the files, each a chunk ahead of the next; on two, CSV is written on its
+    /// own thread, binary files beside the sensors. With --runs, this many runs go at a
+    /// time. The numbers are the same however many.
+    #[arg(long, allow_hyphen_values = true)]
+    pub threads: Option<i64>,
+    /// `euroc`: write the run as a EuRoC sequence, `--out` its folder: the readings in
+    /// `mav0/imu0/data.csv` and the truth in `mav0/state_groundtruth_estimate0/data.csv`, in
+    /// the ASL layout (nanosecond stamps; docs/formats.md).
+    #[arg(long, value_parser = ["euroc"])]
+    pub layout: Option<String>,
+    /// A bag's IMU topic, frame id and start stamp.
+    #[command(flatten)]
+    pub bag_out: BagOutArgs,
+}
+
+/// The arguments of `imukit integrate`.
+#[derive(Args, Debug)]
+pub struct IntegrateArgs {
+    /// IMU data. 3D: CSV with rates (`accel_*_m_s2`, `gyro_*_rad_s`) or increments
+    /// (`dv_*_m_s`, `dtheta_*_rad`). Planar: CSV (`t_s, accel_x_m_s2, accel_y_m_s2,
+    /// gyro_z_rad_s`) or the exercise's whitespace `.dat` (t, a_x, a_y, ω_z).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// 3D: initial state from the first row of this truth file, or of a reference in
+    /// latitude, longitude and height or ECEF (docs/earth.md; else at rest, level, at the
+    /// origin unless --position0-m/--velocity0-m-s/--euler0-rad say otherwise).
+    #[arg(long)]
+    pub init: Option<PathBuf>,
+    /// 3D: the data's frame and accelerometer sign.
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    /// 3D: gravity magnitude, m/s² (`--gravity` is the old spelling) [default: what the input
+    /// files' descriptions say, else 9.81].
+    #[arg(long, alias = "gravity")]
+    pub gravity_m_s2: Option<f64>,
+    /// 3D: switch off the coning and sculling corrections (for comparison).
+    #[arg(long)]
+    pub no_corrections: bool,
+    /// 3D: initial attitude yaw, pitch, roll, rad.
+    #[arg(long = "euler0-rad", alias = "euler0", num_args = 3, value_names = ["YAW", "PITCH", "ROLL"], allow_hyphen_values = true)]
+    pub euler0: Option<Vec<f64>>,
+    /// Planar dead reckoning (cart in a plane: two accelerometers and a yaw gyro).
+    #[arg(long)]
+    pub planar: bool,
+    /// Planar: `trapezoid` (default) or `exercise` (the planar cart exercise's rules). 3D: `auto`
+    /// (default: `rk4` for rates, `coning` for increments or with --no-corrections), `coning`
+    /// (coning/sculling, second order, rates or increments) or `rk4` (fourth order, rates).
+    #[arg(long)]
+    pub scheme: Option<String>,
+    /// 3D `rk4`: RK4 steps per sample interval.
+    #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
+    pub substeps: usize,
+    /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
+    #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_hyphen_values = true)]
+    pub position0: Option<Vec<f64>>,
+    /// Planar: initial heading, rad from nav X, counter-clockwise.
+    #[arg(
+        long = "heading0-rad",
+        alias = "heading0",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub heading0: f64,
+    /// Initial velocity in the navigation frame, m/s: VX VY (planar) or VX VY VZ (3D).
+    #[arg(long = "velocity0-m-s", alias = "velocity0", num_args = 2..=3, allow_hyphen_values = true)]
+    pub velocity0: Option<Vec<f64>>,
+    /// 3D: the Earth: `flat` (non-rotating, constant gravity) or `wgs84` (the
+    /// rotating WGS-84 Earth: Earth rate, transport rate, Coriolis, normal gravity; the start
+    /// needs a geodetic position, from an --init truth file of a `wgs84` scenario or
+    /// --lat0-deg/--lon0-deg/--height0-m). Writes lat_rad, lon_rad, height_m beside the
+    /// local columns [default: what the input files' descriptions say, else flat].
+    #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
+    pub earth: Option<EarthName>,
+    /// 3D, `--earth wgs84`: the vertical channel: `free` (unstable, as physics says),
+    /// `hold` (height and vertical velocity held) or `baro` (a third-order loop on the IMU
+    /// file's `baro_height_m` column).
+    #[arg(long, value_parser = choice::<VerticalName>(), ignore_case = true, default_value_t)]
+    pub vertical: VerticalName,
+    /// 3D, `--vertical baro`: the loop's time constant, s.
+    #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
+    pub baro_time_constant_s: f64,
+    /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
+    /// (--gravity-m-s2) [default: what the input files' descriptions say, else normal].
+    #[arg(long, value_parser = choice::<EarthGravityName>(), ignore_case = true)]
+    pub earth_gravity: Option<EarthGravityName>,
+    /// 3D, `--vertical baro`: barometer readings (`t_s, baro_height_m`, as `imukit simulate
+    /// --baro` writes) instead of a `baro_height_m` column in the IMU file.
+    #[arg(long)]
+    pub baro: Option<PathBuf>,
+    /// 3D, `--earth wgs84`: the starting latitude, degrees (with --lon0-deg and
+    /// --height0-m; instead of, or over, the --init file's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub lat0_deg: Option<f64>,
+    /// 3D, `--earth wgs84`: the starting longitude, degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub lon0_deg: Option<f64>,
+    /// 3D, `--earth wgs84`: the starting height above the WGS-84 ellipsoid, m.
+    #[arg(long, allow_hyphen_values = true)]
+    pub height0_m: Option<f64>,
+    /// Where to write the trajectory (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// The arguments of `imukit fuse`.
+#[derive(Args, Debug)]
+pub struct FuseArgs {
+    /// IMU CSV (rates: `accel_*_m_s2`, `gyro_*_rad_s`).
+    pub imu: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
+    /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
+    pub gnss: Option<PathBuf>,
+    /// The initial state: the first row of this truth file, or of a reference in latitude,
+    /// longitude and height or ECEF (docs/earth.md; without an attitude, with --align).
+    #[arg(long)]
+    pub init: Option<PathBuf>,
+    /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
+    /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); `static` (WGS-84
+    /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s. The
+    /// estimate begins there.
+    #[arg(long, value_parser = choice::<AlignName>(), ignore_case = true)]
+    pub align: Option<AlignName>,
+    /// The scenario whose `[imu]` and `[gnss]` describe the data's errors (or: --imu and
+    /// the --gnss-* accuracies).
+    #[arg(
+        long,
+        required_unless_present = "imu_model",
+        conflicts_with = "imu_model"
+    )]
+    pub scenario: Option<PathBuf>,
+    /// The IMU part, instead of a scenario: a preset's name (`imukit presets`) or a parameter
+    /// file (imukit TOML, MATLAB JSON). The data's frame, Earth and accelerometer sign come
+    /// from the input files' descriptions (else ENU, flat, specific force).
+    #[arg(long = "imu", value_name = "PRESET|FILE")]
+    pub imu_model: Option<String>,
+    /// With --imu: the part in a MATLAB parameter file of several.
+    #[arg(long, requires = "imu_model")]
+    pub part: Option<String>,
+    /// With --imu: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
+    /// when left out).
+    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    pub gnss_horizontal_accuracy_m: Option<f64>,
+    /// With --imu: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
+    /// left out).
+    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    pub gnss_vertical_accuracy_m: Option<f64>,
+    /// With --imu: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
+    /// when left out).
+    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    pub gnss_velocity_accuracy_m_s: Option<f64>,
+    /// With --imu: the antenna's position from the IMU, body frame, m.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
+          requires = "imu_model")]
+    pub gnss_lever_arm_m: Option<Vec<f64>>,
+    /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
+    /// user-equivalent range error, m (one-sigma).
+    #[arg(long, allow_hyphen_values = true)]
+    pub gnss_uere_m: Option<f64>,
+    /// `flat` or `wgs84`: the scenario's Earth (default), checked when given. On `wgs84` the
+    /// filter runs on the Earth's mechanization (Earth rate, transport rate, Coriolis,
+    /// normal gravity) with geodetic fixes and adds `lat_rad, lon_rad, height_m`.
+    #[arg(long, value_parser = choice::<EarthName>(), ignore_case = true)]
+    pub earth: Option<EarthName>,
+    /// The data's frame and accelerometer sign (with --scenario: checked against it).
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    /// Apply every fix (no chi-square innovation gate).
+    #[arg(long)]
+    pub no_gate: bool,
+    /// Odometer readings (`t_s, speed_m_s`, from `imukit simulate --odometer`); the
+    /// scenario's `[odometer]` gives their accuracy.
+    #[arg(long)]
+    pub odometer: Option<PathBuf>,
+    /// Barometer readings (`t_s, baro_height_m`, from `imukit simulate --baro`); the
+    /// scenario's `[baro]` gives their accuracy.
+    #[arg(long)]
+    pub baro: Option<PathBuf>,
+    /// Non-holonomic constraints of a ground vehicle: no sideways or vertical body velocity,
+    /// within this one-sigma (m/s; 0.1 when given without a value), with each odometer
+    /// reading or at 10 Hz.
+    #[arg(long, value_name = "SIGMA_M_S", num_args = 0..=1, default_missing_value = "0.1")]
+    pub nhc: Option<f64>,
+    /// Propagate the covariance once per this interval and at every update, s (0: every IMU
+    /// sample; default 0.05).
+    #[arg(long)]
+    pub covariance_interval_s: Option<f64>,
+    /// Estimate the IMU's scale-factor, misalignment and g-sensitivity errors (36 error states
+    /// instead of 15; their one-sigma at the start from the part's `axes_misalignment_pct`
+    /// and `acceleration_bias`); the estimate gains their columns. Default: when the part's
+    /// figures reach 0.5 % (or 1e-5 (rad/s)/(m/s²) of g-sensitivity); `--sensor-errors`
+    /// alone is `true`.
+    #[arg(long, value_name = "true|false", num_args = 0..=1, default_missing_value = "true")]
+    pub sensor_errors: Option<bool>,
+    /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
+    /// zero-rate updates at every sample there calibrate the gyroscope biases. Default: the
+    /// rest found in the readings (blocks of 0.5 s whose spread and mean stay within the
+    /// part's noise); 0: none.
+    #[arg(long, value_name = "SECONDS")]
+    pub rest_s: Option<f64>,
+    /// Smooth the estimate forward–backward (Rauch–Tung–Striebel over the filter): each
+    /// sample's best estimate from all the data, before and after it, with its one-sigma.
+    #[arg(long)]
+    pub smooth: bool,
+    /// Zero-velocity updates wherever the readings show a stance (a foot-mounted IMU: the
+    /// SHOE detector with the part's noise), zero velocity and zero rate at each.
+    #[arg(long)]
+    pub zupt: bool,
+    /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// The arguments of `imukit orient`.
+#[derive(Args, Debug)]
+pub struct OrientArgs {
+    /// IMU CSV: `t_s`, `accel_*_m_s2`, `gyro_*_rad_s`, and `mag_*_ut` for the filters that
+    /// use a magnetometer (`ahrsfilter`, `ecompass`; the others use it when present).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// The filter.
+    #[arg(long, value_parser = choice::<FilterKind>(), ignore_case = true, default_value_t)]
+    pub filter: FilterKind,
+    /// A filter setting, `KEY=VALUE`, repeatable: MATLAB's property names
+    /// (`GyroscopeNoise=7.6154e-7`, `DecimationFactor=2`, `InitialProcessNoiseScale=10`,
+    /// `SampleRate=100`; `Beta` for madgwick, `Kp`/`Ki` for mahony, `AccelerometerGain`/
+    /// `MagnetometerGain` for complementary). Each sample is integrated over its own
+    /// interval from `t_s`; `SampleRate=…` runs the filter at that fixed rate instead, as
+    /// MATLAB's filters do.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// Run a 9-axis file as 6D: its magnetometer columns are ignored (the filters that may
+    /// use a magnetometer use one when the file has it).
+    #[arg(long)]
+    pub no_mag: bool,
+    /// Smooth the whole run after the fact (robust only): the filter forward, then backward
+    /// from where it ended, and the mean of the two (the heading, with a magnetometer, the
+    /// forward pass's). For logs processed offline; the file is read whole.
+    #[arg(long)]
+    pub smooth: bool,
+    /// Conventions: `imukit` (ENU and specific force, as every command) or `matlab` (NED and
+    /// MATLAB's accelerometer sign, as MATLAB's filters). --nav-frame and --accel-sign
+    /// override either, and so does what the input's description says.
+    #[arg(long, value_parser = choice::<Conventions>(), ignore_case = true, default_value_t)]
+    pub conventions: Conventions,
+    /// Navigation frame of the estimate (default: the input's description's, else the
+    /// conventions').
+    #[arg(long, value_parser = choice::<NavFrameName>(), ignore_case = true)]
+    pub nav_frame: Option<NavFrameName>,
+    /// Sign of the accelerometer columns (default: the input's description's, else the
+    /// conventions').
+    #[arg(long, value_parser = choice::<AccelSignName>(), ignore_case = true)]
+    pub accel_sign: Option<AccelSignName>,
+    /// Where to write the orientation (`t_s, q_w, q_x, q_y, q_z, yaw_rad, pitch_rad,
+    /// roll_rad`).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// The arguments of `imukit identify`.
+#[derive(Args, Debug)]
+pub struct IdentifyArgs {
+    /// The static log (any format imukit reads, with `t_s`).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// Columns to analyse (default: every gyro and accel column present).
+    #[arg(long = "column")]
+    pub columns: Vec<String>,
+    /// Where to write `tau_s` and per column `adev_`, `lower95_`, `upper95_`, `edf_`, `fit_`
+    /// (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the identified part as an imukit parameter file (TOML) for `--imu`.
+    #[arg(long, value_name = "FILE")]
+    pub params: Option<PathBuf>,
+    /// Also write the identified part as Kalibr's imu.yaml.
+    #[arg(long, value_name = "FILE")]
+    pub kalibr: Option<PathBuf>,
+    /// Factor on the Kalibr file's densities (stated in the file).
+    #[arg(long, default_value_t = imukit::io::kalibr::DEFAULT_INFLATION, value_name = "FACTOR")]
+    pub kalibr_inflation: f64,
+    /// The IMU topic written in the Kalibr file.
+    #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC, value_name = "TOPIC")]
+    pub kalibr_topic: String,
+    /// Also draw the curves, their bands and the fitted terms (`.svg` or `.png`).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// The figure's size and resolution.
+    #[command(flatten)]
+    pub figure: FigureArgs,
+}
+
+/// The arguments of `imukit allan`.
+#[derive(Args, Debug)]
+pub struct AllanArgs {
+    /// IMU readings CSV (with `t_s`).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// Columns to analyse (default: every gyro and accel column present).
+    #[arg(long = "column")]
+    pub columns: Vec<String>,
+    /// Where to write `tau_s, adev_<column>…` (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also draw the curves with the fitted lines into this figure (`.svg` or `.png`).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// The figure's size and resolution.
+    #[command(flatten)]
+    pub figure: FigureArgs,
 }
 
 /// What `imukit presets NAME` prints.

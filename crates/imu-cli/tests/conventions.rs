@@ -221,8 +221,8 @@ fn nhc_alone_is_the_librarys_default() {
         "o.csv",
     ])
     .unwrap();
-    let Command::Fuse { nhc, .. } = cli.command else {
+    let Command::Fuse(fuse) = cli.command else {
         panic!("not fuse")
     };
-    assert_eq!(nhc, Some(imukit::run::fuse::DEFAULT_NHC_SIGMA_M_S));
+    assert_eq!(fuse.nhc, Some(imukit::run::fuse::DEFAULT_NHC_SIGMA_M_S));
 }

@@ -30,37 +30,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Completions { shell } => manual::completions(shell),
         Command::Man { out_dir } => manual::man(out_dir.as_deref()),
-        Command::Simulate {
-            scenario,
-            out,
-            truth,
-            gnss,
-            baro,
-            odometer,
-            runs,
-            threads,
-            layout,
-            bag_out,
-        } => {
-            let bag = simulate::bag_options(&bag_out, &out, layout.is_some())?;
-            if layout.is_some() {
-                simulate::euroc(&scenario, &out, truth.as_deref(), runs, threads)
-            } else {
-                simulate::run(
-                    &scenario,
-                    &simulate::Outputs {
-                        out: &out,
-                        truth: truth.as_deref(),
-                        gnss: gnss.as_deref(),
-                        baro: baro.as_deref(),
-                        odometer: odometer.as_deref(),
-                        bag: bag.as_ref(),
-                    },
-                    runs,
-                    threads,
-                )
-            }
-        }
+        Command::Simulate(a) => simulate_command(a),
         Command::Demo { out_dir, scenario } => demo::run(&out_dir, &scenario),
         Command::Scenario { name } => scenario::run(name.as_deref()),
         Command::Example { names, out_dir } => example::run(&names, &out_dir),
@@ -75,179 +45,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             Some(path) => presets::file(&path, part.as_deref(), format, rate_hz, &topic),
             None => presets::run(name.as_deref(), format, rate_hz, &topic),
         },
-        Command::Integrate {
-            input,
-            map,
-            bag,
-            init,
-            frame,
-            gravity_m_s2,
-            no_corrections,
-            euler0,
-            planar,
-            scheme,
-            substeps,
-            position0,
-            heading0,
-            velocity0,
-            earth,
-            vertical,
-            baro_time_constant_s,
-            earth_gravity,
-            baro,
-            lat0_deg,
-            lon0_deg,
-            height0_m,
-            out,
-            window,
-        } => {
-            let mapped = map.input(&input)?;
-            bag.check(&[Some(&input), init.as_deref()])?;
-            let input = bag.input(mapped);
-            let init = init.map(|p| bag.input(Input::new(p)));
-            let common = integrate::Common {
-                input: &input,
-                out: &out,
-                window: window.window()?,
-                position0: position0.as_deref(),
-                velocity0: velocity0.as_deref(),
-            };
-            if planar {
-                integrate::planar(&common, scheme.as_deref(), heading0)
-            } else {
-                let scheme = scheme
-                    .map(|s| SchemeName::parse("--scheme", &s))
-                    .transpose()?
-                    .unwrap_or_default();
-                let request = NavRequest {
-                    scheme,
-                    substeps,
-                    coning: !no_corrections,
-                    sculling: !no_corrections,
-                    vertical,
-                    baro_time_constant_s,
-                    ..NavRequest::default()
-                };
-                let asked = NavAsked {
-                    nav_frame: frame.nav_frame,
-                    accel_sign: frame.accel_sign,
-                    gravity_m_s2,
-                    earth,
-                    earth_gravity,
-                    conventions: frame.conventions,
-                };
-                let opts = integrate::Options3d {
-                    init: init.as_ref(),
-                    euler0: euler0.as_deref(),
-                    baro: baro.as_deref(),
-                    geodetic0: (lat0_deg, lon0_deg, height0_m),
-                };
-                integrate::three_d(&common, &opts, &request, &asked)
-            }
-        }
-        Command::Fuse {
-            imu,
-            map,
-            bag,
-            gnss,
-            init,
-            align,
-            scenario,
-            imu_model,
-            part,
-            gnss_horizontal_accuracy_m,
-            gnss_vertical_accuracy_m,
-            gnss_velocity_accuracy_m_s,
-            gnss_lever_arm_m,
-            gnss_uere_m,
-            earth,
-            frame,
-            no_gate,
-            odometer,
-            baro,
-            nhc,
-            covariance_interval_s,
-            sensor_errors,
-            rest_s,
-            smooth,
-            zupt,
-            out,
-            window,
-        } => {
-            let mapped = map.input(&imu)?;
-            bag.check(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
-            let imu = bag.input(mapped);
-            let gnss = gnss.map(|p| bag.input(Input::new(p)));
-            let init = init.map(|p| bag.input(Input::new(p)));
-            fuse::run(&fuse::Args {
-                imu: &imu,
-                gnss: gnss.as_ref(),
-                init: init.as_ref(),
-                align,
-                scenario: scenario.as_deref(),
-                model: imu_model.map(|imu| imukit::run::fuse::PartModel {
-                    imu: imukit::run::fuse::Part::named(&imu),
-                    part,
-                    gnss: imukit::scenario::gnss::GnssSpec {
-                        horizontal_accuracy_m: gnss_horizontal_accuracy_m,
-                        vertical_accuracy_m: gnss_vertical_accuracy_m,
-                        velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
-                        lever_arm_m: gnss_lever_arm_m.map(|v| [v[0], v[1], v[2]]),
-                        ..Default::default()
-                    },
-                }),
-                gnss_uere_m,
-                asked: imukit::run::navigate::NavAsked {
-                    nav_frame: frame.nav_frame,
-                    accel_sign: frame.accel_sign,
-                    earth,
-                    conventions: frame.conventions,
-                    ..Default::default()
-                },
-                no_gate,
-                odometer: odometer.as_deref(),
-                baro: baro.as_deref(),
-                nhc,
-                covariance_interval_s,
-                sensor_errors,
-                rest_s,
-                smooth,
-                zupt,
-                window: window.window()?,
-                out: &out,
-            })
-        }
+        Command::Integrate(a) => integrate_command(a),
+        Command::Fuse(a) => fuse_command(a),
         Command::Study { study, out, plot } => study::run(&study, &out, plot.as_deref()),
-        Command::Orient {
-            input,
-            map,
-            bag,
-            filter,
-            params,
-            no_mag,
-            smooth,
-            conventions,
-            nav_frame,
-            accel_sign,
-            out,
-            window,
-        } => {
-            let mapped = map.input(&input)?;
-            bag.check(&[Some(&input)])?;
-            let input = bag.input(mapped);
-            orient::run(&orient::Args {
-                input: &input,
-                filter,
-                params: &params,
-                no_mag,
-                smooth,
-                conventions,
-                nav_frame,
-                accel_sign,
-                window: window.window()?,
-                out: &out,
-            })
-        }
+        Command::Orient(a) => orient_command(a),
         Command::Compare {
             truth,
             estimate,
@@ -270,60 +71,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             crate::out_line!("{} {}   ({})", c.value, c.unit, c.fits);
             Ok(())
         }
-        Command::Allan {
-            input,
-            map,
-            bag,
-            columns,
-            out,
-            plot,
-            figure,
-            window,
-        } => {
-            let mapped = map.input(&input)?;
-            bag.check(&[Some(&input)])?;
-            let input = bag.input(mapped);
-            allan::run(
-                &input,
-                &columns,
-                window.window()?,
-                &out,
-                plot.as_deref(),
-                plot::figure_size(&figure)?,
-            )
-        }
-        Command::Identify {
-            input,
-            map,
-            bag,
-            columns,
-            out,
-            params,
-            kalibr,
-            kalibr_inflation,
-            kalibr_topic,
-            plot,
-            figure,
-            window,
-        } => {
-            let mapped = map.input(&input)?;
-            bag.check(&[Some(&input)])?;
-            let input = bag.input(mapped);
-            identify::run(
-                &input,
-                &columns,
-                window.window()?,
-                &identify::Outputs {
-                    out: &out,
-                    params: params.as_deref(),
-                    kalibr: kalibr.as_deref(),
-                    kalibr_inflation,
-                    kalibr_topic: &kalibr_topic,
-                    plot: plot.as_deref(),
-                },
-                plot::figure_size(&figure)?,
-            )
-        }
+        Command::Allan(a) => allan_command(a),
+        Command::Identify(a) => identify_command(a),
         Command::Plot {
             files,
             window,
@@ -444,4 +193,279 @@ impl crate::cli::MapArg {
         }
         Ok(Input::new(input).with_map(imukit::io::column_map::ColumnMap::read(m)?))
     }
+}
+
+/// `imukit simulate`.
+fn simulate_command(a: crate::cli::SimulateArgs) -> Result<(), CliError> {
+    let crate::cli::SimulateArgs {
+        scenario,
+        out,
+        truth,
+        gnss,
+        baro,
+        odometer,
+        runs,
+        threads,
+        layout,
+        bag_out,
+    } = a;
+    let bag = simulate::bag_options(&bag_out, &out, layout.is_some())?;
+    if layout.is_some() {
+        simulate::euroc(&scenario, &out, truth.as_deref(), runs, threads)
+    } else {
+        simulate::run(
+            &scenario,
+            &simulate::Outputs {
+                out: &out,
+                truth: truth.as_deref(),
+                gnss: gnss.as_deref(),
+                baro: baro.as_deref(),
+                odometer: odometer.as_deref(),
+                bag: bag.as_ref(),
+            },
+            runs,
+            threads,
+        )
+    }
+}
+
+/// `imukit integrate`.
+fn integrate_command(a: crate::cli::IntegrateArgs) -> Result<(), CliError> {
+    let crate::cli::IntegrateArgs {
+        input,
+        map,
+        bag,
+        init,
+        frame,
+        gravity_m_s2,
+        no_corrections,
+        euler0,
+        planar,
+        scheme,
+        substeps,
+        position0,
+        heading0,
+        velocity0,
+        earth,
+        vertical,
+        baro_time_constant_s,
+        earth_gravity,
+        baro,
+        lat0_deg,
+        lon0_deg,
+        height0_m,
+        out,
+        window,
+    } = a;
+    let mapped = map.input(&input)?;
+    bag.check(&[Some(&input), init.as_deref()])?;
+    let input = bag.input(mapped);
+    let init = init.map(|p| bag.input(Input::new(p)));
+    let common = integrate::Common {
+        input: &input,
+        out: &out,
+        window: window.window()?,
+        position0: position0.as_deref(),
+        velocity0: velocity0.as_deref(),
+    };
+    if planar {
+        integrate::planar(&common, scheme.as_deref(), heading0)
+    } else {
+        let scheme = scheme
+            .map(|s| SchemeName::parse("--scheme", &s))
+            .transpose()?
+            .unwrap_or_default();
+        let request = NavRequest {
+            scheme,
+            substeps,
+            coning: !no_corrections,
+            sculling: !no_corrections,
+            vertical,
+            baro_time_constant_s,
+            ..NavRequest::default()
+        };
+        let asked = NavAsked {
+            nav_frame: frame.nav_frame,
+            accel_sign: frame.accel_sign,
+            gravity_m_s2,
+            earth,
+            earth_gravity,
+            conventions: frame.conventions,
+        };
+        let opts = integrate::Options3d {
+            init: init.as_ref(),
+            euler0: euler0.as_deref(),
+            baro: baro.as_deref(),
+            geodetic0: (lat0_deg, lon0_deg, height0_m),
+        };
+        integrate::three_d(&common, &opts, &request, &asked)
+    }
+}
+
+/// `imukit fuse`.
+fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
+    let crate::cli::FuseArgs {
+        imu,
+        map,
+        bag,
+        gnss,
+        init,
+        align,
+        scenario,
+        imu_model,
+        part,
+        gnss_horizontal_accuracy_m,
+        gnss_vertical_accuracy_m,
+        gnss_velocity_accuracy_m_s,
+        gnss_lever_arm_m,
+        gnss_uere_m,
+        earth,
+        frame,
+        no_gate,
+        odometer,
+        baro,
+        nhc,
+        covariance_interval_s,
+        sensor_errors,
+        rest_s,
+        smooth,
+        zupt,
+        out,
+        window,
+    } = a;
+    let mapped = map.input(&imu)?;
+    bag.check(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
+    let imu = bag.input(mapped);
+    let gnss = gnss.map(|p| bag.input(Input::new(p)));
+    let init = init.map(|p| bag.input(Input::new(p)));
+    fuse::run(&fuse::Args {
+        imu: &imu,
+        gnss: gnss.as_ref(),
+        init: init.as_ref(),
+        align,
+        scenario: scenario.as_deref(),
+        model: imu_model.map(|imu| imukit::run::fuse::PartModel {
+            imu: imukit::run::fuse::Part::named(&imu),
+            part,
+            gnss: imukit::scenario::gnss::GnssSpec {
+                horizontal_accuracy_m: gnss_horizontal_accuracy_m,
+                vertical_accuracy_m: gnss_vertical_accuracy_m,
+                velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
+                lever_arm_m: gnss_lever_arm_m.map(|v| [v[0], v[1], v[2]]),
+                ..Default::default()
+            },
+        }),
+        gnss_uere_m,
+        asked: imukit::run::navigate::NavAsked {
+            nav_frame: frame.nav_frame,
+            accel_sign: frame.accel_sign,
+            earth,
+            conventions: frame.conventions,
+            ..Default::default()
+        },
+        no_gate,
+        odometer: odometer.as_deref(),
+        baro: baro.as_deref(),
+        nhc,
+        covariance_interval_s,
+        sensor_errors,
+        rest_s,
+        smooth,
+        zupt,
+        window: window.window()?,
+        out: &out,
+    })
+}
+
+/// `imukit orient`.
+fn orient_command(a: crate::cli::OrientArgs) -> Result<(), CliError> {
+    let crate::cli::OrientArgs {
+        input,
+        map,
+        bag,
+        filter,
+        params,
+        no_mag,
+        smooth,
+        conventions,
+        nav_frame,
+        accel_sign,
+        out,
+        window,
+    } = a;
+    let mapped = map.input(&input)?;
+    bag.check(&[Some(&input)])?;
+    let input = bag.input(mapped);
+    orient::run(&orient::Args {
+        input: &input,
+        filter,
+        params: &params,
+        no_mag,
+        smooth,
+        conventions,
+        nav_frame,
+        accel_sign,
+        window: window.window()?,
+        out: &out,
+    })
+}
+
+/// `imukit identify`.
+fn identify_command(a: crate::cli::IdentifyArgs) -> Result<(), CliError> {
+    let crate::cli::IdentifyArgs {
+        input,
+        map,
+        bag,
+        columns,
+        out,
+        params,
+        kalibr,
+        kalibr_inflation,
+        kalibr_topic,
+        plot,
+        figure,
+        window,
+    } = a;
+    let mapped = map.input(&input)?;
+    bag.check(&[Some(&input)])?;
+    let input = bag.input(mapped);
+    identify::run(
+        &input,
+        &columns,
+        window.window()?,
+        &identify::Outputs {
+            out: &out,
+            params: params.as_deref(),
+            kalibr: kalibr.as_deref(),
+            kalibr_inflation,
+            kalibr_topic: &kalibr_topic,
+            plot: plot.as_deref(),
+        },
+        plot::figure_size(&figure)?,
+    )
+}
+
+/// `imukit allan`.
+fn allan_command(a: crate::cli::AllanArgs) -> Result<(), CliError> {
+    let crate::cli::AllanArgs {
+        input,
+        map,
+        bag,
+        columns,
+        out,
+        plot,
+        figure,
+        window,
+    } = a;
+    let mapped = map.input(&input)?;
+    bag.check(&[Some(&input)])?;
+    let input = bag.input(mapped);
+    allan::run(
+        &input,
+        &columns,
+        window.window()?,
+        &out,
+        plot.as_deref(),
+        plot::figure_size(&figure)?,
+    )
 }
