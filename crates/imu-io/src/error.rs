@@ -218,7 +218,72 @@ pub struct Location {
     pub column: Option<String>,
 }
 
+/// An input a job reads, by what it holds. A refusal about one names it by its label
+/// ([`Data::label`], e.g. `IMU data`), and a front end that knows which file it came from
+/// names the file instead ([`Error::data`], [`Error::relabelled`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Data {
+    /// IMU readings.
+    Imu,
+    /// GNSS fixes.
+    Gnss,
+    /// Odometer readings.
+    Odometer,
+    /// Barometer readings.
+    Barometer,
+}
+
+impl Data {
+    /// Every kind.
+    pub const ALL: [Self; 4] = [Self::Imu, Self::Gnss, Self::Odometer, Self::Barometer];
+
+    /// How a refusal names it.
+    #[must_use]
+    pub const fn label(self) -> &'static str {
+        match self {
+            Self::Imu => "IMU data",
+            Self::Gnss => "GNSS data",
+            Self::Odometer => "odometer data",
+            Self::Barometer => "barometer data",
+        }
+    }
+}
+
 impl Error {
+    /// The input this refusal is about, when it names one by its [`Data::label`].
+    #[must_use]
+    pub fn data(&self) -> Option<Data> {
+        let named = match self {
+            Self::Invalid { field: f, .. }
+            | Self::Filter { context: f, .. }
+            | Self::Diverged { context: f, .. } => f,
+            _ => return None,
+        };
+        Data::ALL.into_iter().find(|d| d.label() == named)
+    }
+
+    /// This refusal with the input it names called `name` instead (the file it came from); other
+    /// refusals as they are.
+    #[must_use]
+    pub fn relabelled(self, name: String) -> Self {
+        match self {
+            Self::Invalid { message, .. } => Self::Invalid {
+                field: name,
+                message,
+            },
+            Self::Filter { row, source, .. } => Self::Filter {
+                context: name,
+                row,
+                source,
+            },
+            Self::Diverged { message, .. } => Self::Diverged {
+                context: name,
+                message,
+            },
+            other => other,
+        }
+    }
+
     /// Where the error points.
     #[must_use]
     pub fn location(&self) -> Location {
@@ -302,5 +367,30 @@ pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Error {
     Error::Invalid {
         field: field.into(),
         message: message.into(),
+    }
+}
+
+#[cfg(test)]
+mod data_tests {
+    use super::*;
+
+    #[test]
+    fn a_refusal_about_an_input_is_named_by_the_file_a_front_end_knows() {
+        for data in Data::ALL {
+            let e = invalid(data.label(), "row 3: times must increase");
+            assert_eq!(e.data(), Some(data));
+            let renamed = e.relabelled("log.csv".into());
+            assert_eq!(renamed.to_string(), "log.csv: row 3: times must increase");
+            assert_eq!(renamed.data(), None);
+        }
+        // A request's field names no input.
+        let e = invalid("rest_s", "must be ≥ 0");
+        assert_eq!(e.data(), None);
+        assert_eq!(e.relabelled("x".into()).to_string(), "x: must be ≥ 0");
+        let io = Error::Scenario {
+            origin: "s.toml".into(),
+            message: "bad".into(),
+        };
+        assert_eq!(io.data(), None);
     }
 }

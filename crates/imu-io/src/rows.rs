@@ -12,7 +12,7 @@
 //! every file of one run (the fixes, the reference) at the same instants.
 use std::collections::VecDeque;
 
-use crate::error::{Result, invalid};
+use crate::error::{Data, Result, invalid};
 use crate::read::CsvRows;
 use crate::table::Table;
 
@@ -400,7 +400,7 @@ impl TimedRows {
             if let Some(p) = self.skipped_t
                 && t <= p
             {
-                return Err(not_increasing("IMU data", self.taken + 2));
+                return Err(not_increasing(Data::Imu.label(), self.taken + 2));
             }
             if t >= self.window.0 {
                 if t > self.window.1 {
@@ -453,7 +453,7 @@ impl TimedRows {
             if let Some(p) = self.previous_t.or(self.skipped_t)
                 && t <= p
             {
-                return Err(not_increasing("IMU data", line));
+                return Err(not_increasing(Data::Imu.label(), line));
             }
             if t > self.window.1 {
                 return self.ended();

@@ -2,6 +2,7 @@
 //! library's fuse job with the filter's model from the scenario.
 use std::path::Path;
 
+use imukit::error::Data;
 use imukit::io::Input;
 use imukit::io::bag::Role;
 use imukit::io::conventions::{EarthName, NavFrameName};
@@ -60,10 +61,7 @@ fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<Fu
     Ok(model
         .setup_described(&a.asked, &described, imu)
         .map_err(|e| match e {
-            Error::Invalid { field, message } if field == "IMU data" => Error::Invalid {
-                field: a.imu.display().to_string(),
-                message,
-            },
+            e if e.data() == Some(Data::Imu) => e.relabelled(a.imu.display().to_string()),
             Error::Invalid { field, message } if field.starts_with("gnss.") => Error::Invalid {
                 field: field.replace("gnss.", "--gnss-").replace('_', "-"),
                 message,
@@ -196,41 +194,25 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         baro: baro.as_ref(),
     };
     // The library names its inputs by kind; the user knows them by file.
-    let file_of = |context: &str| match context {
-        "IMU data" => Some(a.imu.path()),
-        "GNSS data" => a.gnss.map(Input::path),
-        "odometer data" => a.odometer,
-        "barometer data" => a.baro,
-        _ => None,
+    let file_of = |data: Data| match data {
+        Data::Imu => Some(a.imu.path()),
+        Data::Gnss => a.gnss.map(Input::path),
+        Data::Odometer => a.odometer,
+        Data::Barometer => a.baro,
     };
-    let rename = |context: String| match file_of(&context) {
-        Some(p) => p.display().to_string(),
-        None if FuseRequest::FIELDS.contains(&context.as_str()) => flag(&context),
-        None => context,
+    // A request's field by its flag.
+    let rename = |context: String| {
+        if FuseRequest::FIELDS.contains(&context.as_str()) {
+            flag(&context)
+        } else {
+            context
+        }
     };
-    let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| match e {
-        Error::Invalid { field, message } => Error::Invalid {
-            field: rename(field),
-            message,
-        },
-        Error::Diverged { context, message } => Error::Diverged {
-            context: rename(context),
-            message,
-        },
-        Error::Filter {
-            context,
-            row,
-            source,
-        } => Error::Filter {
-            context: rename(context),
-            row,
-            source,
-        },
-        Error::Align { field, source } => Error::Align {
-            field: flag(&field),
-            source,
-        },
-        other => other,
+    let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| {
+        if let Some(file) = e.data().and_then(file_of) {
+            return e.relabelled(file.display().to_string());
+        }
+        by_field(e, rename)
     })?;
     nav.write_described(a.out, &setup.description())?;
     let t = imu.column("t_s").unwrap_or_default();
@@ -301,4 +283,32 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         ));
     }
     Ok(())
+}
+
+/// `e` with the request field or context it names renamed by `rename` (the flag a user gave).
+fn by_field(e: Error, rename: impl Fn(String) -> String) -> Error {
+    match e {
+        Error::Invalid { field, message } => Error::Invalid {
+            field: rename(field),
+            message,
+        },
+        Error::Diverged { context, message } => Error::Diverged {
+            context: rename(context),
+            message,
+        },
+        Error::Filter {
+            context,
+            row,
+            source,
+        } => Error::Filter {
+            context: rename(context),
+            row,
+            source,
+        },
+        Error::Align { field, source } => Error::Align {
+            field: flag(&field),
+            source,
+        },
+        other => other,
+    }
 }

@@ -5,6 +5,7 @@ use std::path::Path;
 use imu_core::EulerZyx;
 use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
+use imukit::error::Data;
 use imukit::io::Input;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
@@ -224,14 +225,13 @@ pub fn three_d(
         let t0 = TimeWindow::first_time(&imu, &source)?;
         let imu = c.window.apply(imu, t0, &source, 1)?;
         let readings = imukit::io::read::read_table(baro)?;
-        let joined =
-            imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| match e {
-                Error::Invalid { field, message } if field == "barometer data" => Error::Invalid {
-                    field: baro.display().to_string(),
-                    message,
-                },
-                other => other,
-            })?;
+        let joined = imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| {
+            if e.data() == Some(Data::Barometer) {
+                e.relabelled(baro.display().to_string())
+            } else {
+                e
+            }
+        })?;
         let nav = imukit::run::navigate::integrate(&joined, &initial, &setup).map_err(|e| {
             Error::Invalid {
                 field: c.input.display().to_string(),

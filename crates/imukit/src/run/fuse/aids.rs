@@ -5,6 +5,7 @@ use imu_core::earth::EarthModel;
 use imu_core::fusion::Eskf;
 use imu_core::fusion::gate::gate_99_9;
 
+use crate::error::Data;
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
 use crate::run::fuse::{
@@ -22,20 +23,20 @@ const MIN_RATE_SIGMA: f64 = 1e-9;
 /// Times and values of an aid table, checked: finite, increasing, inside `[t0, t1]`.
 pub(crate) fn aid_series(
     table: &Table,
-    what: &str,
+    what: Data,
     value: &str,
     (t0, t1): (f64, f64),
 ) -> Result<(Vec<f64>, Vec<f64>)> {
     let (Some(t), Some(v)) = (table.column("t_s"), table.column(value)) else {
         return Err(invalid(
-            format!("{what} data"),
+            what.label(),
             format!("missing column(s): needs t_s and {value}"),
         ));
     };
     for (k, (&tk, &vk)) in t.iter().zip(&v).enumerate() {
         if !tk.is_finite() || !vk.is_finite() || (k > 0 && tk <= t[k - 1]) {
             return Err(invalid(
-                format!("{what} data"),
+                what.label(),
                 format!(
                     "row {}: times must be finite and increase, values finite",
                     k + 2
@@ -44,7 +45,7 @@ pub(crate) fn aid_series(
         }
         if tk < t0 || tk > t1 {
             return Err(invalid(
-                format!("{what} data"),
+                what.label(),
                 format!(
                     "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
                     k + 2
@@ -85,20 +86,20 @@ impl AidStreams {
         samples: usize,
     ) -> Result<Self> {
         let odometer = match (aids.odometer, setup.aiding.odometer) {
-            (Some(table), Some(_)) => aid_series(table, "odometer", "speed_m_s", span)?,
+            (Some(table), Some(_)) => aid_series(table, Data::Odometer, "speed_m_s", span)?,
             (Some(_), None) => {
                 return Err(invalid(
-                    "odometer data",
+                    Data::Odometer.label(),
                     "given, but the scenario has no [odometer]: the filter takes its accuracy from it",
                 ));
             }
             (None, _) => (Vec::new(), Vec::new()),
         };
         let baro = match (aids.baro, setup.aiding.baro_sigma_m) {
-            (Some(table), Some(_)) => aid_series(table, "barometer", "baro_height_m", span)?,
+            (Some(table), Some(_)) => aid_series(table, Data::Barometer, "baro_height_m", span)?,
             (Some(_), None) => {
                 return Err(invalid(
-                    "barometer data",
+                    Data::Barometer.label(),
                     "given, but the scenario has no [baro]: the filter takes its accuracy from it",
                 ));
             }

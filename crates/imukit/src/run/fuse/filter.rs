@@ -13,6 +13,7 @@ use super::setup::covariance_interval_refusal;
 use super::smooth::{SMOOTHING_GAP_S, smoothed_rows};
 use super::start::{ALIGN_ATTITUDE_ALLOWANCE_RAD, ALIGN_MIN_SPEED_M_S, Begin, begin};
 use super::{Fuse, FuseSetup, FuseSummary, Start};
+use crate::error::Data;
 use crate::error::{Error, Result};
 use crate::io::columns::FUSE_COLUMNS;
 use crate::io::table::Table;
@@ -54,7 +55,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
                 inputs.w[i],
                 inputs.f[i].map(|x| setup.specific_force_factor() * x),
             )
-            .map_err(|e| filter_error("IMU data", e))?;
+            .map_err(|e| filter_error(Data::Imu.label(), e))?;
         apply_fixes(
             &mut filter,
             (&inputs, &fixes),

@@ -2,6 +2,7 @@
 //! velocities and own accuracies, and the fixes in the filter's terms.
 use imu_core::Vec3;
 
+use crate::error::Data;
 use crate::error::{Result, invalid};
 use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GYRO_COLUMNS};
 use crate::io::table::Table;
@@ -13,13 +14,13 @@ fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<
     for (k, &tk) in g_t.iter().enumerate() {
         if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
             return Err(invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!("row {}: times must be finite and increase", k + 2),
             ));
         }
         if tk < t0 || tk > t1 {
             return Err(invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!(
                     "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
                     k + 2
@@ -37,7 +38,7 @@ fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<
         );
         if fix_dt < imu_dt {
             return Err(invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!(
                     "fixes come every {fix_dt} s, more often than the IMU's samples (every \
                      {imu_dt} s): the filter applies fixes at IMU samples, so the IMU must be the \
@@ -98,16 +99,16 @@ impl FusionInputs {
     ) -> Result<Self> {
         let t = imu
             .column("t_s")
-            .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+            .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
         let (Some(f), Some(w)) = (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS)) else {
             return Err(invalid(
-                "IMU data",
+                Data::Imu.label(),
                 "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
             ));
         };
         if t.len() < 2 {
             return Err(invalid(
-                "IMU data",
+                Data::Imu.label(),
                 format!("{} rows: fusion needs at least two samples", t.len()),
             ));
         }
@@ -140,7 +141,7 @@ impl FusionInputs {
         let missing: Vec<&str> = needed.iter().copied().filter(|c| !has(c)).collect();
         if !missing.is_empty() {
             return Err(invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!("missing column(s) {}{hint}", missing.join(", ")),
             ));
         }
@@ -192,7 +193,7 @@ fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 2]>>> 
     for (k, (a, b)) in h.iter().zip(&v).enumerate() {
         if !(a.is_finite() && b.is_finite() && *a > 0.0 && *b > 0.0) {
             return Err(invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!(
                     "row {}: the fix's accuracy must be positive and finite, got {a} m and {b} m",
                     k + 2
@@ -224,7 +225,7 @@ impl<E: NavEarth> Fixes<E> {
             .map(|(k, &p)| {
                 E::fix_position(p).ok_or_else(|| {
                     invalid(
-                        "GNSS data",
+                        Data::Gnss.label(),
                         format!(
                             "row {}: the latitude must be within ±89.9° and the longitude and \
                              height finite",

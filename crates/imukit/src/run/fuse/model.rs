@@ -3,6 +3,7 @@
 use imu_core::AccelSign;
 
 use super::{FuseSetup, OdometerModel};
+use crate::error::Data;
 use crate::error::{Result, invalid};
 use crate::io::conventions::NavFrameName;
 use crate::io::table::Table;
@@ -94,7 +95,7 @@ impl PartModel {
         let median = crate::io::rows::Gaps::of_times(&t, 0).median_s;
         if median.is_nan() || median <= 0.0 {
             return Err(invalid(
-                "IMU data",
+                Data::Imu.label(),
                 "needs at least two samples with increasing t_s (the sample rate sets the noise)",
             ));
         }

@@ -3,6 +3,7 @@
 //! filter's refusals as errors naming the row.
 use imu_core::fusion::EskfError;
 
+use crate::error::Data;
 use crate::error::{Error, Result};
 
 /// The filter's refusal of reading `index` (0-based) of `what` (`GNSS`, `odometer`, …) as an
@@ -66,7 +67,7 @@ impl Acceptance {
         }
         if self.resets_in_a_row >= MAX_RESETS_IN_A_ROW {
             return Err(Error::Diverged {
-                context: "GNSS data".into(),
+                context: Data::Gnss.label().into(),
                 message: format!(
                     "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
                      gate (the last with NIS {:.1} against {gate:.1}) after {MAX_RESETS_IN_A_ROW} \

@@ -8,6 +8,7 @@ use imu_core::strapdown::NavState;
 
 use super::inputs::{FixVelocity, Fixes, FusionInputs};
 use super::{FuseSetup, Start};
+use crate::error::Data;
 use crate::error::{Error, Result, invalid};
 use crate::run::nav_earth::{self, NavEarth};
 
@@ -139,7 +140,7 @@ fn at_rest<E: NavEarth>(
     let used = g_t.partition_point(|&x| x <= t[i0]);
     if used == 0 {
         return Err(invalid(
-            "GNSS data",
+            Data::Gnss.label(),
             format!(
                 "no fix in the first {duration_s} s: the static alignment takes its position \
                  from the fixes"
@@ -151,7 +152,7 @@ fn at_rest<E: NavEarth>(
         v[0].hypot(v[1]).hypot(v[2]) > STATIC_SPEED_M_S
     }) {
         return Err(invalid(
-            "GNSS data",
+            Data::Gnss.label(),
             format!(
                 "row {}: the vehicle moves ({:.2} m/s) during the static alignment's first \
                  {duration_s} s",
@@ -252,7 +253,7 @@ fn from_gnss<E: NavEarth>(
 fn first_fix_at_speed(inputs: &FusionInputs, latency_s: f64) -> Result<(usize, usize, f64)> {
     if inputs.velocities == FixVelocity::None {
         return Err(invalid(
-            "GNSS data",
+            Data::Gnss.label(),
             "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
              GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
         ));
@@ -263,7 +264,7 @@ fn first_fix_at_speed(inputs: &FusionInputs, latency_s: f64) -> Result<(usize, u
         .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
         .ok_or_else(|| {
             invalid(
-                "GNSS data",
+                Data::Gnss.label(),
                 format!(
                     "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
                      heading cannot be taken from GNSS velocity (give the initial state \

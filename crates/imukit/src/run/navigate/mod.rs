@@ -32,6 +32,7 @@ use imu_core::strapdown::{
 };
 use imu_core::{AccelSign, NavFrame, Rotation};
 
+use crate::error::Data;
 use crate::io::columns::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS};
 
 use crate::error::{Result, invalid};
@@ -108,13 +109,13 @@ impl EarthJob for Integrate<'_> {
         let options = strapdown_options(setup);
         let t = imu
             .column("t_s")
-            .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
-        check_increasing(&t, "IMU data", 2)?;
+            .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
+        check_increasing(&t, Data::Imu.label(), 2)?;
         let (s0, origin) = nav_earth::start::<E>(initial, t.first().copied().unwrap_or(0.0))?;
         let baro = match options.vertical {
             VerticalChannel::Baro { .. } => Some(imu.column(BARO_COLUMN).ok_or_else(|| {
                 invalid(
-                    "IMU data",
+                    Data::Imu.label(),
                     format!("the baro vertical channel needs a {BARO_COLUMN} column"),
                 )
             })?),
@@ -144,16 +145,16 @@ impl EarthJob for Integrate<'_> {
             {
                 if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
                     return Err(invalid(
-                        "IMU data",
+                        Data::Imu.label(),
                         "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
                     ));
                 }
                 strapdown_increments(earth, &t, &dth, &flip(dv), baro, s0, options, &mut out)
             } else {
-                return Err(invalid("IMU data", NEEDS_READINGS));
+                return Err(invalid(Data::Imu.label(), NEEDS_READINGS));
             };
         result.map_err(|source| crate::Error::Strapdown {
-            context: "IMU data".into(),
+            context: Data::Imu.label().into(),
             source,
         })?;
         let mut table = Table::new(&nav_earth::nav_columns::<E>());

@@ -14,6 +14,7 @@ use super::{
     BARO_COLUMN, EarthNav, Emit, InitialState, NavScheme, NavSetup, integrate, strapdown_options,
     with_earth,
 };
+use crate::error::Data;
 use crate::error::{Result, invalid};
 use crate::io::Input;
 use crate::io::columns::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS};
@@ -108,7 +109,7 @@ pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
     // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
     // numbers per row come out (the states and the table).
     let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
-    crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, "IMU data")?;
+    crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, Data::Imu.label())?;
     crate::io::read::read_table(input)
 }
 
@@ -122,19 +123,20 @@ pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
 pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
     let t = imu
         .column("t_s")
-        .ok_or_else(|| invalid("IMU data", "missing column t_s"))?;
+        .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
     let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else {
-        return Err(invalid("IMU data", "has no rows"));
+        return Err(invalid(Data::Imu.label(), "has no rows"));
     };
     // The same rule as the fusion's aids: finite, increasing, within the IMU's span.
-    let (tb, hb) = crate::run::fuse::aids::aid_series(baro, "barometer", BARO_COLUMN, (t0, t1))?;
+    let (tb, hb) =
+        crate::run::fuse::aids::aid_series(baro, Data::Barometer, BARO_COLUMN, (t0, t1))?;
     if tb.is_empty() {
-        return Err(invalid("barometer data", "has no readings"));
+        return Err(invalid(Data::Barometer.label(), "has no readings"));
     }
     let mut columns: Vec<&str> = imu.columns.iter().map(String::as_str).collect();
     if columns.contains(&BARO_COLUMN) {
         return Err(invalid(
-            "IMU data",
+            Data::Imu.label(),
             format!("already has a {BARO_COLUMN} column; give the barometer once"),
         ));
     }
@@ -185,7 +187,7 @@ impl<E: EarthModel> Stepper<E> {
     fn push(&mut self, row: [f64; 7], emit: &mut Emit<'_, E>) -> Result<()> {
         let (t, force, turn) = (row[0], [row[1], row[2], row[3]], [row[4], row[5], row[6]]);
         let failed = |source: StrapdownError| crate::Error::Strapdown {
-            context: "IMU data".into(),
+            context: Data::Imu.label().into(),
             source,
         };
         match self {
@@ -247,7 +249,7 @@ impl<E: EarthModel> Stepper<E> {
         let n = *seen;
         if n < NODES {
             return Err(invalid(
-                "IMU data",
+                Data::Imu.label(),
                 format!("the rk4 scheme needs at least {NODES} samples, got {n}"),
             ));
         }
@@ -256,7 +258,7 @@ impl<E: EarthModel> Stepper<E> {
             let state = nav
                 .interval(&window(held, start - *first_held), k - start, 0.0, k + 1)
                 .map_err(|source| crate::Error::Strapdown {
-                    context: "IMU data".into(),
+                    context: Data::Imu.label().into(),
                     source,
                 })?;
             emit(state)?;
@@ -305,7 +307,7 @@ impl EarthJob for IntegrateCsv<'_> {
         } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
             (DV_COLUMNS, DTHETA_COLUMNS)
         } else {
-            return Err(invalid("IMU data", NEEDS_READINGS));
+            return Err(invalid(Data::Imu.label(), NEEDS_READINGS));
         };
         let mut columns = vec!["t_s"];
         columns.extend(force);
@@ -339,7 +341,7 @@ impl EarthJob for IntegrateCsv<'_> {
             },
             (NavScheme::Rk4 { .. }, false) => {
                 return Err(invalid(
-                    "IMU data",
+                    Data::Imu.label(),
                     "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
                 ));
             }
