@@ -209,7 +209,7 @@ def identify(
     names: list[str],
     source: str,
     *,
-    kalibr_inflation: float = 1.0,
+    kalibr_inflation: float = ...,
     kalibr_topic: str = ...,
 ) -> dict[str, Any]: ...
 def preset_names() -> list[str]: ...
