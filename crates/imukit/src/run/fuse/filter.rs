@@ -48,13 +48,10 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let mut rows = Rows::<E, S>::new(setup, keep_filtered);
     let mut acceptance = Acceptance::default();
     let mut next_fix = begin.next_fix;
+    let sign = setup.specific_force_factor();
     for (i, &ti) in t.iter().enumerate().skip(begin.first) {
         filter
-            .propagate(
-                ti,
-                inputs.w[i],
-                inputs.f[i].map(|x| setup.specific_force_factor() * x),
-            )
+            .propagate(ti, inputs.w[i], inputs.f[i].map(|x| sign * x))
             .map_err(|e| filter_error(Data::Imu.label(), e))?;
         apply_fixes(
             &mut filter,
@@ -196,6 +193,9 @@ fn apply_fixes<E: NavEarth, const S: usize>(
     acceptance: &mut Acceptance,
 ) -> Result<()> {
     let (t, g_t) = (&inputs.t, &inputs.g_t);
+    if !(*next_fix < g_t.len() && g_t[*next_fix] <= t[i]) {
+        return Ok(()); // no fix due: most samples
+    }
     let vel_sigma = setup.gnss_velocity_sigma_m_s.unwrap_or(1.0);
     // The third axis is the vertical in either frame (up in ENU, down in NED).
     let vertical_sigma = if inputs.velocities == FixVelocity::Horizontal {

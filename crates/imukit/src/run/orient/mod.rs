@@ -74,19 +74,15 @@ impl FilterKind {
         }
     }
 
-    /// The settings the filter takes (MATLAB property names; matched without case or `_`).
+    /// The settings the filter takes (MATLAB property names; matched without case or `_`):
+    /// those [`Self::setting_defaults`] gives a default.
     #[must_use]
     pub fn settings(self) -> Vec<&'static str> {
-        match self {
-            Self::ImuFilter => KALMAN_SETTINGS.to_vec(),
-            Self::AhrsFilter => [KALMAN_SETTINGS.as_slice(), &MAGNETIC_SETTINGS].concat(),
-            // The e-compass has no memory; the rate is accepted for uniformity.
-            Self::Ecompass => vec!["SampleRate"],
-            Self::Madgwick => vec!["SampleRate", "Beta"],
-            Self::Mahony => vec!["SampleRate", "Kp", "Ki"],
-            Self::Complementary => vec!["SampleRate", "AccelerometerGain", "MagnetometerGain"],
-            Self::Robust => RobustParams::setting_names().to_vec(),
-        }
+        let magnetometer = self.magnetometer().unwrap_or(false);
+        self.setting_defaults(magnetometer)
+            .into_iter()
+            .map(|(name, _)| name)
+            .collect()
     }
 }
 
@@ -172,27 +168,6 @@ pub const MAHONY_KI: f64 = 0.3;
 
 /// MATLAB `complementaryFilter`'s accelerometer and magnetometer gain.
 pub const COMPLEMENTARY_GAIN: f64 = 0.01;
-
-/// Settings of both Kalman filters.
-const KALMAN_SETTINGS: [&str; 9] = [
-    "SampleRate",
-    "DecimationFactor",
-    "AccelerometerNoise",
-    "GyroscopeNoise",
-    "GyroscopeDriftNoise",
-    "LinearAccelerationNoise",
-    "LinearAccelerationDecayFactor",
-    "InitialProcessNoiseScale",
-    "Gravity",
-];
-
-/// Settings of the AHRS filter's magnetometer.
-const MAGNETIC_SETTINGS: [&str; 4] = [
-    "MagnetometerNoise",
-    "MagneticDisturbanceNoise",
-    "MagneticDisturbanceDecayFactor",
-    "ExpectedMagneticFieldStrength",
-];
 
 /// The conventions an orientation run follows where a front end names neither the frame nor
 /// the accelerometer sign: imukit's unless asked, from every front end.
