@@ -1,8 +1,9 @@
 //! Throughput (samples/s) of every orientation filter on a static, gently noisy IMU: imukit's
 //! robust filter (6D and 9D), the Kalman filters (imufilter and ahrsfilter), the e-compass,
 //! Madgwick, Mahony and the complementary filter (with a magnetometer where they take one);
-//! 1 sample and 10⁵ samples. `benches/broad/broad.py --speed` times the robust filter beside
-//! VQF's C++ core through both Python packages.
+//! 1 sample and 10⁵ samples. `benches/broad/broad.py --speed` times the robust filter's core
+//! beside VQF's C++ core on a recorded trial (the example `orientation_speed` and
+//! `benches/broad/vqf_speed.cpp`), and both through their Python packages.
 //!
 //! Run: `cargo bench -p imu-benches --bench orientation`.
 #![allow(missing_docs)]

@@ -251,14 +251,49 @@ def table(results: dict, names: list[str], trials: list[str], groups: dict) -> l
     return lines
 
 
+def core_speed(d: dict) -> tuple[dict, str] | None:
+    """Both cores in native loops on the trial's readings: imukit's `orientation_speed` example
+    (built with cargo) and VQF's C++ core (`vqf_speed.cpp`, built with g++ against the vqf
+    package's own sources). None when a tool or the sources are missing."""
+    import shutil
+    import subprocess
+    import tempfile
+
+    try:
+        import vqf
+    except ImportError:
+        return None
+    cpp = Path(vqf.__file__).parent / "cpp"
+    if not (cpp / "vqf.cpp").exists() or not shutil.which("g++") or not shutil.which("cargo"):
+        return None
+    root = Path(__file__).resolve().parents[2]
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = Path(tmp) / "rows.bin"
+        np.hstack([d["imu_acc"], d["imu_gyr"], d["imu_mag"]]).astype("<f8").tofile(rows)
+        exe = Path(tmp) / "vqf_speed"
+        subprocess.run(["g++", "-O2", "-std=c++17", f"-I{cpp}", "-o", str(exe),
+                        str(Path(__file__).parent / "vqf_speed.cpp"), str(cpp / "vqf.cpp")], check=True)
+        subprocess.run(["cargo", "build", "--release", "-q", "-p", "imu-benches", "--example",
+                        "orientation_speed"], check=True, cwd=root)
+        ours = root / "target" / "release" / "examples" / "orientation_speed"
+        out = {}
+        for name, cmd in (("imukit", [str(ours)]), ("VQF", [str(exe)])):
+            text = subprocess.run(cmd + [str(rows), repr(d["rate"]), "20"], check=True, capture_output=True,
+                                  text=True).stdout
+            out[name] = dict(line.split() for line in text.splitlines())
+    version = subprocess.run(["g++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+    return out, version
+
+
 def speed(paths: list[Path]) -> list[str]:
-    """Per-sample update time of imukit's default filter and of VQF's C++ core, each run over a
-    whole trial in one call (a native loop on both sides), best of five, 6D and 9D."""
+    """Per-sample update time of imukit's default filter and of VQF's C++ core: each core in a
+    native loop over one whole trial (best of 20), and each through its Python package's batch
+    call (best of 5), 6D and 9D."""
     import imukit
 
     d = load_trial(paths[0])
     n = len(d["imu_gyr"])
-    rows = []
+    batch = {}
     for mag in (False, True):
         def ours():
             f = imukit.RobustFilter(sample_rate=d["rate"], has_magnetometer=mag)
@@ -277,10 +312,22 @@ def speed(paths: list[Path]) -> list[str]:
                 fn()
                 best = min(best, time.perf_counter() - t0)
             cells.append(best / n * 1e9)
-        rows.append(f"| {'9D' if mag else '6D'} | {cells[0]:.0f} | {cells[1]:.0f} |")
-    return [f"Per-sample update time, ns ({n} samples of {paths[0].stem}, one call each, best of 5; "
-            "VQF through its Python package's batch call to its C++ core):", "",
-            "| | imukit robust | VQF 2.1.2 (C++) |", "|---|---|---|"] + rows
+        batch["9D" if mag else "6D"] = cells
+    core = core_speed(d)
+    lines = [f"Per-sample update time, ns ({n} samples of {paths[0].stem}, each sample one update; the same "
+             "machine, one core):", ""]
+    if core:
+        (times, compiler) = core
+        lines.append(f"- core: each filter's own loop over the trial, best of 20 (imukit: `cargo build --release`; "
+                     f"VQF: its C++ core from the vqf package's sources, `g++ -O2`, {compiler})")
+    lines.append("- Python: each package's batch call on the whole trial, best of 5 (imukit's returns its flags "
+                 "and bias too)")
+    lines += ["", "| | imukit robust, core | VQF 2.1.2, core (C++) | imukit robust, Python | VQF 2.1.2, Python |",
+              "|---|---|---|---|---|"]
+    for dim in ("6D", "9D"):
+        c = [f"{float(core[0][k][dim]):.0f}" for k in ("imukit", "VQF")] if core else ["–", "–"]
+        lines.append(f"| {dim} | {c[0]} | {c[1]} | {batch[dim][0]:.0f} | {batch[dim][1]:.0f} |")
+    return lines
 
 
 def main() -> None:

@@ -357,7 +357,8 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 ["orient", "imu.csv", "--filter", "madgwick", "--param", f"Beta={x()}", "--out", "o.csv"],
                 ["orient", "imu.csv", "--smooth", "--param",
                  rng.choice(["AccelerometerTimeConstant", "AccelerationThreshold", "AccelerationSustainedTime",
-                             "BiasForgettingTime", "MagneticRejectionFactor", "BiasSigmaMotion"]) + f"={x()}",
+                             "BiasForgettingTime", "MagneticRejectionFactor", "BiasSigmaMotion",
+                             "BiasStepThreshold", "BiasStepForgettingTime"]) + f"={x()}",
                  "--out", "o.csv"],
             ])
             run_cli(r, work, args, ["imu.csv", "truth.csv"], f"case {k}")

@@ -39,7 +39,7 @@ mod smooth;
 
 pub use smooth::smooth;
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::ecompass::{ecompass_ned, tilt};
 use super::{
@@ -95,6 +95,10 @@ pub struct RobustParams {
     pub bias_vertical_forgetting: f64,
     /// Uncertainty of the bias learnt at rest, rad/s.
     pub bias_sigma_rest_rad_s: f64,
+    /// Low-passed motion innovation above which the bias counts as stepping, rad/s (0: never).
+    pub bias_step_rad_s: f64,
+    /// Time over which the bias may wander by 0.1 °/s while it steps, s.
+    pub bias_step_forgetting_s: f64,
     /// Largest relative magnetic magnitude error before the field counts as disturbed.
     pub mag_rejection: f64,
     /// Largest dip error before the field counts as disturbed, rad.
@@ -138,6 +142,8 @@ impl Default for RobustParams {
             bias_sigma_motion_rad_s: 0.1 * DEG,
             bias_vertical_forgetting: 1e-4,
             bias_sigma_rest_rad_s: 0.03 * DEG,
+            bias_step_rad_s: 0.4 * DEG,
+            bias_step_forgetting_s: 0.3,
             mag_rejection: 0.1,
             dip_rejection_rad: 10.0 * DEG,
             mag_current_tau_s: 0.05,
@@ -163,7 +169,7 @@ enum Range {
 impl RobustParams {
     /// The numeric settings by name (the names `imukit orient --param` and Python's `settings`
     /// take; angles in rad, rates in rad/s, times in s), each with its field.
-    pub fn settings_mut(&mut self) -> [(&'static str, &mut f64); 26] {
+    pub fn settings_mut(&mut self) -> [(&'static str, &mut f64); 28] {
         [
             ("SampleRate", &mut self.sample_rate_hz),
             ("Gravity", &mut self.gravity_m_s2),
@@ -181,6 +187,8 @@ impl RobustParams {
             ("BiasSigmaMotion", &mut self.bias_sigma_motion_rad_s),
             ("BiasVerticalForgetting", &mut self.bias_vertical_forgetting),
             ("BiasSigmaRest", &mut self.bias_sigma_rest_rad_s),
+            ("BiasStepThreshold", &mut self.bias_step_rad_s),
+            ("BiasStepForgettingTime", &mut self.bias_step_forgetting_s),
             ("MagneticRejection", &mut self.mag_rejection),
             ("DipRejection", &mut self.dip_rejection_rad),
             ("MagneticCurrentTimeConstant", &mut self.mag_current_tau_s),
@@ -202,7 +210,7 @@ impl RobustParams {
 
     /// The names [`RobustParams::settings_mut`] takes.
     #[must_use]
-    pub fn setting_names() -> [&'static str; 26] {
+    pub fn setting_names() -> [&'static str; 28] {
         Self::default().settings_mut().map(|(name, _)| name)
     }
 
@@ -213,6 +221,7 @@ impl RobustParams {
                 "RestMinimumTime"
                 | "AccelerationSustainedTime"
                 | "BiasSigmaMotion"
+                | "BiasStepThreshold"
                 | "MagneticMinUndisturbedTime"
                 | "MagneticMaxRejectionTime"
                 | "MagneticNewFieldTime"
@@ -302,7 +311,9 @@ struct Excursion {
 struct State {
     q_gyro: UnitQuaternion<f64>,
     q_incl: UnitQuaternion<f64>,
-    heading_rad: f64,
+    /// The heading as a rotation about the vertical (turned by each correction, so that no
+    /// angle is turned back into a rotation every sample).
+    heading: UnitQuaternion<f64>,
     accel_lp: lowpass::LowPass<3>,
     rest_gyro_lp: lowpass::LowPass<3>,
     rest_accel_lp: lowpass::LowPass<3>,
@@ -377,13 +388,13 @@ impl RobustFilter {
         dt: f64,
     ) -> Result<State, OrientError> {
         let p = &self.params;
-        let (q_incl, heading_rad) = if p.magnetometer {
+        let (q_incl, heading) = if p.magnetometer {
             // Level from gravity, heading from the field: split the e-compass into the two.
             let q = ecompass_ned(down, m)?;
             let yaw = yaw_of(&q);
-            (rotate_z(-yaw) * q, yaw)
+            (rotate_z(-yaw) * q, rotate_z(yaw))
         } else {
-            (tilt::<N>(down)?, 0.0)
+            (tilt::<N>(down)?, UnitQuaternion::identity())
         };
         let mut accel_lp = lowpass::LowPass::new(p.tau_accel_s, dt);
         accel_lp.step((*down).into(), dt);
@@ -394,7 +405,7 @@ impl RobustFilter {
         Ok(State {
             q_gyro: UnitQuaternion::identity(),
             q_incl,
-            heading_rad,
+            heading,
             accel_lp,
             rest_gyro_lp,
             rest_accel_lp,
@@ -430,7 +441,7 @@ impl RobustFilter {
         status.at_rest = s.rest_s >= p.rest_min_s;
         // Gyroscope integration.
         s.q_gyro = UnitQuaternion::new_normalize(
-            (s.q_gyro * UnitQuaternion::from_scaled_axis((w - s.bias.bias()) * dt)).into_inner(),
+            (s.q_gyro * rotation(&((w - s.bias.bias()) * dt))).into_inner(),
         );
         // How much this reading is gravity: its magnitude against gravity's (learnt at rest).
         // (Only near the nominal value: a steady push also looks like rest.)
@@ -470,11 +481,11 @@ impl RobustFilter {
         } else {
             BiasEvidence::Motion(correction)
         };
-        s.bias
-            .update(p, q6.to_rotation_matrix().matrix(), evidence, dt);
+        let r6 = q6.to_rotation_matrix().into_inner();
+        s.bias.update(p, &r6, evidence, dt);
         // Heading from magnetic north.
         if p.magnetometer && (m.x != 0.0 || m.y != 0.0 || m.z != 0.0) {
-            status.mag_disturbed = Self::correct_heading(p, s, &q6, m, gyro_lp.norm(), dt);
+            status.mag_disturbed = Self::correct_heading(p, s, &r6, m, gyro_lp.norm(), dt);
         }
         status.gyro_bias_rad_s = s.bias.bias().into();
         status
@@ -530,17 +541,17 @@ impl RobustFilter {
         (rejected, waiting)
     }
 
-    /// Turns the heading towards magnetic north seen in the level frame `q6`; returns whether
-    /// the field is disturbed.
+    /// Turns the heading towards magnetic north seen in the level frame (`r6`: body to level);
+    /// returns whether the field is disturbed.
     fn correct_heading(
         p: &RobustParams,
         s: &mut State,
-        q6: &UnitQuaternion<f64>,
+        r6: &Matrix3<f64>,
         m: &Vector3<f64>,
         rate_rad_s: f64,
         dt: f64,
     ) -> bool {
-        let level = q6 * m;
+        let level = r6 * m;
         // µT readings: no overflow to guard against with `hypot` (a non-finite one is refused).
         let horizontal = math::sqrt(level.x * level.x + level.y * level.y);
         let gains = s.gains.at(p, dt);
@@ -553,15 +564,23 @@ impl RobustFilter {
             dt,
         );
         if horizontal > 0.0 {
-            let target = -math::atan2(level.y, level.x);
-            let error = wrap(target - s.heading_rad);
+            // The angle from the heading to north seen in the level frame (at `−atan2(y, x)`),
+            // from the heading's half-angle cosine and sine without turning either into angles.
+            let (c, h) = (s.heading.w, s.heading.k);
+            let (cos_psi, sin_psi) = (c * c - h * h, 2.0 * c * h);
+            let (cos_t, sin_t) = (level.x, -level.y);
+            let error = math::atan2(
+                sin_t * cos_psi - cos_t * sin_psi,
+                cos_t * cos_psi + sin_t * sin_psi,
+            );
             let mut k = gains.heading * factor;
             // The mean of the readings so far while that is faster than the time constant.
             if s.elapsed_s < p.tau_mag_s {
                 s.mag_samples += 1.0;
                 k = k.max(1.0 / s.mag_samples);
             }
-            s.heading_rad = wrap(s.heading_rad + k * error);
+            s.heading =
+                UnitQuaternion::new_normalize((s.heading * rotate_z(k * error)).into_inner());
         }
         s.magnetic.disturbed()
     }
@@ -593,18 +612,22 @@ fn yaw_of(q: &UnitQuaternion<f64>) -> f64 {
 
 /// A rotation by `angle` about the NED vertical (down).
 fn rotate_z(angle: f64) -> UnitQuaternion<f64> {
-    let (s, c) = math::sin_cos(0.5 * angle);
-    UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(c, 0.0, 0.0, s))
+    rotation(&Vector3::new(0.0, 0.0, angle))
 }
 
-/// An angle in (−π, π].
-fn wrap(a: f64) -> f64 {
-    let two_pi = 2.0 * core::f64::consts::PI;
-    let r = a - two_pi * math::round(a / two_pi);
-    if r <= -core::f64::consts::PI {
-        r + two_pi
+/// The rotation by the rotation vector `v` (rad). A sample's turn is a few milliradians: there
+/// the half angle's cosine and `sin(x)/x` come from their Taylor series in `x²` (no square root,
+/// division or library call), whose first left-out terms (`x⁸/9!`, `x¹⁰/10!`) are below 1e-23
+/// of the result, so it is exact to rounding; larger turns take the library's sine and cosine.
+fn rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let x2 = 0.25 * v.norm_squared();
+    if x2 < 2.5e-5 {
+        let cos = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+        let sinc = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0));
+        let u = v * (0.5 * sinc);
+        UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(cos, u.x, u.y, u.z))
     } else {
-        r
+        UnitQuaternion::from_scaled_axis(*v)
     }
 }
 
@@ -627,7 +650,7 @@ impl<N: NavFrame> OrientationFilter<N> for RobustFilter {
                 self.state.insert(s)
             }
         };
-        let q = rotate_z(state.heading_rad) * state.q_incl * state.q_gyro;
+        let q = state.heading * state.q_incl * state.q_gyro;
         Ok(Some(Estimate {
             orientation: to_frame(&q),
             angular_velocity_rad_s: (w - state.bias.bias()).into(),
@@ -637,5 +660,31 @@ impl<N: NavFrame> OrientationFilter<N> for RobustFilter {
     fn reset(&mut self) {
         self.state = None;
         self.status = RobustStatus::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_rotation_from_its_series_is_the_library_rotation_to_rounding() {
+        // Turns on both sides of the series' bound (a half angle of 5e-3 rad), about skew axes.
+        for angle in [1e-12, 1e-6, 1e-3, 4e-3, 9.99e-3, 1.001e-2, 0.3, 3.0] {
+            for axis in [
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.3, -0.5, 0.8).normalize(),
+                Vector3::new(-0.1, 0.2, -0.97).normalize(),
+            ] {
+                let v = axis * angle;
+                let ours = rotation(&v);
+                let library = UnitQuaternion::from_scaled_axis(v);
+                let off = (ours.into_inner() - library.into_inner()).coords.amax();
+                assert!(off <= 4.0 * f64::EPSILON, "{angle} rad: off by {off:e}");
+                // Unit length to rounding, so renormalising moves nothing measurable.
+                assert!((ours.norm() - 1.0).abs() <= 2.0 * f64::EPSILON);
+            }
+        }
+        assert_eq!(rotate_z(0.0), UnitQuaternion::identity());
     }
 }
