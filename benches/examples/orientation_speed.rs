@@ -35,7 +35,10 @@ fn main() -> ExitCode {
     let bytes = match std::fs::read(path) {
         Ok(b) if b.len() % 72 == 0 && !b.is_empty() => b,
         Ok(b) => {
-            eprintln!("{path}: {} bytes is not a whole number of 9-value f64 rows", b.len());
+            eprintln!(
+                "{path}: {} bytes is not a whole number of 9-value f64 rows",
+                b.len()
+            );
             return ExitCode::from(2);
         }
         Err(e) => {

@@ -594,10 +594,12 @@ fn toward_down(v: &Vector3<f64>) -> UnitQuaternion<f64> {
     if norm <= 0.0 {
         return UnitQuaternion::identity();
     }
-    let d = v / norm;
-    let w = math::sqrt(0.5 * (1.0 + d.z));
+    let dz = v.z / norm;
+    let w = math::sqrt(0.5 * (1.0 + dz));
     let q = if w > 1e-6 {
-        nalgebra::Quaternion::new(w, 0.5 * d.y / w, -0.5 * d.x / w, 0.0)
+        // One division for both horizontal parts: (d_y, −d_x)/(2w) = (v_y, −v_x)/(2w‖v‖).
+        let scale = 0.5 / (w * norm);
+        nalgebra::Quaternion::new(w, v.y * scale, -v.x * scale, 0.0)
     } else {
         nalgebra::Quaternion::new(0.0, 1.0, 0.0, 0.0)
     };
@@ -622,8 +624,11 @@ fn rotate_z(angle: f64) -> UnitQuaternion<f64> {
 fn rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
     let x2 = 0.25 * v.norm_squared();
     if x2 < 2.5e-5 {
-        let cos = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
-        let sinc = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0));
+        // Horner's scheme with the coefficients 1/n! (constants: no division at run time).
+        const C: [f64; 4] = [1.0 / 2.0, 1.0 / 24.0, 1.0 / 720.0, 1.0 / 40320.0];
+        const S: [f64; 3] = [1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0];
+        let cos = 1.0 - x2 * (C[0] - x2 * (C[1] - x2 * (C[2] - x2 * C[3])));
+        let sinc = 1.0 - x2 * (S[0] - x2 * (S[1] - x2 * S[2]));
         let u = v * (0.5 * sinc);
         UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(cos, u.x, u.y, u.z))
     } else {
