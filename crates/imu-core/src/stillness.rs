@@ -1,6 +1,8 @@
 //! Whether the IMU stands still, from its readings alone: the rest at the start of a log that a
 //! filter can use to calibrate its gyroscopes ([`initial_rest`]), and the stance phases of a
 //! foot-mounted IMU ([`detect_stance`], the SHOE detector) where zero-velocity updates apply.
+//! Both need the sensor's white noise; [`quiet_noise`] learns it from the log's quiet stretches
+//! when no data sheet is trusted.
 //!
 //! The readings are cut into blocks of `window` samples. A block is still when, on each of the
 //! six axes, (a) its sample variance is within what the sensor's white noise allows —
@@ -181,4 +183,154 @@ pub fn detect_stance(
         *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
             .is_some_and(|t| t < threshold);
     }
+}
+
+/// What the quiet stretches of a log say about its sensor ([`quiet_noise`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuietStretches {
+    /// The white noise, one sample's standard deviation per axis (pooled over the axes).
+    pub noise: ReadingNoise,
+    /// The mean magnitude of the specific force there, m/s²: gravity as this accelerometer
+    /// reads it (its bias included).
+    pub gravity_reading_m_s2: f64,
+    /// The quiet blocks found.
+    pub quiet_blocks: usize,
+    /// All blocks of the log.
+    pub blocks: usize,
+}
+
+/// The least number of quiet blocks [`quiet_noise`] learns from.
+pub const MIN_QUIET_BLOCKS: usize = 4;
+
+/// How far a quiet block's mean specific force may be from gravity (a fraction): a consumer
+/// accelerometer's bias of a few 0.01 g passes, a swing does not.
+pub const QUIET_GRAVITY_TOLERANCE: f64 = 0.1;
+
+/// The largest mean rate of a quiet block, rad/s (about 29 °/s: above a consumer gyroscope's
+/// bias, below a foot's or a hand's swing).
+pub const QUIET_MAX_RATE_RAD_S: f64 = 0.5;
+
+/// The fixed point's iterations at most (it settles in a few).
+const MAX_ITERATIONS: usize = 50;
+
+/// The share of the blocks from whose variance [`quiet_noise`] starts (its 5th percentile):
+/// a log whose quiet share is at least twice this starts from within its quiet population.
+const START_QUANTILE: f64 = 0.05;
+
+/// The white noise of readings `accel`, `gyro` learnt from the log itself: the readings cut
+/// into blocks of `window` samples, each block's variance pooled over the three axes of each
+/// sensor (`3(W − 1)` degrees of freedom), and the quiet population separated from the moving
+/// one by a fixed point — start from the blocks' 5th percentile; call a block quiet when both
+/// its variances are within the `1 − FALSE_ALARM` quantile of `σ² χ²_{3(W−1)}/(3(W−1))`;
+/// `σ²` the mean of the quiet blocks' variances over the mean that quantile truncation leaves
+/// (`P(χ²_{k+2} ≤ kc)/P(χ²_k ≤ kc)`); repeat until the quiet set no longer changes.
+/// A motion's blocks, whose variance is far above the noise, never join; nor does a block
+/// whose mean specific force is off `gravity_m_s2` by more than [`QUIET_GRAVITY_TOLERANCE`] or
+/// whose mean rate exceeds [`QUIET_MAX_RATE_RAD_S`] (the crest of a slow swing is smooth but not
+/// still). A log that is quiet throughout is one population. `blocks` is the caller's room for one row per block (at least
+/// `n / window` rows; its contents are overwritten). `None` with fewer than
+/// [`MIN_QUIET_BLOCKS`] quiet blocks, a `window` under 2, too little room, or a noise of zero
+/// (readings quantised flat) or not finite.
+#[must_use]
+pub fn quiet_noise(
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
+    window: usize,
+    gravity_m_s2: f64,
+    blocks: &mut [[f64; 3]],
+) -> Option<QuietStretches> {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let n = accel.len().min(gyro.len());
+    if window < 2 || n < MIN_QUIET_BLOCKS * window || blocks.len() < n / window {
+        return None;
+    }
+    let stats = &mut blocks[..n / window];
+    let w = window as f64;
+    let dof = 3.0 * (w - 1.0);
+    let chi = ChiSquared::new(dof).ok()?;
+    let chi2 = ChiSquared::new(dof + 2.0).ok()?;
+    let limit = chi.inverse_cdf(1.0 - FALSE_ALARM) / dof;
+    let truncation = chi2.cdf(dof * limit) / chi.cdf(dof * limit);
+    let pooled = |rows: &[[f64; 3]]| -> f64 {
+        let mut sum = 0.0;
+        for k in 0..3 {
+            let mean = rows.iter().map(|r| r[k]).sum::<f64>() / w;
+            sum += rows
+                .iter()
+                .map(|r| (r[k] - mean) * (r[k] - mean))
+                .sum::<f64>();
+        }
+        sum / (3.0 * (w - 1.0))
+    };
+    // Per block: accelerometer and gyroscope variances, and the mean specific force's norm.
+    for (b, row) in stats.iter_mut().enumerate() {
+        let range = b * window..(b + 1) * window;
+        let (a, g) = (&accel[range.clone()], &gyro[range]);
+        let norm_of_mean = |rows: &[[f64; 3]]| {
+            let mean = [0, 1, 2].map(|k| rows.iter().map(|r| r[k]).sum::<f64>() / w);
+            math::sqrt(mean.iter().map(|m| m * m).sum::<f64>())
+        };
+        let force = norm_of_mean(a);
+        let still = math::abs(force - gravity_m_s2) <= QUIET_GRAVITY_TOLERANCE * gravity_m_s2
+            && norm_of_mean(g) <= QUIET_MAX_RATE_RAD_S;
+        // A block that cannot be still gets an infinite variance: never quiet.
+        *row = if still {
+            [pooled(a), pooled(g), force]
+        } else {
+            [f64::INFINITY, f64::INFINITY, force]
+        };
+    }
+    if stats.iter().flatten().any(|v| v.is_nan()) || !gravity_m_s2.is_finite() {
+        return None;
+    }
+    let total = stats.len();
+    // The blocks' q-quantile of column k (the rows are reordered, not changed).
+    let mut quantile = |k: usize, q: f64| {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let at = ((q * total as f64) as usize).min(total - 1);
+        stats.select_nth_unstable_by(at, |a, b| a[k].total_cmp(&b[k]));
+        stats[at][k]
+    };
+    let start = [quantile(0, START_QUANTILE), quantile(1, START_QUANTILE)];
+    // The quiet blocks' count and sums under the variances `sigma2`.
+    let quiet_sums = |stats: &[[f64; 3]], sigma2: [f64; 2]| {
+        stats
+            .iter()
+            .filter(|s| s[0] <= sigma2[0] * limit && s[1] <= sigma2[1] * limit)
+            .fold((0usize, [0.0; 3]), |(c, sum), s| {
+                (c + 1, [sum[0] + s[0], sum[1] + s[1], sum[2] + s[2]])
+            })
+    };
+    let usable = |s: [f64; 2]| s.iter().all(|v| v.is_finite() && *v > 0.0);
+    let mut sigma2 = start;
+    let mut quiet = 0usize;
+    for _ in 0..MAX_ITERATIONS {
+        if !usable(sigma2) {
+            return None;
+        }
+        let (count, sum) = quiet_sums(stats, sigma2);
+        if count < MIN_QUIET_BLOCKS {
+            return None;
+        }
+        let next = [0, 1].map(|k| sum[k] / count as f64 / truncation);
+        let settled = count == quiet;
+        quiet = count;
+        sigma2 = next;
+        if settled {
+            break;
+        }
+    }
+    let (count, sum) = quiet_sums(stats, sigma2);
+    if count < MIN_QUIET_BLOCKS || !usable(sigma2) {
+        return None;
+    }
+    Some(QuietStretches {
+        noise: ReadingNoise {
+            accel: math::sqrt(sigma2[0]),
+            gyro: math::sqrt(sigma2[1]),
+        },
+        gravity_reading_m_s2: sum[2] / count as f64,
+        quiet_blocks: count,
+        blocks: total,
+    })
 }

@@ -234,3 +234,61 @@ fn moving_points_the_nose_along_the_velocity_in_both_frames() {
     nose_along_velocity::<Ned>();
     nose_along_velocity::<Enu>();
 }
+
+#[test]
+fn level_recovers_roll_and_pitch_and_takes_the_heading_given() {
+    let g = 9.81;
+    let mut worst = 0.0_f64;
+    for yaw in (-170..=180).step_by(35) {
+        for pitch in [-60.0, -10.0, 0.0, 25.0, 70.0] {
+            for roll in [-150.0, -40.0, 0.0, 15.0, 120.0] {
+                let (yaw, pitch, roll) = (
+                    f64::from(yaw).to_radians(),
+                    f64::to_radians(pitch),
+                    f64::to_radians(roll),
+                );
+                // NED: the attitude itself, to rounding.
+                let truth = Rotation::<Body, Ned>::from_euler(EulerZyx::new(yaw, pitch, roll));
+                let f = truth
+                    .inverse()
+                    .apply(Vec3::<Ned>::new(0.0, 0.0, -g))
+                    .to_array();
+                let found = align::level::<Ned>(f, g, yaw, 10.0, &EXACT).unwrap();
+                worst = worst.max(angle_between(&found.attitude, &truth));
+                // ENU: the same body, levelled; the given heading turns it about the vertical
+                // and nothing else.
+                let enu = Rotation::<Body, Enu>::from_euler(EulerZyx::new(yaw, pitch, roll));
+                let f = enu
+                    .inverse()
+                    .apply(Vec3::<Enu>::new(0.0, 0.0, g))
+                    .to_array();
+                let a = align::level::<Enu>(f, g, 0.0, 10.0, &EXACT)
+                    .unwrap()
+                    .attitude;
+                let b = align::level::<Enu>(f, g, 0.3, 10.0, &EXACT)
+                    .unwrap()
+                    .attitude;
+                let up = a.apply(Vec3::<Body>::from_array(f)).to_array();
+                worst = worst.max(up[0].hypot(up[1]) / g);
+                let turn = b.then(&a.inverse());
+                let axis_angle = turn.quaternion().angle();
+                worst = worst.max((axis_angle - 0.3).abs());
+            }
+        }
+    }
+    assert!(worst < 1e-12, "worst {worst:e}");
+    // The tilt's one-sigma is at_rest's; the heading's is the caller's.
+    let part = PartFigures {
+        accel_bias_m_s2: 0.05,
+        gyro_bias_rad_s: 0.0,
+        accel_psd: 0.002,
+        gyro_psd: 0.0,
+    };
+    let l = align::level::<Ned>([0.0, 0.0, -g], g, 0.0, 4.0, &part).unwrap();
+    assert!((l.tilt_sigma_rad - (0.05_f64.hypot(0.002 / 2.0)) / g).abs() < 1e-15);
+    assert_eq!(l.heading_sigma_rad, 0.0);
+    assert!(matches!(
+        align::level::<Ned>([0.0, 5.0, -g], g, 0.0, 4.0, &part),
+        Err(AlignError::NotAtRest { .. })
+    ));
+}

@@ -142,3 +142,113 @@ fn shoe_finds_the_stances_of_a_walking_foot() {
     );
     assert_eq!(false_stance, 0);
 }
+
+/// A walking foot's readings, simplified: quiet stances (white noise on a biased gravity
+/// reading) between swings whose motion is far above the noise; `quiet_share` of each second is
+/// stance. Returns accelerometer and gyroscope rows and which samples are stance.
+fn foot_like(
+    seconds: usize,
+    quiet_share: f64,
+    noise: ReadingNoise,
+    accel_bias: [f64; 3],
+    seed: u64,
+) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<bool>) {
+    let n = seconds * 100;
+    let nx: Vec<Vec<f64>> = (0..6)
+        .map(|k| {
+            let s = if k < 3 { noise.accel } else { noise.gyro };
+            noisy(n, s, 0.0, seed * 10 + k)
+        })
+        .collect();
+    let mut accel = Vec::with_capacity(n);
+    let mut gyro = Vec::with_capacity(n);
+    let mut quiet = Vec::with_capacity(n);
+    for i in 0..n {
+        let phase = (i % 100) as f64 / 100.0;
+        let still = phase < quiet_share;
+        // The swing: a bell of 20 m/s² and 6 rad/s over the rest of the second.
+        let swing = if still {
+            0.0
+        } else {
+            (std::f64::consts::PI * (phase - quiet_share) / (1.0 - quiet_share)).sin()
+        };
+        accel.push([
+            accel_bias[0] + 20.0 * swing + nx[0][i],
+            accel_bias[1] + 5.0 * swing + nx[1][i],
+            accel_bias[2] + 9.81 - 10.0 * swing + nx[2][i],
+        ]);
+        gyro.push([nx[3][i], 6.0 * swing + nx[4][i], 0.5 * swing + nx[5][i]]);
+        quiet.push(still);
+    }
+    (accel, gyro, quiet)
+}
+
+#[test]
+fn the_noise_is_learnt_from_the_quiet_stretches_of_a_moving_log() {
+    use imu_core::stillness::quiet_noise;
+    // Three times the noise of a consumer preset, a 0.3 m/s² accelerometer bias, stances a
+    // third of each stride: 120 s at 100 Hz, blocks of 10 samples (1200 blocks, ~360 quiet).
+    let noise = ReadingNoise {
+        accel: 0.03,
+        gyro: 0.006,
+    };
+    let bias = [0.3, -0.1, 0.05];
+    for seed in 1..=5 {
+        let (accel, gyro, _) = foot_like(120, 0.35, noise, bias, seed);
+        let mut room = vec![[0.0; 3]; accel.len() / 10];
+        let q = quiet_noise(&accel, &gyro, 10, 9.81, &mut room).expect("quiet stretches");
+        // ~330 quiet blocks × 27 degrees of freedom: a variance to about 1.7 %, a standard
+        // deviation to 0.9 %; 5 % is more than five of its sigmas.
+        for (learnt, truth) in [(q.noise.accel, noise.accel), (q.noise.gyro, noise.gyro)] {
+            assert!(
+                (learnt / truth - 1.0).abs() < 0.05,
+                "seed {seed}: learnt {learnt:.5}, truth {truth}"
+            );
+        }
+        // Gravity as this accelerometer reads it: |g + bias|, to the averaged noise.
+        let read = (bias[0].powi(2) + bias[1].powi(2) + (9.81 + bias[2]).powi(2)).sqrt();
+        assert!(
+            (q.gravity_reading_m_s2 - read).abs() < 1e-3,
+            "seed {seed}: {} against {read}",
+            q.gravity_reading_m_s2
+        );
+        // Blocks wholly inside a stance: 3 of every 10 per stride (a few more partly still
+        // blocks at the ends of a swing pass too, none far into one).
+        assert!(
+            (330..=480).contains(&q.quiet_blocks),
+            "seed {seed}: {} quiet of {}",
+            q.quiet_blocks,
+            q.blocks
+        );
+    }
+}
+
+#[test]
+fn a_log_that_never_rests_has_no_quiet_noise_and_a_still_log_is_all_quiet() {
+    use imu_core::stillness::quiet_noise;
+    let noise = ReadingNoise {
+        accel: 0.01,
+        gyro: 0.002,
+    };
+    let (accel, gyro, _) = foot_like(60, 0.0, noise, [0.0; 3], 7);
+    let mut room = vec![[0.0; 3]; accel.len() / 10];
+    assert_eq!(quiet_noise(&accel, &gyro, 10, 9.81, &mut room), None);
+    // Still throughout: one population, every block (but the rare false alarm) quiet.
+    let accel = rows(
+        &noisy(6000, noise.accel, 0.0, 1),
+        &noisy(6000, noise.accel, 0.0, 2),
+        &noisy(6000, noise.accel, 9.81, 3),
+    );
+    let gyro = rows(
+        &noisy(6000, noise.gyro, 0.01, 4),
+        &noisy(6000, noise.gyro, 0.0, 5),
+        &noisy(6000, noise.gyro, 0.0, 6),
+    );
+    let mut room = vec![[0.0; 3]; 600];
+    let q = quiet_noise(&accel, &gyro, 10, 9.81, &mut room).unwrap();
+    assert!(q.quiet_blocks >= 598, "{} of 600", q.quiet_blocks);
+    assert!((q.noise.accel / noise.accel - 1.0).abs() < 0.05);
+    assert!((q.noise.gyro / noise.gyro - 1.0).abs() < 0.05);
+    // Too little room for the blocks: refused, not cut short.
+    assert_eq!(quiet_noise(&accel, &gyro, 10, 9.81, &mut room[..599]), None);
+}

@@ -135,23 +135,75 @@ pub fn at_rest<E: EarthModel>(
             horizontal_rate_rad_s: horizontal,
         });
     }
-    let roll = math::atan2(-f[1], -f[2]);
-    let pitch = math::atan2(f[0], math::hypot(f[1], f[2]));
+    let (roll, pitch) = roll_pitch(f);
     let level = Rotation::<Frd, Frd>::from_euler(EulerZyx::new(0.0, pitch, roll));
     let wl = level.apply(Vec3::from_array(w)).to_array();
     let yaw = math::atan2(-wl[1], wl[0]);
-    let frd_ned = Rotation::<Frd, Ned>::from_euler(EulerZyx::new(yaw, pitch, roll));
     Ok(RestAlignment {
-        attitude: E::Frame::frd_to_body()
-            .inverse()
-            .then(&frd_ned)
-            .then(&E::Frame::from_ned()),
-        tilt_sigma_rad: math::hypot(
-            part.accel_bias_m_s2,
-            part.accel_psd / math::sqrt(duration_s),
-        ) / gravity,
+        attitude: attitude_of::<E::Frame>(yaw, pitch, roll),
+        tilt_sigma_rad: tilt_sigma(part, duration_s, gravity),
         heading_sigma_rad,
     })
+}
+
+/// Levelling alone, for a start whose heading nothing measures (no Earth rate a gyroscope can
+/// see, no fix): roll and pitch as [`at_rest`] finds them from the mean specific force
+/// `specific_force_m_s2` (body axes of the frame's convention) over `duration_s`, the heading
+/// the given `yaw_rad` (NED yaw: about down, from the frame's north), and the tilt's one-sigma
+/// as [`at_rest`] states it; `heading_sigma_rad` is the caller's to state (0 here).
+///
+/// # Errors
+/// A specific force farther than [`REST_TOLERANCE`] from `gravity_m_s2`.
+pub fn level<N: NavFrame>(
+    specific_force_m_s2: [f64; 3],
+    gravity_m_s2: f64,
+    yaw_rad: f64,
+    duration_s: f64,
+    part: &PartFigures,
+) -> Result<RestAlignment<N>, AlignError> {
+    let f = N::frd_to_body()
+        .inverse()
+        .apply(Vec3::from_array(specific_force_m_s2))
+        .to_array();
+    let magnitude = math::sqrt(f.iter().map(|x| x * x).sum::<f64>());
+    if math::abs(magnitude - gravity_m_s2) > REST_TOLERANCE * gravity_m_s2 || magnitude.is_nan() {
+        return Err(AlignError::NotAtRest {
+            specific_force_m_s2: magnitude,
+            gravity_m_s2,
+        });
+    }
+    let (roll, pitch) = roll_pitch(f);
+    Ok(RestAlignment {
+        attitude: attitude_of::<N>(yaw_rad, pitch, roll),
+        tilt_sigma_rad: tilt_sigma(part, duration_s, gravity_m_s2),
+        heading_sigma_rad: 0.0,
+    })
+}
+
+/// Roll and pitch from a specific force in FRD axes (the sensor level when it reads `(0, 0, −g)`).
+fn roll_pitch(f: [f64; 3]) -> (f64, f64) {
+    (
+        math::atan2(-f[1], -f[2]),
+        math::atan2(f[0], math::hypot(f[1], f[2])),
+    )
+}
+
+/// The body-to-`N` attitude of NED Euler angles (FRD body).
+fn attitude_of<N: NavFrame>(yaw: f64, pitch: f64, roll: f64) -> Rotation<Body, N> {
+    let frd_ned = Rotation::<Frd, Ned>::from_euler(EulerZyx::new(yaw, pitch, roll));
+    N::frd_to_body()
+        .inverse()
+        .then(&frd_ned)
+        .then(&N::from_ned())
+}
+
+/// The tilt's one-sigma from averages over `duration_s`: the accelerometer's bias and its
+/// averaged white noise over gravity.
+fn tilt_sigma(part: &PartFigures, duration_s: f64, gravity_m_s2: f64) -> f64 {
+    math::hypot(
+        part.accel_bias_m_s2,
+        part.accel_psd / math::sqrt(duration_s),
+    ) / gravity_m_s2
 }
 
 /// The attitude of a vehicle moving nose first with velocity `v` (frame `N`): the body's x axis
