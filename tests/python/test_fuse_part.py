@@ -68,8 +68,9 @@ def test_a_bad_part_or_accuracy_is_refused_by_name(drive):
     done = fuse(files, out, "--imu", "stim300", "--scenario", str(scenario))
     assert done.returncode == 2, done.stderr
     assert not out.exists()
-    with pytest.raises(ValueError, match="scenario= .* or imu_model="):
-        imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]))
+    with pytest.raises(ValueError, match="scenario= .* or imu_model=.*not both"):
+        imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]),
+                    scenario=str(scenario), imu_model="stim300")
 
 
 def test_a_scenario_that_contradicts_the_datas_description_is_refused(drive):

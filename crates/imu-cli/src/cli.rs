@@ -489,41 +489,40 @@ pub struct FuseArgs {
     pub init: Option<PathBuf>,
     /// Start without truth: `gnss` takes position, velocity, heading and pitch from the first
     /// fix at 3 m/s or more (roll 0, each with its stated one-sigma); `static` (WGS-84
-    /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s. The
-    /// estimate begins there.
+    /// scenarios, the vehicle at rest) levels and gyrocompasses over the first 60 s; `level`
+    /// levels over the rest at the start, heading zero, at the origin (the default without a
+    /// GNSS file and --init). The estimate begins there.
     #[arg(long, value_parser = choice::<AlignName>(), ignore_case = true)]
     pub align: Option<AlignName>,
     /// The scenario whose `[imu]` and `[gnss]` describe the data's errors (or: --imu and
-    /// the --gnss-* accuracies).
-    #[arg(
-        long,
-        required_unless_present = "imu_model",
-        conflicts_with = "imu_model"
-    )]
+    /// the --gnss-* accuracies; neither: the noise learnt from the log).
+    #[arg(long, conflicts_with = "imu_model")]
     pub scenario: Option<PathBuf>,
     /// The IMU part, instead of a scenario: a preset's name (`imukit presets`) or a parameter
-    /// file (imukit TOML, MATLAB JSON). The data's frame, Earth and accelerometer sign come
-    /// from the input files' descriptions (else ENU, flat, specific force).
+    /// file (imukit TOML, MATLAB JSON). Left out (and no --scenario), the white noise is
+    /// learnt from the log's quiet stretches and the biases are an unknown consumer part's.
+    /// The data's frame, Earth and accelerometer sign come from the input files' descriptions
+    /// (else ENU, flat, specific force).
     #[arg(long = "imu", value_name = "PRESET|FILE")]
     pub imu_model: Option<String>,
     /// With --imu: the part in a MATLAB parameter file of several.
     #[arg(long, requires = "imu_model")]
     pub part: Option<String>,
-    /// With --imu: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
+    /// Without --scenario: the fixes' horizontal position accuracy, m (MATLAB gpsSensor's default
     /// when left out).
-    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
     pub gnss_horizontal_accuracy_m: Option<f64>,
-    /// With --imu: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
+    /// Without --scenario: the fixes' vertical position accuracy, m (MATLAB gpsSensor's default when
     /// left out).
-    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
     pub gnss_vertical_accuracy_m: Option<f64>,
-    /// With --imu: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
+    /// Without --scenario: the fixes' velocity accuracy per axis, m/s (MATLAB gpsSensor's default
     /// when left out).
-    #[arg(long, requires = "imu_model", allow_hyphen_values = true)]
+    #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
     pub gnss_velocity_accuracy_m_s: Option<f64>,
-    /// With --imu: the antenna's position from the IMU, body frame, m.
+    /// Without --scenario: the antenna's position from the IMU, body frame, m.
     #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
-          requires = "imu_model")]
+          conflicts_with = "scenario")]
     pub gnss_lever_arm_m: Option<Vec<f64>>,
     /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
     /// user-equivalent range error, m (one-sigma).
@@ -567,7 +566,7 @@ pub struct FuseArgs {
     /// The vehicle stands still for the IMU's first this many seconds: zero-velocity and
     /// zero-rate updates at every sample there calibrate the gyroscope biases. Default: the
     /// rest found in the readings (blocks of 0.5 s whose spread and mean stay within the
-    /// part's noise); 0: none.
+    /// noise the log shows in its quiet stretches, else the part's); 0: none.
     #[arg(long, value_name = "SECONDS")]
     pub rest_s: Option<f64>,
     /// Smooth the estimate forward–backward (Rauch–Tung–Striebel over the filter): each
@@ -575,7 +574,9 @@ pub struct FuseArgs {
     #[arg(long)]
     pub smooth: bool,
     /// Zero-velocity updates wherever the readings show a stance (a foot-mounted IMU: the
-    /// SHOE detector with the part's noise), zero velocity and zero rate at each.
+    /// SHOE detector with the noise the log shows in its quiet stretches and gravity as its
+    /// accelerometer reads at rest), zero velocity and zero rate at each; a warning when
+    /// under 5 % of the samples are stances.
     #[arg(long)]
     pub zupt: bool,
     /// Where to write the estimate (CSV, or by extension `.parquet`, `.npy`, `.npz`).

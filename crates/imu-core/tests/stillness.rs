@@ -163,6 +163,7 @@ fn foot_like(
     let mut accel = Vec::with_capacity(n);
     let mut gyro = Vec::with_capacity(n);
     let mut quiet = Vec::with_capacity(n);
+    #[allow(clippy::needless_range_loop)] // one sample of six noise streams
     for i in 0..n {
         let phase = (i % 100) as f64 / 100.0;
         let still = phase < quiet_share;

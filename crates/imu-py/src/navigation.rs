@@ -275,6 +275,18 @@ fn fuse<'py>(
     let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
     let model = match imu_model {
+        // Neither a part nor a scenario: the noise learnt from the log.
+        None if scenario.is_none() => Model::Part(PartModel {
+            imu: Part::Learnt,
+            part,
+            gnss: imukit::scenario::gnss::GnssSpec {
+                horizontal_accuracy_m: gnss_horizontal_accuracy_m,
+                vertical_accuracy_m: gnss_vertical_accuracy_m,
+                velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
+                lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m.clone())?,
+                ..Default::default()
+            },
+        }),
         Some(imu) => {
             let gnss = imukit::scenario::gnss::GnssSpec {
                 horizontal_accuracy_m: gnss_horizontal_accuracy_m,
@@ -332,7 +344,8 @@ fn fuse<'py>(
     let (table, summary, description) = py
         .detach(move || {
             let request = FuseRequest {
-                start: Start::of(initial.as_ref(), align)?,
+                start: Start::of(initial.as_ref(), align)?
+                    .or_else(|| Start::when_not_given(!gnss.columns.is_empty())),
                 earth: None,
                 gate,
                 nhc_sigma_m_s,

@@ -115,8 +115,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         None => None,
     };
+    let start = Start::of(initial.as_ref(), a.align).map_err(by_flag)?;
     let request = FuseRequest {
-        start: Start::of(initial.as_ref(), a.align).map_err(by_flag)?,
+        start: start.or_else(|| Start::when_not_given(a.gnss.is_some())),
         earth: a.asked.earth,
         gate: !a.no_gate,
         nhc_sigma_m_s: a.nhc,
@@ -158,7 +159,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         (None, None) => {
             return Err(Error::Invalid {
                 field: "--scenario".into(),
-                message: "the filter needs the data's errors: --scenario FILE or --imu PART".into(),
+                message: "the filter needs the data's errors: --scenario FILE, --imu PART, or \
+                          neither (learnt from the log)"
+                    .into(),
             }
             .into());
         }
@@ -247,12 +250,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         (false, false) => "no rest (--rest-s 0)".to_owned(),
     };
     crate::note!("imukit: the filter had {states} and {rest}");
-    if a.zupt {
-        crate::note!(
-            "imukit: {} samples taken as stances (zero-velocity updates)",
-            summary.stance_samples
-        );
-    }
+    report_detection(a, &summary, imu.rows());
     if summary.resets > 0 {
         let t = nav.column("t_s").unwrap_or_default();
         let resets = nav
@@ -283,6 +281,67 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         ));
     }
     Ok(())
+}
+
+/// What the detectors tested the readings against, and a warning when the log's noise is not
+/// the part's or `--zupt` found (almost) no stance.
+fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samples: usize) {
+    if let Some(d) = summary.detection.filter(|d| d.learnt) {
+        crate::note!(
+            "imukit: white noise learnt from the log's quiet stretches: accelerometer {:.3e} \
+             m/s², gyroscope {:.3e} rad/s per sample; gravity reads {:.4} m/s² at rest",
+            d.noise.accel,
+            d.noise.gyro,
+            d.gravity_m_s2
+        );
+        let ratio = |learnt: f64, part: f64| learnt / part;
+        let (ra, rg) = (
+            ratio(d.noise.accel, d.part_noise.accel),
+            ratio(d.noise.gyro, d.part_noise.gyro),
+        );
+        let off = |r: f64| !(0.5..=2.0).contains(&r);
+        if a.model
+            .as_ref()
+            .is_some_and(|m| m.imu != imukit::run::fuse::Part::Learnt)
+            && (off(ra) || off(rg))
+        {
+            crate::report::warn(&format!(
+                "{}: its white noise is {ra:.2}× (accelerometer) and {rg:.2}× (gyroscope) what \
+                 the part states: the rest and stance detectors use the log's, the filter's \
+                 process noise stays the part's",
+                a.imu.display()
+            ));
+        }
+    }
+    if !a.zupt {
+        return;
+    }
+    crate::note!(
+        "imukit: {} samples taken as stances (zero-velocity updates)",
+        summary.stance_samples
+    );
+    // A walk stands on each foot for about a third of its time or more.
+    #[allow(clippy::cast_precision_loss)]
+    let share = summary.stance_samples as f64 / samples.max(1) as f64;
+    if share < imukit::run::fuse::FEW_STANCES {
+        crate::report::warn(&format!(
+            "{}: --zupt found {} stances ({:.1} % of the samples): a foot-mounted IMU stands \
+             still for a third of a walk or more; without them the estimate is free inertial \
+             and drifts (is the sensor on a foot? is its noise {}?)",
+            a.imu.display(),
+            if summary.stance_samples == 0 {
+                "no"
+            } else {
+                "few"
+            },
+            100.0 * share,
+            if summary.detection.is_some_and(|d| d.learnt) {
+                "learnt from quiet stretches that are not stances"
+            } else {
+                "the part's"
+            }
+        ));
+    }
 }
 
 /// `e` with the request field or context it names renamed by `rename` (the flag a user gave).

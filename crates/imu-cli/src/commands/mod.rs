@@ -344,8 +344,11 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
         init: init.as_ref(),
         align,
         scenario: scenario.as_deref(),
-        model: imu_model.map(|imu| imukit::run::fuse::PartModel {
-            imu: imukit::run::fuse::Part::named(&imu),
+        // Without a scenario: the part named, else learnt from the log.
+        model: scenario.is_none().then(|| imukit::run::fuse::PartModel {
+            imu: imu_model.map_or(imukit::run::fuse::Part::Learnt, |imu| {
+                imukit::run::fuse::Part::named(&imu)
+            }),
             part,
             gnss: imukit::scenario::gnss::GnssSpec {
                 horizontal_accuracy_m: gnss_horizontal_accuracy_m,

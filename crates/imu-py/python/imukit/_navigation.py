@@ -173,8 +173,8 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     ``[gnss]`` accuracy and lever arm, its ``[odometer]`` and ``[baro]``. The filter starts from
     ``initial``, a truth Table (its first row), or without truth from ``align="gnss"``: position,
     velocity, heading and pitch of the first fix at 3 m/s or more (roll 0), or ``align="static"``
-    on the WGS-84 Earth (at rest: levelling and gyrocompassing over the first 60 s); the estimate
-    begins there. Returns the navigation columns of :func:`strapdown`, their one-sigma
+    on the WGS-84 Earth (at rest: levelling and gyrocompassing over the first 60 s), or
+    ``align="level"`` (at rest: levelled, heading zero); the estimate begins there. Returns the navigation columns of :func:`strapdown`, their one-sigma
     (``pos_x_sigma_m`` … ``att_z_sigma_rad``), the bias estimates (``accel_bias_x_m_s2`` …
     ``gyro_bias_z_rad_s``) and their one-sigma (``accel_bias_x_sigma_m_s2`` …); ``gate=False`` applies every update (else a chi-square gate rejects
     outliers). A ground vehicle adds ``odometer=sim.odometer`` (forward speed),
@@ -205,9 +205,16 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     receiver's figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
     ``hdop`` column (HDOP × UERE).
 
+    With neither a scenario nor ``imu_model``, the part is learnt from the log: its white noise
+    from the quiet stretches (a rest, a foot's stances), its biases an unknown consumer part's
+    (docs/your-own-log.md); the sensor-error states are then off unless asked for.
+
     ``zupt=True`` applies zero-velocity (and zero-rate) updates wherever the readings show a
-    stance — a foot-mounted IMU — by the SHOE detector with the part's noise; ``gnss=None``
-    runs without fixes.
+    stance — a foot-mounted IMU — by the SHOE detector with the noise the log shows in its quiet
+    stretches (the part's when it has too few) and gravity as its accelerometer reads it at rest;
+    ``gnss=None`` runs without fixes. Without ``initial``, ``align`` and fixes the filter starts
+    levelled over the rest at the start (``align="level"``): heading zero, at the origin, the
+    frame the start's own.
     ``smooth=True`` returns the forward–backward (Rauch–Tung–Striebel) smoothed estimate instead:
     each sample's best estimate from all the data, with its one-sigma, in the same columns.
 
@@ -215,8 +222,8 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     (position, velocity and, moving, heading), counted in the last column ``gnss_resets``, with
     an :class:`ImuWarning`; fixes still rejected after three resets in a row raise ``ImuError``.
     """
-    if (scenario is None) == (imu_model is None):
-        raise ValueError("give scenario= (the data's [imu] and [gnss]) or imu_model= (a part), not both or neither")
+    if scenario is not None and imu_model is not None:
+        raise ValueError("give scenario= (the data's [imu] and [gnss]) or imu_model= (a part), not both")
     part_keys = dict(imu_model=None if imu_model is None else str(imu_model), part=part,
                      gnss_horizontal_accuracy_m=gnss_horizontal_accuracy_m,
                      gnss_vertical_accuracy_m=gnss_vertical_accuracy_m,

@@ -1,6 +1,11 @@
 //! The detectors a fusion runs on the readings: the rest at the start (the gyroscope biases
-//! are learnt there) and the stances of a foot-mounted IMU (zero-velocity updates), each with
-//! the part's white noise ([`imu_core::stillness`]).
+//! are learnt there) and the stances of a foot-mounted IMU (zero-velocity updates). Both test
+//! the readings against their white noise: the noise the log itself shows in its quiet
+//! stretches ([`imu_core::stillness::quiet_noise`]) when it has enough of them, else the
+//! part's; the stances against gravity as this accelerometer reads it at rest (its bias
+//! included), not nominal gravity.
+use imu_core::stillness::{QuietStretches, ReadingNoise};
+
 use super::FuseSetup;
 
 /// One-sigma of the zero-velocity update at a stance on the move, m/s (OpenShoe's figure).
@@ -9,17 +14,95 @@ pub const STANCE_VELOCITY_SIGMA_M_S: f64 = 0.01;
 /// Window of the stance detector, s (Skog et al. use 3 to 5 samples at 100 Hz and more).
 pub const STANCE_WINDOW_S: f64 = 0.05;
 
+/// A share of stance samples below which a front end warns that `--zupt` found implausibly
+/// few: a walking foot stands for about a third of the time or more.
+pub const FEW_STANCES: f64 = 0.05;
+
 /// False-alarm probability of the stance detector per sample.
 pub const STANCE_FALSE_ALARM: f64 = 1e-3;
 
+/// Block length over which the log's quiet stretches are found, s: a foot's stance holds a few
+/// such blocks, a hand's pause one or two.
+pub const QUIET_WINDOW_S: f64 = 0.1;
+
+/// What the detectors test the readings against.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detection {
+    /// The readings' mean interval, s.
+    pub interval_s: f64,
+    /// Their white noise per sample: the log's own when learnt, else the part's.
+    pub noise: ReadingNoise,
+    /// Gravity as the accelerometer reads it at rest, m/s² (the setup's gravity when nothing
+    /// was learnt).
+    pub gravity_m_s2: f64,
+    /// The part's white noise per sample (what the setup says).
+    pub part_noise: ReadingNoise,
+    /// Whether `noise` and `gravity_m_s2` were learnt from the log.
+    pub learnt: bool,
+}
+
+impl Detection {
+    /// The detection for readings `f`, `w` at times `t` under `setup`; `None` for fewer than
+    /// three samples or times that do not advance.
+    #[must_use]
+    pub fn of(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> Option<Self> {
+        let n = t.len();
+        if n < 3 {
+            return None;
+        }
+        let interval_s = (t[n - 1] - t[0]) / (n - 1) as f64;
+        if interval_s.is_nan() || interval_s <= 0.0 {
+            return None;
+        }
+        let per_sample = |psd: f64| psd / interval_s.sqrt();
+        let part_noise = ReadingNoise {
+            accel: per_sample(setup.noise.accel_psd),
+            gyro: per_sample(setup.noise.gyro_psd),
+        };
+        let learnt = learnt_noise(f, w, interval_s, setup.gravity_m_s2);
+        Some(Self {
+            interval_s,
+            noise: learnt.map_or(part_noise, |q| q.noise),
+            gravity_m_s2: learnt.map_or(setup.gravity_m_s2, |q| q.gravity_reading_m_s2),
+            part_noise,
+            learnt: learnt.is_some(),
+        })
+    }
+}
+
+/// The white noise and gravity reading of readings `f`, `w` (sampled every `interval_s`) from
+/// their quiet stretches, in blocks of [`QUIET_WINDOW_S`]; `None` when the log has too few.
+#[must_use]
+pub fn learnt_noise(
+    f: &[[f64; 3]],
+    w: &[[f64; 3]],
+    interval_s: f64,
+    gravity_m_s2: f64,
+) -> Option<QuietStretches> {
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let window = ((QUIET_WINDOW_S / interval_s).round() as usize).max(3);
+    let mut blocks = vec![[0.0; 3]; f.len().min(w.len()) / window];
+    imu_core::stillness::quiet_noise(f, w, window, gravity_m_s2, &mut blocks)
+}
+
 /// The samples of readings `f`, `w` (specific force and rate, times `t`) that are stances
 /// ([`FuseSetup::zupt`]), as the fusion finds them.
+#[must_use]
 pub fn stance_samples(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> Vec<bool> {
+    Detection::of(t, f, w, setup)
+        .map_or_else(|| vec![false; t.len()], |d| stances(t, f, w, setup, &d))
+}
+
+/// [`stance_samples`] under `detection`.
+pub(super) fn stances(
+    t: &[f64],
+    f: &[[f64; 3]],
+    w: &[[f64; 3]],
+    setup: &FuseSetup,
+    detection: &Detection,
+) -> Vec<bool> {
     use imu_core::stillness::{detect_stance, shoe_threshold};
     let mut stance = vec![false; t.len()];
-    let Some((interval, noise)) = reading_noise(t, setup) else {
-        return stance;
-    };
     // The rest's mean rate is the bias the detector's zero-rate test must not see.
     let rest = t.partition_point(|&x| x < t[0] + setup.rest_s);
     let bias = if rest > 0 {
@@ -32,12 +115,12 @@ pub fn stance_samples(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSet
         .map(|x| [x[0] - bias[0], x[1] - bias[1], x[2] - bias[2]])
         .collect();
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let window = ((STANCE_WINDOW_S / interval).round() as usize).max(3);
+    let window = ((STANCE_WINDOW_S / detection.interval_s).round() as usize).max(3);
     detect_stance(
         f,
         &gyro,
-        setup.gravity_m_s2,
-        noise,
+        detection.gravity_m_s2,
+        detection.noise,
         window,
         shoe_threshold(window, STANCE_FALSE_ALARM),
         &mut stance,
@@ -51,35 +134,16 @@ pub const REST_WINDOW_S: f64 = 0.5;
 /// A start faster than this, m/s, is not at rest: no rest is looked for.
 pub const REST_START_SPEED_M_S: f64 = 0.1;
 
-/// The rest at the start of readings `f`, `w` at times `t`, s ([`imu_core::stillness`] with the
-/// part's white noise per sample and blocks of [`REST_WINDOW_S`]).
-pub(super) fn detected_rest_s(t: &[f64], f: &[[f64; 3]], w: &[[f64; 3]], setup: &FuseSetup) -> f64 {
-    let Some((interval, noise)) = reading_noise(t, setup) else {
-        return 0.0;
-    };
+/// The rest at the start of readings `f`, `w` at times `t`, s ([`imu_core::stillness`] with
+/// the detection's white noise per sample and blocks of [`REST_WINDOW_S`]).
+pub(super) fn detected_rest_s(
+    t: &[f64],
+    f: &[[f64; 3]],
+    w: &[[f64; 3]],
+    detection: &Detection,
+) -> f64 {
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let window = ((REST_WINDOW_S / interval).round() as usize).max(2);
-    let still = imu_core::stillness::initial_rest(f, w, noise, window);
+    let window = ((REST_WINDOW_S / detection.interval_s).round() as usize).max(2);
+    let still = imu_core::stillness::initial_rest(f, w, detection.noise, window);
     if still == 0 { 0.0 } else { t[still] - t[0] }
-}
-
-/// The mean interval of the times `t` and the part's white noise over one such interval, the
-/// stillness tests' noise; `None` for fewer than three samples or times that do not advance.
-fn reading_noise(t: &[f64], setup: &FuseSetup) -> Option<(f64, imu_core::stillness::ReadingNoise)> {
-    let n = t.len();
-    if n < 3 {
-        return None;
-    }
-    let interval = (t[n - 1] - t[0]) / (n - 1) as f64;
-    if interval.is_nan() || interval <= 0.0 {
-        return None;
-    }
-    let per_sample = |psd: f64| psd / interval.sqrt();
-    Some((
-        interval,
-        imu_core::stillness::ReadingNoise {
-            accel: per_sample(setup.noise.accel_psd),
-            gyro: per_sample(setup.noise.gyro_psd),
-        },
-    ))
 }

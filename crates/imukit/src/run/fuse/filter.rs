@@ -5,7 +5,7 @@
 use imu_core::fusion::{Eskf, EskfError, EskfState, FULL_STATES, GnssFix, SensorErrorEstimate};
 use imu_core::{Body, Vec3};
 
-use super::detect::{REST_START_SPEED_M_S, detected_rest_s, stance_samples};
+use super::detect::{Detection, REST_START_SPEED_M_S, detected_rest_s, stances};
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
 use super::rows::{RESETS_COLUMN, fused_columns, push_fused_row};
@@ -37,10 +37,11 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     } = job;
     let [h, _, v] = setup.gnss_position_sigma_m;
     let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT, [h, v])?;
-    let setup = &with_rest_found(setup, start, &inputs);
+    let detection = Detection::of(&inputs.t, &inputs.f, &inputs.w, setup);
+    let setup = &with_rest_found(setup, start, &inputs, detection.as_ref());
     let t = &inputs.t;
     let mut aids = AidStreams::new(aids, setup, inputs.span(), t.len())?;
-    let stances = mark_stances(&mut aids, &inputs, setup);
+    let stances = mark_stances(&mut aids, &inputs, setup, detection.as_ref());
     let fixes = Fixes::<E>::of(&inputs)?;
     let begin = begin(&earth, start, setup, &inputs, &fixes)?;
     aids.start_at(t[begin.first]);
@@ -77,6 +78,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             rest_detected: setup.detect_rest,
             sensor_errors: setup.estimate_sensor_errors,
             stance_samples: stances,
+            detection,
         },
     ))
 }
@@ -85,10 +87,15 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
 /// ([`FuseSetup::detect_rest`]): none for a start in motion, and none beyond the first fix that
 /// moves (steady motion in a straight line reads like rest: a fix moving faster than 5σ of its
 /// velocity before the rest's end overrules the readings, and then there is no rest at all).
-fn with_rest_found(setup: &FuseSetup, start: Start<'_>, inputs: &FusionInputs) -> FuseSetup {
-    if !setup.detect_rest {
+fn with_rest_found(
+    setup: &FuseSetup,
+    start: Start<'_>,
+    inputs: &FusionInputs,
+    detection: Option<&Detection>,
+) -> FuseSetup {
+    let Some(detection) = detection.filter(|_| setup.detect_rest) else {
         return *setup;
-    }
+    };
     let moving_at_start = match start {
         Start::State(initial) => {
             let v = initial.velocity_m_s;
@@ -96,12 +103,12 @@ fn with_rest_found(setup: &FuseSetup, start: Start<'_>, inputs: &FusionInputs) -
         }
         // Aligned from a fix at speed: the vehicle moves.
         Start::AlignGnss => true,
-        Start::AlignStatic { .. } => false,
+        Start::AlignStatic { .. } | Start::Level => false,
     };
     let readings_still = if moving_at_start {
         0.0
     } else {
-        detected_rest_s(&inputs.t, &inputs.f, &inputs.w, setup)
+        detected_rest_s(&inputs.t, &inputs.f, &inputs.w, detection)
     };
     let moves_at = (inputs.velocities != FixVelocity::None)
         .then(|| {
@@ -129,11 +136,16 @@ fn with_rest_found(setup: &FuseSetup, start: Start<'_>, inputs: &FusionInputs) -
 
 /// Marks the stances for zero-velocity updates when `setup` asks for them
 /// ([`FuseSetup::zupt`]); how many samples are stances.
-fn mark_stances(aids: &mut AidStreams, inputs: &FusionInputs, setup: &FuseSetup) -> usize {
-    if !setup.zupt {
+fn mark_stances(
+    aids: &mut AidStreams,
+    inputs: &FusionInputs,
+    setup: &FuseSetup,
+    detection: Option<&Detection>,
+) -> usize {
+    let Some(detection) = detection.filter(|_| setup.zupt) else {
         return 0;
-    }
-    let stance = stance_samples(&inputs.t, &inputs.f, &inputs.w, setup);
+    };
+    let stance = stances(&inputs.t, &inputs.f, &inputs.w, setup, detection);
     let count = stance.iter().filter(|s| **s).count();
     aids.set_stance(stance);
     count

@@ -26,10 +26,10 @@ mod smooth;
 mod start;
 
 pub use detect::{
-    REST_START_SPEED_M_S, REST_WINDOW_S, STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S,
-    STANCE_WINDOW_S, stance_samples,
+    Detection, FEW_STANCES, QUIET_WINDOW_S, REST_START_SPEED_M_S, REST_WINDOW_S,
+    STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S, STANCE_WINDOW_S, learnt_noise, stance_samples,
 };
-pub use model::{FuseModel, Part, PartModel};
+pub use model::{FuseModel, LEARNT_BASE_PRESET, Part, PartModel};
 pub(crate) use recovery::filter_refusal;
 pub use recovery::{MAX_REJECTED_IN_A_ROW, MAX_RESETS_IN_A_ROW};
 pub use request::{AlignName, FuseRequest, STATIC_ALIGN_S, Start};
@@ -75,6 +75,9 @@ pub struct FuseSummary {
     pub sensor_errors: bool,
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
+    /// What the detectors tested the readings against: the noise learnt from the log's quiet
+    /// stretches, or the part's (`None`: too few samples to tell).
+    pub detection: Option<Detection>,
 }
 
 /// Fuses `imu` (rates) with `gnss` ([`GNSS_COLUMNS`](crate::io::columns::GNSS_COLUMNS)) from `initial`;

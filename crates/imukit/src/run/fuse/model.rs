@@ -37,14 +37,23 @@ pub struct FuseModel<'a> {
     pub baro_sigma_m: Option<f64>,
 }
 
-/// A part: a built-in preset by its name, or a parameter file.
+/// A part: a built-in preset by its name, a parameter file, or what the log itself shows.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Part {
     /// A preset's name (`imukit presets`).
     Preset(String),
     /// A parameter file (imukit TOML or JSON, MATLAB `loadparams` JSON).
     File(std::path::PathBuf),
+    /// No data sheet: the white noise learnt from the log's quiet stretches
+    /// ([`learnt_noise`](super::learnt_noise)); the rest — bias stability and constant bias —
+    /// as an unknown consumer part's, [`LEARNT_BASE_PRESET`]'s figures (wide enough that the
+    /// filter learns the biases at rest and at stances).
+    Learnt,
 }
+
+/// The preset whose bias figures stand for an unknown part's ([`Part::Learnt`]): the least
+/// stable consumer part among the presets.
+pub const LEARNT_BASE_PRESET: &str = "mpu-6050";
 
 impl Default for Part {
     fn default() -> Self {
@@ -81,10 +90,12 @@ pub struct PartModel {
 }
 
 impl PartModel {
-    /// [`PartModel::setup`] for the IMU table `imu`, at its median sample rate.
+    /// [`PartModel::setup`] for the IMU table `imu`, at its median sample rate; for
+    /// [`Part::Learnt`], the white noise learnt from the table's quiet stretches.
     ///
     /// # Errors
-    /// As [`PartModel::setup`]; fewer than two samples with increasing times.
+    /// As [`PartModel::setup`]; fewer than two samples with increasing times; for
+    /// [`Part::Learnt`], a log without enough quiet stretches to learn from.
     pub fn setup_for(
         &self,
         nav: &crate::run::navigate::NavSetup,
@@ -99,7 +110,39 @@ impl PartModel {
                 "needs at least two samples with increasing t_s (the sample rate sets the noise)",
             ));
         }
-        self.setup(nav, accel_sign, 1.0 / median)
+        if self.imu != Part::Learnt {
+            return self.setup(nav, accel_sign, 1.0 / median);
+        }
+        let base = Self {
+            imu: Part::Preset(LEARNT_BASE_PRESET.into()),
+            ..self.clone()
+        };
+        let mut setup = base.setup(nav, accel_sign, 1.0 / median)?;
+        let (Some(f), Some(w)) = (
+            imu.triples(&crate::io::columns::ACCEL_COLUMNS),
+            imu.triples(&crate::io::columns::GYRO_COLUMNS),
+        ) else {
+            return Err(invalid(
+                Data::Imu.label(),
+                "needs accel_* and gyro_* columns to learn the sensor's noise from",
+            ));
+        };
+        let quiet = super::learnt_noise(&f, &w, median, setup.gravity_m_s2).ok_or_else(|| {
+            invalid(
+                Data::Imu.label(),
+                format!(
+                    "the log has too few quiet stretches ({} blocks of {} s still) to learn its \
+                     sensor's noise from: name the part (a preset or a parameter file)",
+                    imu_core::stillness::MIN_QUIET_BLOCKS,
+                    super::QUIET_WINDOW_S
+                ),
+            )
+        })?;
+        // Per-sample standard deviations back to densities at this rate.
+        setup.noise.accel_psd = quiet.noise.accel * median.sqrt();
+        setup.noise.gyro_psd = quiet.noise.gyro * median.sqrt();
+        setup.figures_known = false;
+        Ok(setup)
     }
 
     /// The filter's setup for data in the frame, Earth and sign of `nav` (the accelerometer
@@ -117,6 +160,12 @@ impl PartModel {
         let (preset, params) = match &self.imu {
             Part::Preset(name) => (Some(name.clone()), None),
             Part::File(path) => (None, Some(path.clone())),
+            Part::Learnt => {
+                return Err(invalid(
+                    "imu",
+                    "a part learnt from the log needs the log: PartModel::setup_for",
+                ));
+            }
         };
         let spec = crate::scenario::ImuSpec {
             preset,

@@ -24,6 +24,12 @@ pub enum Start<'a> {
         /// How long the vehicle stands still at the start, s.
         duration_s: f64,
     },
+    /// Without truth or heading, at rest (a walk, a hand-held log): levelled from the mean
+    /// specific force over the rest at the start (given or found), heading zero — the frame's
+    /// axes are the body's heading at the start, so its one-sigma is 0 — velocity zero, on the
+    /// flat Earth at the origin (on WGS-84 at the first fix); the estimate begins at the
+    /// rest's end.
+    Level,
 }
 
 /// How long `--align static` averages, s.
@@ -37,12 +43,17 @@ pub enum AlignName {
     Gnss,
     /// [`Start::AlignStatic`] over [`STATIC_ALIGN_S`].
     Static,
+    /// [`Start::Level`].
+    Level,
 }
 
 impl Choice for AlignName {
     const WHAT: &'static str = "alignment";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("gnss", Self::Gnss), ("static", Self::Static)];
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("gnss", Self::Gnss),
+        ("static", Self::Static),
+        ("level", Self::Level),
+    ];
 }
 
 display_as_name!(AlignName);
@@ -63,6 +74,14 @@ impl<'a> Start<'a> {
             (None, a) => Ok(a.map(Self::from)),
         }
     }
+
+    /// The start when a front end is given none: [`Start::Level`] for a log without fixes
+    /// (nothing else could give a heading or a position; the frame is then the start's own),
+    /// none with fixes (the user chooses between a truth row and the alignments).
+    #[must_use]
+    pub fn when_not_given(has_fixes: bool) -> Option<Self> {
+        (!has_fixes).then_some(Self::Level)
+    }
 }
 
 impl From<AlignName> for Start<'_> {
@@ -72,6 +91,7 @@ impl From<AlignName> for Start<'_> {
             AlignName::Static => Self::AlignStatic {
                 duration_s: STATIC_ALIGN_S,
             },
+            AlignName::Level => Self::Level,
         }
     }
 }
@@ -159,8 +179,9 @@ impl<'a> FuseRequest<'a> {
         self.start.ok_or_else(|| {
             invalid(
                 "initial",
-                "the filter needs a start: the initial state (a truth row) or the alignment \
-                 \"gnss\"",
+                "the filter needs a start: the initial state (a truth row) or an alignment: \
+                 \"gnss\" (from the first fix at speed), \"static\" (at rest on the WGS-84 \
+                 Earth) or \"level\" (at rest, heading zero)",
             )
         })
     }

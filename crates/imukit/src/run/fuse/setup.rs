@@ -47,6 +47,10 @@ pub struct FuseSetup {
     /// instead of 15 (see `imu_core::fusion::sensor_errors`), starting from
     /// `sensor_error_sigma`; the estimate gains [`sensor_error_columns`](super::sensor_error_columns). Off by default.
     pub estimate_sensor_errors: bool,
+    /// Whether the part's error figures are its own (a scenario's, a preset's, a parameter
+    /// file's); `false` for a part learnt from the log, whose bias and matrix figures are an
+    /// unknown part's stand-ins: its sensor errors are then estimated only when asked.
+    pub figures_known: bool,
     /// Their initial one-sigma: the part's own figures (`axes_misalignment_pct`,
     /// `acceleration_bias`; worst entry), at least [`MIN_SENSOR_ERROR_SIGMA`] and
     /// [`MIN_G_SENSITIVITY_SIGMA`].
@@ -200,21 +204,22 @@ impl FuseSetup {
         }
     }
 
-    /// Whether the part's scale-factor, misalignment or g-sensitivity figures are large enough
-    /// ([`SENSOR_ERROR_STATES_FROM`], [`G_SENSITIVITY_STATES_FROM`]) that the filter should
-    /// estimate them: what `fuse` does when not told.
+    /// Whether the part's own scale-factor, misalignment or g-sensitivity figures are large
+    /// enough ([`SENSOR_ERROR_STATES_FROM`], [`G_SENSITIVITY_STATES_FROM`]) that the filter
+    /// should estimate them: what `fuse` does when not told (never for figures that are not
+    /// the part's own, [`FuseSetup::figures_known`]).
     #[must_use]
     pub fn warrants_sensor_errors(&self) -> bool {
         let e = &self.sensor_error_sigma;
-        [
+        let matrices = [
             e.accel_scale_factor,
             e.accel_misalignment,
             e.gyro_scale_factor,
             e.gyro_misalignment,
         ]
         .iter()
-        .any(|s| *s >= SENSOR_ERROR_STATES_FROM)
-            || e.gyro_g_sensitivity >= G_SENSITIVITY_STATES_FROM
+        .any(|s| *s >= SENSOR_ERROR_STATES_FROM);
+        self.figures_known && (matrices || e.gyro_g_sensitivity >= G_SENSITIVITY_STATES_FROM)
     }
 
     /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
@@ -311,6 +316,7 @@ impl FuseSetup {
             },
             covariance_interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
             estimate_sensor_errors: false,
+            figures_known: true,
             sensor_error_sigma: SensorErrorSigma {
                 accel_scale_factor,
                 accel_misalignment,

@@ -102,6 +102,7 @@ pub(super) fn begin<E: NavEarth>(
             ));
         }
         Start::AlignStatic { duration_s } => at_rest(earth, duration_s, setup, inputs, fixes)?,
+        Start::Level => level(setup, inputs, fixes)?,
         Start::AlignGnss => from_gnss(earth, setup, inputs, fixes)?,
     };
     Ok(Begin {
@@ -207,6 +208,90 @@ fn at_rest<E: NavEarth>(
         state: NavState {
             t_s: t[i0],
             attitude: aligned.attitude,
+            velocity_m_s: Vec3::zeros(),
+            position,
+        },
+        origin: E::origin_at(&position),
+        sigma,
+        next_fix: used,
+    })
+}
+
+/// The levelled start ([`Start::Level`]) at the end of the rest at the start: roll and pitch
+/// from the mean specific force over the rest, heading zero, velocity zero; on the flat Earth at
+/// the origin unless a fix came by then, on WGS-84 at the last fix by then.
+///
+/// # Errors
+/// No rest at the start, a mean specific force that is not gravity, no fix by then on WGS-84.
+fn level<E: NavEarth>(
+    setup: &FuseSetup,
+    inputs: &FusionInputs,
+    fixes: &Fixes<E>,
+) -> Result<Begin<E>> {
+    let t = &inputs.t;
+    let i0 = t.partition_point(|&ti| ti < t[0] + setup.rest_s);
+    if setup.rest_s <= 0.0 || i0 < 2 || i0 >= t.len() {
+        return Err(invalid(
+            "align",
+            format!(
+                "\"level\" levels the sensor over its rest at the start, and {}: give the rest's \
+                 length (rest_s) if the log does start still, or another start",
+                if setup.detect_rest {
+                    "none was found in the readings".to_owned()
+                } else {
+                    format!("a rest of {} s leaves no samples after it", setup.rest_s)
+                }
+            ),
+        ));
+    }
+    let sign = setup.specific_force_factor();
+    #[allow(clippy::cast_precision_loss)]
+    let mean =
+        [0, 1, 2].map(|k| sign * inputs.f[..i0].iter().map(|x| x[k]).sum::<f64>() / i0 as f64);
+    let part = PartFigures {
+        accel_bias_m_s2: setup.part_bias[0],
+        gyro_bias_rad_s: setup.part_bias[1],
+        accel_psd: setup.noise.accel_psd,
+        gyro_psd: setup.noise.gyro_psd,
+    };
+    let levelled = align::level::<E::Frame>(mean, setup.gravity_m_s2, 0.0, t[i0] - t[0], &part)
+        .map_err(|source| Error::Align {
+            field: "align".into(),
+            source,
+        })?;
+    let used = inputs.g_t.partition_point(|&x| x <= t[i0]);
+    let position = match used.checked_sub(1) {
+        Some(k) => fixes.position[k],
+        None if !E::ROTATING => {
+            E::fix_position([0.0; 3]).ok_or_else(|| invalid("align", "no origin"))?
+        }
+        None => {
+            return Err(invalid(
+                Data::Gnss.label(),
+                "no fix by the end of the rest: on the WGS-84 Earth the levelled start takes \
+                 its position from the fixes",
+            ));
+        }
+    };
+    let sigma = InitialSigma {
+        // The frame is the start's: its origin and heading are exact by definition.
+        position_m: if used == 0 {
+            0.0
+        } else {
+            setup
+                .gnss_position_sigma_m
+                .iter()
+                .fold(0.0_f64, |a, b| a.max(*b))
+        },
+        velocity_m_s: super::REST_VELOCITY_SIGMA_M_S,
+        attitude_rad: [levelled.tilt_sigma_rad, levelled.tilt_sigma_rad, 0.0],
+        ..setup.initial_sigma
+    };
+    Ok(Begin {
+        first: i0,
+        state: NavState {
+            t_s: t[i0],
+            attitude: levelled.attitude,
             velocity_m_s: Vec3::zeros(),
             position,
         },

@@ -1,0 +1,222 @@
+//! A log with no data sheet: a walking foot whose IMU is three times noisier than any preset
+//! (and whose accelerometer reads 0.03 g off, as a phone's does), fused with zero-velocity
+//! updates from nothing but its readings — the noise learnt from its quiet stretches, levelled
+//! over the rest at the start, heading zero, at the origin. The stance detector finds the
+//! stances and calls no swing still; the walk closes its loop; the learnt noise is the part's.
+use std::path::Path;
+
+use imukit::run::fuse::{
+    AidTables, FuseRequest, Part, PartModel, Start, fuse_with, learnt_noise, stance_samples,
+};
+use imukit::run::navigate::NavRequest;
+use imukit::{ScenarioSpec, Simulation, Table};
+
+/// Ten seconds standing, then 270 strides (six laps of a 10 m circle, 377 m) at 0.9 strides a
+/// second, back to the start. The IMU: the ICM-42688-P's ranges (a heel strike fits), white
+/// noise three times the noisiest preset's (the MPU-6050's accelerometer, the MTi-1's
+/// gyroscope), constant biases of 0.03 g and about 1 °/s.
+const NOISY_WALK: &str = r#"
+rate_hz = 100.0
+duration_s = 310.0
+nav_frame = "ENU"
+
+[trajectory]
+type = "walk"
+cadence_hz = 0.9
+stride_m = 1.3962634015954636
+radius_m = 10.0
+start_s = 10.0
+
+[imu]
+kind = "accel-gyro"
+preset = "icm-42688-p"
+
+[imu.accelerometer]
+noise_density_m_s2_per_rt_hz = 0.0117680
+constant_bias_m_s2 = [0.3, -0.2, 0.25]
+
+[imu.gyroscope]
+noise_density_rad_s_per_rt_hz = 0.00036652
+constant_bias_rad_s = [0.02, -0.015, 0.01]
+"#;
+
+fn simulate(run: u64) -> Simulation {
+    ScenarioSpec::from_toml(NOISY_WALK, "noisy_walk.toml")
+        .unwrap()
+        .resolve(Path::new("."))
+        .unwrap()
+        .simulate_run(run)
+        .unwrap()
+}
+
+fn rows3(t: &Table, names: [&str; 3]) -> Vec<[f64; 3]> {
+    let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n).unwrap()).collect();
+    (0..t.rows()).map(|i| [c[0][i], c[1][i], c[2][i]]).collect()
+}
+
+#[test]
+fn a_noisy_walk_with_no_data_sheet_closes_its_loop_from_its_readings_alone() {
+    for run in 0..3 {
+        let sim = simulate(run);
+        let nav = NavRequest::default().setup().unwrap();
+        let model = PartModel {
+            imu: Part::Learnt,
+            ..PartModel::default()
+        };
+        let learnt = model.setup_for(&nav, None, &sim.imu).unwrap();
+        // The noise learnt is the part's density (here single-sided and two-sided alike: the
+        // preset's noise per sample is density × √(rate)).
+        for (learnt, stated) in [
+            (learnt.noise.accel_psd, 0.0117680),
+            (learnt.noise.gyro_psd, 0.00036652),
+        ] {
+            assert!(
+                (learnt / stated - 1.0).abs() < 0.05,
+                "run {run}: learnt {learnt:e}, stated {stated:e}"
+            );
+        }
+        assert!(
+            !learnt.warrants_sensor_errors(),
+            "the part's matrices are unknown"
+        );
+        let request = FuseRequest {
+            start: Start::when_not_given(false),
+            zupt: true,
+            ..FuseRequest::default()
+        };
+        let (setup, start) = request.apply(learnt).unwrap();
+        let (est, summary) = fuse_with(
+            &sim.imu,
+            &Table::default(),
+            AidTables::default(),
+            start,
+            &setup,
+        )
+        .unwrap();
+        assert!(
+            (summary.rest_s - 10.0).abs() < 0.6,
+            "run {run}: rest {} s",
+            summary.rest_s
+        );
+        let detection = summary.detection.unwrap();
+        assert!(detection.learnt);
+        // Gravity as this accelerometer reads it: |g + bias| (the bias is 0.03 g).
+        let reading = (0.3_f64.powi(2) + 0.2_f64.powi(2) + (9.81_f64 + 0.25).powi(2)).sqrt();
+        assert!(
+            (detection.gravity_m_s2 - reading).abs() < 5e-3,
+            "run {run}: {} against {reading}",
+            detection.gravity_m_s2
+        );
+
+        // The stances against the truth's speed: found inside the stances, none in a swing.
+        let t = sim.imu.column("t_s").unwrap();
+        let f = rows3(&sim.imu, ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]);
+        let w = rows3(&sim.imu, ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]);
+        let stance = stance_samples(&t, &f, &w, &setup_with_rest(&setup, summary.rest_s));
+        let speed: Vec<f64> = rows3(&sim.truth, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"])
+            .iter()
+            .map(|v| v.iter().map(|c| c * c).sum::<f64>().sqrt())
+            .collect();
+        let still: Vec<bool> = speed.iter().map(|s| *s == 0.0).collect();
+        // A stance sample whose neighbours (±5 samples, the detector's window and more) are
+        // all still; a swing sample moving faster than 0.05 m/s.
+        let inner = |i: usize| (i.saturating_sub(5)..(i + 6).min(still.len())).all(|j| still[j]);
+        let (stances, found) = (0..still.len())
+            .filter(|&i| inner(i))
+            .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
+        let (swings, called_still) = (0..still.len())
+            .filter(|&i| speed[i] > 0.05)
+            .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
+        eprintln!(
+            "run {run}: stances found {found} of {stances}, swing samples called still \
+             {called_still} of {swings}"
+        );
+        assert!(
+            found * 100 >= 95 * stances,
+            "run {run}: {found} of {stances}"
+        );
+        assert!(
+            called_still * 100 <= swings,
+            "run {run}: {called_still} of {swings}"
+        );
+
+        // The loop closes: the walk ends where it began (the truth's 377 m).
+        let truth = rows3(&sim.truth, ["pos_x_m", "pos_y_m", "pos_z_m"]);
+        let walked: f64 = truth
+            .windows(2)
+            .map(|p| {
+                (0..3)
+                    .map(|k| (p[1][k] - p[0][k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .sum();
+        let pos = rows3(&est, ["pos_x_m", "pos_y_m", "pos_z_m"]);
+        let (first, last) = (pos[0], pos[pos.len() - 1]);
+        let closure = (0..3)
+            .map(|k| (last[k] - first[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        eprintln!(
+            "run {run}: {walked:.1} m walked, loop closed within {closure:.3} m ({:.3} %)",
+            100.0 * closure / walked
+        );
+        assert!(
+            closure <= 0.005 * walked,
+            "run {run}: {closure} m after {walked} m"
+        );
+    }
+}
+
+/// `setup` with the rest the fusion found (the stance detector takes the gyroscope's mean over
+/// it off).
+fn setup_with_rest(
+    setup: &imukit::run::fuse::FuseSetup,
+    rest_s: f64,
+) -> imukit::run::fuse::FuseSetup {
+    imukit::run::fuse::FuseSetup { rest_s, ..*setup }
+}
+
+#[test]
+fn a_log_that_never_rests_is_refused_with_what_to_give_instead() {
+    // The same walk from its first stride: no rest at the start to level over.
+    let sim = simulate(0);
+    let t = sim.imu.column("t_s").unwrap();
+    let from = t.partition_point(|&x| x < 10.5);
+    let width = sim.imu.columns.len();
+    let moving = Table {
+        columns: sim.imu.columns.clone(),
+        data: sim.imu.data[from * width..].to_vec(),
+    };
+    let nav = NavRequest::default().setup().unwrap();
+    let model = PartModel {
+        imu: Part::Learnt,
+        ..PartModel::default()
+    };
+    let learnt = model.setup_for(&nav, None, &moving).unwrap();
+    let request = FuseRequest {
+        start: Start::when_not_given(false),
+        zupt: true,
+        ..FuseRequest::default()
+    };
+    let (setup, start) = request.apply(learnt).unwrap();
+    let err = fuse_with(
+        &moving,
+        &Table::default(),
+        AidTables::default(),
+        start,
+        &setup,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("\"level\"") && err.contains("rest"), "{err}");
+    // The quiet stretches alone (no rest) still give the noise.
+    let f = rows3(&moving, ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]);
+    let w = rows3(&moving, ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]);
+    let q = learnt_noise(&f, &w, 0.01, 9.81).unwrap();
+    assert!(
+        (q.noise.accel / 0.117680 - 1.0).abs() < 0.05,
+        "{}",
+        q.noise.accel
+    );
+}
