@@ -173,3 +173,18 @@ def test_each_fix_s_own_accuracy_weighs_it(drive):
     imukit.Table(list(gnss.columns) + ["horizontal_accuracy_m"], np.column_stack([values, h])).write(paths["marked"])
     done = fuse({**files, "gnss": paths["marked"]}, tmp / "refused.csv", "--scenario", str(scenario))
     assert done.returncode == 65 and "row 5: the fix's accuracy must be positive" in done.stderr, done.stderr
+
+
+def test_a_receiver_stated_as_arguments_fuses_as_the_scenario_does():
+    # One meaning per number: car_tunnel.toml's [imu] and [gnss] stated as arguments give the
+    # same estimate, column by column; left out, the decay factor is MATLAB's 0.999.
+    scenario = ROOT / "examples" / "car_tunnel.toml"
+    sim = imukit.simulate(str(scenario))
+    by_scenario = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, scenario=str(scenario))
+    stated = dict(imu_model="stim300", gnss_horizontal_accuracy_m=1.5, gnss_vertical_accuracy_m=3.0,
+                  gnss_velocity_accuracy_m_s=0.1)
+    by_arguments = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, gnss_decay_factor=0.0, **stated)
+    assert list(by_scenario.columns) == list(by_arguments.columns)
+    assert all(np.array_equal(by_scenario[c], by_arguments[c]) for c in by_scenario.columns)
+    matlab = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, **stated)
+    assert not np.array_equal(matlab["pos_x_sigma_m"], by_scenario["pos_x_sigma_m"])

@@ -524,6 +524,18 @@ pub struct FuseArgs {
     #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
           conflicts_with = "scenario")]
     pub gnss_lever_arm_m: Option<Vec<f64>>,
+    /// Without --scenario: the fixes' MATLAB `DecayFactor` (0: white; MATLAB gpsSensor's
+    /// 0.999 when left out), as a scenario's `[gnss] decay_factor`: the filter takes the
+    /// fixes' stationary deviation from it.
+    #[arg(long, conflicts_with_all = ["scenario", "gnss_correlation_time_s"], allow_hyphen_values = true)]
+    pub gnss_decay_factor: Option<f64>,
+    /// Without --scenario: instead of the decay factor, a Gauss–Markov position error with this
+    /// correlation time, s (`[gnss] correlation_time_s`).
+    #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
+    pub gnss_correlation_time_s: Option<f64>,
+    /// Without --scenario: the fixes are stamped this late, s (`[gnss] latency_s`; 0).
+    #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
+    pub gnss_latency_s: Option<f64>,
     /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
     /// user-equivalent range error, m (one-sigma).
     #[arg(long, allow_hyphen_values = true)]

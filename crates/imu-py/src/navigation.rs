@@ -222,7 +222,9 @@ fn compare<'py>(
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
                     sensor_errors = None, rest_s = None, smooth = false, zupt = false, imu_model = None, part = None,
                     gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
-                    gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None, gnss_uere_m = None,
+                    gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None,
+                    gnss_decay_factor = None, gnss_correlation_time_s = None, gnss_latency_s = None,
+                    gnss_uere_m = None,
                     nav_frame = None, earth = None, earth_gravity = None, accel_sign = None,
                     gravity_m_s2 = None, described = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
@@ -255,6 +257,9 @@ fn fuse<'py>(
     gnss_vertical_accuracy_m: Option<f64>,
     gnss_velocity_accuracy_m_s: Option<f64>,
     gnss_lever_arm_m: Option<Vec<f64>>,
+    gnss_decay_factor: Option<f64>,
+    gnss_correlation_time_s: Option<f64>,
+    gnss_latency_s: Option<f64>,
     gnss_uere_m: Option<f64>,
     nav_frame: Option<&str>,
     earth: Option<&str>,
@@ -274,33 +279,28 @@ fn fuse<'py>(
     }
     let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
+    let gnss = imukit::scenario::gnss::GnssSpec {
+        horizontal_accuracy_m: gnss_horizontal_accuracy_m,
+        vertical_accuracy_m: gnss_vertical_accuracy_m,
+        velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
+        lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m)?,
+        decay_factor: gnss_decay_factor,
+        correlation_time_s: gnss_correlation_time_s,
+        latency_s: gnss_latency_s,
+        ..Default::default()
+    };
     let model = match imu_model {
         // Neither a part nor a scenario: the noise learnt from the log.
         None if scenario.is_none() => Model::Part(PartModel {
             imu: Part::Learnt,
             part,
-            gnss: imukit::scenario::gnss::GnssSpec {
-                horizontal_accuracy_m: gnss_horizontal_accuracy_m,
-                vertical_accuracy_m: gnss_vertical_accuracy_m,
-                velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
-                lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m.clone())?,
-                ..Default::default()
-            },
+            gnss,
         }),
-        Some(imu) => {
-            let gnss = imukit::scenario::gnss::GnssSpec {
-                horizontal_accuracy_m: gnss_horizontal_accuracy_m,
-                vertical_accuracy_m: gnss_vertical_accuracy_m,
-                velocity_accuracy_m_s: gnss_velocity_accuracy_m_s,
-                lever_arm_m: fixed_opt::<3>("gnss_lever_arm_m", gnss_lever_arm_m)?,
-                ..Default::default()
-            };
-            Model::Part(PartModel {
-                imu: Part::named(&imu),
-                part,
-                gnss,
-            })
-        }
+        Some(imu) => Model::Part(PartModel {
+            imu: Part::named(&imu),
+            part,
+            gnss,
+        }),
         None => Model::Scenario(
             match format {
                 "dict" => ScenarioSpec::from_tree(

@@ -163,7 +163,9 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
          imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
          gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
          gnss_velocity_accuracy_m_s: Optional[float] = None,
-         gnss_lever_arm_m: Optional[Sequence[float]] = None, gnss_uere_m: Optional[float] = None,
+         gnss_lever_arm_m: Optional[Sequence[float]] = None, gnss_decay_factor: Optional[float] = None,
+         gnss_correlation_time_s: Optional[float] = None, gnss_latency_s: Optional[float] = None,
+         gnss_uere_m: Optional[float] = None,
          nav_frame: Optional[str] = None, earth: Optional[str] = None, earth_gravity: Optional[str] = None,
          accel_sign: Optional[str] = None, gravity_m_s2: Optional[float] = None) -> Table:
     """Loosely coupled INS/GNSS fusion: a 15-state error-state Kalman filter over IMU rates and
@@ -193,8 +195,10 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
 
     Without a scenario, ``imu_model`` names the part — a preset (``"stim300"``), a parameter
     file or Kalibr's ``imu.yaml`` — and ``gnss_horizontal_accuracy_m``, ``gnss_vertical_accuracy_m``,
-    ``gnss_velocity_accuracy_m_s`` and ``gnss_lever_arm_m`` the receiver (MATLAB gpsSensor's
-    defaults for those left out); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
+    ``gnss_velocity_accuracy_m_s``, ``gnss_lever_arm_m``, ``gnss_decay_factor`` (or
+    ``gnss_correlation_time_s``) and ``gnss_latency_s`` the receiver, as a scenario's ``[gnss]``
+    keys of those names (MATLAB gpsSensor's defaults for those left out: the same figures give
+    the same estimate); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
     ``gravity_m_s2`` say what the tables are in: left out, what the tables' descriptions say
     (a simulated or read table knows its frame), else imukit's defaults (the sign the part's
     profile's). With a scenario, tables or arguments that contradict it are refused. The sample
@@ -229,6 +233,10 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
                      gnss_vertical_accuracy_m=gnss_vertical_accuracy_m,
                      gnss_velocity_accuracy_m_s=gnss_velocity_accuracy_m_s,
                      gnss_lever_arm_m=None if gnss_lever_arm_m is None else [float(v) for v in gnss_lever_arm_m],
+                     gnss_decay_factor=None if gnss_decay_factor is None else float(gnss_decay_factor),
+                     gnss_correlation_time_s=None if gnss_correlation_time_s is None
+                     else float(gnss_correlation_time_s),
+                     gnss_latency_s=None if gnss_latency_s is None else float(gnss_latency_s),
                      gnss_uere_m=None if gnss_uere_m is None else float(gnss_uere_m),
                      nav_frame=nav_frame, earth=earth, earth_gravity=earth_gravity, accel_sign=accel_sign,
                      gravity_m_s2=None if gravity_m_s2 is None else float(gravity_m_s2))

@@ -140,9 +140,19 @@ impl FusionInputs {
         };
         let missing: Vec<&str> = needed.iter().copied().filter(|c| !has(c)).collect();
         if !missing.is_empty() {
+            // Fixes of the other Earth's kind: say which option reads them.
+            let other = if has(&"lat_rad") && missing.contains(&"pos_x_m") {
+                " — these fixes are geodetic (lat_rad, lon_rad, height_m): they are read on the \
+                 WGS-84 Earth (--earth wgs84; Python earth=\"wgs84\")"
+            } else if has(&"pos_x_m") && missing.contains(&"lat_rad") {
+                " — these fixes are plane coordinates (pos_x_m, …): they are read on the flat \
+                 Earth (--earth flat; Python earth=\"flat\")"
+            } else {
+                ""
+            };
             return Err(invalid(
                 Data::Gnss.label(),
-                format!("missing column(s) {}{hint}", missing.join(", ")),
+                format!("missing column(s) {}{hint}{other}", missing.join(", ")),
             ));
         }
         let g_t = gnss.column("t_s").unwrap_or_default();

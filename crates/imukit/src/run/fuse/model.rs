@@ -200,6 +200,13 @@ impl PartModel {
             }
         }
         let gnss = self.gnss.params()?;
+        let latency_s = self.gnss.latency_s.unwrap_or(0.0);
+        if !(latency_s.is_finite() && latency_s >= 0.0) {
+            return Err(invalid(
+                "gnss.latency_s",
+                format!("must be a finite number ≥ 0 (s), got {latency_s}"),
+            ));
+        }
         Ok(FuseSetup::from_model(&FuseModel {
             nav_frame: nav.nav_frame,
             earth: nav.earth.map(|e| e.gravity),
@@ -212,7 +219,7 @@ impl PartModel {
                 "gnss.lever_arm_m",
                 self.gnss.lever_arm_m.unwrap_or([0.0; 3]),
             )?,
-            gnss_latency_s: self.gnss.latency_s.unwrap_or(0.0),
+            gnss_latency_s: latency_s,
             odometer: None,
             baro_sigma_m: None,
         }))

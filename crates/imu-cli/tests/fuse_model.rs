@@ -1,0 +1,125 @@
+//! One meaning per number: the filter's model stated as options (`--imu` and the `--gnss-*`
+//! figures) is the scenario's `[imu]` and `[gnss]` with the same figures, to the byte.
+use std::path::Path;
+use std::process::Command;
+
+fn imukit() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_imukit"))
+}
+
+#[test]
+fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let file = |name: &str| dir.path().join(name);
+    let out = imukit()
+        .arg("simulate")
+        .arg(&example)
+        .arg("--out")
+        .arg(file("imu.csv"))
+        .arg("--truth")
+        .arg(file("truth.csv"))
+        .arg("--gnss")
+        .arg(file("gnss.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fuse = |extra: &[&str], to: &str| {
+        let out = imukit()
+            .arg("fuse")
+            .arg(file("imu.csv"))
+            .arg(file("gnss.csv"))
+            .arg("--init")
+            .arg(file("truth.csv"))
+            .args(extra)
+            .arg("--out")
+            .arg(file(to))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read(file(to)).unwrap()
+    };
+    let by_scenario = fuse(&["--scenario", example.to_str().unwrap()], "s.csv");
+    // car_tunnel.toml: stim300, 1.5 m / 3 m / 0.1 m/s, decay factor 0.
+    let stated = [
+        "--imu",
+        "stim300",
+        "--gnss-horizontal-accuracy-m",
+        "1.5",
+        "--gnss-vertical-accuracy-m",
+        "3",
+        "--gnss-velocity-accuracy-m-s",
+        "0.1",
+    ];
+    let by_options = fuse(
+        &[&stated[..], &["--gnss-decay-factor", "0"]].concat(),
+        "p.csv",
+    );
+    assert!(by_scenario == by_options, "the two estimates differ");
+    // Left out, the decay factor is MATLAB's 0.999, as in a scenario without the key: another
+    // receiver, another estimate.
+    let matlab = fuse(&stated, "m.csv");
+    assert!(matlab != by_scenario);
+    // A latency that is not one is refused by its option.
+    let out = imukit()
+        .arg("fuse")
+        .arg(file("imu.csv"))
+        .arg(file("gnss.csv"))
+        .arg("--init")
+        .arg(file("truth.csv"))
+        .args(stated)
+        .args(["--gnss-latency-s", "-1", "--out"])
+        .arg(file("x.csv"))
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(65), "{log}");
+    assert!(log.contains("--gnss-latency-s"), "{log}");
+}
+
+#[test]
+fn geodetic_fixes_read_on_the_flat_earth_point_at_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let file = |name: &str| dir.path().join(name);
+    let out = imukit()
+        .arg("simulate")
+        .arg(&example)
+        .arg("--out")
+        .arg(file("imu.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A receiver's log as users have it: geodetic, without imukit's description.
+    let mut fixes = String::from("t_s,lat_rad,lon_rad,height_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n");
+    for k in 1..20 {
+        fixes += &format!("{k}.0,0.8,0.2,100.0,5.0,0.0,0.0\n");
+    }
+    std::fs::write(file("fixes.csv"), fixes).unwrap();
+    let out = imukit()
+        .arg("fuse")
+        .arg(file("imu.csv"))
+        .arg(file("fixes.csv"))
+        .args(["--imu", "stim300", "--align", "gnss", "--out"])
+        .arg(file("nav.csv"))
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(65), "{log}");
+    assert!(
+        log.contains("fixes.csv") && log.contains("--earth wgs84"),
+        "{log}"
+    );
+}
