@@ -6,6 +6,7 @@ import tomllib
 
 import numpy as np
 import allantools
+import pytest
 from allantools import ci as allan_ci
 
 import imukit
@@ -61,3 +62,31 @@ def test_identified_part_simulated_again_is_identified_within_the_intervals(tmp_
     # 95 % intervals: over 18 figures, at most 2 outside (the core's test counts the coverage
     # over many runs).
     assert checked == 18 and len(missed) <= 2, missed
+
+
+def test_a_log_that_moves_is_warned_about_and_the_bias_at_rest_is_written(tmp_path):
+    import warnings
+
+    rng = np.random.default_rng(4)
+    n = 60_000
+    still = {f"gyro_{a}_rad_s": b + 1e-3 * rng.standard_normal(n) for a, b in zip("xyz", (0.01, -0.02, 0.003))}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")          # a static log: no warning at all
+        ident = imukit.identify(still, 100.0)
+    part = tomllib.loads(ident.params_toml)
+    for k, a in enumerate("xyz"):
+        mean, sigma = ident.mean_at_rest[f"gyro_{a}_rad_s"]
+        assert abs(mean - (0.01, -0.02, 0.003)[k]) < 5 * 1e-3 / np.sqrt(n)
+        assert part["gyroscope"]["constant_bias_rad_s"][k] == mean
+    moved = dict(still)
+    moved["gyro_z_rad_s"] = moved["gyro_z_rad_s"] + np.where((np.arange(n) >= 20_000) & (np.arange(n) < 21_500), 0.4, 0.0)
+    with pytest.warns(imukit.ImuWarning, match="gyro_z_rad_s: not at rest at t = 200–215 s"):
+        imukit.identify(moved, 100.0)
+    # The CLI: --params alone (no --out) is a run of its own, and says the same.
+    names = ["t_s", *moved]
+    np.savetxt(tmp_path / "moved.csv", np.column_stack([np.arange(n) / 100.0, *moved.values()]),
+               delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+    done = subprocess.run([imukit_bin(), "identify", str(tmp_path / "moved.csv"), "--params",
+                           str(tmp_path / "p.toml")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "not at rest at t = 200–215 s" in done.stderr and (tmp_path / "p.toml").exists()

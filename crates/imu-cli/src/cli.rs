@@ -668,13 +668,14 @@ pub struct IdentifyArgs {
     #[arg(long = "column")]
     pub columns: Vec<String>,
     /// Where to write `tau_s` and per column `adev_`, `lower95_`, `upper95_`, `edf_`, `fit_`
-    /// (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    /// (CSV, or by extension `.parquet`, `.npy`, `.npz`). Each output is optional on its own;
+    /// the terms are printed whatever is written.
     #[arg(long)]
-    pub out: PathBuf,
-    /// Also write the identified part as an imukit parameter file (TOML) for `--imu`.
+    pub out: Option<PathBuf>,
+    /// Write the identified part as an imukit parameter file (TOML) for `--imu`.
     #[arg(long, value_name = "FILE")]
     pub params: Option<PathBuf>,
-    /// Also write the identified part as Kalibr's imu.yaml.
+    /// Write the identified part as Kalibr's imu.yaml.
     #[arg(long, value_name = "FILE")]
     pub kalibr: Option<PathBuf>,
     /// Factor on the Kalibr file's densities (stated in the file).
@@ -683,7 +684,7 @@ pub struct IdentifyArgs {
     /// The IMU topic written in the Kalibr file.
     #[arg(long, default_value = imukit::io::kalibr::DEFAULT_TOPIC, value_name = "TOPIC")]
     pub kalibr_topic: String,
-    /// Also draw the curves, their bands and the fitted terms (`.svg` or `.png`).
+    /// Draw the curves, their bands and the fitted terms (`.svg` or `.png`).
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// The figure's size and resolution.

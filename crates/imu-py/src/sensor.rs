@@ -250,6 +250,18 @@ fn identify<'py>(
     d.set_item("terms", terms)?;
     let chi2: Vec<f64> = result.noise.iter().map(|c| c.fit.reduced_chi2).collect();
     d.set_item("reduced_chi2", chi2)?;
+    let mean: Vec<(f64, f64)> = result
+        .noise
+        .iter()
+        .map(|c| (c.mean, c.mean_sigma))
+        .collect();
+    d.set_item("mean_at_rest", mean)?;
+    let warnings: Vec<String> = result
+        .noise
+        .iter()
+        .flat_map(|c| id::column_warnings(&result, c))
+        .collect();
+    d.set_item("warnings", warnings)?;
     let file = id::param_file(&result, source).ok();
     d.set_item(
         "params_toml",

@@ -1,4 +1,4 @@
-//! `imukit identify STATIC.csv --out CURVE.csv [--params P.toml] [--kalibr imu.yaml] [--plot F]`.
+//! `imukit identify STATIC.csv [--out CURVE.csv] [--params P.toml] [--kalibr imu.yaml] [--plot F]`.
 use std::io::Write;
 use std::path::Path;
 
@@ -7,7 +7,8 @@ use imukit::io::output::{check_outputs, write_atomically};
 use imukit::io::params::to_toml;
 use imukit::io::rows::TimeWindow;
 use imukit::run::identify::{
-    column_header, curve_table, filter_noise, kalibr, param_file, term_rows,
+    column_header, column_warnings, curve_table, filter_noise, kalibr, param_file, rest_line,
+    term_rows,
 };
 
 use super::CliError;
@@ -15,7 +16,7 @@ use super::allan::{analyse, file_name};
 
 /// Where `identify` writes, besides the curve.
 pub struct Outputs<'a> {
-    pub out: &'a Path,
+    pub out: Option<&'a Path>,
     pub params: Option<&'a Path>,
     pub kalibr: Option<&'a Path>,
     pub kalibr_inflation: f64,
@@ -34,7 +35,7 @@ pub fn run(
     if let Some(p) = to.plot {
         imu_plot::check_figure_path(p)?;
     }
-    let mut outputs = vec![("--out", to.out)];
+    let mut outputs: Vec<(&str, &Path)> = to.out.map(|p| ("--out", p)).into_iter().collect();
     outputs.extend(to.params.map(|p| ("--params", p)));
     outputs.extend(to.kalibr.map(|p| ("--kalibr", p)));
     outputs.extend(to.plot.map(|p| ("--plot", p)));
@@ -53,7 +54,9 @@ pub fn run(
         (Some(_), Some(file)) => Some(kalibr(&result, file, to.kalibr_inflation, to.kalibr_topic)?),
         _ => None,
     };
-    curve_table(&result).write(to.out)?;
+    if let Some(out) = to.out {
+        curve_table(&result).write(out)?;
+    }
     if let (Some(path), Some(file)) = (to.params, &file) {
         let text = to_toml(file);
         write_atomically(path, |w| w.write_all(text.as_bytes()))?;
@@ -73,6 +76,12 @@ pub fn run(
         for row in rows.iter().filter(|r| r.column == c.column) {
             crate::out_line!("{}", row.line());
         }
+        crate::out_line!("{}", rest_line(c));
+    }
+    for c in &result.noise {
+        for w in column_warnings(&result, c) {
+            crate::report::warn(&format!("{}: {w}", input.display()));
+        }
     }
     if let Some(file) = &file {
         crate::out_line!(
@@ -90,12 +99,8 @@ pub fn run(
             );
         }
     }
-    crate::note!(
-        "imukit: Allan curves with 95 % bands and fitted terms of {} columns written to {}",
-        result.noise.len(),
-        to.out.display()
-    );
     for (what, path) in [
+        ("Allan curves with 95 % bands and fitted terms", to.out),
         ("Parameter file", to.params),
         ("Kalibr imu.yaml", to.kalibr),
         ("Figure", to.plot),

@@ -443,7 +443,7 @@ fn identify_command(a: crate::cli::IdentifyArgs) -> Result<(), CliError> {
         &columns,
         window.window()?,
         &identify::Outputs {
-            out: &out,
+            out: out.as_deref(),
             params: params.as_deref(),
             kalibr: kalibr.as_deref(),
             kalibr_inflation,

@@ -602,6 +602,11 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
         });
     };
     let dof = len.saturating_sub(mask.count_ones() as usize).max(1);
+    // A curve the model does not describe (reduced χ² above 1) widens every interval by the
+    // Birge ratio: the coefficients' covariance, and the χ² margin within which another subset
+    // of terms counts as describing the curve as well, are scaled by χ²/dof (as the PDG scales
+    // inconsistent measurements); a fit that describes its curve keeps them.
+    let birge = (chi2 / dof as f64).max(1.0);
     let to_x = |term: NoiseTerm, c2: f64| math::sqrt(c2.max(0.0) / term.scale());
     let sample_rate_hz = m[0] as f64 / tau_s[0];
     // Every non-negative fit that describes the curve as well as the best (χ² within the 95 %
@@ -616,14 +621,15 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
         let in_subset = |j: usize| subset & (1 << j) != 0;
         if (0..TERMS).any(|j| {
             in_subset(j) && sol.c[j].partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater)
-        }) || sol.chi2 > chi2 + CHI2_1_95
+        }) || sol.chi2 > chi2 + CHI2_1_95 * birge
         {
             continue;
         }
         for j in 0..TERMS {
             if in_subset(j) {
-                let (lo, hi) = interval(sol.c[j], sol.cov[(j, j)]);
-                let wald_lower = sol.c[j] - Z_95 * math::sqrt(sol.cov[(j, j)].max(0.0));
+                let var = sol.cov[(j, j)] * birge;
+                let (lo, hi) = interval(sol.c[j], var);
+                let wald_lower = sol.c[j] - Z_95 * math::sqrt(var.max(0.0));
                 lower[j] = lower[j].min(if wald_lower > 0.0 { lo } else { 0.0 });
                 upper[j] = upper[j].max(hi);
             } else {

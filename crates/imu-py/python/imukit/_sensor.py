@@ -11,6 +11,7 @@ import numpy as np
 
 from . import _core
 from ._convert import _out, _rows
+from ._warning import _emit
 
 _S = _core.DEFAULTS["imu_sensor"]  # MATLAB imuSensor's defaults, as the library states them
 
@@ -191,7 +192,12 @@ class Identification:
     A term not resolved has ``value`` as fitted, ``lower`` 0 and ``upper`` its 95 % bound.
     ``tau_s`` (T,) and ``adev``, ``lower95``, ``upper95``, ``edf``, ``fit`` (T, k) are the curves;
     ``params_toml`` the part as an imukit parameter file, ``kalibr_yaml`` as Kalibr's imu.yaml;
-    ``filter_noise`` the fusion filter's ``(sensor, white, bias drift)`` for it."""
+    ``filter_noise`` the fusion filter's ``(sensor, white, bias drift)`` for it.
+    ``mean_at_rest`` maps each column to its mean and that mean's one-sigma (a gyroscope's
+    turn-on bias, written as ``constant_bias`` in ``params_toml``); ``warnings`` lists what
+    :func:`identify` also warned about (:class:`ImuWarning`): a log that moves (where), a fit
+    whose reduced χ² exceeds 3 (the intervals are then widened by its square root, and the τ it
+    misses named)."""
 
     def __init__(self, columns, raw: dict) -> None:
         self.columns = list(columns)
@@ -199,6 +205,8 @@ class Identification:
         self.adev, self.lower95, self.upper95 = raw["adev"], raw["lower95"], raw["upper95"]
         self.edf, self.fit = raw["edf"], raw["fit"]
         self.reduced_chi2 = dict(zip(self.columns, raw["reduced_chi2"]))
+        self.mean_at_rest = dict(zip(self.columns, raw["mean_at_rest"]))
+        self.warnings = list(raw["warnings"])
         self.samples = raw["samples"]
         keys = ("column", "term", "symbol", "value", "lower", "upper", "resolved", "needs_record_s",
                 "unit", "datasheet_unit", "datasheet_factor")
@@ -261,7 +269,9 @@ def identify(data, sample_rate_hz: Optional[float] = None, *, columns=None, kali
             sample_rate_hz = (t.size - 1) / (t[-1] - t[0])
     raw = _core.identify(np.ascontiguousarray(a), float(sample_rate_hz), names, source,
                          kalibr_inflation=float(kalibr_inflation), kalibr_topic=kalibr_topic)
-    return Identification(names, raw)
+    ident = Identification(names, raw)
+    _emit(ident.warnings)
+    return ident
 
 def convert(value: float, unit: str) -> tuple:
     """A datasheet figure in imukit's SI parameter units: ``(value, unit, parameters it fits)``.

@@ -17,6 +17,61 @@ pub struct ColumnNoise {
     pub lower: Vec<f64>,
     /// Upper end.
     pub upper: Vec<f64>,
+    /// The column's mean over the record: at rest a gyroscope's turn-on bias (with the Earth
+    /// rate's share on its axis, up to 7.3e-5 rad/s), an accelerometer's bias plus gravity's
+    /// share.
+    pub mean: f64,
+    /// The mean's one-sigma: the deviation of averages over the curve's longest τ (the scatter
+    /// the slow terms leave in an average, an upper estimate for the whole record's).
+    pub mean_sigma: f64,
+    /// Stretches where the column moves instead of resting ([`moving_stretches`]), s from the
+    /// first sample.
+    pub moving: Vec<(f64, f64)>,
+}
+
+/// Length of the blocks [`moving_stretches`] compares, s.
+pub const MOTION_BLOCK_S: f64 = 1.0;
+
+/// How many robust spreads a block's mean must stand off the log's median to count as motion.
+pub const MOTION_SPREADS: f64 = 10.0;
+
+/// The stretches of `x` (sampled at `sample_rate_hz`) that move: blocks of [`MOTION_BLOCK_S`]
+/// whose mean stands more than [`MOTION_SPREADS`] robust spreads (1.4826 × the median absolute
+/// deviation of the block means) off the blocks' median; a static log's block means scatter by
+/// its noise alone, so a turn or a push stands out. Adjacent moving blocks are one stretch.
+/// Empty for fewer than eight blocks.
+#[must_use]
+pub fn moving_stretches(x: &[f64], sample_rate_hz: f64) -> Vec<(f64, f64)> {
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let block = ((MOTION_BLOCK_S * sample_rate_hz).round() as usize).max(1);
+    let means: Vec<f64> = x
+        .chunks_exact(block)
+        .map(|c| c.iter().sum::<f64>() / block as f64)
+        .collect();
+    if means.len() < 8 {
+        return Vec::new();
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let centre = median(&mut means.clone());
+    let spread = 1.4826 * median(&mut means.iter().map(|m| (m - centre).abs()).collect());
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for (k, m) in means.iter().enumerate() {
+        if (m - centre).abs() <= MOTION_SPREADS * spread {
+            continue;
+        }
+        let (from, to) = (
+            (k * block) as f64 / sample_rate_hz,
+            ((k + 1) * block) as f64 / sample_rate_hz,
+        );
+        match out.last_mut() {
+            Some(last) if last.1 >= from => last.1 = to,
+            _ => out.push((from, to)),
+        }
+    }
+    out
 }
 
 /// Allan deviations of several rate columns at octave-spaced τ.
@@ -86,6 +141,9 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
             fit,
             lower,
             upper,
+            mean: x.iter().sum::<f64>() / n as f64,
+            mean_sigma: adev[count - 1],
+            moving: moving_stretches(x, sample_rate_hz),
         });
         names.push(format!("adev_{name}"));
         curves.push(adev);

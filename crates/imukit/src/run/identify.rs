@@ -221,6 +221,17 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
             p.noise_density[axis] = value(NoiseTerm::White);
             p.bias_instability[axis] = value(NoiseTerm::BiasInstability);
             p.random_walk[axis] = value(NoiseTerm::RandomWalk);
+            // A gyroscope at rest reads its turn-on bias (and the Earth rate's share, at most
+            // 7.3e-5 rad/s); an accelerometer's mean also holds gravity's, in an attitude the
+            // log does not give, so only the gyroscope's is written.
+            if sensor == Sensor::Gyroscope {
+                p.constant_bias[axis] = c.mean;
+                notes.push(format!(
+                    "{}: constant_bias is the mean at rest, {:.4e} ± {:.1e} rad/s (Earth rate \
+                     included)",
+                    c.column, c.mean, c.mean_sigma
+                ));
+            }
             for e in c.fit.terms.iter().filter(|e| !e.resolved) {
                 if matches!(
                     e.term,
@@ -351,5 +362,110 @@ pub fn column_header(column: &str, fit: &NoiseFit, samples: usize, rate_hz: f64)
         "{column} ({samples} samples at {rate_hz:.6} Hz, {:.3} h; reduced χ² {:.2})",
         samples as f64 / rate_hz / 3600.0,
         fit.reduced_chi2
+    )
+}
+
+/// A reduced χ² above which `identify` says the five-term model does not describe a curve
+/// (the intervals are widened by its square root whenever it exceeds 1; see
+/// `imu_core::allan::fit`).
+pub const POOR_FIT_CHI2: f64 = 3.0;
+
+/// Where a column's fitted curve misses its Allan curve: the τ ranges, s, of consecutive points
+/// whose variance lies more than three of its standard deviations (`σ²·√(2/ν)`, ν the point's
+/// degrees of freedom) off the fit.
+#[must_use]
+pub fn misfit_ranges(
+    result: &AllanResult,
+    column: &crate::run::allan::ColumnNoise,
+) -> Vec<(f64, f64)> {
+    let tau = result.table.column("tau_s").unwrap_or_default();
+    let adev = result
+        .table
+        .column(&format!("adev_{}", column.column))
+        .unwrap_or_default();
+    let fit = &column.fit;
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    let mut previous_off = false;
+    for i in 0..fit.points.min(tau.len()).min(adev.len()) {
+        let var = adev[i] * adev[i];
+        let sigma = var * (2.0 / fit.edf[i]).sqrt();
+        let off = (var - fit.variance_at(tau[i])).abs() > 3.0 * sigma;
+        if off {
+            match out.last_mut() {
+                Some(last) if previous_off => last.1 = tau[i],
+                _ => out.push((tau[i], tau[i])),
+            }
+        }
+        previous_off = off;
+    }
+    out
+}
+
+/// What `identify` warns about a column: a log that moves (where), a fit that does not
+/// describe the curve (its reduced χ², how the intervals were widened, the τ it misses).
+#[must_use]
+pub fn column_warnings(
+    result: &AllanResult,
+    column: &crate::run::allan::ColumnNoise,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if !column.moving.is_empty() {
+        const SHOWN: usize = 5;
+        let mut at: Vec<String> = column
+            .moving
+            .iter()
+            .take(SHOWN)
+            .map(|(a, b)| format!("{a:.0}–{b:.0} s"))
+            .collect();
+        if column.moving.len() > SHOWN {
+            at.push(format!("… ({} more)", column.moving.len() - SHOWN));
+        }
+        warnings.push(format!(
+            "{}: not at rest at t = {} from the start: identify needs a static log (its curve \
+             and terms mix the motion with the noise; cut the log with --start-s/--end-s)",
+            column.column,
+            at.join(", ")
+        ));
+    }
+    let chi2 = column.fit.reduced_chi2;
+    if chi2 > POOR_FIT_CHI2 {
+        let misses: Vec<String> = misfit_ranges(result, column)
+            .iter()
+            .map(|(a, b)| {
+                if a == b {
+                    format!("τ = {a} s")
+                } else {
+                    format!("τ = {a}–{b} s")
+                }
+            })
+            .collect();
+        warnings.push(format!(
+            "{}: the five-term model does not describe this curve (reduced χ² {chi2:.1}): the \
+             intervals are widened by √{chi2:.1} = {:.1}{}",
+            column.column,
+            chi2.sqrt(),
+            if misses.is_empty() {
+                String::new()
+            } else {
+                format!("; it misses {}", misses.join(", "))
+            }
+        ));
+    }
+    warnings
+}
+
+/// The bias at rest printed for a column: its mean with the mean's one-sigma.
+#[must_use]
+pub fn rest_line(column: &crate::run::allan::ColumnNoise) -> String {
+    let unit = si_unit(sensor_of(&column.column), NoiseTerm::BiasInstability);
+    format!(
+        "  mean at rest     {:>12.4e} ± {:.1e} {unit}{}",
+        column.mean,
+        column.mean_sigma,
+        if sensor_of(&column.column) == Some(Sensor::Accelerometer) {
+            " (with gravity's share)"
+        } else {
+            ""
+        }
     )
 }
