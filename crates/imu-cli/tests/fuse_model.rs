@@ -123,3 +123,86 @@ fn geodetic_fixes_read_on_the_flat_earth_point_at_the_option() {
         "{log}"
     );
 }
+
+#[test]
+fn a_receivers_per_axis_sigmas_are_read_as_its_horizontal_and_vertical_accuracy_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let file = |name: &str| dir.path().join(name);
+    let out = imukit()
+        .arg("simulate")
+        .arg(&example)
+        .arg("--out")
+        .arg(file("imu.csv"))
+        .arg("--truth")
+        .arg(file("truth.csv"))
+        .arg("--gnss")
+        .arg(file("gnss.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The same fixes with their own accuracy, stated two ways (1.2 m across, 2.5 m up).
+    let with = |name: &str, header: &str, values: &str| {
+        let text = std::fs::read_to_string(file("gnss.csv")).unwrap();
+        let mut seen_header = false;
+        let body: String = text
+            .lines()
+            .map(|l| {
+                if l.starts_with('#') {
+                    format!("{l}\n")
+                } else if !seen_header {
+                    seen_header = true;
+                    format!("{l},{header}\n")
+                } else {
+                    format!("{l},{values}\n")
+                }
+            })
+            .collect();
+        std::fs::write(file(name), body).unwrap();
+    };
+    with(
+        "split.csv",
+        "horizontal_accuracy_m,vertical_accuracy_m",
+        "1.2,2.5",
+    );
+    with(
+        "axes.csv",
+        "pos_x_sigma_m,pos_y_sigma_m,pos_z_sigma_m",
+        "1.2,1.2,2.5",
+    );
+    with("partial.csv", "pos_x_sigma_m,pos_y_sigma_m", "1.2,1.2");
+    let fuse = |fixes: &str, to: &str| {
+        imukit()
+            .arg("fuse")
+            .arg(file("imu.csv"))
+            .arg(file(fixes))
+            .arg("--init")
+            .arg(file("truth.csv"))
+            .arg("--scenario")
+            .arg(&example)
+            .arg("--out")
+            .arg(file(to))
+            .output()
+            .unwrap()
+    };
+    for (fixes, to) in [("split.csv", "a.csv"), ("axes.csv", "b.csv")] {
+        let out = fuse(fixes, to);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert!(std::fs::read(file("a.csv")).unwrap() == std::fs::read(file("b.csv")).unwrap());
+    let out = fuse("partial.csv", "c.csv");
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(65), "{log}");
+    assert!(
+        log.contains("partial.csv") && log.contains("missing pos_z_sigma_m"),
+        "{log}"
+    );
+}

@@ -226,6 +226,11 @@ pub const FUSE_COLUMNS: [&str; 35] = concat_columns(
 /// them (either alone, or both) they replace the setup's for that fix.
 pub const FIX_ACCURACY_COLUMNS: [&str; 2] = ["horizontal_accuracy_m", "vertical_accuracy_m"];
 
+/// A fix table's own one-sigma per axis of the fixes' frame (a receiver's per-axis standard
+/// deviations: a vendor's `pos_std_1..3` through a column map), m; instead of
+/// [`FIX_ACCURACY_COLUMNS`], all three or none.
+pub const FIX_SIGMA_COLUMNS: [&str; 3] = ["pos_x_sigma_m", "pos_y_sigma_m", "pos_z_sigma_m"];
+
 /// Columns of an orientation output: time, `q_nb` (scalar first), z-y-x Euler angles (yaw
 /// unwrapped).
 pub const ORIENT_COLUMNS: [&str; 8] = [

@@ -205,8 +205,9 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     rate is the IMU's median.
 
     Fixes may carry their own accuracy, one-sigma per fix: ``horizontal_accuracy_m`` and
-    ``vertical_accuracy_m`` columns (a ROS ``NavSatFix``'s covariance gives them) replace the
-    receiver's figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
+    ``vertical_accuracy_m`` columns (a ROS ``NavSatFix``'s covariance gives them), or
+    ``pos_x_sigma_m``, ``pos_y_sigma_m``, ``pos_z_sigma_m`` per axis, replace the receiver's
+    figures fix by fix; ``gnss_uere_m`` makes the horizontal one of an NMEA log's
     ``hdop`` column (HDOP × UERE).
 
     With neither a scenario nor ``imu_model``, the part is learnt from the log: its white noise

@@ -227,10 +227,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             position_sigma_m: inputs
                 .accuracy
                 .as_ref()
-                .map_or(setup.gnss_position_sigma_m, |a| {
-                    let [h, v] = a[k];
-                    [h, h, v]
-                }),
+                .map_or(setup.gnss_position_sigma_m, |a| a[k]),
             velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma],
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,

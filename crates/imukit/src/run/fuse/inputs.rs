@@ -4,7 +4,7 @@ use imu_core::Vec3;
 
 use crate::error::Data;
 use crate::error::{Result, invalid};
-use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GYRO_COLUMNS};
+use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, FIX_SIGMA_COLUMNS, GYRO_COLUMNS};
 use crate::io::table::Table;
 use crate::run::nav_earth::NavEarth;
 
@@ -62,9 +62,9 @@ pub(super) struct FusionInputs {
     pub(super) g_v: Vec<[f64; 3]>,
     /// What the fixes give of their velocity.
     pub(super) velocities: FixVelocity,
-    /// Each fix's own horizontal and vertical one-sigma ([`FIX_ACCURACY_COLUMNS`]), if the
-    /// table gives them.
-    pub(super) accuracy: Option<Vec<[f64; 2]>>,
+    /// Each fix's own one-sigma per axis of the frame ([`FIX_ACCURACY_COLUMNS`] horizontal and
+    /// vertical, or [`FIX_SIGMA_COLUMNS`] per axis), if the table gives them.
+    pub(super) accuracy: Option<Vec<[f64; 3]>>,
 }
 
 /// What a table of fixes gives of the velocity, by its columns.
@@ -188,30 +188,72 @@ impl FusionInputs {
     }
 }
 
-/// A fix table's own accuracy ([`FIX_ACCURACY_COLUMNS`]; where one of the two is missing,
-/// `setup`'s for it), each value a positive finite number; `None` without either column.
+/// A fix table's own accuracy per axis: [`FIX_SIGMA_COLUMNS`] (all three), or
+/// [`FIX_ACCURACY_COLUMNS`] (horizontal for x and y, vertical for z; where one of the two is
+/// missing, `setup`'s for it), each value a positive finite number; `None` without any.
 ///
 /// # Errors
-/// A value that is not positive and finite (its row).
-fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 2]>>> {
-    let columns = FIX_ACCURACY_COLUMNS.map(|c| gnss.column(c));
-    if columns.iter().all(Option::is_none) {
-        return Ok(None);
-    }
+/// A value that is not positive and finite (its row); per-axis columns beside the horizontal
+/// and vertical ones, or only some of the three.
+fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 3]>>> {
     let rows = gnss.rows();
-    let [h, v] = [0, 1].map(|k| columns[k].clone().unwrap_or_else(|| vec![setup[k]; rows]));
-    for (k, (a, b)) in h.iter().zip(&v).enumerate() {
-        if !(a.is_finite() && b.is_finite() && *a > 0.0 && *b > 0.0) {
+    let per_axis = FIX_SIGMA_COLUMNS.map(|c| gnss.column(c));
+    let split = FIX_ACCURACY_COLUMNS.map(|c| gnss.column(c));
+    let sigmas: Vec<[f64; 3]> = match (
+        per_axis.iter().filter(|c| c.is_some()).count(),
+        split.iter().any(Option::is_some),
+    ) {
+        (0, false) => return Ok(None),
+        (0, true) => {
+            let [h, v] = [0, 1].map(|k| split[k].clone().unwrap_or_else(|| vec![setup[k]; rows]));
+            h.into_iter().zip(v).map(|(a, b)| [a, a, b]).collect()
+        }
+        (3, false) => {
+            let [x, y, z] = per_axis.map(Option::unwrap_or_default);
+            (0..rows).map(|k| [x[k], y[k], z[k]]).collect()
+        }
+        (3, true) => {
             return Err(invalid(
                 Data::Gnss.label(),
                 format!(
-                    "row {}: the fix's accuracy must be positive and finite, got {a} m and {b} m",
-                    k + 2
+                    "give the fixes' accuracy as {} or as {}, not both",
+                    FIX_SIGMA_COLUMNS.join(", "),
+                    FIX_ACCURACY_COLUMNS.join(", ")
                 ),
             ));
         }
+        (_, _) => {
+            let missing: Vec<&str> = FIX_SIGMA_COLUMNS
+                .iter()
+                .zip(&per_axis)
+                .filter(|(_, c)| c.is_none())
+                .map(|(n, _)| *n)
+                .collect();
+            return Err(invalid(
+                Data::Gnss.label(),
+                format!(
+                    "per-axis accuracy needs all three of {}: missing {}",
+                    FIX_SIGMA_COLUMNS.join(", "),
+                    missing.join(", ")
+                ),
+            ));
+        }
+    };
+    if let Some((k, s)) = sigmas
+        .iter()
+        .enumerate()
+        .find(|(_, s)| !s.iter().all(|v| v.is_finite() && *v > 0.0))
+    {
+        return Err(invalid(
+            Data::Gnss.label(),
+            format!(
+                "row {}: the fix's accuracy must be positive and finite, got {} m",
+                k + 2,
+                s.map(|v| v.to_string()).join(" m, ")
+            ),
+        ));
     }
-    Ok(Some(h.into_iter().zip(v).map(|(a, b)| [a, b]).collect()))
+    Ok(Some(sigmas))
 }
 
 /// The fixes in the filter's terms: positions on its Earth, velocities in its frame.
