@@ -37,7 +37,10 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     } = job;
     let [h, _, v] = setup.gnss_position_sigma_m;
     let inputs = FusionInputs::read(imu, gnss, E::GNSS_COLUMNS, E::GNSS_HINT, [h, v])?;
-    let detection = Detection::of(&inputs.t, &inputs.f, &inputs.w, setup);
+    // The detectors' noise, when a detector runs.
+    let detection = (setup.detect_rest || setup.zupt)
+        .then(|| Detection::of(&inputs.t, &inputs.f, &inputs.w, setup))
+        .flatten();
     let setup = &with_rest_found(setup, start, &inputs, detection.as_ref());
     let t = &inputs.t;
     let mut aids = AidStreams::new(aids, setup, inputs.span(), t.len())?;

@@ -76,7 +76,7 @@ pub struct FuseSummary {
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet
-    /// stretches, or the part's (`None`: too few samples to tell).
+    /// stretches, or the part's (`None`: no detector ran, or too few samples to tell).
     pub detection: Option<Detection>,
 }
 
