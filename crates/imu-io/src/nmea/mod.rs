@@ -7,14 +7,15 @@
 //! `vel_e_m_s` (NMEA gives no vertical speed: the filter takes such fixes' velocity as
 //! horizontal only; without velocities the fixes are positions only and it updates on those),
 //! and `hdop` when every `GGA` gives it ([`with_uere`] turns it into each fix's horizontal
-//! accuracy).
+//! accuracy), and `horizontal_accuracy_m` and `vertical_accuracy_m` when every fix has a `GST`
+//! (its latitude and longitude deviations' root mean square, its altitude deviation).
 //! Epochs without a fix (`GGA` quality 0) are left out; an `RMC` marked void gives no velocity.
 //!
 //! `t_s` is the UTC time of day counted from the midnight before the first fix (the rule of
 //! [`crate::asl`]), a day added each time the clock passes midnight. Other sentences
 //! (`GSV`, `GSA`, a vendor's) are skipped; text before a sentence's `$` on its line (a logger's
-//! own stamp) is ignored. A bad checksum, or a `GGA`, `RMC` or `VTG` that does not parse, is
-//! refused naming the file and its line.
+//! own stamp) is ignored. A bad checksum, or a `GGA`, `RMC`, `VTG` or `GST` that does not parse,
+//! is refused naming the file and its line.
 //!
 //! Reading a log needs the `nmea` feature (on by default); a build without it refuses one by
 //! name. [`with_uere`] works on any table of fixes with an `hdop` column.

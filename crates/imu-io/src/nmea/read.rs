@@ -31,6 +31,8 @@ struct Epoch {
     hdop: Option<f64>,
     /// Speed over ground (m/s) and true course (rad).
     ground: Option<(f64, f64)>,
+    /// `GST`'s standard deviations of latitude, longitude and altitude, m.
+    sigma: Option<[f64; 3]>,
 }
 
 /// The columns of a table of fixes with horizontal velocities: the geodetic fix table's
@@ -132,6 +134,18 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 let g = ground(speed, course).map_err(|m| bad(line, format!("RMC: {m}")))?;
                 epoch_at(&mut epochs, nanos_of(time), line).ground = Some(g);
             }
+            Ok(ParseResult::GST(g)) => {
+                // Deviations the receiver left empty, or that are not positive, give nothing.
+                let (Some(time), Some(n), Some(e), Some(u)) =
+                    (g.time, g.lat_sd, g.long_sd, g.alt_sd)
+                else {
+                    continue;
+                };
+                let sigma = [n, e, u].map(f64::from);
+                if sigma.iter().all(|s| s.is_finite() && *s > 0.0) {
+                    epoch_at(&mut epochs, nanos_of(time), line).sigma = Some(sigma);
+                }
+            }
             Ok(ParseResult::VTG(v)) => {
                 // No time of its own: the epoch of the sentences before it.
                 if let (Some(last), Some(speed), Some(course)) =
@@ -151,7 +165,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
             }
             Err(e) => {
                 let kind = sentence.get(3..6).unwrap_or("");
-                if ["GGA", "RMC", "VTG"].contains(&kind) {
+                if ["GGA", "RMC", "VTG", "GST"].contains(&kind) {
                     return Err(bad(line, format!("{kind}: {e}")));
                 }
             }
@@ -169,10 +183,14 @@ pub fn read_table(path: &Path) -> Result<Table> {
     }
     let velocities = fixes.iter().all(|e| e.ground.is_some());
     let hdop = fixes.iter().all(|e| e.hdop.is_some());
+    let gst = fixes.iter().all(|e| e.sigma.is_some());
     let width = if velocities { 6 } else { 4 };
     let mut columns = COLUMNS[..width].to_vec();
     if hdop {
         columns.push(HDOP_COLUMN);
+    }
+    if gst {
+        columns.extend(crate::columns::FIX_ACCURACY_COLUMNS);
     }
     let mut table = Table::new(&columns);
     let (mut day, mut previous) = (0, fixes[0].time_of_day_ns);
@@ -192,6 +210,11 @@ pub fn read_table(path: &Path) -> Result<Table> {
         }
         if let Some(h) = e.hdop.filter(|_| hdop) {
             row.push(h);
+        }
+        // The fix's accuracy per horizontal axis (the mean of north's and east's variances)
+        // and vertically.
+        if let Some([n, east, up]) = e.sigma.filter(|_| gst) {
+            row.extend([(0.5 * (n * n + east * east)).sqrt(), up]);
         }
         table.push_row(&row);
     }
@@ -288,6 +311,46 @@ mod tests {
         // 10 knots due east, then 2 knots due south from the VTG.
         assert!(a[4].abs() < 1e-12 && (a[5] - 10.0 * KNOT_M_S).abs() < 1e-5);
         assert!((b[4] + 2.0 * KNOT_M_S).abs() < 1e-5 && b[5].abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_receivers_gst_gives_each_fix_its_accuracy() {
+        let dir = tempfile::tempdir().expect("dir");
+        let gga = |time: &str| {
+            sentence(&format!(
+                "GPGGA,{time},4807.038,N,01131.000,E,1,08,0.9,545.4,M,47.0,M,,"
+            ))
+        };
+        let gst = |time: &str, n: &str, e: &str, u: &str| {
+            sentence(&format!("GPGST,{time},15.5,15.3,7.2,21.8,{n},{e},{u}"))
+        };
+        let lines = [
+            gga("120000.00"),
+            gst("120000.00", "0.9", "1.2", "2.5"),
+            gga("120001.00"),
+            gst("120001.00", "3.0", "4.0", "5.0"),
+        ];
+        let t = read_table(&write(&dir, &lines)).expect("read");
+        let h = t.column("horizontal_accuracy_m").expect("horizontal");
+        let v = t.column("vertical_accuracy_m").expect("vertical");
+        let f = |x: f32| f64::from(x);
+        assert_eq!(
+            h,
+            [
+                (0.5 * (f(0.9) * f(0.9) + f(1.2) * f(1.2))).sqrt(),
+                (0.5 * (f(3.0) * f(3.0) + f(4.0) * f(4.0))).sqrt()
+            ]
+        );
+        assert_eq!(v, [f(2.5), f(5.0)]);
+        // One fix without (an empty deviation): no accuracy columns at all.
+        let lines = [
+            lines[0].clone(),
+            lines[1].clone(),
+            gga("120001.00"),
+            gst("120001.00", "", "4.0", "5.0"),
+        ];
+        let t = read_table(&write(&dir, &lines)).expect("read");
+        assert_eq!(t.column("horizontal_accuracy_m"), None);
     }
 
     #[test]
