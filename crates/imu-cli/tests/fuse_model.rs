@@ -7,27 +7,33 @@ fn imukit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_imukit"))
 }
 
-#[test]
-fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
-    let dir = tempfile::tempdir().unwrap();
-    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
-    let file = |name: &str| dir.path().join(name);
-    let out = imukit()
-        .arg("simulate")
-        .arg(&example)
+/// `example` simulated into `dir`: `imu.csv`, and with `fixes` also `truth.csv` and `gnss.csv`.
+fn simulate_drive(example: &Path, dir: &Path, fixes: bool) {
+    let mut c = imukit();
+    c.arg("simulate")
+        .arg(example)
         .arg("--out")
-        .arg(file("imu.csv"))
-        .arg("--truth")
-        .arg(file("truth.csv"))
-        .arg("--gnss")
-        .arg(file("gnss.csv"))
-        .output()
-        .unwrap();
+        .arg(dir.join("imu.csv"));
+    if fixes {
+        c.arg("--truth")
+            .arg(dir.join("truth.csv"))
+            .arg("--gnss")
+            .arg(dir.join("gnss.csv"));
+    }
+    let out = c.output().unwrap();
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+#[test]
+fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let file = |name: &str| dir.path().join(name);
+    simulate_drive(&example, dir.path(), true);
     let fuse = |extra: &[&str], to: &str| {
         let out = imukit()
             .arg("fuse")
@@ -90,18 +96,7 @@ fn geodetic_fixes_read_on_the_flat_earth_point_at_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
     let file = |name: &str| dir.path().join(name);
-    let out = imukit()
-        .arg("simulate")
-        .arg(&example)
-        .arg("--out")
-        .arg(file("imu.csv"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    simulate_drive(&example, dir.path(), false);
     // A receiver's log as users have it: geodetic, without imukit's description.
     let mut fixes = String::from("t_s,lat_rad,lon_rad,height_m,vel_x_m_s,vel_y_m_s,vel_z_m_s\n");
     for k in 1..20 {
@@ -129,22 +124,7 @@ fn a_receivers_per_axis_sigmas_are_read_as_its_horizontal_and_vertical_accuracy_
     let dir = tempfile::tempdir().unwrap();
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
     let file = |name: &str| dir.path().join(name);
-    let out = imukit()
-        .arg("simulate")
-        .arg(&example)
-        .arg("--out")
-        .arg(file("imu.csv"))
-        .arg("--truth")
-        .arg(file("truth.csv"))
-        .arg("--gnss")
-        .arg(file("gnss.csv"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    simulate_drive(&example, dir.path(), true);
     // The same fixes with their own accuracy, stated two ways (1.2 m across, 2.5 m up).
     let with = |name: &str, header: &str, values: &str| {
         let text = std::fs::read_to_string(file("gnss.csv")).unwrap();

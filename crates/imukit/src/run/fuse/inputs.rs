@@ -4,7 +4,10 @@ use imu_core::Vec3;
 
 use crate::error::Data;
 use crate::error::{Result, invalid};
-use crate::io::columns::{ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, FIX_SIGMA_COLUMNS, GYRO_COLUMNS};
+use crate::io::columns::{
+    ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, FIX_SIGMA_COLUMNS, GNSS_COLUMNS, GNSS_EARTH_COLUMNS,
+    GYRO_COLUMNS,
+};
 use crate::io::table::Table;
 use crate::run::nav_earth::NavEarth;
 
@@ -141,10 +144,11 @@ impl FusionInputs {
         let missing: Vec<&str> = needed.iter().copied().filter(|c| !has(c)).collect();
         if !missing.is_empty() {
             // Fixes of the other Earth's kind: say which option reads them.
-            let other = if has(&"lat_rad") && missing.contains(&"pos_x_m") {
+            let (plane, geodetic) = (GNSS_COLUMNS[1], GNSS_EARTH_COLUMNS[1]);
+            let other = if has(&geodetic) && missing.contains(&plane) {
                 " — these fixes are geodetic (lat_rad, lon_rad, height_m): they are read on the \
                  WGS-84 Earth (--earth wgs84; Python earth=\"wgs84\")"
-            } else if has(&"pos_x_m") && missing.contains(&"lat_rad") {
+            } else if has(&plane) && missing.contains(&geodetic) {
                 " — these fixes are plane coordinates (pos_x_m, …): they are read on the flat \
                  Earth (--earth flat; Python earth=\"flat\")"
             } else {
