@@ -48,6 +48,10 @@ fi
 
 section "Rust tests"
 cargo test --workspace --exclude imu-py
+# A clean clone (CI) needs the test build no more: the wheel builds into its own folder.
+if [ -n "${IMUKIT_FREE_DISK:-}" ]; then
+  rm -rf target/debug
+fi
 
 section "Wheel (manylinux2014, abi3, with the imukit command) and source distribution"
 rm -rf dist

@@ -1,6 +1,6 @@
 //! Body-rate trajectories (MATLAB kinematicTrajectory): exact cases, MATLAB's platform example,
 //! and inverting the ideal IMU of a trajectory.
-mod common;
+use crate::common;
 
 use imu_core::kinematics::KinematicsError;
 use imu_core::kinematics::body_rates::{BodyRateStart, truth_from_body_rates};

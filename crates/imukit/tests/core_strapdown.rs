@@ -7,7 +7,7 @@ use imu_core::strapdown::{
 };
 use imu_core::{Body, Enu, IdealReading, ImuMount, NavFrame, Ned, Rotation, Truth, Vec3};
 
-mod common;
+use crate::common;
 
 const G: f64 = 9.81;
 

@@ -3,7 +3,7 @@
 //! an error or a result, never a panic, and a result never holds a value that is not finite.
 //!
 //! The Python script `tests/fuzz/hostile.py` drives the command line and the Python API the same
-//! way. Run longer with `PROPTEST_CASES=20000 cargo test --release -p imukit --test hostile`.
+//! way. Run longer with `PROPTEST_CASES=20000 cargo test --release -p imukit --test integration hostile::`.
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,9 @@
+//! The command's integration tests, one binary: each module runs `imukit` as a user would for one concept.
+//! `cargo test -p imu-cli --test integration MODULE::` runs one module's.
+mod cli;
+mod conventions;
+mod fuse_model;
+mod orient;
+mod outputs;
+mod own_log;
+mod plot;

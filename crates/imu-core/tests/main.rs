@@ -1,0 +1,23 @@
+//! imu-core's integration tests, one binary: each module is one concept's tests.
+//! `cargo test -p imu-core --test integration MODULE::` runs one module's.
+mod aids;
+mod align;
+mod allan;
+mod earth;
+mod earth_frames;
+mod earth_strapdown;
+mod eskf;
+mod finite_diff;
+mod gnss;
+mod orientation;
+mod planar;
+mod process_noise;
+mod robust;
+mod robust_motion;
+mod rotation;
+mod sensor;
+mod smoother;
+mod spherical_earth;
+mod stillness;
+mod trig;
+mod wmm;
