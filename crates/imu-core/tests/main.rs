@@ -8,6 +8,7 @@ mod earth_frames;
 mod earth_strapdown;
 mod eskf;
 mod finite_diff;
+mod fix_errors;
 mod gnss;
 mod orientation;
 mod planar;

@@ -2,7 +2,8 @@
 //! position (metres of the navigation frame), velocity, attitude (a small rotation φ of the
 //! navigation frame, `C_true = (I + [φ×]) Ĉ`), accelerometer bias, gyroscope bias — or 36 with
 //! the sensors' scale-factor, misalignment and g-sensitivity errors of
-//! [`super::sensor_errors`], around the strapdown of [`crate::strapdown::increments`]
+//! [`super::sensor_errors`], either with the fixes' correlated errors of
+//! [`super::fix_errors`] (18 or 39), around the strapdown of [`crate::strapdown::increments`]
 //! (increments by the trapezoid of each interval's rate samples, coning and sculling, the
 //! Earth's terms), with closed-loop correction after every update. Fixed-size matrices, no
 //! heap.
@@ -26,9 +27,8 @@
 //! position through [`EarthModel::offset`].
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
-use super::sensor_errors::{
-    BASE_STATES, FULL_STATES, SensorErrorEstimate, SensorErrorSigma, SensorErrors,
-};
+use super::fix_errors::{self, FixErrorModel, has_fix_errors, has_sensor_errors};
+use super::sensor_errors::{BASE_STATES, SensorErrorEstimate, SensorErrorSigma, SensorErrors};
 use super::smoother::{EpochRecord, SmoothingLog};
 use crate::earth::EarthModel;
 use crate::frame::{Body, NavFrame};
@@ -175,8 +175,9 @@ pub(crate) fn skew(v: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
 type Block<const C: usize> = SMatrix<f64, 3, C>;
 
 /// The error-state filter of `S` states on the Earth `E`: [`BASE_STATES`] (15, the default) or
-/// [`FULL_STATES`] (36, with the sensors' scale-factor, misalignment and g-sensitivity errors,
-/// see [`super::sensor_errors`]); any other `S` does not compile.
+/// [`FULL_STATES`](super::FULL_STATES) (36, with the sensors' scale-factor, misalignment and g-sensitivity errors,
+/// see [`super::sensor_errors`]), either plus [`super::FIX_ERROR_STATES`] (18 or 39, with the
+/// fixes' correlated errors, see [`super::fix_errors`]); any other `S` does not compile.
 #[derive(Clone, Copy, Debug)]
 pub struct Eskf<E: EarthModel, const S: usize = BASE_STATES> {
     mechanization: Increments<E>,
@@ -190,6 +191,10 @@ pub struct Eskf<E: EarthModel, const S: usize = BASE_STATES> {
     updates: usize,
     rejected: usize,
     smoothing: Option<SmoothingLog<S>>,
+    /// The fixes' correlated error as modelled (18 and 39 states; `None`: those states stay
+    /// zero) and its estimate `b̂`, navigation axes, m.
+    fix_error: Option<FixErrorModel>,
+    fix_error_m: Vector3<f64>,
     /// The biases' initial variances (accelerometer, then gyroscope), which a reset restores.
     initial_bias_variance: [f64; 6],
 }
@@ -235,6 +240,8 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             updates: 0,
             rejected: 0,
             smoothing: None,
+            fix_error: None,
+            fix_error_m: Vector3::zeros(),
             initial_bias_variance: core::array::from_fn(|k| cov[(9 + k, 9 + k)]),
         })
     }
@@ -294,6 +301,41 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         Ok(self)
     }
 
+    /// The fixes' correlated position error ([`super::fix_errors`]): a filter of 18 or 39
+    /// states estimates it from `model`, starting at zero with the model's initial one-sigma.
+    /// Set before [`Self::with_smoothing`].
+    ///
+    /// # Errors
+    /// A filter without those states, or a model that is not valid
+    /// ([`FixErrorModel::is_valid`]).
+    pub fn with_fix_errors(mut self, model: FixErrorModel) -> Result<Self, EskfError> {
+        if !has_fix_errors(S) {
+            return Err(EskfError::BadParameter {
+                field: "fix error model (only a filter of 18 or 39 states has the fix errors)",
+            });
+        }
+        if !model.is_valid() {
+            return Err(EskfError::BadParameter {
+                field: "fix error model",
+            });
+        }
+        let b = fix_errors::first::<S>();
+        for k in 0..3 {
+            self.cov.row_mut(b + k).fill(0.0);
+            self.cov.column_mut(b + k).fill(0.0);
+            self.cov[(b + k, b + k)] = sq(model.initial_sigma_m[k]);
+        }
+        self.fix_error = Some(model);
+        Ok(self)
+    }
+
+    /// The estimated error of the fixes, navigation axes, m (zero without the fix-error
+    /// states).
+    #[must_use]
+    pub fn fix_error_m(&self) -> [f64; 3] {
+        self.fix_error_m.into()
+    }
+
     /// The Earth the filter runs on.
     #[must_use]
     pub fn earth(&self) -> &E {
@@ -317,8 +359,9 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     }
 
     /// One-sigma of the error states: position (3, m on the navigation axes), velocity (3),
-    /// attitude (3, navigation axes), accelerometer bias (3), gyroscope bias (3), and with 36
-    /// states the sensor errors `M_a`, `M_g` (9 each, row-major) and `k` (3).
+    /// attitude (3, navigation axes), accelerometer bias (3), gyroscope bias (3), with 36 or 39
+    /// states the sensor errors `M_a`, `M_g` (9 each, row-major) and `k` (3), and with 18 or
+    /// 39 the fixes' errors (3, navigation axes) last.
     #[must_use]
     pub fn sigmas(&self) -> [f64; S] {
         core::array::from_fn(|i| math::sqrt(self.cov[(i, i)].max(0.0)))
@@ -375,7 +418,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             .step(t_s, (w * dt).into(), (f * dt).into())
             .map_err(|_| EskfError::NotFinite { index })?;
         let c = (c0 + self.c_nb()) * 0.5;
-        if S == FULL_STATES {
+        if has_sensor_errors(S) {
             self.errors.accumulate(dt, &c, &w, &f);
         }
         if self.intake.accumulate(dt, &c, &f) {
@@ -409,7 +452,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
                 phi_phi: -skew(&(w_ie + w_en)),
             }
         });
-        let sensors = (S == FULL_STATES).then(|| {
+        let sensors = has_sensor_errors(S).then(|| {
             let (cda, cdg) = self.errors.take_pending(dt);
             (-cda, -cdg)
         });
@@ -429,8 +472,15 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         let qd = (qc * 2.0 + aq + aq.transpose() + a.times(&aq.transpose())) * (0.5 * dt);
         self.cov += ap + ap.transpose() + a.times(&ap.transpose()) + qd;
         self.cov = (self.cov + self.cov.transpose()) * 0.5;
-        if let (Some(log), Some(before)) = (self.smoothing.as_mut(), before) {
-            let phi = Cov::<S>::identity() + a.times(&Cov::<S>::identity());
+        let mut phi = before
+            .is_some()
+            .then(|| Cov::<S>::identity() + a.times(&Cov::<S>::identity()));
+        if let Some(model) = &self.fix_error {
+            let (decay, q) = model.step(dt);
+            fix_errors::decay_covariance(&mut self.cov, phi.as_mut(), decay, &q);
+            self.fix_error_m *= decay;
+        }
+        if let (Some(log), Some(before), Some(phi)) = (self.smoothing.as_mut(), before, phi) {
             log.step(&before, &phi, dt, &self.cov, self.nav.t_s);
         }
     }
@@ -478,6 +528,9 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         self.bg = Vector3::from(corrected.gyro_bias_rad_s);
         if !self.errors.inject(dx) {
             return Err(EskfError::Diverged { index });
+        }
+        if has_fix_errors(S) {
+            self.fix_error_m += dx.fixed_rows::<3>(fix_errors::first::<S>());
         }
         self.mechanization
             .reset(&self.nav)

@@ -3,9 +3,9 @@
 use nalgebra::{SMatrix, SVector, Vector3};
 
 use super::{Cov, EskfError, EskfNoise, InitialSigma, StateVec, non_negative, skew, sq};
+use crate::fusion::fix_errors::{self, has_fix_errors, has_sensor_errors, is_state_count};
 use crate::fusion::sensor_errors::{
-    ACCEL_MATRIX, BASE_STATES, FULL_STATES, GYRO_ERRORS, SensorErrorSigma, SensorErrors, d_gyro,
-    d_matrix,
+    ACCEL_MATRIX, GYRO_ERRORS, SensorErrorSigma, SensorErrors, d_gyro, d_matrix,
 };
 
 /// The initial covariance (diagonal, from `sigma`) after checking `sigma` and `noise`, for
@@ -19,8 +19,8 @@ pub(crate) fn initial_covariance<const S: usize>(
 ) -> Result<Cov<S>, EskfError> {
     const {
         assert!(
-            S == BASE_STATES || S == FULL_STATES,
-            "the filters have 15 or 36 error states"
+            is_state_count(S),
+            "the filters have 15, 18, 36 or 39 error states"
         );
     }
     non_negative("accel_psd", noise.accel_psd)?;
@@ -41,17 +41,17 @@ pub(crate) fn initial_covariance<const S: usize>(
     Ok(Cov::<S>::from_diagonal(&diag))
 }
 
-/// Sets the initial variances of the sensor errors in `cov` (36 states).
+/// Sets the initial variances of the sensor errors in `cov` (36 or 39 states).
 ///
 /// # Errors
-/// A 15-state covariance, or a sigma that is negative or not finite.
+/// A covariance without the sensor errors, or a sigma that is negative or not finite.
 pub(crate) fn set_sensor_variances<const S: usize>(
     cov: &mut Cov<S>,
     sigma: &SensorErrorSigma,
 ) -> Result<(), EskfError> {
-    if S != FULL_STATES {
+    if !has_sensor_errors(S) {
         return Err(EskfError::BadParameter {
-            field: "sensor error sigma (only a filter of 36 states has the sensor errors)",
+            field: "sensor error sigma (only a filter of 36 or 39 states has the sensor errors)",
         });
     }
     let variances = sigma.variances().ok_or(EskfError::BadParameter {
@@ -105,7 +105,7 @@ pub(crate) fn zero_rate_model<const S: usize>(
     let mut h = SMatrix::<f64, 3, S>::zeros();
     h.fixed_view_mut::<3, 3>(0, 12)
         .copy_from(&nalgebra::Matrix3::identity());
-    if S == FULL_STATES {
+    if has_sensor_errors(S) {
         h.fixed_view_mut::<3, 12>(0, GYRO_ERRORS)
             .copy_from(&d_gyro(w_true, &f));
     }
@@ -132,10 +132,13 @@ pub(crate) type Rows<const M: usize, const S: usize> =
 /// arm `l`, the fix valid `age_s` earlier (see [`Eskf::update_gnss`]); `sigmas` are the
 /// position and velocity one-sigmas. Returns `(H, y, r)` with unused velocity rows inert. With
 /// the sensor errors the velocity rows also see them through the lever arm
-/// (`Ĉ [l×] D_g δm_g`) and the latency (`τ Ĉ D_a δm_a`).
+/// (`Ĉ [l×] D_g δm_g`) and the latency (`τ Ĉ D_a δm_a`); with the fix errors the position
+/// rows see the fix's error `b` (`H = I` on `δb`, the estimate `fix_error_m` taken off).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn gnss_model<const S: usize>(
     lin: &Linearisation,
     delta_p: Vector3<f64>,
+    fix_error_m: &Vector3<f64>,
     velocity_m_s: Option<Vector3<f64>>,
     l: Vector3<f64>,
     sigmas: [[f64; 3]; 2],
@@ -147,7 +150,7 @@ pub(crate) fn gnss_model<const S: usize>(
     let cwl = c * lin.w_body.cross(&l);
     let cf = c * lin.f_body;
     let accel = cf + lin.g;
-    let z_p = delta_p - (cl - (lin.v + cwl) * age_s + accel * (0.5 * age_s * age_s));
+    let z_p = delta_p - (cl - (lin.v + cwl) * age_s + accel * (0.5 * age_s * age_s)) - fix_error_m;
     let mut finite = z_p.iter().all(|v| v.is_finite());
     let mut h = SMatrix::<f64, 6, S>::zeros();
     let mut y = SVector::<f64, 6>::zeros();
@@ -157,6 +160,10 @@ pub(crate) fn gnss_model<const S: usize>(
     h.fixed_view_mut::<3, 3>(0, 3)
         .copy_from(&(nalgebra::Matrix3::identity() * -age_s));
     h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
+    if has_fix_errors(S) {
+        h.fixed_view_mut::<3, 3>(0, fix_errors::first::<S>())
+            .copy_from(&nalgebra::Matrix3::identity());
+    }
     y.fixed_rows_mut::<3>(0).copy_from(&z_p);
     for i in 0..3 {
         r[i] = sq(sigmas[0][i]);
@@ -170,7 +177,7 @@ pub(crate) fn gnss_model<const S: usize>(
             .copy_from(&(-skew(&cwl) + skew(&cf) * age_s));
         h.fixed_view_mut::<3, 3>(3, 9).copy_from(&(c * age_s));
         h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
-        if S == FULL_STATES {
+        if has_sensor_errors(S) {
             h.fixed_view_mut::<3, 9>(3, ACCEL_MATRIX)
                 .copy_from(&(c * d_matrix(&lin.f_body) * age_s));
             h.fixed_view_mut::<3, 12>(3, GYRO_ERRORS)

@@ -8,6 +8,7 @@ use super::{
 };
 use crate::earth::EarthModel;
 use crate::frame::NavFrame;
+use crate::fusion::fix_errors::{self, has_fix_errors};
 use crate::math;
 
 impl<E: EarthModel, const S: usize> Eskf<E, S> {
@@ -28,6 +29,8 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         if !(fix.age_s.is_finite() && fix.age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
         }
+        // The pending covariance step first: it also decays the fix-error estimate to now.
+        self.step_covariance();
         let (w_last, f_last) = self.intake.last();
         let (w_body, f_body) = self.errors.correct::<S>(w_last - self.bg, f_last - self.ba);
         let earth = self.mechanization.earth();
@@ -46,6 +49,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         let (h, y, r) = gnss_model(
             &lin,
             *delta_p.as_nalgebra(),
+            &self.fix_error_m,
             fix.velocity_m_s.map(|v| *v.as_nalgebra()),
             *fix.lever_arm_m.as_nalgebra(),
             [fix.position_sigma_m, fix.velocity_sigma_m_s],
@@ -65,7 +69,10 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     /// their initial uncertainty, uncorrelated (at least; a larger one is kept): fixes rejected
     /// one after another say the filter was sure of something wrong, and a bias it was sure of
     /// is the likeliest — kept, a wrong gyroscope bias turns the heading away again and brings
-    /// the next reset. Tilt and sensor errors are kept with their covariance. The reset is
+    /// the next reset. Tilt and sensor errors are kept with their covariance. With the fix
+    /// errors ([`super::super::fix_errors`]) the position becomes the fix less its estimated
+    /// error, and its error that error's plus the fix's white part (correlated with the rest as
+    /// the fix error is). The reset is
     /// neither an update nor a rejection in [`Self::update_counts`].
     ///
     /// # Errors
@@ -115,7 +122,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
             .displacement_m(&coords, &E::coordinates(&fix.position))
             .as_nalgebra();
         dx.fixed_rows_mut::<3>(0)
-            .copy_from(&(to_antenna - c * lever));
+            .copy_from(&(to_antenna - c * lever - self.fix_error_m));
         if let Some(v) = fix.velocity_m_s {
             let (w_last, f_last) = self.intake.last();
             let (w_body, _) = self.errors.correct::<S>(w_last - self.bg, f_last - self.ba);
@@ -133,13 +140,31 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         self.inject(&dx, index)?;
         let bias_variance: [f64; 6] =
             core::array::from_fn(|k| self.cov[(9 + k, 9 + k)].max(self.initial_bias_variance[k]));
+        if has_fix_errors(S) {
+            // The position is now the fix less its estimated error: its error is the fix
+            // error's plus the fix's white part, `δp = δb + v`.
+            let b = fix_errors::first::<S>();
+            for k in 0..3 {
+                let row = self.cov.row(b + k).into_owned();
+                self.cov.row_mut(k).copy_from(&row);
+                self.cov.column_mut(k).copy_from(&row.transpose());
+            }
+            for k in 0..3 {
+                for j in 0..3 {
+                    self.cov[(k, j)] = self.cov[(b + k, b + j)];
+                }
+                self.cov[(k, k)] += sq(fix.position_sigma_m[k]);
+            }
+        }
         let mut set = |k: usize, variance: f64| {
             self.cov.row_mut(k).fill(0.0);
             self.cov.column_mut(k).fill(0.0);
             self.cov[(k, k)] = variance;
         };
-        for k in 0..3 {
-            set(k, fix.position_sigma_m[k] * fix.position_sigma_m[k]);
+        if !has_fix_errors(S) {
+            for k in 0..3 {
+                set(k, fix.position_sigma_m[k] * fix.position_sigma_m[k]);
+            }
         }
         if fix.velocity_m_s.is_some() {
             for k in 0..3 {
