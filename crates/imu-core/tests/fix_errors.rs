@@ -114,11 +114,14 @@ fn run<const S: usize>(decay: f64, model: Model, run: u64, at_s: &[f64]) -> Vec<
         };
         f = f.with_sensor_error_sigma(&tight).unwrap();
     }
-    let stationary = (2.0 / (1.0 + decay)).sqrt();
+    let stationary = FixErrorModel::decay_factor_sigma_ratio(decay);
     let fix_sigma = match model {
         Model::White => [HORIZONTAL_M, HORIZONTAL_M, VERTICAL_M].map(|s| s * stationary),
         Model::States => {
-            let m = FixErrorModel::from_decay_factor(decay, 1.0, HORIZONTAL_M, VERTICAL_M).unwrap();
+            let accuracy = [HORIZONTAL_M, HORIZONTAL_M, VERTICAL_M];
+            let ratio = FixErrorModel::decay_factor_sigma_ratio(decay);
+            let m =
+                FixErrorModel::from_decay_factor(decay, 1.0, accuracy.map(|s| s * ratio)).unwrap();
             f = f.with_fix_errors(m).unwrap();
             [WHITE_FLOOR_M; 3]
         }
@@ -231,21 +234,25 @@ fn the_decay_factor_is_the_gauss_markov_process_sampled_at_the_fixes() {
     // τ = −Δt/ln k: over one fix interval the decay is k itself, and the stationary variance
     // σ² 2/(1 + k) is what MATLAB's drive σ² 2(1 − k) sums to, 2(1 − k)/(1 − k²).
     for k in [0.5, 0.99, 0.999] {
-        let m = FixErrorModel::from_decay_factor(k, 0.2, 1.5, 3.0).unwrap();
+        let ratio = FixErrorModel::decay_factor_sigma_ratio(k);
+        let m =
+            FixErrorModel::from_decay_factor(k, 0.2, [1.5, 1.5, 3.0].map(|s| s * ratio)).unwrap();
         let (phi, q) = m.step(0.2);
         assert!((phi - k).abs() < 1e-14, "decay {phi} against {k}");
+        // MATLAB's drive, σ² 2(1 − k), per fix.
         let drive = 2.0 * (1.0 - k) * 1.5 * 1.5;
         assert!((q[0] - drive).abs() < 1e-12 * drive.max(1.0), "{q:?}");
         assert!((m.sigma_m[2] - 3.0 * (2.0 / (1.0 + k)).sqrt()).abs() < 1e-14);
-        assert_eq!(m.initial_sigma_m, [0.0; 3]);
+        // The start: the first fix's error, MATLAB's drive.
+        assert!((m.initial_sigma_m[0] * m.initial_sigma_m[0] - drive).abs() < 1e-12);
         // Two half steps are one step.
         let (half, q_half) = m.step(0.1);
         assert!((half * half - phi).abs() < 1e-14);
         assert!((q_half[0] * half * half + q_half[0] - q[0]).abs() < 1e-12);
     }
-    assert!(FixErrorModel::from_decay_factor(0.0, 1.0, 1.0, 1.0).is_none());
-    assert!(FixErrorModel::from_decay_factor(1.0, 1.0, 1.0, 1.0).is_none());
-    assert!(FixErrorModel::stationary(0.0, 1.0, 1.0).is_none());
+    assert!(FixErrorModel::from_decay_factor(0.0, 1.0, [1.0; 3]).is_none());
+    assert!(FixErrorModel::from_decay_factor(1.0, 1.0, [1.0; 3]).is_none());
+    assert!(FixErrorModel::stationary(0.0, [1.0; 3]).is_none());
     // A filter without the states refuses the model.
     let earth = FlatEarth::<Enu>::new(9.81);
     let start = EskfState::<FlatEarth<Enu>> {
@@ -258,7 +265,7 @@ fn the_decay_factor_is_the_gauss_markov_process_sampled_at_the_fixes() {
         accel_bias_m_s2: [0.0; 3],
         gyro_bias_rad_s: [0.0; 3],
     };
-    let m = FixErrorModel::stationary(60.0, 1.0, 2.0).unwrap();
+    let m = FixErrorModel::stationary(60.0, [1.0, 1.0, 2.0]).unwrap();
     let plain = Eskf::<FlatEarth<Enu>, BASE_STATES>::new(earth, &start, &SIGMA, NOISE).unwrap();
     assert!(plain.with_fix_errors(m).is_err());
     let with = Eskf::<FlatEarth<Enu>, FIX_STATES>::new(earth, &start, &SIGMA, NOISE)

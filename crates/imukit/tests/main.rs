@@ -7,6 +7,7 @@ mod core_body_rates;
 mod core_closed_form;
 mod core_sampled;
 mod core_strapdown;
+mod correlated_fixes;
 mod earth;
 mod fusion;
 mod gnss;

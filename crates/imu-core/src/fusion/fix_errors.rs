@@ -15,7 +15,8 @@
 //!
 //! MATLAB gpsSensor's `DecayFactor` `k` per fix of interval `Δt_f` is the same process sampled
 //! at the fixes: `τ = −Δt_f / ln k`, stationary deviation `σ √(2/(1 + k))`, started from zero
-//! ([`FixErrorModel::from_decay_factor`]).
+//! (the filter's start at the first fix's error, [`FixErrorModel::from_decay_factor`]); a receiver that has run for a while starts in its
+//! stationary state ([`FixErrorModel::stationary`]).
 use nalgebra::SMatrix;
 
 use super::sensor_errors::{BASE_STATES, FULL_STATES};
@@ -50,43 +51,50 @@ pub struct FixErrorModel {
     /// Correlation time `τ`, s (> 0, finite).
     pub correlation_time_s: f64,
     /// One-sigma per axis of the error at the filter's start, m: `sigma_m` for a receiver
-    /// that has run for a while, 0 for MATLAB's process, which starts from zero.
+    /// that has run for a while, one step's for MATLAB's process, which starts from zero.
     pub initial_sigma_m: [f64; 3],
 }
 
 impl FixErrorModel {
     /// MATLAB gpsSensor's position error, `x_k = k x_{k−1} + σ √(2(1 − k)) w_k` from zero, for
-    /// fixes every `fix_interval_s` with horizontal and vertical accuracies `horizontal_m`,
-    /// `vertical_m` (on the frame's x, y and z): `τ = −Δt_f / ln k`, stationary one-sigma
-    /// `σ √(2/(1 + k))`, zero at the start. `None` for a factor outside (0, 1) — 0 is white
-    /// noise and 1 an error that stays zero, neither a correlated process — or an interval
-    /// that is not positive.
+    /// fixes every `fix_interval_s`, given its stationary one-sigma per axis
+    /// (`σ ×` [`Self::decay_factor_sigma_ratio`], the receiver's accuracy σ): `τ = −Δt_f / ln k`;
+    /// at the start the first fix's error, one step of the process from zero (one-sigma
+    /// `σ √(2(1 − k))`, the stationary one times `√(1 − k²)`), so that a fix at the filter's
+    /// first sample is not taken for exact. `None` for a factor outside (0, 1) — 0 is white noise and 1 an error
+    /// that stays zero, neither a correlated process — or an interval that is not positive.
     #[must_use]
     pub fn from_decay_factor(
         decay_factor: f64,
         fix_interval_s: f64,
-        horizontal_m: f64,
-        vertical_m: f64,
+        stationary_sigma_m: [f64; 3],
     ) -> Option<Self> {
         let k = decay_factor;
         if !(k > 0.0 && k < 1.0 && fix_interval_s.is_finite() && fix_interval_s > 0.0) {
             return None;
         }
-        let scale = math::sqrt(2.0 / (1.0 + k));
+        let first_fix = math::sqrt(1.0 - k * k);
         let model = Self {
-            sigma_m: [horizontal_m, horizontal_m, vertical_m].map(|s| s * scale),
+            sigma_m: stationary_sigma_m,
             correlation_time_s: -fix_interval_s / math::ln(k),
-            initial_sigma_m: [0.0; 3],
+            initial_sigma_m: stationary_sigma_m.map(|s| s * first_fix),
         };
         model.is_valid().then_some(model)
     }
 
-    /// A first-order Gauss–Markov error of correlation time `correlation_time_s` and
-    /// stationary one-sigmas `horizontal_m`, `vertical_m`, in its stationary state at the
-    /// start. `None` for a time that is not positive or sigmas that are negative.
+    /// The stationary one-sigma of MATLAB's process over its accuracy σ: `√(2/(1 + k))` (1 for
+    /// `k = 1`, √2 for white fixes, `k = 0`).
     #[must_use]
-    pub fn stationary(correlation_time_s: f64, horizontal_m: f64, vertical_m: f64) -> Option<Self> {
-        let sigma_m = [horizontal_m, horizontal_m, vertical_m];
+    pub fn decay_factor_sigma_ratio(decay_factor: f64) -> f64 {
+        math::sqrt(2.0 / (1.0 + decay_factor))
+    }
+
+    /// A first-order Gauss–Markov error of correlation time `correlation_time_s` and
+    /// stationary one-sigma `sigma_m` per axis, in its stationary state at the start (a
+    /// receiver that has run for a while). `None` for a time that is not positive or sigmas
+    /// that are negative.
+    #[must_use]
+    pub fn stationary(correlation_time_s: f64, sigma_m: [f64; 3]) -> Option<Self> {
         let model = Self {
             sigma_m,
             correlation_time_s,

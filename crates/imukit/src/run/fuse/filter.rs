@@ -2,14 +2,17 @@
 //! stances marked, the start (a state, or an alignment), the filter built, every IMU sample
 //! propagated with the fixes and aid readings due by then, the rows written (forward, or
 //! smoothed after a backward pass).
-use imu_core::fusion::{Eskf, EskfError, EskfState, FULL_STATES, GnssFix, SensorErrorEstimate};
+use imu_core::fusion::{
+    Eskf, EskfError, EskfState, FixErrorModel, GnssFix, SensorErrorEstimate, has_fix_errors,
+    has_sensor_errors,
+};
 use imu_core::{Body, Vec3};
 
 use super::detect::{Detection, REST_START_SPEED_M_S, detected_rest_s, stances};
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
 use super::rows::{RESETS_COLUMN, fused_columns, push_fused_row};
-use super::setup::covariance_interval_refusal;
+use super::setup::{FIX_WHITE_SIGMA_M, covariance_interval_refusal};
 use super::smooth::{SMOOTHING_GAP_S, smoothed_rows};
 use super::start::{ALIGN_ATTITUDE_ALLOWANCE_RAD, ALIGN_MIN_SPEED_M_S, Begin, begin};
 use super::{Fuse, FuseSetup, FuseSummary, Start};
@@ -48,7 +51,8 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let fixes = Fixes::<E>::of(&inputs)?;
     let begin = begin(&earth, start, setup, &inputs, &fixes)?;
     aids.start_at(t[begin.first]);
-    let mut filter = new_filter::<E, S>(earth, &begin, setup)?;
+    let fix_errors = fix_error_model::<S>(setup, &inputs.g_t);
+    let mut filter = new_filter::<E, S>(earth, &begin, setup, fix_errors)?;
     let mut rows = Rows::<E, S>::new(setup, keep_filtered);
     let mut acceptance = Acceptance::default();
     let mut next_fix = begin.next_fix;
@@ -60,7 +64,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
         apply_fixes(
             &mut filter,
             (&inputs, &fixes),
-            setup,
+            (setup, fix_errors.is_some()),
             i,
             &mut next_fix,
             &mut acceptance,
@@ -163,12 +167,24 @@ fn filter_error(context: &str, source: EskfError) -> Error {
     }
 }
 
+/// The fixes' correlated error for a filter of `S` states, the decay factor's interval the
+/// fixes' median one (at times `g_t`): `None` without the fix-error states or with fewer than
+/// two fixes.
+fn fix_error_model<const S: usize>(setup: &FuseSetup, g_t: &[f64]) -> Option<FixErrorModel> {
+    if !has_fix_errors(S) {
+        return None;
+    }
+    let interval_s = crate::io::rows::Gaps::of_times(g_t, 0).median_s;
+    setup.fix_error_model(interval_s)
+}
+
 /// The filter at `begin` on `earth`, with `setup`'s noise, covariance interval, sensor-error
-/// states and smoothing.
+/// states, the fixes' correlated errors (`fix_errors`) and smoothing.
 fn new_filter<E: NavEarth, const S: usize>(
     earth: E,
     begin: &Begin<E>,
     setup: &FuseSetup,
+    fix_errors: Option<FixErrorModel>,
 ) -> Result<Eskf<E, S>> {
     let start = EskfState {
         nav: begin.state,
@@ -179,12 +195,18 @@ fn new_filter<E: NavEarth, const S: usize>(
         .map_err(|e| filter_error("filter", e))?
         .with_covariance_interval(setup.covariance_interval_s)
         .map_err(|_| covariance_interval_refusal(setup))?;
-    let filter = if S == FULL_STATES {
+    let filter = if has_sensor_errors(S) {
         filter
             .with_sensor_error_sigma(&setup.sensor_error_sigma)
             .map_err(|e| filter_error("sensor_error_sigma", e))?
     } else {
         filter
+    };
+    let filter = match fix_errors {
+        Some(model) => filter
+            .with_fix_errors(model)
+            .map_err(|e| filter_error("gnss", e))?,
+        None => filter,
     };
     if setup.smooth {
         filter
@@ -198,11 +220,12 @@ fn new_filter<E: NavEarth, const S: usize>(
 /// Applies every fix from `next_fix` stamped at or before IMU sample `i`, each valid its
 /// latency before its stamp; after [`MAX_REJECTED_IN_A_ROW`](super::MAX_REJECTED_IN_A_ROW)
 /// rejected in a row the filter is reset to the fix, the heading along its velocity when the
-/// vehicle moves.
+/// vehicle moves. With the fix-error states (`correlated`) a fix is told only its white part:
+/// its own accuracy columns, else [`FIX_WHITE_SIGMA_M`].
 fn apply_fixes<E: NavEarth, const S: usize>(
     filter: &mut Eskf<E, S>,
     (inputs, fixes): (&FusionInputs, &Fixes<E>),
-    setup: &FuseSetup,
+    (setup, correlated): (&FuseSetup, bool),
     i: usize,
     next_fix: &mut usize,
     acceptance: &mut Acceptance,
@@ -227,10 +250,14 @@ fn apply_fixes<E: NavEarth, const S: usize>(
                 .filter(|_| inputs.velocities != FixVelocity::None)
                 .map(|_| fixes.velocity[k]),
             lever_arm_m: Vec3::<Body>::from_array(setup.lever_arm_m),
-            position_sigma_m: inputs
-                .accuracy
-                .as_ref()
-                .map_or(setup.gnss_position_sigma_m, |a| a[k]),
+            position_sigma_m: inputs.accuracy.as_ref().map_or(
+                if correlated {
+                    [FIX_WHITE_SIGMA_M; 3]
+                } else {
+                    setup.gnss_position_sigma_m
+                },
+                |a| a[k],
+            ),
             velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma],
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,
@@ -272,7 +299,7 @@ impl<E: NavEarth, const S: usize> Rows<E, S> {
     fn new(setup: &FuseSetup, keep_filtered: bool) -> Self {
         let mut columns: Vec<&str> = FUSE_COLUMNS.to_vec();
         columns.extend(E::POSITION_COLUMNS);
-        let mut columns = fused_columns(&columns, S == FULL_STATES);
+        let mut columns = fused_columns(&columns, has_sensor_errors(S));
         columns.push(RESETS_COLUMN.to_string());
         let filtered_table = (setup.smooth && keep_filtered).then(|| Table {
             columns: columns.clone(),

@@ -35,14 +35,15 @@ pub use recovery::{MAX_REJECTED_IN_A_ROW, MAX_RESETS_IN_A_ROW};
 pub use request::{AlignName, FuseRequest, STATIC_ALIGN_S, Start};
 pub use rows::{RESETS_COLUMN, sensor_error_columns};
 pub use setup::{
-    AidingSetup, CHI2_99_9_6DOF, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S, FuseSetup,
-    G_SENSITIVITY_STATES_FROM, Gate, MIN_G_SENSITIVITY_SIGMA, MIN_SENSOR_ERROR_SIGMA, NHC_RATE_HZ,
-    OdometerModel, REST_VELOCITY_SIGMA_M_S, SENSOR_ERROR_STATES_FROM,
+    AidingSetup, CHI2_99_9_6DOF, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S,
+    FIX_WHITE_SIGMA_M, FuseSetup, G_SENSITIVITY_STATES_FROM, Gate, MIN_G_SENSITIVITY_SIGMA,
+    MIN_SENSOR_ERROR_SIGMA, NHC_RATE_HZ, OdometerModel, REST_VELOCITY_SIGMA_M_S,
+    SENSOR_ERROR_STATES_FROM,
 };
 pub use smooth::SMOOTHING_GAP_S;
 pub use start::{ALIGN_ATTITUDE_ALLOWANCE_RAD, ALIGN_MIN_SPEED_M_S, gnss_alignment_sigma};
 
-use imu_core::fusion::{BASE_STATES, FULL_STATES};
+use imu_core::fusion::{BASE_STATES, FIX_ERROR_STATES, FULL_STATES};
 
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
@@ -184,10 +185,15 @@ impl EarthJob for Fuse<'_> {
     type Output = Result<(Table, Option<Table>, FuseSummary)>;
 
     fn run<E: NavEarth>(self, earth: E) -> Self::Output {
-        if self.setup.estimate_sensor_errors {
-            filter::fuse_on::<E, FULL_STATES>(earth, self)
-        } else {
-            filter::fuse_on::<E, BASE_STATES>(earth, self)
+        const FIXES: usize = FIX_ERROR_STATES;
+        match (
+            self.setup.estimate_sensor_errors,
+            self.setup.correlated_fixes(),
+        ) {
+            (false, false) => filter::fuse_on::<E, BASE_STATES>(earth, self),
+            (false, true) => filter::fuse_on::<E, { BASE_STATES + FIXES }>(earth, self),
+            (true, false) => filter::fuse_on::<E, FULL_STATES>(earth, self),
+            (true, true) => filter::fuse_on::<E, { FULL_STATES + FIXES }>(earth, self),
         }
     }
 }

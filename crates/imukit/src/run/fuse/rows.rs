@@ -1,6 +1,8 @@
 //! The fused table's rows: the navigation columns, the one-sigmas, the bias estimates, the
 //! position on the Earth, the sensor errors when estimated, the resets so far.
-use imu_core::fusion::{EskfState, FULL_STATES, SensorErrorEstimate};
+use imu_core::fusion::{
+    BASE_STATES, EskfState, FULL_STATES, SensorErrorEstimate, has_sensor_errors,
+};
 
 use crate::io::columns::NAV_COLUMNS;
 use crate::io::table::Table;
@@ -79,8 +81,8 @@ pub(super) fn push_fused_row<E: NavEarth, const S: usize>(
     row.extend_from_slice(&s.gyro_bias_rad_s);
     row.extend_from_slice(&sig[9..15]);
     row.extend_from_slice(&nav[base..nav_width]);
-    if S == FULL_STATES {
-        push_sensor_errors(row, errors, &sig[15..]);
+    if has_sensor_errors(S) {
+        push_sensor_errors(row, errors, &sig[BASE_STATES..FULL_STATES]);
     }
     #[allow(clippy::cast_precision_loss)]
     row.push(resets as f64);

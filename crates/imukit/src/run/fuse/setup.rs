@@ -2,8 +2,9 @@
 //! its policy (gate, covariance interval, rest, smoothing, stances) and the settings it takes
 //! from a scenario or a part's figures.
 use imu_core::AccelSign;
+use imu_core::aiding::PositionNoise;
 use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
-use imu_core::fusion::{EskfNoise, InitialSigma, SensorErrorSigma};
+use imu_core::fusion::{EskfNoise, FixErrorModel, InitialSigma, SensorErrorSigma};
 
 use super::FuseModel;
 use crate::error::{Error, Result, invalid};
@@ -30,8 +31,16 @@ pub struct FuseSetup {
     /// accuracy from them (the filter's `initial_sigma` keeps wider floors for parts that give
     /// no figure).
     pub part_bias: [f64; 2],
-    /// GNSS position one-sigma (x, y, z of the frame), m.
+    /// GNSS position one-sigma (x, y, z of the frame), m: white fixes' own, or the stationary
+    /// deviation of correlated ones.
     pub gnss_position_sigma_m: [f64; 3],
+    /// How the fixes' position errors evolve (the receiver's `[gnss]` model). Correlated in
+    /// time — MATLAB's decay factor `k` in (0, 1) per fix, or a Gauss–Markov correlation
+    /// time — they become filter states (`imu_core::fusion::fix_errors`) of stationary
+    /// one-sigma `gnss_position_sigma_m`, each fix then told only a white part of
+    /// [`FIX_WHITE_SIGMA_M`] (or its own accuracy columns): MATLAB's process starts from zero, a
+    /// Gauss–Markov one in its stationary state. A decay factor of 0 or 1: white fixes.
+    pub gnss_position_noise: PositionNoise,
     /// GNSS velocity one-sigma per axis, m/s (`None`: position only).
     pub gnss_velocity_sigma_m_s: Option<f64>,
     /// Antenna lever arm, body frame, m.
@@ -133,6 +142,11 @@ pub struct OdometerModel {
     pub scale_factor_error: f64,
 }
 
+/// The white part of a correlated fix's error the filter is told when the fixes carry no
+/// accuracy of their own, m: MATLAB's processes have none, and a filter told none would have
+/// nothing between its state and the fix but the fix-error states.
+pub const FIX_WHITE_SIGMA_M: f64 = 1e-3;
+
 /// The least initial one-sigma of a scale-factor or misalignment entry the filter estimates
 /// (a fraction: 100 ppm), for parts whose parameters state none.
 pub const MIN_SENSOR_ERROR_SIGMA: f64 = 1e-4;
@@ -204,6 +218,28 @@ impl FuseSetup {
         }
     }
 
+    /// The fixes' correlated error as the filter models it, for fixes every `fix_interval_s`
+    /// (the decay factor is per fix): `None` for white fixes
+    /// ([`FuseSetup::gnss_position_noise`]) or an interval that is not positive.
+    #[must_use]
+    pub fn fix_error_model(&self, fix_interval_s: f64) -> Option<FixErrorModel> {
+        match self.gnss_position_noise {
+            PositionNoise::DecayFactor(k) => {
+                FixErrorModel::from_decay_factor(k, fix_interval_s, self.gnss_position_sigma_m)
+            }
+            PositionNoise::GaussMarkov { correlation_time_s } => {
+                FixErrorModel::stationary(correlation_time_s, self.gnss_position_sigma_m)
+            }
+        }
+    }
+
+    /// Whether the fixes' errors are correlated in time, so that the filter carries them as
+    /// states ([`FuseSetup::fix_error_model`]).
+    #[must_use]
+    pub fn correlated_fixes(&self) -> bool {
+        self.fix_error_model(1.0).is_some()
+    }
+
     /// Whether the part's own scale-factor, misalignment or g-sensitivity figures are large
     /// enough ([`SENSOR_ERROR_STATES_FROM`], [`G_SENSITIVITY_STATES_FROM`]) that the filter
     /// should estimate them: what `fuse` does when not told (never for figures that are not
@@ -223,9 +259,10 @@ impl FuseSetup {
     }
 
     /// The filter for data simulated by `scenario`: its frame, accelerometer sign, gravity, the
-    /// IMU's noise (white and drift PSDs, `imu_core::fusion::process_noise`) and the `[gnss]` receiver's accuracy and lever arm (the fixes'
-    /// stationary deviation, `σ √(2/(1 + k))` for MATLAB's decay factor `k`, as white noise; the
-    /// filter assumes uncorrelated fixes). Initial uncertainty: position as the fixes, 0.1 m/s,
+    /// IMU's noise (white and drift PSDs, `imu_core::fusion::process_noise`) and the `[gnss]`
+    /// receiver's accuracy, error process and lever arm (the fixes' stationary deviation,
+    /// `σ √(2/(1 + k))` for MATLAB's decay factor `k`; correlated fixes' errors as filter
+    /// states, [`FuseSetup::gnss_position_noise`]). Initial uncertainty: position as the fixes, 0.1 m/s,
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
     /// 0.01 m/s² and 1e-4 rad/s). Aids: the `[odometer]` noise and scale-factor error, the
     /// `[baro]` noise with its bias in quadrature (neither estimated); the non-holonomic
@@ -264,16 +301,16 @@ impl FuseSetup {
 
     /// The filter's setup from its model ([`FuseModel`]): noise from the part's densities at
     /// the sample rate, initial uncertainty from its biases and the fixes' accuracy, the
-    /// GNSS one-sigmas from the receiver's accuracies (MATLAB's decay factor's steady share),
+    /// GNSS one-sigmas from the receiver's accuracies (MATLAB's decay factor's steady share) and
+    /// its error process,
     /// the gate at 99.9 %, the covariance every [`DEFAULT_COVARIANCE_INTERVAL_S`].
     #[must_use]
     pub fn from_model(m: &FuseModel<'_>) -> Self {
-        use imu_core::aiding::PositionNoise;
         let p = m.imu;
         let noise = eskf_noise(&p.accelerometer, &p.gyroscope, m.sample_rate_hz);
         let g = m.gnss;
         let scale = match g.position_noise {
-            PositionNoise::DecayFactor(k) => (2.0 / (1.0 + k)).sqrt(),
+            PositionNoise::DecayFactor(k) => FixErrorModel::decay_factor_sigma_ratio(k),
             PositionNoise::GaussMarkov { .. } => 1.0,
         };
         // A zero accuracy (exact fixes) still needs a little trust in the model.
@@ -305,6 +342,7 @@ impl FuseSetup {
                     .hypot(FLICKER_FLOOR * max_abs(p.gyroscope.bias_instability)),
             ],
             gnss_position_sigma_m: [h, h, v],
+            gnss_position_noise: g.position_noise,
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: m.lever_arm_m,
             gnss_latency_s: m.gnss_latency_s,

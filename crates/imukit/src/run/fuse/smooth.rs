@@ -1,7 +1,7 @@
 //! The smoothed estimate: the backward pass over the filter's epochs, and each sample's
 //! filtered state corrected by the smoothed correction interpolated between the epochs.
 use imu_core::fusion::smoother::{ErrorVector, rts_backward};
-use imu_core::fusion::{EskfState, FULL_STATES, SensorErrorEstimate, corrected_state};
+use imu_core::fusion::{EskfState, SensorErrorEstimate, corrected_state, has_sensor_errors};
 
 use super::rows::push_fused_row;
 use crate::io::table::Table;
@@ -55,7 +55,7 @@ pub(super) fn smoothed_rows<E: NavEarth, const S: usize>(
         };
         let s = corrected_state(earth, state, dx.as_slice());
         let mut e = *errors;
-        if S == FULL_STATES {
+        if has_sensor_errors(S) {
             for k in 0..9 {
                 e.accel[k / 3][k % 3] += dx[15 + k];
                 e.gyro[k / 3][k % 3] += dx[24 + k];
