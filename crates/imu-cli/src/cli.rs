@@ -524,13 +524,15 @@ pub struct FuseArgs {
     #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
           conflicts_with = "scenario")]
     pub gnss_lever_arm_m: Option<Vec<f64>>,
-    /// Without --scenario: the fixes' MATLAB `DecayFactor` (0: white; MATLAB gpsSensor's
-    /// 0.999 when left out), as a scenario's `[gnss] decay_factor`: the filter takes the
-    /// fixes' stationary deviation from it.
+    /// Without --scenario: the fixes' MATLAB `DecayFactor` per fix, as a scenario's `[gnss]
+    /// decay_factor` (0: white fixes of σ√2; between 0 and 1 the error drifts from the first
+    /// fix and the filter estimates it). Left out, with no correlation time either, the fixes
+    /// are taken as white with the accuracies given.
     #[arg(long, conflicts_with_all = ["scenario", "gnss_correlation_time_s"], allow_hyphen_values = true)]
     pub gnss_decay_factor: Option<f64>,
-    /// Without --scenario: instead of the decay factor, a Gauss–Markov position error with this
-    /// correlation time, s (`[gnss] correlation_time_s`).
+    /// Without --scenario: instead of the decay factor, a receiver's Gauss–Markov position error
+    /// with this correlation time, s (`[gnss] correlation_time_s`), of the horizontal and
+    /// vertical accuracies as its one-sigma: the filter estimates it.
     #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
     pub gnss_correlation_time_s: Option<f64>,
     /// Without --scenario: the fixes are stamped this late, s (`[gnss] latency_s`; 0).

@@ -122,3 +122,27 @@ fn fixes_with_a_decay_factor_of_0_99_and_0_999_leave_the_uncertainty_honest() {
         }
     }
 }
+
+#[test]
+fn a_receiver_whose_process_is_not_stated_is_taken_as_white() {
+    // The road's receiver without its decay factor: the simulator draws MATLAB's default
+    // (0.999), the filter takes the fixes as white; a correlation time makes them states, in
+    // their stationary state from the start.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(dir.join("car_tunnel.toml")).unwrap();
+    let setup = |replacement: &str| {
+        let text = text.replace("decay_factor = 0.0", replacement);
+        let sc = ScenarioSpec::from_toml(&text, "car_tunnel.toml")
+            .unwrap()
+            .resolve(&dir)
+            .unwrap();
+        FuseSetup::from_scenario(&sc).unwrap()
+    };
+    assert!(!setup("").correlated_fixes());
+    assert!(!setup("decay_factor = 0.0").correlated_fixes());
+    let markov = setup("correlation_time_s = 30.0");
+    let model = markov.fix_error_model(0.2).unwrap();
+    assert_eq!(model.correlation_time_s, 30.0);
+    assert_eq!(model.initial_sigma_m, markov.gnss_position_sigma_m);
+    assert_eq!(model.sigma_m, [1.5, 1.5, 3.0]);
+}

@@ -71,7 +71,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
             gyro_bias_rad_s: 1e-5,
         },
         gnss_position_sigma_m: [1e-3; 3],
-        gnss_position_noise: imu_core::aiding::PositionNoise::DecayFactor(0.0),
+        gnss_position_noise: None,
         gnss_velocity_sigma_m_s: Some(1e-3),
         lever_arm_m: [0.0; 3],
         gnss_latency_s: 0.0,

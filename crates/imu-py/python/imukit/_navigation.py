@@ -198,7 +198,9 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     ``gnss_velocity_accuracy_m_s``, ``gnss_lever_arm_m``, ``gnss_decay_factor`` (or
     ``gnss_correlation_time_s``) and ``gnss_latency_s`` the receiver, as a scenario's ``[gnss]``
     keys of those names (MATLAB gpsSensor's defaults for those left out: the same figures give
-    the same estimate); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
+    the same estimate; a receiver whose process — decay factor or correlation time — is stated
+    has its correlated errors estimated by the filter, one whose process is not is taken as
+    white); ``nav_frame``, ``earth``, ``earth_gravity``, ``accel_sign`` and
     ``gravity_m_s2`` say what the tables are in: left out, what the tables' descriptions say
     (a simulated or read table knows its frame), else imukit's defaults (the sign the part's
     profile's). With a scenario, tables or arguments that contradict it are refused. The sample

@@ -68,9 +68,19 @@ pub struct GnssSetup {
     pub outages: Vec<(f64, f64)>,
     /// Seed of the noise.
     pub seed: u64,
+    /// Whether the receiver's error process was stated ([`GnssSpec::process_stated`]).
+    pub process_stated: bool,
 }
 
 impl GnssSpec {
+    /// Whether the receiver's error process is stated (a decay factor or a correlation time),
+    /// not MATLAB's default: a filter models correlated fixes only then, and takes a receiver
+    /// of unknown process as white (the simulator draws MATLAB's default either way).
+    #[must_use]
+    pub fn process_stated(&self) -> bool {
+        self.decay_factor.is_some() || self.correlation_time_s.is_some()
+    }
+
     /// The receiver's error model: these keys, MATLAB's defaults for the others (the rate
     /// unchecked against any IMU's).
     ///
@@ -162,6 +172,7 @@ impl GnssSpec {
             latency_s,
             outages,
             seed,
+            process_stated: self.process_stated(),
         })
     }
 }

@@ -27,6 +27,10 @@ pub struct FuseModel<'a> {
     pub sample_rate_hz: f64,
     /// The receiver's accuracies and noise model.
     pub gnss: &'a imu_core::aiding::GnssParams,
+    /// Whether the receiver's error process (decay factor or correlation time) is stated, not
+    /// a default: only then are correlated fixes modelled as such
+    /// ([`FuseSetup::gnss_position_noise`]); a receiver of unknown process is taken as white.
+    pub gnss_process_stated: bool,
     /// Antenna lever arm, body frame, m.
     pub lever_arm_m: [f64; 3],
     /// The receiver's latency, s.
@@ -215,6 +219,7 @@ impl PartModel {
             imu: &sensors.params,
             sample_rate_hz,
             gnss: &gnss,
+            gnss_process_stated: self.gnss.process_stated(),
             lever_arm_m: crate::scenario::resolve::finite_vec(
                 "gnss.lever_arm_m",
                 self.gnss.lever_arm_m.unwrap_or([0.0; 3]),

@@ -34,13 +34,14 @@ pub struct FuseSetup {
     /// GNSS position one-sigma (x, y, z of the frame), m: white fixes' own, or the stationary
     /// deviation of correlated ones.
     pub gnss_position_sigma_m: [f64; 3],
-    /// How the fixes' position errors evolve (the receiver's `[gnss]` model). Correlated in
-    /// time — MATLAB's decay factor `k` in (0, 1) per fix, or a Gauss–Markov correlation
-    /// time — they become filter states (`imu_core::fusion::fix_errors`) of stationary
-    /// one-sigma `gnss_position_sigma_m`, each fix then told only a white part of
-    /// [`FIX_WHITE_SIGMA_M`] (or its own accuracy columns): MATLAB's process starts from zero, a
-    /// Gauss–Markov one in its stationary state. A decay factor of 0 or 1: white fixes.
-    pub gnss_position_noise: PositionNoise,
+    /// How the fixes' position errors evolve (the receiver's `[gnss]` model), when it is
+    /// stated. Correlated in time — MATLAB's decay factor `k` in (0, 1) per fix, or a
+    /// Gauss–Markov correlation time — they become filter states
+    /// (`imu_core::fusion::fix_errors`) of stationary one-sigma `gnss_position_sigma_m`, each
+    /// fix then told only a white part of [`FIX_WHITE_SIGMA_M`] (or its own accuracy columns):
+    /// MATLAB's process from its first fix, a Gauss–Markov one in its stationary state. A decay
+    /// factor of 0 or 1, or no process stated (`None`): white fixes.
+    pub gnss_position_noise: Option<PositionNoise>,
     /// GNSS velocity one-sigma per axis, m/s (`None`: position only).
     pub gnss_velocity_sigma_m_s: Option<f64>,
     /// Antenna lever arm, body frame, m.
@@ -223,7 +224,7 @@ impl FuseSetup {
     /// ([`FuseSetup::gnss_position_noise`]) or an interval that is not positive.
     #[must_use]
     pub fn fix_error_model(&self, fix_interval_s: f64) -> Option<FixErrorModel> {
-        match self.gnss_position_noise {
+        match self.gnss_position_noise? {
             PositionNoise::DecayFactor(k) => {
                 FixErrorModel::from_decay_factor(k, fix_interval_s, self.gnss_position_sigma_m)
             }
@@ -262,7 +263,7 @@ impl FuseSetup {
     /// IMU's noise (white and drift PSDs, `imu_core::fusion::process_noise`) and the `[gnss]`
     /// receiver's accuracy, error process and lever arm (the fixes' stationary deviation,
     /// `σ √(2/(1 + k))` for MATLAB's decay factor `k`; correlated fixes' errors as filter
-    /// states, [`FuseSetup::gnss_position_noise`]). Initial uncertainty: position as the fixes, 0.1 m/s,
+    /// states when `[gnss]` states its process, [`FuseSetup::gnss_position_noise`]). Initial uncertainty: position as the fixes, 0.1 m/s,
     /// 0.01 rad of tilt and 0.05 rad of heading, and the parts' constant biases (at least
     /// 0.01 m/s² and 1e-4 rad/s). Aids: the `[odometer]` noise and scale-factor error, the
     /// `[baro]` noise with its bias in quadrature (neither estimated); the non-holonomic
@@ -289,6 +290,7 @@ impl FuseSetup {
             imu: &scenario.imu.sensors.params,
             sample_rate_hz: scenario.sample_rate_hz,
             gnss: &gnss.params,
+            gnss_process_stated: gnss.process_stated,
             lever_arm_m: gnss.lever_arm_m,
             gnss_latency_s: gnss.latency_s,
             odometer: scenario.odometer.map(|o| OdometerModel {
@@ -342,7 +344,7 @@ impl FuseSetup {
                     .hypot(FLICKER_FLOOR * max_abs(p.gyroscope.bias_instability)),
             ],
             gnss_position_sigma_m: [h, h, v],
-            gnss_position_noise: g.position_noise,
+            gnss_position_noise: m.gnss_process_stated.then_some(g.position_noise),
             gnss_velocity_sigma_m_s: Some(floor(g.velocity_accuracy_m_s)),
             lever_arm_m: m.lever_arm_m,
             gnss_latency_s: m.gnss_latency_s,
