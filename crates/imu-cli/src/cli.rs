@@ -136,9 +136,10 @@ pub enum Command {
     /// `imufilter` and `ahrsfilter` (MATLAB's Kalman filters), `ecompass`, `madgwick`, `mahony`
     /// or `complementary`.
     Orient(OrientArgs),
-    /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states) over IMU rates
-    /// and GNSS fixes, the filter's model taken from the scenario that made them (`[imu]` errors,
-    /// `[gnss]` accuracy and lever arm); writes the navigation columns, their one-sigma and the
+    /// Loosely coupled INS/GNSS fusion: an error-state Kalman filter (15 states; the sensor
+    /// errors and the fixes' lasting errors add more) over IMU rates and GNSS fixes, the filter's
+    /// model taken from the scenario that made them (`[imu]` errors, `[gnss]` accuracy, process
+    /// and lever arm) or from the part and receiver named; writes the navigation columns, their one-sigma and the
     /// bias estimates with their one-sigma.
     Fuse(FuseArgs),
     /// Which IMU bridges a GNSS outage: a scenario with `[[gnss.outages]]` simulated with each

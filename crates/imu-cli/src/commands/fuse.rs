@@ -238,10 +238,24 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         last("pos_z_sigma_m"),
         a.out.display()
     );
-    let states = if summary.sensor_errors {
-        "36 states (with the sensor errors)"
+    let with: Vec<String> = [
+        summary
+            .sensor_errors
+            .then(|| "the sensor errors".to_owned()),
+        summary.fix_errors.map(|m| {
+            format!(
+                "the fixes' errors, correlation time {:.1} s",
+                m.correlation_time_s
+            )
+        }),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let states = if with.is_empty() {
+        format!("{} states", summary.states)
     } else {
-        "15 states"
+        format!("{} states (with {})", summary.states, with.join(" and "))
     };
     let rest = match (summary.rest_detected, summary.rest_s > 0.0) {
         (true, true) => format!("a rest of {:.2} s found at the start", summary.rest_s),

@@ -84,6 +84,8 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             rest_s: setup.rest_s,
             rest_detected: setup.detect_rest,
             sensor_errors: setup.estimate_sensor_errors,
+            fix_errors,
+            states: S,
             stance_samples: stances,
             detection,
         },

@@ -72,8 +72,12 @@ pub struct FuseSummary {
     pub rest_s: f64,
     /// Whether that rest was found in the readings ([`FuseSetup::detect_rest`]).
     pub rest_detected: bool,
-    /// Whether the sensor-error states were estimated (36 states).
+    /// Whether the sensor-error states were estimated (36 or 39 states).
     pub sensor_errors: bool,
+    /// The fixes' correlated error the filter estimated (18 or 39 states), as modelled.
+    pub fix_errors: Option<imu_core::fusion::FixErrorModel>,
+    /// The filter's error states: 15, 18, 36 or 39.
+    pub states: usize,
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet
