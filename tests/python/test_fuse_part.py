@@ -188,3 +188,18 @@ def test_a_receiver_stated_as_arguments_fuses_as_the_scenario_does():
     assert all(np.array_equal(by_scenario[c], by_arguments[c]) for c in by_scenario.columns)
     matlab = imukit.fuse(sim.imu, sim.gnss, initial=sim.truth, **stated)
     assert not np.array_equal(matlab["pos_x_sigma_m"], by_scenario["pos_x_sigma_m"])
+
+
+def test_gnss_adaptive_is_the_same_switch_in_python(drive):
+    """`--gnss-adaptive` and `gnss_adaptive=True` scale the fixes' noise alike (the scaling
+    itself is tested in crates/imu-cli/tests/fuse_model.rs and crates/imukit/tests)."""
+    tmp, _, files = drive
+    out = tmp / "adaptive.csv"
+    done = fuse(files, out, *PART, "--gnss-adaptive")
+    assert done.returncode == 0, done.stderr
+    imu, gnss, truth = (imukit.read(files[k]) for k in ("imu", "gnss", "truth"))
+    python = imukit.fuse(imu, gnss, initial=truth, imu_model="stim300", gnss_horizontal_accuracy_m=1.5,
+                         gnss_vertical_accuracy_m=3.0, gnss_velocity_accuracy_m_s=0.1, gnss_adaptive=True)
+    cli = imukit.read(out)
+    for column in cli:
+        np.testing.assert_array_equal(python[column], cli[column], err_msg=column)

@@ -539,6 +539,12 @@ pub struct FuseArgs {
     /// Without --scenario: the fixes are stamped this late, s (`[gnss] latency_s`; 0).
     #[arg(long, conflicts_with = "scenario", allow_hyphen_values = true)]
     pub gnss_latency_s: Option<f64>,
+    /// Scale the fixes' noise from their innovations: every 8 fixes whose normalised innovations
+    /// lie outside a consistent filter's 99 % range scale it by their mean, between the stated
+    /// accuracy and 5× it (a receiver worse than its figures). Off by default: the innovations
+    /// cannot tell a receiver worse than stated from an IMU worse than modelled.
+    #[arg(long)]
+    pub gnss_adaptive: bool,
     /// Each fix's horizontal accuracy from its `hdop` column (an NMEA log's) times this
     /// user-equivalent range error, m (one-sigma).
     #[arg(long, allow_hyphen_values = true)]

@@ -186,3 +186,57 @@ fn a_receivers_per_axis_sigmas_are_read_as_its_horizontal_and_vertical_accuracy_
         "{log}"
     );
 }
+
+#[test]
+fn a_receiver_worse_than_stated_is_scaled_with_gnss_adaptive_and_said_so() {
+    // The tunnel road's fixes drawn three times worse than the receiver the filter is told of
+    // (white, 4.5 m / 9 m / 0.3 m/s against 1.5 m / 3 m / 0.1 m/s): taken as stated the filter
+    // loses them; with --gnss-adaptive it scales their noise, is never reset and says by how much.
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    let text = std::fs::read_to_string(&example)
+        .unwrap()
+        .replace("horizontal_accuracy_m = 1.5", "horizontal_accuracy_m = 4.5")
+        .replace("vertical_accuracy_m = 3.0", "vertical_accuracy_m = 9.0")
+        .replace("velocity_accuracy_m_s = 0.1", "velocity_accuracy_m_s = 0.3");
+    let worse = dir.path().join("worse.toml");
+    std::fs::write(&worse, text).unwrap();
+    simulate_drive(&worse, dir.path(), true);
+    let file = |name: &str| dir.path().join(name);
+    let fuse = |extra: &[&str], to: &str| {
+        imukit()
+            .arg("fuse")
+            .arg(file("imu.csv"))
+            .arg(file("gnss.csv"))
+            .arg("--init")
+            .arg(file("truth.csv"))
+            .args(["--scenario", example.to_str().unwrap()])
+            .args(extra)
+            .arg("--out")
+            .arg(file(to))
+            .output()
+            .unwrap()
+    };
+    let stated = fuse(&[], "stated.csv");
+    let log = String::from_utf8_lossy(&stated.stderr).to_string();
+    assert!(
+        !stated.status.success() || log.contains("reset to them"),
+        "{log}"
+    );
+    let adaptive = fuse(&["--gnss-adaptive"], "adaptive.csv");
+    let log = String::from_utf8_lossy(&adaptive.stderr).to_string();
+    assert!(adaptive.status.success(), "{log}");
+    assert!(!log.contains("reset to them"), "{log}");
+    let note = log
+        .lines()
+        .find(|l| l.contains("noisier than stated"))
+        .unwrap_or_else(|| panic!("{log}"));
+    // The one-sigmas scaled by about the factor the fixes are worse (3), within the bound (5).
+    let factor: f64 = note
+        .split("were ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap();
+    assert!((2.0..=5.0).contains(&factor), "{note}");
+}

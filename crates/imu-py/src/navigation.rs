@@ -220,7 +220,8 @@ fn compare<'py>(
                     scenario, *, format = "dict", base_dir = ".", gate = true, align = None,
                     odometer_columns = None, odometer_values = None, baro_columns = None,
                     baro_values = None, nhc_sigma_m_s = None, covariance_interval_s = None,
-                    sensor_errors = None, rest_s = None, smooth = false, zupt = false, imu_model = None, part = None,
+                    sensor_errors = None, rest_s = None, smooth = false, zupt = false, gnss_adaptive = false,
+                    imu_model = None, part = None,
                     gnss_horizontal_accuracy_m = None, gnss_vertical_accuracy_m = None,
                     gnss_velocity_accuracy_m_s = None, gnss_lever_arm_m = None,
                     gnss_decay_factor = None, gnss_correlation_time_s = None, gnss_latency_s = None,
@@ -251,6 +252,7 @@ fn fuse<'py>(
     rest_s: Option<f64>,
     smooth: bool,
     zupt: bool,
+    gnss_adaptive: bool,
     imu_model: Option<String>,
     part: Option<String>,
     gnss_horizontal_accuracy_m: Option<f64>,
@@ -354,6 +356,7 @@ fn fuse<'py>(
                 rest_s,
                 smooth,
                 zupt,
+                adapt_fixes: gnss_adaptive,
             };
             let (setup, start) = match model {
                 Model::Scenario(spec) => {

@@ -30,12 +30,29 @@ const PART: &str = "[imu.accelerometer]\nNoiseDensity = 0.003\nRandomWalk = 2e-4
 /// The road without its outage and odometer, the receiver's decay factor `decay`, the IMU
 /// [`PART`].
 fn road(decay: f64) -> imukit::Scenario {
+    road_with(decay, 1.0)
+}
+
+/// [`road`] with the receiver's accuracies (position and velocity) `worse` times the road's.
+fn road_with(decay: f64, worse: f64) -> imukit::Scenario {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let text = std::fs::read_to_string(dir.join("car_tunnel.toml")).unwrap();
     let text = text
         .replace("decay_factor = 0.0", &format!("decay_factor = {decay}"))
         .replace("preset = \"stim300\"", "#")
-        .replace("seed = 11\n", &format!("seed = 11\n{PART}\n"));
+        .replace("seed = 11\n", &format!("seed = 11\n{PART}\n"))
+        .replace(
+            "horizontal_accuracy_m = 1.5",
+            &format!("horizontal_accuracy_m = {}", 1.5 * worse),
+        )
+        .replace(
+            "vertical_accuracy_m = 3.0",
+            &format!("vertical_accuracy_m = {}", 3.0 * worse),
+        )
+        .replace(
+            "velocity_accuracy_m_s = 0.1",
+            &format!("velocity_accuracy_m_s = {}", 0.1 * worse),
+        );
     let cut = text.find("[[gnss.outages]]").unwrap();
     ScenarioSpec::from_toml(&text[..cut], "car_tunnel.toml")
         .unwrap()
@@ -58,9 +75,14 @@ const CHECKS_S: [f64; 29] = {
 /// Average NEES of position and velocity over [`RUNS`] runs and the epochs [`CHECKS_S`],
 /// filtered and smoothed (`[filtered, smoothed][position, velocity]`).
 fn average_nees(decay: f64) -> [[f64; 2]; 2] {
-    let sc = road(decay);
-    let setup = FuseSetup::from_scenario(&sc).unwrap();
+    let setup = FuseSetup::from_scenario(&road(decay)).unwrap();
     assert_eq!(setup.correlated_fixes(), decay > 0.0);
+    average_nees_of(&road(decay), &setup)
+}
+
+/// [`average_nees`] of the data of `sc` fused with `setup`.
+fn average_nees_of(sc: &imukit::Scenario, setup: &FuseSetup) -> [[f64; 2]; 2] {
+    let setup = *setup;
     let mut sums = [[0.0; 2]; 2];
     for run in 0..RUNS {
         let sim = sc.simulate_run(run).unwrap();
@@ -145,4 +167,40 @@ fn a_receiver_whose_process_is_not_stated_is_taken_as_white() {
     assert_eq!(model.correlation_time_s, 30.0);
     assert_eq!(model.initial_sigma_m, markov.gnss_position_sigma_m);
     assert_eq!(model.sigma_m, [1.5, 1.5, 3.0]);
+}
+
+#[test]
+fn a_receiver_three_times_worse_than_stated_is_found_out_by_its_innovations() {
+    // White fixes three times worse (position and velocity) than the filter is told: taken as
+    // stated, they are lost; with the fixes' noise scaled from their
+    // innovations (up to 25× in variance) it is inside them, filtered and smoothed.
+    let runs = RUNS as f64;
+    let (lo, hi) = (
+        chi2_quantile(3.0 * runs, -1.959_964) / runs,
+        chi2_quantile(3.0 * runs, 1.959_964) / runs,
+    );
+    let data = road_with(0.0, 3.0);
+    let told = FuseSetup::from_scenario(&road(0.0)).unwrap();
+    // Taken as stated, the filter rejects the fixes, is reset to them and gives up.
+    let sim = data.simulate_run(0).unwrap();
+    let initial = InitialState::from_table(&sim.truth).unwrap();
+    match fuse(&sim.imu, sim.gnss.as_ref().unwrap(), &initial, &told) {
+        Ok((_, summary)) => assert!(summary.resets > 0, "{summary:?}"),
+        Err(e) => assert!(matches!(e, imukit::Error::Diverged { .. }), "{e}"),
+    }
+    let adaptive = FuseSetup {
+        max_fix_noise_scale: imukit::run::fuse::DEFAULT_MAX_FIX_NOISE_SCALE,
+        ..told
+    };
+    let nees = average_nees_of(&data, &adaptive);
+    eprintln!("scaled from the innovations: NEES {nees:?}, bounds [{lo:.3}, {hi:.3}]");
+    for (s, name) in ["filtered", "smoothed"].iter().enumerate() {
+        for (q, what) in ["position", "velocity"].iter().enumerate() {
+            let v = nees[s][q];
+            assert!(
+                (lo..=hi).contains(&v),
+                "{name} {what}: NEES {v} outside [{lo}, {hi}]"
+            );
+        }
+    }
 }

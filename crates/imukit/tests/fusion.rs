@@ -79,6 +79,7 @@ fn ideal_sensors_and_exact_fixes_reproduce_the_truth() {
         gate: Gate::Off,
         aiding: Default::default(),
         covariance_interval_s: 0.0,
+        max_fix_noise_scale: 1.0,
         estimate_sensor_errors: false,
         figures_known: true,
         sensor_error_sigma: SensorErrorSigma {

@@ -41,6 +41,8 @@ pub struct Args<'a> {
     pub rest_s: Option<f64>,
     pub smooth: bool,
     pub zupt: bool,
+    /// `--gnss-adaptive`.
+    pub gnss_adaptive: bool,
     /// `--start-s`, `--end-s`: every input is cut at the same instants.
     pub window: TimeWindow,
     pub out: &'a Path,
@@ -126,6 +128,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         rest_s: a.rest_s,
         smooth: a.smooth,
         zupt: a.zupt,
+        adapt_fixes: a.gnss_adaptive,
     };
     crate::report::warn_implausible_read(&imu, a.imu);
     let (setup, start) = match (a.scenario, &a.model) {
@@ -264,6 +267,12 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         (false, false) => "no rest (--rest-s 0)".to_owned(),
     };
     crate::note!("imukit: the filter had {states} and {rest}");
+    if summary.fix_noise_scale > 1.0 {
+        crate::note!(
+            "imukit: the fixes' innovations showed them noisier than stated (--gnss-adaptive):              their one-sigmas were {:.2} times the stated ones at the end",
+            summary.fix_noise_scale.sqrt()
+        );
+    }
     report_detection(a, &summary, imu.rows());
     if summary.resets > 0 {
         let t = nav.column("t_s").unwrap_or_default();

@@ -321,6 +321,7 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
         gnss_decay_factor,
         gnss_correlation_time_s,
         gnss_latency_s,
+        gnss_adaptive,
         gnss_uere_m,
         earth,
         frame,
@@ -381,6 +382,7 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
         rest_s,
         smooth,
         zupt,
+        gnss_adaptive,
         window: window.window()?,
         out: &out,
     })

@@ -280,6 +280,7 @@ def fuse(
     rest_s: Optional[float] = None,
     smooth: bool = False,
     zupt: bool = False,
+    gnss_adaptive: bool = False,
     imu_model: Optional[str] = None,
     part: Optional[str] = None,
     gnss_horizontal_accuracy_m: Optional[float] = None,

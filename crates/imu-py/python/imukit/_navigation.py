@@ -159,7 +159,7 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
          odometer: Optional[TableLike] = None, baro: Optional[TableLike] = None,
          nhc_sigma_m_s: Optional[float] = None, covariance_interval_s: Optional[float] = None,
          sensor_errors: Optional[bool] = None, rest_s: Optional[float] = None, smooth: bool = False,
-         zupt: bool = False,
+         zupt: bool = False, gnss_adaptive: bool = False,
          imu_model: Optional[Union[str, os.PathLike]] = None, part: Optional[str] = None,
          gnss_horizontal_accuracy_m: Optional[float] = None, gnss_vertical_accuracy_m: Optional[float] = None,
          gnss_velocity_accuracy_m_s: Optional[float] = None,
@@ -216,6 +216,11 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     from the quiet stretches (a rest, a foot's stances), its biases an unknown consumer part's
     (docs/your-own-log.md); the sensor-error states are then off unless asked for.
 
+    ``gnss_adaptive=True`` scales the fixes' noise from their innovations (every 8 fixes whose
+    normalised innovations lie outside a consistent filter's 99 % range scale it by their mean,
+    between the stated accuracy and 5× it): a receiver worse than its figures. Off by default:
+    the innovations cannot tell a receiver worse than stated from an IMU worse than modelled.
+
     ``zupt=True`` applies zero-velocity (and zero-rate) updates wherever the readings show a
     stance — a foot-mounted IMU — by the SHOE detector with the noise the log shows in its quiet
     stretches (the part's when it has too few) and gravity as its accelerometer reads it at rest;
@@ -268,7 +273,7 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
                              covariance_interval_s=None if covariance_interval_s is None else float(covariance_interval_s),
                              sensor_errors=None if sensor_errors is None else bool(sensor_errors),
                              rest_s=None if rest_s is None else float(rest_s), smooth=bool(smooth),
-                             zupt=bool(zupt),
+                             zupt=bool(zupt), gnss_adaptive=bool(gnss_adaptive),
                              **aids, **part_keys,
                              described=_described(imu=imu, gnss=gnss, initial=initial, odometer=odometer, baro=baro))
     fused = _table(table)

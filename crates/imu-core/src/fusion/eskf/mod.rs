@@ -329,6 +329,46 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         Ok(self)
     }
 
+    /// Scales the fixes' correlated error by `factor` in variance (its stationary one-sigma, its
+    /// estimate's one-sigma and its correlations by `√factor`; the estimate itself kept): what
+    /// an adaptive filter does when the fixes' innovations show a receiver worse or better than
+    /// modelled. Rows and columns scaled alike keep the covariance positive definite. Nothing
+    /// without the fix-error states.
+    ///
+    /// # Errors
+    /// A factor that is not finite and positive.
+    pub fn scale_fix_errors(&mut self, factor: f64) -> Result<(), EskfError> {
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(EskfError::BadParameter {
+                field: "fix error scale",
+            });
+        }
+        if self.fix_error.is_none() {
+            return Ok(());
+        }
+        self.step_covariance();
+        let root = math::sqrt(factor);
+        if let Some(model) = self.fix_error.as_mut() {
+            model.sigma_m = model.sigma_m.map(|s| s * root);
+        }
+        let b = fix_errors::first::<S>();
+        let before = self.cov;
+        for k in b..S {
+            self.cov.row_mut(k).scale_mut(root);
+            self.cov.column_mut(k).scale_mut(root);
+        }
+        // To the smoother a transition of no duration, `Φ = diag(1, …, √factor)`.
+        let (t, after) = (self.nav.t_s, self.cov);
+        if let Some(log) = self.smoothing.as_mut() {
+            let mut phi = Cov::<S>::identity();
+            for k in b..S {
+                phi[(k, k)] = root;
+            }
+            log.step(&before, &phi, 0.0, &after, t);
+        }
+        Ok(())
+    }
+
     /// The estimated error of the fixes, navigation axes, m (zero without the fix-error
     /// states).
     #[must_use]

@@ -8,6 +8,7 @@ use imu_core::fusion::{
 };
 use imu_core::{Body, Vec3};
 
+use super::adapt::FixNoiseScale;
 use super::detect::{Detection, REST_START_SPEED_M_S, detected_rest_s, stances};
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
@@ -56,6 +57,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let mut rows = Rows::<E, S>::new(setup, keep_filtered);
     let mut acceptance = Acceptance::default();
     let mut next_fix = begin.next_fix;
+    let mut noise_scale = FixNoiseScale::new(setup.max_fix_noise_scale);
     let sign = setup.specific_force_factor();
     for (i, &ti) in t.iter().enumerate().skip(begin.first) {
         filter
@@ -67,7 +69,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             (setup, fix_errors.is_some()),
             i,
             &mut next_fix,
-            &mut acceptance,
+            (&mut acceptance, &mut noise_scale),
         )?;
         aids.apply(&mut filter, ti, i)?;
         rows.push(&mut filter, &begin.origin, acceptance.resets, setup.smooth);
@@ -86,6 +88,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             sensor_errors: setup.estimate_sensor_errors,
             fix_errors,
             states: S,
+            fix_noise_scale: noise_scale.scale(),
             stance_samples: stances,
             detection,
         },
@@ -230,7 +233,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
     (setup, correlated): (&FuseSetup, bool),
     i: usize,
     next_fix: &mut usize,
-    acceptance: &mut Acceptance,
+    (acceptance, noise_scale): (&mut Acceptance, &mut FixNoiseScale),
 ) -> Result<()> {
     let (t, g_t) = (&inputs.t, &inputs.g_t);
     if !(*next_fix < g_t.len() && g_t[*next_fix] <= t[i]) {
@@ -245,6 +248,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
     };
     while *next_fix < g_t.len() && g_t[*next_fix] <= t[i] {
         let k = *next_fix;
+        let root = noise_scale.scale().sqrt();
         let fix = GnssFix::<E> {
             position: fixes.position[k],
             velocity_m_s: setup
@@ -252,20 +256,33 @@ fn apply_fixes<E: NavEarth, const S: usize>(
                 .filter(|_| inputs.velocities != FixVelocity::None)
                 .map(|_| fixes.velocity[k]),
             lever_arm_m: Vec3::<Body>::from_array(setup.lever_arm_m),
-            position_sigma_m: inputs.accuracy.as_ref().map_or(
-                if correlated {
-                    [FIX_WHITE_SIGMA_M; 3]
-                } else {
-                    setup.gnss_position_sigma_m
-                },
-                |a| a[k],
-            ),
-            velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma],
+            position_sigma_m: inputs
+                .accuracy
+                .as_ref()
+                .map_or(
+                    if correlated {
+                        [FIX_WHITE_SIGMA_M; 3]
+                    } else {
+                        setup.gnss_position_sigma_m
+                    },
+                    |a| a[k],
+                )
+                .map(|s| s * root),
+            velocity_sigma_m_s: [vel_sigma, vel_sigma, vertical_sigma].map(|s| s * root),
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,
         };
         let gate = setup.gate.threshold();
-        if acceptance.count(filter.update_gnss(&fix, gate), k, gate)? {
+        let outcome = filter.update_gnss(&fix, gate);
+        if let Ok(o) = &outcome {
+            let rows = if fix.velocity_m_s.is_some() { 6 } else { 3 };
+            if let Some(change) = noise_scale.observe(o.nis, rows) {
+                filter
+                    .scale_fix_errors(change)
+                    .map_err(|e| filter_refusal("GNSS", k, e))?;
+            }
+        }
+        if acceptance.count(outcome, k, gate)? {
             let heading = fix.velocity_m_s.and_then(|v| {
                 let speed = v.x().hypot(v.y());
                 (speed >= ALIGN_MIN_SPEED_M_S).then(|| {

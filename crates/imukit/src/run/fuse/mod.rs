@@ -13,6 +13,7 @@
 //! setup and model ([`FuseSetup`], [`PartModel`]), the inputs read and checked, the detectors
 //! (rest, stances), the start's alignment, the recovery from lost fixes, the run itself
 //! (`filter`: a short sequence of named steps), the rows, the smoothing, the aids.
+mod adapt;
 pub(crate) mod aids;
 mod detect;
 mod filter;
@@ -25,6 +26,7 @@ mod setup;
 mod smooth;
 mod start;
 
+pub use adapt::{ADAPT_WINDOW, DEFAULT_MAX_FIX_NOISE_SCALE};
 pub use detect::{
     Detection, FEW_STANCES, QUIET_WINDOW_S, REST_START_SPEED_M_S, REST_WINDOW_S,
     STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S, STANCE_WINDOW_S, learnt_noise, stance_samples,
@@ -78,6 +80,9 @@ pub struct FuseSummary {
     pub fix_errors: Option<imu_core::fusion::FixErrorModel>,
     /// The filter's error states: 15, 18, 36 or 39.
     pub states: usize,
+    /// The variance factor of the fixes' noise at the end, from their innovations (1: as
+    /// stated; [`FuseSetup::max_fix_noise_scale`]).
+    pub fix_noise_scale: f64,
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet

@@ -122,6 +122,10 @@ pub struct FuseRequest<'a> {
     pub smooth: bool,
     /// Zero-velocity updates at stances ([`FuseSetup::zupt`]).
     pub zupt: bool,
+    /// Scale the fixes' noise from their innovations, up to
+    /// [`DEFAULT_MAX_FIX_NOISE_SCALE`](super::DEFAULT_MAX_FIX_NOISE_SCALE) in variance
+    /// ([`FuseSetup::max_fix_noise_scale`]).
+    pub adapt_fixes: bool,
 }
 
 impl Default for FuseRequest<'_> {
@@ -136,6 +140,7 @@ impl Default for FuseRequest<'_> {
             rest_s: None,
             smooth: false,
             zupt: false,
+            adapt_fixes: false,
         }
     }
 }
@@ -229,6 +234,9 @@ impl<'a> FuseRequest<'a> {
         }
         setup.smooth = self.smooth;
         setup.zupt = self.zupt;
+        if self.adapt_fixes {
+            setup.max_fix_noise_scale = super::DEFAULT_MAX_FIX_NOISE_SCALE;
+        }
         Ok(setup)
     }
 }

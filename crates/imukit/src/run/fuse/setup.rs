@@ -85,6 +85,14 @@ pub struct FuseSetup {
     /// IMU sample); see `Eskf::with_covariance_interval`. The one-sigma columns then hold the
     /// covariance of the last step.
     pub covariance_interval_s: f64,
+    /// The bound of the fixes' noise scaling from their innovations, in variance (see
+    /// `run::fuse::adapt`; 1, the default: the stated accuracy always). Off by default: the
+    /// innovations cannot tell a receiver worse than stated from an IMU worse than modelled,
+    /// and scaling the fixes for the IMU's fault would hide it (a consumer part without its
+    /// sensor-error states is then never reset to the fixes, its one-sigma grown instead).
+    /// [`DEFAULT_MAX_FIX_NOISE_SCALE`](super::DEFAULT_MAX_FIX_NOISE_SCALE) is the bound a front
+    /// end's switch turns it on with.
+    pub max_fix_noise_scale: f64,
 }
 
 /// Which fixes the filter takes: all, or those whose normalised innovation squared (NIS) is
@@ -355,6 +363,7 @@ impl FuseSetup {
                 baro_sigma_m: m.baro_sigma_m,
             },
             covariance_interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
+            max_fix_noise_scale: 1.0,
             estimate_sensor_errors: false,
             figures_known: true,
             sensor_error_sigma: SensorErrorSigma {
