@@ -309,3 +309,18 @@ def test_simulate_writes_a_euroc_sequence_that_reads_back_bit_for_bit(tmp_path):
     done = subprocess.run([imukit_bin(), "simulate", str(scenario), "--layout", "euroc", "--out", str(tmp_path / "s2"),
                            "--truth", str(tmp_path / "t.csv")], capture_output=True, text=True)
     assert done.returncode == 65 and "--truth: a EuRoC sequence keeps its ground truth" in done.stderr, done.stderr
+
+
+def test_a_map_gives_a_receivers_columns_to_imukits_by_name(tmp_path):
+    """A map's `columns` table (here a dict): the receiver's names become imukit's, as they are;
+    a name imukit does not read is refused by key."""
+    path = tmp_path / "receiver.csv"
+    path.write_text("gps_time,e,n,u,pos_std_1,pos_std_2,pos_std_3\n0.0,1.0,2.0,3.0,0.5,0.6,0.7\n"
+                    "0.2,1.5,2.5,3.5,0.5,0.6,0.7\n")
+    columns = {"pos_x_m": "e", "pos_y_m": "n", "pos_z_m": "u", "pos_x_sigma_m": "pos_std_1",
+               "pos_y_sigma_m": "pos_std_2", "pos_z_sigma_m": "pos_std_3"}
+    fixes = imukit.read(path, map={"time": {"column": "gps_time", "unit": "s"}, "columns": columns})
+    assert list(fixes["pos_y_m"]) == [2.0, 2.5] and list(fixes["pos_z_sigma_m"]) == [0.7, 0.7]
+    assert list(fixes["t_s"]) == [0.0, 0.2]
+    with pytest.raises(imukit.ImuError, match="columns.pos_x_sigma"):
+        imukit.read(path, map={"time": {"column": "gps_time", "unit": "s"}, "columns": {"pos_x_sigma": "e"}})

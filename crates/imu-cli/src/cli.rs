@@ -484,6 +484,11 @@ pub struct FuseArgs {
     /// GNSS CSV (`t_s, pos_x_m, pos_y_m, pos_z_m, vel_x_m_s, vel_y_m_s, vel_z_m_s`); left
     /// out, the filter runs on the IMU and the other aids alone (a foot with `--zupt`).
     pub gnss: Option<PathBuf>,
+    /// A column map (TOML) for the GNSS CSV: its time column and, under `[columns]`, which of
+    /// its columns are imukit's fix columns and accuracies (`pos_x_sigma_m = "pos_std_1"`;
+    /// docs/formats.md).
+    #[arg(long, value_name = "FILE", requires = "gnss")]
+    pub gnss_map: Option<PathBuf>,
     /// The initial state: the first row of this truth file, or of a reference in latitude,
     /// longitude and height or ECEF (docs/earth.md; without an attitude, with --align).
     #[arg(long)]

@@ -240,3 +240,92 @@ fn a_receiver_worse_than_stated_is_scaled_with_gnss_adaptive_and_said_so() {
         .unwrap();
     assert!((2.0..=5.0).contains(&factor), "{note}");
 }
+
+#[test]
+fn a_receivers_own_column_names_and_accuracies_are_read_through_gnss_map() {
+    // The tunnel road's fixes under a vendor's names, each with per-axis standard deviations
+    // (`pos_std_1..3`): through `--gnss-map` they fuse as the same file under imukit's names.
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/car_tunnel.toml");
+    simulate_drive(&example, dir.path(), true);
+    let file = |name: &str| dir.path().join(name);
+    let text = std::fs::read_to_string(file("gnss.csv")).unwrap();
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .collect();
+    let sigma = |k: usize| format!("{}", 1.0 + 0.5 * (k % 3) as f64);
+    let (mut ours, mut theirs) = (
+        String::from(
+            "t_s,pos_x_m,pos_y_m,pos_z_m,vel_x_m_s,vel_y_m_s,vel_z_m_s,pos_x_sigma_m,pos_y_sigma_m,pos_z_sigma_m\n",
+        ),
+        String::from("gps_time,e,n,u,ve,vn,vu,pos_std_1,pos_std_2,pos_std_3\n"),
+    );
+    for (k, r) in rows.iter().enumerate() {
+        let line = format!("{r},{},{},{}\n", sigma(k), sigma(k + 1), sigma(k + 2));
+        ours.push_str(&line);
+        theirs.push_str(&line);
+    }
+    std::fs::write(file("ours.csv"), ours).unwrap();
+    std::fs::write(file("theirs.csv"), theirs).unwrap();
+    std::fs::write(
+        file("receiver.map.toml"),
+        "time = { column = \"gps_time\", unit = \"s\" }\n[columns]\n\
+         pos_x_m = \"e\"\npos_y_m = \"n\"\npos_z_m = \"u\"\n\
+         vel_x_m_s = \"ve\"\nvel_y_m_s = \"vn\"\nvel_z_m_s = \"vu\"\n\
+         pos_x_sigma_m = \"pos_std_1\"\npos_y_sigma_m = \"pos_std_2\"\npos_z_sigma_m = \"pos_std_3\"\n",
+    )
+    .unwrap();
+    let fuse = |gnss: &str, extra: &[&str], to: &str| {
+        let out = imukit()
+            .arg("fuse")
+            .arg(file("imu.csv"))
+            .arg(file(gnss))
+            .arg("--init")
+            .arg(file("truth.csv"))
+            .args(["--scenario", example.to_str().unwrap()])
+            .args(extra)
+            .arg("--out")
+            .arg(file(to))
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (ok, log) = fuse("ours.csv", &[], "ours_nav.csv");
+    assert!(ok, "{log}");
+    let map = file("receiver.map.toml");
+    let (ok, log) = fuse(
+        "theirs.csv",
+        &["--gnss-map", map.to_str().unwrap()],
+        "theirs_nav.csv",
+    );
+    assert!(ok, "{log}");
+    assert_eq!(
+        std::fs::read(file("ours_nav.csv")).unwrap(),
+        std::fs::read(file("theirs_nav.csv")).unwrap()
+    );
+    // Without the map the vendor's file is refused, its missing columns named; a map naming a
+    // column imukit does not read is refused by map and key.
+    let (ok, log) = fuse("theirs.csv", &[], "never.csv");
+    assert!(!ok && log.contains("pos_x_m"), "{log}");
+    std::fs::write(
+        file("typo.map.toml"),
+        "time = { column = \"gps_time\", unit = \"s\" }\n[columns]\npos_x_sigma = \"pos_std_1\"\n",
+    )
+    .unwrap();
+    let typo = file("typo.map.toml");
+    let (ok, log) = fuse(
+        "theirs.csv",
+        &["--gnss-map", typo.to_str().unwrap()],
+        "never.csv",
+    );
+    assert!(
+        !ok && log.contains("columns.pos_x_sigma") && log.contains("typo.map.toml"),
+        "{log}"
+    );
+    assert!(!file("never.csv").exists());
+}

@@ -11,7 +11,9 @@
 //! ```
 //!
 //! `axes` may instead be `rotation = [[…], […], […]]`, the matrix that takes sensor axes to
-//! body axes (rows are body axes). Every key but `time` is optional; the units are the units
+//! body axes (rows are body axes). A table `[columns]` gives a file's column to one of imukit's
+//! by name, as it is (`pos_x_sigma_m = "pos_std_1"`): a receiver's fixes and accuracies, an
+//! odometer's, a barometer's or a truth's columns under their vendor's names. Every key but `time` is optional; the units are the units
 //! room's ([`crate::units`]), read for the quantity they are given to (so `mG` on the
 //! magnetometer is milligauss, `mg` on the accelerometer milli-g). Integer-nanosecond stamps are
 //! kept exactly, as in the ASL layout ([`crate::asl`]).
@@ -98,6 +100,30 @@ struct MapSpec {
     mag: Option<TripleSpec>,
     axes: Option<[String; 3]>,
     rotation: Option<[[f64; 3]; 3]>,
+    /// imukit column → the file's column, taken as it is (already in imukit's unit).
+    columns: Option<std::collections::BTreeMap<String, String>>,
+}
+
+/// The columns a map may give a file's column to by name ([`MapSpec::columns`]): those of the
+/// tables imukit reads beside the IMU's — fixes (flat or geodetic) with their accuracies,
+/// odometer, barometer, truth.
+fn renamable() -> Vec<&'static str> {
+    use crate::columns as c;
+    let mut all: Vec<&'static str> = [
+        &c::GNSS_COLUMNS[..],
+        &c::GNSS_EARTH_COLUMNS[..],
+        &c::FIX_ACCURACY_COLUMNS[..],
+        &c::FIX_SIGMA_COLUMNS[..],
+        &c::ODOMETER_COLUMNS[..],
+        &c::BARO_COLUMNS[..],
+        &c::TRUTH_COLUMNS[..],
+        &c::GEODETIC_COLUMNS[..],
+    ]
+    .concat();
+    all.retain(|name| *name != "t_s");
+    all.sort_unstable();
+    all.dedup();
+    all
 }
 
 /// The sensors a map may name: `(key, imukit columns, the SI unit its units convert to)`.
@@ -135,6 +161,8 @@ pub struct ColumnMap {
     sensors: Vec<([&'static str; 3], [String; 3], f64)>,
     /// Sensor axes to body axes.
     rotation: [[f64; 3]; 3],
+    /// `(imukit column, file column)` taken as they are.
+    renames: Vec<(String, String)>,
 }
 
 impl ColumnMap {
@@ -192,11 +220,26 @@ impl ColumnMap {
             }
             (None, None) => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         };
+        let known = renamable();
+        let mut renames = Vec::new();
+        for (imukit, file) in spec.columns.unwrap_or_default() {
+            if !known.contains(&imukit.as_str()) {
+                return Err(invalid(
+                    key(&format!("columns.{imukit}")),
+                    format!(
+                        "is not a column imukit reads from a fix, odometer, barometer or truth                          table (known: {})",
+                        known.join(", ")
+                    ),
+                ));
+            }
+            renames.push((imukit, file));
+        }
         Ok(Self {
             origin: origin.into(),
             time: spec.time,
             sensors,
             rotation,
+            renames,
         })
     }
 
@@ -267,6 +310,21 @@ impl ColumnMap {
                         .collect(),
                 ));
             }
+        }
+        for (imukit, column) in &self.renames {
+            let f = field(column)?;
+            if used.contains(&f) {
+                return Err(Error::CsvFormat {
+                    file: file.into(),
+                    message: format!(
+                        "the column map {} reads column {column:?} twice: each column of the                          file is one quantity",
+                        self.origin
+                    ),
+                });
+            }
+            used.push(f);
+            names.push(imukit.clone());
+            sources.push(Source::Field(f));
         }
         for (k, h) in header.iter().enumerate() {
             if used.contains(&k) {

@@ -177,13 +177,18 @@ impl crate::cli::MapArg {
     /// An unreadable map; a map given for an input that is not CSV (whose columns are
     /// imukit's already: the map would be ignored).
     fn input(&self, input: &std::path::Path) -> Result<Input, CliError> {
+        self.input_for(input, "--map")
+    }
+
+    /// [`Self::input`] for the option named `flag`.
+    fn input_for(&self, input: &std::path::Path, flag: &str) -> Result<Input, CliError> {
         let Some(m) = &self.map else {
             return Ok(Input::new(input));
         };
         let format = imukit::io::TableFormat::of(input);
         if format != imukit::io::TableFormat::Csv {
             return Err(imukit::Error::Invalid {
-                field: "--map".into(),
+                field: flag.into(),
                 message: format!(
                     "reads a vendor's CSV; {} is not CSV: its columns are imukit's already",
                     input.display()
@@ -309,6 +314,7 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
         map,
         bag,
         gnss,
+        gnss_map,
         init,
         align,
         scenario,
@@ -340,7 +346,12 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
     let mapped = map.input(&imu)?;
     bag.check(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
     let imu = bag.input(mapped);
-    let gnss = gnss.map(|p| bag.input(Input::new(p)));
+    let gnss = match gnss {
+        Some(p) => {
+            Some(bag.input(crate::cli::MapArg { map: gnss_map }.input_for(&p, "--gnss-map")?))
+        }
+        None => None,
+    };
     let init = init.map(|p| bag.input(Input::new(p)));
     fuse::run(&fuse::Args {
         imu: &imu,
