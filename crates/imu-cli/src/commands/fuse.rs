@@ -294,7 +294,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         }
         crate::report::warn(&format!(
             "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
-             time(s), at t = {} s (column {}): its one-sigma understates its error around them",
+             time(s), at t = {} s (column {}): its one-sigma understates its error around them \
+             (an IMU worse than described: --sensor-errors, --rest-s; fixes worse than their \
+             stated accuracy: --gnss-adaptive)",
             a.gnss
                 .map_or_else(|| "GNSS".into(), |p| p.display().to_string()),
             imukit::run::fuse::MAX_REJECTED_IN_A_ROW,

@@ -280,5 +280,7 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     resets = fused["gnss_resets"]
     if len(resets) and resets[-1] > 0:
         _emit([f"the filter lost the fixes (the gate rejected them one after another) and was reset to them "
-               f"{int(resets[-1])} time(s) (column gnss_resets): its one-sigma understates its error around them"])
+               f"{int(resets[-1])} time(s) (column gnss_resets): its one-sigma understates its error around them "
+               f"(an IMU worse than described: sensor_errors=True, rest_s=; fixes worse than their stated "
+               f"accuracy: gnss_adaptive=True)"])
     return fused
