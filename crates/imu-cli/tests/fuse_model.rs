@@ -28,6 +28,22 @@ fn simulate_drive(example: &Path, dir: &Path, fixes: bool) {
     );
 }
 
+/// `imukit fuse` of the drive simulated into `dir`: its `imu.csv`, the fixes `gnss`, from the
+/// first row of `truth.csv`, with `extra` arguments, the estimate to `dir/out`.
+fn fuse_drive(dir: &Path, gnss: &str, extra: &[&str], out: &str) -> std::process::Output {
+    imukit()
+        .arg("fuse")
+        .arg(dir.join("imu.csv"))
+        .arg(dir.join(gnss))
+        .arg("--init")
+        .arg(dir.join("truth.csv"))
+        .args(extra)
+        .arg("--out")
+        .arg(dir.join(out))
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
     let dir = tempfile::tempdir().unwrap();
@@ -35,17 +51,7 @@ fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
     let file = |name: &str| dir.path().join(name);
     simulate_drive(&example, dir.path(), true);
     let fuse = |extra: &[&str], to: &str| {
-        let out = imukit()
-            .arg("fuse")
-            .arg(file("imu.csv"))
-            .arg(file("gnss.csv"))
-            .arg("--init")
-            .arg(file("truth.csv"))
-            .args(extra)
-            .arg("--out")
-            .arg(file(to))
-            .output()
-            .unwrap();
+        let out = fuse_drive(dir.path(), "gnss.csv", extra, to);
         assert!(
             out.status.success(),
             "{}",
@@ -75,17 +81,12 @@ fn a_part_and_receiver_stated_as_options_fuse_as_the_scenario_does() {
     let matlab = fuse(&stated, "m.csv");
     assert!(matlab != by_scenario);
     // A latency that is not one is refused by its option.
-    let out = imukit()
-        .arg("fuse")
-        .arg(file("imu.csv"))
-        .arg(file("gnss.csv"))
-        .arg("--init")
-        .arg(file("truth.csv"))
-        .args(stated)
-        .args(["--gnss-latency-s", "-1", "--out"])
-        .arg(file("x.csv"))
-        .output()
-        .unwrap();
+    let out = fuse_drive(
+        dir.path(),
+        "gnss.csv",
+        &[&stated[..], &["--gnss-latency-s", "-1"]].concat(),
+        "x.csv",
+    );
     let log = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(65), "{log}");
     assert!(log.contains("--gnss-latency-s"), "{log}");
@@ -155,20 +156,8 @@ fn a_receivers_per_axis_sigmas_are_read_as_its_horizontal_and_vertical_accuracy_
         "1.2,1.2,2.5",
     );
     with("partial.csv", "pos_x_sigma_m,pos_y_sigma_m", "1.2,1.2");
-    let fuse = |fixes: &str, to: &str| {
-        imukit()
-            .arg("fuse")
-            .arg(file("imu.csv"))
-            .arg(file(fixes))
-            .arg("--init")
-            .arg(file("truth.csv"))
-            .arg("--scenario")
-            .arg(&example)
-            .arg("--out")
-            .arg(file(to))
-            .output()
-            .unwrap()
-    };
+    let scenario = ["--scenario", example.to_str().unwrap()];
+    let fuse = |fixes: &str, to: &str| fuse_drive(dir.path(), fixes, &scenario, to);
     for (fixes, to) in [("split.csv", "a.csv"), ("axes.csv", "b.csv")] {
         let out = fuse(fixes, to);
         assert!(
@@ -202,20 +191,9 @@ fn a_receiver_worse_than_stated_is_scaled_with_gnss_adaptive_and_said_so() {
     let worse = dir.path().join("worse.toml");
     std::fs::write(&worse, text).unwrap();
     simulate_drive(&worse, dir.path(), true);
-    let file = |name: &str| dir.path().join(name);
+    let scenario = ["--scenario", example.to_str().unwrap()];
     let fuse = |extra: &[&str], to: &str| {
-        imukit()
-            .arg("fuse")
-            .arg(file("imu.csv"))
-            .arg(file("gnss.csv"))
-            .arg("--init")
-            .arg(file("truth.csv"))
-            .args(["--scenario", example.to_str().unwrap()])
-            .args(extra)
-            .arg("--out")
-            .arg(file(to))
-            .output()
-            .unwrap()
+        fuse_drive(dir.path(), "gnss.csv", &[&scenario[..], extra].concat(), to)
     };
     let stated = fuse(&[], "stated.csv");
     let log = String::from_utf8_lossy(&stated.stderr).to_string();
@@ -277,19 +255,9 @@ fn a_receivers_own_column_names_and_accuracies_are_read_through_gnss_map() {
          pos_x_sigma_m = \"pos_std_1\"\npos_y_sigma_m = \"pos_std_2\"\npos_z_sigma_m = \"pos_std_3\"\n",
     )
     .unwrap();
+    let scenario = ["--scenario", example.to_str().unwrap()];
     let fuse = |gnss: &str, extra: &[&str], to: &str| {
-        let out = imukit()
-            .arg("fuse")
-            .arg(file("imu.csv"))
-            .arg(file(gnss))
-            .arg("--init")
-            .arg(file("truth.csv"))
-            .args(["--scenario", example.to_str().unwrap()])
-            .args(extra)
-            .arg("--out")
-            .arg(file(to))
-            .output()
-            .unwrap();
+        let out = fuse_drive(dir.path(), gnss, &[&scenario[..], extra].concat(), to);
         (
             out.status.success(),
             String::from_utf8_lossy(&out.stderr).to_string(),

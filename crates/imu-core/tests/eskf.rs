@@ -15,14 +15,14 @@ const GNSS_EVERY: usize = 100;
 const POSITION_SIGMA_M: f64 = 1.0;
 const VELOCITY_SIGMA_M_S: f64 = 0.1;
 
-const NOISE: EskfNoise = EskfNoise {
+pub(crate) const NOISE: EskfNoise = EskfNoise {
     accel_psd: 2e-3,
     gyro_psd: 1e-4,
     accel_bias_psd: 1e-5,
     gyro_bias_psd: 1e-7,
 };
 
-const SIGMA: InitialSigma = InitialSigma {
+pub(crate) const SIGMA: InitialSigma = InitialSigma {
     position_m: 2.0,
     velocity_m_s: 0.2,
     attitude_rad: [0.01, 0.01, 0.05],
@@ -72,13 +72,13 @@ impl Case for Wgs84<Ned> {
     }
 }
 
-fn chi2_quantile(k: f64, z: f64) -> f64 {
+pub(crate) fn chi2_quantile(k: f64, z: f64) -> f64 {
     // Wilson–Hilferty.
     let c = 2.0 / (9.0 * k);
     k * (1.0 - c + z * c.sqrt()).powi(3)
 }
 
-fn draw3(n: &mut SeededNormals, sigma: [f64; 3]) -> [f64; 3] {
+pub(crate) fn draw3(n: &mut SeededNormals, sigma: [f64; 3]) -> [f64; 3] {
     sigma.map(|s| s * n.standard_normal())
 }
 

@@ -8,12 +8,15 @@
 use imu_core::aiding::{GnssModel, GnssParams, GnssState, PositionNoise};
 use imu_core::earth::FlatEarth;
 use imu_core::fusion::{
-    BASE_STATES, Eskf, EskfNoise, EskfState, FIX_ERROR_STATES, FULL_STATES, FixErrorModel, GnssFix,
-    InitialSigma, SensorErrorSigma,
+    BASE_STATES, Eskf, EskfState, FIX_ERROR_STATES, FULL_STATES, FixErrorModel, GnssFix,
+    SensorErrorSigma,
 };
-use imu_core::sensor::{NoiseSource, SeededNormals};
+use imu_core::sensor::SeededNormals;
 use imu_core::strapdown::NavState;
 use imu_core::{Enu, Rotation, Vec3};
+
+// The filter's noise and start, and the helpers, of the consistency tests beside.
+use crate::eskf::{NOISE, SIGMA, chi2_quantile, draw3};
 
 const RATE_HZ: f64 = 100.0;
 const HORIZONTAL_M: f64 = 1.5;
@@ -22,21 +25,6 @@ const VELOCITY_M_S: f64 = 0.1;
 /// The white part the filter is told a fix has when the receiver's process has none (MATLAB's).
 const WHITE_FLOOR_M: f64 = 1e-3;
 
-const NOISE: EskfNoise = EskfNoise {
-    accel_psd: 2e-3,
-    gyro_psd: 1e-4,
-    accel_bias_psd: 1e-5,
-    gyro_bias_psd: 1e-7,
-};
-
-const SIGMA: InitialSigma = InitialSigma {
-    position_m: 2.0,
-    velocity_m_s: 0.2,
-    attitude_rad: [0.01, 0.01, 0.05],
-    accel_bias_m_s2: 0.02,
-    gyro_bias_rad_s: 2e-4,
-};
-
 const FIX_STATES: usize = BASE_STATES + FIX_ERROR_STATES;
 const FULL_FIX_STATES: usize = FULL_STATES + FIX_ERROR_STATES;
 
@@ -44,16 +32,6 @@ const FULL_FIX_STATES: usize = FULL_STATES + FIX_ERROR_STATES;
 fn truth(t_s: f64) -> (Vec3<Enu>, Vec3<Enu>) {
     let v = Vec3::new(10.0, 5.0, 0.0);
     (Vec3::new(3.0, -2.0, 1.0) + v * t_s, v)
-}
-
-fn chi2_quantile(k: f64, z: f64) -> f64 {
-    // Wilson–Hilferty.
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + z * c.sqrt()).powi(3)
-}
-
-fn draw3(n: &mut SeededNormals, sigma: [f64; 3]) -> [f64; 3] {
-    sigma.map(|s| s * n.standard_normal())
 }
 
 /// How the filter takes the fixes.

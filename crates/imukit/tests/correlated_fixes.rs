@@ -12,10 +12,7 @@ use imukit::run::fuse::{FuseSetup, fuse};
 use imukit::run::navigate::InitialState;
 use imukit::{ScenarioSpec, Table};
 
-fn chi2_quantile(k: f64, z: f64) -> f64 {
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + z * c.sqrt()).powi(3)
-}
+use crate::common::nees_bounds_95;
 
 fn rows3(t: &Table, names: [&str; 3]) -> Vec<[f64; 3]> {
     let c: Vec<Vec<f64>> = names.iter().map(|n| t.column(n).unwrap()).collect();
@@ -122,11 +119,7 @@ fn average_nees_of(sc: &imukit::Scenario, setup: &FuseSetup) -> [[f64; 2]; 2] {
 
 #[test]
 fn fixes_with_a_decay_factor_of_0_99_and_0_999_leave_the_uncertainty_honest() {
-    let runs = RUNS as f64;
-    let (lo, hi) = (
-        chi2_quantile(3.0 * runs, -1.959_964) / runs,
-        chi2_quantile(3.0 * runs, 1.959_964) / runs,
-    );
+    let (lo, hi) = nees_bounds_95(RUNS);
     for decay in [0.99, 0.999] {
         let nees = average_nees(decay);
         for (s, name) in ["filtered", "smoothed"].iter().enumerate() {
@@ -174,11 +167,7 @@ fn a_receiver_three_times_worse_than_stated_is_found_out_by_its_innovations() {
     // White fixes three times worse (position and velocity) than the filter is told: taken as
     // stated, they are lost; with the fixes' noise scaled from their
     // innovations (up to 25× in variance) it is inside them, filtered and smoothed.
-    let runs = RUNS as f64;
-    let (lo, hi) = (
-        chi2_quantile(3.0 * runs, -1.959_964) / runs,
-        chi2_quantile(3.0 * runs, 1.959_964) / runs,
-    );
+    let (lo, hi) = nees_bounds_95(RUNS);
     let data = road_with(0.0, 3.0);
     let told = FuseSetup::from_scenario(&road(0.0)).unwrap();
     // Taken as stated, the filter rejects the fixes, is reset to them and gives up.

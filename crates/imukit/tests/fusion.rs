@@ -17,6 +17,8 @@ use imukit::run::fuse::{FuseSetup, Gate, fuse};
 use imukit::run::navigate::InitialState;
 use imukit::{ScenarioSpec, Simulation, Table};
 
+use crate::common::chi2_quantile;
+
 /// A car-like manoeuvre: a 60 m circle at 8–12 m/s with a gentle hill, nose along the path.
 fn scenario(imu: &str, gnss: &str) -> String {
     format!(
@@ -130,12 +132,6 @@ fn reproduces_the_truth(sim: &Simulation, setup: &FuseSetup) {
     } else {
         assert!(nav.column("accel_scale_factor_x").is_none());
     }
-}
-
-/// Wilson–Hilferty: the chi-square quantile with `k` degrees of freedom at standard normal `z`.
-fn chi2_quantile(k: f64, z: f64) -> f64 {
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + z * c.sqrt()).powi(3)
 }
 
 /// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average

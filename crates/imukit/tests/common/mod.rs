@@ -45,3 +45,20 @@ pub fn helix(rate: f64, seconds: f64) -> HelixData {
         truth,
     }
 }
+
+/// Wilson–Hilferty: the chi-square quantile with `k` degrees of freedom at standard normal `z`.
+pub fn chi2_quantile(k: f64, z: f64) -> f64 {
+    let c = 2.0 / (9.0 * k);
+    k * (1.0 - c + z * c.sqrt()).powi(3)
+}
+
+/// The two-sided 95 % bounds of the average over `runs` runs of a NEES of three degrees of
+/// freedom (χ² with 3 × runs degrees of freedom, over runs).
+pub fn nees_bounds_95(runs: u64) -> (f64, f64) {
+    #[allow(clippy::cast_precision_loss)]
+    let n = runs as f64;
+    (
+        chi2_quantile(3.0 * n, -1.959_964) / n,
+        chi2_quantile(3.0 * n, 1.959_964) / n,
+    )
+}
