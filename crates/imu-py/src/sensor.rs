@@ -14,7 +14,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 
 use crate::convert::{
     check_len, choice_opt, fixed_opt, flat_rows, matrices_in, non_negative, sensor_table,
@@ -185,7 +185,9 @@ fn allan_deviation<'py>(
 /// Noise identification of the named columns of `x` (N, k) sampled at `sample_rate_hz`: a dict
 /// with `tau_s` and (T, k) `adev`, `lower95`, `upper95`, `edf`, `fit`; `terms`, one tuple per
 /// column and term `(column, term, symbol, value, lower, upper, resolved, needs_record_s,
-/// unit, datasheet_unit, datasheet_factor)`; `reduced_chi2` per column; `params_toml` (None
+/// unit, datasheet_unit, datasheet_factor)`; `scaled_terms`, one dict per Markov or sinusoid
+/// term kept (`column`, `term`, `symbol`, `value`, `lower`, `upper`, `scale`, `scale_lower`,
+/// `scale_upper`, `unit`, `scale_unit`, `chi2_drop`, `criterion`); `reduced_chi2` per column; `params_toml` (None
 /// without gyroscope or accelerometer columns) and `kalibr_yaml` (None without both).
 #[pyfunction]
 #[pyo3(signature = (x, sample_rate_hz, names, source, *, kalibr_inflation = imukit::io::kalibr::DEFAULT_INFLATION, kalibr_topic = imukit::io::kalibr::DEFAULT_TOPIC))]
@@ -248,6 +250,30 @@ fn identify<'py>(
         })
         .collect();
     d.set_item("terms", terms)?;
+    let scaled = PyList::empty(py);
+    for r in id::scale_rows(&result) {
+        let e = r.estimate;
+        let row = PyDict::new(py);
+        row.set_item("column", r.column)?;
+        row.set_item("term", e.term.name())?;
+        row.set_item("symbol", e.term.symbol())?;
+        for (key, value) in [
+            ("value", e.value),
+            ("lower", e.lower),
+            ("upper", e.upper),
+            ("scale", e.scale),
+            ("scale_lower", e.scale_lower),
+            ("scale_upper", e.scale_upper),
+        ] {
+            row.set_item(key, value)?;
+        }
+        row.set_item("unit", r.unit)?;
+        row.set_item("scale_unit", r.scale_unit)?;
+        row.set_item("chi2_drop", e.chi2_drop)?;
+        row.set_item("criterion", r.criterion)?;
+        scaled.append(row)?;
+    }
+    d.set_item("scaled_terms", scaled)?;
     let chi2: Vec<f64> = result.noise.iter().map(|c| c.fit.reduced_chi2).collect();
     d.set_item("reduced_chi2", chi2)?;
     let mean: Vec<(f64, f64)> = result

@@ -8,7 +8,7 @@ use imukit::io::params::to_toml;
 use imukit::io::rows::TimeWindow;
 use imukit::run::identify::{
     column_header, column_warnings, curve_table, filter_noise, kalibr, param_file, rest_line,
-    term_rows,
+    scale_rows, term_rows,
 };
 
 use super::CliError;
@@ -68,12 +68,16 @@ pub fn run(
         imu_plot::allan_figure(p, &result, &source, size)?;
     }
     let rows = term_rows(&result);
+    let scaled = scale_rows(&result);
     for c in &result.noise {
         crate::out_line!(
             "{}",
             column_header(&c.column, &c.fit, result.samples, result.sample_rate_hz)
         );
         for row in rows.iter().filter(|r| r.column == c.column) {
+            crate::out_line!("{}", row.line());
+        }
+        for row in scaled.iter().filter(|r| r.column == c.column) {
             crate::out_line!("{}", row.line());
         }
         crate::out_line!("{}", rest_line(c));

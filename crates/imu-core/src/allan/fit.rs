@@ -26,14 +26,38 @@
 //! (χ² within 3.84 of it), and is 0 at the lower end if one of those leaves the term out. A term
 //! is **resolved** when that lower end is above zero. Otherwise the fit states an upper bound and
 //! the record length that would resolve a term of that size with 95 % power.
+//!
+//! Exponentially correlated (Markov) noise and a sinusoid ([`super::scale_terms`]) are linear in
+//! their amplitude squared once their time scale is fixed. Each is sought over a grid of time
+//! scales (four per octave, the best refined by golden-section search) and joins the model when
+//! it lowers χ² by more than `4 ln n` for `n` points: the Bayesian information criterion's
+//! `ln n` for each of its two parameters, and `2 ln n` more because the scale was searched
+//! (about one independent trial per point, and the largest of `n` null drops grows as
+//! `2 ln n`). A term kept must also be resolved (its amplitude's interval, below, excludes
+//! zero); one that is not is left out and the model fitted again. On 200 seeded records without
+//! either term, none was kept. Its time scale's interval is every scale whose best fit describes
+//! the curve as well (χ² within the margin below), its amplitude's spans its intervals over
+//! those scales.
 
 use nalgebra::{SMatrix, SVector};
 
 use super::edf::overlapping_edf;
+use super::scale_terms::ScaleTerm;
 use crate::math;
 
 /// The number of noise terms.
 pub const TERMS: usize = 5;
+
+/// The number of terms with a time scale ([`ScaleTerm`]).
+pub const SCALE_TERMS: usize = 2;
+
+/// Columns of the least-squares design: the five power laws and at most one of each term with
+/// a time scale.
+const COLUMNS: usize = TERMS + SCALE_TERMS;
+
+/// Time scales tried per octave when a term with a time scale is sought (a golden-section
+/// search then refines the best).
+const SCALES_PER_OCTAVE: f64 = 4.0;
 
 /// The two-sided 95 % point of the normal distribution.
 pub const Z_95: f64 = 1.959_963_984_540_054;
@@ -47,6 +71,19 @@ const Z_POWER: f64 = 1.644_853_626_951_472_6;
 /// Record lengths tried when a term is not resolved: the present one doubled up to this many
 /// times.
 const MAX_DOUBLINGS: u32 = 24;
+
+/// Bisections of each end of a time scale's interval (each halves its log-ratio).
+const BISECTIONS: usize = 20;
+
+/// From this many correlation times on, Markov noise's Allan estimates are counted as white
+/// noise's (its variance is then within 20 % of the white asymptote `2σ²T_c/τ`); below, as a
+/// random walk's, with fewer degrees of freedom and stronger correlation: the conservative side
+/// of the transition.
+const MARKOV_WHITE_FROM: f64 = 8.0;
+
+/// Intervals of the time scale's interval at whose ends and joints the amplitude's interval is
+/// taken.
+const AMPLITUDE_SCALES: usize = 8;
 
 /// Passes of reweighting (and of choosing each point's noise type for its degrees of freedom).
 const PASSES: usize = 12;
@@ -165,19 +202,59 @@ pub struct TermEstimate {
     pub needs_record_s: Option<f64>,
 }
 
+/// A term with a time scale ([`ScaleTerm`]) that the curve supports: kept when adding it lowers
+/// the fit's χ² by more than [`NoiseFit::criterion`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScaleEstimate {
+    /// The term.
+    pub term: ScaleTerm,
+    /// Its amplitude (Markov: stationary deviation σ; sinusoid: peak Ω₀), rate units.
+    pub value: f64,
+    /// Lower end of the amplitude's 95 % interval (0 when a fit without the term describes the
+    /// curve about as well).
+    pub lower: f64,
+    /// Upper end.
+    pub upper: f64,
+    /// Its time scale: the correlation time, s, or the frequency, Hz.
+    pub scale: f64,
+    /// Lower end of the time scale's 95 % interval.
+    pub scale_lower: f64,
+    /// Upper end.
+    pub scale_upper: f64,
+    /// How much the term lowered the fit's χ² when it was added.
+    pub chi2_drop: f64,
+}
+
+impl ScaleEstimate {
+    /// The term's Allan variance at `τ = m/f_s`.
+    #[must_use]
+    pub fn variance(&self, m: usize, sample_rate_hz: f64) -> f64 {
+        self.term
+            .variance(self.value, self.scale, m, sample_rate_hz)
+    }
+}
+
 /// Noise terms fitted to an Allan curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoiseFit {
     /// The five terms, in [`NoiseTerm::ALL`] order.
     pub terms: [TermEstimate; TERMS],
-    /// Reduced χ² of the fit (about 1 when the five-term model, the degrees of freedom and the
+    /// The terms with a time scale the curve supports, in [`ScaleTerm::ALL`] order (`None` for
+    /// a term not kept).
+    pub scaled: [Option<ScaleEstimate>; SCALE_TERMS],
+    /// Reduced χ² of the fit (about 1 when the model, the degrees of freedom and the
     /// correlations describe the curve).
     pub reduced_chi2: f64,
+    /// The information criterion a term with a time scale had to pass: the fall in χ² it must
+    /// buy, `4 ln n` for `n` points (module documentation).
+    pub criterion: f64,
     /// Each point's equivalent degrees of freedom, for the noise type the fit found dominant
     /// there (the first `points` entries).
     pub edf: [f64; MAX_POINTS],
     /// The number of points fitted.
     pub points: usize,
+    /// The sample rate of the record, Hz (`m/τ` of the first point).
+    pub sample_rate_hz: f64,
 }
 
 impl NoiseFit {
@@ -187,13 +264,30 @@ impl NoiseFit {
         &self.terms[term as usize]
     }
 
-    /// The fitted Allan variance at `tau_s` (every term at its fitted value).
+    /// The estimate of a term with a time scale, if the curve supports it.
+    #[must_use]
+    pub fn scaled(&self, term: ScaleTerm) -> Option<&ScaleEstimate> {
+        self.scaled[term as usize].as_ref()
+    }
+
+    /// The fitted Allan variance at `tau_s` (every term at its fitted value; the sinusoid's at
+    /// the nearest whole number of samples).
     #[must_use]
     pub fn variance_at(&self, tau_s: f64) -> f64 {
-        self.terms
+        let power: f64 = self
+            .terms
             .iter()
             .map(|t| t.term.variance(t.value, tau_s))
-            .sum()
+            .sum();
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let m = math::round(tau_s * self.sample_rate_hz).max(1.0) as usize;
+        power
+            + self
+                .scaled
+                .iter()
+                .flatten()
+                .map(|e| e.variance(m, self.sample_rate_hz))
+                .sum::<f64>()
     }
 }
 
@@ -231,23 +325,71 @@ impl core::fmt::Display for FitError {
 
 impl core::error::Error for FitError {}
 
-type Mat = SMatrix<f64, TERMS, TERMS>;
-type Vec5 = SVector<f64, TERMS>;
+type Mat = SMatrix<f64, COLUMNS, COLUMNS>;
+type VecC = SVector<f64, COLUMNS>;
 
 /// At most this many τ: cluster sizes are octaves, so 64 covers any record in memory.
 pub const MAX_POINTS: usize = 64;
 
-/// The curve a fit sees: τ, estimated variance, degrees of freedom, and the Cholesky factor of
-/// the estimates' correlation.
+/// One column of the least-squares design: a power law, or a term with a time scale at a given
+/// scale (its coefficient is then the amplitude squared).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Column {
+    Power(NoiseTerm),
+    Scaled(ScaleTerm, f64),
+}
+
+impl Column {
+    /// The column's Allan variance for a unit coefficient at `tau` (`m` samples at `fs`).
+    fn basis(self, tau: f64, m: usize, fs: f64) -> f64 {
+        match self {
+            Self::Power(t) => num_traits::Float::powi(tau, t.tau_power()),
+            Self::Scaled(t, scale) => t.variance(1.0, scale, m, fs),
+        }
+    }
+
+    /// The noise family whose estimates the term's resemble at `tau`: Markov noise is counted
+    /// as a random walk up to [`MARKOV_WHITE_FROM`] correlation times and white beyond; a
+    /// sinusoid as white (its estimates scatter less than that, so its points are weighted no
+    /// more than they deserve).
+    fn family(self, tau: f64) -> Family {
+        match self {
+            Self::Power(t) => Family::of(t),
+            Self::Scaled(ScaleTerm::Markov, tc) if tau < MARKOV_WHITE_FROM * tc => {
+                Family::RandomWalk
+            }
+            Self::Scaled(..) => Family::White,
+        }
+    }
+
+    /// The rate PSD exponent whose degrees of freedom the term's estimates have at `tau` (as
+    /// [`Self::family`] counts them).
+    fn psd_exponent(self, tau: f64) -> i32 {
+        match self {
+            Self::Power(t) => t.psd_exponent(),
+            Self::Scaled(ScaleTerm::Markov, tc) if tau < MARKOV_WHITE_FROM * tc => -2,
+            Self::Scaled(..) => 0,
+        }
+    }
+}
+
+/// The curve a fit sees: τ, estimated variance, degrees of freedom, the Cholesky factor of
+/// the estimates' correlation, and the design's columns at each τ.
 struct Curve {
     tau: [f64; MAX_POINTS],
     var: [f64; MAX_POINTS],
     nu: [f64; MAX_POINTS],
+    m: [usize; MAX_POINTS],
     len: usize,
+    sample_rate_hz: f64,
     /// Each point's share of the model variance per noise family ([`Family`]).
     share: [[f64; FAMILIES]; MAX_POINTS],
     /// Lower-triangular `L` with `L·Lᵀ` the correlation matrix.
     chol: [[f64; MAX_POINTS]; MAX_POINTS],
+    columns: [Column; COLUMNS],
+    ncols: usize,
+    /// `basis[j][i]`: column `j` at point `i`.
+    basis: [[f64; MAX_POINTS]; COLUMNS],
 }
 
 /// How many noise families the correlation of the estimates distinguishes.
@@ -296,21 +438,53 @@ pub fn family_correlation(family: Family, r: f64) -> f64 {
     }
 }
 
+/// The five power laws, as design columns.
+const POWER_COLUMNS: [Column; TERMS] = [
+    Column::Power(NoiseTerm::Quantization),
+    Column::Power(NoiseTerm::White),
+    Column::Power(NoiseTerm::BiasInstability),
+    Column::Power(NoiseTerm::RandomWalk),
+    Column::Power(NoiseTerm::RateRamp),
+];
+
 impl Curve {
-    fn new(tau: &[f64], var: &[f64]) -> Self {
+    fn new(tau: &[f64], var: &[f64], m: &[usize], columns: &[Column]) -> Self {
         let len = tau.len();
         let mut curve = Self {
             tau: [0.0; MAX_POINTS],
             var: [0.0; MAX_POINTS],
             nu: [1.0; MAX_POINTS],
+            m: [1; MAX_POINTS],
             len,
+            sample_rate_hz: m[0] as f64 / tau[0],
             share: [[1.0, 0.0, 0.0]; MAX_POINTS],
             chol: [[0.0; MAX_POINTS]; MAX_POINTS],
+            columns: [Column::Power(NoiseTerm::White); COLUMNS],
+            ncols: 0,
+            basis: [[0.0; MAX_POINTS]; COLUMNS],
         };
         curve.tau[..len].copy_from_slice(tau);
         curve.var[..len].copy_from_slice(var);
+        curve.m[..len].copy_from_slice(m);
+        for (k, c) in columns.iter().enumerate() {
+            curve.set_column(k, *c);
+        }
+        curve.ncols = columns.len();
         curve.factor();
         curve
+    }
+
+    /// Puts `column` at index `k` of the design.
+    fn set_column(&mut self, k: usize, column: Column) {
+        self.columns[k] = column;
+        for i in 0..self.len {
+            self.basis[k][i] = column.basis(self.tau[i], self.m[i], self.sample_rate_hz);
+        }
+    }
+
+    /// The model's variance at point `i` for coefficients `c`.
+    fn model(&self, c: &VecC, i: usize) -> f64 {
+        (0..self.ncols).map(|j| c[j] * self.basis[j][i]).sum()
     }
 
     /// The Cholesky factor of the estimates' correlation for the present shares (positive
@@ -350,22 +524,21 @@ impl Curve {
     }
 }
 
-/// The weighted least-squares solution on the terms in `mask` (bit `j` for term `j`), with
-/// weights `w`; `None` if singular. Returns coefficients of the squares (`scale·X²`, scaled back)
-/// and their covariance.
+/// The weighted least-squares solution on the columns in `mask` (bit `j` for column `j`), with
+/// weights `w`; `None` if singular. Returns the coefficients (`scale·X²` of a power law, the
+/// amplitude squared of a term with a time scale) and their covariance.
 fn solve(curve: &Curve, w: &[f64], mask: u32) -> Option<Solution> {
-    let active: heapless_terms::Active = heapless_terms::Active::of(mask);
+    let active = heapless_terms::Active::of(mask);
     let k = active.len;
     if k == 0 {
         return None;
     }
-    // Columns τ^p scaled to unit weighted norm, so that normal equations spanning τ⁻² … τ² stay
+    // Columns scaled to unit weighted norm, so that normal equations spanning τ⁻² … τ² stay
     // well conditioned.
-    let mut norm = [0.0; TERMS];
+    let mut norm = [0.0; COLUMNS];
     for (a, n) in active.iter().zip(norm.iter_mut()) {
-        let p = NoiseTerm::ALL[a].tau_power();
         let s: f64 = (0..curve.len)
-            .map(|i| w[i] * num_traits::Float::powi(num_traits::Float::powi(curve.tau[i], p), 2))
+            .map(|i| w[i] * curve.basis[a][i] * curve.basis[a][i])
             .sum();
         *n = math::sqrt(s);
         if !(*n > 0.0 && n.is_finite()) {
@@ -373,33 +546,32 @@ fn solve(curve: &Curve, w: &[f64], mask: u32) -> Option<Solution> {
         }
     }
     // Rows scaled by the standard deviations, then decorrelated: columns of `L⁻¹·D⁻¹·[A y]`.
-    let mut cols = [[0.0; MAX_POINTS]; TERMS + 1];
+    let mut cols = [[0.0; MAX_POINTS]; COLUMNS + 1];
     for i in 0..curve.len {
         let sw = math::sqrt(w[i]);
         for (r, (a, n)) in active.iter().zip(norm).enumerate() {
-            cols[r][i] =
-                sw * num_traits::Float::powi(curve.tau[i], NoiseTerm::ALL[a].tau_power()) / n;
+            cols[r][i] = sw * curve.basis[a][i] / n;
         }
-        cols[TERMS][i] = sw * curve.var[i];
+        cols[COLUMNS][i] = sw * curve.var[i];
     }
-    for r in (0..k).chain(core::iter::once(TERMS)) {
+    for r in (0..k).chain(core::iter::once(COLUMNS)) {
         curve.whiten(&mut cols[r][..curve.len]);
     }
     let mut ata = Mat::zeros();
-    let mut aty = Vec5::zeros();
+    let mut aty = VecC::zeros();
     for r in 0..k {
-        aty[r] = dot(&cols[r][..curve.len], &cols[TERMS][..curve.len]);
+        aty[r] = dot(&cols[r][..curve.len], &cols[COLUMNS][..curve.len]);
         for c in 0..k {
             ata[(r, c)] = dot(&cols[r][..curve.len], &cols[c][..curve.len]);
         }
     }
-    for d in k..TERMS {
+    for d in k..COLUMNS {
         ata[(d, d)] = 1.0;
     }
     let chol = ata.cholesky()?;
     let sol = chol.solve(&aty);
     let inv = chol.inverse();
-    let mut c = Vec5::zeros();
+    let mut c = VecC::zeros();
     let mut cov = Mat::zeros();
     for (r, (a, n)) in active.iter().zip(norm).enumerate() {
         c[a] = sol[r] / n;
@@ -411,15 +583,16 @@ fn solve(curve: &Curve, w: &[f64], mask: u32) -> Option<Solution> {
     let chi2 = (0..curve.len)
         .map(|i| {
             let fitted: f64 = (0..k).map(|r| cols[r][i] * sol[r]).sum();
-            num_traits::Float::powi(cols[TERMS][i] - fitted, 2)
+            num_traits::Float::powi(cols[COLUMNS][i] - fitted, 2)
         })
         .sum();
     Some(Solution { c, cov, chi2 })
 }
 
-/// A least-squares solution: coefficients of the squares, their covariance, χ².
+/// A least-squares solution: coefficients, their covariance, χ².
+#[derive(Clone, Copy)]
 struct Solution {
-    c: Vec5,
+    c: VecC,
     cov: Mat,
     chi2: f64,
 }
@@ -428,20 +601,20 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The active set of terms as indices, without allocation.
+/// The active set of columns as indices, without allocation.
 mod heapless_terms {
-    use super::TERMS;
+    use super::COLUMNS;
 
     pub(super) struct Active {
-        idx: [usize; TERMS],
+        idx: [usize; COLUMNS],
         pub(super) len: usize,
     }
 
     impl Active {
         pub(super) fn of(mask: u32) -> Self {
-            let mut idx = [0; TERMS];
+            let mut idx = [0; COLUMNS];
             let mut len = 0;
-            for j in 0..TERMS {
+            for j in 0..COLUMNS {
                 if mask & (1 << j) != 0 {
                     idx[len] = j;
                     len += 1;
@@ -456,25 +629,25 @@ mod heapless_terms {
     }
 }
 
-fn model(c: &Vec5, tau: f64) -> f64 {
-    NoiseTerm::ALL
-        .iter()
-        .enumerate()
-        .map(|(j, t)| c[j] * num_traits::Float::powi(tau, t.tau_power()))
-        .sum()
+/// Whether every column of `mask` has a positive coefficient in `sol`.
+fn non_negative(sol: &Solution, mask: u32) -> bool {
+    (0..COLUMNS).all(|j| {
+        mask & (1 << j) == 0 || sol.c[j].partial_cmp(&0.0) == Some(core::cmp::Ordering::Greater)
+    })
 }
 
-/// The best non-negative fit for weights `w`: the subset of terms (bit `j` for term `j`) and
-/// its solution.
-fn best_non_negative(curve: &Curve, w: &[f64]) -> Option<(u32, Solution)> {
+/// The best non-negative fit for weights `w` among the subsets of the design's columns that hold
+/// every column of `required`: the subset (bit `j` for column `j`) and its solution.
+fn best_non_negative(curve: &Curve, w: &[f64], required: u32) -> Option<(u32, Solution)> {
     let mut best: Option<(u32, Solution)> = None;
-    for mask in 1..(1u32 << TERMS) {
+    for mask in 1..(1u32 << curve.ncols) {
+        if mask & required != required {
+            continue;
+        }
         let Some(sol) = solve(curve, w, mask) else {
             continue;
         };
-        if (0..TERMS).any(|j| {
-            mask & (1 << j) != 0 && sol.c[j].partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater)
-        }) {
+        if !non_negative(&sol, mask) {
             continue;
         }
         if best.as_ref().is_none_or(|b| sol.chi2 < b.1.chi2) {
@@ -486,22 +659,22 @@ fn best_non_negative(curve: &Curve, w: &[f64]) -> Option<(u32, Solution)> {
 
 /// The degrees of freedom of each point for the term that dominates the model there, and the
 /// estimates' correlation for the terms' shares of the model at each point.
-fn degrees_of_freedom(curve: &mut Curve, c: &Vec5, m: &[usize], n: usize) {
-    for (i, &mi) in m.iter().enumerate().take(curve.len) {
+fn degrees_of_freedom(curve: &mut Curve, c: &VecC, n: usize) {
+    for i in 0..curve.len {
         let tau = curve.tau[i];
-        let parts = NoiseTerm::ALL
-            .map(|t| c[t as usize].max(0.0) * num_traits::Float::powi(tau, t.tau_power()));
-        let dominant = NoiseTerm::ALL
-            .iter()
-            .zip(parts)
-            .max_by(|(_, a), (_, b)| a.total_cmp(b))
-            .map_or(NoiseTerm::White, |(t, _)| *t);
-        curve.nu[i] = overlapping_edf(dominant.psd_exponent(), mi, n).unwrap_or(1.0);
+        let mut parts = [0.0; COLUMNS];
+        for (j, p) in parts.iter_mut().enumerate().take(curve.ncols) {
+            *p = c[j].max(0.0) * curve.basis[j][i];
+        }
+        let dominant = (0..curve.ncols)
+            .max_by(|a, b| parts[*a].total_cmp(&parts[*b]))
+            .map_or(0, |j| curve.columns[j].psd_exponent(tau));
+        curve.nu[i] = overlapping_edf(dominant, curve.m[i], n).unwrap_or(1.0);
         let total: f64 = parts.iter().sum();
         if total > 0.0 && total.is_finite() {
             let mut share = [0.0; FAMILIES];
-            for (t, v) in NoiseTerm::ALL.iter().zip(parts) {
-                share[Family::of(*t) as usize] += v / total;
+            for (j, v) in parts.iter().enumerate().take(curve.ncols) {
+                share[curve.columns[j].family(tau) as usize] += v / total;
             }
             curve.share[i] = share;
         }
@@ -510,9 +683,9 @@ fn degrees_of_freedom(curve: &mut Curve, c: &Vec5, m: &[usize], n: usize) {
 }
 
 /// Weights `ν/(2μ²)` with `μ` the model (or the estimate, where the model is zero).
-fn weights(curve: &Curve, c: Option<&Vec5>, w: &mut [f64]) {
+fn weights(curve: &Curve, c: Option<&VecC>, w: &mut [f64]) {
     for (i, wi) in w.iter_mut().enumerate().take(curve.len) {
-        let mu = c.map_or(curve.var[i], |c| model(c, curve.tau[i]));
+        let mu = c.map_or(curve.var[i], |c| curve.model(c, i));
         let mu = if mu > 0.0 { mu } else { curve.var[i] };
         *wi = if mu > 0.0 {
             curve.nu[i] / (2.0 * mu * mu)
@@ -522,9 +695,137 @@ fn weights(curve: &Curve, c: Option<&Vec5>, w: &mut [f64]) {
     }
 }
 
+/// Reweights until the chosen columns and coefficients settle: each pass takes the degrees of
+/// freedom, correlations and weights from the previous fit (the first from `start`, or from
+/// white noise and the estimates themselves). The fit returned is the one made with the
+/// weights left in `w`.
+fn converge(
+    curve: &mut Curve,
+    w: &mut [f64; MAX_POINTS],
+    start: Option<&VecC>,
+    n: usize,
+    required: u32,
+) -> Option<(u32, Solution)> {
+    let len = curve.len;
+    match start {
+        Some(c) => {
+            degrees_of_freedom(curve, c, n);
+            weights(curve, Some(c), w);
+        }
+        None => {
+            let mut white = VecC::zeros();
+            white[NoiseTerm::White as usize] = 1.0;
+            degrees_of_freedom(curve, &white, n);
+            weights(curve, None, w);
+        }
+    }
+    let mut fit = best_non_negative(curve, &w[..len], required);
+    for _ in 0..PASSES {
+        let Some((_, Solution { c, .. })) = fit else {
+            break;
+        };
+        degrees_of_freedom(curve, &c, n);
+        weights(curve, Some(&c), w);
+        let next = best_non_negative(curve, &w[..len], required);
+        let settled = match (&next, &fit) {
+            (Some(a), Some(b)) => {
+                a.0 == b.0
+                    && (0..COLUMNS).all(|j| math::abs(a.1.c[j] - b.1.c[j]) <= 1e-9 * b.1.c[j])
+            }
+            _ => true,
+        };
+        fit = next;
+        if settled {
+            break;
+        }
+    }
+    fit
+}
+
+/// The time scales tried for `term` on `curve`: correlation times over the curve's τ range, and
+/// frequencies whose hump (at τ ≈ 0.371/f₀) lies within it, below the Nyquist frequency.
+fn scale_grid(term: ScaleTerm, curve: &Curve) -> impl Iterator<Item = f64> + use<> {
+    let (first, last) = (curve.tau[0], curve.tau[curve.len - 1]);
+    let (lo, hi) = match term {
+        ScaleTerm::Markov => (first, last),
+        ScaleTerm::Sinusoid => (0.25 / last, 0.5 * curve.sample_rate_hz * (1.0 - 1e-9)),
+    };
+    let step = math::powf(2.0, 1.0 / SCALES_PER_OCTAVE);
+    let count = if hi > lo {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let k = (num_traits::Float::log2(hi / lo) * SCALES_PER_OCTAVE) as usize;
+        k + 1
+    } else {
+        0
+    };
+    (0..count).map(move |k| lo * num_traits::Float::powi(step, k as i32))
+}
+
+/// The χ² of the best non-negative fit with column `k` at `scale` (holding it), with weights `w`.
+fn chi2_at(
+    curve: &mut Curve,
+    w: &[f64],
+    k: usize,
+    term: ScaleTerm,
+    scale: f64,
+) -> Option<Solution> {
+    curve.set_column(k, Column::Scaled(term, scale));
+    best_non_negative(curve, w, 1 << k).map(|(_, s)| s)
+}
+
+/// The time scale of column `k` (a `term`) that fits best with weights `w`: the best of the grid,
+/// refined by a golden-section search on log scale between its neighbours. Leaves the column at
+/// that scale. `None` when no non-negative fit holds the term.
+fn best_scale(curve: &mut Curve, w: &[f64], k: usize, term: ScaleTerm) -> Option<(f64, f64)> {
+    let mut best: Option<(f64, f64)> = None;
+    for scale in scale_grid(term, curve) {
+        if let Some(sol) = chi2_at(curve, w, k, term, scale)
+            && best.is_none_or(|b| sol.chi2 < b.1)
+        {
+            best = Some((scale, sol.chi2));
+        }
+    }
+    let (scale, chi2) = best?;
+    let step = math::powf(2.0, 1.0 / SCALES_PER_OCTAVE);
+    let ln = num_traits::Float::ln;
+    let (mut a, mut b) = (ln(scale / step), ln(scale * step));
+    let ratio = 0.5 * (math::sqrt(5.0) - 1.0);
+    let eval = |x: f64, curve: &mut Curve| {
+        chi2_at(curve, w, k, term, num_traits::Float::exp(x)).map_or(f64::INFINITY, |s| s.chi2)
+    };
+    let (mut x1, mut x2) = (b - ratio * (b - a), a + ratio * (b - a));
+    let (mut f1, mut f2) = (eval(x1, curve), eval(x2, curve));
+    for _ in 0..24 {
+        if f1 < f2 {
+            b = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = b - ratio * (b - a);
+            f1 = eval(x1, curve);
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + ratio * (b - a);
+            f2 = eval(x2, curve);
+        }
+    }
+    let (x, f) = if f1 < f2 { (x1, f1) } else { (x2, f2) };
+    let found = if f < chi2 {
+        (num_traits::Float::exp(x), f)
+    } else {
+        (scale, chi2)
+    };
+    curve.set_column(k, Column::Scaled(term, found.0));
+    Some(found)
+}
+
 /// Fits the five noise terms to an overlapping Allan curve: `tau_s` increasing, `adev` the
 /// deviations, `m` the cluster sizes they were computed at, from `n` integrated points (the
-/// record's sample count).
+/// record's sample count). Exponentially correlated noise and a sinusoid ([`ScaleTerm`]) join
+/// the model when the curve supports them: the best time scale of each is sought, and a term is
+/// kept when it lowers χ² (with the weights of the fit without it) by more than `4 ln n`
+/// (module documentation); the better of the two is tried first.
 ///
 /// # Errors
 /// Slices of different lengths, empty or longer than [`MAX_POINTS`], a point that is not finite,
@@ -547,7 +848,8 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
         }
         var[i] = adev[i] * adev[i];
     }
-    let mut curve = Curve::new(tau_s, &var[..len]);
+    let mut curve = Curve::new(tau_s, &var[..len], m, &POWER_COLUMNS);
+    let criterion = 4.0 * num_traits::Float::ln(len.max(2) as f64);
     let unresolved = |term: NoiseTerm| TermEstimate {
         term,
         value: 0.0,
@@ -556,96 +858,125 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
         resolved: false,
         needs_record_s: None,
     };
-    let mut terms = NoiseTerm::ALL.map(unresolved);
+    let mut out = NoiseFit {
+        terms: NoiseTerm::ALL.map(unresolved),
+        scaled: [None; SCALE_TERMS],
+        reduced_chi2: 0.0,
+        criterion,
+        edf: curve.nu,
+        points: len,
+        sample_rate_hz: curve.sample_rate_hz,
+    };
     if curve.var[..len].iter().all(|v| *v == 0.0) {
-        return Ok(NoiseFit {
-            terms,
-            reduced_chi2: 0.0,
-            edf: curve.nu,
-            points: len,
-        });
+        return Ok(out);
     }
-    // Start from white-noise degrees of freedom and the estimates as their own variances.
-    let white = {
-        let mut c = Vec5::zeros();
-        c[NoiseTerm::White as usize] = 1.0;
-        c
-    };
-    degrees_of_freedom(&mut curve, &white, m, n);
-    let mut w = [0.0; MAX_POINTS];
-    weights(&curve, None, &mut w);
-    let mut fit = best_non_negative(&curve, &w[..len]);
-    for _ in 0..PASSES {
-        let Some((_, Solution { c, .. })) = fit else {
-            break;
-        };
-        degrees_of_freedom(&mut curve, &c, m, n);
-        weights(&curve, Some(&c), &mut w);
-        let next = best_non_negative(&curve, &w[..len]);
-        let settled = match (&next, &fit) {
-            (Some(a), Some(b)) => {
-                a.0 == b.0 && (0..TERMS).all(|j| math::abs(a.1.c[j] - b.1.c[j]) <= 1e-9 * b.1.c[j])
-            }
-            _ => true,
-        };
-        fit = next;
-        if settled {
-            break;
+    // A term with a time scale kept by the criterion but not resolved (a fit without it
+    // describes the curve about as well at some scale) is left out, and the model fitted again.
+    let mut excluded = 0u32;
+    loop {
+        curve.ncols = TERMS;
+        let unresolved = fit_model(&mut curve, n, excluded, &mut out);
+        if unresolved == 0 {
+            return Ok(out);
         }
+        excluded |= unresolved;
+        out.scaled = [None; SCALE_TERMS];
     }
-    let Some((mask, Solution { c, chi2, .. })) = fit else {
-        return Ok(NoiseFit {
-            terms,
-            reduced_chi2: 0.0,
-            edf: curve.nu,
-            points: len,
-        });
+}
+
+/// Fits the model to `curve` (its design reset to the five power laws), the terms with a time
+/// scale in `excluded` (bit per [`ScaleTerm`]) left out, into `out`. Returns the terms with a
+/// time scale it kept whose amplitude the curve does not resolve.
+fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> u32 {
+    let len = curve.len;
+    let criterion = out.criterion;
+    let mut w = [0.0; MAX_POINTS];
+    let Some(mut fit) = converge(curve, &mut w, None, n, 0) else {
+        out.edf = curve.nu;
+        return 0;
     };
-    let dof = len.saturating_sub(mask.count_ones() as usize).max(1);
+    let mut drops = [0.0; SCALE_TERMS];
+    let mut required = 0u32;
+    // The terms with a time scale, the better first, each kept if it pays for its parameters.
+    while curve.ncols < COLUMNS {
+        let k = curve.ncols;
+        curve.ncols += 1;
+        let mut best: Option<(ScaleTerm, f64, f64)> = None;
+        for term in ScaleTerm::ALL {
+            if excluded & (1 << term as u32) != 0
+                || (TERMS..k).any(|j| matches!(curve.columns[j], Column::Scaled(t, _) if t == term))
+            {
+                continue;
+            }
+            if let Some((scale, chi2)) = best_scale(curve, &w[..len], k, term)
+                && best.is_none_or(|b| chi2 < b.2)
+            {
+                best = Some((term, scale, chi2));
+            }
+        }
+        let Some((term, scale, chi2)) = best.filter(|b| fit.1.chi2 - b.2 > criterion) else {
+            curve.ncols -= 1;
+            break;
+        };
+        let before = (fit, curve.nu, curve.share, curve.chol, w);
+        curve.set_column(k, Column::Scaled(term, scale));
+        let start = fit.1.c;
+        let refit = converge(curve, &mut w, Some(&start), n, required | 1 << k)
+            .and_then(|_| best_scale(curve, &w[..len], k, term))
+            .and_then(|_| converge(curve, &mut w, Some(&start), n, required | 1 << k));
+        let Some(next) = refit else {
+            // Reweighted, no non-negative fit holds the term: it is not kept.
+            (fit, curve.nu, curve.share, curve.chol, w) = before;
+            curve.ncols -= 1;
+            break;
+        };
+        drops[term as usize] = fit.1.chi2 - chi2;
+        required |= 1 << k;
+        fit = next;
+    }
+    let (mask, Solution { c, chi2, .. }) = fit;
+    // Each term with a time scale also spends a degree of freedom on its scale.
+    let parameters = mask.count_ones() + required.count_ones();
+    let dof = len.saturating_sub(parameters as usize).max(1);
     // A curve the model does not describe (reduced χ² above 1) widens every interval by the
     // Birge ratio: the coefficients' covariance, and the χ² margin within which another subset
     // of terms counts as describing the curve as well, are scaled by χ²/dof (as the PDG scales
     // inconsistent measurements); a fit that describes its curve keeps them.
     let birge = (chi2 / dof as f64).max(1.0);
-    let to_x = |term: NoiseTerm, c2: f64| math::sqrt(c2.max(0.0) / term.scale());
-    let sample_rate_hz = m[0] as f64 / tau_s[0];
+    let margin = CHI2_1_95 * birge;
     // Every non-negative fit that describes the curve as well as the best (χ² within the 95 %
     // point of χ² with one degree of freedom) is a candidate; each term's interval spans its
     // intervals in all of them (0 in those that leave it out), so that which terms the best fit
     // happened to pick does not narrow it.
-    let (mut lower, mut upper) = ([f64::INFINITY; TERMS], [0.0_f64; TERMS]);
-    for subset in 1..(1u32 << TERMS) {
-        let Some(sol) = solve(&curve, &w[..len], subset) else {
+    let (mut lower, mut upper) = ([f64::INFINITY; COLUMNS], [0.0_f64; COLUMNS]);
+    for subset in 1..(1u32 << curve.ncols) {
+        let Some(sol) = solve(curve, &w[..len], subset) else {
             continue;
         };
-        let in_subset = |j: usize| subset & (1 << j) != 0;
-        if (0..TERMS).any(|j| {
-            in_subset(j) && sol.c[j].partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater)
-        }) || sol.chi2 > chi2 + CHI2_1_95 * birge
-        {
+        if !non_negative(&sol, subset) || sol.chi2 > chi2 + margin {
             continue;
         }
-        for j in 0..TERMS {
-            if in_subset(j) {
-                let var = sol.cov[(j, j)] * birge;
-                let (lo, hi) = interval(sol.c[j], var);
-                let wald_lower = sol.c[j] - Z_95 * math::sqrt(var.max(0.0));
-                lower[j] = lower[j].min(if wald_lower > 0.0 { lo } else { 0.0 });
+        for j in 0..curve.ncols {
+            if subset & (1 << j) != 0 {
+                let (lo, hi) = coefficient_interval(&sol, j, birge);
+                lower[j] = lower[j].min(lo);
                 upper[j] = upper[j].max(hi);
             } else {
                 lower[j] = lower[j].min(0.0);
             }
         }
     }
+    let to_x = |term: NoiseTerm, c2: f64| math::sqrt(c2.max(0.0) / term.scale());
+    let sample_rate_hz = curve.sample_rate_hz;
     for (j, term) in NoiseTerm::ALL.iter().enumerate() {
         let in_fit = mask & (1 << j) != 0;
         let value = if in_fit { c[j] } else { 0.0 };
         let with = mask | (1 << j);
         let resolved = lower[j] > 0.0;
         if !resolved {
-            upper[j] = curve_bound(&curve, *term);
+            upper[j] = curve_bound(curve, j);
         }
-        terms[j] = TermEstimate {
+        out.terms[j] = TermEstimate {
             term: *term,
             value: to_x(*term, value),
             lower: if resolved { to_x(*term, lower[j]) } else { 0.0 },
@@ -654,22 +985,96 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
             needs_record_s: if resolved {
                 None
             } else {
-                record_needed(&c, with, j, upper[j], n, sample_rate_hz)
+                record_needed(curve, &c, with, j, upper[j], n, sample_rate_hz)
             },
         };
     }
-    Ok(NoiseFit {
-        terms,
-        reduced_chi2: chi2 / dof as f64,
-        edf: curve.nu,
-        points: len,
-    })
+    for k in TERMS..curve.ncols {
+        let Column::Scaled(term, scale) = curve.columns[k] else {
+            continue;
+        };
+        let (mut lo, mut hi) = (lower[k], upper[k]);
+        // The time scale's interval: every scale whose best fit holding the term describes the
+        // curve as well (χ² within the margin), found on the grid and its edges bisected. The
+        // amplitude's errors correlate with the scale's, so its interval spans its intervals
+        // at scales across that interval, not only at the best.
+        let accepts = |curve: &mut Curve, s: f64| {
+            chi2_at(curve, &w[..len], k, term, s).filter(|sol| sol.chi2 <= chi2 + margin)
+        };
+        let (mut scale_lo, mut scale_hi) = (scale, scale);
+        let mut below: Option<f64> = None;
+        let mut above: Option<f64> = None;
+        for s in scale_grid(term, curve) {
+            match accepts(curve, s) {
+                Some(_) => {
+                    scale_lo = scale_lo.min(s);
+                    scale_hi = scale_hi.max(s);
+                }
+                None if s < scale => below = Some(s),
+                None => above = above.or(Some(s)),
+            }
+        }
+        let below = below.filter(|b| *b < scale_lo);
+        let above = above.filter(|a| *a > scale_hi);
+        for (inside, outside) in [(scale_lo, below), (scale_hi, above)] {
+            let Some(mut outside) = outside else {
+                continue;
+            };
+            let mut inside = inside;
+            for _ in 0..BISECTIONS {
+                let mid = math::sqrt(inside * outside);
+                if accepts(curve, mid).is_some() {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            scale_lo = scale_lo.min(inside);
+            scale_hi = scale_hi.max(inside);
+        }
+        for step in 0..=AMPLITUDE_SCALES {
+            let s =
+                scale_lo * math::powf(scale_hi / scale_lo, step as f64 / AMPLITUDE_SCALES as f64);
+            if let Some(sol) = chi2_at(curve, &w[..len], k, term, s) {
+                let (a, b) = coefficient_interval(&sol, k, birge);
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+        }
+        curve.set_column(k, Column::Scaled(term, scale));
+        out.scaled[term as usize] = Some(ScaleEstimate {
+            term,
+            value: math::sqrt(c[k].max(0.0)),
+            lower: math::sqrt(lo.max(0.0)),
+            upper: math::sqrt(hi.max(c[k])),
+            scale,
+            scale_lower: scale_lo,
+            scale_upper: scale_hi,
+            chi2_drop: drops[term as usize],
+        });
+    }
+    out.reduced_chi2 = chi2 / dof as f64;
+    out.edf = curve.nu;
+    out.scaled
+        .iter()
+        .flatten()
+        .filter(|e| e.lower <= 0.0)
+        .fold(0, |bits, e| bits | 1 << e.term as u32)
 }
 
-/// The largest `scale·X²` of `term` the curve allows: at every τ the term alone must stay below
-/// the estimate's upper confidence limit, each limit at `1 − 0.05/len` (Bonferroni) so that all
-/// hold together with 95 % confidence.
-fn curve_bound(curve: &Curve, term: NoiseTerm) -> f64 {
+/// The 95 % interval of coefficient `j` of `sol` with its variance scaled by `birge`; its lower
+/// end is 0 when the Wald interval reaches zero.
+fn coefficient_interval(sol: &Solution, j: usize, birge: f64) -> (f64, f64) {
+    let var = sol.cov[(j, j)] * birge;
+    let (lo, hi) = interval(sol.c[j], var);
+    let wald_lower = sol.c[j] - Z_95 * math::sqrt(var.max(0.0));
+    (if wald_lower > 0.0 { lo } else { 0.0 }, hi)
+}
+
+/// The largest coefficient of column `j` the curve allows: at every τ the term alone must stay
+/// below the estimate's upper confidence limit, each limit at `1 − 0.05/len` (Bonferroni) so
+/// that all hold together with 95 % confidence.
+fn curve_bound(curve: &Curve, j: usize) -> f64 {
     use statrs::distribution::{ChiSquared, ContinuousCDF};
     let p = 0.05 / curve.len as f64;
     (0..curve.len)
@@ -677,7 +1082,7 @@ fn curve_bound(curve: &Curve, term: NoiseTerm) -> f64 {
             let nu = curve.nu[i];
             let chi = ChiSquared::new(nu).ok()?;
             let limit = nu * curve.var[i] / chi.inverse_cdf(p);
-            Some(limit / num_traits::Float::powi(curve.tau[i], term.tau_power()))
+            Some(limit / curve.basis[j][i])
         })
         .fold(f64::INFINITY, f64::min)
 }
@@ -698,10 +1103,11 @@ fn interval(c: f64, var: f64) -> (f64, f64) {
 }
 
 /// The shortest record (the present one doubled, up to [`MAX_DOUBLINGS`] times) whose octave
-/// Allan curve, if the terms were `c` with term `j` at `bound`, would give `j` a one-sigma no
-/// larger than `bound/(1.96 + 1.645)`: resolved with 95 % power.
+/// Allan curve, if the terms were `c` (on the design of `fitted`) with column `j` at `bound`,
+/// would give `j` a one-sigma no larger than `bound/(1.96 + 1.645)`: resolved with 95 % power.
 fn record_needed(
-    c: &Vec5,
+    fitted: &Curve,
+    c: &VecC,
     mask: u32,
     j: usize,
     bound: f64,
@@ -713,17 +1119,25 @@ fn record_needed(
     }
     let mut truth = *c;
     truth[j] = bound;
+    let columns = &fitted.columns[..fitted.ncols];
     for doubling in 1..=MAX_DOUBLINGS {
         let n_long = n.checked_mul(1usize << doubling)?;
         let mut sizes = [0usize; MAX_POINTS];
         let count = super::octave_cluster_sizes(n_long, &mut sizes);
-        let (mut tau, mut var) = ([0.0; MAX_POINTS], [0.0; MAX_POINTS]);
+        let mut tau = [0.0; MAX_POINTS];
         for i in 0..count {
             tau[i] = sizes[i] as f64 / sample_rate_hz;
-            var[i] = model(&truth, tau[i]);
         }
-        let mut curve = Curve::new(&tau[..count], &var[..count]);
-        degrees_of_freedom(&mut curve, &truth, &sizes[..count], n_long);
+        let mut curve = Curve::new(
+            &tau[..count],
+            &[1.0; MAX_POINTS][..count],
+            &sizes[..count],
+            columns,
+        );
+        for i in 0..count {
+            curve.var[i] = curve.model(&truth, i);
+        }
+        degrees_of_freedom(&mut curve, &truth, n_long);
         let mut w = [0.0; MAX_POINTS];
         weights(&curve, Some(&truth), &mut w);
         if let Some(sol) = solve(&curve, &w[..count], mask)

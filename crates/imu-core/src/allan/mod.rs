@@ -11,9 +11,11 @@ use core::fmt;
 
 pub mod edf;
 pub mod fit;
+pub mod scale_terms;
 
 pub use edf::{deviation_interval, overlapping_edf};
-pub use fit::{FitError, NoiseFit, NoiseTerm, TermEstimate, fit_noise};
+pub use fit::{FitError, NoiseFit, NoiseTerm, ScaleEstimate, TermEstimate, fit_noise};
+pub use scale_terms::ScaleTerm;
 
 use crate::math;
 

@@ -193,6 +193,11 @@ class Identification:
     ``tau_s`` (T,) and ``adev``, ``lower95``, ``upper95``, ``edf``, ``fit`` (T, k) are the curves;
     ``params_toml`` the part as an imukit parameter file, ``kalibr_yaml`` as Kalibr's imu.yaml;
     ``filter_noise`` the fusion filter's ``(sensor, white, bias drift)`` for it.
+    ``scaled_terms`` lists the terms with a time scale a column's curve supports (IEEE Std 952's
+    exponentially correlated ``markov`` noise and ``sinusoid``): ``value`` is the Markov noise's
+    stationary σ or the sinusoid's peak, ``scale`` its correlation time (s) or frequency (Hz),
+    each with its 95 % interval, and ``chi2_drop`` how much better it made the fit than the
+    ``criterion`` it had to beat (``4 ln n`` for ``n`` points).
     ``mean_at_rest`` maps each column to its mean and that mean's one-sigma (a gyroscope's
     turn-on bias, written as ``constant_bias`` in ``params_toml``); ``warnings`` lists what
     :func:`identify` also warned about (:class:`ImuWarning`): a log that moves (where), a fit
@@ -217,6 +222,7 @@ class Identification:
             shown = d["value"] if d["resolved"] else d["upper"]
             d["datasheet_value"] = None if factor is None else shown / factor
             self.terms.append(d)
+        self.scaled_terms = [dict(row) for row in raw["scaled_terms"]]
         self.params_toml = raw["params_toml"]
         self.kalibr_yaml = raw["kalibr_yaml"]
         self.filter_noise = raw["filter_noise"]

@@ -4,7 +4,7 @@
 //! `imukit.identify`.
 use std::collections::BTreeMap;
 
-use imu_core::allan::{NoiseFit, NoiseTerm, TermEstimate};
+use imu_core::allan::{NoiseFit, NoiseTerm, ScaleEstimate, ScaleTerm, TermEstimate};
 use imu_core::fusion::process_noise::triad_psd;
 use imu_core::sensor::{BiasInstabilityModel, NoiseType};
 
@@ -143,6 +143,71 @@ pub fn term_rows(result: &AllanResult) -> Vec<TermRow> {
         .collect()
 }
 
+/// A term with a time scale (Markov noise, a sinusoid) that a column's curve supports, as
+/// reported.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScaleRow {
+    /// The column.
+    pub column: String,
+    /// The estimate.
+    pub estimate: ScaleEstimate,
+    /// The amplitude's SI unit (the rate's: rad/s or m/s²).
+    pub unit: &'static str,
+    /// The time scale's unit.
+    pub scale_unit: &'static str,
+    /// The fall in χ² a term had to buy to be kept ([`NoiseFit::criterion`]).
+    pub criterion: f64,
+}
+
+impl ScaleRow {
+    /// The line printed for it.
+    #[must_use]
+    pub fn line(&self) -> String {
+        let e = &self.estimate;
+        let (name, amplitude, scale) = match e.term {
+            ScaleTerm::Markov => ("Markov noise", "σ", "correlation time"),
+            ScaleTerm::Sinusoid => ("sinusoid", "amplitude", "frequency"),
+        };
+        format!(
+            "  {} {name:<17} {amplitude} {:.4e} {}  95 %: {:.4e} … {:.4e}; {scale} {:.4} {} \
+             (95 %: {:.4} … {:.4}); χ² fell by {:.1} (kept above {:.1})",
+            e.term.symbol(),
+            e.value,
+            self.unit,
+            e.lower,
+            e.upper,
+            e.scale,
+            self.scale_unit,
+            e.scale_lower,
+            e.scale_upper,
+            e.chi2_drop,
+            self.criterion
+        )
+    }
+}
+
+/// Every term with a time scale kept in a column of `result`, in column order.
+#[must_use]
+pub fn scale_rows(result: &AllanResult) -> Vec<ScaleRow> {
+    result
+        .noise
+        .iter()
+        .flat_map(|c| {
+            let unit = si_unit(sensor_of(&c.column), NoiseTerm::BiasInstability);
+            c.fit.scaled.iter().flatten().map(move |e| ScaleRow {
+                column: c.column.clone(),
+                estimate: *e,
+                unit,
+                scale_unit: match e.term {
+                    ScaleTerm::Markov => "s",
+                    ScaleTerm::Sinusoid => "Hz",
+                },
+                criterion: c.fit.criterion,
+            })
+        })
+        .collect()
+}
+
 /// The curve with its bands and the fitted model: `tau_s`, then per column `adev_<c>`,
 /// `lower95_<c>`, `upper95_<c>`, `edf_<c>`, `fit_<c>` (the fitted terms' deviation).
 #[must_use]
@@ -202,9 +267,21 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
         present[Sensor::ALL.iter().position(|s| *s == sensor).unwrap_or(0)] = true;
         let p = params.get_mut(sensor);
         p.noise_type = NoiseType::SingleSided;
-        p.bias_instability_model = BiasInstabilityModel::Flicker {
-            tau_min_s: tau_lo,
-            tau_max_s: tau_hi.max(tau_lo * 2.0),
+        let markov = gauss_markov_bias(&columns);
+        p.bias_instability_model = match markov {
+            Some(correlation_time_s) => {
+                notes.push(format!(
+                    "{}: bias instability is the Markov noise every axis shows (no flicker \
+                     resolved), a Gauss–Markov bias of correlation time {correlation_time_s:.4} s \
+                     (the axes' median)",
+                    sensor.key()
+                ));
+                BiasInstabilityModel::GaussMarkov { correlation_time_s }
+            }
+            None => BiasInstabilityModel::Flicker {
+                tau_min_s: tau_lo,
+                tau_max_s: tau_hi.max(tau_lo * 2.0),
+            },
         };
         let mut seen = [false; 3];
         for c in &columns {
@@ -219,7 +296,10 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
                 if e.resolved { e.value } else { e.upper }
             };
             p.noise_density[axis] = value(NoiseTerm::White);
-            p.bias_instability[axis] = value(NoiseTerm::BiasInstability);
+            p.bias_instability[axis] = match (markov, c.fit.scaled(ScaleTerm::Markov)) {
+                (Some(_), Some(e)) => e.value,
+                _ => value(NoiseTerm::BiasInstability),
+            };
             p.random_walk[axis] = value(NoiseTerm::RandomWalk);
             // A gyroscope at rest reads its turn-on bias (and the Earth rate's share, at most
             // 7.3e-5 rad/s); an accelerometer's mean also holds gravity's, in an attitude the
@@ -233,16 +313,32 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
                 ));
             }
             for e in c.fit.terms.iter().filter(|e| !e.resolved) {
-                if matches!(
-                    e.term,
-                    NoiseTerm::White | NoiseTerm::BiasInstability | NoiseTerm::RandomWalk
-                ) {
+                if matches!(e.term, NoiseTerm::White | NoiseTerm::RandomWalk)
+                    || (e.term == NoiseTerm::BiasInstability && markov.is_none())
+                {
                     notes.push(format!(
                         "{}: {} not resolved, written as its 95 % bound {:.4e} {}",
                         c.column,
                         e.term.name(),
                         e.upper,
                         si_unit(Some(sensor), e.term)
+                    ));
+                }
+            }
+            for e in c.fit.scaled.iter().flatten() {
+                if e.term == ScaleTerm::Sinusoid || markov.is_none() {
+                    notes.push(format!(
+                        "{}: {} ({:.4e} at {:.4} {}) found but not part of the sensor model \
+                         written",
+                        c.column,
+                        e.term.name(),
+                        e.value,
+                        e.scale,
+                        if e.term == ScaleTerm::Markov {
+                            "s"
+                        } else {
+                            "Hz"
+                        }
                     ));
                 }
             }
@@ -307,6 +403,24 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
     })
 }
 
+/// The correlation time of a Gauss–Markov bias for a sensor whose every column has Markov
+/// noise and none resolves flicker (the median of the columns' correlation times), or `None`:
+/// the sensor model has one bias instability process per sensor.
+fn gauss_markov_bias(columns: &[&crate::run::allan::ColumnNoise]) -> Option<f64> {
+    if columns
+        .iter()
+        .any(|c| c.fit.term(NoiseTerm::BiasInstability).resolved)
+    {
+        return None;
+    }
+    let mut times: Vec<f64> = columns
+        .iter()
+        .map(|c| c.fit.scaled(ScaleTerm::Markov).map(|e| e.scale))
+        .collect::<Option<_>>()?;
+    times.sort_by(f64::total_cmp);
+    times.get(times.len() / 2).copied()
+}
+
 /// The identified part as Kalibr's `imu.yaml` at the log's rate on `topic`, each density
 /// multiplied by `inflation` (Kalibr's authors advise inflating figures from a static log, for
 /// the effects a static log does not show; the factor is written in the file).
@@ -365,7 +479,7 @@ pub fn column_header(column: &str, fit: &NoiseFit, samples: usize, rate_hz: f64)
     )
 }
 
-/// A reduced χ² above which `identify` says the five-term model does not describe a curve
+/// A reduced χ² above which `identify` says the noise model does not describe a curve
 /// (the intervals are widened by its square root whenever it exceeds 1; see
 /// `imu_core::allan::fit`).
 pub const POOR_FIT_CHI2: f64 = 3.0;
@@ -440,7 +554,7 @@ pub fn column_warnings(
             })
             .collect();
         warnings.push(format!(
-            "{}: the five-term model does not describe this curve (reduced χ² {chi2:.1}): the \
+            "{}: the noise model does not describe this curve (reduced χ² {chi2:.1}): the \
              intervals are widened by √{chi2:.1} = {:.1}{}",
             column.column,
             chi2.sqrt(),
