@@ -90,3 +90,45 @@ def test_a_log_that_moves_is_warned_about_and_the_bias_at_rest_is_written(tmp_pa
                            str(tmp_path / "p.toml")], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "not at rest at t = 200–215 s" in done.stderr and (tmp_path / "p.toml").exists()
+
+
+def test_a_gauss_markov_bias_round_trips_through_simulate_and_identify(tmp_path):
+    """A part whose gyroscope bias is first-order Gauss–Markov (σ 2e-4 rad/s, 3 s) simulated at
+    rest for 40 minutes: ``identify`` finds the Markov term on every axis, its σ and correlation
+    time inside their intervals (but for one of the six), and writes the part back as a Gauss–Markov bias; the command
+    and Python write the same file."""
+    part = """name = "markov part"
+[accelerometer]
+noise_density_m_s2_per_rt_hz = 1e-3
+noise_type = "single-sided"
+[gyroscope]
+noise_density_rad_s_per_rt_hz = 1e-4
+bias_instability_rad_s = 2e-4
+bias_instability_correlation_time_s = 3.0
+noise_type = "single-sided"
+"""
+    (tmp_path / "part.toml").write_text(part)
+    scenario = (ROOT / "examples" / "static_log.toml").read_text()
+    scenario = scenario.replace('preset = "stim300"\nseed = 7', 'params = "part.toml"\nseed = 3')
+    scenario = scenario.replace("duration_s = 1200.0", "duration_s = 2400.0")
+    (tmp_path / "still.toml").write_text(scenario)
+    exe = imukit_bin()
+    run = lambda *a: subprocess.run([exe, *map(str, a)], cwd=tmp_path, check=True, capture_output=True, text=True)
+    run("simulate", "still.toml", "--out", "still.csv")
+    printed = run("identify", "still.csv", "--params", "found.toml").stdout
+    ident = imukit.identify(str(tmp_path / "still.csv"))
+    assert ident.params_toml.splitlines()[2:] == (tmp_path / "found.toml").read_text().splitlines()[2:]
+    markov = [d for d in ident.scaled_terms if d["term"] == "markov"]
+    assert sorted(d["column"] for d in markov) == [f"gyro_{a}_rad_s" for a in "xyz"]
+    # Six 95 % intervals (σ and T_c per axis): at most one outside (the core's tests count the
+    # coverage over many runs).
+    missed = [d for d in markov if not d["lower"] <= 2e-4 <= d["upper"]]
+    missed += [d for d in markov if not d["scale_lower"] <= 3.0 <= d["scale_upper"]]
+    assert len(missed) <= 1, missed
+    for d in markov:
+        assert d["chi2_drop"] > d["criterion"] and d["unit"] == "rad/s" and d["scale_unit"] == "s"
+        assert f"correlation time {d['scale']:.4f} s" in printed
+    found = tomllib.loads(ident.params_toml)["gyroscope"]
+    median = sorted(d["scale"] for d in markov)[1]
+    assert found["bias_instability_correlation_time_s"] == pytest.approx(median, rel=1e-5)
+    assert found["bias_instability_rad_s"] == pytest.approx([d["value"] for d in markov], rel=1e-5)

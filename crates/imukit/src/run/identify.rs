@@ -170,7 +170,7 @@ impl ScaleRow {
         };
         format!(
             "  {} {name:<17} {amplitude} {:.4e} {}  95 %: {:.4e} … {:.4e}; {scale} {:.4} {} \
-             (95 %: {:.4} … {:.4}); χ² fell by {:.1} (kept above {:.1})",
+             (95 %: {:.4} … {:.4} {}); χ² fell by {:.1} (kept above {:.1})",
             e.term.symbol(),
             e.value,
             self.unit,
@@ -180,6 +180,7 @@ impl ScaleRow {
             self.scale_unit,
             e.scale_lower,
             e.scale_upper,
+            self.scale_unit,
             e.chi2_drop,
             self.criterion
         )
