@@ -159,6 +159,31 @@ pub fn shoe_threshold(window: usize, p: f64) -> f64 {
     ChiSquared::new(dof).map_or(f64::INFINITY, |c| c.inverse_cdf(1.0 - p) / window as f64)
 }
 
+/// The SHOE statistic of each sample's centred window of `window` samples, in `statistic` (the
+/// length of the readings; samples whose window would run off either end take the nearest full
+/// window; `f64::INFINITY` where the statistic is undefined, a zero mean acceleration).
+pub fn shoe_statistics(
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
+    gravity_m_s2: f64,
+    noise: ReadingNoise,
+    window: usize,
+    statistic: &mut [f64],
+) {
+    let n = accel.len().min(gyro.len()).min(statistic.len());
+    let window = window.max(1);
+    if n < window {
+        statistic[..n].fill(f64::INFINITY);
+        return;
+    }
+    for (i, s) in statistic[..n].iter_mut().enumerate() {
+        let start = i.saturating_sub(window / 2).min(n - window);
+        let range = start..start + window;
+        *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
+            .unwrap_or(f64::INFINITY);
+    }
+}
+
 /// Marks each sample whose centred window of `window` samples passes the SHOE test against
 /// `threshold` ([`shoe_statistic`], [`shoe_threshold`]) as stance, in `stance` (the length of
 /// the readings; samples whose window would run off either end take the nearest full window).
@@ -183,6 +208,87 @@ pub fn detect_stance(
         *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
             .is_some_and(|t| t < threshold);
     }
+}
+
+/// Bins of the histogram [`two_population_threshold`] splits.
+const POPULATION_BINS: usize = 256;
+
+/// The least share of the samples each population must hold for a split to count.
+pub const MIN_POPULATION_SHARE: f64 = 0.05;
+
+/// The least distance between the two populations' mean logarithms, decades: a walking foot's
+/// stances and swings lie three to six decades apart in the SHOE statistic.
+pub const MIN_POPULATION_SEPARATION: f64 = 1.0;
+
+/// The threshold that splits a detector's statistics into two populations, learnt from the
+/// statistics themselves: Otsu's split (the one that maximises the variance between the two
+/// classes) of the histogram of their decimal logarithms, in [`POPULATION_BINS`] bins.
+///
+/// A real foot does not stand still: it rolls from heel to toe, so its stances read rates far
+/// above the gyroscope's noise while the sensor does not move, and a threshold from the noise
+/// alone ([`shoe_threshold`]) finds few of them. Its stances and swings still form two
+/// populations decades apart, which the split separates. `None` unless both populations hold
+/// at least [`MIN_POPULATION_SHARE`] of the finite positive statistics and their mean
+/// logarithms lie at least [`MIN_POPULATION_SEPARATION`] decades apart (a log all at rest or
+/// all in motion has no second population).
+#[must_use]
+pub fn two_population_threshold(statistics: &[f64]) -> Option<f64> {
+    let logs = || {
+        statistics
+            .iter()
+            .filter(|t| t.is_finite() && **t > 0.0)
+            .map(|t| num_traits::Float::log10(*t))
+    };
+    let (lo, hi) = logs().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    if hi.partial_cmp(&lo) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let width = (hi - lo) / POPULATION_BINS as f64;
+    let mut count = [0usize; POPULATION_BINS];
+    let mut sum = [0.0; POPULATION_BINS];
+    for x in logs() {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let k = (((x - lo) / width) as usize).min(POPULATION_BINS - 1);
+        count[k] += 1;
+        sum[k] += x;
+    }
+    let total: usize = count.iter().sum();
+    let total_sum: f64 = sum.iter().sum();
+    let (mut n0, mut s0) = (0usize, 0.0);
+    let mut best: Option<(f64, usize, f64, f64)> = None;
+    for k in 0..POPULATION_BINS - 1 {
+        n0 += count[k];
+        s0 += sum[k];
+        let n1 = total - n0;
+        if n0 == 0 || n1 == 0 {
+            continue;
+        }
+        let (m0, m1) = (s0 / n0 as f64, (total_sum - s0) / n1 as f64);
+        let between = n0 as f64 * n1 as f64 * (m1 - m0) * (m1 - m0);
+        if best.is_none_or(|b| between > b.0) {
+            best = Some((between, n0, m0, m1));
+        }
+    }
+    let (_, n0, m0, m1) = best?;
+    let share = n0 as f64 / total as f64;
+    if !(MIN_POPULATION_SHARE..=1.0 - MIN_POPULATION_SHARE).contains(&share)
+        || m1 - m0 < MIN_POPULATION_SEPARATION
+    {
+        return None;
+    }
+    // The split lies at the upper edge of the last bin of the lower population.
+    let edge = {
+        let mut acc = 0usize;
+        let mut k = 0;
+        while acc < n0 {
+            acc += count[k];
+            k += 1;
+        }
+        lo + k as f64 * width
+    };
+    Some(num_traits::Float::powf(10.0, edge))
 }
 
 /// What the quiet stretches of a log say about its sensor ([`quiet_noise`]).

@@ -342,8 +342,16 @@ fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samp
         return;
     }
     crate::note!(
-        "imukit: {} samples taken as stances (zero-velocity updates)",
-        summary.stance_samples
+        "imukit: {} samples taken as stances (zero-velocity updates){}",
+        summary.stance_samples,
+        match summary.stance_threshold {
+            Some(t) if t.learnt => format!(
+                ", below the split between the log's two populations of the detector's \
+                 statistic ({:.4e}; its noise alone would allow {:.4e})",
+                t.used, t.noise
+            ),
+            _ => String::new(),
+        }
     );
     // A walk stands on each foot for about a third of its time or more.
     #[allow(clippy::cast_precision_loss)]

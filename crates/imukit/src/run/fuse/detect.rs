@@ -101,8 +101,34 @@ pub(super) fn stances(
     setup: &FuseSetup,
     detection: &Detection,
 ) -> Vec<bool> {
-    use imu_core::stillness::{detect_stance, shoe_threshold};
-    let mut stance = vec![false; t.len()];
+    stances_with_threshold(t, f, w, setup, detection).0
+}
+
+/// The threshold the stance detector used: the noise's alone ([`shoe_threshold`] at
+/// [`STANCE_FALSE_ALARM`]), or, when higher, the split between the log's two populations of
+/// the statistic ([`imu_core::stillness::two_population_threshold`]: a real foot rolls while it
+/// stands, far above its sensor's noise).
+///
+/// [`shoe_threshold`]: imu_core::stillness::shoe_threshold
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StanceThreshold {
+    /// The threshold used.
+    pub used: f64,
+    /// The noise's threshold.
+    pub noise: f64,
+    /// Whether the log's two populations set it.
+    pub learnt: bool,
+}
+
+/// [`stances`] and the threshold they used.
+pub(super) fn stances_with_threshold(
+    t: &[f64],
+    f: &[[f64; 3]],
+    w: &[[f64; 3]],
+    setup: &FuseSetup,
+    detection: &Detection,
+) -> (Vec<bool>, StanceThreshold) {
+    use imu_core::stillness::{shoe_statistics, shoe_threshold, two_population_threshold};
     // The rest's mean rate is the bias the detector's zero-rate test must not see.
     let rest = t.partition_point(|&x| x < t[0] + setup.rest_s);
     let bias = if rest > 0 {
@@ -116,16 +142,30 @@ pub(super) fn stances(
         .collect();
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let window = ((STANCE_WINDOW_S / detection.interval_s).round() as usize).max(3);
-    detect_stance(
+    let mut statistic = vec![f64::INFINITY; t.len()];
+    shoe_statistics(
         f,
         &gyro,
         detection.gravity_m_s2,
         detection.noise,
         window,
-        shoe_threshold(window, STANCE_FALSE_ALARM),
-        &mut stance,
+        &mut statistic,
     );
-    stance
+    let noise = shoe_threshold(window, STANCE_FALSE_ALARM);
+    let threshold = match two_population_threshold(&statistic) {
+        Some(split) if split > noise => StanceThreshold {
+            used: split,
+            noise,
+            learnt: true,
+        },
+        _ => StanceThreshold {
+            used: noise,
+            noise,
+            learnt: false,
+        },
+    };
+    let stance = statistic.iter().map(|s| *s < threshold.used).collect();
+    (stance, threshold)
 }
 
 /// Block length of the rest detector, s.

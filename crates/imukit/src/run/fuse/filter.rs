@@ -9,7 +9,9 @@ use imu_core::fusion::{
 use imu_core::{Body, Vec3};
 
 use super::adapt::FixNoiseScale;
-use super::detect::{Detection, REST_START_SPEED_M_S, detected_rest_s, stances};
+use super::detect::{
+    Detection, REST_START_SPEED_M_S, StanceThreshold, detected_rest_s, stances_with_threshold,
+};
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
 use super::rows::{RESETS_COLUMN, fused_columns, push_fused_row};
@@ -48,7 +50,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let setup = &with_rest_found(setup, start, &inputs, detection.as_ref());
     let t = &inputs.t;
     let mut aids = AidStreams::new(aids, setup, inputs.span(), t.len())?;
-    let stances = mark_stances(&mut aids, &inputs, setup, detection.as_ref());
+    let (stances, stance_threshold) = mark_stances(&mut aids, &inputs, setup, detection.as_ref());
     let fixes = Fixes::<E>::of(&inputs)?;
     let begin = begin(&earth, start, setup, &inputs, &fixes)?;
     aids.start_at(t[begin.first]);
@@ -90,6 +92,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             states: S,
             fix_noise_scale: noise_scale.scale(),
             stance_samples: stances,
+            stance_threshold,
             detection,
         },
     ))
@@ -147,20 +150,21 @@ fn with_rest_found(
 }
 
 /// Marks the stances for zero-velocity updates when `setup` asks for them
-/// ([`FuseSetup::zupt`]); how many samples are stances.
+/// ([`FuseSetup::zupt`]); how many samples are stances, and the threshold used.
 fn mark_stances(
     aids: &mut AidStreams,
     inputs: &FusionInputs,
     setup: &FuseSetup,
     detection: Option<&Detection>,
-) -> usize {
+) -> (usize, Option<StanceThreshold>) {
     let Some(detection) = detection.filter(|_| setup.zupt) else {
-        return 0;
+        return (0, None);
     };
-    let stance = stances(&inputs.t, &inputs.f, &inputs.w, setup, detection);
+    let (stance, threshold) =
+        stances_with_threshold(&inputs.t, &inputs.f, &inputs.w, setup, detection);
     let count = stance.iter().filter(|s| **s).count();
     aids.set_stance(stance);
-    count
+    (count, Some(threshold))
 }
 
 /// The filter's refusal of `context` (a setting or the IMU data), without a row.

@@ -29,7 +29,8 @@ mod start;
 pub use adapt::{ADAPT_WINDOW, DEFAULT_MAX_FIX_NOISE_SCALE};
 pub use detect::{
     Detection, FEW_STANCES, QUIET_WINDOW_S, REST_START_SPEED_M_S, REST_WINDOW_S,
-    STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S, STANCE_WINDOW_S, learnt_noise, stance_samples,
+    STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S, STANCE_WINDOW_S, StanceThreshold, learnt_noise,
+    stance_samples,
 };
 pub use model::{FuseModel, LEARNT_BASE_PRESET, Part, PartModel};
 pub(crate) use recovery::filter_refusal;
@@ -85,6 +86,8 @@ pub struct FuseSummary {
     pub fix_noise_scale: f64,
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
+    /// The stance detector's threshold (`None` without `--zupt`).
+    pub stance_threshold: Option<StanceThreshold>,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet
     /// stretches, or the part's (`None`: no detector ran, or too few samples to tell).
     pub detection: Option<Detection>,
