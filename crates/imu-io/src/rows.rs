@@ -250,6 +250,61 @@ pub fn check_increasing(t_s: &[f64], what: &str, first_row: usize) -> Result<()>
     }
 }
 
+/// Samples that repeat the sample before them exactly — the same time and the same readings:
+/// a logger's copy of its last sample, written when it missed one. They carry nothing new and
+/// no interval to integrate over, so the jobs drop them and say so; a repeated time with other
+/// readings stays a refusal ([`check_increasing`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Repeats {
+    /// How many samples repeat the one before.
+    pub count: usize,
+    /// The index of the first that does.
+    pub first: Option<usize>,
+}
+
+/// Per sample at times `t_s` with `readings` (each as long as `t_s`), whether it repeats the
+/// sample before exactly ([`Repeats`]), and the count.
+#[must_use]
+pub fn repeated_samples(t_s: &[f64], readings: &[&[[f64; 3]]]) -> (Vec<bool>, Repeats) {
+    let repeated: Vec<bool> = (0..t_s.len())
+        .map(|i| {
+            i > 0
+                && t_s[i] == t_s[i - 1]
+                && readings
+                    .iter()
+                    .all(|r| r.get(i).is_some() && r.get(i) == r.get(i - 1))
+        })
+        .collect();
+    let count = repeated.iter().filter(|r| **r).count();
+    let first = repeated.iter().position(|r| *r);
+    (repeated, Repeats { count, first })
+}
+
+/// `values` without the entries `drop` marks.
+#[must_use]
+pub fn without<T>(values: Vec<T>, drop: &[bool]) -> Vec<T> {
+    values
+        .into_iter()
+        .zip(drop.iter().copied().chain(core::iter::repeat(false)))
+        .filter_map(|(x, d)| (!d).then_some(x))
+        .collect()
+}
+
+impl Repeats {
+    /// What a run tells its user about the repeats of `what`, its sample 0 at file row
+    /// `first_row` (`None` without repeats).
+    #[must_use]
+    pub fn message(&self, what: &str, first_row: usize) -> Option<String> {
+        let first = self.first?;
+        let (n, s) = (self.count, if self.count == 1 { "" } else { "s" });
+        Some(format!(
+            "{what}: {n} row{s} repeat the row before exactly (time and readings; the first at \
+             row {}): a logger's copies of its last sample, dropped",
+            first + first_row
+        ))
+    }
+}
+
 /// The time of the last sample a run in chunks has taken, so that each chunk's first sample
 /// gets its interval from the chunk before.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

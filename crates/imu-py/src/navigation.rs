@@ -269,7 +269,7 @@ fn fuse<'py>(
     accel_sign: Option<&str>,
     gravity_m_s2: Option<f64>,
     described: DescribedIn<'py>,
-) -> PyResult<(DescribedOut<'py>, usize, usize)> {
+) -> PyResult<(DescribedOut<'py>, usize, usize, Vec<String>)> {
     use imukit::ScenarioSpec;
     use imukit::run::fuse::{AidTables, FuseRequest, Part, PartModel, Start, fuse_with};
     // The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
@@ -382,10 +382,12 @@ fn fuse<'py>(
             fuse_with(&imu, &gnss, aids, start, &setup).map(|(t, s)| (t, s, description))
         })
         .map_err(refused)?;
+    let warnings: Vec<String> = summary.repeats.message("imu", 0).into_iter().collect();
     Ok((
         described_out(py, table, &description)?,
         summary.updates,
         summary.rejected,
+        warnings,
     ))
 }
 

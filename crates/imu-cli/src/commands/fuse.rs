@@ -222,6 +222,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     })?;
     nav.write_described(a.out, &setup.description())?;
     let t = imu.column("t_s").unwrap_or_default();
+    if let Some(m) = summary.repeats.message(&a.imu.display().to_string(), 2) {
+        crate::report::warn(&m);
+    }
     if let Some(m) = Gaps::of_times(&t, 2).message(&a.imu.display().to_string()) {
         crate::report::warn(&m);
     }

@@ -297,7 +297,7 @@ def fuse(
     accel_sign: Optional[str] = None,
     gravity_m_s2: Optional[float] = None,
     described: _DescribedIn = ...,
-) -> tuple[_Described, int, int]: ...
+) -> tuple[_Described, int, int, list[str]]: ...
 def compare(
     truth_columns: Sequence[str],
     truth: npt.NDArray[np.float64],

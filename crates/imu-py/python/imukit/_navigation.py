@@ -266,7 +266,7 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
     start = (None, None) if initial is None else _table_args("initial", initial)
     # No fixes: a table without columns (the IMU and the other aids alone, e.g. zupt=True).
     fixes = ([], np.zeros((0, 0))) if gnss is None else _table_args("gnss", gnss)
-    table, _, _ = _core.fuse(*_table_args("imu", imu), *fixes, *start,
+    table, _, _, warnings = _core.fuse(*_table_args("imu", imu), *fixes, *start,
                              source, format=fmt, base_dir=base, gate=bool(gate),
                              align=None if align is None else str(align),
                              nhc_sigma_m_s=None if nhc_sigma_m_s is None else float(nhc_sigma_m_s),
@@ -276,6 +276,7 @@ def fuse(imu: TableLike, gnss: Optional[TableLike], *, scenario: Optional[Union[
                              zupt=bool(zupt), gnss_adaptive=bool(gnss_adaptive),
                              **aids, **part_keys,
                              described=_described(imu=imu, gnss=gnss, initial=initial, odometer=odometer, baro=baro))
+    _emit(warnings)
     fused = _table(table)
     resets = fused["gnss_resets"]
     if len(resets) and resets[-1] > 0:

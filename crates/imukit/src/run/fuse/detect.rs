@@ -168,6 +168,38 @@ pub(super) fn stances_with_threshold(
     (stance, threshold)
 }
 
+/// The shortest first stance taken as the rest at the start of a walk, s.
+pub const FIRST_STANCE_MIN_S: f64 = 1.0;
+
+/// The rest at the start of a foot-mounted log (`--zupt`), s: its first stance, when that
+/// begins at the first sample and lasts at least [`FIRST_STANCE_MIN_S`]; 0 otherwise. A person
+/// standing sways, so the foot reads rates well above its sensor's white noise, which the rest
+/// detector ([`detected_rest_s`]) refuses and the stance detector, with its threshold learnt
+/// from the walk, does not. The stances are found here without a gyroscope bias (the rest that
+/// would give it is what is sought); a consumer gyroscope's bias adds little to the statistic
+/// next to the learnt threshold.
+pub(super) fn first_stance_s(
+    t: &[f64],
+    f: &[[f64; 3]],
+    w: &[[f64; 3]],
+    setup: &FuseSetup,
+    detection: &Detection,
+) -> f64 {
+    let unbiased = FuseSetup {
+        rest_s: 0.0,
+        ..*setup
+    };
+    let (stance, _) = stances_with_threshold(t, f, w, &unbiased, detection);
+    let end = stance.iter().position(|s| !s).unwrap_or(stance.len());
+    // The last stance sample before the foot moves: the window straddles the motion's start.
+    let last = end.saturating_sub(1);
+    if end == 0 || last >= t.len() || t[last] - t[0] < FIRST_STANCE_MIN_S {
+        0.0
+    } else {
+        t[last] - t[0]
+    }
+}
+
 /// Block length of the rest detector, s.
 pub const REST_WINDOW_S: f64 = 0.5;
 

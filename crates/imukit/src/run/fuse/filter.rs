@@ -10,7 +10,8 @@ use imu_core::{Body, Vec3};
 
 use super::adapt::FixNoiseScale;
 use super::detect::{
-    Detection, REST_START_SPEED_M_S, StanceThreshold, detected_rest_s, stances_with_threshold,
+    Detection, REST_START_SPEED_M_S, StanceThreshold, detected_rest_s, first_stance_s,
+    stances_with_threshold,
 };
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
@@ -92,6 +93,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             states: S,
             fix_noise_scale: noise_scale.scale(),
             stance_samples: stances,
+            repeats: inputs.repeats,
             stance_threshold,
             detection,
         },
@@ -123,7 +125,16 @@ fn with_rest_found(
     let readings_still = if moving_at_start {
         0.0
     } else {
-        detected_rest_s(&inputs.t, &inputs.f, &inputs.w, detection)
+        let rest = detected_rest_s(&inputs.t, &inputs.f, &inputs.w, detection);
+        // On a foot, the first stance is the rest at the start (a standing person sways,
+        // beyond the white noise the rest detector allows).
+        if setup.zupt {
+            rest.max(first_stance_s(
+                &inputs.t, &inputs.f, &inputs.w, setup, detection,
+            ))
+        } else {
+            rest
+        }
     };
     let moves_at = (inputs.velocities != FixVelocity::None)
         .then(|| {

@@ -59,6 +59,8 @@ pub(super) struct FusionInputs {
     pub(super) t: Vec<f64>,
     pub(super) f: Vec<[f64; 3]>,
     pub(super) w: Vec<[f64; 3]>,
+    /// The IMU's samples that repeated the one before exactly, dropped from `t`, `f`, `w`.
+    pub(super) repeats: crate::io::rows::Repeats,
     pub(super) g_t: Vec<f64>,
     pub(super) g_p: Vec<[f64; 3]>,
     /// The fixes' velocities (zeros where they have none).
@@ -109,6 +111,18 @@ impl FusionInputs {
                 "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
             ));
         };
+        // A logger's copies of its last sample are dropped (counted in `repeats`).
+        let (repeated, repeats) = crate::io::rows::repeated_samples(&t, &[&f, &w]);
+        let (t, f, w) = if repeats.count > 0 {
+            use crate::io::rows::without;
+            (
+                without(t, &repeated),
+                without(f, &repeated),
+                without(w, &repeated),
+            )
+        } else {
+            (t, f, w)
+        };
         if t.len() < 2 {
             return Err(invalid(
                 Data::Imu.label(),
@@ -122,6 +136,7 @@ impl FusionInputs {
                 t,
                 f,
                 w,
+                repeats,
                 g_t: Vec::new(),
                 g_p: Vec::new(),
                 g_v: Vec::new(),
@@ -178,6 +193,7 @@ impl FusionInputs {
             t,
             f,
             w,
+            repeats,
             g_t,
             g_p,
             g_v,

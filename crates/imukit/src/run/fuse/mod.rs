@@ -86,6 +86,9 @@ pub struct FuseSummary {
     pub fix_noise_scale: f64,
     /// Samples taken as stances by the zero-velocity detector ([`FuseSetup::zupt`]).
     pub stance_samples: usize,
+    /// The IMU's rows that repeated the row before exactly, dropped
+    /// ([`crate::io::rows::Repeats`]).
+    pub repeats: crate::io::rows::Repeats,
     /// The stance detector's threshold (`None` without `--zupt`).
     pub stance_threshold: Option<StanceThreshold>,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet
