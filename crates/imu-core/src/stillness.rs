@@ -211,7 +211,7 @@ pub fn detect_stance(
 }
 
 /// Bins of the histogram [`two_population_threshold`] splits.
-const POPULATION_BINS: usize = 256;
+pub const POPULATION_BINS: usize = 256;
 
 /// The least share of the samples each population must hold for a split to count.
 pub const MIN_POPULATION_SHARE: f64 = 0.05;
