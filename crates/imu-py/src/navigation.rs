@@ -382,7 +382,15 @@ fn fuse<'py>(
             fuse_with(&imu, &gnss, aids, start, &setup).map(|(t, s)| (t, s, description))
         })
         .map_err(refused)?;
-    let warnings: Vec<String> = summary.repeats.message("imu", 0).into_iter().collect();
+    let warnings: Vec<String> = summary
+        .repeats
+        .message("imu", 0)
+        .into_iter()
+        .chain(imukit::run::fuse::stance_gap_message(
+            "imu",
+            summary.stance_gap,
+        ))
+        .collect();
     Ok((
         described_out(py, table, &description)?,
         summary.updates,

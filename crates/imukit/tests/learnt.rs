@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use imukit::run::fuse::{
-    AidTables, FuseRequest, Part, PartModel, Start, fuse_with, learnt_noise, stance_samples,
+    AidTables, FuseRequest, MAX_STANCE_GAP_S, Part, PartModel, Start, fuse_with, learnt_noise,
+    longest_without_stance, stance_gap_message, stance_samples,
 };
 use imukit::run::navigate::NavRequest;
 use imukit::{ScenarioSpec, Simulation, Table};
@@ -103,6 +104,13 @@ fn a_noisy_walk_with_no_data_sheet_closes_its_loop_from_its_readings_alone() {
         );
         let detection = summary.detection.unwrap();
         assert!(detection.learnt);
+        // The foot stands at every stride (1.1 s apart): nothing to warn about.
+        let (_, gap) = summary.stance_gap.unwrap();
+        assert!(
+            gap < MAX_STANCE_GAP_S,
+            "run {run}: {gap} s without a stance"
+        );
+        assert_eq!(stance_gap_message("imu", summary.stance_gap), None);
         // Gravity as this accelerometer reads it: |g + bias| (the bias is 0.03 g).
         let reading = (0.3_f64.powi(2) + 0.2_f64.powi(2) + (9.81_f64 + 0.25).powi(2)).sqrt();
         assert!(
@@ -301,4 +309,27 @@ fn a_car_idling_is_at_rest_although_its_engine_shakes_the_sensor() {
         };
         assert_eq!(imu_core::stillness::initial_rest(&f, &w, part, 50), 0);
     }
+}
+
+#[test]
+fn a_stretch_without_stances_is_found_and_warned_about() {
+    // 10 Hz: stances at 0–1 s (the rest), 2 s, 2.5 s, then none until 6 s.
+    let t: Vec<f64> = (0..80).map(|i| f64::from(i) * 0.1).collect();
+    let stance: Vec<bool> = t
+        .iter()
+        .map(|x| *x < 1.0 || (*x - 2.0).abs() < 1e-9 || (*x - 2.5).abs() < 1e-9 || *x >= 6.0)
+        .collect();
+    let gap = longest_without_stance(&t, &stance, 1.0).unwrap();
+    assert!(
+        (gap.0 - 2.5).abs() < 1e-9 && (gap.1 - 3.5).abs() < 1e-9,
+        "{gap:?}"
+    );
+    let message = stance_gap_message("walk.csv", Some(gap)).unwrap();
+    assert!(
+        message.contains("no stance for 3.5 s (from t = 2.5 s"),
+        "{message}"
+    );
+    // The rest itself is not a stretch without stances; one stance after it is no stretch.
+    assert_eq!(longest_without_stance(&t[..25], &stance[..25], 1.0), None);
+    assert_eq!(stance_gap_message("walk.csv", Some((1.0, 1.9))), None);
 }

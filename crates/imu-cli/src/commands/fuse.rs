@@ -356,6 +356,11 @@ fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samp
             _ => String::new(),
         }
     );
+    if let Some(m) =
+        imukit::run::fuse::stance_gap_message(&a.imu.display().to_string(), summary.stance_gap)
+    {
+        crate::report::warn(&m);
+    }
     // A walk stands on each foot for about a third of its time or more.
     #[allow(clippy::cast_precision_loss)]
     let share = summary.stance_samples as f64 / samples.max(1) as f64;

@@ -200,6 +200,47 @@ pub(super) fn first_stance_s(
     }
 }
 
+/// The longest a walking foot goes without standing, s: a stride at any walking pace is
+/// shorter, and the foot stands in each.
+pub const MAX_STANCE_GAP_S: f64 = 2.0;
+
+/// The longest stretch of samples at times `t` with no stance in `stance`, after the rest at the
+/// start (`rest_s` from the first sample) and before the last stance: `(start, length)`, s from
+/// the first sample. `None` with fewer than two stances after the rest.
+#[must_use]
+pub fn longest_without_stance(t: &[f64], stance: &[bool], rest_s: f64) -> Option<(f64, f64)> {
+    let t0 = *t.first()?;
+    let mut previous: Option<f64> = None;
+    let mut longest: Option<(f64, f64)> = None;
+    for (ti, _) in t
+        .iter()
+        .zip(stance)
+        .filter(|(ti, s)| **s && **ti - t0 >= rest_s)
+    {
+        if let Some(p) = previous
+            && longest.is_none_or(|(_, l)| ti - p > l)
+        {
+            longest = Some((p - t0, ti - p));
+        }
+        previous = Some(*ti);
+    }
+    longest
+}
+
+/// What a run says when its foot went longer than [`MAX_STANCE_GAP_S`] without a stance
+/// (`what` the IMU's name; `None` otherwise): the estimate runs free-inertial there, and its
+/// one-sigma, from the part's white noise alone, understates what it does.
+#[must_use]
+pub fn stance_gap_message(what: &str, gap: Option<(f64, f64)>) -> Option<String> {
+    let (start, length) = gap.filter(|(_, l)| *l > MAX_STANCE_GAP_S)?;
+    Some(format!(
+        "{what}: --zupt found no stance for {length:.1} s (from t = {start:.1} s after the first \
+         sample; a walking foot stands at least every {MAX_STANCE_GAP_S} s): the estimate is free \
+         inertial there and drifts beyond its one-sigma (is the sensor on a foot? does the foot \
+         stand still at each step?)"
+    ))
+}
+
 /// Block length of the rest detector, s.
 pub const REST_WINDOW_S: f64 = 0.5;
 

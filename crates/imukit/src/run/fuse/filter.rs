@@ -11,7 +11,7 @@ use imu_core::{Body, Vec3};
 use super::adapt::FixNoiseScale;
 use super::detect::{
     Detection, REST_START_SPEED_M_S, StanceThreshold, detected_rest_s, first_stance_s,
-    stances_with_threshold,
+    longest_without_stance, stances_with_threshold,
 };
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
@@ -51,7 +51,8 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     let setup = &with_rest_found(setup, start, &inputs, detection.as_ref());
     let t = &inputs.t;
     let mut aids = AidStreams::new(aids, setup, inputs.span(), t.len())?;
-    let (stances, stance_threshold) = mark_stances(&mut aids, &inputs, setup, detection.as_ref());
+    let (stances, stance_threshold, stance_gap) =
+        mark_stances(&mut aids, &inputs, setup, detection.as_ref());
     let fixes = Fixes::<E>::of(&inputs)?;
     let begin = begin(&earth, start, setup, &inputs, &fixes)?;
     aids.start_at(t[begin.first]);
@@ -94,6 +95,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             fix_noise_scale: noise_scale.scale(),
             stance_samples: stances,
             repeats: inputs.repeats,
+            stance_gap,
             stance_threshold,
             detection,
         },
@@ -161,21 +163,23 @@ fn with_rest_found(
 }
 
 /// Marks the stances for zero-velocity updates when `setup` asks for them
-/// ([`FuseSetup::zupt`]); how many samples are stances, and the threshold used.
+/// ([`FuseSetup::zupt`]): how many samples are stances, the threshold used, and the longest
+/// stretch without one after the rest.
 fn mark_stances(
     aids: &mut AidStreams,
     inputs: &FusionInputs,
     setup: &FuseSetup,
     detection: Option<&Detection>,
-) -> (usize, Option<StanceThreshold>) {
+) -> (usize, Option<StanceThreshold>, Option<(f64, f64)>) {
     let Some(detection) = detection.filter(|_| setup.zupt) else {
-        return (0, None);
+        return (0, None, None);
     };
     let (stance, threshold) =
         stances_with_threshold(&inputs.t, &inputs.f, &inputs.w, setup, detection);
     let count = stance.iter().filter(|s| **s).count();
+    let gap = longest_without_stance(&inputs.t, &stance, setup.rest_s);
     aids.set_stance(stance);
-    (count, Some(threshold))
+    (count, Some(threshold), gap)
 }
 
 /// The filter's refusal of `context` (a setting or the IMU data), without a row.

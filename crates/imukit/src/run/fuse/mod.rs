@@ -28,9 +28,9 @@ mod start;
 
 pub use adapt::{ADAPT_WINDOW, DEFAULT_MAX_FIX_NOISE_SCALE};
 pub use detect::{
-    Detection, FEW_STANCES, QUIET_WINDOW_S, REST_START_SPEED_M_S, REST_WINDOW_S,
+    Detection, FEW_STANCES, MAX_STANCE_GAP_S, QUIET_WINDOW_S, REST_START_SPEED_M_S, REST_WINDOW_S,
     STANCE_FALSE_ALARM, STANCE_VELOCITY_SIGMA_M_S, STANCE_WINDOW_S, StanceThreshold, learnt_noise,
-    stance_samples,
+    longest_without_stance, stance_gap_message, stance_samples,
 };
 pub use model::{FuseModel, LEARNT_BASE_PRESET, Part, PartModel};
 pub(crate) use recovery::filter_refusal;
@@ -89,6 +89,9 @@ pub struct FuseSummary {
     /// The IMU's rows that repeated the row before exactly, dropped
     /// ([`crate::io::rows::Repeats`]).
     pub repeats: crate::io::rows::Repeats,
+    /// The longest stretch without a stance after the rest at the start, `(start, length)`, s
+    /// from the first sample ([`longest_without_stance`]; `None` without `--zupt`).
+    pub stance_gap: Option<(f64, f64)>,
     /// The stance detector's threshold (`None` without `--zupt`).
     pub stance_threshold: Option<StanceThreshold>,
     /// What the detectors tested the readings against: the noise learnt from the log's quiet
