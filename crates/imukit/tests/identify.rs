@@ -250,3 +250,29 @@ fn two_sinusoids_are_warned_about_and_every_term_reported_holds_its_truth() {
     assert_eq!(warned, runs);
     assert!(held * 10 >= 9 * runs as usize, "{held} of {runs}");
 }
+
+#[test]
+fn a_column_that_reads_a_constant_is_said_to_have_no_noise() {
+    // An ideal accelerometer: gravity to the last digits, and a zero axis.
+    let n = 50_000;
+    let z: Vec<f64> = normals(n, 9).iter().map(|e| -9.80665 + 1e-15 * e).collect();
+    let result = allan(
+        &[
+            ("accel_z_m_s2".into(), z),
+            ("accel_x_m_s2".into(), vec![0.0; n]),
+            ("gyro_x_rad_s".into(), white(n, 1e-3, 0.0, 10)),
+        ],
+        RATE,
+    )
+    .unwrap();
+    for c in &result.noise[..2] {
+        assert!(c.constant, "{}", c.column);
+        let warnings = column_warnings(&result, c);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("reads a constant"), "{warnings:?}");
+        assert!(c.fit.terms.iter().all(|t| !t.resolved && t.value == 0.0));
+        assert!(c.fit.scaled.iter().all(Option::is_none));
+    }
+    let noisy = &result.noise[2];
+    assert!(!noisy.constant && noisy.fit.term(NoiseTerm::White).resolved);
+}

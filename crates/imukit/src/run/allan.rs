@@ -27,7 +27,15 @@ pub struct ColumnNoise {
     /// Stretches where the column moves instead of resting ([`moving_stretches`]), s from the
     /// first sample.
     pub moving: Vec<(f64, f64)>,
+    /// Whether the column reads a constant but for rounding (its shortest-τ deviation within
+    /// [`CONSTANT_TO`] of its mean): no noise to identify, its terms all zero.
+    pub constant: bool,
 }
+
+/// A column whose deviation at the shortest τ is at most this fraction of its mean reads a
+/// constant (a simulated ideal sensor, a stuck channel): eleven digits below the value, far
+/// above a double's rounding and far below any sensor's noise.
+pub const CONSTANT_TO: f64 = 1e-11;
 
 /// Length of the blocks [`moving_stretches`] compares, s.
 pub const MOTION_BLOCK_S: f64 = 1.0;
@@ -129,8 +137,14 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
                 ),
             ));
         }
+        // A column constant but for rounding has no noise to identify: its curve is fitted
+        // as the flat zero it is, and the column is warned about.
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let constant = adev[0] <= CONSTANT_TO * mean.abs();
+        let zeros = vec![0.0; adev.len()];
+        let fitted = if constant { &zeros } else { &adev };
         let fit =
-            fit_noise(&tau, &adev, &m, n).map_err(|e| invalid(name.clone(), e.to_string()))?;
+            fit_noise(&tau, fitted, &m, n).map_err(|e| invalid(name.clone(), e.to_string()))?;
         let (lower, upper) = adev
             .iter()
             .zip(&fit.edf)
@@ -141,9 +155,10 @@ pub fn allan(columns: &[(String, Vec<f64>)], sample_rate_hz: f64) -> Result<Alla
             fit,
             lower,
             upper,
-            mean: x.iter().sum::<f64>() / n as f64,
+            mean,
             mean_sigma: adev[count - 1],
             moving: moving_stretches(x, sample_rate_hz),
+            constant,
         });
         names.push(format!("adev_{name}"));
         curves.push(adev);

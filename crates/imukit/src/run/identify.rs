@@ -524,6 +524,14 @@ pub fn column_warnings(
     column: &crate::run::allan::ColumnNoise,
 ) -> Vec<String> {
     let mut warnings = Vec::new();
+    if column.constant {
+        warnings.push(format!(
+            "{}: reads a constant ({:.6e}) but for rounding: there is no noise to identify (an \
+             ideal sensor, or a stuck channel?)",
+            column.column, column.mean
+        ));
+        return warnings;
+    }
     if !column.moving.is_empty() {
         const SHOWN: usize = 5;
         let mut at: Vec<String> = column
