@@ -177,11 +177,17 @@ pub fn shoe_statistics(
         return;
     }
     for (i, s) in statistic[..n].iter_mut().enumerate() {
-        let start = i.saturating_sub(window / 2).min(n - window);
-        let range = start..start + window;
+        let range = centred_window(i, n, window);
         *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
             .unwrap_or(f64::INFINITY);
     }
+}
+
+/// The window of `window` samples centred on sample `i` of `n` (`window ≤ n`), the nearest
+/// full window where it would run off either end.
+fn centred_window(i: usize, n: usize, window: usize) -> core::ops::Range<usize> {
+    let start = i.saturating_sub(window / 2).min(n - window);
+    start..start + window
 }
 
 /// Marks each sample whose centred window of `window` samples passes the SHOE test against
@@ -203,8 +209,7 @@ pub fn detect_stance(
         return;
     }
     for (i, s) in stance[..n].iter_mut().enumerate() {
-        let start = i.saturating_sub(window / 2).min(n - window);
-        let range = start..start + window;
+        let range = centred_window(i, n, window);
         *s = shoe_statistic(&accel[range.clone()], &gyro[range], gravity_m_s2, noise)
             .is_some_and(|t| t < threshold);
     }

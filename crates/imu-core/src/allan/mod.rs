@@ -11,6 +11,7 @@ use core::fmt;
 
 pub mod edf;
 pub mod fit;
+mod gls;
 pub mod scale_terms;
 
 pub use edf::{deviation_interval, overlapping_edf};
