@@ -2,6 +2,7 @@
 //! real processes writing one name, links planted beside an output, and a command whose last
 //! output fails. Never a partial file, a mixed file, a write through a link, or half of a
 //! command's outputs.
+use crate::common::run_in;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -289,4 +290,131 @@ fn a_command_whose_last_output_fails_puts_none_of_them_in_place() {
         String::from_utf8_lossy(&run.stderr)
     );
     assert_eq!(names(dir), ["o.csv", "s.toml", "st.toml"]);
+}
+
+#[test]
+fn outputs_never_overwrite_inputs_or_each_other_and_special_files_stay_special() {
+    let dir = temp_dir("outputs");
+    let dir = dir.path();
+    let scenario = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/expression.toml"),
+    )
+    .unwrap();
+    std::fs::write(dir.join("s.toml"), &scenario).unwrap();
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "s.toml"]);
+    assert_eq!(code, Some(65));
+    assert!(
+        err.contains("--out: s.toml is also the scenario file"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("s.toml")).unwrap(),
+        scenario
+    );
+    let (code, err) = run_in(
+        dir,
+        &["simulate", "s.toml", "--out", "i.csv", "--truth", "./i.csv"],
+    );
+    assert_eq!(code, Some(65));
+    assert!(err.contains("--truth: ./i.csv is also the --out"), "{err}");
+    std::fs::create_dir_all(dir.join("folder")).unwrap();
+    let (code, err) = run_in(
+        dir,
+        &["simulate", "s.toml", "--out", "i.csv", "--truth", "folder"],
+    );
+    assert_eq!(code, Some(65));
+    assert!(err.contains("folder is a folder"), "{err}");
+    let (code, err) = run_in(dir, &["simulate", "s.toml", "--out", "-"]);
+    assert_eq!(code, Some(65));
+    assert!(err.contains("/dev/stdout"), "{err}");
+    // Nothing was written by the refused runs.
+    let mut left: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["folder", "s.toml"]);
+
+    // The usual way to discard outputs: /dev/null is written, not replaced.
+    let (code, err) = run_in(
+        dir,
+        &[
+            "simulate",
+            "s.toml",
+            "--out",
+            "/dev/null",
+            "--truth",
+            "/dev/null",
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let null = std::fs::metadata("/dev/null").unwrap();
+    assert!(!null.is_file(), "/dev/null must stay a device");
+
+    // A long legal name still gets a temporary name within the file-name limit.
+    let long = format!("{}.csv", "x".repeat(250));
+    let (code, err) = run_in(
+        dir,
+        &["simulate", "s.toml", "--out", &long, "--truth", "t.csv"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(dir.join(&long).exists());
+
+    // Each command compares its outputs with its inputs (a CSV may have any extension).
+    std::fs::copy(dir.join("t.csv"), dir.join("t.svg")).unwrap();
+    for args in [
+        vec!["integrate", &long, "--out", &long],
+        vec!["integrate", &long, "--init", "t.csv", "--out", "t.csv"],
+        vec!["orient", &long, "--out", &long],
+        vec!["compare", "t.csv", "t.csv", "--out", "t.csv"],
+        vec!["allan", &long, "--out", &long],
+        vec!["plot", "t.svg", "--out", "t.svg"],
+    ] {
+        let before = std::fs::read(dir.join(args.last().unwrap())).unwrap();
+        let (code, err) = run_in(dir, &args);
+        assert_eq!(code, Some(65), "{args:?}: {err}");
+        assert!(
+            err.contains("writing it would destroy the input"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(
+            std::fs::read(dir.join(args.last().unwrap())).unwrap(),
+            before
+        );
+    }
+    // A figure extension is checked before the table is written.
+    let (code, err) = run_in(dir, &["allan", &long, "--out", "a.csv", "--plot", "a.txt"]);
+    assert_eq!(code, Some(74));
+    assert!(
+        err.contains("a.txt: the figure file must end in .svg or .png"),
+        "{err}"
+    );
+    assert!(!dir.join("a.csv").exists());
+    // An unknown built-in leaves no folder behind.
+    let (code, _) = run_in(
+        dir,
+        &["demo", "--scenario", "nosuch", "--out-dir", "newdir"],
+    );
+    assert_eq!(code, Some(65));
+    assert!(!dir.join("newdir").exists());
+}
+
+/// A reader that goes away (`imukit … | head`) does not fail the command: it finishes and its
+/// files are written.
+#[test]
+fn a_closed_standard_output_does_not_lose_the_files() {
+    let dir = temp_dir("closed-stdout");
+    let bin = env!("CARGO_BIN_EXE_imukit");
+    let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let script = format!(
+        "set -o pipefail; \"{bin}\" simulate {examples}/static_log.toml --out still.csv \
+         --quiet && \"{bin}\" identify still.csv --out curve.csv | true"
+    );
+    let status = Command::new("bash")
+        .args(["-c", &script])
+        .current_dir(dir.path())
+        .status()
+        .unwrap();
+    assert!(status.success(), "{status}");
+    assert!(dir.path().join("curve.csv").exists());
 }
