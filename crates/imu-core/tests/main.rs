@@ -17,6 +17,7 @@ mod robust;
 mod robust_motion;
 mod rotation;
 mod sensor;
+mod sensor_noise;
 mod smoother;
 mod spherical_earth;
 mod stillness;
