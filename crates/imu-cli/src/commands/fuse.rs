@@ -13,7 +13,7 @@ use imukit::io::rows::{Gaps, TimeWindow};
 use imukit::run::fuse::{
     AidTables, AlignName, FuseRequest, FuseSetup, PartModel, Start, fuse_with,
 };
-use imukit::run::navigate::{NavAsked, NavRequest};
+use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
@@ -88,7 +88,8 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
     Ok((nav.nav_frame, nav.earth == EarthName::Wgs84))
 }
 
-pub fn run(a: &Args<'_>) -> Result<(), CliError> {
+/// Refuses an output that would overwrite an input or another output.
+fn check_files(a: &Args<'_>) -> Result<(), CliError> {
     let mut inputs = vec![("IMU file", a.imu.path())];
     inputs.extend(a.gnss.map(|p| ("GNSS file", p.path())));
     inputs.extend(a.scenario.map(|p| ("--scenario", p)));
@@ -97,29 +98,38 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     inputs.extend(a.baro.map(|p| ("--baro", p)));
     check_outputs(&inputs, &[("--out", a.out)])?;
     imukit::io::output::check_table_outputs(&[("--out", a.out)])?;
-    let imu = read_table_as(a.imu, Role::Readings)?;
-    // The window's seconds count from the IMU's first sample; every input is cut there.
-    let t0 = TimeWindow::first_time(&imu, &a.imu.display().to_string())?;
-    let cut = |table: imukit::Table, path: &Path, at_least: usize| {
-        a.window
-            .apply(table, t0, &path.display().to_string(), at_least)
+    Ok(())
+}
+
+/// `table` cut to the window, whose seconds count from the IMU's first sample `t0`.
+fn cut(
+    a: &Args<'_>,
+    table: imukit::Table,
+    t0: f64,
+    path: &Path,
+    at_least: usize,
+) -> Result<imukit::Table, CliError> {
+    Ok(a.window
+        .apply(table, t0, &path.display().to_string(), at_least)?)
+}
+
+/// `--init`'s row at the window's start, if given.
+fn initial_of(a: &Args<'_>, t0: f64) -> Result<Option<InitialState>, CliError> {
+    let Some(init) = a.init else {
+        return Ok(None);
     };
-    let imu = cut(imu, a.imu, 2)?;
-    let initial = match a.init {
-        Some(init) => {
-            let (frame, on_earth) = data_frame(a)?;
-            let attitude = a.align.is_some().then_some("--align");
-            let at = a.window.start_s.map(|s| t0 + s);
-            let s =
-                super::integrate::start_from(init, frame, on_earth, attitude.ok_or("--align"), at)?;
-            s.check(&format!("{}, row 2", init.display()))?;
-            Some(s)
-        }
-        None => None,
-    };
-    let start = Start::of(initial.as_ref(), a.align).map_err(by_flag)?;
-    let request = FuseRequest {
-        start: start.or_else(|| Start::when_not_given(a.gnss.is_some())),
+    let (frame, on_earth) = data_frame(a)?;
+    let attitude = a.align.is_some().then_some("--align");
+    let at = a.window.start_s.map(|s| t0 + s);
+    let s = super::integrate::start_from(init, frame, on_earth, attitude.ok_or("--align"), at)?;
+    s.check(&format!("{}, row 2", init.display()))?;
+    Ok(Some(s))
+}
+
+/// The library's request from the options.
+fn request_of<'s>(a: &Args<'_>, start: Option<Start<'s>>) -> FuseRequest<'s> {
+    FuseRequest {
+        start,
         earth: a.asked.earth,
         gate: !a.no_gate,
         nhc_sigma_m_s: a.nhc,
@@ -129,9 +139,17 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         smooth: a.smooth,
         zupt: a.zupt,
         adapt_fixes: a.gnss_adaptive,
-    };
-    crate::report::warn_implausible_read(&imu, a.imu);
-    let (setup, start) = match (a.scenario, &a.model) {
+    }
+}
+
+/// The filter's setup and start: the scenario's model, the part's (`--imu`, `--gnss-*`), or the
+/// one learnt from the log.
+fn setup_of<'s>(
+    a: &Args<'_>,
+    request: &FuseRequest<'s>,
+    imu: &imukit::Table,
+) -> Result<(FuseSetup, Start<'s>), CliError> {
+    match (a.scenario, &a.model) {
         (Some(path), _) => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));
             let scenario = ScenarioSpec::from_file(path)?.resolve(base)?;
@@ -146,80 +164,103 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
                     &source,
                 )
                 .map_err(by_flag)?;
-            request.setup(&scenario).map_err(|e| match e {
+            Ok(request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.
                 Error::Invalid { field, message } if field == "earth" => Error::Invalid {
                     field: flag(&field),
                     message: format!("{message} ({})", path.display()),
                 },
                 other => by_flag(other),
-            })?
+            })?)
         }
         (None, Some(model)) => {
-            let setup = part_setup(a, model, &imu)?;
-            request.apply(setup).map_err(by_flag)?
+            let setup = part_setup(a, model, imu)?;
+            Ok(request.apply(setup).map_err(by_flag)?)
         }
-        (None, None) => {
-            return Err(Error::Invalid {
-                field: "--scenario".into(),
-                message: "the filter needs the data's errors: --scenario FILE, --imu PART, or \
-                          neither (learnt from the log)"
-                    .into(),
-            }
-            .into());
+        (None, None) => Err(Error::Invalid {
+            field: "--scenario".into(),
+            message: "the filter needs the data's errors: --scenario FILE, --imu PART, or \
+                      neither (learnt from the log)"
+                .into(),
         }
-    };
-    let gnss = match a.gnss {
-        Some(path) => cut(read_table_as(path, Role::Fixes)?, path, 0)?,
-        // No fixes: a table without columns, which the filter reads as none.
-        None => imukit::Table::default(),
-    };
-    let gnss = match (a.gnss_uere_m, a.gnss) {
-        (Some(uere), Some(path)) => {
-            imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
-                Error::Invalid { message, .. } => Error::Invalid {
-                    field: format!("--gnss-uere-m ({})", path.display()),
-                    message,
-                },
-                other => other,
-            })?
-        }
-        (Some(_), None) => {
+        .into()),
+    }
+}
+
+/// The fixes, cut to the window, with their accuracy from their HDOP when `--gnss-uere-m` asks
+/// (no file: a table without columns, which the filter reads as none).
+fn fixes_of(a: &Args<'_>, t0: f64) -> Result<imukit::Table, CliError> {
+    let Some(path) = a.gnss else {
+        if a.gnss_uere_m.is_some() {
             return Err(Error::Invalid {
                 field: "--gnss-uere-m".into(),
                 message: "needs a GNSS file whose fixes carry an HDOP".into(),
             }
             .into());
         }
-        (None, _) => gnss,
+        return Ok(imukit::Table::default());
     };
-    let odometer = a.odometer.map(|p| cut(read_table(p)?, p, 0)).transpose()?;
-    let baro = a.baro.map(|p| cut(read_table(p)?, p, 0)).transpose()?;
-    let aids = AidTables {
-        odometer: odometer.as_ref(),
-        baro: baro.as_ref(),
+    let gnss = cut(a, read_table_as(path, Role::Fixes)?, t0, path, 0)?;
+    let Some(uere) = a.gnss_uere_m else {
+        return Ok(gnss);
     };
-    // The library names its inputs by kind; the user knows them by file.
+    Ok(
+        imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
+            Error::Invalid { message, .. } => Error::Invalid {
+                field: format!("--gnss-uere-m ({})", path.display()),
+                message,
+            },
+            other => other,
+        })?,
+    )
+}
+
+/// A library refusal named as the user knows its source: an input by its file, a request's
+/// field by its flag.
+fn named(a: &Args<'_>, e: Error) -> Error {
     let file_of = |data: Data| match data {
         Data::Imu => Some(a.imu.path()),
         Data::Gnss => a.gnss.map(Input::path),
         Data::Odometer => a.odometer,
         Data::Barometer => a.baro,
     };
-    // A request's field by its flag.
-    let rename = |context: String| {
+    if let Some(file) = e.data().and_then(file_of) {
+        return e.relabelled(file.display().to_string());
+    }
+    by_field(e, |context: String| {
         if FuseRequest::FIELDS.contains(&context.as_str()) {
             flag(&context)
         } else {
             context
         }
+    })
+}
+
+pub fn run(a: &Args<'_>) -> Result<(), CliError> {
+    check_files(a)?;
+    let imu = read_table_as(a.imu, Role::Readings)?;
+    // The window's seconds count from the IMU's first sample; every input is cut there.
+    let t0 = TimeWindow::first_time(&imu, &a.imu.display().to_string())?;
+    let imu = cut(a, imu, t0, a.imu, 2)?;
+    let initial = initial_of(a, t0)?;
+    let start = Start::of(initial.as_ref(), a.align).map_err(by_flag)?;
+    let request = request_of(a, start.or_else(|| Start::when_not_given(a.gnss.is_some())));
+    crate::report::warn_implausible_read(&imu, a.imu);
+    let (setup, start) = setup_of(a, &request, &imu)?;
+    let gnss = fixes_of(a, t0)?;
+    let odometer = a
+        .odometer
+        .map(|p| cut(a, read_table(p)?, t0, p, 0))
+        .transpose()?;
+    let baro = a
+        .baro
+        .map(|p| cut(a, read_table(p)?, t0, p, 0))
+        .transpose()?;
+    let aids = AidTables {
+        odometer: odometer.as_ref(),
+        baro: baro.as_ref(),
     };
-    let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| {
-        if let Some(file) = e.data().and_then(file_of) {
-            return e.relabelled(file.display().to_string());
-        }
-        by_field(e, rename)
-    })?;
+    let (nav, summary) = fuse_with(&imu, &gnss, aids, start, &setup).map_err(|e| named(a, e))?;
     nav.write_described(a.out, &setup.description())?;
     let t = imu.column("t_s").unwrap_or_default();
     if let Some(m) = summary.repeats.message(&a.imu.display().to_string(), 2) {
@@ -228,6 +269,14 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     if let Some(m) = Gaps::of_times(&t, 2).message(&a.imu.display().to_string()) {
         crate::report::warn(&m);
     }
+    report_filter(a, &nav, &summary);
+    report_detection(a, &summary, imu.rows());
+    report_resets(a, &nav, &summary);
+    Ok(())
+}
+
+/// What the filter did: its updates, its final one-sigma, its states and its rest.
+fn report_filter(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse::FuseSummary) {
     let last = |c: &str| {
         nav.column(c)
             .and_then(|v| v.last().copied())
@@ -272,43 +321,47 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     crate::note!("imukit: the filter had {states} and {rest}");
     if summary.fix_noise_scale > 1.0 {
         crate::note!(
-            "imukit: the fixes' innovations showed them noisier than stated (--gnss-adaptive):              their one-sigmas were {:.2} times the stated ones at the end",
+            "imukit: the fixes' innovations showed them noisier than stated (--gnss-adaptive): \
+             their one-sigmas were {:.2} times the stated ones at the end",
             summary.fix_noise_scale.sqrt()
         );
     }
-    report_detection(a, &summary, imu.rows());
-    if summary.resets > 0 {
-        let t = nav.column("t_s").unwrap_or_default();
-        let resets = nav
-            .column(imukit::run::fuse::RESETS_COLUMN)
-            .unwrap_or_default();
-        // The first few times; the column has them all.
-        const SHOWN: usize = 10;
-        let mut at: Vec<String> = resets
-            .windows(2)
-            .zip(&t[1..])
-            .filter(|(r, _)| r[1] > r[0])
-            .map(|(_, t)| format!("{t:.2}"))
-            .collect();
-        if at.len() > SHOWN {
-            let more = at.len() - SHOWN;
-            at.truncate(SHOWN);
-            at.push(format!("… ({more} more)"));
-        }
-        crate::report::warn(&format!(
-            "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
-             time(s), at t = {} s (column {}): its one-sigma understates its error around them \
-             (an IMU worse than described: --sensor-errors, --rest-s; fixes worse than their \
-             stated accuracy: --gnss-adaptive)",
-            a.gnss
-                .map_or_else(|| "GNSS".into(), |p| p.display().to_string()),
-            imukit::run::fuse::MAX_REJECTED_IN_A_ROW,
-            summary.resets,
-            at.join(", "),
-            imukit::run::fuse::RESETS_COLUMN
-        ));
+}
+
+/// A warning with the times at which the filter was reset to the fixes, if it was.
+fn report_resets(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse::FuseSummary) {
+    if summary.resets == 0 {
+        return;
     }
-    Ok(())
+    let t = nav.column("t_s").unwrap_or_default();
+    let resets = nav
+        .column(imukit::run::fuse::RESETS_COLUMN)
+        .unwrap_or_default();
+    // The first few times; the column has them all.
+    const SHOWN: usize = 10;
+    let mut at: Vec<String> = resets
+        .windows(2)
+        .zip(&t[1..])
+        .filter(|(r, _)| r[1] > r[0])
+        .map(|(_, t)| format!("{t:.2}"))
+        .collect();
+    if at.len() > SHOWN {
+        let more = at.len() - SHOWN;
+        at.truncate(SHOWN);
+        at.push(format!("… ({more} more)"));
+    }
+    crate::report::warn(&format!(
+        "{}: the filter lost the fixes ({} rejected in a row) and was reset to them {} \
+         time(s), at t = {} s (column {}): its one-sigma understates its error around them \
+         (an IMU worse than described: --sensor-errors, --rest-s; fixes worse than their \
+         stated accuracy: --gnss-adaptive)",
+        a.gnss
+            .map_or_else(|| "GNSS".into(), |p| p.display().to_string()),
+        imukit::run::fuse::MAX_REJECTED_IN_A_ROW,
+        summary.resets,
+        at.join(", "),
+        imukit::run::fuse::RESETS_COLUMN
+    ));
 }
 
 /// What the detectors tested the readings against, and a warning when the log's noise is not

@@ -10,7 +10,7 @@ use imukit::io::Input;
 use imukit::io::description::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::{Gaps, TimeWindow};
-use imukit::run::navigate::{InitialState, NavAsked, NavRequest, integrate_csv};
+use imukit::run::navigate::{InitialState, NavAsked, NavRequest, NavSetup, integrate_csv};
 use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
@@ -161,6 +161,40 @@ pub fn three_d(
     .map_err(by_flag)?;
     let setup = request.setup().map_err(by_flag)?;
     crate::report::warn_implausible(c.input);
+    let initial = initial_of(c, o, &setup, &described)?;
+    if let Some(baro) = o.baro {
+        return with_baro(c, baro, &initial, &setup);
+    }
+    // Streamed: memory does not grow with the input file.
+    let summary =
+        integrate_csv(c.input, &initial, &setup, c.window, c.out).map_err(|e| match e {
+            Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
+                field: c.input.display().to_string(),
+                message: e.to_string(),
+            },
+            other => other,
+        })?;
+    if let Some(m) = summary.gaps.message(&c.input.display().to_string()) {
+        crate::report::warn(&m);
+    }
+    let [x, y, z] = summary.end_position_m;
+    crate::note!(
+        "imukit: {} samples, strapdown ({}); end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
+        summary.rows,
+        summary.scheme.describe(),
+        c.out.display()
+    );
+    Ok(())
+}
+
+/// The start of a 3-D run: `--init`'s row (at the window's start), else the origin at rest and
+/// level (said, not silently taken); the start options over it; on the Earth its reference.
+fn initial_of(
+    c: &Common<'_>,
+    o: &Options3d<'_>,
+    setup: &NavSetup,
+    described: &Described,
+) -> Result<InitialState, CliError> {
     let mut initial = match o.init {
         Some(p) => {
             let attitude = o.euler0.map(|_| "--euler0-rad").ok_or("--euler0-rad");
@@ -218,53 +252,41 @@ pub fn three_d(
     if let Some(p) = o.init {
         initial.check(&format!("{}, row 2", p.display()))?;
     }
-    if let Some(baro) = o.baro {
-        // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
-        let imu = imukit::run::navigate::read_whole(c.input)?;
-        let source = c.input.display().to_string();
-        let t0 = TimeWindow::first_time(&imu, &source)?;
-        let imu = c.window.apply(imu, t0, &source, 1)?;
-        let readings = imukit::io::read::read_table(baro)?;
-        let joined = imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| {
-            if e.data() == Some(Data::Barometer) {
-                e.relabelled(baro.display().to_string())
-            } else {
-                e
-            }
+    Ok(initial)
+}
+
+/// A barometer-damped run: the barometer joins the IMU samples (the Earth mechanization reads
+/// its input whole).
+fn with_baro(
+    c: &Common<'_>,
+    baro: &Path,
+    initial: &InitialState,
+    setup: &NavSetup,
+) -> Result<(), CliError> {
+    // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
+    let imu = imukit::run::navigate::read_whole(c.input)?;
+    let source = c.input.display().to_string();
+    let t0 = TimeWindow::first_time(&imu, &source)?;
+    let imu = c.window.apply(imu, t0, &source, 1)?;
+    let readings = imukit::io::read::read_table(baro)?;
+    let joined = imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| {
+        if e.data() == Some(Data::Barometer) {
+            e.relabelled(baro.display().to_string())
+        } else {
+            e
+        }
+    })?;
+    let nav =
+        imukit::run::navigate::integrate(&joined, initial, setup).map_err(|e| Error::Invalid {
+            field: c.input.display().to_string(),
+            message: e.to_string(),
         })?;
-        let nav = imukit::run::navigate::integrate(&joined, &initial, &setup).map_err(|e| {
-            Error::Invalid {
-                field: c.input.display().to_string(),
-                message: e.to_string(),
-            }
-        })?;
-        nav.write_described(c.out, &setup.description())?;
-        warn_gaps(&joined.column("t_s").unwrap_or_default(), 2, c.input);
-        report(
-            &nav,
-            "strapdown on the WGS-84 Earth, baro-damped height",
-            c.out,
-        );
-        return Ok(());
-    }
-    // Streamed: memory does not grow with the input file.
-    let summary =
-        integrate_csv(c.input, &initial, &setup, c.window, c.out).map_err(|e| match e {
-            Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
-                field: c.input.display().to_string(),
-                message: e.to_string(),
-            },
-            other => other,
-        })?;
-    if let Some(m) = summary.gaps.message(&c.input.display().to_string()) {
-        crate::report::warn(&m);
-    }
-    let [x, y, z] = summary.end_position_m;
-    crate::note!(
-        "imukit: {} samples, strapdown ({}); end position ({x:.3}, {y:.3}, {z:.3}) m; trajectory in {}",
-        summary.rows,
-        summary.scheme.describe(),
-        c.out.display()
+    nav.write_described(c.out, &setup.description())?;
+    warn_gaps(&joined.column("t_s").unwrap_or_default(), 2, c.input);
+    report(
+        &nav,
+        "strapdown on the WGS-84 Earth, baro-damped height",
+        c.out,
     );
     Ok(())
 }

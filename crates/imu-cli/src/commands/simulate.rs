@@ -2,14 +2,15 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use imukit::ScenarioSpec;
 use imukit::io::TableFormat;
 use imukit::io::bag::BagOptions;
+use imukit::io::description::Description;
 use imukit::io::output::{check_outputs, check_table_outputs, create_folder_within};
 use imukit::io::table::run_path;
 use imukit::run::pipeline::{RunThreads, available_cores};
 use imukit::run::simulate::StreamOutputs;
 use imukit::scenario::report::RunReport;
+use imukit::{Scenario, ScenarioSpec};
 use rayon::prelude::*;
 
 use super::CliError;
@@ -58,23 +59,13 @@ pub fn bag_options(
     Ok(Some(options))
 }
 
-pub fn run(
+/// Refuses an output that would overwrite an input or another output, every run's file counted.
+fn check_files(
     scenario: &Path,
+    spec: &ScenarioSpec,
     o: &Outputs<'_>,
     runs: Option<u64>,
-    threads: Option<i64>,
 ) -> Result<(), CliError> {
-    let Outputs {
-        out,
-        truth,
-        gnss,
-        baro,
-        odometer,
-        bag,
-    } = *o;
-    // One run's stages, or the runs at a time: refused before anything is read if below 1.
-    let run_threads = RunThreads::at_most(threads, "--threads")?;
-    let spec = ScenarioSpec::from_file(scenario)?;
     let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let files = spec.input_files(base);
     let mut inputs = vec![("scenario file", scenario)];
@@ -85,56 +76,91 @@ pub fn run(
             None => vec![path.to_path_buf()],
         }
     };
-    let run_files = per_run(out);
-    let gnss_files = gnss.map(per_run).unwrap_or_default();
-    let baro_files = baro.map(per_run).unwrap_or_default();
-    let odometer_files = odometer.map(per_run).unwrap_or_default();
+    let run_files = per_run(o.out);
+    let gnss_files = o.gnss.map(per_run).unwrap_or_default();
+    let baro_files = o.baro.map(per_run).unwrap_or_default();
+    let odometer_files = o.odometer.map(per_run).unwrap_or_default();
     let mut outputs: Vec<(&str, &Path)> =
         run_files.iter().map(|p| ("--out", p.as_path())).collect();
-    outputs.extend(truth.map(|t| ("--truth", t)));
+    outputs.extend(o.truth.map(|t| ("--truth", t)));
     outputs.extend(gnss_files.iter().map(|p| ("--gnss", p.as_path())));
     outputs.extend(baro_files.iter().map(|p| ("--baro", p.as_path())));
     outputs.extend(odometer_files.iter().map(|p| ("--odometer", p.as_path())));
     check_outputs(&inputs, &outputs)?;
     check_table_outputs(&outputs)?;
+    Ok(())
+}
+
+pub fn run(
+    scenario: &Path,
+    o: &Outputs<'_>,
+    runs: Option<u64>,
+    threads: Option<i64>,
+) -> Result<(), CliError> {
+    // One run's stages, or the runs at a time: refused before anything is read if below 1.
+    let run_threads = RunThreads::at_most(threads, "--threads")?;
+    let spec = ScenarioSpec::from_file(scenario)?;
+    check_files(scenario, &spec, o, runs)?;
+    let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let sc = spec.resolve(base)?;
     for w in &sc.warnings {
         crate::report::warn(w);
     }
     // What the files hold, written into those whose format has room for it.
     let description = sc.description(std::fs::read_to_string(scenario).ok());
-    let Some(runs) = runs else {
-        // Streamed: chunks are written as they are made, so memory does not grow with duration.
-        let outputs = StreamOutputs {
-            imu: Some(out),
-            truth,
-            gnss,
-            baro,
-            odometer,
-            description: &description,
-            asl: false,
-            bag,
-        };
-        let report = sc
-            .stream_to_files(None, run_threads, &outputs)
-            .map_err(threads_by_flag)?;
-        for w in report.warnings(sc.sample_rate_hz) {
-            crate::report::warn(&w);
-        }
-        let mut written = format!("IMU readings in {}", out.display());
-        for (what, path) in [
-            ("truth", truth),
-            ("GNSS fixes", gnss),
-            ("barometer readings", baro),
-            ("odometer readings", odometer),
-        ] {
-            if let Some(p) = path {
-                written += &format!(", {what} in {}", p.display());
-            }
-        }
-        crate::note!("imukit: {} samples; {written}", sc.t_s.len());
-        return Ok(());
+    match runs {
+        None => one_run(&sc, o, run_threads, &description),
+        Some(runs) => many_runs(&sc, o, runs, threads, &description),
+    }
+}
+
+/// One run, streamed: chunks are written as they are made, so memory does not grow with duration.
+fn one_run(
+    sc: &Scenario,
+    o: &Outputs<'_>,
+    run_threads: RunThreads,
+    description: &Description,
+) -> Result<(), CliError> {
+    let outputs = StreamOutputs {
+        imu: Some(o.out),
+        truth: o.truth,
+        gnss: o.gnss,
+        baro: o.baro,
+        odometer: o.odometer,
+        description,
+        asl: false,
+        bag: o.bag,
     };
+    let report = sc
+        .stream_to_files(None, run_threads, &outputs)
+        .map_err(threads_by_flag)?;
+    for w in report.warnings(sc.sample_rate_hz) {
+        crate::report::warn(&w);
+    }
+    let mut written = format!("IMU readings in {}", o.out.display());
+    for (what, path) in [
+        ("truth", o.truth),
+        ("GNSS fixes", o.gnss),
+        ("barometer readings", o.baro),
+        ("odometer readings", o.odometer),
+    ] {
+        if let Some(p) = path {
+            written += &format!(", {what} in {}", p.display());
+        }
+    }
+    crate::note!("imukit: {} samples; {written}", sc.t_s.len());
+    Ok(())
+}
+
+/// `runs` seeded runs at a time (every core, or at most `threads`), each on one thread, each
+/// run's files named by [`run_path`]; the truth once.
+fn many_runs(
+    sc: &Scenario,
+    o: &Outputs<'_>,
+    runs: u64,
+    threads: Option<i64>,
+    description: &Description,
+) -> Result<(), CliError> {
     if runs == 0 {
         return Err(imukit::Error::Invalid {
             field: "--runs".into(),
@@ -144,7 +170,6 @@ pub fn run(
     }
     let progress = crate::report::Progress::start(runs, "runs");
     let done = AtomicU64::new(0);
-    // Runs at a time: every core, or at most --threads of them; each run on one thread.
     let cores = available_cores();
     let pool_threads = threads.map_or(cores, |n| {
         usize::try_from(n).unwrap_or(usize::MAX).min(cores)
@@ -162,20 +187,24 @@ pub fn run(
             .into_par_iter()
             .try_for_each(|r| -> Result<(), CliError> {
                 let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
-                let (imu_file, gnss_file, baro_file, odometer_file) =
-                    (run_path(out, r, runs), per(gnss), per(baro), per(odometer));
+                let (imu_file, gnss_file, baro_file, odometer_file) = (
+                    run_path(o.out, r, runs),
+                    per(o.gnss),
+                    per(o.baro),
+                    per(o.odometer),
+                );
                 let report = sc.stream_to_files(
                     Some(r),
                     RunThreads::One,
                     &StreamOutputs {
                         imu: Some(&imu_file),
-                        truth: truth.filter(|_| r == 0),
+                        truth: o.truth.filter(|_| r == 0),
                         gnss: gnss_file.as_deref(),
                         baro: baro_file.as_deref(),
                         odometer: odometer_file.as_deref(),
-                        description: &description,
+                        description,
                         asl: false,
-                        bag,
+                        bag: o.bag,
                     },
                 )?;
                 if let Ok(mut m) = merged.lock() {
@@ -196,14 +225,12 @@ pub fn run(
         "imukit: {} runs of {} samples; IMU readings in {} … {}",
         done.load(Ordering::Relaxed),
         sc.t_s.len(),
-        run_path(out, 0, runs).display(),
-        run_path(out, runs - 1, runs).display()
+        run_path(o.out, 0, runs).display(),
+        run_path(o.out, runs - 1, runs).display()
     );
     Ok(())
 }
 
-/// The library names its `threads` setting (a refused second thread) by the field; here it is
-/// the flag that set it.
 /// `imukit simulate SCENARIO --layout euroc --out DIR`: one run as a EuRoC sequence, the
 /// readings and the truth in the ASL layout under `DIR/mav0/`.
 pub fn euroc(
@@ -272,6 +299,8 @@ pub fn euroc(
     Ok(())
 }
 
+/// The library names its `threads` setting (a refused second thread) by the field; here it is
+/// the flag that set it.
 fn threads_by_flag(e: imukit::Error) -> imukit::Error {
     match e {
         imukit::Error::Invalid { ref field, .. } if field == "threads" => crate::error::by_flag(e),
