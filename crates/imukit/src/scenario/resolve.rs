@@ -140,28 +140,8 @@ impl ScenarioSpec {
     /// # Errors
     /// Any invalid key, formula or file, named.
     pub fn resolve(&self, base_dir: &Path) -> Result<Scenario> {
-        let merged;
-        let spec = if let TrajectorySpec::Builtin(BuiltinSpec { name }) = &self.trajectory {
-            let b = builtin::spec(name)?;
-            merged = ScenarioSpec {
-                rate_hz: self.rate_hz.or(b.rate_hz),
-                duration_s: self.duration_s.or(b.duration_s),
-                nav_frame: self.nav_frame.or(b.nav_frame),
-                gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
-                earth: self.earth.or(b.earth),
-                origin: self.origin.or(b.origin),
-                magnetic_model: self.magnetic_model.or(b.magnetic_model),
-                date: self.date.clone().or(b.date),
-                trajectory: b.trajectory,
-                imu: self.imu.or(&b.imu),
-                gnss: self.gnss.clone().or(b.gnss),
-                baro: self.baro.clone().or(b.baro),
-                odometer: self.odometer.clone().or(b.odometer),
-            };
-            &merged
-        } else {
-            self
-        };
+        let merged = self.over_builtin()?;
+        let spec = merged.as_ref().unwrap_or(self);
         let gravity_m_s2 = spec.gravity_m_s2.unwrap_or(imu_core::DEFAULT_GRAVITY_M_S2);
         check_gravity("gravity_m_s2", gravity_m_s2)?;
         // On the WGS-84 Earth, normal gravity unless this file sets a constant (a built-in's
@@ -177,137 +157,8 @@ impl ScenarioSpec {
         if let EarthSetup::Wgs84(plane) = &mut earth {
             plane.magnetic = magnetic;
         }
-        let sensors = SensorSetup::resolve(&spec.imu, base_dir)?;
-        let accel_sign = spec
-            .imu
-            .accel_sign
-            .map_or(sensors.profile.accel_sign(), AccelSign::from);
-        let imu = ImuSetup {
-            kind: spec.imu.kind.unwrap_or_default(),
-            output: spec.imu.output.unwrap_or_default(),
-            lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
-            accel_sign,
-            magnetic_field_ut: spec
-                .imu
-                .magnetic_field_ut
-                .map(|m| finite_vec("imu.magnetic_field_ut", m))
-                .transpose()?,
-            sensors,
-        };
-        let need = |v: Option<f64>, field: &str| {
-            v.ok_or_else(|| invalid(field, "missing (required for this trajectory type)"))
-        };
-        let (trajectory, t_s) = match &spec.trajectory {
-            TrajectorySpec::Expression(e) => {
-                let min_speed_m_s = check_min_speed("trajectory.min_speed_m_s", e.min_speed_m_s)?;
-                let t = regular_times(
-                    need(spec.rate_hz, "rate_hz")?,
-                    need(spec.duration_s, "duration_s")?,
-                )?;
-                let mut motion = e.motion()?;
-                if motion.geodetic.is_some() {
-                    let EarthSetup::Wgs84(plane) = &earth else {
-                        return Err(invalid(
-                            "trajectory.latitude_rad",
-                            "latitude, longitude and height formulas need earth = \"wgs84\" and an origin",
-                        ));
-                    };
-                    motion.geodetic = Some(GeodeticPlane::placed(
-                        &plane.origin,
-                        spec.nav_frame.unwrap_or_default(),
-                    ));
-                    motion.check_latitudes((0..t.len()).map(|k| t.at(k)))?;
-                }
-                (
-                    Trajectory::Expression(motion, AnalyticOptions { min_speed_m_s }),
-                    t,
-                )
-            }
-            TrajectorySpec::Walk(w) => {
-                let walk = crate::motion::walk::WalkMotion {
-                    cadence_hz: w.cadence_hz,
-                    stride_m: w.stride_m,
-                    stance_fraction: w.stance_fraction.unwrap_or(0.6),
-                    lift_m: w.lift_m.unwrap_or(0.1),
-                    foot_pitch_rad: w.foot_pitch_rad.unwrap_or(0.3),
-                    radius_m: w.radius_m,
-                    start_s: w.start_s.unwrap_or(0.0),
-                    heading_rad: w.heading_rad.unwrap_or(0.0),
-                    start_m: w.start_m.unwrap_or([0.0; 3]),
-                };
-                check_walk(&walk)?;
-                let t = regular_times(
-                    need(spec.rate_hz, "rate_hz")?,
-                    need(spec.duration_s, "duration_s")?,
-                )?;
-                (Trajectory::Walk(walk), t)
-            }
-            TrajectorySpec::Track(k) => {
-                let speed = match k.accel_m_s2 {
-                    Some(accel_m_s2) => SpeedProfile::Trapezoid {
-                        speed_m_s: k.speed_m_s,
-                        accel_m_s2,
-                    },
-                    None => SpeedProfile::Constant(k.speed_m_s),
-                };
-                let track = Track::new(k.start_m, k.heading_rad, k.segments.clone(), speed)?;
-                let duration = spec.duration_s.unwrap_or_else(|| track.travel_time_s());
-                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
-                (Trajectory::Track(track), t)
-            }
-            TrajectorySpec::Samples(s) => {
-                let tangent = match s.attitude.as_deref() {
-                    None => false,
-                    Some("tangent") => true,
-                    Some(other) => {
-                        return Err(invalid(
-                            "trajectory.attitude",
-                            format!(
-                                "unknown attitude \"{other}\" for samples (use \"tangent\" or leave it out)"
-                            ),
-                        ));
-                    }
-                };
-                let path = base_dir.join(&s.file);
-                let order = s
-                    .order
-                    .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
-                let min_speed = check_min_speed("trajectory.min_speed_m_s", s.min_speed_m_s)?;
-                let mut path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
-                if path.geodetic {
-                    let EarthSetup::Wgs84(plane) = &earth else {
-                        return Err(invalid(
-                            "trajectory.file",
-                            format!(
-                                "{} has lat_rad, lon_rad, height_m and no pos_*: geodetic samples need earth = \"wgs84\" and an origin",
-                                path.origin
-                            ),
-                        ));
-                    };
-                    plane.place_samples(&mut path, spec.nav_frame.unwrap_or_default())?;
-                }
-                path.check()?;
-                let t = SampleTimes::Listed(path.t_s.clone());
-                (Trajectory::Samples(path), t)
-            }
-            TrajectorySpec::Waypoints(w) => {
-                let positions = waypoint_positions(w, &earth, spec.nav_frame.unwrap_or_default())?;
-                let path = Waypoints::new(
-                    &w.time_s,
-                    &positions,
-                    w.velocity_m_s.as_deref(),
-                    w.euler_rad.as_deref(),
-                )?;
-                let duration = spec.duration_s.unwrap_or(path.end_s);
-                let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
-                (Trajectory::Waypoints(path), t)
-            }
-            TrajectorySpec::BodyRates(b) => {
-                let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
-                (Trajectory::BodyRates(data), SampleTimes::Listed(t))
-            }
-            TrajectorySpec::Builtin(_) => unreachable!("built-ins resolve to another type"),
-        };
+        let imu = imu_setup(spec, base_dir)?;
+        let (trajectory, t_s) = trajectory_of(spec, &earth, base_dir)?;
         let sample_rate_hz = match spec.rate_hz {
             Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
             _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s.at(t_s.len() - 1) - t_s.at(0)),
@@ -350,6 +201,190 @@ impl ScenarioSpec {
             odometer,
         })
     }
+
+    /// A built-in trajectory's scenario with this file's keys over it (`None`: not a built-in).
+    fn over_builtin(&self) -> Result<Option<ScenarioSpec>> {
+        let TrajectorySpec::Builtin(BuiltinSpec { name }) = &self.trajectory else {
+            return Ok(None);
+        };
+        let b = builtin::spec(name)?;
+        Ok(Some(ScenarioSpec {
+            rate_hz: self.rate_hz.or(b.rate_hz),
+            duration_s: self.duration_s.or(b.duration_s),
+            nav_frame: self.nav_frame.or(b.nav_frame),
+            gravity_m_s2: self.gravity_m_s2.or(b.gravity_m_s2),
+            earth: self.earth.or(b.earth),
+            origin: self.origin.or(b.origin),
+            magnetic_model: self.magnetic_model.or(b.magnetic_model),
+            date: self.date.clone().or(b.date),
+            trajectory: b.trajectory,
+            imu: self.imu.or(&b.imu),
+            gnss: self.gnss.clone().or(b.gnss),
+            baro: self.baro.clone().or(b.baro),
+            odometer: self.odometer.clone().or(b.odometer),
+        }))
+    }
+}
+
+/// The IMU's setup: its sensors' parameters (a preset, a file or keys), sign, lever arm and field.
+fn imu_setup(spec: &ScenarioSpec, base_dir: &Path) -> Result<ImuSetup> {
+    let sensors = SensorSetup::resolve(&spec.imu, base_dir)?;
+    let accel_sign = spec
+        .imu
+        .accel_sign
+        .map_or(sensors.profile.accel_sign(), AccelSign::from);
+    Ok(ImuSetup {
+        kind: spec.imu.kind.unwrap_or_default(),
+        output: spec.imu.output.unwrap_or_default(),
+        lever_arm_m: finite_vec("imu.lever_arm_m", spec.imu.lever_arm_m.unwrap_or([0.0; 3]))?,
+        accel_sign,
+        magnetic_field_ut: spec
+            .imu
+            .magnetic_field_ut
+            .map(|m| finite_vec("imu.magnetic_field_ut", m))
+            .transpose()?,
+        sensors,
+    })
+}
+
+/// A key a trajectory type needs.
+fn need(v: Option<f64>, field: &str) -> Result<f64> {
+    v.ok_or_else(|| invalid(field, "missing (required for this trajectory type)"))
+}
+
+/// The trajectory and its sample times.
+fn trajectory_of(
+    spec: &ScenarioSpec,
+    earth: &EarthSetup,
+    base_dir: &Path,
+) -> Result<(Trajectory, SampleTimes)> {
+    Ok(match &spec.trajectory {
+        TrajectorySpec::Expression(e) => expression_trajectory(e, spec, earth)?,
+        TrajectorySpec::Walk(w) => {
+            let walk = crate::motion::walk::WalkMotion {
+                cadence_hz: w.cadence_hz,
+                stride_m: w.stride_m,
+                stance_fraction: w.stance_fraction.unwrap_or(0.6),
+                lift_m: w.lift_m.unwrap_or(0.1),
+                foot_pitch_rad: w.foot_pitch_rad.unwrap_or(0.3),
+                radius_m: w.radius_m,
+                start_s: w.start_s.unwrap_or(0.0),
+                heading_rad: w.heading_rad.unwrap_or(0.0),
+                start_m: w.start_m.unwrap_or([0.0; 3]),
+            };
+            check_walk(&walk)?;
+            let t = regular_times(
+                need(spec.rate_hz, "rate_hz")?,
+                need(spec.duration_s, "duration_s")?,
+            )?;
+            (Trajectory::Walk(walk), t)
+        }
+        TrajectorySpec::Track(k) => {
+            let speed = match k.accel_m_s2 {
+                Some(accel_m_s2) => SpeedProfile::Trapezoid {
+                    speed_m_s: k.speed_m_s,
+                    accel_m_s2,
+                },
+                None => SpeedProfile::Constant(k.speed_m_s),
+            };
+            let track = Track::new(k.start_m, k.heading_rad, k.segments.clone(), speed)?;
+            let duration = spec.duration_s.unwrap_or_else(|| track.travel_time_s());
+            let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+            (Trajectory::Track(track), t)
+        }
+        TrajectorySpec::Samples(s) => sampled_trajectory(s, spec, earth, base_dir)?,
+        TrajectorySpec::Waypoints(w) => {
+            let positions = waypoint_positions(w, earth, spec.nav_frame.unwrap_or_default())?;
+            let path = Waypoints::new(
+                &w.time_s,
+                &positions,
+                w.velocity_m_s.as_deref(),
+                w.euler_rad.as_deref(),
+            )?;
+            let duration = spec.duration_s.unwrap_or(path.end_s);
+            let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+            (Trajectory::Waypoints(path), t)
+        }
+        TrajectorySpec::BodyRates(b) => {
+            let (t, data) = body_rates(b, spec.rate_hz, spec.duration_s, base_dir)?;
+            (Trajectory::BodyRates(data), SampleTimes::Listed(t))
+        }
+        TrajectorySpec::Builtin(_) => unreachable!("built-ins resolve to another type"),
+    })
+}
+
+/// A trajectory of formulas, placed on the Earth when they give latitude and longitude.
+fn expression_trajectory(
+    e: &ExpressionSpec,
+    spec: &ScenarioSpec,
+    earth: &EarthSetup,
+) -> Result<(Trajectory, SampleTimes)> {
+    let min_speed_m_s = check_min_speed("trajectory.min_speed_m_s", e.min_speed_m_s)?;
+    let t = regular_times(
+        need(spec.rate_hz, "rate_hz")?,
+        need(spec.duration_s, "duration_s")?,
+    )?;
+    let mut motion = e.motion()?;
+    if motion.geodetic.is_some() {
+        let EarthSetup::Wgs84(plane) = earth else {
+            return Err(invalid(
+                "trajectory.latitude_rad",
+                "latitude, longitude and height formulas need earth = \"wgs84\" and an origin",
+            ));
+        };
+        motion.geodetic = Some(GeodeticPlane::placed(
+            &plane.origin,
+            spec.nav_frame.unwrap_or_default(),
+        ));
+        motion.check_latitudes((0..t.len()).map(|k| t.at(k)))?;
+    }
+    Ok((
+        Trajectory::Expression(motion, AnalyticOptions { min_speed_m_s }),
+        t,
+    ))
+}
+
+/// A trajectory through the positions (and attitudes) of a file, placed on the Earth when the
+/// file gives latitude and longitude.
+fn sampled_trajectory(
+    s: &SamplesSpec,
+    spec: &ScenarioSpec,
+    earth: &EarthSetup,
+    base_dir: &Path,
+) -> Result<(Trajectory, SampleTimes)> {
+    let tangent = match s.attitude.as_deref() {
+        None => false,
+        Some("tangent") => true,
+        Some(other) => {
+            return Err(invalid(
+                "trajectory.attitude",
+                format!(
+                    "unknown attitude \"{other}\" for samples (use \"tangent\" or leave it out)"
+                ),
+            ));
+        }
+    };
+    let path = base_dir.join(&s.file);
+    let order = s
+        .order
+        .unwrap_or(imu_core::kinematics::finite_diff::DEFAULT_ORDER);
+    let min_speed = check_min_speed("trajectory.min_speed_m_s", s.min_speed_m_s)?;
+    let mut path = SampledPath::from_csv(&path, order, tangent, min_speed)?;
+    if path.geodetic {
+        let EarthSetup::Wgs84(plane) = earth else {
+            return Err(invalid(
+                "trajectory.file",
+                format!(
+                    "{} has lat_rad, lon_rad, height_m and no pos_*: geodetic samples need earth = \"wgs84\" and an origin",
+                    path.origin
+                ),
+            ));
+        };
+        plane.place_samples(&mut path, spec.nav_frame.unwrap_or_default())?;
+    }
+    path.check()?;
+    let t = SampleTimes::Listed(path.t_s.clone());
+    Ok((Trajectory::Samples(path), t))
 }
 
 /// The magnetic model and the decimal year at `t = 0`: both or neither, on the WGS-84 Earth,
