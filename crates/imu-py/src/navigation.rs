@@ -270,15 +270,7 @@ fn fuse<'py>(
     gravity_m_s2: Option<f64>,
     described: DescribedIn<'py>,
 ) -> PyResult<(DescribedOut<'py>, usize, usize, Vec<String>)> {
-    use imukit::ScenarioSpec;
-    use imukit::run::fuse::{AidTables, FuseRequest, Part, PartModel, Start, fuse_with};
-    // The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
-    // made once per call: its size does not matter).
-    #[allow(clippy::large_enum_variant)]
-    enum Model {
-        Scenario(ScenarioSpec),
-        Part(PartModel),
-    }
+    use imukit::run::fuse::{AidTables, FuseRequest, Start, fuse_with};
     let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
     let gnss = imukit::scenario::gnss::GnssSpec {
@@ -291,35 +283,7 @@ fn fuse<'py>(
         latency_s: gnss_latency_s,
         ..Default::default()
     };
-    let model = match imu_model {
-        // Neither a part nor a scenario: the noise learnt from the log.
-        None if scenario.is_none() => Model::Part(PartModel {
-            imu: Part::Learnt,
-            part,
-            gnss,
-        }),
-        Some(imu) => Model::Part(PartModel {
-            imu: Part::named(&imu),
-            part,
-            gnss,
-        }),
-        None => Model::Scenario(
-            match format {
-                "dict" => ScenarioSpec::from_tree(
-                    &crate::convert::value_tree(scenario, "scenario")?,
-                    "scenario dict",
-                ),
-                "toml" => ScenarioSpec::from_toml(&scenario.extract::<String>()?, "scenario"),
-                "json" => ScenarioSpec::from_json(&scenario.extract::<String>()?, "scenario"),
-                other => {
-                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                        "format must be \"dict\", \"toml\" or \"json\", got {other:?}"
-                    )));
-                }
-            }
-            .map_err(refused)?,
-        ),
-    };
+    let model = model_of(scenario, format, imu_model, part, gnss)?;
     let imu = table_in("imu", imu_columns, &imu_values)?;
     let gnss = table_in("gnss", gnss_columns, &gnss_values)?;
     let gnss = match gnss_uere_m {
@@ -333,15 +297,8 @@ fn fuse<'py>(
         _ => None,
     };
     let align = choice_opt("align", align.as_deref())?;
-    let optional =
-        |name: &str, columns: Option<Vec<String>>, values: &Option<PyReadonlyArray2<'py, f64>>| {
-            match (columns, values) {
-                (Some(c), Some(v)) => table_in(name, c, v).map(Some),
-                _ => Ok(None),
-            }
-        };
-    let odometer = optional("odometer", odometer_columns, &odometer_values)?;
-    let baro = optional("baro", baro_columns, &baro_values)?;
+    let odometer = optional_table("odometer", odometer_columns, odometer_values.as_ref())?;
+    let baro = optional_table("baro", baro_columns, baro_values.as_ref())?;
     let base = base_dir.to_string();
     let (table, summary, description) = py
         .detach(move || {
@@ -382,7 +339,78 @@ fn fuse<'py>(
             fuse_with(&imu, &gnss, aids, start, &setup).map(|(t, s)| (t, s, description))
         })
         .map_err(refused)?;
-    let warnings: Vec<String> = summary
+    Ok((
+        described_out(py, table, &description)?,
+        summary.updates,
+        summary.rejected,
+        fuse_warnings(&summary),
+    ))
+}
+
+/// An aid's table, when both its columns and its values were given.
+fn optional_table(
+    name: &str,
+    columns: Option<Vec<String>>,
+    values: Option<&PyReadonlyArray2<'_, f64>>,
+) -> PyResult<Option<imukit::Table>> {
+    match (columns, values) {
+        (Some(c), Some(v)) => table_in(name, c, v).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// The filter's model: the scenario's, or a part with the receiver's accuracies (one value,
+/// made once per call: its size does not matter).
+#[allow(clippy::large_enum_variant)]
+enum Model {
+    Scenario(imukit::ScenarioSpec),
+    Part(imukit::run::fuse::PartModel),
+}
+
+/// The model `fuse` was given: `imu_model` (a preset or a file) with `part` and the receiver's
+/// figures, the scenario in `format`, or neither (the noise learnt from the log).
+fn model_of(
+    scenario: &Bound<'_, PyAny>,
+    format: &str,
+    imu_model: Option<String>,
+    part: Option<String>,
+    gnss: imukit::scenario::gnss::GnssSpec,
+) -> PyResult<Model> {
+    use imukit::ScenarioSpec;
+    use imukit::run::fuse::{Part, PartModel};
+    Ok(match imu_model {
+        None if scenario.is_none() => Model::Part(PartModel {
+            imu: Part::Learnt,
+            part,
+            gnss,
+        }),
+        Some(imu) => Model::Part(PartModel {
+            imu: Part::named(&imu),
+            part,
+            gnss,
+        }),
+        None => Model::Scenario(
+            match format {
+                "dict" => ScenarioSpec::from_tree(
+                    &crate::convert::value_tree(scenario, "scenario")?,
+                    "scenario dict",
+                ),
+                "toml" => ScenarioSpec::from_toml(&scenario.extract::<String>()?, "scenario"),
+                "json" => ScenarioSpec::from_json(&scenario.extract::<String>()?, "scenario"),
+                other => {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "format must be \"dict\", \"toml\" or \"json\", got {other:?}"
+                    )));
+                }
+            }
+            .map_err(refused)?,
+        ),
+    })
+}
+
+/// What a fuse run warns of: the IMU's repeated rows and a long stretch without stances.
+fn fuse_warnings(summary: &imukit::run::fuse::FuseSummary) -> Vec<String> {
+    summary
         .repeats
         .message("imu", 0)
         .into_iter()
@@ -390,13 +418,7 @@ fn fuse<'py>(
             "imu",
             summary.stance_gap,
         ))
-        .collect();
-    Ok((
-        described_out(py, table, &description)?,
-        summary.updates,
-        summary.rejected,
-        warnings,
-    ))
+        .collect()
 }
 
 /// Adds this module's functions.

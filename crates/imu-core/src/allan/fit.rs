@@ -468,51 +468,12 @@ pub fn fit_noise(tau_s: &[f64], adev: &[f64], m: &[usize], n: usize) -> Result<N
 /// time scale it kept whose amplitude the curve does not resolve.
 fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> u32 {
     let len = curve.len;
-    let criterion = out.criterion;
     let mut w = [0.0; MAX_POINTS];
-    let Some(mut fit) = converge(curve, &mut w, None, n, 0) else {
+    let Some(fit) = converge(curve, &mut w, None, n, 0) else {
         out.edf = curve.nu;
         return 0;
     };
-    let mut drops = [0.0; SCALE_TERMS];
-    let mut required = 0u32;
-    // The terms with a time scale, the better first, each kept if it pays for its parameters.
-    while curve.ncols < COLUMNS {
-        let k = curve.ncols;
-        curve.ncols += 1;
-        let mut best: Option<(ScaleTerm, f64, f64)> = None;
-        for term in ScaleTerm::ALL {
-            if excluded & (1 << term as u32) != 0
-                || (TERMS..k).any(|j| matches!(curve.columns[j], Column::Scaled(t, _) if t == term))
-            {
-                continue;
-            }
-            if let Some((scale, chi2)) = best_scale(curve, &w[..len], k, term)
-                && best.is_none_or(|b| chi2 < b.2)
-            {
-                best = Some((term, scale, chi2));
-            }
-        }
-        let Some((term, scale, chi2)) = best.filter(|b| fit.1.chi2 - b.2 > criterion) else {
-            curve.ncols -= 1;
-            break;
-        };
-        let before = (fit, curve.nu, curve.share, curve.chol, w);
-        curve.set_column(k, Column::Scaled(term, scale));
-        let start = fit.1.c;
-        let refit = converge(curve, &mut w, Some(&start), n, required | 1 << k)
-            .and_then(|_| best_scale(curve, &w[..len], k, term))
-            .and_then(|_| converge(curve, &mut w, Some(&start), n, required | 1 << k));
-        let Some(next) = refit else {
-            // Reweighted, no non-negative fit holds the term: it is not kept.
-            (fit, curve.nu, curve.share, curve.chol, w) = before;
-            curve.ncols -= 1;
-            break;
-        };
-        drops[term as usize] = fit.1.chi2 - chi2;
-        required |= 1 << k;
-        fit = next;
-    }
+    let (fit, required, drops) = add_scaled_terms(curve, &mut w, fit, n, excluded, out.criterion);
     let (mask, Solution { c, chi2, .. }) = fit;
     // Each term with a time scale also spends a degree of freedom on its scale.
     let parameters = mask.count_ones() + required.count_ones();
@@ -522,29 +483,8 @@ fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> 
     // of terms counts as describing the curve as well, are scaled by χ²/dof (as the PDG scales
     // inconsistent measurements); a fit that describes its curve keeps them.
     let birge = (chi2 / dof as f64).max(1.0);
-    let margin = CHI2_1_95 * birge;
-    // Every non-negative fit that describes the curve as well as the best (χ² within the 95 %
-    // point of χ² with one degree of freedom) is a candidate; each term's interval spans its
-    // intervals in all of them (0 in those that leave it out), so that which terms the best fit
-    // happened to pick does not narrow it.
-    let (mut lower, mut upper) = ([f64::INFINITY; COLUMNS], [0.0_f64; COLUMNS]);
-    for subset in 1..(1u32 << curve.ncols) {
-        let Some(sol) = solve(curve, &w[..len], subset) else {
-            continue;
-        };
-        if !non_negative(&sol, subset) || sol.chi2 > chi2 + margin {
-            continue;
-        }
-        for j in 0..curve.ncols {
-            if subset & (1 << j) != 0 {
-                let (lo, hi) = coefficient_interval(&sol, j, birge);
-                lower[j] = lower[j].min(lo);
-                upper[j] = upper[j].max(hi);
-            } else {
-                lower[j] = lower[j].min(0.0);
-            }
-        }
-    }
+    let within = chi2 + CHI2_1_95 * birge;
+    let (lower, mut upper) = subset_intervals(curve, &w[..len], within, birge);
     let to_x = |term: NoiseTerm, c2: f64| math::sqrt(c2.max(0.0) / term.scale());
     let sample_rate_hz = curve.sample_rate_hz;
     for (j, term) in NoiseTerm::ALL.iter().enumerate() {
@@ -572,54 +512,8 @@ fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> 
         let Column::Scaled(term, scale) = curve.columns[k] else {
             continue;
         };
-        let (mut lo, mut hi) = (lower[k], upper[k]);
-        // The time scale's interval: every scale whose best fit holding the term describes the
-        // curve as well (χ² within the margin), found on the grid and its edges bisected. The
-        // amplitude's errors correlate with the scale's, so its interval spans its intervals
-        // at scales across that interval, not only at the best.
-        let accepts = |curve: &mut Curve, s: f64| {
-            chi2_at(curve, &w[..len], k, term, s).filter(|sol| sol.chi2 <= chi2 + margin)
-        };
-        let (mut scale_lo, mut scale_hi) = (scale, scale);
-        let mut below: Option<f64> = None;
-        let mut above: Option<f64> = None;
-        for s in scale_grid(term, curve) {
-            match accepts(curve, s) {
-                Some(_) => {
-                    scale_lo = scale_lo.min(s);
-                    scale_hi = scale_hi.max(s);
-                }
-                None if s < scale => below = Some(s),
-                None => above = above.or(Some(s)),
-            }
-        }
-        let below = below.filter(|b| *b < scale_lo);
-        let above = above.filter(|a| *a > scale_hi);
-        for (inside, outside) in [(scale_lo, below), (scale_hi, above)] {
-            let Some(mut outside) = outside else {
-                continue;
-            };
-            let mut inside = inside;
-            for _ in 0..BISECTIONS {
-                let mid = math::sqrt(inside * outside);
-                if accepts(curve, mid).is_some() {
-                    inside = mid;
-                } else {
-                    outside = mid;
-                }
-            }
-            scale_lo = scale_lo.min(inside);
-            scale_hi = scale_hi.max(inside);
-        }
-        for step in 0..=AMPLITUDE_SCALES {
-            let s =
-                scale_lo * math::powf(scale_hi / scale_lo, step as f64 / AMPLITUDE_SCALES as f64);
-            if let Some(sol) = chi2_at(curve, &w[..len], k, term, s) {
-                let (a, b) = coefficient_interval(&sol, k, birge);
-                lo = lo.min(a);
-                hi = hi.max(b);
-            }
-        }
+        let scales = scale_interval(curve, &w[..len], k, within);
+        let (lo, hi) = amplitude_interval(curve, &w[..len], k, scales, birge, (lower[k], upper[k]));
         curve.set_column(k, Column::Scaled(term, scale));
         out.scaled[term as usize] = Some(ScaleEstimate {
             term,
@@ -627,8 +521,8 @@ fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> 
             lower: math::sqrt(lo.max(0.0)),
             upper: math::sqrt(hi.max(c[k])),
             scale,
-            scale_lower: scale_lo,
-            scale_upper: scale_hi,
+            scale_lower: scales.0,
+            scale_upper: scales.1,
             chi2_drop: drops[term as usize],
         });
     }
@@ -639,6 +533,157 @@ fn fit_model(curve: &mut Curve, n: usize, excluded: u32, out: &mut NoiseFit) -> 
         .flatten()
         .filter(|e| e.lower <= 0.0)
         .fold(0, |bits, e| bits | 1 << e.term as u32)
+}
+
+/// Adds to the power-law fit `fit` the terms with a time scale, the better first, each kept if
+/// χ² falls by more than `criterion` and a reweighted non-negative fit holds it; the terms in
+/// `excluded` left out. Returns the fit, the columns it requires and each term's χ² drop.
+fn add_scaled_terms(
+    curve: &mut Curve,
+    w: &mut [f64; MAX_POINTS],
+    mut fit: (u32, Solution),
+    n: usize,
+    excluded: u32,
+    criterion: f64,
+) -> ((u32, Solution), u32, [f64; SCALE_TERMS]) {
+    let len = curve.len;
+    let mut drops = [0.0; SCALE_TERMS];
+    let mut required = 0u32;
+    while curve.ncols < COLUMNS {
+        let k = curve.ncols;
+        curve.ncols += 1;
+        let mut best: Option<(ScaleTerm, f64, f64)> = None;
+        for term in ScaleTerm::ALL {
+            if excluded & (1 << term as u32) != 0
+                || (TERMS..k).any(|j| matches!(curve.columns[j], Column::Scaled(t, _) if t == term))
+            {
+                continue;
+            }
+            if let Some((scale, chi2)) = best_scale(curve, &w[..len], k, term)
+                && best.is_none_or(|b| chi2 < b.2)
+            {
+                best = Some((term, scale, chi2));
+            }
+        }
+        let Some((term, scale, chi2)) = best.filter(|b| fit.1.chi2 - b.2 > criterion) else {
+            curve.ncols -= 1;
+            break;
+        };
+        let before = (fit, curve.nu, curve.share, curve.chol, *w);
+        curve.set_column(k, Column::Scaled(term, scale));
+        let start = fit.1.c;
+        let refit = converge(curve, w, Some(&start), n, required | 1 << k)
+            .and_then(|_| best_scale(curve, &w[..len], k, term))
+            .and_then(|_| converge(curve, w, Some(&start), n, required | 1 << k));
+        let Some(next) = refit else {
+            // Reweighted, no non-negative fit holds the term: it is not kept.
+            (fit, curve.nu, curve.share, curve.chol, *w) = before;
+            curve.ncols -= 1;
+            break;
+        };
+        drops[term as usize] = fit.1.chi2 - chi2;
+        required |= 1 << k;
+        fit = next;
+    }
+    (fit, required, drops)
+}
+
+/// Each coefficient's interval over every non-negative fit that describes the curve as well as
+/// the best (χ² up to `within`, the best's plus the 95 % point of χ² with one degree of
+/// freedom): it spans its intervals in all of them (0 in those that leave it out), so that which
+/// terms the best fit happened to pick does not narrow it.
+fn subset_intervals(
+    curve: &Curve,
+    w: &[f64],
+    within: f64,
+    birge: f64,
+) -> ([f64; COLUMNS], [f64; COLUMNS]) {
+    let (mut lower, mut upper) = ([f64::INFINITY; COLUMNS], [0.0_f64; COLUMNS]);
+    for subset in 1..(1u32 << curve.ncols) {
+        let Some(sol) = solve(curve, w, subset) else {
+            continue;
+        };
+        if !non_negative(&sol, subset) || sol.chi2 > within {
+            continue;
+        }
+        for j in 0..curve.ncols {
+            if subset & (1 << j) != 0 {
+                let (lo, hi) = coefficient_interval(&sol, j, birge);
+                lower[j] = lower[j].min(lo);
+                upper[j] = upper[j].max(hi);
+            } else {
+                lower[j] = lower[j].min(0.0);
+            }
+        }
+    }
+    (lower, upper)
+}
+
+/// The interval of column `k`'s time scale: every scale whose best fit holding the term
+/// describes the curve as well (χ² up to `within`), found on the grid and its edges bisected.
+fn scale_interval(curve: &mut Curve, w: &[f64], k: usize, within: f64) -> (f64, f64) {
+    let Column::Scaled(term, scale) = curve.columns[k] else {
+        return (0.0, 0.0);
+    };
+    let accepts =
+        |curve: &mut Curve, s: f64| chi2_at(curve, w, k, term, s).filter(|sol| sol.chi2 <= within);
+    let (mut scale_lo, mut scale_hi) = (scale, scale);
+    let mut below: Option<f64> = None;
+    let mut above: Option<f64> = None;
+    for s in scale_grid(term, curve) {
+        match accepts(curve, s) {
+            Some(_) => {
+                scale_lo = scale_lo.min(s);
+                scale_hi = scale_hi.max(s);
+            }
+            None if s < scale => below = Some(s),
+            None => above = above.or(Some(s)),
+        }
+    }
+    let below = below.filter(|b| *b < scale_lo);
+    let above = above.filter(|a| *a > scale_hi);
+    for (inside, outside) in [(scale_lo, below), (scale_hi, above)] {
+        let Some(mut outside) = outside else {
+            continue;
+        };
+        let mut inside = inside;
+        for _ in 0..BISECTIONS {
+            let mid = math::sqrt(inside * outside);
+            if accepts(curve, mid).is_some() {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+        }
+        scale_lo = scale_lo.min(inside);
+        scale_hi = scale_hi.max(inside);
+    }
+    (scale_lo, scale_hi)
+}
+
+/// The interval of column `k`'s amplitude (squared), from `(lo, hi)` at the best scale: its
+/// errors correlate with the scale's, so it spans its intervals at scales across `scales`, not
+/// only at the best.
+fn amplitude_interval(
+    curve: &mut Curve,
+    w: &[f64],
+    k: usize,
+    (scale_lo, scale_hi): (f64, f64),
+    birge: f64,
+    (mut lo, mut hi): (f64, f64),
+) -> (f64, f64) {
+    let Column::Scaled(term, _) = curve.columns[k] else {
+        return (lo, hi);
+    };
+    for step in 0..=AMPLITUDE_SCALES {
+        let s = scale_lo * math::powf(scale_hi / scale_lo, step as f64 / AMPLITUDE_SCALES as f64);
+        if let Some(sol) = chi2_at(curve, w, k, term, s) {
+            let (a, b) = coefficient_interval(&sol, k, birge);
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+    }
+    (lo, hi)
 }
 
 /// The 95 % interval of coefficient `j` of `sol` with its variance scaled by `birge`; its lower

@@ -45,6 +45,22 @@ const COLUMNS: &[&str] = GNSS_EARTH_COLUMNS.split_at(6).0;
 /// An unreadable file, a line longer than 4096 bytes, a bad checksum or a sentence of the three
 /// read that does not parse (file and line), a log without a fix.
 pub fn read_table(path: &Path) -> Result<Table> {
+    let epochs = read_epochs(path)?;
+    let fixes: Vec<Epoch> = epochs
+        .into_iter()
+        .filter(|e| e.position.is_some())
+        .collect();
+    if fixes.is_empty() {
+        return Err(Error::CsvFormat {
+            file: path.into(),
+            message: "no GGA sentence with a fix".into(),
+        });
+    }
+    Ok(table_of(&fixes))
+}
+
+/// The epochs of the log at `path`, in the order of their sentences.
+fn read_epochs(path: &Path) -> Result<Vec<Epoch>> {
     let (file, _) = crate::open_with_length(path)?;
     let bad = |line: usize, message: String| Error::CsvFormat {
         file: path.into(),
@@ -76,52 +92,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
         };
         let sentence = text[start..].trim_end();
         match nmea::parse_str(sentence) {
-            Ok(ParseResult::GGA(g)) => {
-                let (Some(time), Some(lat), Some(lon)) = (g.fix_time, g.latitude, g.longitude)
-                else {
-                    continue;
-                };
-                if g.fix_type.is_none_or(|f| !f.is_valid()) {
-                    continue;
-                }
-                let altitude = f64::from(g.altitude.unwrap_or(0.0));
-                let separation = f64::from(g.geoid_separation.unwrap_or(0.0));
-                if !(lat.abs() <= 90.0 && lon.abs() <= 180.0) {
-                    return Err(bad(
-                        line,
-                        format!("GGA: latitude {lat}, longitude {lon} is not a place on the Earth"),
-                    ));
-                }
-                let height = altitude + separation;
-                if height.is_nan() || height.abs() >= MAX_HEIGHT_M {
-                    return Err(bad(
-                        line,
-                        format!(
-                            "GGA: altitude {altitude} m and geoid separation {separation} m is \
-                             not a height within {MAX_HEIGHT_M} m of the Earth"
-                        ),
-                    ));
-                }
-                let position = [lat.to_radians(), lon.to_radians(), height];
-                let at = nanos_of(time);
-                if let Some(last) = epochs.last()
-                    && last.time_of_day_ns == at
-                    && last.position.is_some_and(|p| p != position)
-                {
-                    return Err(bad(
-                        line,
-                        format!(
-                            "GGA: a second fix, elsewhere, at the time of line {} ({} s of the \
-                             day): one fix per time",
-                            last.line,
-                            at as f64 / 1e9
-                        ),
-                    ));
-                }
-                let epoch = epoch_at(&mut epochs, at, line);
-                epoch.position = Some(position);
-                epoch.hdop = g.hdop.map(f64::from).filter(|h| h.is_finite() && *h > 0.0);
-            }
+            Ok(ParseResult::GGA(g)) => add_gga(&mut epochs, &g, line, bad)?,
             Ok(ParseResult::RMC(r)) => {
                 let (Some(time), Some(speed), Some(course)) =
                     (r.fix_time, r.speed_over_ground, r.true_course)
@@ -171,16 +142,64 @@ pub fn read_table(path: &Path) -> Result<Table> {
             }
         }
     }
-    let fixes: Vec<Epoch> = epochs
-        .into_iter()
-        .filter(|e| e.position.is_some())
-        .collect();
-    if fixes.is_empty() {
-        return Err(Error::CsvFormat {
-            file: path.into(),
-            message: "no GGA sentence with a fix".into(),
-        });
+    Ok(epochs)
+}
+
+/// Adds a `GGA` sentence's fix to its epoch (nothing when it has no valid fix).
+fn add_gga(
+    epochs: &mut Vec<Epoch>,
+    g: &nmea::sentences::GgaData,
+    line: usize,
+    bad: impl Fn(usize, String) -> Error,
+) -> Result<()> {
+    let (Some(time), Some(lat), Some(lon)) = (g.fix_time, g.latitude, g.longitude) else {
+        return Ok(());
+    };
+    if g.fix_type.is_none_or(|f| !f.is_valid()) {
+        return Ok(());
     }
+    let altitude = f64::from(g.altitude.unwrap_or(0.0));
+    let separation = f64::from(g.geoid_separation.unwrap_or(0.0));
+    if !(lat.abs() <= 90.0 && lon.abs() <= 180.0) {
+        return Err(bad(
+            line,
+            format!("GGA: latitude {lat}, longitude {lon} is not a place on the Earth"),
+        ));
+    }
+    let height = altitude + separation;
+    if height.is_nan() || height.abs() >= MAX_HEIGHT_M {
+        return Err(bad(
+            line,
+            format!(
+                "GGA: altitude {altitude} m and geoid separation {separation} m is \
+                 not a height within {MAX_HEIGHT_M} m of the Earth"
+            ),
+        ));
+    }
+    let position = [lat.to_radians(), lon.to_radians(), height];
+    let at = nanos_of(time);
+    if let Some(last) = epochs.last()
+        && last.time_of_day_ns == at
+        && last.position.is_some_and(|p| p != position)
+    {
+        return Err(bad(
+            line,
+            format!(
+                "GGA: a second fix, elsewhere, at the time of line {} ({} s of the \
+                 day): one fix per time",
+                last.line,
+                at as f64 / 1e9
+            ),
+        ));
+    }
+    let epoch = epoch_at(epochs, at, line);
+    epoch.position = Some(position);
+    epoch.hdop = g.hdop.map(f64::from).filter(|h| h.is_finite() && *h > 0.0);
+    Ok(())
+}
+
+/// The table of the epochs with a fix: velocities, HDOP and accuracies when every fix has them.
+fn table_of(fixes: &[Epoch]) -> Table {
     let velocities = fixes.iter().all(|e| e.ground.is_some());
     let hdop = fixes.iter().all(|e| e.hdop.is_some());
     let gst = fixes.iter().all(|e| e.sigma.is_some());
@@ -194,7 +213,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
     }
     let mut table = Table::new(&columns);
     let (mut day, mut previous) = (0, fixes[0].time_of_day_ns);
-    for e in &fixes {
+    for e in fixes {
         // Past midnight: the clock starts again.
         if e.time_of_day_ns < previous - DAY_NS / 2 {
             day += DAY_NS;
@@ -218,7 +237,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
         }
         table.push_row(&row);
     }
-    Ok(table)
+    table
 }
 
 /// The epoch at time of day `t` (the last one when it is the same time, else a new one).
