@@ -13,7 +13,8 @@ use crate::io::kalibr::KalibrImu;
 use crate::io::params::{ImuParams, ParamFile, Sensor};
 use crate::io::table::Table;
 use crate::io::units::factor_to;
-use crate::run::allan::AllanResult;
+use crate::run::allan::{AllanResult, ColumnNoise};
+use crate::sensor::SensorParams;
 
 /// What a column measures, from its name's unit suffix.
 fn sensor_of(column: &str) -> Option<Sensor> {
@@ -290,90 +291,10 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
                 continue;
             };
             seen[axis] = true;
-            // A term not resolved is written at its bound: a filter tuned from the file then
-            // allows for as much of it as the log cannot rule out.
-            let value = |t: NoiseTerm| {
-                let e = c.fit.term(t);
-                if e.resolved { e.value } else { e.upper }
-            };
-            p.noise_density[axis] = value(NoiseTerm::White);
-            p.bias_instability[axis] = match (markov, c.fit.scaled(ScaleTerm::Markov)) {
-                (Some(_), Some(e)) => e.value,
-                _ => value(NoiseTerm::BiasInstability),
-            };
-            p.random_walk[axis] = value(NoiseTerm::RandomWalk);
-            // A gyroscope at rest reads its turn-on bias (and the Earth rate's share, at most
-            // 7.3e-5 rad/s); an accelerometer's mean also holds gravity's, in an attitude the
-            // log does not give, so only the gyroscope's is written.
-            if sensor == Sensor::Gyroscope {
-                p.constant_bias[axis] = c.mean;
-                notes.push(format!(
-                    "{}: constant_bias is the mean at rest, {:.4e} ± {:.1e} rad/s (Earth rate \
-                     included)",
-                    c.column, c.mean, c.mean_sigma
-                ));
-            }
-            for e in c.fit.terms.iter().filter(|e| !e.resolved) {
-                if matches!(e.term, NoiseTerm::White | NoiseTerm::RandomWalk)
-                    || (e.term == NoiseTerm::BiasInstability && markov.is_none())
-                {
-                    notes.push(format!(
-                        "{}: {} not resolved, written as its 95 % bound {:.4e} {}",
-                        c.column,
-                        e.term.name(),
-                        e.upper,
-                        si_unit(Some(sensor), e.term)
-                    ));
-                }
-            }
-            for e in c.fit.scaled.iter().flatten() {
-                if e.term == ScaleTerm::Sinusoid || markov.is_none() {
-                    notes.push(format!(
-                        "{}: {} ({:.4e} at {:.4} {}) found but not part of the sensor model \
-                         written",
-                        c.column,
-                        e.term.name(),
-                        e.value,
-                        e.scale,
-                        if e.term == ScaleTerm::Markov {
-                            "s"
-                        } else {
-                            "Hz"
-                        }
-                    ));
-                }
-            }
-            for t in [NoiseTerm::Quantization, NoiseTerm::RateRamp] {
-                let e = c.fit.term(t);
-                if e.resolved {
-                    notes.push(format!(
-                        "{}: {} {:.4e} {} resolved but not part of the sensor model",
-                        c.column,
-                        t.name(),
-                        e.value,
-                        si_unit(Some(sensor), t)
-                    ));
-                }
-            }
+            column_into(p, c, axis, sensor, markov, &mut notes);
+            notes.extend(unmodelled_terms(c, sensor, markov));
         }
-        if seen.iter().any(|s| !s) {
-            let largest = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(*b));
-            let (n, b, k) = (
-                largest(p.noise_density),
-                largest(p.bias_instability),
-                largest(p.random_walk),
-            );
-            for axis in (0..3).filter(|a| !seen[*a]) {
-                p.noise_density[axis] = n;
-                p.bias_instability[axis] = b;
-                p.random_walk[axis] = k;
-                notes.push(format!(
-                    "{} axis {} had no column: the largest identified axis is used",
-                    sensor.key(),
-                    ["x", "y", "z"][axis]
-                ));
-            }
-        }
+        fill_missing_axes(p, seen, sensor, &mut notes);
     }
     if !present.iter().any(|p| *p) {
         return Err(invalid(
@@ -402,6 +323,117 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
         warnings: Vec::new(),
         datasheet: None,
     })
+}
+
+/// One column's terms written into its sensor's axis `axis` of `p`; a term not resolved is
+/// written at its bound (a filter tuned from the file then allows for as much of it as the log
+/// cannot rule out), and so noted.
+fn column_into(
+    p: &mut SensorParams,
+    c: &ColumnNoise,
+    axis: usize,
+    sensor: Sensor,
+    markov: Option<f64>,
+    notes: &mut Vec<String>,
+) {
+    let value = |t: NoiseTerm| {
+        let e = c.fit.term(t);
+        if e.resolved { e.value } else { e.upper }
+    };
+    p.noise_density[axis] = value(NoiseTerm::White);
+    p.bias_instability[axis] = match (markov, c.fit.scaled(ScaleTerm::Markov)) {
+        (Some(_), Some(e)) => e.value,
+        _ => value(NoiseTerm::BiasInstability),
+    };
+    p.random_walk[axis] = value(NoiseTerm::RandomWalk);
+    // A gyroscope at rest reads its turn-on bias (and the Earth rate's share, at most
+    // 7.3e-5 rad/s); an accelerometer's mean also holds gravity's, in an attitude the
+    // log does not give, so only the gyroscope's is written.
+    if sensor == Sensor::Gyroscope {
+        p.constant_bias[axis] = c.mean;
+        notes.push(format!(
+            "{}: constant_bias is the mean at rest, {:.4e} ± {:.1e} rad/s (Earth rate \
+             included)",
+            c.column, c.mean, c.mean_sigma
+        ));
+    }
+    for e in c.fit.terms.iter().filter(|e| !e.resolved) {
+        if matches!(e.term, NoiseTerm::White | NoiseTerm::RandomWalk)
+            || (e.term == NoiseTerm::BiasInstability && markov.is_none())
+        {
+            notes.push(format!(
+                "{}: {} not resolved, written as its 95 % bound {:.4e} {}",
+                c.column,
+                e.term.name(),
+                e.upper,
+                si_unit(Some(sensor), e.term)
+            ));
+        }
+    }
+}
+
+/// Notes of the terms a column shows that the sensor model written has no place for: a
+/// sinusoid, Markov noise not written as the bias, resolved quantization and rate ramp.
+fn unmodelled_terms(c: &ColumnNoise, sensor: Sensor, markov: Option<f64>) -> Vec<String> {
+    let mut notes = Vec::new();
+    for e in c.fit.scaled.iter().flatten() {
+        if e.term == ScaleTerm::Sinusoid || markov.is_none() {
+            notes.push(format!(
+                "{}: {} ({:.4e} at {:.4} {}) found but not part of the sensor model \
+                 written",
+                c.column,
+                e.term.name(),
+                e.value,
+                e.scale,
+                if e.term == ScaleTerm::Markov {
+                    "s"
+                } else {
+                    "Hz"
+                }
+            ));
+        }
+    }
+    for t in [NoiseTerm::Quantization, NoiseTerm::RateRamp] {
+        let e = c.fit.term(t);
+        if e.resolved {
+            notes.push(format!(
+                "{}: {} {:.4e} {} resolved but not part of the sensor model",
+                c.column,
+                t.name(),
+                e.value,
+                si_unit(Some(sensor), t)
+            ));
+        }
+    }
+    notes
+}
+
+/// The axes of `p` without a column (`seen` false) take the largest identified axis's terms.
+fn fill_missing_axes(
+    p: &mut SensorParams,
+    seen: [bool; 3],
+    sensor: Sensor,
+    notes: &mut Vec<String>,
+) {
+    if seen.iter().all(|s| *s) {
+        return;
+    }
+    let largest = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(*b));
+    let (n, b, k) = (
+        largest(p.noise_density),
+        largest(p.bias_instability),
+        largest(p.random_walk),
+    );
+    for axis in (0..3).filter(|a| !seen[*a]) {
+        p.noise_density[axis] = n;
+        p.bias_instability[axis] = b;
+        p.random_walk[axis] = k;
+        notes.push(format!(
+            "{} axis {} had no column: the largest identified axis is used",
+            sensor.key(),
+            ["x", "y", "z"][axis]
+        ));
+    }
 }
 
 /// The correlation time of a Gauss–Markov bias for a sensor whose every column has Markov

@@ -568,15 +568,7 @@ fn compare_rows(
         last_truth = row[0];
         Ok(true)
     };
-    let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
-    if !truth(&mut a)? {
-        return Err(invalid("compare", "empty table"));
-    }
-    let t0 = a[0];
-    let mut truth_ended = !truth(&mut b)?;
-    if truth_ended {
-        b = a;
-    }
+    let mut bracket = Bracket::start(&mut truth, "compare")?;
     let mut e = [0.0; 11];
     let (mut pos, mut vel, mut att) = (
         DistanceStats::default(),
@@ -588,50 +580,141 @@ fn compare_rows(
     while estimate(&mut e)? {
         let (t, row) = (e[0], rows + 2);
         rows += 1;
-        if !t.is_finite() {
-            return Err(invalid(
+        let late = |message: String| {
+            invalid(
                 estimate_name,
-                format!("estimate time {t} s (row {row}) is not a finite number"),
-            ));
+                format!("estimate time {t} s (row {row}) {message}"),
+            )
+        };
+        if !t.is_finite() {
+            return Err(late("is not a finite number".into()));
         }
         if t < previous_t {
-            return Err(invalid(
-                estimate_name,
-                format!("estimate time {t} s (row {row}) goes back from {previous_t} s"),
-            ));
+            return Err(late(format!("goes back from {previous_t} s")));
         }
         previous_t = t;
-        // Advance to the first truth row later than t (or the last one).
-        while !truth_ended && b[0] <= t {
-            if truth(&mut next)? {
-                (a, b) = (b, next);
+        bracket.advance(t, &mut truth)?;
+        if t < bracket.t0 - 1e-9 {
+            return Err(late(format!(
+                "is before the truth's first, {} s",
+                bracket.t0
+            )));
+        }
+        if bracket.ended && t > bracket.b[0] + 1e-9 {
+            return Err(late(format!(
+                "is after the truth's last, {} s",
+                bracket.b[0]
+            )));
+        }
+        let (dp, dv, angle) = bracket.errors(parts, &e, truth_name, row)?;
+        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let np = norm(&dp);
+        pos.push(np);
+        let mut out = [0.0; 9];
+        out[..5].copy_from_slice(&[t, dp[0], dp[1], dp[2], np]);
+        let mut width = 5;
+        if parts.velocity {
+            vel.push(norm(&dv));
+            out[5..8].copy_from_slice(&dv);
+            width = 8;
+        }
+        if parts.attitude {
+            att.push(angle);
+            out[width] = angle;
+            width += 1;
+        }
+        sink(&out[..width])?;
+    }
+    if rows == 0 {
+        return Err(invalid("compare", "empty table"));
+    }
+    // The truth rows past the last estimate are read too: a truth file is refused whole or not
+    // at all.
+    while !bracket.ended && truth(&mut bracket.next)? {}
+    Ok(ErrorSummary {
+        kind: EstimateKind::Navigation,
+        position: Some(pos),
+        velocity: parts.velocity.then_some(vel),
+        attitude: parts.attitude.then_some(att),
+        heading: None,
+        inclination: None,
+        heading_offset_rad: None,
+        skipped: 0,
+        rows,
+    })
+}
+
+/// The two truth rows that bracket an estimate's time, read in time order.
+struct Bracket {
+    a: StateRow,
+    b: StateRow,
+    /// The row being read.
+    next: StateRow,
+    /// No truth row is left.
+    ended: bool,
+    /// The truth's first time.
+    t0: f64,
+}
+
+impl Bracket {
+    /// The first two truth rows (one row brackets with itself); no row is refused, named `empty`.
+    fn start(truth: &mut impl FnMut(&mut StateRow) -> Result<bool>, empty: &str) -> Result<Self> {
+        let (mut a, mut b) = ([0.0; 11], [0.0; 11]);
+        if !truth(&mut a)? {
+            return Err(invalid(empty, "empty table"));
+        }
+        let ended = !truth(&mut b)?;
+        if ended {
+            b = a;
+        }
+        Ok(Self {
+            a,
+            b,
+            next: [0.0; 11],
+            ended,
+            t0: a[0],
+        })
+    }
+
+    /// Advances to the first truth row later than `t` (or the last one).
+    fn advance(
+        &mut self,
+        t: f64,
+        truth: &mut impl FnMut(&mut StateRow) -> Result<bool>,
+    ) -> Result<()> {
+        while !self.ended && self.b[0] <= t {
+            if truth(&mut self.next)? {
+                (self.a, self.b) = (self.b, self.next);
             } else {
-                truth_ended = true;
+                self.ended = true;
             }
         }
-        if t < t0 - 1e-9 {
-            return Err(invalid(
-                estimate_name,
-                format!("estimate time {t} s (row {row}) is before the truth's first, {t0} s"),
-            ));
-        }
-        if truth_ended && t > b[0] + 1e-9 {
-            return Err(invalid(
-                estimate_name,
-                format!(
-                    "estimate time {t} s (row {row}) is after the truth's last, {} s",
-                    b[0]
-                ),
-            ));
-        }
-        let w = if b[0] == a[0] {
+        Ok(())
+    }
+
+    /// The interpolation weight of time `t` between the two rows (0 at `a`, 1 at `b`).
+    fn weight(&self, t: f64) -> f64 {
+        let (a, b) = (self.a[0], self.b[0]);
+        if b == a {
             0.0
         } else {
-            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
-        };
+            ((t - a) / (b - a)).clamp(0.0, 1.0)
+        }
+    }
+
+    /// The estimate row `e`'s position error (north, east, down on the Earth), velocity error
+    /// and attitude error angle (0 when not compared) against the truth interpolated to its time.
+    fn errors(
+        &self,
+        parts: Parts,
+        e: &StateRow,
+        truth_name: &str,
+        row: usize,
+    ) -> Result<([f64; 3], [f64; 3], f64)> {
+        let (a, b, w) = (&self.a, &self.b, self.weight(e[0]));
         let q = |r: &StateRow| Rotation::<Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]]);
         let angle = if parts.attitude {
-            let (Some(qa), Some(qb), Some(qe)) = (q(&a), q(&b), q(&e)) else {
+            let (Some(qa), Some(qb), Some(qe)) = (q(a), q(b), q(e)) else {
                 return Err(invalid(
                     "compare",
                     format!("zero quaternion near estimate row {row}"),
@@ -640,9 +723,7 @@ fn compare_rows(
             let qt = Rotation::<Body, Enu>::assume_from_quaternion(
                 qa.quaternion().slerp(qb.quaternion(), w),
             );
-            let angle = quaternion_distance(&qe, &qt);
-            att.push(angle);
-            angle
+            quaternion_distance(&qe, &qt)
         } else {
             0.0
         };
@@ -659,38 +740,6 @@ fn compare_rows(
             dp = ned_of_difference(&at, dp);
         }
         let dv: [f64; 3] = std::array::from_fn(|j| e[4 + j] - lerp(4 + j));
-        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let np = norm(&dp);
-        pos.push(np);
-        let mut out = [0.0; 9];
-        out[..5].copy_from_slice(&[t, dp[0], dp[1], dp[2], np]);
-        let mut width = 5;
-        if parts.velocity {
-            vel.push(norm(&dv));
-            out[5..8].copy_from_slice(&dv);
-            width = 8;
-        }
-        if parts.attitude {
-            out[width] = angle;
-            width += 1;
-        }
-        sink(&out[..width])?;
+        Ok((dp, dv, angle))
     }
-    if rows == 0 {
-        return Err(invalid("compare", "empty table"));
-    }
-    // The truth rows past the last estimate are read too: a truth file is refused whole or not
-    // at all.
-    while !truth_ended && truth(&mut next)? {}
-    Ok(ErrorSummary {
-        kind: EstimateKind::Navigation,
-        position: Some(pos),
-        velocity: parts.velocity.then_some(vel),
-        attitude: parts.attitude.then_some(att),
-        heading: None,
-        inclination: None,
-        heading_offset_rad: None,
-        skipped: 0,
-        rows,
-    })
 }

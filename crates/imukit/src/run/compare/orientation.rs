@@ -16,7 +16,7 @@ use imu_core::orientation::{DistanceStats, quaternion_distance};
 use imu_core::{Body, Enu, Rotation};
 use nalgebra::{Quaternion, UnitQuaternion};
 
-use super::{ErrorSummary, EstimateKind, StateRow, angle_difference};
+use super::{Bracket, ErrorSummary, EstimateKind, StateRow, angle_difference};
 use crate::error::{Result, invalid};
 
 /// Reference intervals whose median is the typical interval.
@@ -81,23 +81,11 @@ pub(super) fn compare_orientation_rows(
         last_truth = row[0];
         Ok(true)
     };
-    let (mut a, mut b, mut next) = ([0.0; 11], [0.0; 11], [0.0; 11]);
-    if !truth(&mut a)? {
-        return Err(invalid(truth_name, "empty table"));
-    }
-    let t_first = a[0];
-    let mut truth_ended = !truth(&mut b)?;
-    if truth_ended {
-        b = a;
-    }
+    let mut bracket = Bracket::start(&mut truth, truth_name)?;
+    let t_first = bracket.t0;
     let align = align_rad.map(|offset| about_vertical(-offset));
     let mut e = [0.0; 11];
-    let (mut total, mut heading, mut inclination) = (
-        DistanceStats::default(),
-        DistanceStats::default(),
-        DistanceStats::default(),
-    );
-    let (mut sin_sum, mut cos_sum) = (0.0, 0.0);
+    let mut score = Score::default();
     let (mut rows, mut skipped, mut previous_t) = (0usize, 0usize, f64::NEG_INFINITY);
     while estimate(&mut e)? {
         let (t, row) = (e[0], rows + skipped + 2);
@@ -110,29 +98,16 @@ pub(super) fn compare_orientation_rows(
             ));
         }
         previous_t = t;
-        while !truth_ended && b[0] <= t {
-            if truth(&mut next)? {
-                (a, b) = (b, next);
-            } else {
-                truth_ended = true;
-            }
-        }
-        let typical = {
-            let mut first = intervals.get();
-            let first = &mut first[..seen.get().max(1)];
-            first.sort_by(f64::total_cmp);
-            first[first.len() / 2]
-        };
-        let w = if b[0] == a[0] {
-            0.0
-        } else {
-            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
-        };
+        bracket.advance(t, &mut truth)?;
+        let w = bracket.weight(t);
+        let (a, b) = (&bracket.a, &bracket.b);
         // An estimate at a reference sample needs only that sample; between two, both and no gap.
         let finite = |r: &StateRow| r[7..].iter().all(|v| v.is_finite());
-        let outside = t < t_first - 1e-9 || (truth_ended && t > b[0] + 1e-9);
-        let hole = !finite(&a) || (w > 0.0 && !finite(&b));
-        let gap = w > 0.0 && seen.get() > 0 && b[0] - a[0] > GAP_FACTOR * typical;
+        let outside = t < t_first - 1e-9 || (bracket.ended && t > b[0] + 1e-9);
+        let hole = !finite(a) || (w > 0.0 && !finite(b));
+        let gap = w > 0.0
+            && seen.get() > 0
+            && b[0] - a[0] > GAP_FACTOR * typical_interval(&intervals.get()[..seen.get()]);
         if outside || hole || gap {
             skipped += 1;
             continue;
@@ -141,9 +116,9 @@ pub(super) fn compare_orientation_rows(
             Rotation::<Body, Enu>::from_wxyz([r[7], r[8], r[9], r[10]])
                 .ok_or_else(|| invalid(side, format!("zero quaternion near estimate row {row}")))
         };
-        let qa = quaternion(&a, truth_name)?;
+        let qa = quaternion(a, truth_name)?;
         let qb = if w > 0.0 {
-            quaternion(&b, truth_name)?
+            quaternion(b, truth_name)?
         } else {
             qa
         };
@@ -156,26 +131,10 @@ pub(super) fn compare_orientation_rows(
         let qt = Rotation::<Body, Enu>::assume_from_quaternion(UnitQuaternion::new_normalize(
             qa.quaternion().slerp(qb.quaternion(), w).into_inner(),
         ));
-        let angle = quaternion_distance(&qe, &qt);
-        let (h, i, signed) = heading_inclination(&(qe.quaternion() * qt.quaternion().inverse()));
-        total.push(angle);
-        heading.push(h);
-        inclination.push(i);
-        sin_sum += signed.sin();
-        cos_sum += signed.cos();
-        let (ee, et) = (qe.to_euler(), qt.to_euler());
-        sink(&[
-            t,
-            angle,
-            h,
-            i,
-            angle_difference(ee.yaw_rad, et.yaw_rad),
-            angle_difference(ee.pitch_rad, et.pitch_rad),
-            angle_difference(ee.roll_rad, et.roll_rad),
-        ])?;
+        sink(&score.push(t, &qe, &qt))?;
         rows += 1;
     }
-    while !truth_ended && truth(&mut next)? {}
+    while !bracket.ended && truth(&mut bracket.next)? {}
     if rows == 0 {
         return Err(invalid(
             estimate_name,
@@ -185,6 +144,13 @@ pub(super) fn compare_orientation_rows(
             ),
         ));
     }
+    let Score {
+        total,
+        heading,
+        inclination,
+        sin_sum,
+        cos_sum,
+    } = score;
     let mean_heading = sin_sum.atan2(cos_sum);
     Ok(ErrorSummary {
         kind: EstimateKind::Orientation,
@@ -197,6 +163,49 @@ pub(super) fn compare_orientation_rows(
         skipped,
         rows,
     })
+}
+
+/// The median of a reference's first intervals (0 when it has none yet).
+fn typical_interval(first: &[f64]) -> f64 {
+    let mut sorted = [0.0; TYPICAL_OF];
+    let sorted = &mut sorted[..first.len().min(TYPICAL_OF)];
+    sorted.copy_from_slice(&first[..sorted.len()]);
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// The scores of the rows so far: total, heading and inclination angles, and the sums whose
+/// circular mean is the mean signed heading error.
+#[derive(Default)]
+struct Score {
+    total: DistanceStats,
+    heading: DistanceStats,
+    inclination: DistanceStats,
+    sin_sum: f64,
+    cos_sum: f64,
+}
+
+impl Score {
+    /// Scores estimate `qe` against reference `qt` at time `t`; returns the error row.
+    fn push(&mut self, t: f64, qe: &Rotation<Body, Enu>, qt: &Rotation<Body, Enu>) -> [f64; 7] {
+        let angle = quaternion_distance(qe, qt);
+        let (h, i, signed) = heading_inclination(&(qe.quaternion() * qt.quaternion().inverse()));
+        self.total.push(angle);
+        self.heading.push(h);
+        self.inclination.push(i);
+        self.sin_sum += signed.sin();
+        self.cos_sum += signed.cos();
+        let (ee, et) = (qe.to_euler(), qt.to_euler());
+        [
+            t,
+            angle,
+            h,
+            i,
+            angle_difference(ee.yaw_rad, et.yaw_rad),
+            angle_difference(ee.pitch_rad, et.pitch_rad),
+            angle_difference(ee.roll_rad, et.roll_rad),
+        ]
+    }
 }
 
 #[cfg(test)]
