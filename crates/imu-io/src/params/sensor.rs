@@ -135,10 +135,7 @@ pub(super) fn parse_sensor_keys(
     let key = |name: &str| format!("{name}_{u}");
     let mut p = base;
     let mut noise_set = false;
-    let mut numerator: Option<Vec<f64>> = None;
-    let mut denominator: Option<Vec<f64>> = None;
-    let mut flicker: Option<[f64; 2]> = None;
-    let mut correlation: Option<f64> = None;
+    let mut model = BiasModelKeys::default();
     let known = [
         key("measurement_range"),
         key("resolution"),
@@ -169,40 +166,17 @@ pub(super) fn parse_sensor_keys(
             }
             (Some(4), _) | (_, "NoiseDensity") => p.noise_density = triple(v, &field)?,
             (Some(5), _) | (_, "BiasInstability") => p.bias_instability = triple(v, &field)?,
-            (Some(6), _) => numerator = Some(list(v, &field)?),
-            (Some(7), _) => denominator = Some(list(v, &field)?),
-            (_, "BiasInstabilityCoefficients") => {
-                let ParamValue::Table(t) = v else {
-                    return Err(invalid(field, "needs Numerator and Denominator"));
-                };
-                if let Some(other) = t
-                    .keys()
-                    .find(|k| !matches!(k.as_str(), "Numerator" | "Denominator"))
-                {
-                    return Err(invalid(
-                        format!("{field}.{other}"),
-                        "unknown key (BiasInstabilityCoefficients has Numerator and Denominator)",
-                    ));
-                }
-                let get = |name: &str| {
-                    t.get(name)
-                        .map(|x| list(x, &format!("{field}.{name}")))
-                        .transpose()
-                };
-                numerator = get("Numerator")?;
-                denominator = get("Denominator")?;
-                if numerator.is_none() || denominator.is_none() {
-                    return Err(invalid(field, "needs Numerator and Denominator"));
-                }
-            }
+            (Some(6), _) => model.numerator = Some(list(v, &field)?),
+            (Some(7), _) => model.denominator = Some(list(v, &field)?),
+            (_, "BiasInstabilityCoefficients") => model.matlab_coefficients(v, &field)?,
             (Some(8), _) => {
                 let l = list(v, &field)?;
                 if l.len() != 2 {
                     return Err(invalid(field, "expected [tau_min_s, tau_max_s]"));
                 }
-                flicker = Some([l[0], l[1]]);
+                model.flicker = Some([l[0], l[1]]);
             }
-            (Some(9), _) => correlation = Some(finite_number(v, &field)?),
+            (Some(9), _) => model.correlation = Some(finite_number(v, &field)?),
             (Some(10), _) | (_, "RandomWalk") => p.random_walk = triple(v, &field)?,
             (Some(11), _) | (_, "NoiseType") => {
                 p.noise_type = noise_type(v, &field)?;
@@ -242,38 +216,80 @@ pub(super) fn parse_sensor_keys(
     if let (false, Some(n)) = (noise_set, default_noise) {
         p.noise_type = n;
     }
-    let chosen = [
-        numerator.is_some() || denominator.is_some(),
-        flicker.is_some(),
-        correlation.is_some(),
-    ];
-    if chosen.iter().filter(|c| **c).count() > 1 {
-        return Err(invalid(
-            format!("{prefix}.bias_instability"),
-            "give one of the filter coefficients, bias_instability_flicker_tau_s or bias_instability_correlation_time_s",
-        ));
-    }
-    if numerator.is_some() || denominator.is_some() {
-        let num = numerator.unwrap_or_else(|| vec![1.0]);
-        let den = denominator.unwrap_or_else(|| vec![1.0, -0.5]);
-        let c = FilterCoefficients::new(&num, &den).map_err(|source| Error::Param {
-            context: prefix.into(),
-            source,
-        })?;
-        p.bias_instability_model = BiasInstabilityModel::Filter(c);
-    }
-    if let Some([tau_min_s, tau_max_s]) = flicker {
-        p.bias_instability_model = BiasInstabilityModel::Flicker {
-            tau_min_s,
-            tau_max_s,
-        };
-    }
-    if let Some(correlation_time_s) = correlation {
-        p.bias_instability_model = BiasInstabilityModel::GaussMarkov { correlation_time_s };
+    if let Some(m) = model.chosen(prefix)? {
+        p.bias_instability_model = m;
     }
     p.validate().map_err(|source| Error::Param {
         context: prefix.into(),
         source,
     })?;
     Ok(p)
+}
+
+/// The keys that choose a bias instability process other than the default filter, as read.
+#[derive(Default)]
+struct BiasModelKeys {
+    numerator: Option<Vec<f64>>,
+    denominator: Option<Vec<f64>>,
+    flicker: Option<[f64; 2]>,
+    correlation: Option<f64>,
+}
+
+impl BiasModelKeys {
+    /// MATLAB's `BiasInstabilityCoefficients`, a table of `Numerator` and `Denominator`.
+    fn matlab_coefficients(&mut self, v: &ParamValue, field: &str) -> Result<()> {
+        let ParamValue::Table(t) = v else {
+            return Err(invalid(field, "needs Numerator and Denominator"));
+        };
+        if let Some(other) = t
+            .keys()
+            .find(|k| !matches!(k.as_str(), "Numerator" | "Denominator"))
+        {
+            return Err(invalid(
+                format!("{field}.{other}"),
+                "unknown key (BiasInstabilityCoefficients has Numerator and Denominator)",
+            ));
+        }
+        let get = |name: &str| {
+            t.get(name)
+                .map(|x| list(x, &format!("{field}.{name}")))
+                .transpose()
+        };
+        self.numerator = get("Numerator")?;
+        self.denominator = get("Denominator")?;
+        if self.numerator.is_none() || self.denominator.is_none() {
+            return Err(invalid(field, "needs Numerator and Denominator"));
+        }
+        Ok(())
+    }
+
+    /// The process the keys choose (`None`: none given); more than one is refused.
+    fn chosen(self, prefix: &str) -> Result<Option<BiasInstabilityModel>> {
+        let filter = self.numerator.is_some() || self.denominator.is_some();
+        let given = [filter, self.flicker.is_some(), self.correlation.is_some()];
+        if given.iter().filter(|c| **c).count() > 1 {
+            return Err(invalid(
+                format!("{prefix}.bias_instability"),
+                "give one of the filter coefficients, bias_instability_flicker_tau_s or bias_instability_correlation_time_s",
+            ));
+        }
+        if filter {
+            let num = self.numerator.unwrap_or_else(|| vec![1.0]);
+            let den = self.denominator.unwrap_or_else(|| vec![1.0, -0.5]);
+            let c = FilterCoefficients::new(&num, &den).map_err(|source| Error::Param {
+                context: prefix.into(),
+                source,
+            })?;
+            return Ok(Some(BiasInstabilityModel::Filter(c)));
+        }
+        if let Some([tau_min_s, tau_max_s]) = self.flicker {
+            return Ok(Some(BiasInstabilityModel::Flicker {
+                tau_min_s,
+                tau_max_s,
+            }));
+        }
+        Ok(self
+            .correlation
+            .map(|correlation_time_s| BiasInstabilityModel::GaussMarkov { correlation_time_s }))
+    }
 }

@@ -84,78 +84,19 @@ fn orient_csv_in<N: NavFrame>(
     out: &Path,
 ) -> Result<OrientSummary> {
     let header = crate::io::read::read_header(input)?;
-    let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
     let mut spec = spec.clone();
-    // A filter that may use a magnetometer uses one when the file has it; a file with only some
-    // of the mag_* columns is a mistake to name, not a reason to drop the magnetometer silently.
-    let some_mag = MAG_COLUMNS.iter().any(|c| header.iter().any(|h| h == c));
-    let name = spec.kind.name();
-    let mut warnings = Vec::new();
-    spec.magnetometer = match (spec.kind.magnetometer(), spec.use_magnetometer) {
-        (Some(true), false) => {
-            return Err(invalid(
-                "use_magnetometer",
-                format!("the {name} filter needs a magnetometer; for 6D use {SIX_AXIS_FILTERS}"),
-            ));
-        }
-        (Some(true), true) => true,
-        (Some(false), _) => {
-            if some_mag && spec.use_magnetometer {
-                warnings.push(format!(
-                    "{}: the {name} filter uses no magnetometer: the file's mag_* columns are \
-                     ignored and the heading is not held (robust, ahrsfilter, madgwick, mahony \
-                     and complementary use them; --no-mag says you mean 6D)",
-                    input.path().display()
-                ));
-            }
-            false
-        }
-        (None, use_it) => some_mag && use_it,
-    };
-    if spec.magnetometer && !has(&MAG_COLUMNS) {
-        let missing = MAG_COLUMNS
-            .iter()
-            .filter(|c| !header.iter().any(|h| h == *c))
-            .map(|c| (*c).to_string())
-            .collect();
-        let hint = if some_mag {
-            format!(
-                "; the {name} filter uses all three magnetometer columns when the file has any \
-                 (--no-mag ignores them)"
-            )
-        } else {
-            format!(
-                "; the {name} filter needs a magnetometer and this file has none: for 6D use \
-                 {SIX_AXIS_FILTERS}"
-            )
-        };
-        return Err(crate::Error::MissingColumns {
-            file: input.path().into(),
-            missing,
-            hint,
-        });
-    }
+    let warnings = choose_magnetometer(&mut spec, &header, input)?;
     if spec.smooth && spec.kind != FilterKind::Robust {
         return Err(invalid(
             "smooth",
-            format!("only the robust filter smooths a run, not {name}"),
+            format!(
+                "only the robust filter smooths a run, not {}",
+                spec.kind.name()
+            ),
         ));
     }
     let gyro = spec.kind != FilterKind::Ecompass;
-    let mut columns = vec!["t_s"];
-    columns.extend(ACCEL_COLUMNS);
-    if gyro {
-        columns.extend(GYRO_COLUMNS);
-    }
-    if spec.magnetometer {
-        columns.extend(MAG_COLUMNS);
-    }
-    let hint = format!(
-        "; the {} filter needs t_s, accel_*{}{}",
-        spec.kind.name(),
-        if gyro { ", gyro_*" } else { "" },
-        if spec.magnetometer { ", mag_*" } else { "" }
-    );
+    let (columns, hint) = input_columns(&spec);
     let mut rows = TimedRows::open(input, &columns, &hint)?.within(window);
     let data_rate = rows.median_interval().map_or(f64::NAN, |m| 1.0 / m);
     let rate = spec.sample_rate_hz(data_rate)?;
@@ -227,6 +168,85 @@ fn orient_csv_in<N: NavFrame>(
         gaps: rows.gaps(),
         warnings,
     })
+}
+
+/// Sets whether `spec`'s filter uses the magnetometer: a filter that may use one uses one when
+/// the file (its `header`) has it; a file with only some of the mag_* columns is a mistake to
+/// name, not a reason to drop the magnetometer silently. Returns the warnings to give.
+fn choose_magnetometer(
+    spec: &mut FilterSpec,
+    header: &[String],
+    input: &Input,
+) -> Result<Vec<String>> {
+    let has = |cols: &[&str]| cols.iter().all(|c| header.iter().any(|h| h == c));
+    let some_mag = MAG_COLUMNS.iter().any(|c| header.iter().any(|h| h == c));
+    let name = spec.kind.name();
+    let mut warnings = Vec::new();
+    spec.magnetometer = match (spec.kind.magnetometer(), spec.use_magnetometer) {
+        (Some(true), false) => {
+            return Err(invalid(
+                "use_magnetometer",
+                format!("the {name} filter needs a magnetometer; for 6D use {SIX_AXIS_FILTERS}"),
+            ));
+        }
+        (Some(true), true) => true,
+        (Some(false), _) => {
+            if some_mag && spec.use_magnetometer {
+                warnings.push(format!(
+                    "{}: the {name} filter uses no magnetometer: the file's mag_* columns are \
+                     ignored and the heading is not held (robust, ahrsfilter, madgwick, mahony \
+                     and complementary use them; --no-mag says you mean 6D)",
+                    input.path().display()
+                ));
+            }
+            false
+        }
+        (None, use_it) => some_mag && use_it,
+    };
+    if spec.magnetometer && !has(&MAG_COLUMNS) {
+        let missing = MAG_COLUMNS
+            .iter()
+            .filter(|c| !header.iter().any(|h| h == *c))
+            .map(|c| (*c).to_string())
+            .collect();
+        let hint = if some_mag {
+            format!(
+                "; the {name} filter uses all three magnetometer columns when the file has any \
+                 (--no-mag ignores them)"
+            )
+        } else {
+            format!(
+                "; the {name} filter needs a magnetometer and this file has none: for 6D use \
+                 {SIX_AXIS_FILTERS}"
+            )
+        };
+        return Err(crate::Error::MissingColumns {
+            file: input.path().into(),
+            missing,
+            hint,
+        });
+    }
+    Ok(warnings)
+}
+
+/// The columns `spec`'s filter reads, and the hint a file without them is given.
+fn input_columns(spec: &FilterSpec) -> (Vec<&'static str>, String) {
+    let gyro = spec.kind != FilterKind::Ecompass;
+    let mut columns = vec!["t_s"];
+    columns.extend(ACCEL_COLUMNS);
+    if gyro {
+        columns.extend(GYRO_COLUMNS);
+    }
+    if spec.magnetometer {
+        columns.extend(MAG_COLUMNS);
+    }
+    let hint = format!(
+        "; the {} filter needs t_s, accel_*{}{}",
+        spec.kind.name(),
+        if gyro { ", gyro_*" } else { "" },
+        if spec.magnetometer { ", mag_*" } else { "" }
+    );
+    (columns, hint)
 }
 
 /// Smooths the whole `run` (times and samples) with the robust filter `filter` and writes its
