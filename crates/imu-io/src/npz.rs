@@ -203,50 +203,8 @@ pub fn read_table(path: &Path) -> Result<Table> {
             "a member appears twice (NumPy refuses such an archive; which one is meant?)",
         ));
     }
+    check_sizes(&mut archive, path, file_bytes)?;
     let width = archive.len();
-    let (mut total, mut stored_total) = (0u64, 0u64);
-    for i in 0..width {
-        let member = archive.by_index_raw(i).map_err(|e| format_error(path, e))?;
-        let name = String::from_utf8_lossy(member.name_raw()).into_owned();
-        let (declared, stored) = (member.size(), member.compressed_size());
-        let limit = match member.compression() {
-            CompressionMethod::Stored => stored,
-            _ => stored.saturating_mul(MAX_DEFLATE_RATIO),
-        };
-        if stored > file_bytes || declared > limit {
-            return Err(format_error(
-                path,
-                format!(
-                    "member {name} declares {declared} bytes from {stored} stored in a file of \
-                     {file_bytes} (not a valid archive)"
-                ),
-            ));
-        }
-        total = total.saturating_add(declared);
-        stored_total = stored_total.saturating_add(stored);
-    }
-    let limit = crate::memory::max_memory_bytes();
-    #[allow(clippy::cast_precision_loss)]
-    if total as f64 > limit {
-        return Err(format_error(
-            path,
-            format!(
-                "its members hold {total} bytes, more than the memory limit of {:.1} GB (a .npz \
-                 table is read whole: write a larger one as .parquet or .npy, read row by row, \
-                 or raise the limit with IMUKIT_MAX_MEMORY_GB)",
-                limit / 1e9
-            ),
-        ));
-    }
-    if total > RATIO_FREE_BYTES && total / stored_total.max(1) > MAX_ARCHIVE_RATIO {
-        return Err(format_error(
-            path,
-            format!(
-                "its members expand {stored_total} stored bytes into {total}, more than \
-                 {MAX_ARCHIVE_RATIO} times: not a table of measurements (a decompression bomb?)"
-            ),
-        ));
-    }
     let mut names: Vec<String> = Vec::with_capacity(width);
     let mut table = Table::new(&[]);
     let mut rows = 0usize;
@@ -291,21 +249,7 @@ pub fn read_table(path: &Path) -> Result<Table> {
                 names[0]
             )));
         }
-        // The values, a block at a time, each to its place in its row.
-        let mut block = vec![0u8; 8 * 8192];
-        let mut row = 0;
-        while row < rows {
-            let take = (rows - row).min(8192);
-            let bytes = &mut block[..8 * take];
-            reader
-                .read_exact(bytes)
-                .map_err(|e| bad(format!("ends before its {rows} values ({e})")))?;
-            for (j, b) in bytes.chunks_exact(8).enumerate() {
-                let v = f64::from_le_bytes(b.try_into().expect("eight bytes"));
-                table.data[(row + j) * width + k] = v;
-            }
-            row += take;
-        }
+        read_column(&mut reader, &mut table.data, (k, width), &bad)?;
         // To the member's end: nothing may follow the values, and the end checks the CRC-32.
         let mut rest = [0u8; 64];
         match reader.read(&mut rest) {
@@ -321,6 +265,85 @@ pub fn read_table(path: &Path) -> Result<Table> {
     table.columns = names;
     crate::table::check_finite_from(&table.columns, &table.data, &path.display().to_string(), 1)?;
     Ok(table)
+}
+
+/// Refuses an archive whose members declare more than it can hold, more than the memory limit
+/// allows, or expand too far (a decompression bomb), before anything is read.
+fn check_sizes<R: Read + std::io::Seek>(
+    archive: &mut zip::ZipArchive<R>,
+    path: &Path,
+    file_bytes: u64,
+) -> Result<()> {
+    let (mut total, mut stored_total) = (0u64, 0u64);
+    for i in 0..archive.len() {
+        let member = archive.by_index_raw(i).map_err(|e| format_error(path, e))?;
+        let name = String::from_utf8_lossy(member.name_raw()).into_owned();
+        let (declared, stored) = (member.size(), member.compressed_size());
+        let limit = match member.compression() {
+            CompressionMethod::Stored => stored,
+            _ => stored.saturating_mul(MAX_DEFLATE_RATIO),
+        };
+        if stored > file_bytes || declared > limit {
+            return Err(format_error(
+                path,
+                format!(
+                    "member {name} declares {declared} bytes from {stored} stored in a file of \
+                     {file_bytes} (not a valid archive)"
+                ),
+            ));
+        }
+        total = total.saturating_add(declared);
+        stored_total = stored_total.saturating_add(stored);
+    }
+    let limit = crate::memory::max_memory_bytes();
+    #[allow(clippy::cast_precision_loss)]
+    if total as f64 > limit {
+        return Err(format_error(
+            path,
+            format!(
+                "its members hold {total} bytes, more than the memory limit of {:.1} GB (a .npz \
+                 table is read whole: write a larger one as .parquet or .npy, read row by row, \
+                 or raise the limit with IMUKIT_MAX_MEMORY_GB)",
+                limit / 1e9
+            ),
+        ));
+    }
+    if total > RATIO_FREE_BYTES && total / stored_total.max(1) > MAX_ARCHIVE_RATIO {
+        return Err(format_error(
+            path,
+            format!(
+                "its members expand {stored_total} stored bytes into {total}, more than \
+                 {MAX_ARCHIVE_RATIO} times: not a table of measurements (a decompression bomb?)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads column `k` of a table `width` columns wide from `reader` into `data`, a block at a
+/// time, each value to its place in its row; `bad` names what went wrong.
+fn read_column(
+    reader: &mut impl Read,
+    data: &mut [f64],
+    (k, width): (usize, usize),
+    bad: &impl Fn(String) -> Error,
+) -> Result<()> {
+    let rows = data.len() / width.max(1);
+    let mut block = vec![0u8; 8 * 8192];
+    let mut row = 0;
+    while row < rows {
+        let take = (rows - row).min(8192);
+        let bytes = &mut block[..8 * take];
+        reader
+            .read_exact(bytes)
+            .map_err(|e| bad(format!("ends before its {rows} values ({e})")))?;
+        for (j, b) in bytes.chunks_exact(8).enumerate() {
+            let v = f64::from_le_bytes(b.try_into().expect("eight bytes"));
+            data[(row + j) * width + k] = v;
+        }
+        row += take;
+    }
+    Ok(())
 }
 
 /// The column names of a `.npz` archive: its members' names without `.npy` (from the archive's

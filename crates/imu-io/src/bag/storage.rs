@@ -118,57 +118,63 @@ pub(in crate::bag) fn mcap_messages(path: &Path, each: &mut McapVisitor<'_>) -> 
     Ok(())
 }
 
+/// A walk through an MCAP record's fields, each length checked against what is left.
+struct Walk<'a>(&'a [u8]);
+impl Walk<'_> {
+    /// Skips `n` bytes.
+    fn skip(&mut self, n: u64, what: &str) -> core::result::Result<(), String> {
+        match usize::try_from(n).ok().filter(|n| *n <= self.0.len()) {
+            Some(n) => {
+                self.0 = &self.0[n..];
+                Ok(())
+            }
+            None => Err(format!(
+                "{what} declares {n} bytes where {} are left",
+                self.0.len()
+            )),
+        }
+    }
+    /// A little-endian unsigned integer of `width` bytes.
+    fn uint(&mut self, width: usize, what: &str) -> core::result::Result<u64, String> {
+        let Some(bytes) = self.0.get(..width) else {
+            return Err(format!("{what} is cut short"));
+        };
+        let mut v = 0u64;
+        for (k, b) in bytes.iter().enumerate() {
+            v |= u64::from(*b) << (8 * k);
+        }
+        self.0 = &self.0[width..];
+        Ok(v)
+    }
+    /// Skips a string: a u32 length and its bytes.
+    fn string(&mut self, what: &str) -> core::result::Result<(), String> {
+        let n = self.uint(4, what)?;
+        self.skip(n, what)
+    }
+    /// Skips a string map: a u32 length and as many bytes of key and value strings.
+    fn string_map(&mut self, what: &str) -> core::result::Result<(), String> {
+        let n = self.uint(4, what)?;
+        let Some(map) = usize::try_from(n).ok().and_then(|n| self.0.get(..n)) else {
+            return Err(format!(
+                "{what} declares {n} bytes where {} are left",
+                self.0.len()
+            ));
+        };
+        let mut inner = Walk(map);
+        while !inner.0.is_empty() {
+            inner.string(&format!("a key of {what}"))?;
+            inner.string(&format!("a value of {what}"))?;
+        }
+        self.0 = &self.0[map.len()..];
+        Ok(())
+    }
+}
+
 /// Whether the length fields of an MCAP record (`opcode`, its body `data`) fit in the record:
 /// the strings, string maps and prefixed byte fields of each record type, walked field by field
 /// (<https://mcap.dev/spec>). Records of other types have no such field, or none that the
 /// `mcap` crate reserves memory for.
 pub(super) fn mcap_lengths_fit(opcode: u8, data: &[u8]) -> core::result::Result<(), String> {
-    struct Walk<'a>(&'a [u8]);
-    impl Walk<'_> {
-        fn skip(&mut self, n: u64, what: &str) -> core::result::Result<(), String> {
-            match usize::try_from(n).ok().filter(|n| *n <= self.0.len()) {
-                Some(n) => {
-                    self.0 = &self.0[n..];
-                    Ok(())
-                }
-                None => Err(format!(
-                    "{what} declares {n} bytes where {} are left",
-                    self.0.len()
-                )),
-            }
-        }
-        fn uint(&mut self, width: usize, what: &str) -> core::result::Result<u64, String> {
-            let Some(bytes) = self.0.get(..width) else {
-                return Err(format!("{what} is cut short"));
-            };
-            let mut v = 0u64;
-            for (k, b) in bytes.iter().enumerate() {
-                v |= u64::from(*b) << (8 * k);
-            }
-            self.0 = &self.0[width..];
-            Ok(v)
-        }
-        fn string(&mut self, what: &str) -> core::result::Result<(), String> {
-            let n = self.uint(4, what)?;
-            self.skip(n, what)
-        }
-        fn string_map(&mut self, what: &str) -> core::result::Result<(), String> {
-            let n = self.uint(4, what)?;
-            let Some(map) = usize::try_from(n).ok().and_then(|n| self.0.get(..n)) else {
-                return Err(format!(
-                    "{what} declares {n} bytes where {} are left",
-                    self.0.len()
-                ));
-            };
-            let mut inner = Walk(map);
-            while !inner.0.is_empty() {
-                inner.string(&format!("a key of {what}"))?;
-                inner.string(&format!("a value of {what}"))?;
-            }
-            self.0 = &self.0[map.len()..];
-            Ok(())
-        }
-    }
     let mut w = Walk(data);
     match opcode {
         // Header: profile, library.

@@ -130,6 +130,73 @@ fn find<const N: usize>(columns: &[String], names: [&str; N]) -> Option<[usize; 
     Some(out)
 }
 
+/// The messages a table's rows become, by the columns it has (their indices): IMU readings
+/// (with the magnetometer's), a truth or estimate (with the reference point's fix on the
+/// Earth), GNSS fixes (with their accuracies and velocities), or positions (with velocities).
+enum Layout {
+    Imu {
+        accel: [usize; 3],
+        gyro: [usize; 3],
+        mag: Option<[usize; 3]>,
+    },
+    Truth {
+        position: [usize; 3],
+        velocity: [usize; 3],
+        quaternion: [usize; 4],
+        omega: Option<[usize; 3]>,
+        fix: Option<[usize; 3]>,
+    },
+    Fix {
+        llh: [usize; 3],
+        accuracy: Option<[usize; 2]>,
+        velocity: Option<[usize; 3]>,
+    },
+    Position {
+        position: [usize; 3],
+        velocity: Option<[usize; 3]>,
+    },
+}
+
+impl Layout {
+    /// The layout of a table with columns `c` (`None`: a table a bag does not hold).
+    fn of(c: &[String]) -> Option<Self> {
+        let position = find(c, Position::Plane.columns());
+        let position_velocity = find(c, Velocity::Nav.columns());
+        let fix = find(c, GEODETIC_COLUMNS);
+        if let Some((accel, gyro)) = find(c, ACCEL_COLUMNS).zip(find(c, GYRO_COLUMNS)) {
+            return Some(Self::Imu {
+                accel,
+                gyro,
+                mag: find(c, MAG_COLUMNS),
+            });
+        }
+        if let Some(((position, velocity), quaternion)) = position
+            .zip(position_velocity)
+            .zip(find(c, QUATERNION_COLUMNS))
+        {
+            return Some(Self::Truth {
+                position,
+                velocity,
+                quaternion,
+                omega: find(c, ["omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"]),
+                fix,
+            });
+        }
+        // Fixes: a position, and where the table has them a velocity and each fix's accuracy.
+        if let Some(llh) = fix {
+            return Some(Self::Fix {
+                llh,
+                accuracy: find(c, FIX_ACCURACY_COLUMNS),
+                velocity: find(c, Velocity::Ned.columns()),
+            });
+        }
+        position.map(|position| Self::Position {
+            position,
+            velocity: position_velocity,
+        })
+    }
+}
+
 impl BagWriter {
     /// Starts a bag on `writer` (the file named `name` in messages), each channel carrying
     /// `description`; poses go to `/odometry` when its kind is an estimate (strapdown or fused),
@@ -219,103 +286,131 @@ impl BagWriter {
     }
 
     /// Appends the messages of `table` to `messages`.
-    #[allow(clippy::too_many_lines)]
     fn messages_of(&self, table: &Table, messages: &mut Vec<(i64, Stream, Vec<u8>)>) -> Result<()> {
         let c = &table.columns;
         let width = c.len().max(1);
-        let header = |stamp: ros::Time, stream: Stream| ros::Header {
-            stamp,
-            frame_id: stream.frame(&self.options),
-        };
-        let v3 = |row: &[f64], at: [usize; 3]| ros::Vector3::of(at.map(|k| row[k]));
         let Some([t]) = find(c, ["t_s"]) else {
             return Err(self.unwritable(c));
         };
-        let imu = find(c, ACCEL_COLUMNS).zip(find(c, GYRO_COLUMNS));
-        let mag = find(c, MAG_COLUMNS);
-        let position = find(c, Position::Plane.columns());
-        let position_velocity = find(c, Velocity::Nav.columns());
-        let truth = position
-            .zip(position_velocity)
-            .zip(find(c, QUATERNION_COLUMNS));
-        // Fixes: a position, and where the table has them a velocity and each fix's accuracy.
-        let fix = find(c, GEODETIC_COLUMNS);
-        let fix_velocity = find(c, Velocity::Ned.columns());
-        let accuracy = find(c, FIX_ACCURACY_COLUMNS);
+        let layout = Layout::of(c);
         for (k, row) in table.data.chunks_exact(width).enumerate() {
-            let ns = stamp_ns(row[t])
-                .and_then(|ns| ns.checked_add(self.options.start_ns))
-                .filter(|&ns| ros::Time::from_ns(ns).is_some());
-            let Some(ns) = ns else {
-                let start = if self.options.start_ns == 0 {
-                    String::new()
-                } else {
-                    format!(" after the start {} s", self.options.start_ns as f64 * 1e-9)
-                };
-                return Err(Error::CsvFormat {
-                    file: self.name.clone().into(),
-                    message: format!(
-                        "row {}: t_s = {}{start} is outside a ROS time stamp's range (1970 to 2038)",
-                        k + 1,
-                        row[t]
-                    ),
-                });
+            let ns = self.stamp_of(row[t], k)?;
+            let Some(layout) = &layout else {
+                return Err(self.unwritable(c));
             };
-            let stamp = ros::Time::from_ns(ns).unwrap_or_default();
-            if let Some((a, g)) = imu {
+            self.row_messages(layout, row, ns, messages);
+        }
+        Ok(())
+    }
+
+    /// The bag time stamp of a row's `t_s` (row `k`, from 0), the bag's start added.
+    fn stamp_of(&self, t_s: f64, k: usize) -> Result<i64> {
+        let ns = stamp_ns(t_s)
+            .and_then(|ns| ns.checked_add(self.options.start_ns))
+            .filter(|&ns| ros::Time::from_ns(ns).is_some());
+        ns.ok_or_else(|| {
+            let start = if self.options.start_ns == 0 {
+                String::new()
+            } else {
+                format!(" after the start {} s", self.options.start_ns as f64 * 1e-9)
+            };
+            Error::CsvFormat {
+                file: self.name.clone().into(),
+                message: format!(
+                    "row {}: t_s = {t_s}{start} is outside a ROS time stamp's range (1970 to 2038)",
+                    k + 1
+                ),
+            }
+        })
+    }
+
+    /// Appends the messages of one row, stamped `ns`, to `messages`.
+    fn row_messages(
+        &self,
+        layout: &Layout,
+        row: &[f64],
+        ns: i64,
+        messages: &mut Vec<(i64, Stream, Vec<u8>)>,
+    ) {
+        let stamp = ros::Time::from_ns(ns).unwrap_or_default();
+        let header = |stream: Stream| ros::Header {
+            stamp,
+            frame_id: stream.frame(&self.options),
+        };
+        let v3 = |at: [usize; 3]| ros::Vector3::of(at.map(|k| row[k]));
+        let twist = |stream: Stream, linear: ros::Vector3| ros::TwistStamped {
+            header: header(stream),
+            twist: ros::Twist {
+                linear,
+                angular: ros::Vector3::default(),
+            },
+        };
+        match *layout {
+            Layout::Imu { accel, gyro, mag } => {
                 let m = ros::Imu {
-                    header: header(stamp, Stream::Imu),
+                    header: header(Stream::Imu),
                     orientation: ros::Quaternion::default(),
                     orientation_covariance: ros::UNKNOWN_COVARIANCE,
-                    angular_velocity: v3(row, g),
+                    angular_velocity: v3(gyro),
                     angular_velocity_covariance: [0.0; 9],
-                    linear_acceleration: v3(row, a),
+                    linear_acceleration: v3(accel),
                     linear_acceleration_covariance: [0.0; 9],
                 };
                 messages.push((ns, Stream::Imu, ros::encode(&m)));
                 if let Some(b) = mag {
                     let m = ros::MagneticField {
-                        header: header(stamp, Stream::Mag),
+                        header: header(Stream::Mag),
                         magnetic_field: ros::Vector3::of(b.map(|k| row[k] / 1e6)),
                         magnetic_field_covariance: [0.0; 9],
                     };
                     messages.push((ns, Stream::Mag, ros::encode(&m)));
                 }
-            } else if let Some(((p, v), q)) = truth {
-                let q = q.map(|k| row[k]);
+            }
+            Layout::Truth {
+                position,
+                velocity,
+                quaternion,
+                omega,
+                fix,
+            } => {
+                let q = quaternion.map(|k| row[k]);
                 let conj = [q[0], -q[1], -q[2], -q[3]];
+                let stream = if self.estimate {
+                    Stream::Estimate
+                } else {
+                    Stream::Truth
+                };
                 let m = ros::Odometry {
-                    header: header(stamp, Stream::Truth),
+                    header: header(Stream::Truth),
                     child_frame_id: "base_link".into(),
                     pose: ros::PoseWithCovariance {
                         pose: ros::Pose {
-                            position: v3(row, p),
+                            position: v3(position),
                             orientation: ros::Quaternion::of_wxyz(q),
                         },
                         covariance: ros::Covariance6::default(),
                     },
                     twist: ros::TwistWithCovariance {
                         twist: ros::Twist {
-                            linear: ros::Vector3::of(rotate(conj, v.map(|k| row[k]))),
-                            angular: find(c, ["omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"])
-                                .map_or_else(ros::Vector3::default, |w| v3(row, w)),
+                            linear: ros::Vector3::of(rotate(conj, velocity.map(|k| row[k]))),
+                            angular: omega.map_or_else(ros::Vector3::default, v3),
                         },
                         covariance: ros::Covariance6::default(),
                     },
                 };
-                let stream = if self.estimate {
-                    Stream::Estimate
-                } else {
-                    Stream::Truth
-                };
                 messages.push((ns, stream, ros::encode(&m)));
                 // On the WGS-84 Earth, the reference point's latitude, longitude and height.
                 if let (Some(llh), false) = (fix, self.estimate) {
-                    let m = nav_sat_fix(header(stamp, Stream::TruthFix), llh.map(|k| row[k]));
+                    let m = nav_sat_fix(header(Stream::TruthFix), llh.map(|k| row[k]));
                     messages.push((ns, Stream::TruthFix, ros::encode(&m)));
                 }
-            } else if let Some(llh) = fix {
-                let mut m = nav_sat_fix(header(stamp, Stream::Fix), llh.map(|k| row[k]));
+            }
+            Layout::Fix {
+                llh,
+                accuracy,
+                velocity,
+            } => {
+                let mut m = nav_sat_fix(header(Stream::Fix), llh.map(|k| row[k]));
                 if let Some([h, v]) = accuracy.map(|a| a.map(|k| row[k])) {
                     // East, north, up variances.
                     let (h2, v2) = (h * h, v * v);
@@ -323,38 +418,24 @@ impl BagWriter {
                     m.position_covariance_type = ros::COVARIANCE_TYPE_DIAGONAL_KNOWN;
                 }
                 messages.push((ns, Stream::Fix, ros::encode(&m)));
-                if let Some(ned) = fix_velocity {
+                if let Some(ned) = velocity {
                     let [n, e, d] = ned.map(|k| row[k]);
-                    let m = ros::TwistStamped {
-                        header: header(stamp, Stream::Velocity),
-                        twist: ros::Twist {
-                            linear: ros::Vector3::of([e, n, -d]),
-                            angular: ros::Vector3::default(),
-                        },
-                    };
+                    let m = twist(Stream::Velocity, ros::Vector3::of([e, n, -d]));
                     messages.push((ns, Stream::Velocity, ros::encode(&m)));
                 }
-            } else if let Some(p) = position {
+            }
+            Layout::Position { position, velocity } => {
                 let m = ros::PointStamped {
-                    header: header(stamp, Stream::Position),
-                    point: v3(row, p),
+                    header: header(Stream::Position),
+                    point: v3(position),
                 };
                 messages.push((ns, Stream::Position, ros::encode(&m)));
-                if let Some(v) = position_velocity {
-                    let m = ros::TwistStamped {
-                        header: header(stamp, Stream::Velocity),
-                        twist: ros::Twist {
-                            linear: v3(row, v),
-                            angular: ros::Vector3::default(),
-                        },
-                    };
+                if let Some(v) = velocity {
+                    let m = twist(Stream::Velocity, v3(v));
                     messages.push((ns, Stream::Velocity, ros::encode(&m)));
                 }
-            } else {
-                return Err(self.unwritable(c));
             }
         }
-        Ok(())
     }
 
     fn unwritable(&self, columns: &[String]) -> Error {

@@ -133,25 +133,7 @@ impl Track {
                 "start position and heading must be finite",
             ));
         }
-        let (v, accel) = match speed {
-            SpeedProfile::Constant(v) => (v, 0.0),
-            SpeedProfile::Trapezoid {
-                speed_m_s,
-                accel_m_s2,
-            } => (speed_m_s, accel_m_s2),
-        };
-        if !(v.is_finite() && v > 0.0) {
-            return Err(invalid(
-                "trajectory.speed_m_s",
-                format!("must be > 0, got {v}"),
-            ));
-        }
-        if matches!(speed, SpeedProfile::Trapezoid { .. }) && !(accel.is_finite() && accel > 0.0) {
-            return Err(invalid(
-                "trajectory.accel_m_s2",
-                format!("must be > 0, got {accel}"),
-            ));
-        }
+        let (v, accel) = speed_of(speed)?;
         let mut starts = Vec::with_capacity(segments.len());
         let mut driven = Vec::with_capacity(segments.len());
         // Each leg's length and the wait after it.
@@ -159,16 +141,10 @@ impl Track {
         let mut wait_first = 0.0;
         let (mut s, mut p, mut h) = (0.0, [start_m[0], start_m[1]], heading_rad);
         for (i, seg) in segments.iter().enumerate() {
-            let field = format!("trajectory.segments[{i}]");
+            check_segment(seg, i, accel)?;
             let before = s;
             match *seg {
                 Segment::Straight { straight_m } => {
-                    if !(straight_m.is_finite() && straight_m > 0.0) {
-                        return Err(invalid(
-                            field,
-                            format!("straight_m must be > 0, got {straight_m}"),
-                        ));
-                    }
                     starts.push((s, p, h));
                     p = [p[0] + straight_m * h.cos(), p[1] + straight_m * h.sin()];
                     s += straight_m;
@@ -177,15 +153,6 @@ impl Track {
                     arc_radius_m: r,
                     arc_angle_rad: a,
                 } => {
-                    if !(r.is_finite() && r > 0.0) {
-                        return Err(invalid(field, format!("arc_radius_m must be > 0, got {r}")));
-                    }
-                    if !(a.is_finite() && a != 0.0) {
-                        return Err(invalid(
-                            field,
-                            format!("arc_angle_rad must be non-zero, got {a}"),
-                        ));
-                    }
                     starts.push((s, p, h));
                     let sg = a.signum();
                     let c = [p[0] - sg * r * h.sin(), p[1] + sg * r * h.cos()];
@@ -194,16 +161,6 @@ impl Track {
                     s += r * a.abs();
                 }
                 Segment::Wait { wait_s } => {
-                    if !(wait_s.is_finite() && wait_s > 0.0) {
-                        return Err(invalid(field, format!("wait_s must be > 0, got {wait_s}")));
-                    }
-                    if accel == 0.0 {
-                        return Err(invalid(
-                            field,
-                            "a wait stops the track and starts it again: give \
-                             trajectory.accel_m_s2 (with a constant speed the body could not stop)",
-                        ));
-                    }
                     let n = pieces.len();
                     if pieces[n - 1].0 > 0.0 {
                         pieces[n - 1].1 += wait_s;
@@ -229,35 +186,7 @@ impl Track {
             pieces.pop();
         }
         let length_m = s;
-        let mut legs = Vec::with_capacity(pieces.len());
-        let (mut t, mut s0) = (wait_first, 0.0);
-        for (length, wait_after) in pieces {
-            let leg = if accel == 0.0 {
-                Leg {
-                    t0: t,
-                    s0,
-                    length,
-                    peak_speed: v,
-                    t_ramp: 0.0,
-                    duration: length / v,
-                }
-            } else {
-                let peak = v.min((accel * length).sqrt());
-                let t_ramp = peak / accel;
-                let cruise = (length - peak * t_ramp) / peak;
-                Leg {
-                    t0: t,
-                    s0,
-                    length,
-                    peak_speed: peak,
-                    t_ramp,
-                    duration: 2.0 * t_ramp + cruise,
-                }
-            };
-            t += leg.duration + wait_after;
-            s0 += length;
-            legs.push(leg);
-        }
+        let (legs, t_end) = legs_of(pieces, wait_first, v, accel);
         Ok(Self {
             start: start_m,
             starts,
@@ -265,7 +194,7 @@ impl Track {
             length_m,
             accel,
             legs,
-            t_end: t,
+            t_end,
         })
     }
 
@@ -313,6 +242,109 @@ impl Track {
         };
         along + leg.s0
     }
+}
+
+/// The cruise speed and the acceleration (0: a constant speed) of `speed`, checked.
+fn speed_of(speed: SpeedProfile) -> Result<(f64, f64)> {
+    let (v, accel) = match speed {
+        SpeedProfile::Constant(v) => (v, 0.0),
+        SpeedProfile::Trapezoid {
+            speed_m_s,
+            accel_m_s2,
+        } => (speed_m_s, accel_m_s2),
+    };
+    if !(v.is_finite() && v > 0.0) {
+        return Err(invalid(
+            "trajectory.speed_m_s",
+            format!("must be > 0, got {v}"),
+        ));
+    }
+    if matches!(speed, SpeedProfile::Trapezoid { .. }) && !(accel.is_finite() && accel > 0.0) {
+        return Err(invalid(
+            "trajectory.accel_m_s2",
+            format!("must be > 0, got {accel}"),
+        ));
+    }
+    Ok((v, accel))
+}
+
+/// Segment `i` checked: positive finite lengths, radii and waits, a non-zero angle, and no wait
+/// at a constant speed (`accel` 0).
+fn check_segment(seg: &Segment, i: usize, accel: f64) -> Result<()> {
+    let field = format!("trajectory.segments[{i}]");
+    match *seg {
+        Segment::Straight { straight_m } => {
+            if !(straight_m.is_finite() && straight_m > 0.0) {
+                return Err(invalid(
+                    field,
+                    format!("straight_m must be > 0, got {straight_m}"),
+                ));
+            }
+        }
+        Segment::Arc {
+            arc_radius_m: r,
+            arc_angle_rad: a,
+        } => {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(invalid(field, format!("arc_radius_m must be > 0, got {r}")));
+            }
+            if !(a.is_finite() && a != 0.0) {
+                return Err(invalid(
+                    field,
+                    format!("arc_angle_rad must be non-zero, got {a}"),
+                ));
+            }
+        }
+        Segment::Wait { wait_s } => {
+            if !(wait_s.is_finite() && wait_s > 0.0) {
+                return Err(invalid(field, format!("wait_s must be > 0, got {wait_s}")));
+            }
+            if accel == 0.0 {
+                return Err(invalid(
+                    field,
+                    "a wait stops the track and starts it again: give \
+                     trajectory.accel_m_s2 (with a constant speed the body could not stop)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The legs driven from rest to rest (`pieces`: each leg's length and the wait after it), the
+/// first after `wait_first`, at cruise speed `v` and acceleration `accel` (0: one leg at
+/// constant speed); and the time the last ends.
+fn legs_of(pieces: Vec<(f64, f64)>, wait_first: f64, v: f64, accel: f64) -> (Vec<Leg>, f64) {
+    let mut legs = Vec::with_capacity(pieces.len());
+    let (mut t, mut s0) = (wait_first, 0.0);
+    for (length, wait_after) in pieces {
+        let leg = if accel == 0.0 {
+            Leg {
+                t0: t,
+                s0,
+                length,
+                peak_speed: v,
+                t_ramp: 0.0,
+                duration: length / v,
+            }
+        } else {
+            let peak = v.min((accel * length).sqrt());
+            let t_ramp = peak / accel;
+            let cruise = (length - peak * t_ramp) / peak;
+            Leg {
+                t0: t,
+                s0,
+                length,
+                peak_speed: peak,
+                t_ramp,
+                duration: 2.0 * t_ramp + cruise,
+            }
+        };
+        t += leg.duration + wait_after;
+        s0 += length;
+        legs.push(leg);
+    }
+    (legs, t)
 }
 
 impl Motion for Track {

@@ -118,130 +118,8 @@ impl Perturbation {
     /// Unknown parameters or distributions, missing or invalid distribution parameters.
     pub fn from_spec(spec: &PerturbationSpec, index: usize) -> Result<Self> {
         let at = format!("imu.perturbations[{index}]");
-        let (sensor_key, key) = spec.parameter.split_once('.').ok_or_else(|| {
-            invalid(
-                format!("{at}.parameter"),
-                "expected sensor.parameter, e.g. gyroscope.constant_bias_rad_s",
-            )
-        })?;
-        let sensor = Sensor::ALL
-            .into_iter()
-            .find(|s| s.key() == sensor_key)
-            .ok_or_else(|| {
-                invalid(
-                    format!("{at}.parameter"),
-                    format!(
-                        "unknown sensor \"{sensor_key}\" (accelerometer, gyroscope, magnetometer)"
-                    ),
-                )
-            })?;
-        let u = sensor.unit();
-        let fields = [
-            (format!("measurement_range_{u}"), Field::MeasurementRange),
-            (format!("resolution_{u}"), Field::Resolution),
-            (format!("constant_bias_{u}"), Field::ConstantBias),
-            (format!("noise_density_{u}_per_rt_hz"), Field::NoiseDensity),
-            (format!("bias_instability_{u}"), Field::BiasInstability),
-            (format!("random_walk_{u}_rt_hz"), Field::RandomWalk),
-            (
-                format!("temperature_bias_{u}_per_c"),
-                Field::TemperatureBias,
-            ),
-            (
-                "temperature_scale_factor_pct_per_c".to_string(),
-                Field::TemperatureScaleFactor,
-            ),
-            (
-                "acceleration_bias_rad_s_per_m_s2".to_string(),
-                Field::AccelerationBias,
-            ),
-        ];
-        let field = fields
-            .iter()
-            .filter(|(_, f)| *f != Field::AccelerationBias || sensor == Sensor::Gyroscope)
-            .find(|(n, _)| n == key)
-            .map(|(_, f)| *f)
-            .ok_or_else(|| {
-                let known: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
-                invalid(
-                    format!("{at}.parameter"),
-                    format!(
-                        "cannot perturb \"{key}\" (perturbable: {})",
-                        known.join(", ")
-                    ),
-                )
-            })?;
-        let f = |name: &str| format!("{at}.{name}");
-        let distribution = match spec.distribution.as_str() {
-            "normal" => Distribution::Normal {
-                mean: need(spec.mean, &f("mean"), "mean")?,
-                std: need(spec.std, &f("std"), "std")?,
-            },
-            "truncated-normal" => Distribution::TruncatedNormal {
-                mean: need(spec.mean, &f("mean"), "mean")?,
-                std: need(spec.std, &f("std"), "std")?,
-                lower: need(spec.lower, &f("lower"), "lower")?,
-                upper: need(spec.upper, &f("upper"), "upper")?,
-            },
-            "uniform" => Distribution::Uniform {
-                lower: need(spec.lower, &f("lower"), "lower")?,
-                upper: need(spec.upper, &f("upper"), "upper")?,
-            },
-            "selection" => {
-                let values = spec
-                    .values
-                    .clone()
-                    .ok_or_else(|| invalid(f("values"), "needs values"))?;
-                if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
-                    return Err(invalid(f("values"), "needs at least one finite value"));
-                }
-                let p = spec
-                    .probabilities
-                    .clone()
-                    .unwrap_or_else(|| vec![1.0 / values.len() as f64; values.len()]);
-                if p.len() != values.len() || p.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
-                    return Err(invalid(f("probabilities"), "one probability ≥ 0 per value"));
-                }
-                let total: f64 = p.iter().sum();
-                if (total - 1.0).abs() > 1e-9 {
-                    return Err(invalid(
-                        f("probabilities"),
-                        format!("must add up to 1, add up to {total}"),
-                    ));
-                }
-                let mut acc = 0.0;
-                let cumulative = p.iter().map(|x| {
-                    acc += x;
-                    acc / total
-                });
-                Distribution::Selection {
-                    values,
-                    cumulative: cumulative.collect(),
-                }
-            }
-            other => {
-                return Err(invalid(
-                    f("distribution"),
-                    format!(
-                        "unknown distribution \"{other}\" (normal, truncated-normal, uniform, selection)"
-                    ),
-                ));
-            }
-        };
-        match distribution {
-            Distribution::Normal { std, .. } | Distribution::TruncatedNormal { std, .. }
-                if std < 0.0 =>
-            {
-                return Err(invalid(f("std"), "must be ≥ 0"));
-            }
-            Distribution::TruncatedNormal { lower, upper, .. }
-            | Distribution::Uniform { lower, upper }
-                if lower > upper =>
-            {
-                return Err(invalid(f("lower"), "must not exceed upper"));
-            }
-            _ => {}
-        }
+        let (sensor, field) = target_of(&spec.parameter, &at)?;
+        let distribution = distribution_of(spec, &at)?;
         Ok(Self {
             sensor,
             field,
@@ -300,6 +178,138 @@ impl Perturbation {
             Field::AccelerationBias => p.acceleration_bias = three(),
         }
     }
+}
+
+/// The sensor and the field `parameter` (`sensor.field`) names; `at` locates it in messages.
+fn target_of(parameter: &str, at: &str) -> Result<(Sensor, Field)> {
+    let (sensor_key, key) = parameter.split_once('.').ok_or_else(|| {
+        invalid(
+            format!("{at}.parameter"),
+            "expected sensor.parameter, e.g. gyroscope.constant_bias_rad_s",
+        )
+    })?;
+    let sensor = Sensor::ALL
+        .into_iter()
+        .find(|s| s.key() == sensor_key)
+        .ok_or_else(|| {
+            invalid(
+                format!("{at}.parameter"),
+                format!("unknown sensor \"{sensor_key}\" (accelerometer, gyroscope, magnetometer)"),
+            )
+        })?;
+    let u = sensor.unit();
+    let fields = [
+        (format!("measurement_range_{u}"), Field::MeasurementRange),
+        (format!("resolution_{u}"), Field::Resolution),
+        (format!("constant_bias_{u}"), Field::ConstantBias),
+        (format!("noise_density_{u}_per_rt_hz"), Field::NoiseDensity),
+        (format!("bias_instability_{u}"), Field::BiasInstability),
+        (format!("random_walk_{u}_rt_hz"), Field::RandomWalk),
+        (
+            format!("temperature_bias_{u}_per_c"),
+            Field::TemperatureBias,
+        ),
+        (
+            "temperature_scale_factor_pct_per_c".to_string(),
+            Field::TemperatureScaleFactor,
+        ),
+        (
+            "acceleration_bias_rad_s_per_m_s2".to_string(),
+            Field::AccelerationBias,
+        ),
+    ];
+    let field = fields
+        .iter()
+        .filter(|(_, f)| *f != Field::AccelerationBias || sensor == Sensor::Gyroscope)
+        .find(|(n, _)| n == key)
+        .map(|(_, f)| *f)
+        .ok_or_else(|| {
+            let known: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
+            invalid(
+                format!("{at}.parameter"),
+                format!(
+                    "cannot perturb \"{key}\" (perturbable: {})",
+                    known.join(", ")
+                ),
+            )
+        })?;
+    Ok((sensor, field))
+}
+
+/// The distribution `spec` describes, its parameters checked; `at` locates it in messages.
+fn distribution_of(spec: &PerturbationSpec, at: &str) -> Result<Distribution> {
+    let f = |name: &str| format!("{at}.{name}");
+    let distribution = match spec.distribution.as_str() {
+        "normal" => Distribution::Normal {
+            mean: need(spec.mean, &f("mean"), "mean")?,
+            std: need(spec.std, &f("std"), "std")?,
+        },
+        "truncated-normal" => Distribution::TruncatedNormal {
+            mean: need(spec.mean, &f("mean"), "mean")?,
+            std: need(spec.std, &f("std"), "std")?,
+            lower: need(spec.lower, &f("lower"), "lower")?,
+            upper: need(spec.upper, &f("upper"), "upper")?,
+        },
+        "uniform" => Distribution::Uniform {
+            lower: need(spec.lower, &f("lower"), "lower")?,
+            upper: need(spec.upper, &f("upper"), "upper")?,
+        },
+        "selection" => {
+            let values = spec
+                .values
+                .clone()
+                .ok_or_else(|| invalid(f("values"), "needs values"))?;
+            if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+                return Err(invalid(f("values"), "needs at least one finite value"));
+            }
+            let p = spec
+                .probabilities
+                .clone()
+                .unwrap_or_else(|| vec![1.0 / values.len() as f64; values.len()]);
+            if p.len() != values.len() || p.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                return Err(invalid(f("probabilities"), "one probability ≥ 0 per value"));
+            }
+            let total: f64 = p.iter().sum();
+            if (total - 1.0).abs() > 1e-9 {
+                return Err(invalid(
+                    f("probabilities"),
+                    format!("must add up to 1, add up to {total}"),
+                ));
+            }
+            let mut acc = 0.0;
+            let cumulative = p.iter().map(|x| {
+                acc += x;
+                acc / total
+            });
+            Distribution::Selection {
+                values,
+                cumulative: cumulative.collect(),
+            }
+        }
+        other => {
+            return Err(invalid(
+                f("distribution"),
+                format!(
+                    "unknown distribution \"{other}\" (normal, truncated-normal, uniform, selection)"
+                ),
+            ));
+        }
+    };
+    match distribution {
+        Distribution::Normal { std, .. } | Distribution::TruncatedNormal { std, .. }
+            if std < 0.0 =>
+        {
+            return Err(invalid(f("std"), "must be ≥ 0"));
+        }
+        Distribution::TruncatedNormal { lower, upper, .. }
+        | Distribution::Uniform { lower, upper }
+            if lower > upper =>
+        {
+            return Err(invalid(f("lower"), "must not exceed upper"));
+        }
+        _ => {}
+    }
+    Ok(distribution)
 }
 
 /// The generator of run `run` (`None`: the single run of `imukit simulate` without `--runs`)
