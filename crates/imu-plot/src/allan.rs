@@ -2,7 +2,7 @@
 //! sum dashed.
 use std::path::Path;
 
-use imukit::run::allan::AllanResult;
+use imukit::run::allan::{AllanResult, ColumnNoise};
 use plotters::prelude::*;
 
 use crate::PlotError;
@@ -137,40 +137,49 @@ pub fn allan_figure(
                 chart
                     .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))
                     .map_err(err)?;
-                let Some(noise) = result.noise.get(k) else {
-                    continue;
-                };
-                // The 95 % band of each deviation, thin; the fitted terms' sum, dashed.
-                for edge in [&noise.lower, &noise.upper] {
-                    let points: Vec<(f64, f64)> = tau
-                        .iter()
-                        .copied()
-                        .zip(edge.iter().copied())
-                        .filter(|(_, a)| *a > 0.0)
-                        .collect();
-                    chart
-                        .draw_series(LineSeries::new(points, color.mix(0.35).stroke_width(1)))
-                        .map_err(err)?;
+                if let Some(noise) = result.noise.get(k) {
+                    draw_band_and_fit(&mut chart, &tau, noise, color)?;
                 }
-                let (t0, t1) = (tau[0], tau[tau.len() - 1]);
-                let fitted: Vec<(f64, f64)> = (0..=64)
-                    .map(|i| {
-                        let t = t0 * (t1 / t0).powf(f64::from(i) / 64.0);
-                        (t, noise.fit.variance_at(t).sqrt())
-                    })
-                    .filter(|(_, a)| *a > 0.0)
-                    .collect();
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        fitted,
-                        6,
-                        4,
-                        color.mix(0.8).stroke_width(1),
-                    ))
-                    .map_err(err)?;
             }
             draw_legend(&mut chart)?;
         }
         Ok(())
     })
+}
+
+/// Draws a deviation's 95 % band, thin, and its fitted terms' sum, dashed, in `color`.
+fn draw_band_and_fit<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
+    tau: &[f64],
+    noise: &ColumnNoise,
+    color: RGBColor,
+) -> Result<(), String> {
+    for edge in [&noise.lower, &noise.upper] {
+        let points: Vec<(f64, f64)> = tau
+            .iter()
+            .copied()
+            .zip(edge.iter().copied())
+            .filter(|(_, a)| *a > 0.0)
+            .collect();
+        chart
+            .draw_series(LineSeries::new(points, color.mix(0.35).stroke_width(1)))
+            .map_err(err)?;
+    }
+    let (t0, t1) = (tau[0], tau[tau.len() - 1]);
+    let fitted: Vec<(f64, f64)> = (0..=64)
+        .map(|i| {
+            let t = t0 * (t1 / t0).powf(f64::from(i) / 64.0);
+            (t, noise.fit.variance_at(t).sqrt())
+        })
+        .filter(|(_, a)| *a > 0.0)
+        .collect();
+    chart
+        .draw_series(DashedLineSeries::new(
+            fitted,
+            6,
+            4,
+            color.mix(0.8).stroke_width(1),
+        ))
+        .map_err(err)?;
+    Ok(())
 }

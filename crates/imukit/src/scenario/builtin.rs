@@ -57,21 +57,6 @@ fn expression(
 /// # Errors
 /// Unknown name (the known ones are listed in the message).
 pub fn spec(name: &str) -> Result<ScenarioSpec> {
-    let base = |rate_hz: f64, duration_s: Option<f64>, trajectory: TrajectorySpec| ScenarioSpec {
-        rate_hz: Some(rate_hz),
-        duration_s,
-        nav_frame: Some(NavFrameName::ENU),
-        gravity_m_s2: Some(imu_core::DEFAULT_GRAVITY_M_S2),
-        earth: None,
-        origin: None,
-        magnetic_model: None,
-        date: None,
-        trajectory,
-        imu: ImuSpec::default(),
-        gnss: None,
-        baro: None,
-        odometer: None,
-    };
     Ok(match name {
         "figure8" => {
             let mut s = base(
@@ -107,26 +92,7 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
                 ]),
             ),
         ),
-        "rounded-rectangle" => {
-            let side = [
-                Segment::Straight { straight_m: 0.8 },
-                Segment::Arc {
-                    arc_radius_m: 0.1,
-                    arc_angle_rad: -FRAC_PI_2,
-                },
-            ];
-            base(
-                2000.0,
-                None,
-                TrajectorySpec::Track(TrackSpec {
-                    start_m: [-0.4, 0.5, 0.0],
-                    heading_rad: 0.0,
-                    speed_m_s: 0.8,
-                    accel_m_s2: None,
-                    segments: (0..4).flat_map(|_| side).collect(),
-                }),
-            )
-        }
+        "rounded-rectangle" => rounded_rectangle(),
         "static" => base(
             100.0,
             Some(10.0),
@@ -145,71 +111,8 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
             s.nav_frame = Some(NavFrameName::NED);
             s
         }
-        "cart" => {
-            let half_turn = Segment::Arc {
-                arc_radius_m: 5.0,
-                arc_angle_rad: std::f64::consts::PI,
-            };
-            let straight = Segment::Straight { straight_m: 20.0 };
-            let mut s = base(
-                50.0,
-                None,
-                TrajectorySpec::Track(TrackSpec {
-                    start_m: [100.0, 100.0, 0.0],
-                    heading_rad: 0.0,
-                    speed_m_s: 2.0,
-                    accel_m_s2: Some(0.5),
-                    segments: vec![straight, half_turn, straight, half_turn],
-                }),
-            );
-            s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
-            s
-        }
-        "gnss-car" => {
-            let quarter = Segment::Arc {
-                arc_radius_m: 30.0,
-                arc_angle_rad: FRAC_PI_2,
-            };
-            let long = Segment::Straight { straight_m: 200.0 };
-            let short = Segment::Straight { straight_m: 100.0 };
-            let mut s = base(
-                100.0,
-                None,
-                TrajectorySpec::Track(TrackSpec {
-                    start_m: [0.0, 0.0, 0.0],
-                    heading_rad: 0.0,
-                    speed_m_s: 10.0,
-                    accel_m_s2: Some(1.0),
-                    segments: vec![
-                        Segment::Wait { wait_s: 20.0 },
-                        long,
-                        quarter,
-                        short,
-                        quarter,
-                        long,
-                        quarter,
-                        short,
-                        quarter,
-                    ],
-                }),
-            );
-            s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
-            s.imu.preset = Some("icm-42688-p".into());
-            s.imu.seed = Some(1);
-            s.gnss = Some(crate::scenario::gnss::GnssSpec {
-                rate_hz: Some(5.0),
-                horizontal_accuracy_m: Some(1.5),
-                vertical_accuracy_m: Some(3.0),
-                velocity_accuracy_m_s: Some(0.1),
-                decay_factor: Some(0.0),
-                outages: vec![crate::scenario::gnss::OutageSpec {
-                    start_s: 60.0,
-                    duration_s: 15.0,
-                }],
-                ..Default::default()
-            });
-            s
-        }
+        "cart" => cart(),
+        "gnss-car" => gnss_car(),
         _ => {
             return Err(invalid(
                 "trajectory.name",
@@ -220,6 +123,118 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
             ));
         }
     })
+}
+
+/// A built-in's scenario: this rate, duration and trajectory in ENU on the flat Earth, an
+/// ideal IMU.
+fn base(rate_hz: f64, duration_s: Option<f64>, trajectory: TrajectorySpec) -> ScenarioSpec {
+    ScenarioSpec {
+        rate_hz: Some(rate_hz),
+        duration_s,
+        nav_frame: Some(NavFrameName::ENU),
+        gravity_m_s2: Some(imu_core::DEFAULT_GRAVITY_M_S2),
+        earth: None,
+        origin: None,
+        magnetic_model: None,
+        date: None,
+        trajectory,
+        imu: ImuSpec::default(),
+        gnss: None,
+        baro: None,
+        odometer: None,
+    }
+}
+
+/// A rounded rectangle driven at a constant speed.
+fn rounded_rectangle() -> ScenarioSpec {
+    let side = [
+        Segment::Straight { straight_m: 0.8 },
+        Segment::Arc {
+            arc_radius_m: 0.1,
+            arc_angle_rad: -FRAC_PI_2,
+        },
+    ];
+    base(
+        2000.0,
+        None,
+        TrajectorySpec::Track(TrackSpec {
+            start_m: [-0.4, 0.5, 0.0],
+            heading_rad: 0.0,
+            speed_m_s: 0.8,
+            accel_m_s2: None,
+            segments: (0..4).flat_map(|_| side).collect(),
+        }),
+    )
+}
+
+/// A cart around a 20 m oval at 2 m/s, started and stopped at 0.5 m/s², at 50 Hz.
+fn cart() -> ScenarioSpec {
+    let half_turn = Segment::Arc {
+        arc_radius_m: 5.0,
+        arc_angle_rad: std::f64::consts::PI,
+    };
+    let straight = Segment::Straight { straight_m: 20.0 };
+    let mut s = base(
+        50.0,
+        None,
+        TrajectorySpec::Track(TrackSpec {
+            start_m: [100.0, 100.0, 0.0],
+            heading_rad: 0.0,
+            speed_m_s: 2.0,
+            accel_m_s2: Some(0.5),
+            segments: vec![straight, half_turn, straight, half_turn],
+        }),
+    );
+    s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
+    s
+}
+
+/// A consumer IMU in a car that stands 20 s, then drives a rounded 200 m × 100 m rectangle, with
+/// a 5 Hz receiver that loses its fixes from 60 s to 75 s.
+fn gnss_car() -> ScenarioSpec {
+    let quarter = Segment::Arc {
+        arc_radius_m: 30.0,
+        arc_angle_rad: FRAC_PI_2,
+    };
+    let long = Segment::Straight { straight_m: 200.0 };
+    let short = Segment::Straight { straight_m: 100.0 };
+    let mut s = base(
+        100.0,
+        None,
+        TrajectorySpec::Track(TrackSpec {
+            start_m: [0.0, 0.0, 0.0],
+            heading_rad: 0.0,
+            speed_m_s: 10.0,
+            accel_m_s2: Some(1.0),
+            segments: vec![
+                Segment::Wait { wait_s: 20.0 },
+                long,
+                quarter,
+                short,
+                quarter,
+                long,
+                quarter,
+                short,
+                quarter,
+            ],
+        }),
+    );
+    s.imu.kind = Some(crate::io::table::ImuKind::AccelGyro);
+    s.imu.preset = Some("icm-42688-p".into());
+    s.imu.seed = Some(1);
+    s.gnss = Some(crate::scenario::gnss::GnssSpec {
+        rate_hz: Some(5.0),
+        horizontal_accuracy_m: Some(1.5),
+        vertical_accuracy_m: Some(3.0),
+        velocity_accuracy_m_s: Some(0.1),
+        decay_factor: Some(0.0),
+        outages: vec![crate::scenario::gnss::OutageSpec {
+            start_s: 60.0,
+            duration_s: 15.0,
+        }],
+        ..Default::default()
+    });
+    s
 }
 
 /// A built-in scenario as TOML text, to edit and run with `imukit simulate`.
