@@ -138,24 +138,21 @@ fn reproduces_the_truth(sim: &Simulation, setup: &FuseSetup) {
     }
 }
 
-/// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average
-/// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`; with
-/// `wheels`, an odometer (10 Hz) and the non-holonomic constraints aid the filter too; the
-/// covariance is stepped every `covariance_interval_s` (0: every sample). With `parts`, each run
-/// is a different part whose scale factors, misalignment and g-sensitivity are drawn with these
-/// one-sigmas; a filter of `S = 36` states is told them, one of 15 is not.
-fn average_nees<const S: usize>(
-    runs: u64,
-    q_scale: f64,
-    wheels: bool,
-    covariance_interval_s: f64,
-    parts: Option<SensorErrorSigma>,
-) -> ([f64; 3], f64, usize) {
-    // IMU: white noise and bias random walk (single-sided densities: the continuous PSD is N²,
-    // so the filter's √q is N). GNSS: white (MATLAB decay factor 0: deviation σ√2).
-    let (n_a, n_g, k_a, k_g) = (0.003, 2e-4, 2e-4, 2e-6);
-    let (sigma_h, sigma_v, sigma_vel) = (0.8, 1.2, 0.05);
-    let (sigma_odo, sigma_nhc) = (0.05, 0.02);
+/// The IMU's white noise and bias random walk of the consistency runs, accelerometer and
+/// gyroscope (single-sided densities: the continuous PSD is N², so the filter's √q is N).
+const IMU_NOISE: (f64, f64, f64, f64) = (0.003, 2e-4, 2e-4, 2e-6);
+/// The fixes' horizontal, vertical and velocity accuracies: white (MATLAB decay factor 0:
+/// deviation σ√2).
+const FIX_SIGMA: (f64, f64, f64) = (0.8, 1.2, 0.05);
+/// The odometer's noise and the vehicle constraints' sigma, m/s.
+const WHEEL_SIGMA: (f64, f64) = (0.05, 0.02);
+
+/// The consistency runs' scenario: the car of [`scenario`] with [`IMU_NOISE`], [`FIX_SIGMA`],
+/// an odometer when `wheels`, and the part's scale factors and misalignment when `parts`.
+fn consistency_scenario(wheels: bool, parts: Option<SensorErrorSigma>) -> String {
+    let (n_a, n_g, k_a, k_g) = IMU_NOISE;
+    let (sigma_h, sigma_v, sigma_vel) = FIX_SIGMA;
+    let sigma_odo = WHEEL_SIGMA.0;
     let odometer = if wheels {
         format!("\n[odometer]\nrate_hz = 10.0\nnoise_m_s = {sigma_odo}")
     } else {
@@ -179,7 +176,7 @@ fn average_nees<const S: usize>(
             ),
         )
     });
-    let text = scenario(
+    scenario(
         &format!(
             "[imu.accelerometer]\nNoiseDensity = {n_a}\nRandomWalk = {k_a}{accel_part}\n\
              [imu.gyroscope]\nNoiseDensity = {n_g}\nRandomWalk = {k_g}{gyro_part}"
@@ -188,7 +185,68 @@ fn average_nees<const S: usize>(
             "horizontal_accuracy_m = {sigma_h}\nvertical_accuracy_m = {sigma_v}\n\
              velocity_accuracy_m_s = {sigma_vel}\ndecay_factor = 0.0{odometer}"
         ),
-    );
+    )
+}
+
+/// A filter start drawn from the initial uncertainty `sigma0` about the truth at `t0`, every
+/// state (seeded by `run`).
+fn drawn_start(
+    t0: f64,
+    p: [f64; 3],
+    v: [f64; 3],
+    q: [f64; 4],
+    sigma0: &InitialSigma,
+    run: u64,
+) -> EskfState<FlatEarth<Enu>> {
+    // The start drawn from the initial uncertainty, every state: the true biases start at
+    // 0 (the random walks' start), so the estimates start at a draw. (Drawing only position,
+    // velocity and attitude left the filter pessimistic about the attitude: tilt and
+    // accelerometer bias are told apart only slowly, and a bias uncertainty with no bias
+    // error behind it keeps the tilt's covariance up.)
+    let mut draw = SeededNormals::for_run(99, run);
+    let mut d = |s: f64| s * draw.standard_normal();
+    let tilt = [
+        d(sigma0.attitude_rad[0]),
+        d(sigma0.attitude_rad[1]),
+        d(sigma0.attitude_rad[2]),
+    ];
+    let c0 = Rotation::<Body, Enu>::from_wxyz(q).unwrap();
+    let start_q = *c0.quaternion();
+    EskfState {
+        nav: NavState {
+            t_s: t0,
+            position: Vec3::<Enu>::from_array(p)
+                + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.position_m,
+            velocity_m_s: Vec3::<Enu>::from_array(v)
+                + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.velocity_m_s,
+            // Ĉ = (I − [φ×]) C_true: the estimate off by −φ.
+            attitude: Rotation::assume_from_quaternion(
+                nalgebra::UnitQuaternion::from_scaled_axis(-nalgebra::Vector3::from(tilt))
+                    * start_q,
+            ),
+        },
+        accel_bias_m_s2: [0, 1, 2].map(|_| d(sigma0.accel_bias_m_s2)),
+        gyro_bias_rad_s: [0, 1, 2].map(|_| d(sigma0.gyro_bias_rad_s)),
+    }
+}
+
+/// Average NEES of position, velocity and attitude at `check_s` over `runs` runs, and the average
+/// NIS of every fix with its count, with the filter's process noise scaled by `q_scale`; with
+/// `wheels`, an odometer (10 Hz) and the non-holonomic constraints aid the filter too; the
+/// covariance is stepped every `covariance_interval_s` (0: every sample). With `parts`, each run
+/// is a different part whose scale factors, misalignment and g-sensitivity are drawn with these
+/// one-sigmas; a filter of `S = 36` states is told them, one of 15 is not.
+fn average_nees<const S: usize>(
+    runs: u64,
+    q_scale: f64,
+    wheels: bool,
+    covariance_interval_s: f64,
+    parts: Option<SensorErrorSigma>,
+) -> ([f64; 3], f64, usize) {
+    let (n_a, n_g, k_a, k_g) = IMU_NOISE;
+    let (sigma_h, sigma_v, sigma_vel) = FIX_SIGMA;
+    let (sigma_odo, sigma_nhc) = WHEEL_SIGMA;
+    let text = consistency_scenario(wheels, parts);
     let noise = EskfNoise {
         accel_psd: n_a * q_scale.sqrt(),
         gyro_psd: n_g * q_scale.sqrt(),
@@ -213,42 +271,13 @@ fn average_nees<const S: usize>(
     for run in 0..runs {
         let sim = sc.simulate_run(run).unwrap();
         let gnss = sim.gnss.as_ref().unwrap();
-        // The start drawn from the initial uncertainty, every state: the true biases start at
-        // 0 (the random walks' start), so the estimates start at a draw. (Drawing only position,
-        // velocity and attitude left the filter pessimistic about the attitude: tilt and
-        // accelerometer bias are told apart only slowly, and a bias uncertainty with no bias
-        // error behind it keeps the tilt's covariance up.)
-        let mut draw = SeededNormals::for_run(99, run);
-        let mut d = |s: f64| s * draw.standard_normal();
         let t = col(&sim.truth, "t_s");
         let p_true = rows3(&sim.truth, ["pos_x_m", "pos_y_m", "pos_z_m"]);
         let v_true = rows3(&sim.truth, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"]);
         let q_true: Vec<[f64; 4]> = (0..t.len())
             .map(|i| ["q_w", "q_x", "q_y", "q_z"].map(|c| col(&sim.truth, c)[i]))
             .collect();
-        let tilt = [
-            d(sigma0.attitude_rad[0]),
-            d(sigma0.attitude_rad[1]),
-            d(sigma0.attitude_rad[2]),
-        ];
-        let c0 = Rotation::<Body, Enu>::from_wxyz(q_true[0]).unwrap();
-        let start_q = *c0.quaternion();
-        let start = EskfState {
-            nav: NavState {
-                t_s: t[0],
-                position: Vec3::<Enu>::from_array(p_true[0])
-                    + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.position_m,
-                velocity_m_s: Vec3::<Enu>::from_array(v_true[0])
-                    + Vec3::new(d(1.0), d(1.0), d(1.0)) * sigma0.velocity_m_s,
-                // Ĉ = (I − [φ×]) C_true: the estimate off by −φ.
-                attitude: Rotation::assume_from_quaternion(
-                    nalgebra::UnitQuaternion::from_scaled_axis(-nalgebra::Vector3::from(tilt))
-                        * start_q,
-                ),
-            },
-            accel_bias_m_s2: [0, 1, 2].map(|_| d(sigma0.accel_bias_m_s2)),
-            gyro_bias_rad_s: [0, 1, 2].map(|_| d(sigma0.gyro_bias_rad_s)),
-        };
+        let start = drawn_start(t[0], p_true[0], v_true[0], q_true[0], &sigma0, run);
         let mut f = Eskf::<_, S>::new(FlatEarth::<Enu>::new(9.81), &start, &sigma0, noise)
             .unwrap()
             .with_covariance_interval(covariance_interval_s)
