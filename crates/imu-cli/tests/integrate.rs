@@ -1,34 +1,79 @@
 //! `imukit integrate` and `compare`: the loop from a simulation back to its truth, flat and WGS-84.
 use crate::common::{imukit, run_in, table_text, temp_dir};
 
-#[test]
-fn simulate_integrate_compare_closes_the_loop() {
-    let dir = temp_dir("loop");
-    let dir = dir.path();
+/// A folder with a helix simulated in NED at 400 Hz: `helix.toml`, `imu.csv`, `truth.csv`.
+fn helix(name: &str) -> tempfile::TempDir {
+    let dir = temp_dir(name);
     std::fs::write(
-        dir.join("helix.toml"),
+        dir.path().join("helix.toml"),
         "rate_hz = 400.0\nduration_s = 10.0\nnav_frame = \"NED\"\n[trajectory]\ntype = \"expression\"\n\
          position_m = [\"5*cos(0.5*t)\", \"5*sin(0.5*t)\", \"-0.3*t\"]\nyaw_rad = \"0.5*t + pi/2\"\n\
          pitch_rad = \"0.05\"\nroll_rad = \"0.4*sin(1.7*t)\"\n",
     )
     .unwrap();
-    let run = |args: &[&str]| {
-        let out = imukit().current_dir(dir).args(args).output().unwrap();
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8(out.stdout).unwrap()
-    };
-    run(&[
-        "simulate",
-        "helix.toml",
-        "--out",
-        "imu.csv",
-        "--truth",
-        "truth.csv",
-    ]);
+    ok(
+        dir.path(),
+        &[
+            "simulate",
+            "helix.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+        ],
+    );
+    dir
+}
+
+/// The largest position error `imukit compare TRUTH ESTIMATE` reports, m, and its report.
+fn max_position_error(dir: &std::path::Path, truth: &str, estimate: &str) -> (f64, String) {
+    let report = ok(dir, &["compare", truth, estimate]);
+    let max = report
+        .lines()
+        .find(|l| l.starts_with("position"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    (max, report)
+}
+
+/// A folder with the built-in `gnss-car` simulated: `car.toml`, `imu.csv`, `truth.csv`, `gnss.csv`.
+fn gnss_car(name: &str) -> tempfile::TempDir {
+    let dir = temp_dir(name);
+    let toml = ok(dir.path(), &["scenario", "gnss-car"]);
+    std::fs::write(dir.path().join("car.toml"), toml).unwrap();
+    ok(
+        dir.path(),
+        &[
+            "simulate",
+            "car.toml",
+            "--out",
+            "imu.csv",
+            "--truth",
+            "truth.csv",
+            "--gnss",
+            "gnss.csv",
+        ],
+    );
+    dir
+}
+
+/// Runs `imukit` in `dir`, asserts it succeeds, and returns its standard output.
+fn ok(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = imukit().current_dir(dir).args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn simulate_integrate_compare_closes_the_loop() {
+    let dir = helix("loop");
+    let dir = dir.path();
+    let run = |args: &[&str]| ok(dir, args);
     run(&[
         "integrate",
         "imu.csv",
@@ -70,8 +115,25 @@ fn simulate_integrate_compare_closes_the_loop() {
     run(&["compare", "truth.csv", "nav4.csv", "--out", "err4.csv"]);
     let err4 = imukit::io::read::read_columns(dir.join("err4.csv"), &["pos_err_m"], "").unwrap();
     assert!(*err4.get("pos_err_m").last().unwrap() < 1e-6);
-    // The files say what they hold (NED, flat Earth, gravity, sign), so no flag is needed: the
-    // same numbers as with the flag, from CSV and from Parquet alike.
+}
+
+/// The files say what they hold (NED, flat Earth, gravity, sign), so no flag is needed.
+#[test]
+fn integrate_takes_the_frame_from_the_files() {
+    let dir = helix("described");
+    let dir = dir.path();
+    let run = |args: &[&str]| ok(dir, args);
+    run(&[
+        "integrate",
+        "imu.csv",
+        "--init",
+        "truth.csv",
+        "--nav-frame",
+        "NED",
+        "--out",
+        "nav.csv",
+    ]);
+    // The same numbers as with the flag, from CSV and from Parquet alike.
     let readings = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
     let description = readings.lines().next().unwrap();
     for entry in [
@@ -118,6 +180,16 @@ fn simulate_integrate_compare_closes_the_loop() {
         std::fs::read_to_string(dir.join("parquet.csv")).unwrap(),
         nav_text
     );
+}
+
+/// A flag or an input that contradicts what the files say is refused by name, and nothing is
+/// written.
+#[test]
+fn integrate_refuses_a_flag_or_an_input_that_contradicts_the_files() {
+    let dir = helix("contradicted");
+    let dir = dir.path();
+    ok(dir, &["simulate", "helix.toml", "--out", "imu.parquet"]);
+    let readings = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
     // A flag that contradicts the files is refused by name, naming the file and both frames,
     // and nothing is written; so are inputs that disagree.
     for (args, needles) in [
@@ -233,18 +305,7 @@ fn integrate_on_the_wgs84_earth_recovers_a_wgs84_flight_and_names_what_is_missin
             .unwrap()
             .ends_with(",lat_rad,lon_rad,height_m")
     );
-    let out = imukit()
-        .current_dir(dir)
-        .args(["compare", "truth.csv", "nav.csv"])
-        .output()
-        .unwrap();
-    let report = String::from_utf8(out.stdout).unwrap();
-    let max_position: f64 = report
-        .lines()
-        .find(|l| l.starts_with("position"))
-        .and_then(|l| l.split_whitespace().nth(3))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(f64::NAN);
+    let (max_position, report) = max_position_error(dir, "truth.csv", "nav.csv");
     assert!(max_position < 1e-6, "{report}");
     // Described, the readings start at the scenario's origin without --init or --lat0-deg
     // (at rest and level there: far off for this flight, but on the WGS-84 Earth in NED).
@@ -362,28 +423,8 @@ fn compare_refuses_a_truth_and_an_estimate_in_different_frames() {
 /// starts and is the integration of those rows alone.
 #[test]
 fn a_time_window_cuts_every_input_at_the_same_instants() {
-    let dir = temp_dir("window");
+    let dir = gnss_car("window");
     let dir = dir.path();
-    let toml = imukit()
-        .current_dir(dir)
-        .args(["scenario", "gnss-car"])
-        .output()
-        .unwrap();
-    std::fs::write(dir.join("car.toml"), toml.stdout).unwrap();
-    let (code, err) = run_in(
-        dir,
-        &[
-            "simulate",
-            "car.toml",
-            "--out",
-            "imu.csv",
-            "--truth",
-            "truth.csv",
-            "--gnss",
-            "gnss.csv",
-        ],
-    );
-    assert_eq!(code, Some(0), "{err}");
     let (code, err) = run_in(
         dir,
         &[
@@ -455,6 +496,12 @@ fn a_time_window_cuts_every_input_at_the_same_instants() {
     assert_eq!((fused[0][0], fused[fused.len() - 1][0]), (25.0, 50.0));
     // The fixes of 25 s to 50 s at 5 Hz, both ends included.
     assert!(err.contains("2501 samples fused with 126 updates"), "{err}");
+}
+
+#[test]
+fn a_window_without_rows_or_the_wrong_way_round_is_refused_by_name() {
+    let dir = gnss_car("empty-window");
+    let dir = dir.path();
     // An empty window, and a window the wrong way round, are refused by name.
     for (args, needle) in [
         (

@@ -124,20 +124,7 @@ fn a_noisy_walk_with_no_data_sheet_closes_its_loop_from_its_readings_alone() {
         let f = rows3(&sim.imu, ["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]);
         let w = rows3(&sim.imu, ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]);
         let stance = stance_samples(&t, &f, &w, &setup_with_rest(&setup, summary.rest_s));
-        let speed: Vec<f64> = rows3(&sim.truth, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"])
-            .iter()
-            .map(|v| v.iter().map(|c| c * c).sum::<f64>().sqrt())
-            .collect();
-        let still: Vec<bool> = speed.iter().map(|s| *s == 0.0).collect();
-        // A stance sample whose neighbours (±5 samples, the detector's window and more) are
-        // all still; a swing sample moving faster than 0.05 m/s.
-        let inner = |i: usize| (i.saturating_sub(5)..(i + 6).min(still.len())).all(|j| still[j]);
-        let (stances, found) = (0..still.len())
-            .filter(|&i| inner(i))
-            .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
-        let (swings, called_still) = (0..still.len())
-            .filter(|&i| speed[i] > 0.05)
-            .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
+        let ((found, stances), (called_still, swings)) = stance_scores(&sim.truth, &stance);
         eprintln!(
             "run {run}: stances found {found} of {stances}, swing samples called still \
              {called_still} of {swings}"
@@ -152,22 +139,7 @@ fn a_noisy_walk_with_no_data_sheet_closes_its_loop_from_its_readings_alone() {
         );
 
         // The loop closes: the walk ends where it began (the truth's 377 m).
-        let truth = rows3(&sim.truth, ["pos_x_m", "pos_y_m", "pos_z_m"]);
-        let walked: f64 = truth
-            .windows(2)
-            .map(|p| {
-                (0..3)
-                    .map(|k| (p[1][k] - p[0][k]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .sum();
-        let pos = rows3(&est, ["pos_x_m", "pos_y_m", "pos_z_m"]);
-        let (first, last) = (pos[0], pos[pos.len() - 1]);
-        let closure = (0..3)
-            .map(|k| (last[k] - first[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let (walked, closure) = walked_and_closure(&sim.truth, &est);
         eprintln!(
             "run {run}: {walked:.1} m walked, loop closed within {closure:.3} m ({:.3} %)",
             100.0 * closure / walked
@@ -177,6 +149,46 @@ fn a_noisy_walk_with_no_data_sheet_closes_its_loop_from_its_readings_alone() {
             "run {run}: {closure} m after {walked} m"
         );
     }
+}
+
+/// The stance samples `stance` found against the truth's speed: (found, of the stance samples
+/// whose neighbours (±5 samples, the detector's window and more) are all still), and (called
+/// still, of the swing samples moving faster than 0.05 m/s).
+fn stance_scores(truth: &Table, stance: &[bool]) -> ((usize, usize), (usize, usize)) {
+    let speed: Vec<f64> = rows3(truth, ["vel_x_m_s", "vel_y_m_s", "vel_z_m_s"])
+        .iter()
+        .map(|v| v.iter().map(|c| c * c).sum::<f64>().sqrt())
+        .collect();
+    let still: Vec<bool> = speed.iter().map(|s| *s == 0.0).collect();
+    let inner = |i: usize| (i.saturating_sub(5)..(i + 6).min(still.len())).all(|j| still[j]);
+    let (stances, found) = (0..still.len())
+        .filter(|&i| inner(i))
+        .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
+    let (swings, called_still) = (0..still.len())
+        .filter(|&i| speed[i] > 0.05)
+        .fold((0, 0), |(s, k), i| (s + 1, k + usize::from(stance[i])));
+    ((found, stances), (called_still, swings))
+}
+
+/// The distance the truth walked and how far the estimate's end is from its start, m.
+fn walked_and_closure(truth: &Table, est: &Table) -> (f64, f64) {
+    let truth = rows3(truth, ["pos_x_m", "pos_y_m", "pos_z_m"]);
+    let walked: f64 = truth
+        .windows(2)
+        .map(|p| {
+            (0..3)
+                .map(|k| (p[1][k] - p[0][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .sum();
+    let pos = rows3(est, ["pos_x_m", "pos_y_m", "pos_z_m"]);
+    let (first, last) = (pos[0], pos[pos.len() - 1]);
+    let closure = (0..3)
+        .map(|k| (last[k] - first[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    (walked, closure)
 }
 
 /// `setup` with the rest the fusion found (the stance detector takes the gyroscope's mean over

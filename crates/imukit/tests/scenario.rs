@@ -173,7 +173,7 @@ fn err_text(r: Result<impl std::fmt::Debug, Error>) -> String {
 }
 
 #[test]
-fn errors_say_what_and_where() {
+fn errors_in_a_scenario_name_its_key_and_column() {
     let dir = temp_dir("errors");
     let dir = dir.path();
     // Unknown function, with key and column.
@@ -211,6 +211,18 @@ fn errors_say_what_and_where() {
     let lock = "rate_hz = 10.0\nduration_s = 1.0\n[trajectory]\ntype = \"expression\"\nposition_m = [0, 0, 0]\npitch_rad = \"pi/2*t/0.5\"\n";
     let e = err_text(run_toml(lock, dir));
     assert!(e.contains("gimbal lock") && e.contains("t = 0.5 s"), "{e}");
+    // Missing rate for an expression.
+    let e = err_text(run_toml(
+        "[trajectory]\ntype = \"expression\"\nposition_m = [0, 0, 0]\n",
+        dir,
+    ));
+    assert!(e.contains("rate_hz: missing"), "{e}");
+}
+
+#[test]
+fn errors_in_a_samples_file_name_the_file_row_and_column() {
+    let dir = temp_dir("sample-errors");
+    let dir = dir.path();
     // Missing columns in a samples file.
     std::fs::write(dir.join("nocols.csv"), "t_s,pos_x_m,pos_y_m\n0,0,0\n").unwrap();
     let e = err_text(run_toml(
@@ -293,12 +305,6 @@ fn errors_say_what_and_where() {
         dir,
     ));
     assert!(e.contains("empty.csv") && e.contains("empty"), "{e}");
-    // Missing rate for an expression.
-    let e = err_text(run_toml(
-        "[trajectory]\ntype = \"expression\"\nposition_m = [0, 0, 0]\n",
-        dir,
-    ));
-    assert!(e.contains("rate_hz: missing"), "{e}");
 }
 
 #[test]
