@@ -3,9 +3,41 @@
 //! a description that names another kind of table than its file's columns is refused.
 use std::path::Path;
 
-use crate::description::{Description, Origin};
+use crate::TableFormat;
+use crate::description::{Description, KEY_PREFIX, Origin, Value};
 use crate::error::{Error, Result};
 use crate::schema::TableKind;
+
+impl Description {
+    /// The description of the table file at `path` in the format its extension names: Parquet
+    /// metadata, a CSV file's first line; `None` when it has none (or the format has no room).
+    ///
+    /// # Errors
+    /// An unreadable file; a description that is not what imukit writes (bad JSON, an unknown
+    /// name, a number that is not finite), naming the file and the key.
+    pub fn read(path: &Path) -> Result<Option<Self>> {
+        match TableFormat::of(path) {
+            TableFormat::Parquet => {
+                let metadata = crate::parquet::read_metadata(path)?;
+                let entries: Vec<(&str, Value)> = metadata
+                    .iter()
+                    .filter_map(|(k, v)| {
+                        k.strip_prefix(KEY_PREFIX)
+                            .map(|k| (k, Value::Text(v.clone())))
+                    })
+                    .collect();
+                if entries.is_empty() {
+                    return Ok(None);
+                }
+                let place = format!("{}, metadata", path.display());
+                Self::from_entries(entries, &place).map(Some)
+            }
+            TableFormat::Npy | TableFormat::Npz | TableFormat::Nmea => Ok(None),
+            TableFormat::Mcap => crate::bag::description(path),
+            TableFormat::Csv => Self::read_csv(path),
+        }
+    }
+}
 
 /// Refuses a file whose description names a kind of table its columns are not (a description
 /// copied onto other data, or edited by hand): its settings would then be taken for data they
@@ -209,5 +241,211 @@ impl Described {
     /// Two files with different origins.
     pub fn origin(&self) -> Result<Option<Origin>> {
         Ok(self.agreed("origin", |d| d.origin)?.map(|(o, _)| o))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
+    use crate::description::*;
+
+    /// A description copied onto data of another kind is refused by name; a matching one is read.
+    #[test]
+    fn a_description_of_another_kind_of_table_is_refused() {
+        let dir = tempfile::tempdir().expect("dir");
+        let wrong = dir.path().join("imu.csv");
+        std::fs::write(
+            &wrong,
+            "# imukit: {\"kind\": \"truth\", \"nav_frame\": \"NED\"}\n\
+             t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n\
+             0,0,0,-9.8,0,0,0\n",
+        )
+        .expect("written");
+        let e = Described::read(&[wrong.as_path()])
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            e.contains("imu.csv")
+                && e.contains("says it holds truth but its columns are those of readings"),
+            "{e}"
+        );
+        let right = dir.path().join("ok.csv");
+        std::fs::write(
+            &right,
+            "# imukit: {\"kind\": \"readings\", \"nav_frame\": \"NED\"}\n\
+             t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n\
+             0,0,0,-9.8,0,0,0\n",
+        )
+        .expect("written");
+        assert!(Described::read(&[right.as_path()]).is_ok());
+    }
+
+    fn full() -> Description {
+        Description {
+            kind: Some(TableKind::Readings),
+            nav_frame: Some(NavFrameName::NED),
+            earth: Some(EarthName::Wgs84),
+            origin: Some(Origin {
+                latitude_deg: 45.5,
+                longitude_deg: -7.25,
+                height_m: 312.125,
+            }),
+            gravity_m_s2: Some(9.80665),
+            earth_gravity: Some(EarthGravityName::Constant),
+            accel_sign: Some(AccelSignName::Matlab),
+            sensor: Some("[gyroscope]\nnoise_density_rad_s = 1e-5\n".into()),
+            scenario: Some("rate_hz = 100.0\n# \"quoted\" and ünïcode\n".into()),
+        }
+    }
+
+    #[test]
+    fn a_description_comes_back_from_csv_and_parquet_metadata() {
+        let d = full();
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("t.csv");
+        let line = d.csv_line().unwrap();
+        assert!(
+            line.starts_with("# imukit: {\"kind\": \"readings\""),
+            "{line}"
+        );
+        assert!(!line.contains('\n'));
+        std::fs::write(&csv, format!("{line}\nt_s,gyro_x_rad_s\n0.0,1.0\n")).unwrap();
+        assert_eq!(Description::read(&csv).unwrap(), Some(d.clone()));
+        let entries: Vec<(String, String)> = d.metadata();
+        assert!(
+            entries
+                .iter()
+                .any(|(k, v)| k == "imukit.body_frame" && v == "FRD")
+        );
+        let back = Description::from_entries(
+            entries.iter().filter_map(|(k, v)| {
+                k.strip_prefix(KEY_PREFIX)
+                    .map(|k| (k, Value::Text(v.clone())))
+            }),
+            "m",
+        )
+        .unwrap();
+        assert_eq!(back, d);
+        // A file without one, and an empty description, say nothing.
+        std::fs::write(&csv, "t_s,gyro_x_rad_s\n0.0,1.0\n").unwrap();
+        assert_eq!(Description::read(&csv).unwrap(), None);
+        assert!(Description::default().csv_line().is_none());
+        assert!(Description::default().metadata().is_empty());
+    }
+
+    #[test]
+    fn rows_are_counted_from_the_header_whatever_the_description_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("t.csv");
+        let line = Description::of_kind(TableKind::Readings)
+            .csv_line()
+            .unwrap();
+        std::fs::write(&csv, format!("{line}\nt_s,gyro_x_rad_s\n0.0,1.0\n0.1,x\n")).unwrap();
+        let mut rows = crate::read::CsvRows::open(&csv, &["t_s", "gyro_x_rad_s"], "").unwrap();
+        let mut r = [0.0; 2];
+        assert_eq!(rows.next_row(&mut r).unwrap(), Some(2));
+        let e = rows.next_row(&mut r).unwrap_err().to_string();
+        assert!(e.contains("row 3") && e.contains("gyro_x_rad_s"), "{e}");
+        std::fs::write(&csv, format!("{line}\nt_s,gyro_x_rad_s\n0.0,1.0\n0.1\n")).unwrap();
+        let mut rows = crate::read::CsvRows::open(&csv, &["t_s"], "").unwrap();
+        rows.next_row(&mut r[..1]).unwrap();
+        let e = rows.next_row(&mut r[..1]).unwrap_err().to_string();
+        assert!(e.contains("row 3 has 1 fields"), "{e}");
+    }
+
+    #[test]
+    fn a_bad_description_is_refused_by_file_and_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("t.csv");
+        let refused = |line: &str| {
+            std::fs::write(&csv, format!("{line}\nt_s\n0.0\n")).unwrap();
+            Description::read(&csv).unwrap_err().to_string()
+        };
+        let e = refused("# imukit: {\"nav_frame\": \"NWU\"}");
+        assert!(
+            e.contains("t.csv, line 1: key nav_frame") && e.contains("NWU"),
+            "{e}"
+        );
+        let e = refused("# imukit: {\"gravity_m_s2\": \"heavy\"}");
+        assert!(e.contains("key gravity_m_s2") && e.contains("heavy"), "{e}");
+        let e = refused("# imukit: {\"nav_frame\": \"ENU\", \"body_frame\": \"FRD\"}");
+        assert!(e.contains("key body_frame") && e.contains("FLU"), "{e}");
+        let e = refused("# imukit: {\"origin_latitude_deg\": 45}");
+        assert!(e.contains("latitude, longitude and height together"), "{e}");
+        let e = refused("# imukit: {\"kind\": ");
+        assert!(e.contains("line 1") && e.contains("not valid JSON"), "{e}");
+        let e = refused("# imukit: [1, 2]");
+        assert!(e.contains("not a JSON object"), "{e}");
+        // Entries of a later version are ignored.
+        std::fs::write(
+            &csv,
+            "# imukit: {\"kind\": \"truth\", \"unheard_of\": [1]}\nt_s\n",
+        )
+        .unwrap();
+        assert_eq!(
+            Description::read(&csv).unwrap(),
+            Some(Description::of_kind(TableKind::Truth))
+        );
+    }
+
+    #[test]
+    fn a_setting_is_the_option_else_the_files_else_the_default() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b, plain) = (
+            dir.path().join("a.csv"),
+            dir.path().join("b.csv"),
+            dir.path().join("plain.csv"),
+        );
+        let write = |p: &Path, d: &Description| {
+            std::fs::write(p, format!("{}\nt_s\n", d.csv_line().unwrap())).unwrap();
+        };
+        write(&a, &full());
+        write(
+            &b,
+            &Description {
+                nav_frame: Some(NavFrameName::ENU),
+                ..full()
+            },
+        );
+        std::fs::write(&plain, "t_s\n").unwrap();
+        let nav = |d: &Description| d.nav_frame;
+        let one = Described::read(&[&a, &plain]).unwrap();
+        assert_eq!(
+            one.pick("nav_frame", None, nav, NavFrameName::ENU).unwrap(),
+            NavFrameName::NED
+        );
+        assert_eq!(
+            one.pick("nav_frame", Some(NavFrameName::NED), nav, NavFrameName::ENU)
+                .unwrap(),
+            NavFrameName::NED
+        );
+        let e = one
+            .pick("nav_frame", Some(NavFrameName::ENU), nav, NavFrameName::ENU)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("nav_frame")
+                && e.contains("ENU contradicts")
+                && e.contains("a.csv")
+                && e.contains("NED"),
+            "{e}"
+        );
+        let none = Described::read(&[&plain]).unwrap();
+        assert_eq!(
+            none.pick("nav_frame", None, nav, NavFrameName::ENU)
+                .unwrap(),
+            NavFrameName::ENU
+        );
+        let e = Described::read(&[&a, &b])
+            .unwrap()
+            .pick("nav_frame", None, nav, NavFrameName::ENU)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("disagree") && e.contains("a.csv") && e.contains("b.csv"),
+            "{e}"
+        );
+        assert_eq!(one.origin().unwrap(), full().origin);
     }
 }

@@ -53,6 +53,7 @@ pub mod schema;
 pub mod table;
 pub mod units;
 pub mod value_tree;
+pub mod writeback;
 
 pub use error::{Error, Result};
 pub use input::Input;

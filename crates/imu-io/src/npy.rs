@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use npyz::{DType, NpyHeader, NpyWriter, TypeStr, WriterBuilder};
 
 use crate::error::{Error, Result};
-use crate::output::{OutputFile, WRITE_BLOCK};
+use crate::writeback::{OutputFile, WRITE_BLOCK};
 
 /// NumPy's own limit on a header's length (`max_header_size` of `numpy.load`), bytes: a longer
 /// header is refused before it is read.

@@ -20,8 +20,8 @@ use zip::write::SimpleFileOptions;
 
 use crate::error::{Error, Result};
 use crate::npy::{MAX_HEADER_BYTES, float64};
-use crate::output::OutputFile;
 use crate::table::Table;
+use crate::writeback::OutputFile;
 
 /// Bytes of rows a writer keeps in memory before moving them to its temporary file.
 const BLOCK_BYTES: usize = 8 << 20;

@@ -19,8 +19,8 @@ use parquet::file::properties::WriterProperties;
 
 use crate::description::Description;
 use crate::error::{Error, Result};
-use crate::output::OutputFile;
 use crate::table::Table;
+use crate::writeback::OutputFile;
 
 /// Rows per row group (and per write): memory stays flat however long the table.
 pub const ROW_GROUP: usize = 65_536;

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use crate::description::Description;
 use crate::error::{Result, invalid};
-use crate::output::OutputFile;
 use crate::table::Table;
+use crate::writeback::OutputFile;
 
 fn refused(path: &Path) -> crate::Error {
     invalid(

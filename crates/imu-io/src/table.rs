@@ -10,13 +10,10 @@ use std::path::{Path, PathBuf};
 use imu_core::sensor::ImuReading;
 use imu_core::{NavFrame, Truth};
 
-use crate::TableFormat;
 use crate::columns::{
     ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, TRUTH_COLUMNS,
 };
-use crate::description::Description;
 use crate::error::{Error, Result};
-use crate::output::write_atomically;
 
 /// What the accelerometer and gyroscope columns hold.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -376,80 +373,6 @@ impl Table {
         }
     }
 
-    /// Writes the table in the format its path's extension names ([`TableFormat::written`]:
-    /// Parquet for `.parquet`, NumPy for `.npy` and `.npz`, a bag for `.mcap`, CSV for `.csv`,
-    /// `.txt` or no extension), atomically.
-    ///
-    /// # Errors
-    /// A name of another format; a value that is not finite; [`Error::Io`] naming the file.
-    pub fn write(&self, path: &Path) -> Result<()> {
-        self.write_described(path, &Description::of_columns(&self.columns))
-    }
-
-    /// [`Self::write`] with `description` in the file ([`crate::description`]: Parquet's
-    /// metadata, CSV's first line; the NumPy formats have no room for it), its kind, when it
-    /// gives none, found from the columns.
-    ///
-    /// # Errors
-    /// As [`Self::write`].
-    pub fn write_described(&self, path: &Path, description: &Description) -> Result<()> {
-        let kinded;
-        let description = if description.kind.is_none() {
-            kinded = Description {
-                kind: crate::schema::TableKind::detect(&self.columns),
-                ..description.clone()
-            };
-            &kinded
-        } else {
-            description
-        };
-        match TableFormat::written(&path.display().to_string(), path)? {
-            TableFormat::Parquet
-            | TableFormat::Npy
-            | TableFormat::Npz
-            | TableFormat::Mcap
-            | TableFormat::Nmea => self.write_binary(path, description),
-            TableFormat::Csv => self.write_csv_described(path, description),
-        }
-    }
-
-    /// Writes the table in the binary format its path's extension names (Parquet, `.npy`,
-    /// `.npz`), with `description` where the format has room for it, atomically; every value must
-    /// be finite (refused, naming row and column — rows from 1, no header row — before the file
-    /// is made).
-    ///
-    /// # Errors
-    /// A value that is not finite; the writer's or the file system's refusal, naming the file.
-    pub(crate) fn write_binary(&self, path: &Path, description: &Description) -> Result<()> {
-        check_finite_from(&self.columns, &self.data, &path.display().to_string(), 1)?;
-        let mut file = crate::output::AtomicFile::create(path)?;
-        file.begin_table(&self.columns, description)?;
-        file.write_table_rows(&self.data)?;
-        file.commit()
-    }
-
-    /// Writes the table as CSV with a header row, atomically (temporary file, then rename),
-    /// described by its kind ([`Self::write`]).
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file.
-    pub fn write_csv(&self, path: &Path) -> Result<()> {
-        self.write_csv_described(path, &Description::of_columns(&self.columns))
-    }
-
-    fn write_csv_described(&self, path: &Path, description: &Description) -> Result<()> {
-        check_column_names(&self.columns, path)?;
-        self.check_finite(&path.display().to_string())?;
-        let line = description.csv_line();
-        write_atomically(path, |w| {
-            if let Some(l) = &line {
-                writeln!(w, "{l}")?;
-            }
-            self.write_header(w)?;
-            self.write_body(w)
-        })
-    }
-
     /// Writes the CSV header row.
     ///
     /// # Errors
@@ -481,7 +404,7 @@ pub fn write_rows(
     // Rows are formatted into one local buffer (zmij straight into it) and handed to the writer
     // a block at a time: no call into the writer per field, and few calls into the system.
     let mut buf = zmij::Buffer::new();
-    let mut text: Vec<u8> = Vec::with_capacity(crate::output::WRITE_BLOCK + 4096);
+    let mut text: Vec<u8> = Vec::with_capacity(crate::writeback::WRITE_BLOCK + 4096);
     for row in data.chunks(width.max(1)) {
         for (k, v) in row.iter().enumerate() {
             if k > 0 {
@@ -490,7 +413,7 @@ pub fn write_rows(
             text.extend_from_slice(buf.format(*v).as_bytes());
         }
         text.push(b'\n');
-        if text.len() >= crate::output::WRITE_BLOCK {
+        if text.len() >= crate::writeback::WRITE_BLOCK {
             w.write_all(&text)?;
             text.clear();
         }
@@ -600,7 +523,7 @@ mod tests {
             assert_eq!(text.lines().count(), 3);
             if width == 80_000 {
                 let row = text.lines().next().map_or(0, str::len);
-                assert!(row > crate::output::WRITE_BLOCK, "a row of {row} bytes");
+                assert!(row > crate::writeback::WRITE_BLOCK, "a row of {row} bytes");
             }
             let back: Vec<f64> = text
                 .lines()
@@ -657,7 +580,7 @@ mod tests {
                 }
                 assert!(out == want, "width {width}, separator {separator:?}");
                 assert!(
-                    out.len() > 2 * crate::output::WRITE_BLOCK,
+                    out.len() > 2 * crate::writeback::WRITE_BLOCK,
                     "{} bytes",
                     out.len()
                 );

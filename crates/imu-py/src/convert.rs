@@ -1,7 +1,8 @@
 //! NumPy and Python objects in, library types out, and back: shapes are checked here, once, with
 //! the argument named. Nothing here computes.
 use imukit::Table;
-use imukit::io::description::{Described, Description, Value};
+use imukit::io::described::Described;
+use imukit::io::description::{Description, Value};
 use imukit::io::params::{MAX_DEPTH, ParamValue, SensorTable};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{

@@ -6,7 +6,7 @@ use imukit::error::Data;
 use imukit::io::Input;
 use imukit::io::bag::Role;
 use imukit::io::conventions::{EarthName, NavFrameName};
-use imukit::io::description::Described;
+use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::read::{read_table, read_table_as};
 use imukit::io::rows::{Gaps, TimeWindow};

@@ -7,7 +7,7 @@ use imukit::choice::Choice;
 use imukit::core::strapdown::planar::PlanarScheme;
 use imukit::error::Data;
 use imukit::io::Input;
-use imukit::io::description::Described;
+use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::{Gaps, TimeWindow};
 use imukit::run::navigate::{InitialState, NavAsked, NavRequest, NavSetup, integrate_csv};

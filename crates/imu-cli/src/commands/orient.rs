@@ -3,7 +3,7 @@ use std::path::Path;
 
 use imukit::io::Input;
 use imukit::io::conventions::{AccelSignName, NavFrameName};
-use imukit::io::description::Described;
+use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
 use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};

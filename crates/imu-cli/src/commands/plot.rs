@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use imu_plot::animate::{self as anim, AnimateOptions};
 use imu_plot::{FigureSize, plot_files};
 use imukit::io::conventions::NavFrameName;
-use imukit::io::description::Described;
+use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::read::read_table;
 use imukit::io::rows::TimeWindow;

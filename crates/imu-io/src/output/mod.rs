@@ -7,8 +7,7 @@
 //! and a job's outputs checked against its inputs and against each other before work starts
 //! ([`check_outputs`]), so no input is overwritten.
 use std::fs::File;
-use std::io::{BufWriter, Seek, SeekFrom, Write};
-use std::num::NonZeroU64;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::TableFormat;
@@ -27,99 +26,7 @@ const NAME_MAX: usize = 255;
 /// The suffix of a file being written.
 const PARTIAL: &str = ".imukit-partial";
 
-/// What an output gathers before it hands it to the system in one write, bytes: the block CSV
-/// rows are formatted into (at most; a chunk of rows is written when formatted) and the buffer
-/// `.npy` records go through — fewer, larger calls. Parquet's pages (about 50 KB) are written as
-/// they come.
-pub const WRITE_BLOCK: usize = 1 << 20;
-
-/// How much an output file is written before its new part is handed to the disk, bytes.
-pub const WRITEBACK_STEP: u64 = 8 << 20;
-
-/// An output file whose written part is handed to the disk as it grows, every
-/// [`WRITEBACK_STEP`] bytes, while the command goes on working, instead of all at once when it
-/// ends: the sync at the end (the file must be on the disk before it is renamed into place)
-/// then waits for the last step only. On Linux the kernel is asked to start writing the new
-/// part back (`posix_fadvise`'s `DONTNEED`, which starts the write-back of dirty pages without
-/// waiting for it); elsewhere, and where the file system declines, the file is written as any
-/// other. Seeks and the file's contents are those of the file itself.
-#[derive(Debug)]
-pub struct OutputFile {
-    file: File,
-    /// Where the next byte goes.
-    position: u64,
-    /// Up to where the disk has been asked to write.
-    handed: u64,
-}
-
-impl OutputFile {
-    /// `file`, written from its start.
-    #[must_use]
-    pub fn new(file: File) -> Self {
-        Self {
-            file,
-            position: 0,
-            handed: 0,
-        }
-    }
-
-    /// The file.
-    #[must_use]
-    pub fn get_ref(&self) -> &File {
-        &self.file
-    }
-
-    /// The file, with what was written.
-    #[must_use]
-    pub fn into_inner(self) -> File {
-        self.file
-    }
-
-    /// Hands the bytes written since the last step to the disk, once there are enough.
-    fn hand_over(&mut self) {
-        if self.position < self.handed {
-            // Written again further back (an archive's header): from there on.
-            self.handed = self.position;
-        }
-        let Some(len) = NonZeroU64::new(self.position - self.handed) else {
-            return;
-        };
-        if len.get() < WRITEBACK_STEP {
-            return;
-        }
-        #[cfg(any(target_os = "linux", target_os = "android"))]
-        {
-            // Advice only: a refusal changes nothing, the sync at the end reports real errors.
-            let _ = rustix::fs::fadvise(
-                &self.file,
-                self.handed,
-                Some(len),
-                rustix::fs::Advice::DontNeed,
-            );
-        }
-        self.handed = self.position;
-    }
-}
-
-impl Write for OutputFile {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let n = self.file.write(buf)?;
-        self.position += n as u64;
-        self.hand_over();
-        Ok(n)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.file.flush()
-    }
-}
-
-impl Seek for OutputFile {
-    fn seek(&mut self, to: SeekFrom) -> std::io::Result<u64> {
-        self.position = self.file.seek(to)?;
-        Ok(self.position)
-    }
-}
+pub use crate::writeback::{OutputFile, WRITE_BLOCK, WRITEBACK_STEP};
 
 /// Writes a file through `fill` into a temporary file beside it, put in place only when
 /// complete ([`AtomicFile`]); nothing is left on error.
@@ -591,6 +498,7 @@ fn name_unnamed(_file: &File, _folder: &Path, _path: &Path) -> std::io::Result<P
 
 mod check;
 mod group;
+mod table;
 #[cfg(test)]
 mod tests;
 

@@ -1,5 +1,3 @@
-use std::io::Read;
-
 use super::*;
 
 #[test]
@@ -94,57 +92,4 @@ fn an_output_in_a_missing_folder_is_refused_naming_the_file_and_its_folder() {
     assert!(message.contains("nosuch does not exist"), "{message}");
     assert!(!message.contains(PARTIAL), "{message}");
     assert!(!dir.path().join("nosuch").exists());
-}
-
-#[test]
-fn an_output_file_holds_what_was_written_and_hands_each_step_to_the_disk() {
-    // Past several steps, then back to the start (as an archive rewrites its header) and
-    // on from the end: the file is exactly what was written, and the part handed to the
-    // disk follows the writes (`handed` is where the last hand-over ended).
-    let dir = tempfile::tempdir().expect("a folder");
-    let path = dir.path().join("out.bin");
-    let mut out = OutputFile::new(File::create(&path).expect("a file"));
-    let step = usize::try_from(WRITEBACK_STEP).expect("a step fits");
-    let block: Vec<u8> = (0..step / 3 + 7).map(|i| (i % 251) as u8).collect();
-    let mut want = Vec::new();
-    let mut handed = Vec::new();
-    for _ in 0..10 {
-        out.write_all(&block).expect("written");
-        want.extend_from_slice(&block);
-        handed.push((out.position, out.handed));
-    }
-    // Handed over a step at a time, at the end of a write, never further behind than a step.
-    let step = WRITEBACK_STEP;
-    assert!(
-        handed
-            .iter()
-            .all(|&(at, h)| h % (block.len() as u64) == 0 && at - h < step),
-        "{handed:?}"
-    );
-    let handed: Vec<u64> = handed.into_iter().map(|(_, h)| h).collect();
-    assert!(
-        handed.contains(&0) && handed.iter().any(|&h| h >= 2 * step),
-        "{handed:?}"
-    );
-    out.seek(SeekFrom::Start(0)).expect("seek");
-    out.write_all(b"head").expect("written");
-    want[..4].copy_from_slice(b"head");
-    assert_eq!(out.handed, 4, "handed from the rewritten place on");
-    out.seek(SeekFrom::End(0)).expect("seek");
-    out.write_all(b"tail").expect("written");
-    want.extend_from_slice(b"tail");
-    out.flush().expect("flushed");
-    out.get_ref().sync_all().expect("synced");
-    drop(out);
-    let mut back = Vec::new();
-    File::open(&path)
-        .expect("opened")
-        .read_to_end(&mut back)
-        .expect("read");
-    assert!(
-        back == want,
-        "{} bytes back, {} written",
-        back.len(),
-        want.len()
-    );
 }

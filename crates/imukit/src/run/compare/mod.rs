@@ -377,7 +377,7 @@ fn next_state(
 ///
 /// # Errors
 /// [`crate::Error::Invalid`] naming the setting and both inputs.
-pub fn check_comparable(described: &crate::io::description::Described) -> Result<()> {
+pub fn check_comparable(described: &crate::io::described::Described) -> Result<()> {
     described.known("nav_frame", None, |d| d.nav_frame)?;
     described.known("earth", None, |d| d.earth)?;
     Ok(())
@@ -438,7 +438,7 @@ pub fn compare_csv_with(
     {
         return earth::compare_on_earth(truth, estimate, layout, (window, t0), out);
     }
-    check_comparable(&crate::io::description::Described::read(&[
+    check_comparable(&crate::io::described::Described::read(&[
         truth.path(),
         estimate.path(),
     ])?)?;

@@ -242,7 +242,7 @@ impl PartModel {
     pub fn setup_described(
         &self,
         asked: &crate::run::navigate::NavAsked,
-        described: &crate::io::description::Described,
+        described: &crate::io::described::Described,
         imu: &Table,
     ) -> Result<FuseSetup> {
         let nav = crate::run::navigate::NavRequest::default()

@@ -7,7 +7,8 @@ use super::EarthNav;
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
-use crate::io::description::{Described, Description};
+use crate::io::described::Described;
+use crate::io::description::Description;
 use crate::io::schema::TableKind;
 use crate::scenario::resolve::check_gravity;
 

@@ -10,7 +10,7 @@ use imu_core::{AccelSign, NavFrame};
 use crate::choice::{Choice, display_as_name};
 use crate::error::{Result, invalid};
 use crate::io::conventions::{AccelSignName, NavFrameName};
-use crate::io::description::Described;
+use crate::io::described::Described;
 
 /// The robust filter's status as the values of [`crate::io::columns::ROBUST_COLUMNS`].
 #[must_use]
