@@ -84,3 +84,30 @@ impl Choice for EarthGravityName {
 }
 
 display_as_name!(NavFrameName, AccelSignName, EarthName, EarthGravityName);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn round_trip<T: Choice>() {
+        for (name, choice) in T::NAMES {
+            assert_eq!(T::parse("f", name).unwrap(), *choice);
+            assert_eq!(T::parse("f", &name.to_ascii_uppercase()).unwrap(), *choice);
+            assert_eq!(choice.name(), *name);
+        }
+        assert!(T::NAMES.iter().any(|(_, c)| *c == T::default()));
+    }
+
+    #[test]
+    fn names_round_trip_and_refusals_list_them() {
+        round_trip::<NavFrameName>();
+        round_trip::<AccelSignName>();
+        round_trip::<EarthName>();
+        let e = NavFrameName::parse("nav_frame", "ECEF").unwrap_err();
+        assert_eq!(e.location().field.as_deref(), Some("nav_frame"));
+        assert_eq!(
+            e.to_string(),
+            "nav_frame: unknown navigation frame \"ECEF\" (ENU, NED)"
+        );
+    }
+}

@@ -8,8 +8,27 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::bag::Selection;
 use crate::column_map::ColumnMap;
+
+/// Which time a message of a bag is read at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Clock {
+    /// Its header's stamp: when the data were taken (the default).
+    #[default]
+    Header,
+    /// When the recorder received it (the bag's log time): for drivers whose header stamps
+    /// are missing or wrong.
+    Receive,
+}
+
+/// What to read from a bag: its topics (all when empty) and at which time.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Selection {
+    /// The topics to choose among (the command line's `--topic`, Python's `topic=`).
+    pub topics: Vec<String>,
+    /// Whose stamps (`--receive-time`, Python's `receive_time=`).
+    pub clock: Clock,
+}
 
 /// A file to read, with how to read it.
 #[derive(Clone, Debug, Default)]

@@ -30,7 +30,6 @@ use imu_core::allan::BIAS_INSTABILITY_FACTOR;
 use imu_core::sensor::{BiasInstabilityModel, FilterBuffer, NoiseType, SensorParams};
 
 use crate::error::{Error, Result};
-use crate::params::{ParamFile, Sensor};
 
 /// The longest Kalibr file read, bytes (Kalibr's own are a few hundred).
 const MAX_YAML_BYTES: u64 = 64 * 1024;
@@ -290,7 +289,7 @@ fn largest(v: [f64; 3]) -> f64 {
     v.into_iter().fold(0.0, f64::max)
 }
 
-fn sensor<B: FilterBuffer>(p: &SensorParams<B>, unit: &str) -> KalibrSensor {
+pub(crate) fn sensor<B: FilterBuffer>(p: &SensorParams<B>, unit: &str) -> KalibrSensor {
     let mut notes = Vec::new();
     let (n, k) = (largest(p.noise_density), largest(p.random_walk));
     if p.noise_density.iter().any(|&x| x != n) || p.random_walk.iter().any(|&x| x != k) {
@@ -341,35 +340,6 @@ fn sensor<B: FilterBuffer>(p: &SensorParams<B>, unit: &str) -> KalibrSensor {
 }
 
 impl KalibrImu {
-    /// Kalibr's figures of a parameter file's accelerometer and gyroscope, at `update_rate_hz`
-    /// on `rostopic`.
-    ///
-    /// # Errors
-    /// A rate that is not finite and positive, a file without an accelerometer or gyroscope.
-    pub fn from_params(file: &ParamFile, update_rate_hz: f64, rostopic: &str) -> Result<Self> {
-        if !(update_rate_hz.is_finite() && update_rate_hz > 0.0) {
-            return Err(Error::Invalid {
-                field: "rate_hz".into(),
-                message: format!("must be a finite rate above 0 Hz, got {update_rate_hz}"),
-            });
-        }
-        for (s, present) in Sensor::ALL.iter().zip(file.present) {
-            if *s != Sensor::Magnetometer && !present {
-                return Err(Error::Invalid {
-                    field: s.key().into(),
-                    message: "Kalibr's IMU file needs an accelerometer and a gyroscope".into(),
-                });
-            }
-        }
-        Ok(Self {
-            accelerometer: sensor(&file.params.accelerometer, "m/s²"),
-            gyroscope: sensor(&file.params.gyroscope, "rad/s"),
-            update_rate_hz,
-            rostopic: rostopic.to_owned(),
-            name: file.info.get("name").cloned(),
-        })
-    }
-
     /// The figures as an imukit parameter file (TOML): single-sided noise density and bias
     /// random walk on every axis of both sensors, nothing else.
     #[must_use]
@@ -460,70 +430,6 @@ mod tests {
         let path = dir.path().join(name);
         std::fs::write(&path, text).expect("written");
         path
-    }
-
-    #[test]
-    fn a_topic_is_written_quoted_and_a_file_that_says_a_key_twice_is_refused() {
-        let dir = tempfile::tempdir().expect("dir");
-        let file = crate::presets::load("stim300").expect("preset");
-        for topic in ["a: b", "/imu # x", "two\nupdate_rate: 1.0", "\"quoted\""] {
-            let written = KalibrImu::from_params(&file, 125.0, topic).expect("kalibr");
-            let path = write(&dir, "imu.yaml", &written.to_yaml());
-            let back = read(&path).expect("read back");
-            assert_eq!(
-                (back.rostopic.as_str(), back.update_rate_hz),
-                (topic, 125.0)
-            );
-        }
-        let good = KalibrImu::from_params(&file, 125.0, "/imu0")
-            .expect("kalibr")
-            .to_yaml();
-        let twice = format!("{good}update_rate: 200.0\n");
-        let e = read(&write(&dir, "twice.yaml", &twice))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("twice.yaml") && e.contains("key update_rate given twice"),
-            "{e}"
-        );
-        let second = format!("{good}---\n{good}");
-        let e = read(&write(&dir, "second.yaml", &second))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("a second YAML document"), "{e}");
-    }
-
-    #[test]
-    fn a_written_file_reads_back_as_its_figures() {
-        let dir = tempfile::tempdir().expect("dir");
-        let file = crate::presets::load("stim300").expect("preset");
-        let written = KalibrImu::from_params(&file, 125.0, "/imu0").expect("kalibr");
-        let path = write(&dir, "imu.yaml", &written.to_yaml());
-        let back = read(&path).expect("read");
-        assert_eq!(
-            (back.update_rate_hz, back.rostopic.as_str()),
-            (125.0, "/imu0")
-        );
-        for (a, b) in [
-            (&written.accelerometer, &back.accelerometer),
-            (&written.gyroscope, &back.gyroscope),
-        ] {
-            // Seven significant digits written.
-            assert!((a.noise_density - b.noise_density).abs() <= 5e-7 * a.noise_density);
-            assert!((a.random_walk - b.random_walk).abs() <= 5e-7 * a.random_walk);
-        }
-        // As a parameter file: the same figures on every axis, single-sided, nothing else.
-        let params = crate::params::read_param_file(&path, None, crate::params::Profile::default())
-            .expect("parameters");
-        let g = &params.params.gyroscope;
-        assert_eq!(g.noise_density, [back.gyroscope.noise_density; 3]);
-        assert_eq!(g.random_walk, [back.gyroscope.random_walk; 3]);
-        assert_eq!(g.noise_type, NoiseType::SingleSided);
-        assert_eq!(g.bias_instability, [0.0; 3]);
-        assert_eq!(
-            params.params.accelerometer.random_walk,
-            [back.accelerometer.random_walk; 3]
-        );
     }
 
     #[test]

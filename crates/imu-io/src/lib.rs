@@ -45,6 +45,7 @@ pub mod parquet;
 #[cfg(not(feature = "parquet"))]
 #[path = "parquet_off.rs"]
 pub mod parquet;
+pub mod part_file;
 pub mod plausible;
 pub mod presets;
 pub mod read;

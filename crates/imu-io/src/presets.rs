@@ -8,7 +8,8 @@
 //! transcribed, the field keeps its ideal value and the preset's `notes` say so.
 
 use crate::error::{Error, Result, invalid};
-use crate::params::{ParamFile, Profile, parse_param_document};
+use crate::params::Profile;
+use crate::part_file::{ParamFile, parse_param_document};
 
 /// `(name, TOML text)` of every preset.
 pub const PRESETS: [(&str, &str); 9] = [

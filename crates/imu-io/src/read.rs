@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use crate::TableFormat;
 use crate::column_map::{ColumnMap, Source, TimeUnit};
-use crate::error::{Error, Result, invalid};
+use crate::error::{Error, Result};
 use crate::input::Input;
 use crate::table::Table;
 
@@ -344,13 +344,13 @@ enum RowSource {
 /// file).
 #[derive(Debug)]
 pub struct CsvRows {
-    path: PathBuf,
+    pub(crate) path: PathBuf,
     reader: RowSource,
     record: csv::ByteRecord,
     /// The header's column names.
     names: Vec<String>,
     /// (field index, column name) of each requested column, in request order.
-    wanted: Vec<(usize, String)>,
+    pub(crate) wanted: Vec<(usize, String)>,
     /// Comment lines before a CSV file's header (its description line): not rows.
     comments: usize,
     /// How each column is made from the fields ([`Layout`]; `None`: column k is field k).
@@ -360,7 +360,7 @@ pub struct CsvRows {
     /// The file's own column names, by field, for messages.
     file_names: Option<Vec<String>>,
     /// Rows given only from `.1` to `.2` in the time column `.0` ([`CsvRows::within`]).
-    window: Option<(usize, f64, f64)>,
+    pub(crate) window: Option<(usize, f64, f64)>,
     /// Per requested column: an empty or NaN cell is a missing value, given as NaN
     /// ([`CsvRows::allowing_missing`]).
     missing_ok: Vec<bool>,
@@ -378,26 +378,6 @@ impl CsvRows {
             .map(|(_, name)| names.contains(&name.as_str()))
             .collect();
         self
-    }
-
-    /// Gives only the rows whose `t_s` (a column asked for) lies in `window`, its seconds
-    /// counted from `t0`: the rows before it are skipped, and the rows end after it.
-    ///
-    /// # Errors
-    /// `t_s` not among the columns asked for.
-    pub fn within(mut self, window: crate::rows::TimeWindow, t0: f64) -> Result<Self> {
-        if window.is_whole() {
-            return Ok(self);
-        }
-        let Some(k) = self.wanted.iter().position(|(_, name)| name == "t_s") else {
-            return Err(invalid(
-                self.path.display().to_string(),
-                "has no t_s column to cut a time window from",
-            ));
-        };
-        let (lo, hi) = window.bounds(t0);
-        self.window = Some((k, lo, hi));
-        Ok(self)
     }
 
     /// Opens `input` and checks that its header has every column of `required`; a CSV file is
@@ -647,5 +627,74 @@ impl CsvRows {
         } else {
             Err(self.bad(f, name, row, format!("not a finite number: \"{text}\"")))
         }
+    }
+}
+
+#[cfg(all(test, not(feature = "bags")))]
+mod bag_refused {
+    #[test]
+    fn a_bag_is_refused_by_name() {
+        let e = super::read_table(std::path::Path::new("run.mcap"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("run.mcap") && e.contains("`bags` feature is off"),
+            "{e}"
+        );
+    }
+}
+
+#[cfg(all(test, not(feature = "nmea")))]
+mod nmea_refused {
+    #[test]
+    fn a_log_is_refused_by_name() {
+        let e = super::read_table(std::path::Path::new("fixes.nmea"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fixes.nmea") && e.contains("`nmea` feature is off"),
+            "{e}"
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_are_read_with_whitespace_trimmed_and_bad_ones_named_by_row_and_column() {
+        let dir = tempfile::Builder::new()
+            .prefix("imukit-table-trim-")
+            .tempdir()
+            .unwrap();
+        let dir = dir.path();
+        let path = dir.join("t.csv");
+        // Spaces, a tab and no-break spaces (Unicode whitespace) around names and values.
+        std::fs::write(&path, " t_s ,\tx\n 0.5 ,\u{a0}-2\u{a0}\n1,\t3e2 \n").expect("written");
+        let columns = read_columns(&path, &["t_s", "x"], "").expect("read");
+        assert_eq!(columns.get("t_s"), [0.5, 1.0].as_slice());
+        assert_eq!(columns.get("x"), [-2.0, 300.0].as_slice());
+        for (row2, message) in [
+            (
+                b" 2, 1.0x".as_slice(),
+                "t.csv, row 3, column x: not a number: \"1.0x\"",
+            ),
+            (
+                b"2,inf",
+                "t.csv, row 3, column x: not a finite number: \"inf\"",
+            ),
+            (
+                b"2,\xff1",
+                "t.csv, row 3, column x: not a number: \"\u{fffd}1\"",
+            ),
+        ] {
+            let mut text = b"t_s,x\n1,2\n".to_vec();
+            text.extend_from_slice(row2);
+            std::fs::write(&path, &text).expect("written");
+            let err = read_columns(&path, &["t_s", "x"], "").expect_err("a bad value");
+            assert!(err.to_string().ends_with(message), "{err}");
+        }
+        let _ = std::fs::remove_dir_all(dir);
     }
 }

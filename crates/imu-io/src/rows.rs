@@ -544,6 +544,28 @@ impl TimedRows {
     }
 }
 
+impl CsvRows {
+    /// Gives only the rows whose `t_s` (a column asked for) lies in `window`, its seconds
+    /// counted from `t0`: the rows before it are skipped, and the rows end after it.
+    ///
+    /// # Errors
+    /// `t_s` not among the columns asked for.
+    pub fn within(mut self, window: TimeWindow, t0: f64) -> Result<Self> {
+        if window.is_whole() {
+            return Ok(self);
+        }
+        let Some(k) = self.wanted.iter().position(|(_, name)| name == "t_s") else {
+            return Err(invalid(
+                self.path.display().to_string(),
+                "has no t_s column to cut a time window from",
+            ));
+        };
+        let (lo, hi) = window.bounds(t0);
+        self.window = Some((k, lo, hi));
+        Ok(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -476,7 +476,6 @@ pub fn run_path(out: &Path, run: u64, runs: u64) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::read::read_columns;
 
     #[test]
     fn the_first_value_not_finite_is_found_wherever_it_is() {
@@ -590,41 +589,5 @@ mod tests {
             lengths.iter().copied().eq(3..=24),
             "text lengths: {lengths:?}"
         );
-    }
-
-    #[test]
-    fn values_are_read_with_whitespace_trimmed_and_bad_ones_named_by_row_and_column() {
-        let dir = tempfile::Builder::new()
-            .prefix("imukit-table-trim-")
-            .tempdir()
-            .unwrap();
-        let dir = dir.path();
-        let path = dir.join("t.csv");
-        // Spaces, a tab and no-break spaces (Unicode whitespace) around names and values.
-        std::fs::write(&path, " t_s ,\tx\n 0.5 ,\u{a0}-2\u{a0}\n1,\t3e2 \n").expect("written");
-        let columns = read_columns(&path, &["t_s", "x"], "").expect("read");
-        assert_eq!(columns.get("t_s"), [0.5, 1.0].as_slice());
-        assert_eq!(columns.get("x"), [-2.0, 300.0].as_slice());
-        for (row2, message) in [
-            (
-                b" 2, 1.0x".as_slice(),
-                "t.csv, row 3, column x: not a number: \"1.0x\"",
-            ),
-            (
-                b"2,inf",
-                "t.csv, row 3, column x: not a finite number: \"inf\"",
-            ),
-            (
-                b"2,\xff1",
-                "t.csv, row 3, column x: not a number: \"\u{fffd}1\"",
-            ),
-        ] {
-            let mut text = b"t_s,x\n1,2\n".to_vec();
-            text.extend_from_slice(row2);
-            std::fs::write(&path, &text).expect("written");
-            let err = read_columns(&path, &["t_s", "x"], "").expect_err("a bad value");
-            assert!(err.to_string().ends_with(message), "{err}");
-        }
-        let _ = std::fs::remove_dir_all(dir);
     }
 }

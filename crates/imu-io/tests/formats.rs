@@ -332,3 +332,51 @@ fn a_bad_npz_archive_is_refused_saying_what_and_where() {
         "{e}"
     );
 }
+
+#[test]
+fn a_table_is_written_only_under_a_name_whose_format_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = Table {
+        columns: vec!["t_s".into()],
+        data: vec![0.0, 1.0],
+    };
+    for (name, needle) in [
+        ("err.xlsx", ".xlsx is not a table format imukit writes"),
+        ("x.mat", ".mat is not a table format"),
+        ("x.h5", ".h5 is not a table format"),
+        ("x.db3", "name it .mcap"),
+        ("x.bag", "name it .mcap"),
+        ("x.nmea", ".nmea is not a table format"),
+    ] {
+        let path = dir.path().join(name);
+        let e = table.write(&path).unwrap_err().to_string();
+        assert!(e.contains(name) && e.contains(needle), "{name}: {e}");
+        assert!(!path.exists(), "{name} was written");
+        assert!(imu_io::output::check_table_outputs(&[("--out", &path)]).is_err());
+    }
+    for name in [
+        "t.csv",
+        "t.CSV",
+        "t.txt",
+        "t.parquet",
+        "t.npy",
+        "t.npz",
+        "noext",
+    ] {
+        let path = dir.path().join(name);
+        imu_io::output::check_table_outputs(&[("--out", &path)]).unwrap();
+        if cfg!(not(feature = "parquet")) && name.ends_with(".parquet") {
+            // A build without Parquet refuses the file by name and leaves nothing.
+            let e = table.write(&path).unwrap_err().to_string();
+            assert!(e.contains("`parquet` feature is off"), "{e}");
+            assert!(!path.exists());
+            continue;
+        }
+        table.write(&path).unwrap();
+        assert_eq!(
+            imu_io::read::read_table(&path).unwrap().data,
+            table.data,
+            "{name}"
+        );
+    }
+}

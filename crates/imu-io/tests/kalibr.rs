@@ -1,6 +1,9 @@
 //! Kalibr's `imu.yaml` from a parameter file: the figures against their closed forms.
 use imu_core::sensor::{BiasInstabilityModel, NoiseType};
+use imu_io::kalibr::read;
 use imu_io::kalibr::{DEFAULT_RATE_HZ, DEFAULT_TOPIC, KalibrImu};
+use imu_io::params::Profile;
+use imu_io::part_file::read_param_file;
 use imu_io::presets;
 
 fn close(got: f64, want: f64) {
@@ -90,4 +93,73 @@ fn a_rate_that_is_not_positive_is_refused_by_name() {
         let e = KalibrImu::from_params(&file, rate, DEFAULT_TOPIC).expect_err("refused");
         assert!(e.to_string().contains("rate_hz"), "{e}");
     }
+}
+
+fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).expect("written");
+    path
+}
+
+#[test]
+fn a_topic_is_written_quoted_and_a_file_that_says_a_key_twice_is_refused() {
+    let dir = tempfile::tempdir().expect("dir");
+    let file = presets::load("stim300").expect("preset");
+    for topic in ["a: b", "/imu # x", "two\nupdate_rate: 1.0", "\"quoted\""] {
+        let written = KalibrImu::from_params(&file, 125.0, topic).expect("kalibr");
+        let path = write(&dir, "imu.yaml", &written.to_yaml());
+        let back = read(&path).expect("read back");
+        assert_eq!(
+            (back.rostopic.as_str(), back.update_rate_hz),
+            (topic, 125.0)
+        );
+    }
+    let good = KalibrImu::from_params(&file, 125.0, "/imu0")
+        .expect("kalibr")
+        .to_yaml();
+    let twice = format!("{good}update_rate: 200.0\n");
+    let e = read(&write(&dir, "twice.yaml", &twice))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("twice.yaml") && e.contains("key update_rate given twice"),
+        "{e}"
+    );
+    let second = format!("{good}---\n{good}");
+    let e = read(&write(&dir, "second.yaml", &second))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("a second YAML document"), "{e}");
+}
+
+#[test]
+fn a_written_file_reads_back_as_its_figures() {
+    let dir = tempfile::tempdir().expect("dir");
+    let file = presets::load("stim300").expect("preset");
+    let written = KalibrImu::from_params(&file, 125.0, "/imu0").expect("kalibr");
+    let path = write(&dir, "imu.yaml", &written.to_yaml());
+    let back = read(&path).expect("read");
+    assert_eq!(
+        (back.update_rate_hz, back.rostopic.as_str()),
+        (125.0, "/imu0")
+    );
+    for (a, b) in [
+        (&written.accelerometer, &back.accelerometer),
+        (&written.gyroscope, &back.gyroscope),
+    ] {
+        // Seven significant digits written.
+        assert!((a.noise_density - b.noise_density).abs() <= 5e-7 * a.noise_density);
+        assert!((a.random_walk - b.random_walk).abs() <= 5e-7 * a.random_walk);
+    }
+    // As a parameter file: the same figures on every axis, single-sided, nothing else.
+    let params = read_param_file(&path, None, Profile::default()).expect("parameters");
+    let g = &params.params.gyroscope;
+    assert_eq!(g.noise_density, [back.gyroscope.noise_density; 3]);
+    assert_eq!(g.random_walk, [back.gyroscope.random_walk; 3]);
+    assert_eq!(g.noise_type, NoiseType::SingleSided);
+    assert_eq!(g.bias_instability, [0.0; 3]);
+    assert_eq!(
+        params.params.accelerometer.random_walk,
+        [back.accelerometer.random_walk; 3]
+    );
 }

@@ -47,7 +47,7 @@ fn read_table_file<'py>(
     topic: Option<String>,
     receive_time: bool,
 ) -> PyResult<DescribedOut<'py>> {
-    use imukit::io::bag::{Clock, Selection};
+    use imukit::io::input::{Clock, Selection};
     let mut input = Input::new(path);
     if topic.is_some() || receive_time {
         let clock = if receive_time {

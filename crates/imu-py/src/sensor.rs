@@ -2,7 +2,8 @@
 //! datasheet units, and Allan deviation with noise identification.
 use std::path::Path;
 
-use imukit::io::params::{Profile, read_param_file, to_toml};
+use imukit::io::params::Profile;
+use imukit::io::part_file::{read_param_file, to_toml};
 use imukit::io::{presets, units};
 use imukit::run::allan;
 use imukit::run::imu_sensor::{ImuSensor, ImuSensorRequest, Orientation};
@@ -291,7 +292,7 @@ fn identify<'py>(
     let file = id::param_file(&result, source).ok();
     d.set_item(
         "params_toml",
-        file.as_ref().map(imukit::io::params::to_toml),
+        file.as_ref().map(imukit::io::part_file::to_toml),
     )?;
     let yaml = match &file {
         Some(f) if f.present[0] && f.present[1] => {

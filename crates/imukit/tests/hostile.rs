@@ -7,7 +7,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use imukit::io::params::{Profile, read_param_file};
+use imukit::io::params::Profile;
+use imukit::io::part_file::read_param_file;
 use imukit::io::read::read_table;
 use imukit::motion::expr::Expr;
 use imukit::run::allan::allan;

@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use imu_core::sensor::NoiseType;
-use imukit::io::params::{ParamFile, Profile, parse_any_document, read_param_file, to_toml};
+use imukit::io::params::Profile;
+use imukit::io::part_file::{ParamFile, parse_any_document, read_param_file, to_toml};
 use imukit::io::presets;
 use imukit::sensor::{BiasInstabilityModel, SensorParams};
 use imukit::{ScenarioSpec, Simulation};

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use imukit::io::Input;
 use imukit::io::output::{check_outputs, write_atomically};
-use imukit::io::params::to_toml;
+use imukit::io::part_file::to_toml;
 use imukit::io::rows::TimeWindow;
 use imukit::run::identify::{
     column_header, column_warnings, curve_table, filter_noise, kalibr, param_file, rest_line,

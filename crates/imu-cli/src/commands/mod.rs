@@ -17,7 +17,7 @@ mod study;
 
 use imukit::choice::Choice;
 use imukit::io::Input;
-use imukit::io::bag::{Clock, Selection};
+use imukit::io::input::{Clock, Selection};
 use imukit::io::rows::TimeWindow;
 use imukit::run::navigate::{NavAsked, NavRequest, SchemeName};
 

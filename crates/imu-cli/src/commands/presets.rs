@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use imukit::io::kalibr::KalibrImu;
-use imukit::io::params::{ParamFile, Profile, read_param_file, to_toml};
+use imukit::io::params::Profile;
+use imukit::io::part_file::{ParamFile, read_param_file, to_toml};
 use imukit::io::presets;
 
 use super::CliError;

@@ -15,12 +15,12 @@
 //! | `nav_msgs/Odometry` | `t_s`, `pos_*_m`, `vel_*_m_s` (turned from the child frame into the pose's), `q_w…q_z` (+ `lat_rad`, `lon_rad`, `height_m` of a `NavSatFix` topic stamped alike) |
 //! | `geometry_msgs/PoseStamped` | `t_s`, `pos_*_m`, `q_w…q_z` (+ the same) |
 //!
-//! Stamps are the header's (or, with [`Clock::Receive`], the recorder's receive times), integer
+//! Stamps are the header's (or, with [`crate::input::Clock::Receive`], the recorder's receive times), integer
 //! nanoseconds, as seconds after the UTC midnight before the bag's earliest stamp (the rule of [`crate::asl`]: every topic of one bag on one clock, to
 //! the nanosecond). A fix without a fix (`status` −1) is left out.
 //!
 //! **Choosing a topic.** A reader asks for the columns it needs; the topics whose table has
-//! them are the candidates, narrowed to those the input's [`Selection`] names (`--topic`,
+//! them are the candidates, narrowed to those the input's [`crate::input::Selection`] names (`--topic`,
 //! Python's `topic=`; [`crate::Input::with_selection`]). One candidate is read; none or several is an error that lists the
 //! bag's topics. A topic merged into another (a magnetometer into its IMU) is a candidate only
 //! when named.
@@ -36,7 +36,7 @@
 //!
 //! The readers, the decoding and the writer need the `bags` feature (on by default): a build
 //! without it reads and writes no bag, and refuses one by name. What a reader asks of a bag
-//! ([`Selection`], [`Role`]) is always there, so that an [`crate::Input`] can carry it.
+//! ([`crate::input::Selection`], [`Role`]) is always there, so that an [`crate::Input`] can carry it.
 #[cfg(feature = "bags")]
 mod decode;
 #[cfg(feature = "bags")]
@@ -62,26 +62,6 @@ use crate::error::{Result, invalid};
 
 #[cfg(not(feature = "bags"))]
 pub use without::{BagOptions, BagWriter, column_names, description, read_table, read_table_as};
-
-/// Which time a message of a bag is read at.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Clock {
-    /// Its header's stamp: when the data were taken (the default).
-    #[default]
-    Header,
-    /// When the recorder received it (the bag's log time): for drivers whose header stamps
-    /// are missing or wrong.
-    Receive,
-}
-
-/// What to read from a bag: its topics (all when empty) and at which time.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Selection {
-    /// The topics to choose among (the command line's `--topic`, Python's `topic=`).
-    pub topics: Vec<String>,
-    /// Whose stamps (`--receive-time`, Python's `receive_time=`).
-    pub clock: Clock,
-}
 
 /// What a table is read as, where a file holds several (a bag's topics).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -209,7 +189,7 @@ mod without {
         /// # Errors
         /// Always.
         pub fn create(
-            _writer: std::io::BufWriter<crate::output::OutputFile>,
+            _writer: std::io::BufWriter<crate::writeback::OutputFile>,
             name: &str,
             _description: &Description,
             _options: &BagOptions,
@@ -229,7 +209,7 @@ mod without {
         ///
         /// # Errors
         /// None.
-        pub fn finish(self) -> Result<std::io::BufWriter<crate::output::OutputFile>> {
+        pub fn finish(self) -> Result<std::io::BufWriter<crate::writeback::OutputFile>> {
             match self {}
         }
     }
@@ -271,19 +251,5 @@ mod without {
     /// Always.
     pub fn description(path: &Path) -> Result<Option<Description>> {
         Err(refused(path))
-    }
-}
-
-#[cfg(all(test, not(feature = "bags")))]
-mod refused {
-    #[test]
-    fn a_bag_is_refused_by_name() {
-        let e = crate::read::read_table(std::path::Path::new("run.mcap"))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("run.mcap") && e.contains("`bags` feature is off"),
-            "{e}"
-        );
     }
 }

@@ -5,9 +5,9 @@ use super::storage::{mcap_messages, read_mcap, read_ros1, read_sqlite};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use super::Role;
 use super::decode::decode_row;
 use super::ros::{self, MessageType};
-use super::{Clock, Role};
 use crate::asl::{seconds_after, time_origin_ns};
 use crate::columns::{
     ACCEL_COLUMNS, FIX_ACCURACY_COLUMNS, GEODETIC_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, Position,
@@ -15,6 +15,7 @@ use crate::columns::{
 };
 use crate::description::Description;
 use crate::error::{Error, Result};
+use crate::input::Clock;
 use crate::input::Input;
 use crate::table::Table;
 

@@ -7,14 +7,11 @@ use super::*;
 use crate::asl::stamp_ns;
 use crate::columns::{ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS};
 use crate::description::Description;
-use crate::input::Input;
+use crate::input::{Clock, Input, Selection};
 use crate::table::Table;
 
 fn write_bag(path: &Path, tables: &[&Table], description: &Description) {
-    let mut file = crate::output::AtomicFile::create(path).expect("created");
-    file.begin_bag(description).expect("begun");
-    file.write_bag(tables).expect("written");
-    file.commit().expect("committed");
+    super::writer::write_bag_file(path, tables, description, &BagOptions::default());
 }
 
 fn readings(rows: usize, mag: bool) -> Table {

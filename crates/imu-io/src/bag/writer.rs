@@ -15,9 +15,9 @@ use crate::columns::{
 };
 use crate::description::Description;
 use crate::error::{Error, Result};
-use crate::output::OutputFile;
 use crate::schema::TableKind;
 use crate::table::Table;
+use crate::writeback::OutputFile;
 
 /// A topic being written: its channel and what it holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -461,10 +461,31 @@ impl BagWriter {
     }
 }
 
+/// Writes `tables` into a bag at `path` straight through a [`BagWriter`] (the tests' way: the
+/// atomic outputs that put a bag in place stand above this room).
+#[cfg(test)]
+pub(crate) fn write_bag_file(
+    path: &std::path::Path,
+    tables: &[&Table],
+    description: &Description,
+    options: &BagOptions,
+) {
+    let file = std::fs::File::create(path).expect("created");
+    let mut bag = BagWriter::create(
+        BufWriter::new(OutputFile::new(file)),
+        &path.display().to_string(),
+        description,
+        options,
+    )
+    .expect("begun");
+    bag.write(tables).expect("written");
+    let mut out = bag.finish().expect("finished");
+    std::io::Write::flush(&mut out).expect("flushed");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::AtomicFile;
     use crate::table::Table;
 
     fn readings() -> Table {
@@ -492,11 +513,7 @@ mod tests {
             Some(1_700_000_000.0),
         )
         .expect("valid");
-        let mut file = AtomicFile::create(&path).expect("created");
-        file.begin_bag_with(&Description::default(), &options)
-            .expect("begun");
-        file.write_bag(&[&readings()]).expect("written");
-        file.commit().expect("committed");
+        write_bag_file(&path, &[&readings()], &Description::default(), &options);
         let contents = super::super::read(&path).expect("read");
         let names: Vec<&str> = contents.topics.iter().map(|t| t.name.as_str()).collect();
         assert_eq!(names, ["/sensors/imu0", "/sensors/imu0/mag"]);

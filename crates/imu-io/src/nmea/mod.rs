@@ -84,17 +84,3 @@ pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
     }
     Ok(out)
 }
-
-#[cfg(all(test, not(feature = "nmea")))]
-mod refused {
-    #[test]
-    fn a_log_is_refused_by_name() {
-        let e = crate::read::read_table(std::path::Path::new("fixes.nmea"))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("fixes.nmea") && e.contains("`nmea` feature is off"),
-            "{e}"
-        );
-    }
-}

@@ -34,11 +34,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::sensor::SensorParams;
 
-mod file;
 mod sensor;
 
-pub use file::{ParamFile, parse_any_document, parse_param_document, read_param_file, to_toml};
 pub use sensor::parse_sensor;
+pub(crate) use sensor::parse_sensor_keys;
 
 /// A value as written in a parameter or scenario file or handed over from Python: a boolean, an
 /// integer, a number (infinity allowed where the key allows it; TOML writes `inf`, MATLAB's

@@ -123,7 +123,7 @@ pub fn parse_sensor(
 
 /// [`parse_sensor`], skipping unknown keys into `skipped` when it is given (MATLAB's
 /// `loadparams` ignores properties it does not know) instead of refusing them.
-pub(super) fn parse_sensor_keys(
+pub(crate) fn parse_sensor_keys(
     map: &SensorTable,
     sensor: Sensor,
     prefix: &str,

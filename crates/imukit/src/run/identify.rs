@@ -10,7 +10,8 @@ use imu_core::sensor::{BiasInstabilityModel, NoiseType};
 
 use crate::error::{Result, invalid};
 use crate::io::kalibr::KalibrImu;
-use crate::io::params::{ImuParams, ParamFile, Sensor};
+use crate::io::params::{ImuParams, Sensor};
+use crate::io::part_file::ParamFile;
 use crate::io::table::Table;
 use crate::io::units::factor_to;
 use crate::run::allan::{AllanResult, ColumnNoise};

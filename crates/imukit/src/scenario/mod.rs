@@ -135,7 +135,7 @@ impl Scenario {
             }
         };
         let kind = self.imu.kind;
-        let sensor = crate::io::params::to_toml(&crate::io::params::ParamFile {
+        let sensor = crate::io::part_file::to_toml(&crate::io::part_file::ParamFile {
             params: self.imu.sensors.params.clone(),
             present: [true, kind.has_gyro(), kind.has_mag()],
             ..Default::default()

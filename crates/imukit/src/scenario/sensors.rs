@@ -22,7 +22,8 @@ use imu_core::sensor::{GyroAccelerationInput, ImuReading, Temperatures};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
-use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor, read_param_file};
+use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor};
+use crate::io::part_file::read_param_file;
 use crate::io::presets;
 use crate::io::read::read_columns;
 use crate::scenario::perturb::Perturbation;

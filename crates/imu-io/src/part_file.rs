@@ -5,9 +5,9 @@ use std::path::Path;
 
 use imu_core::sensor::NoiseType;
 
-use super::sensor::parse_sensor_keys;
-use super::{ImuParams, ParamValue, Profile, Sensor};
 use crate::error::{Error, Result, invalid};
+use crate::kalibr::KalibrImu;
+use crate::params::{ImuParams, ParamValue, Profile, Sensor, parse_sensor_keys};
 use crate::sensor::{BiasInstabilityModel, SensorParams};
 
 /// A parameter file's content: the three sensors (missing ones ideal) and its description.
@@ -32,7 +32,7 @@ const INFO_KEYS: [&str; 4] = ["name", "grade", "source", "notes"];
 /// tables and descriptive strings) given as a JSON value.
 ///
 /// # Errors
-/// As [`parse_sensor`](super::parse_sensor); unknown top-level keys.
+/// As [`parse_sensor`](crate::params::parse_sensor); unknown top-level keys.
 pub fn parse_param_document(doc: &ParamValue, origin: &str, profile: Profile) -> Result<ParamFile> {
     parse_document(doc, origin, profile, false)
 }
@@ -326,4 +326,35 @@ pub fn to_toml(file: &ParamFile) -> String {
 
 fn fmt3_full(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", fmt1(v[0]), fmt1(v[1]), fmt1(v[2]))
+}
+
+impl KalibrImu {
+    /// Kalibr's figures of a parameter file's accelerometer and gyroscope, at `update_rate_hz`
+    /// on `rostopic`.
+    ///
+    /// # Errors
+    /// A rate that is not finite and positive, a file without an accelerometer or gyroscope.
+    pub fn from_params(file: &ParamFile, update_rate_hz: f64, rostopic: &str) -> Result<Self> {
+        if !(update_rate_hz.is_finite() && update_rate_hz > 0.0) {
+            return Err(Error::Invalid {
+                field: "rate_hz".into(),
+                message: format!("must be a finite rate above 0 Hz, got {update_rate_hz}"),
+            });
+        }
+        for (s, present) in Sensor::ALL.iter().zip(file.present) {
+            if *s != Sensor::Magnetometer && !present {
+                return Err(Error::Invalid {
+                    field: s.key().into(),
+                    message: "Kalibr's IMU file needs an accelerometer and a gyroscope".into(),
+                });
+            }
+        }
+        Ok(Self {
+            accelerometer: crate::kalibr::sensor(&file.params.accelerometer, "m/s²"),
+            gyroscope: crate::kalibr::sensor(&file.params.gyroscope, "rad/s"),
+            update_rate_hz,
+            rostopic: rostopic.to_owned(),
+            name: file.info.get("name").cloned(),
+        })
+    }
 }
