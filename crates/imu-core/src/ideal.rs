@@ -3,8 +3,9 @@
 //! `f_b = C_nbᵀ (a_n − g_n) + ω_b × (ω_b × r) + α_b × r` (rigid-body kinematics, eq. 9 of the MATLAB trajectory tool,
 //! with gravity taken out as a real accelerometer senses it), `ω_b` unchanged (the same at every
 //! point of a rigid body), `m_b = C_nbᵀ m_n`.
-use crate::frame::{Body, Frame, NavFrame};
+use crate::frame::{Body, Frame};
 use crate::kinematics::Truth;
+use crate::nav_frame::NavFrame;
 use crate::vector::Vec3;
 
 /// Sign convention of accelerometer output.

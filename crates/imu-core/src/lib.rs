@@ -33,6 +33,7 @@ pub mod fusion;
 pub mod ideal;
 pub mod kinematics;
 mod math;
+pub mod nav_frame;
 pub mod orientation;
 pub mod rotation;
 pub mod sensor;
@@ -41,8 +42,9 @@ pub mod strapdown;
 pub mod trig;
 pub mod vector;
 
-pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, Frd, NavFrame, Ned};
+pub use frame::{Body, DEFAULT_GRAVITY_M_S2, Ecef, Enu, Frame, Frd, Ned};
 pub use ideal::{AccelSign, IdealReading, ImuMount};
 pub use kinematics::{KinematicsError, Truth};
+pub use nav_frame::NavFrame;
 pub use rotation::{EulerZyx, Rotation};
 pub use vector::Vec3;

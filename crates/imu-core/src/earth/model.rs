@@ -14,8 +14,9 @@ use core::marker::PhantomData;
 use crate::earth::gravity::GravityModel;
 use crate::earth::rates::{MAX_LATITUDE_RAD, earth_rate_ned, geodetic_rates, transport_rate_ned};
 use crate::earth::wgs84::{Geodetic, OMEGA_IE_RAD_S};
-use crate::frame::{NavFrame, Ned};
+use crate::frame::Ned;
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::vector::Vec3;
 
 /// Gravity and the frame's rotation at one position and velocity, resolved in the navigation

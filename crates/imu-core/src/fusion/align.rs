@@ -8,8 +8,9 @@
 //! Body axes follow the frame's convention (FLU under ENU, FRD under NED); the formulas are
 //! written in NED/FRD and the frames exchanged exactly.
 use crate::earth::EarthModel;
-use crate::frame::{Body, Frd, NavFrame, Ned};
+use crate::frame::{Body, Frd, Ned};
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::rotation::{EulerZyx, Rotation};
 use crate::vector::Vec3;
 

@@ -8,10 +8,11 @@
 //! ([`finite_diff`](super::finite_diff)), or supplied by the caller.
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
 use crate::kinematics::finite_diff::{Stencils, check_order};
 use crate::kinematics::{KinematicsError, Truth, check_times};
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 use crate::vector::Vec3;
 

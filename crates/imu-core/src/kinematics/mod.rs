@@ -14,7 +14,8 @@ pub mod tangent;
 
 pub use error::KinematicsError;
 
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
+use crate::nav_frame::NavFrame;
 use crate::rotation::{EulerZyx, Rotation};
 use crate::vector::Vec3;
 

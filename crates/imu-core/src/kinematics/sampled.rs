@@ -7,11 +7,12 @@
 //! number and drops out of the vector part).
 use nalgebra::Quaternion;
 
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
 use crate::kinematics::finite_diff::{self, Stencils};
 use crate::kinematics::tangent::{DEFAULT_MIN_SPEED_M_S, TangentTracker};
 use crate::kinematics::{KinematicsError, Truth, check_times};
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::rotation::{EulerZyx, Rotation};
 use crate::vector::Vec3;
 

@@ -12,9 +12,10 @@ use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use super::{
     Estimate, FilterInput, OrientError, OrientationFilter, check_finite, gravity_reading, to_frame,
 };
-use crate::frame::{Body, NavFrame, Ned};
+use crate::frame::{Body, Ned};
 use crate::ideal::AccelSign;
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::rotation::{EulerZyx, Rotation};
 
 /// Orientation `q_nb` from an accelerometer reading (m/s², in `sign`) and a magnetometer

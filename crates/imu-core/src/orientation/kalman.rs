@@ -51,8 +51,8 @@ use super::{
     Estimate, FilterInput, OrientError, OrientationFilter, check_finite, gravity_reading, positive,
     to_frame,
 };
-use crate::frame::NavFrame;
 use crate::ideal::AccelSign;
+use crate::nav_frame::NavFrame;
 
 /// Error states: orientation, gyroscope offset, linear acceleration, magnetic disturbance.
 const STATES: usize = 12;

@@ -1,6 +1,7 @@
 //! How far an orientation estimate is from truth.
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
 use crate::math;
+use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 
 /// The quaternion distance between two orientations, rad: the angle of the rotation that takes

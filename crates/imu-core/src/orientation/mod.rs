@@ -27,8 +27,9 @@ pub use simple::{Complementary, Madgwick, Mahony};
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::frame::{Body, NavFrame, Ned};
+use crate::frame::{Body, Ned};
 use crate::ideal::AccelSign;
+use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 
 /// One sample for an orientation filter (body frame).

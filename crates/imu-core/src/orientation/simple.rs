@@ -24,9 +24,9 @@ use super::{
     Estimate, FilterInput, OrientError, OrientationFilter, check_finite, gravity_reading, positive,
     to_frame,
 };
-use crate::frame::NavFrame;
 use crate::ideal::AccelSign;
 use crate::math;
+use crate::nav_frame::NavFrame;
 
 /// What the three filters share: rate, sensors, sign, and the running quaternion. Each sample
 /// is integrated over its own interval when it has one ([`FilterInput::interval_s`]), else over

@@ -1,9 +1,10 @@
 //! A whole IMU: accelerometer, optional gyroscope and magnetometer, on a mount, in frame `N`.
 use core::fmt;
 
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
 use crate::ideal::{AccelSign, ImuMount};
 use crate::kinematics::Truth;
+use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 use crate::sensor::{
     Environment, FilterBuffer, InlineBuffer, NoiseSource, ParamError, SensorModel, SensorParams,

@@ -4,7 +4,7 @@
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::earth::EarthModel;
-use crate::frame::NavFrame;
+use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 use crate::vector::Vec3;
 

@@ -19,7 +19,7 @@
 use nalgebra::Vector3;
 
 use crate::earth::EarthModel;
-use crate::frame::NavFrame;
+use crate::nav_frame::NavFrame;
 use crate::rotation::{quaternion_product, rotate, rotation_vector_quaternion};
 
 use super::equations::{State, all_finite, check_initial, earth_terms, finish, keep_unit, start};

@@ -7,9 +7,9 @@ use super::{
     gnss_model, sq, zero_rate_model,
 };
 use crate::earth::EarthModel;
-use crate::frame::NavFrame;
 use crate::fusion::fix_errors::{self, has_fix_errors};
 use crate::math;
+use crate::nav_frame::NavFrame;
 
 impl<E: EarthModel, const S: usize> Eskf<E, S> {
     /// A GNSS position (and, when given, velocity) fix valid `fix.age_s = τ` before the

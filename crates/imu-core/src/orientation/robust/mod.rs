@@ -46,9 +46,9 @@ use super::{
     Estimate, FilterInput, OrientError, OrientationFilter, check_finite, gravity_reading, positive,
     to_frame,
 };
-use crate::frame::NavFrame;
 use crate::ideal::AccelSign;
 use crate::math;
+use crate::nav_frame::NavFrame;
 use bias::{BiasEstimate, BiasEvidence};
 use magnetic::MagneticTest;
 

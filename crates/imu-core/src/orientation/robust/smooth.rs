@@ -13,7 +13,8 @@
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use super::{RobustFilter, RobustParams, RobustStatus};
-use crate::frame::{Body, NavFrame};
+use crate::frame::Body;
+use crate::nav_frame::NavFrame;
 use crate::orientation::{Estimate, FilterInput, OrientError, OrientationFilter};
 use crate::rotation::Rotation;
 
