@@ -136,3 +136,92 @@ fn a_walk_is_fused_from_its_readings_alone() {
     assert!(out.status.success(), "{log}");
     assert!(log.contains("--zupt found"), "{log}");
 }
+
+/// A logger's exact copies of its last sample (x-io's NGIMU writes them) are dropped and said
+/// by every job that reads readings, with the same numbers as the log without them; a repeated
+/// time with other readings is refused, naming the file and the row.
+#[test]
+fn every_job_drops_a_loggers_repeated_rows_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let header =
+        "t_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s";
+    let row = |k: u32| {
+        let x = f64::from(k);
+        format!(
+            "{},{},{},{},{},{},{}",
+            x * 0.01,
+            0.01 * (0.7 * x).sin(),
+            0.01 * (1.3 * x).cos(),
+            9.81 + 0.01 * (0.9 * x).sin(),
+            1e-3 * (1.1 * x).sin(),
+            1e-3 * (0.5 * x).cos(),
+            1e-3 * (0.3 * x).sin()
+        )
+    };
+    let rows: Vec<String> = (0..2000).map(row).collect();
+    let mut repeated = rows.clone();
+    // File rows 12 and 503 (header 1) copy the row before.
+    repeated.insert(10, rows[9].clone());
+    repeated.insert(501, rows[499].clone());
+    std::fs::write(
+        dir.join("clean.csv"),
+        format!("{header}\n{}\n", rows.join("\n")),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("copies.csv"),
+        format!("{header}\n{}\n", repeated.join("\n")),
+    )
+    .unwrap();
+    for job in [
+        vec!["orient", "--out"],
+        vec!["integrate", "--out"],
+        vec!["allan", "--out"],
+    ] {
+        let run = |input: &str, out: &str| {
+            imukit()
+                .current_dir(dir)
+                .args([job[0], input, job[1], out])
+                .output()
+                .unwrap()
+        };
+        let out = run("copies.csv", "copies_out.csv");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{job:?}: {err}");
+        assert!(
+            err.contains("copies.csv: 2 rows repeat the row before exactly")
+                && err.contains("the first at row 12"),
+            "{job:?}: {err}"
+        );
+        assert!(run("clean.csv", "clean_out.csv").status.success());
+        let body = |name: &str| {
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
+            text.lines()
+                .filter(|l| !l.starts_with('#'))
+                .map(str::to_owned)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(body("copies_out.csv"), body("clean_out.csv"), "{job:?}");
+    }
+    // The same time with other readings is no copy.
+    let mut other = rows.clone();
+    other.insert(10, rows[9].replace(",9.81", ",9.7"));
+    std::fs::write(
+        dir.join("other.csv"),
+        format!("{header}\n{}\n", other.join("\n")),
+    )
+    .unwrap();
+    let out = imukit()
+        .current_dir(dir)
+        .args(["orient", "other.csv", "--out", "o.csv"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(65), "{err}");
+    assert!(
+        err.contains("other.csv: time at row 12 does not increase"),
+        "{err}"
+    );
+    assert!(!dir.join("o.csv").exists());
+}

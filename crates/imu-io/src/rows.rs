@@ -266,14 +266,19 @@ pub struct Repeats {
 /// sample before exactly ([`Repeats`]), and the count.
 #[must_use]
 pub fn repeated_samples(t_s: &[f64], readings: &[&[[f64; 3]]]) -> (Vec<bool>, Repeats) {
+    repeated_rows(t_s, |i| {
+        readings
+            .iter()
+            .all(|r| r.get(i).is_some() && r.get(i) == r.get(i - 1))
+    })
+}
+
+/// Per row at times `t_s`, whether it repeats the row before exactly: the same time, and
+/// `same(i)` says its values equal row `i − 1`'s ([`repeated_samples`] for triads of readings).
+#[must_use]
+pub fn repeated_rows(t_s: &[f64], same: impl Fn(usize) -> bool) -> (Vec<bool>, Repeats) {
     let repeated: Vec<bool> = (0..t_s.len())
-        .map(|i| {
-            i > 0
-                && t_s[i] == t_s[i - 1]
-                && readings
-                    .iter()
-                    .all(|r| r.get(i).is_some() && r.get(i) == r.get(i - 1))
-        })
+        .map(|i| i > 0 && t_s[i] == t_s[i - 1] && same(i))
         .collect();
     let count = repeated.iter().filter(|r| **r).count();
     let first = repeated.iter().position(|r| *r);
@@ -381,6 +386,10 @@ pub struct TimedRows {
     /// The time of the last row skipped before the window (for the order check).
     skipped_t: Option<f64>,
     width: usize,
+    /// The last row given, to drop a logger's exact copy of it ([`Repeats`]).
+    last: Vec<f64>,
+    /// The rows dropped as exact copies of the row before, by sample index from file row 2.
+    repeats: Repeats,
 }
 
 impl TimedRows {
@@ -423,6 +432,8 @@ impl TimedRows {
             given: 0,
             skipped_t: None,
             width: columns.len(),
+            last: Vec::new(),
+            repeats: Repeats::default(),
         })
     }
 
@@ -452,6 +463,14 @@ impl TimedRows {
                 self.ahead.push_back(row);
             }
             let t = self.ahead[0][0];
+            if self.skipped_t == Some(t) && self.last == self.ahead[0] {
+                // A logger's copy of the row before, skipped with it.
+                self.repeats.count += 1;
+                self.repeats.first.get_or_insert(self.taken);
+                self.ahead.pop_front();
+                self.taken += 1;
+                continue;
+            }
             if let Some(p) = self.skipped_t
                 && t <= p
             {
@@ -464,7 +483,9 @@ impl TimedRows {
                 return Ok(t);
             }
             self.skipped_t = Some(t);
-            self.ahead.pop_front();
+            if let Some(row) = self.ahead.pop_front() {
+                self.last = row;
+            }
             self.taken += 1;
         }
     }
@@ -482,6 +503,12 @@ impl TimedRows {
     /// The gaps among the rows read so far.
     pub fn gaps(&self) -> Gaps {
         self.gaps
+    }
+
+    /// The rows dropped as exact copies of the row before (time and values): a logger's
+    /// copies of its last sample ([`Repeats::message`] with first row 2).
+    pub fn repeats(&self) -> Repeats {
+        self.repeats
     }
 
     /// The file row (header = 1) of the row last read.
@@ -505,6 +532,12 @@ impl TimedRows {
             }
             self.taken += 1;
             let (t, line) = (row[0], self.last_row());
+            if self.previous_t.or(self.skipped_t) == Some(t) && self.last.as_slice() == &row[..] {
+                // A logger's copy of the row before: nothing new, no interval.
+                self.repeats.count += 1;
+                self.repeats.first.get_or_insert(line - 2);
+                continue;
+            }
             if let Some(p) = self.previous_t.or(self.skipped_t)
                 && t <= p
             {
@@ -516,6 +549,8 @@ impl TimedRows {
             if t < self.window.0 {
                 // Before the window: checked in order, then skipped as if not in the file.
                 self.skipped_t = Some(t);
+                self.last.clear();
+                self.last.extend_from_slice(row);
                 continue;
             }
             if let Some(p) = self.previous_t {
@@ -523,6 +558,8 @@ impl TimedRows {
                 self.interval = Some(t - p);
             }
             self.previous_t = Some(t);
+            self.last.clear();
+            self.last.extend_from_slice(row);
             self.given += 1;
             return Ok(true);
         }
@@ -635,5 +672,47 @@ mod tests {
                 && e.contains("0 row(s) of 100 lie in the window [50 s, the end]"),
             "{e}"
         );
+    }
+
+    /// Rows streamed from `text` (columns `t_s`, `x`) within `window`: the values given, the
+    /// repeats dropped, or the refusal.
+    fn streamed(text: &str, window: TimeWindow) -> Result<(Vec<[f64; 2]>, Repeats)> {
+        let dir = tempfile::tempdir().expect("a folder");
+        let path = dir.path().join("log.csv");
+        std::fs::write(&path, text).expect("written");
+        let mut rows = TimedRows::open(path.as_path(), &["t_s", "x"], "")?.within(window);
+        rows.start_time()?;
+        let (mut out, mut row) = (Vec::new(), [0.0; 2]);
+        while rows.next_row(&mut row)? {
+            out.push(row);
+        }
+        Ok((out, rows.repeats()))
+    }
+
+    #[test]
+    fn a_loggers_copy_of_its_last_row_is_dropped_and_counted_and_a_new_value_at_its_time_refused() {
+        // Rows 3 and 6 (file rows, header 1) copy the row before; row 7 copies row 6's copy.
+        let text = "t_s,x\n0,1\n0,1\n0.1,2\n0.2,3\n0.2,3\n0.2,3\n0.3,4\n";
+        let (rows, repeats) = streamed(text, TimeWindow::default()).expect("read");
+        assert_eq!(rows, [[0.0, 1.0], [0.1, 2.0], [0.2, 3.0], [0.3, 4.0]]);
+        assert_eq!(repeats.count, 3);
+        let m = repeats.message("log.csv", 2).expect("said");
+        assert!(
+            m.contains("3 rows repeat") && m.contains("the first at row 3"),
+            "{m}"
+        );
+        // Before a window's start the copies are skipped with their rows.
+        let window = TimeWindow {
+            start_s: Some(0.15),
+            end_s: None,
+        };
+        let (rows, repeats) = streamed(text, window).expect("read");
+        assert_eq!(rows, [[0.2, 3.0], [0.3, 4.0]]);
+        assert_eq!((repeats.count, repeats.first), (3, Some(1)));
+        // The same time with another value is not a copy: refused by its row.
+        let e = streamed("t_s,x\n0,1\n0.1,2\n0.1,5\n", TimeWindow::default())
+            .expect_err("refused")
+            .to_string();
+        assert!(e.contains("time at row 4 does not increase"), "{e}");
     }
 }

@@ -5,7 +5,7 @@ use imukit::io::Input;
 use imukit::io::columns::{ACCEL_COLUMNS, GYRO_COLUMNS};
 use imukit::io::output::check_outputs;
 use imukit::io::read::{read_columns, read_header};
-use imukit::io::rows::TimeWindow;
+use imukit::io::rows::{TimeWindow, not_increasing, repeated_rows};
 use imukit::run::allan::{AllanResult, allan, mean_rate};
 
 use super::CliError;
@@ -108,12 +108,23 @@ pub(crate) fn analyse(
         ""
     };
     let data = read_columns(source, &required, hint)?;
-    // The window's rows: the times are checked in order below, so they are a run of rows.
-    let all_t = data.get("t_s");
+    // A logger's exact copies of its last sample carry nothing: dropped, and said. The times
+    // left must increase (refused by file row); `kept` maps samples back to rows.
+    let (repeated, repeats) = repeated_rows(data.get("t_s"), |i| {
+        chosen.iter().all(|c| data.get(c)[i] == data.get(c)[i - 1])
+    });
+    if let Some(m) = repeats.message(&input.display().to_string(), 2) {
+        crate::report::warn(&m);
+    }
+    let kept: Vec<usize> = (0..repeated.len()).filter(|&i| !repeated[i]).collect();
+    let all_t: Vec<f64> = kept.iter().map(|&i| data.get("t_s")[i]).collect();
+    if let Some(k) = (1..all_t.len()).find(|&k| all_t[k].is_nan() || all_t[k] <= all_t[k - 1]) {
+        return Err(not_increasing(&input.display().to_string(), kept[k] + 2).into());
+    }
+    // The window's rows.
     let rows = match (window.is_whole(), all_t.first()) {
         (false, Some(&t0)) => {
             let (lo, hi) = window.bounds(t0);
-            imukit::io::rows::check_increasing(all_t, &input.display().to_string(), 2)?;
             let from = all_t.partition_point(|&t| t < lo);
             let to = all_t.partition_point(|&t| t <= hi);
             if to < from + 2 {
@@ -133,11 +144,11 @@ pub(crate) fn analyse(
         _ => 0..all_t.len(),
     };
     let t = &all_t[rows.clone()];
-    // The Allan deviation takes the samples as evenly spaced: times that go back are refused
-    // by row, and gaps are said (the clusters that span them are not the sensor's noise).
-    imukit::io::rows::check_increasing(t, &input.display().to_string(), 2)?;
-    let gaps = imukit::io::rows::Gaps::of_times(t, 2);
+    // The Allan deviation takes the samples as evenly spaced: gaps are said (the clusters that
+    // span them are not the sensor's noise).
+    let mut gaps = imukit::io::rows::Gaps::of_times(t, 0);
     if gaps.count > 0 {
+        gaps.longest_after_row = kept[rows.start + gaps.longest_after_row] + 2;
         crate::report::warn(&format!(
             "{}: {} interval(s) longer than {} median intervals ({} s), the longest {} s after \
              row {}: the Allan deviation takes the samples as evenly spaced, so its clusters \
@@ -153,7 +164,11 @@ pub(crate) fn analyse(
     let rate = mean_rate(t)?;
     let series: Vec<(String, Vec<f64>)> = chosen
         .iter()
-        .map(|c| (c.clone(), data.get(c)[rows.clone()].to_vec()))
+        .map(|c| {
+            let kept_values: Vec<f64> =
+                kept[rows.clone()].iter().map(|&i| data.get(c)[i]).collect();
+            (c.clone(), kept_values)
+        })
         .collect();
     // The library names the column; the file is named here.
     let in_file = |column: String| format!("{}, column {column}", input.display());

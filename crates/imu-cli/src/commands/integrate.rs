@@ -174,6 +174,9 @@ pub fn three_d(
             },
             other => other,
         })?;
+    if let Some(m) = summary.repeats.message(&c.input.display().to_string(), 2) {
+        crate::report::warn(&m);
+    }
     if let Some(m) = summary.gaps.message(&c.input.display().to_string()) {
         crate::report::warn(&m);
     }

@@ -64,6 +64,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         {
             crate::error::by_flag(e)
         }
+        e if e.data() == Some(imukit::error::Data::Imu) => {
+            e.relabelled(input.display().to_string())
+        }
         other => other,
     })?;
     for w in &s.warnings {
@@ -82,6 +85,9 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         s.rows,
         out.display()
     );
+    if let Some(m) = s.repeats.message(&input.display().to_string(), 2) {
+        crate::report::warn(&m);
+    }
     if let Some(m) = s.gaps.message(&input.display().to_string()) {
         crate::report::warn(&m);
     }

@@ -19,7 +19,7 @@ use crate::error::{Result, invalid};
 use crate::io::Input;
 use crate::io::columns::{ACCEL_COLUMNS, DTHETA_COLUMNS, DV_COLUMNS, GYRO_COLUMNS};
 use crate::io::output::AtomicFile;
-use crate::io::rows::{Gaps, TimeWindow, TimedRows};
+use crate::io::rows::{Gaps, Repeats, TimeWindow, TimedRows};
 use crate::io::table::Table;
 use crate::run::nav_earth::{self, EarthJob, NavEarth};
 
@@ -34,6 +34,8 @@ pub struct NavSummary {
     pub end_position_m: [f64; 3],
     /// The gaps in the sample times, integrated across.
     pub gaps: Gaps,
+    /// The rows dropped as exact copies of the row before (a logger's repeats).
+    pub repeats: Repeats,
 }
 
 /// Integrates the IMU CSV file `input` into the navigation CSV `out` (the columns of
@@ -78,6 +80,8 @@ pub fn integrate_csv(
                 .for_input(rates, setup.options.coning || setup.options.sculling),
             end_position_m: [last("pos_x_m"), last("pos_y_m"), last("pos_z_m")],
             gaps: Gaps::of_times(&imu.column("t_s").unwrap_or_default(), 2),
+            // Read whole, the readings' times are checked as they are: a repeat is refused.
+            repeats: Repeats::default(),
         });
     }
     with_earth(
@@ -385,6 +389,7 @@ impl EarthJob for IntegrateCsv<'_> {
             scheme,
             end_position_m: E::plane_m(&end.position, &origin),
             gaps: rows.gaps(),
+            repeats: rows.repeats(),
         })
     }
 }

@@ -15,7 +15,7 @@ use crate::io::columns::{
 use crate::io::conventions::NavFrameName;
 use crate::io::description::Description;
 use crate::io::output::AtomicFile;
-use crate::io::rows::{Gaps, TimeWindow, TimedRows};
+use crate::io::rows::{Gaps, Repeats, TimeWindow, TimedRows};
 use crate::io::schema::TableKind;
 use crate::run::navigate::euler_unwrapped;
 
@@ -48,6 +48,8 @@ pub struct OrientSummary {
     pub per_sample: bool,
     /// The gaps in the sample times, integrated across.
     pub gaps: Gaps,
+    /// The rows dropped as exact copies of the row before (a logger's repeats).
+    pub repeats: Repeats,
     /// What the user should know about the run (a magnetometer the filter ignores).
     pub warnings: Vec<String>,
 }
@@ -166,6 +168,7 @@ fn orient_csv_in<N: NavFrame>(
         sample_rate_hz: rate,
         per_sample,
         gaps: rows.gaps(),
+        repeats: rows.repeats(),
         warnings,
     })
 }
