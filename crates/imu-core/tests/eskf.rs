@@ -3,6 +3,7 @@
 //! chi-square bounds) on the flat Earth and on WGS-84, a mistuned filter outside them, and a
 //! covariance still symmetric and positive definite after 10⁶ steps.
 use imu_core::earth::{EarthModel, EarthMount, EarthTruth, FlatEarth, Geodetic, Wgs84};
+use imu_core::fusion::gate::Gate;
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma, SensorErrorSigma,
 };
@@ -151,7 +152,7 @@ fn run<E: Case>(seed: u64, run: u64, seconds: f64, draw_scale: f64) -> [f64; 3] 
                 velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, f64::INFINITY).unwrap();
+            f.update_gnss(&fix, Gate::Off).unwrap();
         }
     }
     let t_end = samples as f64 / RATE_HZ;
@@ -248,7 +249,7 @@ fn long_run<E: Case, const S: usize>(name: &str) {
                 velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, f64::INFINITY).unwrap();
+            f.update_gnss(&fix, Gate::Off).unwrap();
         }
     }
     let p = nalgebra::DMatrix::from_fn(S, S, |i, j| f.covariance(i, j));
@@ -298,7 +299,7 @@ fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
         f.propagate(k as f64 / RATE_HZ, [0.0; 3], [0.0, 0.0, 9.81])
             .unwrap();
         if k % 10 == 0 {
-            f.update_gnss(&standstill, 1e6).unwrap();
+            f.update_gnss(&standstill, Gate::ChiSquare(1e6)).unwrap();
         }
     }
     let bias_before: Vec<f64> = (9..15).map(|k| f.covariance(k, k)).collect();

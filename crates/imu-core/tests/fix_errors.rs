@@ -7,6 +7,7 @@
 //! believes every fix anew while their error lasts hundreds of fixes.
 use imu_core::aiding::{GnssModel, GnssParams, GnssState, PositionNoise};
 use imu_core::earth::FlatEarth;
+use imu_core::fusion::gate::Gate;
 use imu_core::fusion::{
     BASE_STATES, Eskf, EskfState, FIX_ERROR_STATES, FULL_STATES, FixErrorModel, GnssFix,
     SensorErrorSigma,
@@ -133,7 +134,7 @@ fn run<const S: usize>(decay: f64, model: Model, run: u64, at_s: &[f64]) -> Vec<
                 velocity_sigma_m_s: [VELOCITY_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, f64::INFINITY).unwrap();
+            f.update_gnss(&fix, Gate::Off).unwrap();
         }
         if at_s.iter().any(|a| (a * RATE_HZ).round() as usize == k) {
             let (p, v) = truth(t);

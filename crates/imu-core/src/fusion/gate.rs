@@ -14,11 +14,38 @@ pub const CHI2_99_9: [f64; 6] = [
     22.457_744_484_825_323,
 ];
 
-/// The 99.9 % gate for an update of `rows` rows (1 to 6; no gate, `f64::INFINITY`, beyond).
+/// Which updates the filter takes: all, or those whose normalised innovation squared (NIS) is
+/// within a chi-square value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gate {
+    /// Every update is applied.
+    Off,
+    /// An update whose NIS exceeds this value is rejected (and counted).
+    ChiSquare(f64),
+}
+
+impl Gate {
+    /// Whether an update of normalised innovation squared `nis` is rejected.
+    #[must_use]
+    pub fn rejects(self, nis: f64) -> bool {
+        match self {
+            Self::Off => false,
+            Self::ChiSquare(x) => nis > x,
+        }
+    }
+
+    /// Whether updates are gated at all.
+    #[must_use]
+    pub fn is_on(self) -> bool {
+        matches!(self, Self::ChiSquare(_))
+    }
+}
+
+/// The 99.9 % gate for an update of `rows` rows (1 to 6; off beyond).
 #[must_use]
-pub fn gate_99_9(rows: usize) -> f64 {
+pub fn gate_99_9(rows: usize) -> Gate {
     match rows {
-        1..=6 => CHI2_99_9[rows - 1],
-        _ => f64::INFINITY,
+        1..=6 => Gate::ChiSquare(CHI2_99_9[rows - 1]),
+        _ => Gate::Off,
     }
 }

@@ -312,7 +312,7 @@ fn average_nees<const S: usize>(
                     velocity_sigma_m_s: [sigma_vel; 3],
                     age_s: 0.0,
                 };
-                let outcome = f.update_gnss(&fix, f64::INFINITY).unwrap();
+                let outcome = f.update_gnss(&fix, Gate::Off).unwrap();
                 nis_sum += outcome.nis;
                 fixes += 1;
                 next += 1;
@@ -321,7 +321,7 @@ fn average_nees<const S: usize>(
                 f.update_body_velocity(
                     [Some(odo_v[next_odo]), Some(0.0), Some(0.0)],
                     [sigma_odo, sigma_nhc, sigma_nhc],
-                    f64::INFINITY,
+                    Gate::Off,
                 )
                 .unwrap();
                 next_odo += 1;

@@ -25,6 +25,7 @@
 //! non-holonomic zero lateral and vertical velocity) with `δv_b = Ĉᵀ δv + Ĉᵀ [v̂×] φ`; height
 //! (barometer) on the frame's up axis; zero angular rate. Corrections are injected into the
 //! position through [`EarthModel::offset`].
+use crate::fusion::gate::Gate;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::fix_errors::{self, FixErrorModel, has_fix_errors, has_sensor_errors};
@@ -535,7 +536,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         h: &SMatrix<f64, M, S>,
         y: &SVector<f64, M>,
         r: &SVector<f64, M>,
-        gate: f64,
+        gate: Gate,
         index: usize,
     ) -> Result<UpdateOutcome, EskfError> {
         self.step_covariance();

@@ -4,6 +4,7 @@ use nalgebra::{SMatrix, SVector, Vector3};
 
 use super::{Cov, EskfError, EskfNoise, InitialSigma, StateVec, non_negative, skew, sq};
 use crate::fusion::fix_errors::{self, has_fix_errors, has_sensor_errors, is_state_count};
+use crate::fusion::gate::Gate;
 use crate::fusion::sensor_errors::{
     ACCEL_MATRIX, GYRO_ERRORS, SensorErrorSigma, SensorErrors, d_gyro, d_matrix,
 };
@@ -242,7 +243,7 @@ pub(crate) fn kalman_update<const M: usize, const S: usize>(
     h: &SMatrix<f64, M, S>,
     y: &SVector<f64, M>,
     r: &SVector<f64, M>,
-    gate: f64,
+    gate: Gate,
     index: usize,
 ) -> Result<(f64, Option<StateVec<S>>), EskfError> {
     let rm = SMatrix::<f64, M, M>::from_diagonal(r);
@@ -254,7 +255,7 @@ pub(crate) fn kalman_update<const M: usize, const S: usize>(
     if !nis.is_finite() || nis < 0.0 {
         return Err(EskfError::Diverged { index });
     }
-    if nis > gate {
+    if gate.rejects(nis) {
         return Ok((nis, None));
     }
     let pht = *cov * h.transpose();

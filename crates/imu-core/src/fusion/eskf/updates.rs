@@ -1,5 +1,6 @@
 //! The measurement updates: GNSS position and velocity (and the reset to a fix), body-frame
 //! velocity (odometer, non-holonomic constraints, zero velocity), height, zero rate.
+use crate::fusion::gate::Gate;
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::{
@@ -18,13 +19,16 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     /// `v_a = v + Ĉ(ω̂×l) − τ a`, so `δp_a = δp − τ δv − [(Ĉl)×] φ` and
     /// `δv_a = δv − [(Ĉ(ω̂×l))×] φ + τ [(Ĉf̂)×] φ + τ Ĉ δb_a + Ĉ [l×] δb_g` (the change of the
     /// lever-arm terms over `τ` is neglected). Rejected (and counted) when its NIS exceeds
-    /// `gate` (a chi-square quantile for 3 or 6 degrees of freedom; `f64::INFINITY` turns the
-    /// gate off).
+    /// `gate` (a chi-square quantile for 3 or 6 degrees of freedom, or [`Gate::Off`]).
     ///
     /// # Errors
     /// Non-finite input, sigmas that are not positive, an age that is negative or not finite,
     /// or a covariance that can no longer be inverted (divergence).
-    pub fn update_gnss(&mut self, fix: &GnssFix<E>, gate: f64) -> Result<UpdateOutcome, EskfError> {
+    pub fn update_gnss(
+        &mut self,
+        fix: &GnssFix<E>,
+        gate: Gate,
+    ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
         if !(fix.age_s.is_finite() && fix.age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
@@ -194,7 +198,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         &mut self,
         measured_m_s: [Option<f64>; 3],
         sigma_m_s: [f64; 3],
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
         let v = *self.nav.velocity_m_s.as_nalgebra();
@@ -213,7 +217,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         speed_m_s: f64,
         sigma_m_s: f64,
         constraint_sigma_m_s: Option<f64>,
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         match constraint_sigma_m_s {
             Some(c) => self.update_body_velocity(
@@ -237,7 +241,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     pub fn update_nonholonomic(
         &mut self,
         sigma_m_s: f64,
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         self.update_body_velocity(
             [None, Some(0.0), Some(0.0)],
@@ -254,7 +258,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     pub fn update_zero_velocity(
         &mut self,
         sigma_m_s: f64,
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         self.update_body_velocity([Some(0.0); 3], [sigma_m_s; 3], gate)
     }
@@ -269,7 +273,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
         &mut self,
         height_m: f64,
         sigma_m: f64,
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
         if !(height_m.is_finite() && sigma_m.is_finite() && sigma_m > 0.0) {
@@ -295,7 +299,7 @@ impl<E: EarthModel, const S: usize> Eskf<E, S> {
     pub fn update_zero_rate(
         &mut self,
         sigma_rad_s: f64,
-        gate: f64,
+        gate: Gate,
     ) -> Result<UpdateOutcome, EskfError> {
         let index = self.updates + self.rejected;
         let w_true = if E::ROTATING {

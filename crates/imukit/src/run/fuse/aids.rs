@@ -3,7 +3,7 @@
 //! read, checked and applied at their times, the same way on every Earth.
 use imu_core::earth::EarthModel;
 use imu_core::fusion::Eskf;
-use imu_core::fusion::gate::gate_99_9;
+use imu_core::fusion::gate::{Gate, gate_99_9};
 
 use crate::error::Data;
 use crate::error::{Result, invalid};
@@ -155,11 +155,11 @@ impl AidStreams {
     }
 
     /// The χ² 99.9 % gate for `rows` rows (none when the fusion's gate is off).
-    fn gate(&self, rows: usize) -> f64 {
+    fn gate(&self, rows: usize) -> Gate {
         if self.gate_on {
             gate_99_9(rows)
         } else {
-            f64::INFINITY
+            Gate::Off
         }
     }
 
@@ -178,10 +178,10 @@ impl AidStreams {
             // A stance on the move: the detector is the gate, and the foot is still only to
             // about a centimetre a second (it rolls and settles).
             filter
-                .update_zero_velocity(STANCE_VELOCITY_SIGMA_M_S, f64::INFINITY)
+                .update_zero_velocity(STANCE_VELOCITY_SIGMA_M_S, Gate::Off)
                 .map_err(|e| filter_refusal("IMU (stance, zero velocity)", i, e))?;
             filter
-                .update_zero_rate(self.rest.1, f64::INFINITY)
+                .update_zero_rate(self.rest.1, Gate::Off)
                 .map_err(|e| filter_refusal("IMU (stance, zero rate)", i, e))?;
         } else if t_s < self.rest.0 {
             filter

@@ -291,8 +291,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,
         };
-        let gate = setup.gate.threshold();
-        let outcome = filter.update_gnss(&fix, gate);
+        let outcome = filter.update_gnss(&fix, setup.gate);
         if let Ok(o) = &outcome {
             let rows = if fix.velocity_m_s.is_some() { 6 } else { 3 };
             if let Some(change) = noise_scale.observe(o.nis, rows) {
@@ -301,7 +300,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
                     .map_err(|e| filter_refusal("GNSS", k, e))?;
             }
         }
-        if acceptance.count(outcome, k, gate)? {
+        if acceptance.count(outcome, k, setup.gate)? {
             let heading = fix.velocity_m_s.and_then(|v| {
                 let speed = v.x().hypot(v.y());
                 (speed >= ALIGN_MIN_SPEED_M_S).then(|| {

@@ -2,6 +2,7 @@
 //! filter to the last of them, and a filter that cannot be brought back is a divergence; the
 //! filter's refusals as errors naming the row.
 use imu_core::fusion::EskfError;
+use imu_core::fusion::gate::Gate;
 
 use crate::error::Data;
 use crate::error::{Error, Result};
@@ -53,7 +54,7 @@ impl Acceptance {
         &mut self,
         outcome: std::result::Result<imu_core::fusion::UpdateOutcome, EskfError>,
         index: usize,
-        gate: f64,
+        gate: Gate,
     ) -> Result<bool> {
         let outcome = outcome.map_err(|e| filter_refusal("GNSS", index, e))?;
         if outcome.accepted {
@@ -66,6 +67,11 @@ impl Acceptance {
             return Ok(false);
         }
         if self.resets_in_a_row >= MAX_RESETS_IN_A_ROW {
+            // Only a gate that is on rejects.
+            let gate = match gate {
+                Gate::ChiSquare(x) => x,
+                Gate::Off => f64::INFINITY,
+            };
             return Err(Error::Diverged {
                 context: Data::Gnss.label().into(),
                 message: format!(

@@ -95,33 +95,8 @@ pub struct FuseSetup {
     pub max_fix_noise_scale: f64,
 }
 
-/// Which fixes the filter takes: all, or those whose normalised innovation squared (NIS) is
-/// within a chi-square value.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Gate {
-    /// Every fix is applied.
-    Off,
-    /// A fix whose NIS exceeds this value is rejected (and counted).
-    ChiSquare(f64),
-}
-
-impl Gate {
-    /// The NIS above which a fix is rejected (infinite when the gate is off: the core filter's
-    /// way of saying so).
-    #[must_use]
-    pub fn threshold(self) -> f64 {
-        match self {
-            Self::Off => f64::INFINITY,
-            Self::ChiSquare(x) => x,
-        }
-    }
-
-    /// Whether fixes (and aid readings) are gated at all.
-    #[must_use]
-    pub fn is_on(self) -> bool {
-        matches!(self, Self::ChiSquare(_))
-    }
-}
+/// Which fixes (and aid readings) the filter takes: the core's [`Gate`].
+pub use imu_core::fusion::gate::Gate;
 
 /// The covariance interval [`FuseSetup::from_scenario`] chooses, s: 20 Hz, four times less
 /// work than every sample at 100 Hz, and the same NEES to three digits in the consistency test
