@@ -5,9 +5,10 @@ use imu_plot::PlotError;
 /// What went wrong, for the user; `Display` says what and where.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
-    /// Input or I/O errors from the library.
+    /// Input or I/O errors from the library (a request's option named by its flag: see the
+    /// `From` conversion).
     #[error(transparent)]
-    Library(#[from] imukit::Error),
+    Library(imukit::Error),
     /// A figure or animation could not be made.
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -19,6 +20,19 @@ pub enum CliError {
         /// The OS error.
         source: std::io::Error,
     },
+}
+
+impl From<imukit::Error> for CliError {
+    /// The library's error, a refused request option named by the flag that sets it.
+    fn from(e: imukit::Error) -> Self {
+        Self::Library(match e {
+            imukit::Error::Request { option, message } => imukit::Error::Invalid {
+                field: option.flag().into(),
+                message,
+            },
+            other => other,
+        })
+    }
 }
 
 impl CliError {
@@ -33,22 +47,13 @@ impl CliError {
     }
 }
 
-/// The request fields whose flag is not the field's name with `-` for `_`.
-const FLAGS: [(&str, &str); 4] = [
-    ("initial", "--init"),
-    ("nhc_sigma_m_s", "--nhc"),
-    ("gate", "--no-gate"),
-    ("use_magnetometer", "--no-mag"),
-];
-
-/// The flag that sets a library request field: the table `FLAGS`, else the field's name with `-` for
-/// `_` (`gravity_m_s2` → `--gravity-m-s2`). Python's keywords are the fields' own names.
+/// The flag that sets a library request field named as a string: the field's name with `-` for
+/// `_` (`gravity_m_s2` → `--gravity-m-s2`; Python's keywords are the fields' own names). The
+/// options whose flag is spelt otherwise are refused as [`imukit::Error::Request`], which
+/// carries its flag.
 #[must_use]
 pub fn flag(field: &str) -> String {
-    FLAGS.iter().find(|(f, _)| *f == field).map_or_else(
-        || format!("--{}", field.replace('_', "-")),
-        |(_, flag)| (*flag).to_string(),
-    )
+    format!("--{}", field.replace('_', "-"))
 }
 
 /// A library refusal of a request field, named by its flag.
@@ -57,6 +62,10 @@ pub fn by_flag(e: imukit::Error) -> imukit::Error {
     match e {
         imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
             field: flag(&field),
+            message,
+        },
+        imukit::Error::Request { option, message } => imukit::Error::Invalid {
+            field: option.flag().into(),
             message,
         },
         other => other,
@@ -72,5 +81,32 @@ pub fn plot_by_flag(e: PlotError) -> PlotError {
             message,
         },
         other => other,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use imukit::error::RequestOption;
+
+    use super::CliError;
+
+    #[test]
+    fn a_refused_request_option_is_named_by_its_flag_and_a_file_key_is_left() {
+        let named = |e: imukit::Error| match CliError::from(e) {
+            CliError::Library(imukit::Error::Invalid { field, .. }) => field,
+            other => panic!("{other:?}"),
+        };
+        for (option, flag) in [
+            (RequestOption::Threads, "--threads"),
+            (RequestOption::UseMagnetometer, "--no-mag"),
+            (RequestOption::Initial, "--init"),
+        ] {
+            assert_eq!(named(imukit::error::refused(option, "m")), flag);
+        }
+        let key = imukit::Error::Invalid {
+            field: "imu.gyroscope.NoiseDensity".into(),
+            message: "m".into(),
+        };
+        assert_eq!(named(key), "imu.gyroscope.NoiseDensity");
     }
 }

@@ -10,6 +10,68 @@ use imu_core::sensor::{ImuParamError, ParamError};
 use imu_core::strapdown::StrapdownError;
 use imu_core::strapdown::planar::PlanarError;
 
+/// An option of a job's request, as the library names it in a refusal ([`Error::Request`]):
+/// one name per option, which the front ends turn into their own without matching strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RequestOption {
+    /// The sample rate a file is written for.
+    RateHz,
+    /// The threads a run may use.
+    Threads,
+    /// Whether an orientation filter uses the file's magnetometer.
+    UseMagnetometer,
+    /// Whether a run is smoothed after the fact.
+    Smooth,
+    /// The Earth a job navigates on.
+    Earth,
+    /// The filter's initial state (a truth row).
+    Initial,
+    /// The one-sigma of the vehicle constraints.
+    NhcSigma,
+    /// The rest at the start of a run.
+    RestS,
+}
+
+impl RequestOption {
+    /// The option's name in the library's requests and in Python's keywords.
+    #[must_use]
+    pub const fn key(self) -> &'static str {
+        match self {
+            Self::RateHz => "rate_hz",
+            Self::Threads => "threads",
+            Self::UseMagnetometer => "use_magnetometer",
+            Self::Smooth => "smooth",
+            Self::Earth => "earth",
+            Self::Initial => "initial",
+            Self::NhcSigma => "nhc_sigma_m_s",
+            Self::RestS => "rest_s",
+        }
+    }
+
+    /// The command line's flag that sets the option.
+    #[must_use]
+    pub const fn flag(self) -> &'static str {
+        match self {
+            Self::RateHz => "--rate-hz",
+            Self::Threads => "--threads",
+            Self::UseMagnetometer => "--no-mag",
+            Self::Smooth => "--smooth",
+            Self::Earth => "--earth",
+            Self::Initial => "--init",
+            Self::NhcSigma => "--nhc",
+            Self::RestS => "--rest-s",
+        }
+    }
+}
+
+/// A refusal of the request option `option`.
+pub fn refused(option: RequestOption, message: impl Into<String>) -> Error {
+    Error::Request {
+        option,
+        message: message.into(),
+    }
+}
+
 /// Why a scenario could not be read or run.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -37,6 +99,15 @@ pub enum Error {
         /// Dotted key path, e.g. `imu.seed`; empty for the whole scenario.
         field: String,
         /// What does not fit.
+        message: String,
+    },
+    /// A request's option refused, named by its typed name ([`RequestOption`]): each front end
+    /// spells it its own way (Python's keyword, the command line's flag).
+    #[error("{}: {message}", option.key())]
+    Request {
+        /// The option.
+        option: RequestOption,
+        /// What is wrong.
         message: String,
     },
     /// A scenario key with an invalid value.
@@ -298,6 +369,7 @@ impl Error {
         match self {
             Self::Io { path, .. } => file(path),
             Self::Scenario { .. } => Location::default(),
+            Self::Request { option, .. } => field(option.key()),
             Self::Invalid { field: f, .. }
             | Self::ScenarioKey { field: f, .. }
             | Self::UnknownChoice { field: f, .. }

@@ -2,7 +2,7 @@
 //! library's fuse job with the filter's model from the scenario.
 use std::path::Path;
 
-use imukit::error::Data;
+use imukit::error::{Data, RequestOption};
 use imukit::io::Input;
 use imukit::io::bag::Role;
 use imukit::io::conventions::{EarthName, NavFrameName};
@@ -166,8 +166,11 @@ fn setup_of<'s>(
                 .map_err(by_flag)?;
             Ok(request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.
-                Error::Invalid { field, message } if field == "earth" => Error::Invalid {
-                    field: flag(&field),
+                Error::Request {
+                    option: RequestOption::Earth,
+                    message,
+                } => Error::Invalid {
+                    field: RequestOption::Earth.flag().into(),
                     message: format!("{message} ({})", path.display()),
                 },
                 other => by_flag(other),

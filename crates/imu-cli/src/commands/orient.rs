@@ -59,11 +59,6 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     crate::report::warn_implausible(input);
     let s = orient_csv(input, &spec, nav, window, out).map_err(|e| match e {
         // The request's own field; other refusals name the file.
-        imukit::Error::Invalid { ref field, .. }
-            if field == "use_magnetometer" || field == "smooth" =>
-        {
-            crate::error::by_flag(e)
-        }
         e if e.data() == Some(imukit::error::Data::Imu) => {
             e.relabelled(input.display().to_string())
         }

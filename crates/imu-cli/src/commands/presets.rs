@@ -9,7 +9,6 @@ use imukit::io::presets;
 
 use super::CliError;
 use crate::cli::PresetFormat;
-use crate::error::by_flag;
 
 pub fn run(
     name: Option<&str>,
@@ -61,10 +60,7 @@ pub fn file(
 }
 
 fn kalibr(params: &ParamFile, rate_hz: f64, topic: &str) -> Result<(), CliError> {
-    let imu = KalibrImu::from_params(params, rate_hz, topic).map_err(|e| match e {
-        imukit::Error::Invalid { ref field, .. } if field == "rate_hz" => by_flag(e),
-        other => other,
-    })?;
+    let imu = KalibrImu::from_params(params, rate_hz, topic)?;
     crate::out!("{}", imu.to_yaml());
     Ok(())
 }

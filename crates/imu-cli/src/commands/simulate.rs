@@ -131,9 +131,7 @@ fn one_run(
         asl: false,
         bag: o.bag,
     };
-    let report = sc
-        .stream_to_files(None, run_threads, &outputs)
-        .map_err(threads_by_flag)?;
+    let report = sc.stream_to_files(None, run_threads, &outputs)?;
     for w in report.warnings(sc.sample_rate_hz) {
         crate::report::warn(&w);
     }
@@ -284,9 +282,7 @@ pub fn euroc(
         asl: true,
         ..StreamOutputs::default()
     };
-    let report = sc
-        .stream_to_files(None, run_threads, &outputs)
-        .map_err(threads_by_flag)?;
+    let report = sc.stream_to_files(None, run_threads, &outputs)?;
     for w in report.warnings(sc.sample_rate_hz) {
         crate::report::warn(&w);
     }
@@ -297,34 +293,4 @@ pub fn euroc(
         truth.display()
     );
     Ok(())
-}
-
-/// The library names its `threads` setting (a refused second thread) by the field; here it is
-/// the flag that set it.
-fn threads_by_flag(e: imukit::Error) -> imukit::Error {
-    match e {
-        imukit::Error::Invalid { ref field, .. } if field == "threads" => crate::error::by_flag(e),
-        other => other,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::threads_by_flag;
-
-    #[test]
-    fn a_refused_second_thread_is_named_by_the_flag_and_other_fields_are_left() {
-        let named = |field: &str| match threads_by_flag(imukit::Error::Invalid {
-            field: field.into(),
-            message: "m".into(),
-        }) {
-            imukit::Error::Invalid { field, .. } => field,
-            other => panic!("{other:?}"),
-        };
-        assert_eq!(named("threads"), "--threads");
-        assert_eq!(
-            named("imu.gyroscope.NoiseDensity"),
-            "imu.gyroscope.NoiseDensity"
-        );
-    }
 }

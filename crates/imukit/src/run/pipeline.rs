@@ -10,10 +10,9 @@
 //!
 //! Memory stays flat: at most two finished chunks wait between two stages, and their buffers go
 //! back to the producer to be refilled.
+use crate::error::{Error, RequestOption, Result, invalid, refused};
 use std::num::NonZeroUsize;
 use std::sync::mpsc;
-
-use crate::error::{Error, Result, invalid};
 
 /// How many threads one streamed run uses ([`crate::Scenario::stream`] and the calls built on
 /// it).
@@ -124,8 +123,8 @@ pub(crate) fn run_in_stages<T: Clone + Send>(
                 })
             })
             .map_err(|e| {
-                invalid(
-                    "threads",
+                refused(
+                    RequestOption::Threads,
                     format!("could not start a second thread ({e}); one thread would do"),
                 )
             })?;

@@ -1,12 +1,11 @@
 //! The aids of a fusion besides GNSS — odometer readings, barometer readings, the
 //! non-holonomic constraints and a rest at the start (zero velocity and zero angular rate) —
 //! read, checked and applied at their times, the same way on every Earth.
+use crate::error::{Data, RequestOption, Result, invalid, refused};
 use imu_core::earth::EarthModel;
 use imu_core::fusion::Eskf;
 use imu_core::fusion::gate::{Gate, gate_99_9};
 
-use crate::error::Data;
-use crate::error::{Result, invalid};
 use crate::io::table::Table;
 use crate::run::fuse::{
     AidTables, FuseSetup, NHC_RATE_HZ, OdometerModel, REST_VELOCITY_SIGMA_M_S,
@@ -109,14 +108,14 @@ impl AidStreams {
         if let Some(c) = nhc
             && !(c.is_finite() && c > 0.0)
         {
-            return Err(invalid(
-                "nhc_sigma_m_s",
+            return Err(refused(
+                RequestOption::NhcSigma,
                 format!("must be a finite number > 0 (m/s), got {c}"),
             ));
         }
         if !(setup.rest_s.is_finite() && setup.rest_s >= 0.0) {
-            return Err(invalid(
-                "rest_s",
+            return Err(refused(
+                RequestOption::RestS,
                 format!("must be a finite number ≥ 0 (s), got {}", setup.rest_s),
             ));
         }

@@ -2,7 +2,7 @@
 //! ([`Start`]).
 use super::{FuseSetup, Gate};
 use crate::choice::{Choice, display_as_name};
-use crate::error::{Result, invalid};
+use crate::error::{RequestOption, Result, refused};
 use crate::io::conventions::EarthName;
 use crate::run::navigate::InitialState;
 
@@ -66,8 +66,8 @@ impl<'a> Start<'a> {
     /// Both (field `initial`).
     pub fn of(initial: Option<&'a InitialState>, align: Option<AlignName>) -> Result<Option<Self>> {
         match (initial, align) {
-            (Some(_), Some(_)) => Err(invalid(
-                "initial",
+            (Some(_), Some(_)) => Err(refused(
+                RequestOption::Initial,
                 "give the initial state or an alignment, not both",
             )),
             (Some(s), None) => Ok(Some(Self::State(s))),
@@ -182,8 +182,8 @@ impl<'a> FuseRequest<'a> {
     /// No start (field `initial`).
     pub fn start(&self) -> Result<Start<'a>> {
         self.start.ok_or_else(|| {
-            invalid(
-                "initial",
+            refused(
+                RequestOption::Initial,
                 "the filter needs a start: the initial state (a truth row) or an alignment: \
                  \"gnss\" (from the first fix at speed), \"static\" (at rest on the WGS-84 \
                  Earth) or \"level\" (at rest, heading zero)",
@@ -207,8 +207,8 @@ impl<'a> FuseRequest<'a> {
         if let Some(e) = self.earth
             && e != earth
         {
-            return Err(invalid(
-                "earth",
+            return Err(refused(
+                RequestOption::Earth,
                 format!(
                     "\"{e}\": the filter's model (the scenario's, or the data's) is on the \
                      {earth} Earth"

@@ -1,4 +1,5 @@
 //! An orientation filter over an IMU file, streamed into an orientation table (`imukit orient`).
+use crate::error::{Data, RequestOption, Result, invalid, refused};
 use std::path::Path;
 
 use imu_core::orientation::{FilterInput, OrientationFilter};
@@ -6,8 +7,6 @@ use imu_core::{Body, Enu, NavFrame, Ned, Rotation};
 
 use super::{AnyFilter, FilterKind, FilterSpec, SIX_AXIS_FILTERS, robust_row};
 use crate::choice::Choice;
-use crate::error::Data;
-use crate::error::{Result, invalid};
 use crate::io::Input;
 use crate::io::columns::{
     ACCEL_COLUMNS, GYRO_COLUMNS, MAG_COLUMNS, ORIENT_COLUMNS, ROBUST_COLUMNS,
@@ -89,8 +88,8 @@ fn orient_csv_in<N: NavFrame>(
     let mut spec = spec.clone();
     let warnings = choose_magnetometer(&mut spec, &header, input)?;
     if spec.smooth && spec.kind != FilterKind::Robust {
-        return Err(invalid(
-            "smooth",
+        return Err(refused(
+            RequestOption::Smooth,
             format!(
                 "only the robust filter smooths a run, not {}",
                 spec.kind.name()
@@ -187,8 +186,8 @@ fn choose_magnetometer(
     let mut warnings = Vec::new();
     spec.magnetometer = match (spec.kind.magnetometer(), spec.use_magnetometer) {
         (Some(true), false) => {
-            return Err(invalid(
-                "use_magnetometer",
+            return Err(refused(
+                RequestOption::UseMagnetometer,
                 format!("the {name} filter needs a magnetometer; for 6D use {SIX_AXIS_FILTERS}"),
             ));
         }
@@ -260,7 +259,10 @@ fn write_smoothed<N: NavFrame>(
     file: &mut AtomicFile,
 ) -> Result<usize> {
     let AnyFilter::Robust(robust) = filter else {
-        return Err(invalid("smooth", "only the robust filter smooths a run"));
+        return Err(refused(
+            RequestOption::Smooth,
+            "only the robust filter smooths a run",
+        ));
     };
     let inputs: Vec<FilterInput> = run.iter().map(|(_, s)| *s).collect();
     let smoothed = super::rows::smooth_inputs::<N>(*robust.params(), &inputs)
