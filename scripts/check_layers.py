@@ -7,13 +7,20 @@ so that arrow cannot turn). A room may name itself and the rooms below it, never
 check lists every `crate::<room>` path of every file (imports and paths written inline) and
 prints each one that points up with its file and line; with `--list`, it prints every room's
 imports of the others.
+
+It also fails on a circle between rooms in `imu-core` and `imu-io`, whose rooms have no fixed
+order: a room (a top-level module) that imports, directly or through others, a room that
+imports it. A circle inside one room is that room's business.
 """
 import re
 import sys
 from collections import Counter
 from pathlib import Path
 
-SRC = Path(__file__).resolve().parent.parent / "crates" / "imukit" / "src"
+ROOT = Path(__file__).resolve().parent.parent
+SRC = ROOT / "crates" / "imukit" / "src"
+# The crates whose rooms must not import each other in a circle.
+UNORDERED = [ROOT / "crates" / "imu-core" / "src", ROOT / "crates" / "imu-io" / "src"]
 # Bottom first; a room may use the rooms before it in this list.
 ORDER = ["examples", "motion", "scenario", "run"]
 PATH = re.compile(r"\bcrate::(\w+)\b")
@@ -24,6 +31,58 @@ def room_of(path: Path) -> str | None:
     first = path.relative_to(SRC).parts[0]
     name = first[:-3] if first.endswith(".rs") else first
     return name if name in ORDER else None
+
+
+def room_imports(src: Path) -> dict[str, dict[str, str]]:
+    """Each room of `src` (a top-level module) and the rooms it imports, each with a place."""
+    rooms = {p.stem if p.suffix == ".rs" else p.name for p in src.iterdir()}
+    edges: dict[str, dict[str, str]] = {}
+    for path in sorted(src.rglob("*.rs")):
+        first = path.relative_to(src).parts[0]
+        room = first[:-3] if first.endswith(".rs") else first
+        text = path.read_text(encoding="utf-8")
+        names = [(m.start(), m.group(1)) for m in PATH.finditer(text)]
+        for g in GROUP.finditer(text):
+            names += [(g.start(), n.strip().split("::")[0]) for n in g.group(1).split(",") if n.strip()]
+        for at, target in names:
+            start = text.rfind("\n", 0, at) + 1
+            if text[start:at].lstrip().startswith("//") or target not in rooms or target == room:
+                continue
+            line = text.count("\n", 0, at) + 1
+            edges.setdefault(room, {}).setdefault(target, f"{path.relative_to(ROOT)}:{line}")
+    return edges
+
+
+def circles(edges: dict[str, dict[str, str]]) -> list[list[str]]:
+    """The rooms that import each other in a circle (strongly connected, more than one)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in edges.get(v, {}):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for v in sorted(edges):
+        if v not in index:
+            visit(v)
+    return found
 
 
 def main() -> int:
@@ -48,10 +107,19 @@ def main() -> int:
             print(f"{room} -> {target}: {n}")
     for u in up:
         print(u)
+    failed = bool(up)
     if up:
         print(f"{len(up)} import(s) point up; the order is {' < '.join(ORDER)} (scripts/check_layers.py)")
-        return 1
-    return 0
+    for src in UNORDERED:
+        edges = room_imports(src)
+        for group in circles(edges):
+            failed = True
+            print(f"{src.relative_to(ROOT)}: rooms {', '.join(group)} import each other in a circle:")
+            for a in group:
+                for b, place in sorted(edges.get(a, {}).items()):
+                    if b in group:
+                        print(f"  {place}: {a} imports {b}")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

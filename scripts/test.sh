@@ -20,7 +20,7 @@ python -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" "zig
 
 section "Format and lints"
 cargo fmt --all -- --check
-python3 scripts/check_layers.py   # no room of the library imports a room above its own
+python3 scripts/check_layers.py   # no room of the library imports a room above its own; no circle between rooms of imu-core or imu-io
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 check-jsonschema --builtin-schema vendor.github-workflows .github/workflows/*.yml
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p imu-core -p imu-io -p imukit -p imu-plot -p imu-cli   # doc links resolve
