@@ -27,10 +27,23 @@ PATH = re.compile(r"\bcrate::(\w+)\b")
 GROUP = re.compile(r"\buse crate::\{([^;]*)\};", re.S)
 
 
+def top_module(path: Path, src: Path) -> str:
+    """The top-level module of `src` that the file at `path` belongs to."""
+    first = path.relative_to(src).parts[0]
+    return first[:-3] if first.endswith(".rs") else first
+
+
 def room_of(path: Path) -> str | None:
-    first = path.relative_to(SRC).parts[0]
-    name = first[:-3] if first.endswith(".rs") else first
+    name = top_module(path, SRC)
     return name if name in ORDER else None
+
+
+def crate_paths(text: str) -> list[tuple[int, str]]:
+    """Every `crate::<room>` the text names (imports and paths written inline), with where."""
+    names = [(m.start(), m.group(1)) for m in PATH.finditer(text)]
+    for g in GROUP.finditer(text):
+        names += [(g.start(), n.strip().split("::")[0]) for n in g.group(1).split(",") if n.strip()]
+    return names
 
 
 def room_imports(src: Path) -> dict[str, dict[str, str]]:
@@ -38,13 +51,9 @@ def room_imports(src: Path) -> dict[str, dict[str, str]]:
     rooms = {p.stem if p.suffix == ".rs" else p.name for p in src.iterdir()}
     edges: dict[str, dict[str, str]] = {}
     for path in sorted(src.rglob("*.rs")):
-        first = path.relative_to(src).parts[0]
-        room = first[:-3] if first.endswith(".rs") else first
+        room = top_module(path, src)
         text = path.read_text(encoding="utf-8")
-        names = [(m.start(), m.group(1)) for m in PATH.finditer(text)]
-        for g in GROUP.finditer(text):
-            names += [(g.start(), n.strip().split("::")[0]) for n in g.group(1).split(",") if n.strip()]
-        for at, target in names:
+        for at, target in crate_paths(text):
             start = text.rfind("\n", 0, at) + 1
             if text[start:at].lstrip().startswith("//") or target not in rooms or target == room:
                 continue
@@ -92,10 +101,7 @@ def main() -> int:
         if room is None:  # lib.rs: the crate's face, above every room
             continue
         text = path.read_text(encoding="utf-8")
-        names = [(m.start(), m.group(1)) for m in PATH.finditer(text)]
-        for g in GROUP.finditer(text):
-            names += [(g.start(), n.strip().split("::")[0]) for n in g.group(1).split(",") if n.strip()]
-        for at, target in names:
+        for at, target in crate_paths(text):
             if target not in ORDER or target == room:
                 continue
             seen[(room, target)] += 1

@@ -64,10 +64,7 @@ pub fn by_flag(e: imukit::Error) -> imukit::Error {
             field: flag(&field),
             message,
         },
-        imukit::Error::Request { option, message } => imukit::Error::Invalid {
-            field: option.flag().into(),
-            message,
-        },
+        // A refused request option is named by its flag in `CliError`'s conversion.
         other => other,
     }
 }

@@ -336,10 +336,10 @@ impl KalibrImu {
     /// A rate that is not finite and positive, a file without an accelerometer or gyroscope.
     pub fn from_params(file: &ParamFile, update_rate_hz: f64, rostopic: &str) -> Result<Self> {
         if !(update_rate_hz.is_finite() && update_rate_hz > 0.0) {
-            return Err(Error::Request {
-                option: crate::error::RequestOption::RateHz,
-                message: format!("must be a finite rate above 0 Hz, got {update_rate_hz}"),
-            });
+            return Err(crate::error::refused(
+                crate::error::RequestOption::RateHz,
+                format!("must be a finite rate above 0 Hz, got {update_rate_hz}"),
+            ));
         }
         for (s, present) in Sensor::ALL.iter().zip(file.present) {
             if *s != Sensor::Magnetometer && !present {

@@ -463,10 +463,8 @@ impl TimedRows {
                 self.ahead.push_back(row);
             }
             let t = self.ahead[0][0];
-            if self.skipped_t == Some(t) && self.last == self.ahead[0] {
-                // A logger's copy of the row before, skipped with it.
-                self.repeats.count += 1;
-                self.repeats.first.get_or_insert(self.taken);
+            if self.is_copy(&self.ahead[0]) {
+                self.count_copy(self.taken + 2);
                 self.ahead.pop_front();
                 self.taken += 1;
                 continue;
@@ -532,10 +530,8 @@ impl TimedRows {
             }
             self.taken += 1;
             let (t, line) = (row[0], self.last_row());
-            if self.previous_t.or(self.skipped_t) == Some(t) && self.last.as_slice() == &row[..] {
-                // A logger's copy of the row before: nothing new, no interval.
-                self.repeats.count += 1;
-                self.repeats.first.get_or_insert(line - 2);
+            if self.is_copy(row) {
+                self.count_copy(line);
                 continue;
             }
             if let Some(p) = self.previous_t.or(self.skipped_t)
@@ -549,8 +545,7 @@ impl TimedRows {
             if t < self.window.0 {
                 // Before the window: checked in order, then skipped as if not in the file.
                 self.skipped_t = Some(t);
-                self.last.clear();
-                self.last.extend_from_slice(row);
+                self.remember(row);
                 continue;
             }
             if let Some(p) = self.previous_t {
@@ -558,11 +553,28 @@ impl TimedRows {
                 self.interval = Some(t - p);
             }
             self.previous_t = Some(t);
-            self.last.clear();
-            self.last.extend_from_slice(row);
+            self.remember(row);
             self.given += 1;
             return Ok(true);
         }
+    }
+
+    /// Whether `row` is a logger's exact copy of the row before it, given or skipped: nothing
+    /// new and no interval.
+    fn is_copy(&self, row: &[f64]) -> bool {
+        self.previous_t.or(self.skipped_t) == Some(row[0]) && self.last == row
+    }
+
+    /// Counts the copy at file row `line` in [`Self::repeats`].
+    fn count_copy(&mut self, line: usize) {
+        self.repeats.count += 1;
+        self.repeats.first.get_or_insert(line - 2);
+    }
+
+    /// Keeps `row` as the row before the next, to recognise its copy.
+    fn remember(&mut self, row: &[f64]) {
+        self.last.clear();
+        self.last.extend_from_slice(row);
     }
 
     /// The end of the rows given; refused when a window held none.
