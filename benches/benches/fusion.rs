@@ -23,7 +23,7 @@ fn gnss_update<E: BenchEarth, const S: usize>(f: &Eskf<E, S>) -> imu_core::fusio
         velocity_sigma_m_s: [0.1; 3],
         age_s: 0.0,
     };
-    g.update_gnss(&fix, imu_core::fusion::gate::Gate::Off)
+    g.update(&fix, imu_core::fusion::gate::Gate::Off)
         .expect("valid")
 }
 

@@ -5,7 +5,7 @@
 //! and the quantiles are the chi-square distribution's.
 use imu_core::earth::{EarthModel, FlatEarth, Geodetic, Wgs84};
 use imu_core::fusion::gate::{CHI2_99_9, Gate, gate_99_9};
-use imu_core::fusion::{BASE_STATES, Eskf, EskfNoise, EskfState, InitialSigma};
+use imu_core::fusion::{BASE_STATES, BodyVelocity, Eskf, EskfNoise, EskfState, InitialSigma};
 use imu_core::strapdown::NavState;
 use imu_core::{Body, Enu, EulerZyx, Ned, Rotation, Vec3};
 
@@ -78,14 +78,17 @@ fn close(a: (f64, f64), b: (f64, f64), what: &str) {
 fn updates_are_scalar_kalman_updates<E: EarthModel + Copy>(earth: E, position: E::Position) {
     // An odometer alone: forward only.
     let mut f = filter(earth, position);
-    let outcome = f.update_odometer(0.5, 0.1, None, Gate::Off).unwrap();
+    let outcome = f
+        .update(&BodyVelocity::odometer(0.5, 0.1, None), Gate::Off)
+        .unwrap();
     assert!(outcome.accepted);
     close(along(&f, 0), scalar_update(0.5, 0.1), "odometer, forward");
     close(along(&f, 1), (0.0, SIGMA_V * SIGMA_V), "odometer, lateral");
     close(along(&f, 2), (0.0, SIGMA_V * SIGMA_V), "odometer, vertical");
     // With the constraints: forward as before, lateral and vertical held to 0 ± 0.05.
     let mut f = filter(earth, position);
-    f.update_odometer(0.5, 0.1, Some(0.05), Gate::Off).unwrap();
+    f.update(&BodyVelocity::odometer(0.5, 0.1, Some(0.05)), Gate::Off)
+        .unwrap();
     close(
         along(&f, 0),
         scalar_update(0.5, 0.1),
@@ -103,12 +106,13 @@ fn updates_are_scalar_kalman_updates<E: EarthModel + Copy>(earth: E, position: E
     );
     // The constraints alone leave the forward axis.
     let mut f = filter(earth, position);
-    f.update_nonholonomic(0.05, Gate::Off).unwrap();
+    f.update(&BodyVelocity::nonholonomic(0.05), Gate::Off)
+        .unwrap();
     close(along(&f, 0), (0.0, SIGMA_V * SIGMA_V), "NHC, forward");
     close(along(&f, 1), scalar_update(0.0, 0.05), "NHC, lateral");
     // A zero-velocity update: every axis.
     let mut f = filter(earth, position);
-    f.update_zero_velocity(0.01, Gate::Off).unwrap();
+    f.update(&BodyVelocity::zero(0.01), Gate::Off).unwrap();
     for k in 0..3 {
         close(along(&f, k), scalar_update(0.0, 0.01), "zero velocity");
     }
@@ -116,13 +120,19 @@ fn updates_are_scalar_kalman_updates<E: EarthModel + Copy>(earth: E, position: E
     let limit = (CHI2_99_9[0] * (SIGMA_V * SIGMA_V + 0.01)).sqrt();
     let mut f = filter(earth, position);
     assert!(
-        f.update_odometer(0.99 * limit, 0.1, None, gate_99_9(1))
-            .unwrap()
-            .accepted
+        f.update(
+            &BodyVelocity::odometer(0.99 * limit, 0.1, None),
+            gate_99_9(1)
+        )
+        .unwrap()
+        .accepted
     );
     let mut f = filter(earth, position);
     let outcome = f
-        .update_odometer(1.01 * limit, 0.1, None, gate_99_9(1))
+        .update(
+            &BodyVelocity::odometer(1.01 * limit, 0.1, None),
+            gate_99_9(1),
+        )
         .unwrap();
     assert!(!outcome.accepted);
     assert!((outcome.nis / (1.01 * 1.01 * CHI2_99_9[0]) - 1.0).abs() < 1e-9);

@@ -262,8 +262,8 @@ fn the_filter_on_wgs84_is_the_same_in_enu_and_ned() {
                 velocity_sigma_m_s: [0.1; 3],
                 age_s: 0.02,
             };
-            let a = ned.update_gnss(&fix_ned, Gate::Off).unwrap();
-            let b = enu.update_gnss(&fix_enu, Gate::Off).unwrap();
+            let a = ned.update(&fix_ned, Gate::Off).unwrap();
+            let b = enu.update(&fix_enu, Gate::Off).unwrap();
             worst[3] = worst[3].max((a.nis - b.nis).abs() / a.nis);
             let d = differences(&[ned.state().nav], &[enu.state().nav]);
             // One-sigmas: NED (N, E, D) against ENU (E, N, U) for position, velocity, attitude.

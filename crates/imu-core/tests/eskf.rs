@@ -152,7 +152,7 @@ fn run<E: Case>(seed: u64, run: u64, seconds: f64, draw_scale: f64) -> [f64; 3] 
                 velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, Gate::Off).unwrap();
+            f.update(&fix, Gate::Off).unwrap();
         }
     }
     let t_end = samples as f64 / RATE_HZ;
@@ -249,7 +249,7 @@ fn long_run<E: Case, const S: usize>(name: &str) {
                 velocity_sigma_m_s: [VELOCITY_SIGMA_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, Gate::Off).unwrap();
+            f.update(&fix, Gate::Off).unwrap();
         }
     }
     let p = nalgebra::DMatrix::from_fn(S, S, |i, j| f.covariance(i, j));
@@ -299,7 +299,7 @@ fn a_reset_puts_the_filter_on_the_fix_with_the_fix_s_uncertainty() {
         f.propagate(k as f64 / RATE_HZ, [0.0; 3], [0.0, 0.0, 9.81])
             .unwrap();
         if k % 10 == 0 {
-            f.update_gnss(&standstill, Gate::ChiSquare(1e6)).unwrap();
+            f.update(&standstill, Gate::ChiSquare(1e6)).unwrap();
         }
     }
     let bias_before: Vec<f64> = (9..15).map(|k| f.covariance(k, k)).collect();

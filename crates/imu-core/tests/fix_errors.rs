@@ -134,7 +134,7 @@ fn run<const S: usize>(decay: f64, model: Model, run: u64, at_s: &[f64]) -> Vec<
                 velocity_sigma_m_s: [VELOCITY_M_S; 3],
                 age_s: 0.0,
             };
-            f.update_gnss(&fix, Gate::Off).unwrap();
+            f.update(&fix, Gate::Off).unwrap();
         }
         if at_s.iter().any(|a| (a * RATE_HZ).round() as usize == k) {
             let (p, v) = truth(t);

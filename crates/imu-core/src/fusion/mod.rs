@@ -14,7 +14,8 @@ pub mod sensor_errors;
 pub mod smoother;
 
 pub use eskf::{
-    Eskf, EskfError, EskfNoise, EskfState, GnssFix, InitialSigma, UpdateOutcome, corrected_state,
+    BodyVelocity, Eskf, EskfError, EskfNoise, EskfState, GnssFix, Height, InitialSigma,
+    Measurement, UpdateOutcome, ZeroRate, corrected_state,
 };
 pub use fix_errors::{FIX_ERROR_STATES, FixErrorModel, has_fix_errors, has_sensor_errors};
 pub use sensor_errors::{BASE_STATES, FULL_STATES, SensorErrorEstimate, SensorErrorSigma};

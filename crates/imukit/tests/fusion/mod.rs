@@ -7,7 +7,8 @@ use std::path::Path;
 
 use imu_core::earth::FlatEarth;
 use imu_core::fusion::{
-    BASE_STATES, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma, SensorErrorSigma,
+    BASE_STATES, BodyVelocity, Eskf, EskfNoise, EskfState, FULL_STATES, GnssFix, InitialSigma,
+    SensorErrorSigma,
 };
 use imu_core::sensor::{NoiseSource, SeededNormals};
 use imu_core::strapdown::NavState;
@@ -312,15 +313,14 @@ fn average_nees<const S: usize>(
                     velocity_sigma_m_s: [sigma_vel; 3],
                     age_s: 0.0,
                 };
-                let outcome = f.update_gnss(&fix, Gate::Off).unwrap();
+                let outcome = f.update(&fix, Gate::Off).unwrap();
                 nis_sum += outcome.nis;
                 fixes += 1;
                 next += 1;
             }
             while next_odo < odo_t.len() && odo_t[next_odo] <= t[i] {
-                f.update_body_velocity(
-                    [Some(odo_v[next_odo]), Some(0.0), Some(0.0)],
-                    [sigma_odo, sigma_nhc, sigma_nhc],
+                f.update(
+                    &BodyVelocity::odometer(odo_v[next_odo], sigma_odo, Some(sigma_nhc)),
                     Gate::Off,
                 )
                 .unwrap();

@@ -32,7 +32,6 @@ use super::fix_errors::{self, FixErrorModel, has_fix_errors, has_sensor_errors};
 use super::sensor_errors::{BASE_STATES, SensorErrorEstimate, SensorErrorSigma, SensorErrors};
 use super::smoother::{EpochRecord, SmoothingLog};
 use crate::earth::EarthModel;
-use crate::frame::Body;
 use crate::math;
 use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
@@ -40,15 +39,14 @@ use crate::strapdown::{Increments, NavState, StrapdownOptions};
 use crate::vector::Vec3;
 
 mod intake;
+mod measurements;
 mod models;
+mod reset;
 mod transition;
-mod updates;
 
 pub(crate) use intake::Intake;
-pub(crate) use models::{
-    Linearisation, body_velocity_model, gnss_model, initial_covariance, kalman_update,
-    process_noise, set_sensor_variances, zero_rate_model,
-};
+pub use measurements::{BodyVelocity, GnssFix, Height, Measurement, ZeroRate};
+pub(crate) use models::{initial_covariance, kalman_update, process_noise, set_sensor_variances};
 use transition::{Dynamics, EarthCouplings, Transition};
 
 pub(crate) type Cov<const S: usize> = SMatrix<f64, S, S>;
@@ -101,24 +99,6 @@ pub struct UpdateOutcome {
     pub nis: f64,
     /// Whether it was applied (false: rejected by the gate).
     pub accepted: bool,
-}
-
-/// One GNSS fix as the filter takes it (see [`Eskf::update_gnss`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GnssFix<E: EarthModel> {
-    /// Antenna position.
-    pub position: E::Position,
-    /// Antenna velocity, navigation frame, m/s (`None`: position only).
-    pub velocity_m_s: Option<Vec3<E::Frame>>,
-    /// Antenna lever arm, body frame, m.
-    pub lever_arm_m: Vec3<Body>,
-    /// Position one-sigma per navigation axis, m.
-    pub position_sigma_m: [f64; 3],
-    /// Velocity one-sigma per axis, m/s.
-    pub velocity_sigma_m_s: [f64; 3],
-    /// How long before the filter's current time the fix was valid, s (≥ 0): the receiver's
-    /// latency plus the wait for the next IMU sample.
-    pub age_s: f64,
 }
 
 /// Why the filter refused input.

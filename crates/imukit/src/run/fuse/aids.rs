@@ -3,8 +3,8 @@
 //! read, checked and applied at their times, the same way on every Earth.
 use crate::error::{Data, RequestOption, Result, invalid, refused};
 use imu_core::earth::EarthModel;
-use imu_core::fusion::Eskf;
 use imu_core::fusion::gate::{Gate, gate_99_9};
+use imu_core::fusion::{BodyVelocity, Eskf, Height, ZeroRate};
 
 use crate::io::table::Table;
 use crate::run::fuse::{
@@ -177,17 +177,27 @@ impl AidStreams {
             // A stance on the move: the detector is the gate, and the foot is still only to
             // about a centimetre a second (it rolls and settles).
             filter
-                .update_zero_velocity(STANCE_VELOCITY_SIGMA_M_S, Gate::Off)
+                .update(&BodyVelocity::zero(STANCE_VELOCITY_SIGMA_M_S), Gate::Off)
                 .map_err(|e| filter_refusal("IMU (stance, zero velocity)", i, e))?;
             filter
-                .update_zero_rate(self.rest.1, Gate::Off)
+                .update(
+                    &ZeroRate {
+                        sigma_rad_s: self.rest.1,
+                    },
+                    Gate::Off,
+                )
                 .map_err(|e| filter_refusal("IMU (stance, zero rate)", i, e))?;
         } else if t_s < self.rest.0 {
             filter
-                .update_zero_velocity(REST_VELOCITY_SIGMA_M_S, self.gate(3))
+                .update(&BodyVelocity::zero(REST_VELOCITY_SIGMA_M_S), self.gate(3))
                 .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;
             filter
-                .update_zero_rate(self.rest.1, self.gate(3))
+                .update(
+                    &ZeroRate {
+                        sigma_rad_s: self.rest.1,
+                    },
+                    self.gate(3),
+                )
                 .map_err(|e| filter_refusal("IMU (at rest, zero rate)", i, e))?;
         }
         let (odo_t, odo_v) = (&self.odometer.0, &self.odometer.1);
@@ -199,9 +209,9 @@ impl AidStreams {
                 .noise_m_s
                 .hypot(m.scale_factor_error * speed)
                 .max(MIN_SIGMA);
-            let rows = if self.nhc_sigma_m_s.is_some() { 3 } else { 1 };
+            let odometer = BodyVelocity::odometer(speed, sigma, self.nhc_sigma_m_s);
             filter
-                .update_odometer(speed, sigma, self.nhc_sigma_m_s, self.gate(rows))
+                .update(&odometer, self.gate(odometer.rows()))
                 .map_err(|e| filter_refusal("odometer", k, e))?;
             self.next.0 += 1;
         }
@@ -210,7 +220,7 @@ impl AidStreams {
             && t_s >= self.next_nhc_t
         {
             filter
-                .update_nonholonomic(c, self.gate(2))
+                .update(&BodyVelocity::nonholonomic(c), self.gate(2))
                 .map_err(|e| filter_refusal("constraint", i, e))?;
             self.next_nhc_t = t_s + 1.0 / NHC_RATE_HZ;
         }
@@ -218,7 +228,13 @@ impl AidStreams {
         while self.next.1 < baro_t.len() && baro_t[self.next.1] <= t_s {
             let k = self.next.1;
             filter
-                .update_height(baro_h[k], self.baro_sigma_m, self.gate(1))
+                .update(
+                    &Height {
+                        height_m: baro_h[k],
+                        sigma_m: self.baro_sigma_m,
+                    },
+                    self.gate(1),
+                )
                 .map_err(|e| filter_refusal("barometer", k, e))?;
             self.next.1 += 1;
         }

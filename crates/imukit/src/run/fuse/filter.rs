@@ -291,7 +291,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             // Valid at its stamp minus the latency; applied at this IMU sample.
             age_s: t[i] - g_t[k] + setup.gnss_latency_s,
         };
-        let outcome = filter.update_gnss(&fix, setup.gate);
+        let outcome = filter.update(&fix, setup.gate);
         if let Ok(o) = &outcome {
             let rows = if fix.velocity_m_s.is_some() { 6 } else { 3 };
             if let Some(change) = noise_scale.observe(o.nis, rows) {
