@@ -71,6 +71,15 @@ def test_a_bad_part_or_accuracy_is_refused_by_name(drive):
     with pytest.raises(ValueError, match="scenario= .* or imu_model=.*not both"):
         imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]), initial=imukit.read(files["truth"]),
                     scenario=str(scenario), imu_model="stim300")
+    # The receiver's options are refused by Python's keyword, as the command line names its flag.
+    for keyword, value in [("gnss_horizontal_accuracy_m", -1.0), ("gnss_decay_factor", 2.0),
+                           ("gnss_latency_s", -0.5), ("gnss_lever_arm_m", [0.0, float("nan"), 0.0])]:
+        with pytest.raises(ValueError) as e:
+            imukit.fuse(imukit.read(files["imu"]), imukit.read(files["gnss"]),
+                        initial=imukit.read(files["truth"]), imu_model="stim300", **{keyword: value})
+        assert e.value.field == keyword, e.value
+    done = fuse(files, out, "--imu", "stim300", "--gnss-decay-factor", "2")
+    assert done.returncode == 65 and "--gnss-decay-factor" in done.stderr, done.stderr
 
 
 def test_a_scenario_that_contradicts_the_datas_description_is_refused(drive):

@@ -25,13 +25,7 @@ pub enum CliError {
 impl From<imukit::Error> for CliError {
     /// The library's error, a refused request option named by the flag that sets it.
     fn from(e: imukit::Error) -> Self {
-        Self::Library(match e {
-            imukit::Error::Request { option, message } => imukit::Error::Invalid {
-                field: option.flag().into(),
-                message,
-            },
-            other => other,
-        })
+        Self::Library(e.naming_options(imukit::error::RequestOption::flag))
     }
 }
 
@@ -97,6 +91,8 @@ mod tests {
             (RequestOption::Threads, "--threads"),
             (RequestOption::UseMagnetometer, "--no-mag"),
             (RequestOption::Initial, "--init"),
+            (RequestOption::Align, "--align"),
+            (RequestOption::GnssLeverArm, "--gnss-lever-arm-m"),
         ] {
             assert_eq!(named(imukit::error::refused(option, "m")), flag);
         }

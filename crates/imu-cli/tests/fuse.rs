@@ -466,6 +466,34 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     assert_eq!(header[35], "accel_scale_factor_x");
     assert_eq!(header[76], "gyro_g_sensitivity_z_sigma_rad_s_per_m_s2");
     assert_eq!(header[77], "gnss_resets");
+    // A levelling over a "rest" whose specific force is twice gravity is refused by the start
+    // that was asked for.
+    let mut accelerating = String::from(
+        "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2\n",
+    );
+    for i in 0..300 {
+        accelerating.push_str(&format!("{},0,0,0,0,0,19.6\n", f64::from(i) / 100.0));
+    }
+    std::fs::write(dir.join("pushed.csv"), accelerating).unwrap();
+    let args = [
+        "fuse",
+        "pushed.csv",
+        "--imu",
+        "stim300",
+        "--align",
+        "level",
+        "--rest-s",
+        "1",
+        "--out",
+        "level.csv",
+    ];
+    let (code, err) = run_in(dir, &args);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains("--align: \"level\": the mean specific force is 19.600"),
+        "{err}"
+    );
+    assert!(!dir.join("level.csv").exists());
 }
 
 #[test]

@@ -30,6 +30,24 @@ pub enum RequestOption {
     NhcSigma,
     /// The rest at the start of a run.
     RestS,
+    /// How the filter finds its initial attitude (an alignment).
+    Align,
+    /// The interval between the filter's covariance steps.
+    CovarianceInterval,
+    /// A receiver's horizontal position one-sigma.
+    GnssHorizontalAccuracy,
+    /// A receiver's vertical position one-sigma.
+    GnssVerticalAccuracy,
+    /// A receiver's velocity one-sigma.
+    GnssVelocityAccuracy,
+    /// A receiver's position-error decay factor (MATLAB's).
+    GnssDecayFactor,
+    /// A receiver's position-error correlation time.
+    GnssCorrelationTime,
+    /// A receiver's latency.
+    GnssLatency,
+    /// The antenna's lever arm.
+    GnssLeverArm,
 }
 
 impl RequestOption {
@@ -45,6 +63,15 @@ impl RequestOption {
             Self::Initial => "initial",
             Self::NhcSigma => "nhc_sigma_m_s",
             Self::RestS => "rest_s",
+            Self::Align => "align",
+            Self::CovarianceInterval => "covariance_interval_s",
+            Self::GnssHorizontalAccuracy => "gnss_horizontal_accuracy_m",
+            Self::GnssVerticalAccuracy => "gnss_vertical_accuracy_m",
+            Self::GnssVelocityAccuracy => "gnss_velocity_accuracy_m_s",
+            Self::GnssDecayFactor => "gnss_decay_factor",
+            Self::GnssCorrelationTime => "gnss_correlation_time_s",
+            Self::GnssLatency => "gnss_latency_s",
+            Self::GnssLeverArm => "gnss_lever_arm_m",
         }
     }
 
@@ -60,6 +87,15 @@ impl RequestOption {
             Self::Initial => "--init",
             Self::NhcSigma => "--nhc",
             Self::RestS => "--rest-s",
+            Self::Align => "--align",
+            Self::CovarianceInterval => "--covariance-interval-s",
+            Self::GnssHorizontalAccuracy => "--gnss-horizontal-accuracy-m",
+            Self::GnssVerticalAccuracy => "--gnss-vertical-accuracy-m",
+            Self::GnssVelocityAccuracy => "--gnss-velocity-accuracy-m-s",
+            Self::GnssDecayFactor => "--gnss-decay-factor",
+            Self::GnssCorrelationTime => "--gnss-correlation-time-s",
+            Self::GnssLatency => "--gnss-latency-s",
+            Self::GnssLeverArm => "--gnss-lever-arm-m",
         }
     }
 }
@@ -141,11 +177,12 @@ pub enum Error {
         /// The core's error.
         source: EskfError,
     },
-    /// A static alignment that could not be made.
-    #[error("{field}: \"static\": {source}{}", align_hint(source))]
+    /// An alignment that could not be made: the start `start` (`static`, `level`) asked for by
+    /// the request option [`RequestOption::Align`].
+    #[error("{}: {}", RequestOption::Align.key(), align_message(start, source))]
     Align {
-        /// The request field, `align`.
-        field: String,
+        /// The alignment asked for.
+        start: &'static str,
         /// The core's error.
         source: AlignError,
     },
@@ -355,6 +392,23 @@ impl Error {
         }
     }
 
+    /// This refusal, when it names a request option, as [`Error::Invalid`] of the option's
+    /// name in a front end, `name(option)` (the command line's flag); other refusals as they are.
+    #[must_use]
+    pub fn naming_options(self, name: impl Fn(RequestOption) -> &'static str) -> Self {
+        match self {
+            Self::Request { option, message } => Self::Invalid {
+                field: name(option).into(),
+                message,
+            },
+            Self::Align { start, source } => Self::Invalid {
+                field: name(RequestOption::Align).into(),
+                message: align_message(start, &source),
+            },
+            other => other,
+        }
+    }
+
     /// Where the error points.
     #[must_use]
     pub fn location(&self) -> Location {
@@ -370,10 +424,10 @@ impl Error {
             Self::Io { path, .. } => file(path),
             Self::Scenario { .. } => Location::default(),
             Self::Request { option, .. } => field(option.key()),
+            Self::Align { .. } => field(RequestOption::Align.key()),
             Self::Invalid { field: f, .. }
             | Self::ScenarioKey { field: f, .. }
             | Self::UnknownChoice { field: f, .. }
-            | Self::Align { field: f, .. }
             | Self::Expression { field: f, .. }
             | Self::BadQuaternion { field: f }
             | Self::Diverged { context: f, .. } => field(f),
@@ -423,11 +477,13 @@ impl Error {
 }
 
 /// What to do instead when a static alignment fails.
-fn align_hint(e: &AlignError) -> &'static str {
-    match e {
+/// Why the alignment `start` failed, with what to do instead.
+fn align_message(start: &str, e: &AlignError) -> String {
+    let hint = match e {
         AlignError::NoNorth { .. } => "; use \"gnss\" or give the initial state",
         AlignError::NotAtRest { .. } => "",
-    }
+    };
+    format!("\"{start}\": {e}{hint}")
 }
 
 /// Result with [`Error`].

@@ -699,6 +699,7 @@ fn a_fuse_request_finishes_the_scenario_setup_and_names_its_fields() {
 
 #[test]
 fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
+    use imukit::error::RequestOption;
     use imukit::run::fuse::PartModel;
     use imukit::run::navigate::NavSetup;
     use imukit::scenario::gnss::GnssSpec;
@@ -713,29 +714,56 @@ fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
                 velocity_accuracy_m_s: Some(0.0),
                 ..GnssSpec::default()
             },
-            "gnss.velocity_accuracy_m_s",
+            RequestOption::GnssVelocityAccuracy,
         ),
         (
             GnssSpec {
                 horizontal_accuracy_m: Some(-1.0),
                 ..GnssSpec::default()
             },
-            "gnss.horizontal_accuracy_m",
+            RequestOption::GnssHorizontalAccuracy,
         ),
         (
             GnssSpec {
                 vertical_accuracy_m: Some(f64::NAN),
                 ..GnssSpec::default()
             },
-            "gnss.vertical_accuracy_m",
+            RequestOption::GnssVerticalAccuracy,
+        ),
+        (
+            GnssSpec {
+                decay_factor: Some(1.5),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssDecayFactor,
+        ),
+        (
+            GnssSpec {
+                latency_s: Some(-0.1),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssLatency,
+        ),
+        (
+            GnssSpec {
+                lever_arm_m: Some([0.0, f64::INFINITY, 0.0]),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssLeverArm,
         ),
     ] {
         match part(gnss).setup(&NavSetup::default(), None, 100.0) {
-            Err(Error::Invalid { field: f, message }) => {
-                assert_eq!(f, field);
-                assert!(message.contains("above 0"), "{message}");
+            Err(Error::Request { option, message }) => {
+                assert_eq!(option, field);
+                let accuracy = matches!(
+                    option,
+                    RequestOption::GnssVelocityAccuracy
+                        | RequestOption::GnssHorizontalAccuracy
+                        | RequestOption::GnssVerticalAccuracy
+                );
+                assert!(!accuracy || message.contains("above 0"), "{message}");
             }
-            other => panic!("{field}: {other:?}"),
+            other => panic!("{field:?}: {other:?}"),
         }
     }
     let given = GnssSpec {

@@ -17,7 +17,7 @@ use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
-use crate::error::{by_flag, flag};
+use crate::error::by_flag;
 
 /// The command's arguments.
 pub struct Args<'a> {
@@ -64,10 +64,6 @@ fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<Fu
         .setup_described(&a.asked, &described, imu)
         .map_err(|e| match e {
             e if e.data() == Some(Data::Imu) => e.relabelled(a.imu.display().to_string()),
-            Error::Invalid { field, message } if field.starts_with("gnss.") => Error::Invalid {
-                field: field.replace("gnss.", "--gnss-").replace('_', "-"),
-                message,
-            },
             other => by_flag(other),
         })?)
 }
@@ -218,8 +214,8 @@ fn fixes_of(a: &Args<'_>, t0: f64) -> Result<imukit::Table, CliError> {
     )
 }
 
-/// A library refusal named as the user knows its source: an input by its file, a request's
-/// field by its flag.
+/// A library refusal named as the user knows its source: an input by its file (a request's
+/// option is named by its flag in [`CliError`]'s conversion).
 fn named(a: &Args<'_>, e: Error) -> Error {
     let file_of = |data: Data| match data {
         Data::Imu => Some(a.imu.path()),
@@ -227,16 +223,10 @@ fn named(a: &Args<'_>, e: Error) -> Error {
         Data::Odometer => a.odometer,
         Data::Barometer => a.baro,
     };
-    if let Some(file) = e.data().and_then(file_of) {
-        return e.relabelled(file.display().to_string());
+    match e.data().and_then(file_of) {
+        Some(file) => e.relabelled(file.display().to_string()),
+        None => e,
     }
-    by_field(e, |context: String| {
-        if FuseRequest::FIELDS.contains(&context.as_str()) {
-            flag(&context)
-        } else {
-            context
-        }
-    })
 }
 
 pub fn run(a: &Args<'_>) -> Result<(), CliError> {
@@ -438,33 +428,5 @@ fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samp
                 "the part's"
             }
         ));
-    }
-}
-
-/// `e` with the request field or context it names renamed by `rename` (the flag a user gave).
-fn by_field(e: Error, rename: impl Fn(String) -> String) -> Error {
-    match e {
-        Error::Invalid { field, message } => Error::Invalid {
-            field: rename(field),
-            message,
-        },
-        Error::Diverged { context, message } => Error::Diverged {
-            context: rename(context),
-            message,
-        },
-        Error::Filter {
-            context,
-            row,
-            source,
-        } => Error::Filter {
-            context: rename(context),
-            row,
-            source,
-        },
-        Error::Align { field, source } => Error::Align {
-            field: flag(&field),
-            source,
-        },
-        other => other,
     }
 }

@@ -52,11 +52,43 @@ impl Default for GnssParams {
     }
 }
 
+/// One of [`GnssParams`]' parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GnssParam {
+    /// [`GnssParams::rate_hz`].
+    RateHz,
+    /// [`GnssParams::horizontal_accuracy_m`].
+    HorizontalAccuracy,
+    /// [`GnssParams::vertical_accuracy_m`].
+    VerticalAccuracy,
+    /// [`GnssParams::velocity_accuracy_m_s`].
+    VelocityAccuracy,
+    /// [`PositionNoise::DecayFactor`].
+    DecayFactor,
+    /// [`PositionNoise::GaussMarkov`]'s correlation time.
+    CorrelationTime,
+}
+
+impl GnssParam {
+    /// The parameter's name with its unit, as files and requests spell it.
+    #[must_use]
+    pub const fn key(self) -> &'static str {
+        match self {
+            Self::RateHz => "rate_hz",
+            Self::HorizontalAccuracy => "horizontal_accuracy_m",
+            Self::VerticalAccuracy => "vertical_accuracy_m",
+            Self::VelocityAccuracy => "velocity_accuracy_m_s",
+            Self::DecayFactor => "decay_factor",
+            Self::CorrelationTime => "correlation_time_s",
+        }
+    }
+}
+
 /// A parameter out of its range.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GnssError {
     /// The parameter.
-    pub field: &'static str,
+    pub field: GnssParam,
     /// Its value.
     pub value: f64,
     /// What it must be.
@@ -68,7 +100,9 @@ impl core::fmt::Display for GnssError {
         write!(
             f,
             "{} must be {}, got {}",
-            self.field, self.rule, self.value
+            self.field.key(),
+            self.rule,
+            self.value
         )
     }
 }
@@ -106,23 +140,48 @@ impl GnssModel {
             }
         };
         let rate = params.rate_hz;
-        check("rate_hz", rate, rate > 0.0, "a finite number > 0")?;
+        check(GnssParam::RateHz, rate, rate > 0.0, "a finite number > 0")?;
         let h = params.horizontal_accuracy_m;
         let v = params.vertical_accuracy_m;
         let s = params.velocity_accuracy_m_s;
-        check("horizontal_accuracy_m", h, h >= 0.0, "a finite number ≥ 0")?;
-        check("vertical_accuracy_m", v, v >= 0.0, "a finite number ≥ 0")?;
-        check("velocity_accuracy_m_s", s, s >= 0.0, "a finite number ≥ 0")?;
+        check(
+            GnssParam::HorizontalAccuracy,
+            h,
+            h >= 0.0,
+            "a finite number ≥ 0",
+        )?;
+        check(
+            GnssParam::VerticalAccuracy,
+            v,
+            v >= 0.0,
+            "a finite number ≥ 0",
+        )?;
+        check(
+            GnssParam::VelocityAccuracy,
+            s,
+            s >= 0.0,
+            "a finite number ≥ 0",
+        )?;
         let sigma = [h, h, v];
         let (phi, drive, stationary) = match params.position_noise {
             PositionNoise::DecayFactor(k) => {
-                check("decay_factor", k, (0.0..=1.0).contains(&k), "within [0, 1]")?;
+                check(
+                    GnssParam::DecayFactor,
+                    k,
+                    (0.0..=1.0).contains(&k),
+                    "within [0, 1]",
+                )?;
                 let scale = math::sqrt(2.0 * (1.0 - k));
                 (k, sigma.map(|x| x * scale), None)
             }
             PositionNoise::GaussMarkov { correlation_time_s } => {
                 let t = correlation_time_s;
-                check("correlation_time_s", t, t > 0.0, "a finite number > 0")?;
+                check(
+                    GnssParam::CorrelationTime,
+                    t,
+                    t > 0.0,
+                    "a finite number > 0",
+                )?;
                 let phi = math::exp(-1.0 / (rate * t));
                 let scale = math::sqrt(1.0 - phi * phi);
                 (phi, sigma.map(|x| x * scale), Some(sigma))

@@ -5,13 +5,14 @@
 //! Output ([`GNSS_COLUMNS`] on the flat Earth, [`GNSS_EARTH_COLUMNS`] on WGS-84): the stamp
 //! time, the position (navigation-frame metres, or latitude, longitude, height) and the ground
 //! velocity (navigation-frame axes, or north, east, down).
+use imu_core::aiding::gnss::GnssParam;
 use imu_core::aiding::{GnssModel, GnssParams, GnssState, PositionNoise};
 use imu_core::earth::{EarthTruth, Geodetic};
 use imu_core::sensor::SeededNormals;
 use imu_core::{Body, NavFrame, Ned, Truth, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, invalid};
+use crate::error::{Error, RequestOption, Result, invalid, refused};
 use crate::io::columns::{GNSS_COLUMNS, GNSS_EARTH_COLUMNS};
 use crate::io::table::Table;
 
@@ -53,6 +54,40 @@ pub struct GnssSpec {
     pub outages: Vec<OutageSpec>,
 }
 
+/// The front ends' option that sets the receiver's parameter `p` for a filter; the rate has
+/// none.
+fn option_of(p: GnssParam) -> Option<RequestOption> {
+    match p {
+        GnssParam::RateHz => None,
+        GnssParam::HorizontalAccuracy => Some(RequestOption::GnssHorizontalAccuracy),
+        GnssParam::VerticalAccuracy => Some(RequestOption::GnssVerticalAccuracy),
+        GnssParam::VelocityAccuracy => Some(RequestOption::GnssVelocityAccuracy),
+        GnssParam::DecayFactor => Some(RequestOption::GnssDecayFactor),
+        GnssParam::CorrelationTime => Some(RequestOption::GnssCorrelationTime),
+    }
+}
+
+/// A refused parameter of the `[gnss]` table, before it is named as its source knows it.
+struct GnssRefusal {
+    param: GnssParam,
+    message: String,
+}
+
+impl GnssRefusal {
+    /// Named by its key path in a scenario file (`gnss.decay_factor`).
+    fn into_scenario(self) -> Error {
+        invalid(format!("gnss.{}", self.param.key()), self.message)
+    }
+
+    /// Named by the front end's option that set it (the key path where none does).
+    fn into_request(self) -> Error {
+        match option_of(self.param) {
+            Some(option) => refused(option, self.message),
+            None => self.into_scenario(),
+        }
+    }
+}
+
 /// The resolved receiver.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GnssSetup {
@@ -87,13 +122,18 @@ impl GnssSpec {
     /// # Errors
     /// A parameter out of range, both a decay factor and a correlation time (named by key).
     pub fn params(&self) -> Result<GnssParams> {
+        self.checked_params().map_err(GnssRefusal::into_scenario)
+    }
+
+    /// [`Self::params`], its refusal typed by key.
+    fn checked_params(&self) -> std::result::Result<GnssParams, GnssRefusal> {
         let d = GnssParams::default();
         let position_noise = match (self.decay_factor, self.correlation_time_s) {
             (Some(_), Some(_)) => {
-                return Err(invalid(
-                    "gnss.correlation_time_s",
-                    "give decay_factor (MATLAB's) or correlation_time_s, not both",
-                ));
+                return Err(GnssRefusal {
+                    param: GnssParam::CorrelationTime,
+                    message: "give decay_factor (MATLAB's) or correlation_time_s, not both".into(),
+                });
             }
             (_, Some(t)) => PositionNoise::GaussMarkov {
                 correlation_time_s: t,
@@ -112,8 +152,55 @@ impl GnssSpec {
                 .unwrap_or(d.velocity_accuracy_m_s),
             position_noise,
         };
-        GnssModel::new(&params).map_err(|e| invalid(format!("gnss.{}", e.field), e.to_string()))?;
+        GnssModel::new(&params).map_err(|e| GnssRefusal {
+            param: e.field,
+            message: e.to_string(),
+        })?;
         Ok(params)
+    }
+
+    /// The receiver as a filter takes it from a front end's options: its error model (every
+    /// accuracy a one-sigma above 0: a filter told a receiver is exact rejects its fixes), its
+    /// latency and its lever arm; a refusal names the option that set the key.
+    ///
+    /// # Errors
+    /// [`Error::Request`] naming the option, or a key path for the rate, which no front end
+    /// sets.
+    pub fn for_filter(&self) -> Result<(GnssParams, f64, [f64; 3])> {
+        for (param, value) in [
+            (GnssParam::HorizontalAccuracy, self.horizontal_accuracy_m),
+            (GnssParam::VerticalAccuracy, self.vertical_accuracy_m),
+            (GnssParam::VelocityAccuracy, self.velocity_accuracy_m_s),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(GnssRefusal {
+                    param,
+                    message: format!(
+                        "must be a one-sigma above 0 for the filter, got {v} (no receiver is \
+                         exact: a filter told so rejects its fixes)"
+                    ),
+                }
+                .into_request());
+            }
+        }
+        let params = self.checked_params().map_err(GnssRefusal::into_request)?;
+        let latency_s = self.latency_s.unwrap_or(0.0);
+        if !(latency_s.is_finite() && latency_s >= 0.0) {
+            return Err(refused(
+                RequestOption::GnssLatency,
+                format!("must be a finite number ≥ 0 (s), got {latency_s}"),
+            ));
+        }
+        let lever_arm_m = self.lever_arm_m.unwrap_or([0.0; 3]);
+        if !lever_arm_m.iter().all(|c| c.is_finite()) {
+            return Err(refused(
+                RequestOption::GnssLeverArm,
+                format!("must be finite, got {lever_arm_m:?}"),
+            ));
+        }
+        Ok((params, latency_s, lever_arm_m))
     }
 
     /// Checks the table against the scenario's sample rate `imu_rate_hz`; errors name the key
@@ -238,8 +325,13 @@ impl<'a> GnssStream<'a> {
     pub fn new(setup: &'a GnssSetup, run: Option<u64>, end_s: f64) -> Result<Self> {
         Ok(Self {
             setup,
-            model: GnssModel::new(&setup.params)
-                .map_err(|e| invalid(format!("gnss.{}", e.field), e.to_string()))?,
+            model: GnssModel::new(&setup.params).map_err(|e| {
+                GnssRefusal {
+                    param: e.field,
+                    message: e.to_string(),
+                }
+                .into_scenario()
+            })?,
             state: GnssState::default(),
             noise: SeededNormals::for_sensor(setup.seed, run, GNSS_STREAM),
             next_sample: 0,

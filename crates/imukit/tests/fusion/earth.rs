@@ -288,14 +288,14 @@ fn a_consumer_gyroscope_cannot_gyrocompass_and_says_why_as_a_typed_source() {
     // The core's error is the source, not text: a program can tell why.
     match &e {
         imukit::Error::Align {
-            field,
+            start,
             source:
                 AlignError::NoNorth {
                     horizontal_rate_rad_s,
                     ..
                 },
         } => {
-            assert_eq!(field, "align");
+            assert_eq!(*start, "static");
             // Ω cos 45°: the horizontal Earth rate the part's bias drowns.
             let omega_h = 7.292_115e-5 * std::f64::consts::FRAC_1_SQRT_2;
             assert!((horizontal_rate_rad_s - omega_h).abs() < 1e-9);

@@ -179,38 +179,7 @@ impl PartModel {
         };
         let sensors =
             crate::scenario::sensors::SensorSetup::resolve(&spec, std::path::Path::new("."))?;
-        // A simulated receiver may be exact; a filter told so gates away every real fix.
-        for (field, value) in [
-            (
-                "gnss.horizontal_accuracy_m",
-                self.gnss.horizontal_accuracy_m,
-            ),
-            ("gnss.vertical_accuracy_m", self.gnss.vertical_accuracy_m),
-            (
-                "gnss.velocity_accuracy_m_s",
-                self.gnss.velocity_accuracy_m_s,
-            ),
-        ] {
-            if let Some(v) = value
-                && !(v.is_finite() && v > 0.0)
-            {
-                return Err(invalid(
-                    field,
-                    format!(
-                        "must be a one-sigma above 0 for the filter, got {v} (no receiver is \
-                         exact: a filter told so rejects its fixes)"
-                    ),
-                ));
-            }
-        }
-        let gnss = self.gnss.params()?;
-        let latency_s = self.gnss.latency_s.unwrap_or(0.0);
-        if !(latency_s.is_finite() && latency_s >= 0.0) {
-            return Err(invalid(
-                "gnss.latency_s",
-                format!("must be a finite number ≥ 0 (s), got {latency_s}"),
-            ));
-        }
+        let (gnss, latency_s, lever_arm_m) = self.gnss.for_filter()?;
         Ok(FuseSetup::from_model(&FuseModel {
             nav_frame: nav.nav_frame,
             earth: nav.earth.map(|e| e.gravity),
@@ -220,10 +189,7 @@ impl PartModel {
             sample_rate_hz,
             gnss: &gnss,
             gnss_process_stated: self.gnss.process_stated(),
-            lever_arm_m: crate::scenario::resolve::finite_vec(
-                "gnss.lever_arm_m",
-                self.gnss.lever_arm_m.unwrap_or([0.0; 3]),
-            )?,
+            lever_arm_m,
             gnss_latency_s: latency_s,
             odometer: None,
             baro_sigma_m: None,

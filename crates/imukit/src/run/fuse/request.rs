@@ -146,16 +146,6 @@ impl Default for FuseRequest<'_> {
 }
 
 impl<'a> FuseRequest<'a> {
-    /// The fields an error of [`Self::setup`] or of the fusion it sets up may name.
-    pub const FIELDS: [&'static str; 6] = [
-        "initial",
-        "align",
-        "earth",
-        "nhc_sigma_m_s",
-        "covariance_interval_s",
-        "rest_s",
-    ];
-
     /// The filter's setup from `scenario` and this request, and where it starts.
     ///
     /// # Errors

@@ -7,7 +7,7 @@ use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::{EskfNoise, FixErrorModel, InitialSigma, SensorErrorSigma};
 
 use super::FuseModel;
-use crate::error::{Error, Result, invalid};
+use crate::error::{Error, RequestOption, Result, invalid, refused};
 use crate::io::conventions::NavFrameName;
 
 /// How to fuse.
@@ -151,8 +151,8 @@ pub const NHC_RATE_HZ: f64 = 10.0;
 
 /// The refusal of `setup`'s covariance interval.
 pub(super) fn covariance_interval_refusal(setup: &FuseSetup) -> Error {
-    invalid(
-        "covariance_interval_s",
+    refused(
+        RequestOption::CovarianceInterval,
         format!(
             "must be a finite number ≥ 0 (s), got {}",
             setup.covariance_interval_s

@@ -9,7 +9,7 @@ use imu_core::strapdown::NavState;
 use super::inputs::{FixVelocity, Fixes, FusionInputs};
 use super::{FuseSetup, Start};
 use crate::error::Data;
-use crate::error::{Error, Result, invalid};
+use crate::error::{Error, RequestOption, Result, invalid, refused};
 use crate::run::nav_earth::{self, NavEarth};
 
 /// The horizontal speed from which a GNSS velocity gives the heading, m/s.
@@ -94,8 +94,8 @@ pub(super) fn begin<E: NavEarth>(
             }
         }
         Start::AlignStatic { .. } if !E::ROTATING => {
-            return Err(invalid(
-                "align",
+            return Err(refused(
+                RequestOption::Align,
                 "\"static\": on the flat Earth the gyroscopes cannot find north (the flat model \
                  has no Earth rate); a static alignment needs a scenario on the WGS-84 Earth — \
                  use \"gnss\" (heading from the first fix at speed) or give the initial state",
@@ -130,8 +130,8 @@ fn at_rest<E: NavEarth>(
     let t0 = t[0];
     let i0 = t.partition_point(|&ti| ti < t0 + duration_s);
     if i0 < 2 || i0 >= t.len() {
-        return Err(invalid(
-            "align",
+        return Err(refused(
+            RequestOption::Align,
             format!(
                 "\"static\" averages the first {duration_s} s at rest: the IMU data must last \
                  longer"
@@ -185,7 +185,7 @@ fn at_rest<E: NavEarth>(
         &part,
     )
     .map_err(|source| Error::Align {
-        field: "align".into(),
+        start: "static",
         source,
     })?;
     let sigma = InitialSigma {
@@ -231,8 +231,8 @@ fn level<E: NavEarth>(
     let t = &inputs.t;
     let i0 = t.partition_point(|&ti| ti < t[0] + setup.rest_s);
     if setup.rest_s <= 0.0 || i0 < 2 || i0 >= t.len() {
-        return Err(invalid(
-            "align",
+        return Err(refused(
+            RequestOption::Align,
             format!(
                 "\"level\" levels the sensor over its rest at the start, and {}: give the rest's \
                  length (rest_s) if the log does start still, or another start",
@@ -256,14 +256,14 @@ fn level<E: NavEarth>(
     };
     let levelled = align::level::<E::Frame>(mean, setup.gravity_m_s2, 0.0, t[i0] - t[0], &part)
         .map_err(|source| Error::Align {
-            field: "align".into(),
+            start: "level",
             source,
         })?;
     let used = inputs.g_t.partition_point(|&x| x <= t[i0]);
     let position = match used.checked_sub(1) {
         Some(k) => fixes.position[k],
         None if !E::ROTATING => {
-            E::fix_position([0.0; 3]).ok_or_else(|| invalid("align", "no origin"))?
+            E::fix_position([0.0; 3]).ok_or_else(|| refused(RequestOption::Align, "no origin"))?
         }
         None => {
             return Err(invalid(
