@@ -276,3 +276,74 @@ fn a_column_that_reads_a_constant_is_said_to_have_no_noise() {
     let noisy = &result.noise[2];
     assert!(!noisy.constant && noisy.fit.term(NoiseTerm::White).resolved);
 }
+
+/// A logged file's curves are the curves of its samples: a logger's exact repeats dropped (and
+/// said, with the first repeated row), a gap said with the file row after which it falls, a
+/// window cut by seconds from the first sample, and a window too short refused by file.
+#[test]
+fn a_logs_curves_drop_its_repeats_name_its_gaps_and_keep_to_the_window() {
+    use imukit::io::rows::TimeWindow;
+    use imukit::run::allan::allan_of_log;
+    let dir = std::env::temp_dir().join(format!("imukit-allan-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let x = white(4000, 1e-3, 0.01, 11);
+    // Sample k at k / RATE, but the 0.5 s from sample 3000 on missing: a gap after row 3001.
+    let t: Vec<f64> = (0..x.len())
+        .map(|k| (k as f64 + if k >= 3000 { 50.0 } else { 0.0 }) / RATE)
+        .collect();
+    let mut text = String::from("t_s,gyro_x_rad_s\n");
+    for k in 0..x.len() {
+        text.push_str(&format!("{},{}\n", t[k], x[k]));
+        if k == 10 || k == 20 {
+            // The logger writes its last sample again.
+            text.push_str(&format!("{},{}\n", t[k], x[k]));
+        }
+    }
+    let path = dir.join("log.csv");
+    std::fs::write(&path, text).unwrap();
+    let log = allan_of_log(&path.as_path().into(), &[], TimeWindow::default()).unwrap();
+    assert_eq!(
+        log.result,
+        allan(&[("gyro_x_rad_s".into(), x.clone())], mean(&t)).unwrap()
+    );
+    assert_eq!(log.warnings.len(), 2, "{:?}", log.warnings);
+    assert!(
+        log.warnings[0].contains("2 rows repeat"),
+        "{}",
+        log.warnings[0]
+    );
+    assert!(log.warnings[0].contains("row 13"), "{}", log.warnings[0]);
+    // Sample 2999 is file row 2999 + 2 + the two repeats before it.
+    assert!(
+        log.warnings[1].contains("after row 3003"),
+        "{}",
+        log.warnings[1]
+    );
+    // Ten seconds from the fifth: samples 500 to 1500.
+    let window = TimeWindow {
+        start_s: Some(5.0),
+        end_s: Some(15.0),
+    };
+    let cut = allan_of_log(&path.as_path().into(), &[], window).unwrap();
+    let inside = x[500..=1500].to_vec();
+    assert_eq!(
+        cut.result,
+        allan(&[("gyro_x_rad_s".into(), inside)], mean(&t[500..=1500])).unwrap()
+    );
+    let empty = TimeWindow {
+        start_s: Some(5.001),
+        end_s: Some(5.005),
+    };
+    let e = allan_of_log(&path.as_path().into(), &[], empty).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("log.csv: 0 row(s) lie in the window"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The mean sample rate of times `t`, as the log's curves take it.
+fn mean(t: &[f64]) -> f64 {
+    imukit::run::allan::mean_rate(t).unwrap()
+}

@@ -6,6 +6,9 @@ use imu_core::allan::{
 use crate::error::{Result, invalid};
 use crate::io::table::Table;
 
+mod log;
+pub use log::{AllanLog, allan_of_log};
+
 /// One column's noise terms and its curve's 95 % confidence band.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColumnNoise {
