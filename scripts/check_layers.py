@@ -11,6 +11,13 @@ imports of the others.
 It also fails on a circle between rooms in `imu-core` and `imu-io`, whose rooms have no fixed
 order: a room (a top-level module) that imports, directly or through others, a room that
 imports it. A circle inside one room is that room's business.
+
+And it fails when a front end (the command line, Python's binding, the figures) reaches past the
+library's face: every job is at the crate's root (`imukit::fuse`, not `imukit::run::fuse`), and
+a front end names an item of a job's own module, never of a room inside a job
+(`imukit::fuse::detect::…`); the rooms of data, `io` (its own crate, one room per format or
+concept), `scenario` and `motion`, may be named one level down (`imukit::io::rows::TimeWindow`).
+The core (`imukit::core`) is its own crate with its own rooms.
 """
 import re
 import sys
@@ -21,6 +28,12 @@ ROOT = Path(__file__).resolve().parent.parent
 SRC = ROOT / "crates" / "imukit" / "src"
 # The crates whose rooms must not import each other in a circle.
 UNORDERED = [ROOT / "crates" / "imu-core" / "src", ROOT / "crates" / "imu-io" / "src"]
+# The front ends, which use the library through its face.
+FRONT_ENDS = [ROOT / "crates" / n / "src" for n in ("imu-cli", "imu-py", "imu-plot")]
+# The library's rooms a front end may name one level down.
+DATA_ROOMS = {"io": ROOT / "crates" / "imu-io" / "src", "scenario": SRC / "scenario", "motion": SRC / "motion"}
+IMUKIT_PATH = re.compile(r"(?<![\w:])imukit((?:::\w+)+)")
+IMUKIT_GROUP = re.compile(r"\buse imukit::\{([^;]*)\};", re.S)
 # Bottom first; a room may use the rooms before it in this list.
 ORDER = ["examples", "motion", "scenario", "run"]
 PATH = re.compile(r"\bcrate::(\w+)\b")
@@ -94,6 +107,46 @@ def circles(edges: dict[str, dict[str, str]]) -> list[list[str]]:
     return found
 
 
+def is_module(folder: Path, name: str) -> bool:
+    return (folder / f"{name}.rs").exists() or (folder / name / "mod.rs").exists()
+
+
+def module_depth(segments: list[str]) -> tuple[int, str]:
+    """How many modules deep below `imukit` a path's segments go, and through which first one."""
+    first = segments[0]
+    if first in DATA_ROOMS:
+        folder, depth = DATA_ROOMS[first], 1
+    elif is_module(SRC, first) or is_module(SRC / "run", first):
+        folder, depth = (SRC / first if is_module(SRC, first) else SRC / "run" / first), 1
+    else:
+        return 0, first
+    for name in segments[1:]:
+        if not is_module(folder, name):
+            break
+        folder, depth = folder / name, depth + 1
+    return depth, first
+
+
+def past_the_face() -> list[str]:
+    """Every path of a front end into the library that reaches past its face, with where."""
+    found = []
+    for src in FRONT_ENDS:
+        for path in sorted(src.rglob("*.rs")):
+            text = path.read_text(encoding="utf-8")
+            spans = [(m.start(), m.group(1).strip(":").split("::")) for m in IMUKIT_PATH.finditer(text)]
+            for g in IMUKIT_GROUP.finditer(text):
+                spans += [(g.start(), n.strip().split("::")) for n in g.group(1).split(",") if n.strip()]
+            for at, segments in spans:
+                if not segments or not segments[0] or segments[0] == "core":
+                    continue
+                depth, first = module_depth(segments)
+                allowed = 2 if first in DATA_ROOMS else 1
+                if segments[0] == "run" or depth > allowed:
+                    line = text.count("\n", 0, at) + 1
+                    found.append(f"{path.relative_to(ROOT)}:{line}: imukit::{'::'.join(segments)} reaches past the library's face")
+    return found
+
+
 def main() -> int:
     up, seen = [], Counter()
     for path in sorted(SRC.rglob("*.rs")):
@@ -116,6 +169,12 @@ def main() -> int:
     failed = bool(up)
     if up:
         print(f"{len(up)} import(s) point up; the order is {' < '.join(ORDER)} (scripts/check_layers.py)")
+    deep = past_the_face()
+    for d in deep:
+        print(d)
+    if deep:
+        failed = True
+        print(f"{len(deep)} path(s) of the front ends reach past the library's face (scripts/check_layers.py)")
     for src in UNORDERED:
         edges = room_imports(src)
         for group in circles(edges):

@@ -11,8 +11,8 @@
 use std::path::Path;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use imukit::run::pipeline::RunThreads;
-use imukit::run::simulate::StreamOutputs;
+use imukit::pipeline::RunThreads;
+use imukit::simulate::StreamOutputs;
 use imukit::{Scenario, ScenarioSpec};
 
 const JOB: &str = include_str!("../formula_job.toml");

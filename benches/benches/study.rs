@@ -9,7 +9,7 @@
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use imukit::run::study::{Study, StudySpec};
+use imukit::study::{Study, StudySpec};
 
 fn bench(c: &mut Criterion) {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");

@@ -4,10 +4,10 @@ use std::path::PathBuf;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
 use imukit::choice::Choice;
+use imukit::fuse::AlignName;
 use imukit::io::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
-use imukit::run::fuse::AlignName;
-use imukit::run::navigate::VerticalName;
-use imukit::run::orient::{Conventions, FilterKind};
+use imukit::navigate::VerticalName;
+use imukit::orient::{Conventions, FilterKind};
 
 /// A flag that takes one of a library choice's names (any case): the names for help and
 /// completion, the library's value.
@@ -413,7 +413,7 @@ pub struct IntegrateArgs {
     #[arg(long)]
     pub scheme: Option<String>,
     /// 3D `rk4`: RK4 steps per sample interval.
-    #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS)]
+    #[arg(long, default_value_t = imukit::navigate::DEFAULT_RK4_SUBSTEPS)]
     pub substeps: usize,
     /// Initial position, m: X Y (planar; the exercise's 100 100 by default) or X Y Z (3D).
     #[arg(long = "position0-m", alias = "position0", num_args = 2..=3, allow_hyphen_values = true)]
@@ -442,7 +442,7 @@ pub struct IntegrateArgs {
     #[arg(long, value_parser = choice::<VerticalName>(), ignore_case = true, default_value_t)]
     pub vertical: VerticalName,
     /// 3D, `--vertical baro`: the loop's time constant, s.
-    #[arg(long, default_value_t = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
+    #[arg(long, default_value_t = imukit::navigate::DEFAULT_BARO_TIME_CONSTANT_S)]
     pub baro_time_constant_s: f64,
     /// 3D, `--earth wgs84`: gravity, `normal` (WGS-84 normal gravity) or `constant`
     /// (--gravity-m-s2) [default: what the input files' descriptions say, else normal].

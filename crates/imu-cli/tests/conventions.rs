@@ -176,7 +176,7 @@ fn progress_goes_to_a_log_as_lines_and_quiet_silences_it() {
 /// that the help text does not follow fails here.
 #[test]
 fn fuse_help_states_the_librarys_numbers() {
-    use imukit::run::fuse::{
+    use imukit::fuse::{
         ALIGN_MIN_SPEED_M_S, DEFAULT_COVARIANCE_INTERVAL_S, DEFAULT_NHC_SIGMA_M_S,
         G_SENSITIVITY_STATES_FROM, NHC_RATE_HZ, REST_WINDOW_S, SENSOR_ERROR_STATES_FROM,
         STATIC_ALIGN_S,
@@ -224,5 +224,5 @@ fn nhc_alone_is_the_librarys_default() {
     let Command::Fuse(fuse) = cli.command else {
         panic!("not fuse")
     };
-    assert_eq!(fuse.nhc, Some(imukit::run::fuse::DEFAULT_NHC_SIGMA_M_S));
+    assert_eq!(fuse.nhc, Some(imukit::fuse::DEFAULT_NHC_SIGMA_M_S));
 }

@@ -2,7 +2,7 @@
 //! sum dashed.
 use std::path::Path;
 
-use imukit::run::allan::{AllanResult, ColumnNoise};
+use imukit::allan::{AllanResult, ColumnNoise};
 use plotters::prelude::*;
 
 use crate::PlotError;

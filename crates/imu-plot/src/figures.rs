@@ -2,7 +2,7 @@
 use std::path::{Path, PathBuf};
 
 use imukit::Table;
-use imukit::run::allan::AllanResult;
+use imukit::allan::AllanResult;
 
 use super::panels::{Panel, Series, Trace, draw_3d, draw_panel, draw_plan_view, is_3d};
 use crate::PlotError;

@@ -14,7 +14,7 @@ use crate::draw::{COLORS, draw_legend, err, key, tick, write_figure};
 const SMOOTHED: &str = "_smoothed_rms_error_m";
 
 /// Draws a study table (`t_s`, then per preset `<preset>_rms_error_m` and `<preset>_sigma_m`,
-/// and `<preset>_smoothed_rms_error_m` with smoothing, as `imukit::run::study` writes it) into
+/// and `<preset>_smoothed_rms_error_m` with smoothing, as `imukit::study` writes it) into
 /// `path` (SVG or PNG).
 ///
 /// # Errors

@@ -3,9 +3,9 @@
 //! theirs from the same requests) cannot disagree.
 use imukit::choice::Choice;
 use imukit::io::table::ImuKind;
-use imukit::run::navigate::NavRequest;
-use imukit::run::orient::{Conventions, FilterKind};
-use imukit::run::planar::PlanarRequest;
+use imukit::navigate::NavRequest;
+use imukit::orient::{Conventions, FilterKind};
+use imukit::planar::PlanarRequest;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -34,7 +34,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     d.set_item("animation_fps", imu_plot::spec::DEFAULT_FPS)?;
     d.set_item(
         "planar_position0_m",
-        imukit::run::planar::EXERCISE_POSITION0_M.to_vec(),
+        imukit::planar::EXERCISE_POSITION0_M.to_vec(),
     )?;
     d.set_item(
         "finite_difference_order",
@@ -53,7 +53,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     d.set_item("filters", filters)?;
     // MATLAB imuSensor's defaults, as the library's request states them.
-    let s = imukit::run::imu_sensor::ImuSensorRequest::default();
+    let s = imukit::imu_sensor::ImuSensorRequest::default();
     let sensor = PyDict::new(m.py());
     sensor.set_item("imu_type", s.imu_type.name())?;
     sensor.set_item("reference_frame", s.reference_frame.name())?;

@@ -4,11 +4,9 @@ use std::path::Path;
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme};
 use imukit::Table;
 use imukit::choice::Choice;
-use imukit::run::compare as comparison;
-use imukit::run::navigate::{
-    InitialState, NavAsked, NavRequest, SchemeName, VerticalName, integrate,
-};
-use imukit::run::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
+use imukit::compare as comparison;
+use imukit::navigate::{InitialState, NavAsked, NavRequest, SchemeName, VerticalName, integrate};
+use imukit::planar::{self, EXERCISE_POSITION0_M, PlanarRequest};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -101,9 +99,9 @@ fn nav_asked(
                     velocity0_m_s = None, quaternion0 = None, euler0_rad = None,
                     nav_frame = None, gravity_m_s2 = None, coning = true, sculling = true,
                     accel_sign = None, scheme = SchemeName::default_name(),
-                    substeps = imukit::run::navigate::DEFAULT_RK4_SUBSTEPS as i64,
+                    substeps = imukit::navigate::DEFAULT_RK4_SUBSTEPS as i64,
                     earth = None, vertical = VerticalName::default_name(),
-                    baro_time_constant_s = imukit::run::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
+                    baro_time_constant_s = imukit::navigate::DEFAULT_BARO_TIME_CONSTANT_S,
                     earth_gravity = None, lat0_deg = None, lon0_deg = None, height0_m = None,
                     baro_columns = None, baro_values = None, described = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
@@ -155,8 +153,8 @@ fn strapdown<'py>(
     .map_err(refused)?;
     let mut imu = table_in("imu", columns, &values)?;
     if let (Some(c), Some(v)) = (baro_columns, &baro_values) {
-        imu = imukit::run::navigate::with_baro_column(&imu, &table_in("baro", c, v)?)
-            .map_err(refused)?;
+        imu =
+            imukit::navigate::with_baro_column(&imu, &table_in("baro", c, v)?).map_err(refused)?;
     }
     let initial = match (initial_columns, &initial_values) {
         (Some(c), Some(v)) => InitialState::from_table(&table_in("initial", c, v)?),
@@ -270,7 +268,7 @@ fn fuse<'py>(
     gravity_m_s2: Option<f64>,
     described: DescribedIn<'py>,
 ) -> PyResult<(DescribedOut<'py>, usize, usize, Vec<String>)> {
-    use imukit::run::fuse::{AidTables, FuseRequest, Start, fuse_with};
+    use imukit::fuse::{AidTables, FuseRequest, Start, fuse_with};
     let asked = nav_asked(nav_frame, accel_sign, gravity_m_s2, earth, earth_gravity)?;
     let described = described_in(&described)?;
     let gnss = imukit::scenario::gnss::GnssSpec {
@@ -364,7 +362,7 @@ fn optional_table(
 #[allow(clippy::large_enum_variant)]
 enum Model {
     Scenario(imukit::ScenarioSpec),
-    Part(imukit::run::fuse::PartModel),
+    Part(imukit::fuse::PartModel),
 }
 
 /// The model `fuse` was given: `imu_model` (a preset or a file) with `part` and the receiver's
@@ -377,7 +375,7 @@ fn model_of(
     gnss: imukit::scenario::gnss::GnssSpec,
 ) -> PyResult<Model> {
     use imukit::ScenarioSpec;
-    use imukit::run::fuse::{Part, PartModel};
+    use imukit::fuse::{Part, PartModel};
     Ok(match imu_model {
         None if scenario.is_none() => Model::Part(PartModel {
             imu: Part::Learnt,
@@ -409,15 +407,12 @@ fn model_of(
 }
 
 /// What a fuse run warns of: the IMU's repeated rows and a long stretch without stances.
-fn fuse_warnings(summary: &imukit::run::fuse::FuseSummary) -> Vec<String> {
+fn fuse_warnings(summary: &imukit::fuse::FuseSummary) -> Vec<String> {
     summary
         .repeats
         .message("imu", 0)
         .into_iter()
-        .chain(imukit::run::fuse::stance_gap_message(
-            "imu",
-            summary.stance_gap,
-        ))
+        .chain(imukit::fuse::stance_gap_message("imu", summary.stance_gap))
         .collect()
 }
 

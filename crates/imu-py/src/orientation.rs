@@ -3,7 +3,7 @@
 use imu_core::{Enu, Ned};
 use imukit::io::conventions::NavFrameName;
 use imukit::io::rows::SampleClock;
-use imukit::run::orient::{
+use imukit::orient::{
     AnyFilter, FilterKind, OrientRequest, ecompass_rows, frame_and_sign, quaternion_distances,
     run_rows, smooth_rows,
 };

@@ -1,6 +1,6 @@
 //! Attitude conversions between z-y-x Euler angles `[yaw, pitch, roll]`, quaternions `q_nb`
 //! `[w, x, y, z]` and direction cosine matrices `C_nb`, row by row.
-use imukit::run::arrays;
+use imukit::arrays;
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 

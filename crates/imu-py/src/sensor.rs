@@ -2,11 +2,11 @@
 //! datasheet units, and Allan deviation with noise identification.
 use std::path::Path;
 
+use imukit::allan;
+use imukit::imu_sensor::{ImuSensor, ImuSensorRequest, Orientation};
 use imukit::io::params::Profile;
 use imukit::io::part_file::{read_param_file, to_toml};
 use imukit::io::{presets, units};
-use imukit::run::allan;
-use imukit::run::imu_sensor::{ImuSensor, ImuSensorRequest, Orientation};
 use imukit::scenario::ImuSpec;
 use numpy::ndarray::Array2;
 use numpy::{
@@ -201,7 +201,7 @@ fn identify<'py>(
     kalibr_inflation: f64,
     kalibr_topic: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use imukit::run::identify as id;
+    use imukit::identify as id;
     let v = x.as_array();
     check_len("names", names.len(), v.ncols())?;
     let series: Vec<(String, Vec<f64>)> = names

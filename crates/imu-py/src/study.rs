@@ -27,7 +27,7 @@ fn study_run<'py>(
     usize,
     Option<Bound<'py, PyArray1<f64>>>,
 )> {
-    use imukit::run::study::{RunOutcome, Study};
+    use imukit::study::{RunOutcome, Study};
     let path = Path::new(path).to_path_buf();
     let outcome = py
         .detach(move || Study::from_file(&path)?.run_one(case, run))
@@ -49,14 +49,14 @@ fn study_run<'py>(
 /// (`Study::undescribed`).
 #[pyfunction]
 fn study_undescribed(path: &str) -> PyResult<Vec<String>> {
-    let s = imukit::run::study::Study::from_file(Path::new(path)).map_err(refused)?;
+    let s = imukit::study::Study::from_file(Path::new(path)).map_err(refused)?;
     Ok(s.undescribed())
 }
 
 /// The study at `path`: its presets and runs per preset.
 #[pyfunction]
 fn study_plan(path: &str) -> PyResult<(Vec<String>, u64)> {
-    let s = imukit::run::study::Study::from_file(Path::new(path)).map_err(refused)?;
+    let s = imukit::study::Study::from_file(Path::new(path)).map_err(refused)?;
     Ok((s.presets().map(str::to_string).collect(), s.runs()))
 }
 
@@ -90,7 +90,7 @@ fn study_summarise<'py>(
         Option<(f64, f64)>,
     )>,
 )> {
-    use imukit::run::study::{OutageRun, RunOutcome, Study};
+    use imukit::study::{OutageRun, RunOutcome, Study};
     let study = Study::from_file(Path::new(path)).map_err(refused)?;
     let outcomes: Vec<Vec<RunOutcome>> = outcomes
         .into_iter()

@@ -19,7 +19,7 @@
 //! | [`scenario`] | the scenario file as written ([`ScenarioSpec`]), its resolution into a runnable [`Scenario`], built-ins, sensor setups, Monte Carlo perturbations |
 //! | [`motion`] | motions: formula strings with exact derivatives, Rust functions over dual numbers, tracks, waypoints, samples, body rates |
 //! | [`io`] | the `imu-io` crate: [`Table`], every column set, the formats (CSV, Parquet, NumPy, bags, NMEA; readers that name file, row and column; writers that leave no partial file), parameter files, presets, datasheet units |
-//! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), orient, compare, Allan |
+//! | [`run`] | the jobs: simulate (streamed), navigate (3D and planar), fuse, orient, compare, Allan, identify, study; each also at the crate's root ([`fuse`], [`orient`], …), where programs and the front ends name them |
 //! | [`examples`] | the shipped examples (scenario files, data, Python scripts), written where the docs' commands read them |
 //!
 //! From `imu-io`, also at this crate's root: [`choice`] (options chosen by name), [`error`]
@@ -54,7 +54,7 @@
 //! ## Integrate an IMU file
 //!
 //! ```
-//! use imukit::run::navigate::{InitialState, NavSetup, integrate_csv};
+//! use imukit::navigate::{InitialState, NavSetup, integrate_csv};
 //! use imukit::{Scenario, ScenarioSpec};
 //!
 //! let dir = std::env::temp_dir().join(format!("imukit-doc-{}", std::process::id()));
@@ -105,6 +105,13 @@ pub use error::{Error, Result};
 pub use imu_core as core;
 pub use io::table::Table;
 pub use scenario::{Scenario, ScenarioSpec, Simulation};
+
+// The jobs at the crate's root, where programs and the front ends name them
+// (`imukit::fuse::fuse_with`, `imukit::orient::orient_csv`): `run` only groups them.
+pub use run::{
+    allan, arrays, compare, epochs, fuse, identify, imu_sensor, navigate, orient, pipeline, planar,
+    reference, simulate, study,
+};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -1,10 +1,10 @@
 //! `imukit allan IMU.csv [--column NAME …] --out ADEV.csv`.
 use std::path::Path;
 
+use imukit::allan::{AllanResult, allan_of_log};
 use imukit::io::Input;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
-use imukit::run::allan::{AllanResult, allan_of_log};
 
 use super::CliError;
 

@@ -3,10 +3,10 @@
 use std::path::Path;
 
 use imu_core::orientation::DistanceStats;
+use imukit::compare::{CompareOptions, compare_csv_with};
 use imukit::io::Input;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
-use imukit::run::compare::{CompareOptions, compare_csv_with};
 
 use super::CliError;
 

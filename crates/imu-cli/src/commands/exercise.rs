@@ -4,7 +4,7 @@ use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarScheme, PlanarState};
 use imukit::Table;
-use imukit::run::planar::{integrate, samples_from_table, write_dat};
+use imukit::planar::{integrate, samples_from_table, write_dat};
 use imukit::scenario::builtin;
 
 use super::CliError;

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use imukit::error::{Data, RequestOption};
+use imukit::fuse::{AidTables, AlignName, FuseRequest, FuseSetup, PartModel, Start, fuse_with};
 use imukit::io::Input;
 use imukit::io::bag::Role;
 use imukit::io::conventions::{EarthName, NavFrameName};
@@ -10,10 +11,7 @@ use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::read::{read_table, read_table_as};
 use imukit::io::rows::{Gaps, TimeWindow};
-use imukit::run::fuse::{
-    AidTables, AlignName, FuseRequest, FuseSetup, PartModel, Start, fuse_with,
-};
-use imukit::run::navigate::{InitialState, NavAsked, NavRequest};
+use imukit::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
@@ -269,7 +267,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
 }
 
 /// What the filter did: its updates, its final one-sigma, its states and its rest.
-fn report_filter(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse::FuseSummary) {
+fn report_filter(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::fuse::FuseSummary) {
     let last = |c: &str| {
         nav.column(c)
             .and_then(|v| v.last().copied())
@@ -322,14 +320,12 @@ fn report_filter(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse:
 }
 
 /// A warning with the times at which the filter was reset to the fixes, if it was.
-fn report_resets(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse::FuseSummary) {
+fn report_resets(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::fuse::FuseSummary) {
     if summary.resets == 0 {
         return;
     }
     let t = nav.column("t_s").unwrap_or_default();
-    let resets = nav
-        .column(imukit::run::fuse::RESETS_COLUMN)
-        .unwrap_or_default();
+    let resets = nav.column(imukit::fuse::RESETS_COLUMN).unwrap_or_default();
     // The first few times; the column has them all.
     const SHOWN: usize = 10;
     let mut at: Vec<String> = resets
@@ -350,16 +346,16 @@ fn report_resets(a: &Args<'_>, nav: &imukit::Table, summary: &imukit::run::fuse:
          stated accuracy: --gnss-adaptive)",
         a.gnss
             .map_or_else(|| "GNSS".into(), |p| p.display().to_string()),
-        imukit::run::fuse::MAX_REJECTED_IN_A_ROW,
+        imukit::fuse::MAX_REJECTED_IN_A_ROW,
         summary.resets,
         at.join(", "),
-        imukit::run::fuse::RESETS_COLUMN
+        imukit::fuse::RESETS_COLUMN
     ));
 }
 
 /// What the detectors tested the readings against, and a warning when the log's noise is not
 /// the part's or `--zupt` found (almost) no stance.
-fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samples: usize) {
+fn report_detection(a: &Args<'_>, summary: &imukit::fuse::FuseSummary, samples: usize) {
     if let Some(d) = summary.detection.filter(|d| d.learnt) {
         crate::note!(
             "imukit: white noise learnt from the log's quiet stretches: accelerometer {:.3e} \
@@ -376,7 +372,7 @@ fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samp
         let off = |r: f64| !(0.5..=2.0).contains(&r);
         if a.model
             .as_ref()
-            .is_some_and(|m| m.imu != imukit::run::fuse::Part::Learnt)
+            .is_some_and(|m| m.imu != imukit::fuse::Part::Learnt)
             && (off(ra) || off(rg))
         {
             crate::report::warn(&format!(
@@ -403,14 +399,14 @@ fn report_detection(a: &Args<'_>, summary: &imukit::run::fuse::FuseSummary, samp
         }
     );
     if let Some(m) =
-        imukit::run::fuse::stance_gap_message(&a.imu.display().to_string(), summary.stance_gap)
+        imukit::fuse::stance_gap_message(&a.imu.display().to_string(), summary.stance_gap)
     {
         crate::report::warn(&m);
     }
     // A walk stands on each foot for about a third of its time or more.
     #[allow(clippy::cast_precision_loss)]
     let share = summary.stance_samples as f64 / samples.max(1) as f64;
-    if share < imukit::run::fuse::FEW_STANCES {
+    if share < imukit::fuse::FEW_STANCES {
         crate::report::warn(&format!(
             "{}: --zupt found {} stances ({:.1} % of the samples): a foot-mounted IMU stands \
              still for a third of a walk or more; without them the estimate is free inertial \

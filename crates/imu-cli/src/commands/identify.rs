@@ -2,14 +2,14 @@
 use std::io::Write;
 use std::path::Path;
 
+use imukit::identify::{
+    column_header, column_warnings, curve_table, filter_noise, kalibr, param_file, rest_line,
+    scale_rows, term_rows,
+};
 use imukit::io::Input;
 use imukit::io::output::{check_outputs, write_atomically};
 use imukit::io::part_file::to_toml;
 use imukit::io::rows::TimeWindow;
-use imukit::run::identify::{
-    column_header, column_warnings, curve_table, filter_noise, kalibr, param_file, rest_line,
-    scale_rows, term_rows,
-};
 
 use super::CliError;
 use super::allan::{analyse, file_name};

@@ -10,8 +10,8 @@ use imukit::io::Input;
 use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::{Gaps, TimeWindow};
-use imukit::run::navigate::{InitialState, NavAsked, NavRequest, NavSetup, integrate_csv};
-use imukit::run::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
+use imukit::navigate::{InitialState, NavAsked, NavRequest, NavSetup, integrate_csv};
+use imukit::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
 use crate::{CliError, by_flag};
@@ -267,23 +267,22 @@ fn with_baro(
     setup: &NavSetup,
 ) -> Result<(), CliError> {
     // The barometer joins the IMU samples (the Earth mechanization reads its input whole).
-    let imu = imukit::run::navigate::read_whole(c.input)?;
+    let imu = imukit::navigate::read_whole(c.input)?;
     let source = c.input.display().to_string();
     let t0 = TimeWindow::first_time(&imu, &source)?;
     let imu = c.window.apply(imu, t0, &source, 1)?;
     let readings = imukit::io::read::read_table(baro)?;
-    let joined = imukit::run::navigate::with_baro_column(&imu, &readings).map_err(|e| {
+    let joined = imukit::navigate::with_baro_column(&imu, &readings).map_err(|e| {
         if e.data() == Some(Data::Barometer) {
             e.relabelled(baro.display().to_string())
         } else {
             e
         }
     })?;
-    let nav =
-        imukit::run::navigate::integrate(&joined, initial, setup).map_err(|e| Error::Invalid {
-            field: c.input.display().to_string(),
-            message: e.to_string(),
-        })?;
+    let nav = imukit::navigate::integrate(&joined, initial, setup).map_err(|e| Error::Invalid {
+        field: c.input.display().to_string(),
+        message: e.to_string(),
+    })?;
     nav.write_described(c.out, &setup.description())?;
     warn_gaps(&joined.column("t_s").unwrap_or_default(), 2, c.input);
     report(

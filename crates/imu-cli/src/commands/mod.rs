@@ -19,7 +19,7 @@ use imukit::choice::Choice;
 use imukit::io::Input;
 use imukit::io::input::{Clock, Selection};
 use imukit::io::rows::TimeWindow;
-use imukit::run::navigate::{NavAsked, NavRequest, SchemeName};
+use imukit::navigate::{NavAsked, NavRequest, SchemeName};
 
 use crate::CliError;
 use crate::cli::{Cli, Command};
@@ -62,7 +62,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 bag.input(Input::new(truth)),
                 bag.input(Input::new(estimate)),
             );
-            let options = imukit::run::compare::CompareOptions { align_heading };
+            let options = imukit::compare::CompareOptions { align_heading };
             compare::run(&truth, &estimate, window.window()?, options, out.as_deref())
         }
         Command::Exercise { out_dir, seed } => exercise::run(&out_dir, seed),
@@ -360,9 +360,9 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
         align,
         scenario: scenario.as_deref(),
         // Without a scenario: the part named, else learnt from the log.
-        model: scenario.is_none().then(|| imukit::run::fuse::PartModel {
-            imu: imu_model.map_or(imukit::run::fuse::Part::Learnt, |imu| {
-                imukit::run::fuse::Part::named(&imu)
+        model: scenario.is_none().then(|| imukit::fuse::PartModel {
+            imu: imu_model.map_or(imukit::fuse::Part::Learnt, |imu| {
+                imukit::fuse::Part::named(&imu)
             }),
             part,
             gnss: imukit::scenario::gnss::GnssSpec {
@@ -377,7 +377,7 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
             },
         }),
         gnss_uere_m,
-        asked: imukit::run::navigate::NavAsked {
+        asked: imukit::navigate::NavAsked {
             nav_frame: frame.nav_frame,
             accel_sign: frame.accel_sign,
             earth,

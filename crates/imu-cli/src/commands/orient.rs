@@ -6,7 +6,7 @@ use imukit::io::conventions::{AccelSignName, NavFrameName};
 use imukit::io::described::Described;
 use imukit::io::output::check_outputs;
 use imukit::io::rows::TimeWindow;
-use imukit::run::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
+use imukit::orient::{Conventions, FilterKind, FilterSpec, OrientRequest, orient_csv};
 
 use crate::CliError;
 

@@ -7,9 +7,9 @@ use imukit::io::bag::BagOptions;
 use imukit::io::description::Description;
 use imukit::io::output::{check_outputs, check_table_outputs, create_folder_within};
 use imukit::io::table::run_path;
-use imukit::run::pipeline::{RunThreads, available_cores};
-use imukit::run::simulate::StreamOutputs;
+use imukit::pipeline::{RunThreads, available_cores};
 use imukit::scenario::report::RunReport;
+use imukit::simulate::StreamOutputs;
 use imukit::{Scenario, ScenarioSpec};
 use rayon::prelude::*;
 

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use imukit::io::output::check_outputs;
-use imukit::run::study::Study;
+use imukit::study::Study;
 use rayon::prelude::*;
 
 use super::CliError;
