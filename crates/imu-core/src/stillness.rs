@@ -225,23 +225,49 @@ pub const MIN_POPULATION_SHARE: f64 = 0.05;
 /// stances and swings lie three to six decades apart in the SHOE statistic.
 pub const MIN_POPULATION_SEPARATION: f64 = 1.0;
 
-/// The threshold that splits a detector's statistics into two populations, learnt from the
-/// statistics themselves: Otsu's split (the one that maximises the variance between the two
-/// classes) of the histogram of their decimal logarithms, in [`POPULATION_BINS`] bins.
-///
-/// A real foot does not stand still: it rolls from heel to toe, so its stances read rates far
-/// above the gyroscope's noise while the sensor does not move, and a threshold from the noise
-/// alone ([`shoe_threshold`]) finds few of them. Its stances and swings still form two
-/// populations decades apart, which the split separates. `None` unless both populations hold
-/// at least [`MIN_POPULATION_SHARE`] of the finite positive statistics and their mean
-/// logarithms lie at least [`MIN_POPULATION_SEPARATION`] decades apart (a log all at rest or
-/// all in motion has no second population).
+/// The least share of the statistics' variance the split between the stances and the swings
+/// above a walk's rests must explain (Otsu's effectiveness, between-class over total variance)
+/// for [`stance_threshold`] to take it: one normal population split in two gives about 0.64
+/// and a uniform one 0.75, two populations decades apart nearly 1 (a simulated foot that
+/// stands still has swings alone above its split, and they are not split again).
+pub const MIN_SPLIT_EFFECTIVENESS: f64 = 0.8;
+
+/// One population of a split: its mean and standard deviation of the decimal logarithm and its
+/// number of statistics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Population {
+    /// Mean of `log10` of its statistics.
+    pub mean_log: f64,
+    /// Standard deviation of `log10` of its statistics.
+    pub sd_log: f64,
+    /// How many statistics it holds.
+    pub count: usize,
+}
+
+/// Otsu's split of the logarithms of some statistics into two populations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PopulationSplit {
+    /// The threshold between them (the statistic, not its logarithm).
+    pub threshold: f64,
+    /// The population below it.
+    pub lower: Population,
+    /// The population above it.
+    pub upper: Population,
+    /// The share of the logarithms' variance the split explains.
+    pub effectiveness: f64,
+}
+
+/// Otsu's split (the one that maximises the variance between the two classes) of the histogram
+/// of the decimal logarithms of the finite positive `statistics` above `above`, in
+/// [`POPULATION_BINS`] bins; `None` unless it separates two populations: each at least
+/// [`MIN_POPULATION_SHARE`] of the statistics split, their mean logarithms at least
+/// [`MIN_POPULATION_SEPARATION`] decades apart.
 #[must_use]
-pub fn two_population_threshold(statistics: &[f64]) -> Option<f64> {
+pub fn population_split(statistics: &[f64], above: f64) -> Option<PopulationSplit> {
     let logs = || {
         statistics
             .iter()
-            .filter(|t| t.is_finite() && **t > 0.0)
+            .filter(move |t| t.is_finite() && **t > 0.0 && **t > above)
             .map(|t| num_traits::Float::log10(*t))
     };
     let (lo, hi) = logs().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
@@ -253,16 +279,19 @@ pub fn two_population_threshold(statistics: &[f64]) -> Option<f64> {
     let width = (hi - lo) / POPULATION_BINS as f64;
     let mut count = [0usize; POPULATION_BINS];
     let mut sum = [0.0; POPULATION_BINS];
+    let mut squares = [0.0; POPULATION_BINS];
     for x in logs() {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         let k = (((x - lo) / width) as usize).min(POPULATION_BINS - 1);
         count[k] += 1;
         sum[k] += x;
+        squares[k] += x * x;
     }
     let total: usize = count.iter().sum();
     let total_sum: f64 = sum.iter().sum();
     let (mut n0, mut s0) = (0usize, 0.0);
-    let mut best: Option<(f64, usize, f64, f64)> = None;
+    // (between-class variance × total², bins in the lower class)
+    let mut best: Option<(f64, usize)> = None;
     for k in 0..POPULATION_BINS - 1 {
         n0 += count[k];
         s0 += sum[k];
@@ -273,27 +302,78 @@ pub fn two_population_threshold(statistics: &[f64]) -> Option<f64> {
         let (m0, m1) = (s0 / n0 as f64, (total_sum - s0) / n1 as f64);
         let between = n0 as f64 * n1 as f64 * (m1 - m0) * (m1 - m0);
         if best.is_none_or(|b| between > b.0) {
-            best = Some((between, n0, m0, m1));
+            best = Some((between, k + 1));
         }
     }
-    let (_, n0, m0, m1) = best?;
-    let share = n0 as f64 / total as f64;
+    let (between, bins) = best?;
+    let class = |range: core::ops::Range<usize>| {
+        let n: usize = count[range.clone()].iter().sum();
+        let s: f64 = sum[range.clone()].iter().sum();
+        let q: f64 = squares[range].iter().sum();
+        let mean = s / n as f64;
+        Population {
+            mean_log: mean,
+            sd_log: math::sqrt((q / n as f64 - mean * mean).max(0.0)),
+            count: n,
+        }
+    };
+    let (lower, upper) = (class(0..bins), class(bins..POPULATION_BINS));
+    let n = total as f64;
+    let mean = total_sum / n;
+    let variance = squares.iter().sum::<f64>() / n - mean * mean;
+    let effectiveness = between / (n * n) / variance;
+    let share = lower.count as f64 / n;
     if !(MIN_POPULATION_SHARE..=1.0 - MIN_POPULATION_SHARE).contains(&share)
-        || m1 - m0 < MIN_POPULATION_SEPARATION
+        || upper.mean_log - lower.mean_log < MIN_POPULATION_SEPARATION
     {
         return None;
     }
     // The split lies at the upper edge of the last bin of the lower population.
-    let edge = {
-        let mut acc = 0usize;
-        let mut k = 0;
-        while acc < n0 {
-            acc += count[k];
-            k += 1;
+    Some(PopulationSplit {
+        threshold: num_traits::Float::powf(10.0, lo + bins as f64 * width),
+        lower,
+        upper,
+        effectiveness,
+    })
+}
+
+/// The threshold that splits a detector's statistics into two populations, learnt from the
+/// statistics themselves ([`population_split`] of all of them).
+///
+/// A real foot does not stand still: it rolls from heel to toe, so its stances read rates far
+/// above its gyroscope's noise while the sensor does not move, and a threshold from the noise
+/// alone ([`shoe_threshold`]) finds few of them. Its stances and swings still form two
+/// populations decades apart, which the split separates. `None` for a log all at rest or all in
+/// motion (no second population).
+#[must_use]
+pub fn two_population_threshold(statistics: &[f64]) -> Option<f64> {
+    population_split(statistics, 0.0).map(|s| s.threshold)
+}
+
+/// The stance detector's threshold learnt from a walk's SHOE statistics; `None` without two
+/// populations ([`population_split`]).
+///
+/// A walk with long rests has three populations: the rests, at the noise; the stances, where
+/// the foot rolls from heel to toe at rates far above the noise; the swings. The split of all
+/// of them then falls between the rests and the stances and misses the rolling stances; when
+/// the statistics above the split hold two populations of their own (split explaining at least
+/// [`MIN_SPLIT_EFFECTIVENESS`] of their variance), the stances are the lower of those. The
+/// threshold is then the stances' mean plus one standard deviation (of the logarithm), at most
+/// their split from the swings: a stance's upper tail is the foot striking the ground and
+/// pushing off, when it moves, and a zero-velocity update there pulls the estimate off. With
+/// two populations only, the split between them.
+#[must_use]
+pub fn stance_threshold(statistics: &[f64]) -> Option<f64> {
+    let split = population_split(statistics, 0.0)?;
+    let above = population_split(statistics, split.threshold)
+        .filter(|s| s.effectiveness >= MIN_SPLIT_EFFECTIVENESS);
+    match above {
+        Some(stances) => {
+            let edge = num_traits::Float::powf(10.0, stances.lower.mean_log + stances.lower.sd_log);
+            Some(edge.min(stances.threshold))
         }
-        lo + k as f64 * width
-    };
-    Some(num_traits::Float::powf(10.0, edge))
+        None => Some(split.threshold),
+    }
 }
 
 /// What the quiet stretches of a log say about its sensor ([`quiet_noise`]).

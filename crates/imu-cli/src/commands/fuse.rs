@@ -391,8 +391,9 @@ fn report_detection(a: &Args<'_>, summary: &imukit::fuse::FuseSummary, samples: 
         summary.stance_samples,
         match summary.stance_threshold {
             Some(t) if t.learnt => format!(
-                ", below the split between the log's two populations of the detector's \
-                 statistic ({:.4e}; its noise alone would allow {:.4e})",
+                ", below the threshold learnt from the populations of the detector's statistic \
+                 (stances apart from swings and rests: {:.4e}; its noise alone would allow \
+                 {:.4e})",
                 t.used, t.noise
             ),
             _ => String::new(),

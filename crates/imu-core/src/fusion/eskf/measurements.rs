@@ -303,6 +303,22 @@ pub struct ZeroRate {
     pub sigma_rad_s: f64,
 }
 
+impl ZeroRate {
+    /// A zero rate at a stance that may roll: a walking foot rolls from heel to toe while it
+    /// stands, so the rate `rate_rad_s` it reads there (the bias taken off) is not the bias's
+    /// noise but a turn the foot makes. Its size bounds how far the true rate is from zero: the
+    /// one-sigma is `√(σ² + |ω|²)` with `σ` one sample's white noise, as tight as a rest's where
+    /// the foot is still, loose where it rolls. Told `σ` alone, the update takes the roll for a
+    /// bias and turns the attitude away.
+    #[must_use]
+    pub fn rolling(sigma_rad_s: f64, rate_rad_s: [f64; 3]) -> Self {
+        let rate_squared: f64 = rate_rad_s.iter().map(|x| x * x).sum();
+        Self {
+            sigma_rad_s: crate::math::sqrt(sigma_rad_s * sigma_rad_s + rate_squared),
+        }
+    }
+}
+
 impl<E: EarthModel> Measurement<E, 3> for ZeroRate {
     fn model<const S: usize>(
         &self,

@@ -67,6 +67,8 @@ pub(crate) struct AidStreams {
     rest: (f64, f64),
     /// Per IMU sample, whether it is a stance (zero-velocity updates on the move).
     stance: Vec<bool>,
+    /// The gyroscope's bias as the rest at the start shows it, rad/s.
+    stance_bias: [f64; 3],
     next: (usize, usize),
     next_nhc_t: f64,
 }
@@ -134,14 +136,17 @@ impl AidStreams {
             gate_on: setup.gate.is_on(),
             rest: (span.0 + setup.rest_s, gyro_sample_sigma),
             stance: Vec::new(),
+            stance_bias: [0.0; 3],
             next: (0, 0),
             next_nhc_t: span.0,
         })
     }
 
-    /// The stance samples, by IMU sample index ([`super::fuse::FuseSetup::zupt`]).
-    pub(crate) fn set_stance(&mut self, stance: Vec<bool>) {
+    /// The stance samples, by IMU sample index ([`super::fuse::FuseSetup::zupt`]), and the
+    /// gyroscope's bias as the rest at the start shows it (rad/s).
+    pub(crate) fn set_stance(&mut self, stance: Vec<bool>, bias_rad_s: [f64; 3]) {
         self.stance = stance;
+        self.stance_bias = bias_rad_s;
     }
 
     /// Skips the readings before the filter's first sample at `t_first`.
@@ -162,7 +167,8 @@ impl AidStreams {
         }
     }
 
-    /// Every aid reading up to IMU sample `i` at `t_s`: odometer speeds (with the constraints
+    /// Every aid reading up to IMU sample `i` at `t_s` (its gyroscope reading `gyro_rad_s`):
+    /// zero velocity and rate at the rest and the stances, odometer speeds (with the constraints
     /// when they are on), the constraints alone at [`NHC_RATE_HZ`] without an odometer, heights.
     ///
     /// # Errors
@@ -172,20 +178,20 @@ impl AidStreams {
         filter: &mut Eskf<E, S>,
         t_s: f64,
         i: usize,
+        gyro_rad_s: [f64; 3],
     ) -> Result<()> {
         if t_s >= self.rest.0 && self.stance.get(i).copied().unwrap_or(false) {
             // A stance on the move: the detector is the gate, and the foot is still only to
             // about a centimetre a second (it rolls and settles).
+            // ... and it rolls: its rate is not the bias. The bias taken off is the rest's, a
+            // fixed number: the filter's own estimate would let the update pull the estimate
+            // towards the roll and then trust it more.
+            let rate = [0, 1, 2].map(|k| gyro_rad_s[k] - self.stance_bias[k]);
             filter
                 .update(&BodyVelocity::zero(STANCE_VELOCITY_SIGMA_M_S), Gate::Off)
                 .map_err(|e| filter_refusal("IMU (stance, zero velocity)", i, e))?;
             filter
-                .update(
-                    &ZeroRate {
-                        sigma_rad_s: self.rest.1,
-                    },
-                    Gate::Off,
-                )
+                .update(&ZeroRate::rolling(self.rest.1, rate), Gate::Off)
                 .map_err(|e| filter_refusal("IMU (stance, zero rate)", i, e))?;
         } else if t_s < self.rest.0 {
             filter

@@ -105,9 +105,9 @@ pub(super) fn stances(
 }
 
 /// The threshold the stance detector used: the noise's alone ([`shoe_threshold`] at
-/// [`STANCE_FALSE_ALARM`]), or, when higher, the split between the log's two populations of
-/// the statistic ([`imu_core::stillness::two_population_threshold`]: a real foot rolls while it
-/// stands, far above its sensor's noise).
+/// [`STANCE_FALSE_ALARM`]), or, when higher, the one learnt from the log's populations of the
+/// statistic ([`imu_core::stillness::stance_threshold`]: a real foot rolls while it stands, far
+/// above its sensor's noise, and a walk's rests are a population of their own).
 ///
 /// [`shoe_threshold`]: imu_core::stillness::shoe_threshold
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,7 +116,7 @@ pub struct StanceThreshold {
     pub used: f64,
     /// The noise's threshold.
     pub noise: f64,
-    /// Whether the log's two populations set it.
+    /// Whether the log's populations of the statistic set it.
     pub learnt: bool,
 }
 
@@ -128,14 +128,9 @@ pub(super) fn stances_with_threshold(
     setup: &FuseSetup,
     detection: &Detection,
 ) -> (Vec<bool>, StanceThreshold) {
-    use imu_core::stillness::{shoe_statistics, shoe_threshold, two_population_threshold};
+    use imu_core::stillness::{shoe_statistics, shoe_threshold, stance_threshold};
     // The rest's mean rate is the bias the detector's zero-rate test must not see.
-    let rest = t.partition_point(|&x| x < t[0] + setup.rest_s);
-    let bias = if rest > 0 {
-        [0, 1, 2].map(|k| w[..rest].iter().map(|x| x[k]).sum::<f64>() / rest as f64)
-    } else {
-        [0.0; 3]
-    };
+    let bias = rest_rate(t, w, setup.rest_s);
     let gyro: Vec<[f64; 3]> = w
         .iter()
         .map(|x| [x[0] - bias[0], x[1] - bias[1], x[2] - bias[2]])
@@ -152,7 +147,7 @@ pub(super) fn stances_with_threshold(
         &mut statistic,
     );
     let noise = shoe_threshold(window, STANCE_FALSE_ALARM);
-    let threshold = match two_population_threshold(&statistic) {
+    let threshold = match stance_threshold(&statistic) {
         Some(split) if split > noise => StanceThreshold {
             used: split,
             noise,
@@ -166,6 +161,21 @@ pub(super) fn stances_with_threshold(
     };
     let stance = statistic.iter().map(|s| *s < threshold.used).collect();
     (stance, threshold)
+}
+
+/// The mean rate over the rest at the start (`rest_s` from the first of the times `t`), rad/s:
+/// the gyroscope's bias as the rest shows it (zero without a rest).
+#[must_use]
+pub fn rest_rate(t: &[f64], w: &[[f64; 3]], rest_s: f64) -> [f64; 3] {
+    let Some(&t0) = t.first() else {
+        return [0.0; 3];
+    };
+    let rest = t.partition_point(|&x| x < t0 + rest_s).min(w.len());
+    if rest == 0 {
+        return [0.0; 3];
+    }
+    #[allow(clippy::cast_precision_loss)]
+    [0, 1, 2].map(|k| w[..rest].iter().map(|x| x[k]).sum::<f64>() / rest as f64)
 }
 
 /// The shortest first stance taken as the rest at the start of a walk, s.

@@ -11,7 +11,7 @@ use imu_core::{Body, Vec3};
 use super::adapt::FixNoiseScale;
 use super::detect::{
     Detection, REST_START_SPEED_M_S, StanceThreshold, detected_rest_s, first_stance_s,
-    longest_without_stance, stances_with_threshold,
+    longest_without_stance, rest_rate, stances_with_threshold,
 };
 use super::inputs::{FixVelocity, Fixes, FusionInputs, UNKNOWN_VELOCITY_SIGMA_M_S};
 use super::recovery::{Acceptance, filter_refusal};
@@ -75,7 +75,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
             &mut next_fix,
             (&mut acceptance, &mut noise_scale),
         )?;
-        aids.apply(&mut filter, ti, i)?;
+        aids.apply(&mut filter, ti, i, inputs.w[i])?;
         rows.push(&mut filter, &begin.origin, acceptance.resets, setup.smooth);
     }
     let (updates, rejected) = filter.update_counts();
@@ -178,7 +178,7 @@ fn mark_stances(
         stances_with_threshold(&inputs.t, &inputs.f, &inputs.w, setup, detection);
     let count = stance.iter().filter(|s| **s).count();
     let gap = longest_without_stance(&inputs.t, &stance, setup.rest_s);
-    aids.set_stance(stance);
+    aids.set_stance(stance, rest_rate(&inputs.t, &inputs.w, setup.rest_s));
     (count, Some(threshold), gap)
 }
 
