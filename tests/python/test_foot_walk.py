@@ -1,6 +1,6 @@
-"""A real foot-mounted walk (x-io's public `short_walk.csv`, tests/data/gait/README.md): fused from
-its readings and column map alone, the foot ends where it started within 0.5 % of the ~25 m
-walked — the command and Python alike."""
+"""Real foot-mounted walks (x-io's public `short_walk.csv` and `long_walk.csv`,
+tests/data/gait/README.md): fused from their readings and column map alone, the foot ends where
+it started within 0.5 % of the ~25 m and ~60 m walked — the command and Python alike."""
 import subprocess
 
 import numpy as np
@@ -40,3 +40,17 @@ def test_a_real_walk_closes_its_loop_from_its_readings_alone(tmp_path):
     with pytest.warns(imukit.ImuWarning, match="205 rows repeat the row before exactly"):
         fused = imukit.fuse(imu, None, zupt=True)
     np.testing.assert_array_equal(np.asarray(fused["pos_x_m"]), np.asarray(nav["pos_x_m"]))
+
+
+def test_a_long_walk_with_long_rests_finds_every_stance_and_closes_its_loop(tmp_path):
+    # Its rests fill half the log: a third population of the stance detector's statistic, below
+    # the rolling stances, which the threshold must not settle between.
+    out = tmp_path / "nav.csv"
+    done = subprocess.run([imukit_bin(), "fuse", str(GAIT / "long_walk.csv"), "--map", str(GAIT / "ngimu.map.toml"),
+                           "--zupt", "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "252 rows repeat the row before exactly" in done.stderr
+    assert "stances apart from swings and rests" in done.stderr
+    assert "found no stance" not in done.stderr
+    error = closure(imukit.read(str(out)))
+    assert error <= 0.005 * 60.0, f"{error:.3f} m"
