@@ -466,8 +466,14 @@ fn fuse_aligns_from_gnss_without_truth_and_refuses_a_start_it_cannot_make() {
     assert_eq!(header[35], "accel_scale_factor_x");
     assert_eq!(header[76], "gyro_g_sensitivity_z_sigma_rad_s_per_m_s2");
     assert_eq!(header[77], "gnss_resets");
-    // A levelling over a "rest" whose specific force is twice gravity is refused by the start
-    // that was asked for.
+}
+
+/// A levelling over a "rest" whose specific force is twice gravity is refused by the start that
+/// was asked for, and nothing is written.
+#[test]
+fn fuse_refuses_a_levelling_over_a_rest_that_is_not_one() {
+    let tmp = temp_dir("level");
+    let dir = tmp.path();
     let mut accelerating = String::from(
         "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2\n",
     );

@@ -289,3 +289,79 @@ fn a_barometer_reads_the_height_and_an_odometer_the_forward_speed_with_their_err
         assert!(e.contains(want), "{keys}: {e}");
     }
 }
+
+#[test]
+fn a_filter_told_its_fixes_are_exact_is_refused_by_the_accuracy_named() {
+    use imukit::error::RequestOption;
+    use imukit::run::fuse::PartModel;
+    use imukit::run::navigate::NavSetup;
+    use imukit::scenario::gnss::GnssSpec;
+    let part = |gnss: GnssSpec| PartModel {
+        imu: imukit::run::fuse::Part::Preset("stim300".into()),
+        part: None,
+        gnss,
+    };
+    for (gnss, field) in [
+        (
+            GnssSpec {
+                velocity_accuracy_m_s: Some(0.0),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssVelocityAccuracy,
+        ),
+        (
+            GnssSpec {
+                horizontal_accuracy_m: Some(-1.0),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssHorizontalAccuracy,
+        ),
+        (
+            GnssSpec {
+                vertical_accuracy_m: Some(f64::NAN),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssVerticalAccuracy,
+        ),
+        (
+            GnssSpec {
+                decay_factor: Some(1.5),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssDecayFactor,
+        ),
+        (
+            GnssSpec {
+                latency_s: Some(-0.1),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssLatency,
+        ),
+        (
+            GnssSpec {
+                lever_arm_m: Some([0.0, f64::INFINITY, 0.0]),
+                ..GnssSpec::default()
+            },
+            RequestOption::GnssLeverArm,
+        ),
+    ] {
+        match part(gnss).setup(&NavSetup::default(), None, 100.0) {
+            Err(Error::Request { option, message }) => {
+                assert_eq!(option, field);
+                let accuracy = matches!(
+                    option,
+                    RequestOption::GnssVelocityAccuracy
+                        | RequestOption::GnssHorizontalAccuracy
+                        | RequestOption::GnssVerticalAccuracy
+                );
+                assert!(!accuracy || message.contains("above 0"), "{message}");
+            }
+            other => panic!("{field:?}: {other:?}"),
+        }
+    }
+    let given = GnssSpec {
+        velocity_accuracy_m_s: Some(0.05),
+        ..GnssSpec::default()
+    };
+    assert!(part(given).setup(&NavSetup::default(), None, 100.0).is_ok());
+}
