@@ -17,11 +17,17 @@ def closure(nav) -> float:
     return float(np.hypot(nav["pos_x_m"][-1] - nav["pos_x_m"][0], nav["pos_y_m"][-1] - nav["pos_y_m"][0]))
 
 
-def test_a_real_walk_closes_its_loop_from_its_readings_alone(tmp_path):
-    out = tmp_path / "nav.csv"
-    done = subprocess.run([imukit_bin(), "fuse", str(GAIT / "short_walk.csv"), "--map", str(GAIT / "ngimu.map.toml"),
+def fuse_walk(name: str, out):
+    """`imukit fuse LOG --map ngimu.map.toml --zupt --out OUT` on the walk `name`, checked to succeed."""
+    done = subprocess.run([imukit_bin(), "fuse", str(GAIT / name), "--map", str(GAIT / "ngimu.map.toml"),
                            "--zupt", "--out", str(out)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+    return done
+
+
+def test_a_real_walk_closes_its_loop_from_its_readings_alone(tmp_path):
+    out = tmp_path / "nav.csv"
+    done = fuse_walk("short_walk.csv", out)
     # What the run learnt and dropped, said.
     assert "205 rows repeat the row before exactly" in done.stderr
     assert "found at the start" in done.stderr
@@ -46,9 +52,7 @@ def test_a_long_walk_with_long_rests_finds_every_stance_and_closes_its_loop(tmp_
     # Its rests fill half the log: a third population of the stance detector's statistic, below
     # the rolling stances, which the threshold must not settle between.
     out = tmp_path / "nav.csv"
-    done = subprocess.run([imukit_bin(), "fuse", str(GAIT / "long_walk.csv"), "--map", str(GAIT / "ngimu.map.toml"),
-                           "--zupt", "--out", str(out)], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    done = fuse_walk("long_walk.csv", out)
     assert "252 rows repeat the row before exactly" in done.stderr
     assert "stances apart from swings and rests" in done.stderr
     assert "found no stance" not in done.stderr

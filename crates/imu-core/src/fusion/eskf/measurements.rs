@@ -16,6 +16,11 @@ use crate::fusion::sensor_errors::{ACCEL_MATRIX, GYRO_ERRORS, d_gyro, d_matrix};
 use crate::nav_frame::NavFrame;
 use crate::vector::Vec3;
 
+/// A measurement model's rows at the nominal state: `H` (`M` × `S`), the innovation `y` and the
+/// measurement variances `r`.
+pub type ModelRows<const M: usize, const S: usize> =
+    (SMatrix<f64, M, S>, SVector<f64, M>, SVector<f64, M>);
+
 /// A measurement of `M` rows the filter on the Earth `E` takes through [`Eskf::update`]. The
 /// models are the filter's own ([`GnssFix`], [`BodyVelocity`], [`Height`], [`ZeroRate`]): the
 /// trait is sealed, since a model reads the filter's nominal state and sensor-error terms.
@@ -26,12 +31,11 @@ pub trait Measurement<E: EarthModel, const M: usize>: sealed::Sealed {
     /// # Errors
     /// A value that is not finite, a sigma that is not positive (named), no IMU sample yet.
     #[doc(hidden)]
-    #[allow(clippy::type_complexity)]
     fn model<const S: usize>(
         &self,
         filter: &Eskf<E, S>,
         index: usize,
-    ) -> Result<(SMatrix<f64, M, S>, SVector<f64, M>, SVector<f64, M>), EskfError>;
+    ) -> Result<ModelRows<M, S>, EskfError>;
 }
 
 mod sealed {
@@ -97,7 +101,7 @@ impl<E: EarthModel> Measurement<E, 6> for GnssFix<E> {
         &self,
         filter: &Eskf<E, S>,
         index: usize,
-    ) -> Result<(SMatrix<f64, 6, S>, SVector<f64, 6>, SVector<f64, 6>), EskfError> {
+    ) -> Result<ModelRows<6, S>, EskfError> {
         let age_s = self.age_s;
         if !(age_s.is_finite() && age_s >= 0.0) {
             return Err(EskfError::NotFinite { index });
@@ -238,7 +242,7 @@ impl<E: EarthModel> Measurement<E, 3> for BodyVelocity {
         &self,
         filter: &Eskf<E, S>,
         index: usize,
-    ) -> Result<(SMatrix<f64, 3, S>, SVector<f64, 3>, SVector<f64, 3>), EskfError> {
+    ) -> Result<ModelRows<3, S>, EskfError> {
         let v = *filter.nav.velocity_m_s.as_nalgebra();
         let ct = filter.c_nb().transpose();
         let predicted = ct * v;
@@ -279,7 +283,7 @@ impl<E: EarthModel> Measurement<E, 1> for Height {
         &self,
         filter: &Eskf<E, S>,
         index: usize,
-    ) -> Result<(SMatrix<f64, 1, S>, SVector<f64, 1>, SVector<f64, 1>), EskfError> {
+    ) -> Result<ModelRows<1, S>, EskfError> {
         if !(self.height_m.is_finite() && self.sigma_m.is_finite() && self.sigma_m > 0.0) {
             return Err(EskfError::NotFinite { index });
         }
@@ -324,7 +328,7 @@ impl<E: EarthModel> Measurement<E, 3> for ZeroRate {
         &self,
         filter: &Eskf<E, S>,
         index: usize,
-    ) -> Result<(SMatrix<f64, 3, S>, SVector<f64, 3>, SVector<f64, 3>), EskfError> {
+    ) -> Result<ModelRows<3, S>, EskfError> {
         let w_true = if E::ROTATING {
             let coords = E::coordinates(&filter.nav.position);
             let t = filter

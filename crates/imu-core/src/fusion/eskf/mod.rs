@@ -45,7 +45,7 @@ mod reset;
 mod transition;
 
 pub(crate) use intake::Intake;
-pub use measurements::{BodyVelocity, GnssFix, Height, Measurement, ZeroRate};
+pub use measurements::{BodyVelocity, GnssFix, Height, Measurement, ModelRows, ZeroRate};
 pub(crate) use models::{initial_covariance, kalman_update, process_noise, set_sensor_variances};
 use transition::{Dynamics, EarthCouplings, Transition};
 

@@ -182,10 +182,9 @@ impl AidStreams {
     ) -> Result<()> {
         if t_s >= self.rest.0 && self.stance.get(i).copied().unwrap_or(false) {
             // A stance on the move: the detector is the gate, and the foot is still only to
-            // about a centimetre a second (it rolls and settles).
-            // ... and it rolls: its rate is not the bias. The bias taken off is the rest's, a
-            // fixed number: the filter's own estimate would let the update pull the estimate
-            // towards the roll and then trust it more.
+            // about a centimetre a second. It rolls, so its rate is not the bias; the bias taken
+            // off is the rest's, a fixed number (the filter's own estimate would let the update
+            // pull the estimate towards the roll and then trust it more).
             let rate = [0, 1, 2].map(|k| gyro_rad_s[k] - self.stance_bias[k]);
             filter
                 .update(&BodyVelocity::zero(STANCE_VELOCITY_SIGMA_M_S), Gate::Off)
