@@ -9,9 +9,10 @@ pub enum CliError {
     /// `From` conversion).
     #[error(transparent)]
     Library(imukit::Error),
-    /// A figure or animation could not be made.
+    /// A figure or animation could not be made (a refused option named by its flag: see the
+    /// `From` conversion).
     #[error(transparent)]
-    Plot(#[from] PlotError),
+    Plot(PlotError),
     /// Other I/O errors (creating folders, writing text).
     #[error("{path}: {source}")]
     Io {
@@ -29,6 +30,20 @@ impl From<imukit::Error> for CliError {
     }
 }
 
+impl From<PlotError> for CliError {
+    /// The figure's error, a refused option named by the flag that sets it.
+    fn from(e: PlotError) -> Self {
+        match e {
+            PlotError::Option { option, message } => Self::Plot(PlotError::Invalid {
+                field: option.flag().into(),
+                message,
+            }),
+            PlotError::Data(e) => Self::from(e),
+            other => Self::Plot(other),
+        }
+    }
+}
+
 impl CliError {
     /// Exit code: 74 for I/O problems, 65 for bad input data (sysexits.h).
     #[must_use]
@@ -38,40 +53,6 @@ impl CliError {
             Self::Plot(p) if p.is_io() => 74,
             Self::Library(_) | Self::Plot(_) => 65,
         }
-    }
-}
-
-/// The flag that sets a library request field named as a string: the field's name with `-` for
-/// `_` (`gravity_m_s2` → `--gravity-m-s2`; Python's keywords are the fields' own names). The
-/// options whose flag is spelt otherwise are refused as [`imukit::Error::Request`], which
-/// carries its flag.
-#[must_use]
-pub fn flag(field: &str) -> String {
-    format!("--{}", field.replace('_', "-"))
-}
-
-/// A library refusal of a request field, named by its flag.
-#[must_use]
-pub fn by_flag(e: imukit::Error) -> imukit::Error {
-    match e {
-        imukit::Error::Invalid { field, message } => imukit::Error::Invalid {
-            field: flag(&field),
-            message,
-        },
-        // A refused request option is named by its flag in `CliError`'s conversion.
-        other => other,
-    }
-}
-
-/// A figure's refusal of an option, named by its flag.
-#[must_use]
-pub fn plot_by_flag(e: PlotError) -> PlotError {
-    match e {
-        PlotError::Invalid { field, message } => PlotError::Invalid {
-            field: flag(&field),
-            message,
-        },
-        other => other,
     }
 }
 
@@ -101,5 +82,59 @@ mod tests {
             message: "m".into(),
         };
         assert_eq!(named(key), "imu.gyroscope.NoiseDensity");
+    }
+
+    /// Every long flag of every command (aliases included).
+    fn flags() -> std::collections::BTreeSet<String> {
+        fn walk(c: &clap::Command, out: &mut std::collections::BTreeSet<String>) {
+            for a in c.get_arguments() {
+                out.extend(
+                    a.get_long_and_visible_aliases()
+                        .into_iter()
+                        .flatten()
+                        .map(|l| format!("--{l}")),
+                );
+            }
+            for s in c.get_subcommands() {
+                walk(s, out);
+            }
+        }
+        let mut out = std::collections::BTreeSet::new();
+        walk(
+            &<crate::cli::Cli as clap::CommandFactory>::command(),
+            &mut out,
+        );
+        out
+    }
+
+    #[test]
+    fn every_typed_option_is_named_by_a_flag_the_command_line_has() {
+        let flags = flags();
+        for option in RequestOption::ALL {
+            assert!(
+                flags.contains(option.flag()),
+                "{option:?}: {}",
+                option.flag()
+            );
+        }
+        for option in imu_plot::FigureOption::ALL {
+            assert!(
+                flags.contains(option.flag()),
+                "{option:?}: {}",
+                option.flag()
+            );
+        }
+        // A flag not there is noticed.
+        assert!(!flags.contains("--no-such-flag"));
+    }
+
+    #[test]
+    fn a_refused_figure_option_is_named_by_its_flag() {
+        let e = CliError::from(imu_plot::PlotError::Option {
+            option: imu_plot::FigureOption::Body,
+            message: "m".into(),
+        });
+        assert_eq!(e.to_string(), "--body-m: m");
+        assert_eq!(e.exit_code(), 65);
     }
 }

@@ -18,4 +18,4 @@ pub mod interrupt;
 pub mod report;
 
 pub use entry::main_with_args;
-pub use error::{CliError, by_flag, flag, plot_by_flag};
+pub use error::CliError;

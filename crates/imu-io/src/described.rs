@@ -5,7 +5,7 @@ use std::path::Path;
 
 use crate::TableFormat;
 use crate::description::{Description, KEY_PREFIX, Origin, Value};
-use crate::error::{Error, Result};
+use crate::error::{Error, RequestOption, Result, refused};
 use crate::schema::TableKind;
 
 impl Description {
@@ -132,64 +132,72 @@ impl Described {
         Ok(found)
     }
 
-    /// The setting `field`: `asked` if given, else what the files say ([`Description`]'s entry
-    /// `get`), else `default`.
+    /// The setting of the request option `option`: `asked` if given, else what the files say
+    /// ([`Description`]'s entry `get`), else `default`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming `field` when `asked` contradicts a file (naming the file and
+    /// [`Error::Request`] naming `option` when `asked` contradicts a file (naming the file and
     /// both values), or when two files disagree.
     pub fn pick<T: PartialEq + Copy + core::fmt::Display>(
         &self,
-        field: &str,
+        option: RequestOption,
         asked: Option<T>,
         get: impl Fn(&Description) -> Option<T>,
         default: T,
     ) -> Result<T> {
-        Ok(self.known(field, asked, get)?.unwrap_or(default))
+        Ok(self.known(option, asked, get)?.unwrap_or(default))
     }
 
-    /// The setting `field` when the user or the files fix it: `asked` if given, else what the
-    /// files say, else `None` (for a default that depends on other settings).
+    /// The setting of the request option `option` when the user or the files fix it: `asked`
+    /// if given, else what the files say, else `None` (for a default that depends on other
+    /// settings).
     ///
     /// # Errors
     /// As [`Self::pick`].
     pub fn known<T: PartialEq + Copy + core::fmt::Display>(
         &self,
-        field: &str,
+        option: RequestOption,
         asked: Option<T>,
         get: impl Fn(&Description) -> Option<T>,
     ) -> Result<Option<T>> {
-        match (asked, self.agreed(field, get)?) {
-            (Some(a), Some((d, path))) if a != d => Err(Error::Invalid {
-                field: field.to_string(),
-                message: format!(
+        match (
+            asked,
+            self.agreed(option.key(), get)
+                .map_err(|e| e.of_option(option))?,
+        ) {
+            (Some(a), Some((d, path))) if a != d => Err(refused(
+                option,
+                format!(
                     "{a} contradicts {path}, whose description says {d} (leave the option out to \
                      use it)"
                 ),
-            }),
+            )),
             (Some(a), _) => Ok(Some(a)),
             (None, found) => Ok(found.map(|(d, _)| d)),
         }
     }
 
-    /// Refuses files whose description says another `field` than `value`, which `source` (a
-    /// scenario file, say) fixes.
+    /// Refuses files whose description says another value of the setting of `option` than
+    /// `value`, which `source` (a scenario file, say) fixes.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming `field`, `source`, the file and both values; two files that
+    /// [`Error::Request`] naming `option`, `source`, the file and both values; two files that
     /// disagree.
     pub fn check<T: PartialEq + Copy + core::fmt::Display>(
         &self,
-        field: &str,
+        option: RequestOption,
         value: T,
         source: &str,
         get: impl Fn(&Description) -> Option<T>,
     ) -> Result<()> {
-        match self.agreed(field, get)? {
-            Some((d, path)) if d != value => Err(Error::Invalid {
-                field: field.to_string(),
-                message: format!("{source} says {value}, the description of {path} says {d}"),
-            }),
+        match self
+            .agreed(option.key(), get)
+            .map_err(|e| e.of_option(option))?
+        {
+            Some((d, path)) if d != value => Err(refused(
+                option,
+                format!("{source} says {value}, the description of {path} says {d}"),
+            )),
             _ => Ok(()),
         }
     }
@@ -207,30 +215,40 @@ impl Described {
         source: &str,
     ) -> Result<()> {
         fn option<T: PartialEq + core::fmt::Display>(
-            field: &str,
+            option: RequestOption,
             asked: Option<T>,
             fixed: Option<T>,
             source: &str,
         ) -> Result<()> {
             match (asked, fixed) {
-                (Some(a), Some(f)) if a != f => Err(Error::Invalid {
-                    field: field.to_string(),
-                    message: format!("{a} contradicts {source}, which says {f}"),
-                }),
+                (Some(a), Some(f)) if a != f => Err(refused(
+                    option,
+                    format!("{a} contradicts {source}, which says {f}"),
+                )),
                 _ => Ok(()),
             }
         }
-        option("nav_frame", asked.nav_frame, fixed.nav_frame, source)?;
-        option("earth", asked.earth, fixed.earth, source)?;
-        option("accel_sign", asked.accel_sign, fixed.accel_sign, source)?;
+        option(
+            RequestOption::NavFrame,
+            asked.nav_frame,
+            fixed.nav_frame,
+            source,
+        )?;
+        option(RequestOption::Earth, asked.earth, fixed.earth, source)?;
+        option(
+            RequestOption::AccelSign,
+            asked.accel_sign,
+            fixed.accel_sign,
+            source,
+        )?;
         if let Some(v) = fixed.nav_frame {
-            self.check("nav_frame", v, source, |d| d.nav_frame)?;
+            self.check(RequestOption::NavFrame, v, source, |d| d.nav_frame)?;
         }
         if let Some(v) = fixed.earth {
-            self.check("earth", v, source, |d| d.earth)?;
+            self.check(RequestOption::Earth, v, source, |d| d.earth)?;
         }
         if let Some(v) = fixed.accel_sign {
-            self.check("accel_sign", v, source, |d| d.accel_sign)?;
+            self.check(RequestOption::AccelSign, v, source, |d| d.accel_sign)?;
         }
         Ok(())
     }
@@ -412,16 +430,27 @@ mod tests {
         let nav = |d: &Description| d.nav_frame;
         let one = Described::read(&[&a, &plain]).unwrap();
         assert_eq!(
-            one.pick("nav_frame", None, nav, NavFrameName::ENU).unwrap(),
-            NavFrameName::NED
-        );
-        assert_eq!(
-            one.pick("nav_frame", Some(NavFrameName::NED), nav, NavFrameName::ENU)
+            one.pick(RequestOption::NavFrame, None, nav, NavFrameName::ENU)
                 .unwrap(),
             NavFrameName::NED
         );
+        assert_eq!(
+            one.pick(
+                RequestOption::NavFrame,
+                Some(NavFrameName::NED),
+                nav,
+                NavFrameName::ENU
+            )
+            .unwrap(),
+            NavFrameName::NED
+        );
         let e = one
-            .pick("nav_frame", Some(NavFrameName::ENU), nav, NavFrameName::ENU)
+            .pick(
+                RequestOption::NavFrame,
+                Some(NavFrameName::ENU),
+                nav,
+                NavFrameName::ENU,
+            )
             .unwrap_err()
             .to_string();
         assert!(
@@ -433,13 +462,13 @@ mod tests {
         );
         let none = Described::read(&[&plain]).unwrap();
         assert_eq!(
-            none.pick("nav_frame", None, nav, NavFrameName::ENU)
+            none.pick(RequestOption::NavFrame, None, nav, NavFrameName::ENU)
                 .unwrap(),
             NavFrameName::ENU
         );
         let e = Described::read(&[&a, &b])
             .unwrap()
-            .pick("nav_frame", None, nav, NavFrameName::ENU)
+            .pick(RequestOption::NavFrame, None, nav, NavFrameName::ENU)
             .unwrap_err()
             .to_string();
         assert!(

@@ -48,9 +48,102 @@ pub enum RequestOption {
     GnssLatency,
     /// The antenna's lever arm.
     GnssLeverArm,
+    /// The navigation frame (`ned`, `enu`).
+    NavFrame,
+    /// The sign convention of the accelerometer readings.
+    AccelSign,
+    /// The constant gravity's magnitude.
+    Gravity,
+    /// The gravity model on the WGS-84 Earth.
+    EarthGravity,
+    /// The vertical channel on the WGS-84 Earth.
+    Vertical,
+    /// The time constant of the baro-damped vertical channel.
+    BaroTimeConstant,
+    /// The integration substeps per sample.
+    Substeps,
+    /// Barometer readings beside the IMU's.
+    Barometer,
+    /// The starting position.
+    Position0,
+    /// The starting velocity.
+    Velocity0,
+    /// The starting attitude as a quaternion (on the command line, from the `--init` file).
+    Quaternion0,
+    /// The starting attitude as Euler angles.
+    Euler0,
+    /// The starting heading of planar dead reckoning.
+    Heading0,
+    /// The starting latitude.
+    Lat0,
+    /// The starting longitude.
+    Lon0,
+    /// The starting height.
+    Height0,
+    /// The start of the time window, after the first sample.
+    StartS,
+    /// The end of the time window, after the first sample.
+    EndS,
+    /// The IMU's topic in a bag written.
+    BagTopic,
+    /// The frame id of the IMU's messages in a bag written.
+    BagFrameId,
+    /// The stamp of time 0 in a bag written.
+    BagStart,
+    /// The user-equivalent range error that scales a fix's HDOP.
+    GnssUere,
+    /// The IMU part the filter is tuned for (a preset or a parameter file).
+    Imu,
+    /// The scenario that made the data.
+    Scenario,
 }
 
 impl RequestOption {
+    /// Every option.
+    pub const ALL: [Self; 41] = [
+        Self::RateHz,
+        Self::Threads,
+        Self::UseMagnetometer,
+        Self::Smooth,
+        Self::Earth,
+        Self::Initial,
+        Self::NhcSigma,
+        Self::RestS,
+        Self::Align,
+        Self::CovarianceInterval,
+        Self::GnssHorizontalAccuracy,
+        Self::GnssVerticalAccuracy,
+        Self::GnssVelocityAccuracy,
+        Self::GnssDecayFactor,
+        Self::GnssCorrelationTime,
+        Self::GnssLatency,
+        Self::GnssLeverArm,
+        Self::NavFrame,
+        Self::AccelSign,
+        Self::Gravity,
+        Self::EarthGravity,
+        Self::Vertical,
+        Self::BaroTimeConstant,
+        Self::Substeps,
+        Self::Barometer,
+        Self::Position0,
+        Self::Velocity0,
+        Self::Quaternion0,
+        Self::Euler0,
+        Self::Heading0,
+        Self::Lat0,
+        Self::Lon0,
+        Self::Height0,
+        Self::StartS,
+        Self::EndS,
+        Self::BagTopic,
+        Self::BagFrameId,
+        Self::BagStart,
+        Self::GnssUere,
+        Self::Imu,
+        Self::Scenario,
+    ];
+
     /// The option's name in the library's requests and in Python's keywords.
     #[must_use]
     pub const fn key(self) -> &'static str {
@@ -72,6 +165,30 @@ impl RequestOption {
             Self::GnssCorrelationTime => "gnss_correlation_time_s",
             Self::GnssLatency => "gnss_latency_s",
             Self::GnssLeverArm => "gnss_lever_arm_m",
+            Self::NavFrame => "nav_frame",
+            Self::AccelSign => "accel_sign",
+            Self::Gravity => "gravity_m_s2",
+            Self::EarthGravity => "earth_gravity",
+            Self::Vertical => "vertical",
+            Self::BaroTimeConstant => "baro_time_constant_s",
+            Self::Substeps => "substeps",
+            Self::Barometer => "baro",
+            Self::Position0 => "position0_m",
+            Self::Velocity0 => "velocity0_m_s",
+            Self::Quaternion0 => "quaternion0",
+            Self::Euler0 => "euler0_rad",
+            Self::Heading0 => "heading0_rad",
+            Self::Lat0 => "lat0_deg",
+            Self::Lon0 => "lon0_deg",
+            Self::Height0 => "height0_m",
+            Self::StartS => "start_s",
+            Self::EndS => "end_s",
+            Self::BagTopic => "bag_topic",
+            Self::BagFrameId => "bag_frame_id",
+            Self::BagStart => "bag_start_s",
+            Self::GnssUere => "gnss_uere_m",
+            Self::Imu => "imu",
+            Self::Scenario => "scenario",
         }
     }
 
@@ -96,6 +213,30 @@ impl RequestOption {
             Self::GnssCorrelationTime => "--gnss-correlation-time-s",
             Self::GnssLatency => "--gnss-latency-s",
             Self::GnssLeverArm => "--gnss-lever-arm-m",
+            Self::NavFrame => "--nav-frame",
+            Self::AccelSign => "--accel-sign",
+            Self::Gravity => "--gravity-m-s2",
+            Self::EarthGravity => "--earth-gravity",
+            Self::Vertical => "--vertical",
+            Self::BaroTimeConstant => "--baro-time-constant-s",
+            Self::Substeps => "--substeps",
+            Self::Barometer => "--baro",
+            Self::Position0 => "--position0-m",
+            Self::Velocity0 => "--velocity0-m-s",
+            Self::Quaternion0 => "--init",
+            Self::Euler0 => "--euler0-rad",
+            Self::Heading0 => "--heading0-rad",
+            Self::Lat0 => "--lat0-deg",
+            Self::Lon0 => "--lon0-deg",
+            Self::Height0 => "--height0-m",
+            Self::StartS => "--start-s",
+            Self::EndS => "--end-s",
+            Self::BagTopic => "--bag-topic",
+            Self::BagFrameId => "--bag-frame-id",
+            Self::BagStart => "--bag-start-s",
+            Self::GnssUere => "--gnss-uere-m",
+            Self::Imu => "--imu",
+            Self::Scenario => "--scenario",
         }
     }
 }
@@ -388,6 +529,16 @@ impl Error {
                 context: name,
                 message,
             },
+            other => other,
+        }
+    }
+
+    /// This refusal of a value ([`Error::Invalid`], from a check shared with other keys) as a
+    /// refusal of the request option `option`; other refusals as they are.
+    #[must_use]
+    pub fn of_option(self, option: RequestOption) -> Self {
+        match self {
+            Self::Invalid { message, .. } => Self::Request { option, message },
             other => other,
         }
     }

@@ -35,8 +35,8 @@ impl TimeWindow {
         if let Some(s) = start_s
             && !(s.is_finite() && s >= 0.0)
         {
-            return Err(invalid(
-                "start_s",
+            return Err(crate::error::refused(
+                crate::error::RequestOption::StartS,
                 format!("must be a finite number of seconds ≥ 0 after the first sample, got {s}"),
             ));
         }
@@ -44,8 +44,8 @@ impl TimeWindow {
         if let Some(e) = end_s
             && !(e.is_finite() && e > after)
         {
-            return Err(invalid(
-                "end_s",
+            return Err(crate::error::refused(
+                crate::error::RequestOption::EndS,
                 format!("must be a finite number of seconds after the start ({after} s), got {e}"),
             ));
         }

@@ -11,9 +11,9 @@ use crate::spec::{FramePlan, default_body_m, frame_plan};
 use imukit::Table;
 use plotters::prelude::*;
 
-use crate::PlotError;
 use crate::draw::{COLORS, err, every, rasterise, stride_for};
 use crate::scene::{BOX_EDGES, BOX_NOSE, body_point_enu, box_corners_m, pose_enu};
+use crate::{FigureOption, PlotError};
 
 /// Animation settings.
 #[derive(Clone, Copy, Debug)]
@@ -115,8 +115,8 @@ struct Scene {
 
 impl Scene {
     fn new(truth: &Table, source: &str, opts: &AnimateOptions) -> Result<Self, PlotError> {
-        let bad = |field: &str, message: &str| PlotError::Invalid {
-            field: field.into(),
+        let bad = |option, message: &str| PlotError::Option {
+            option,
             message: message.into(),
         };
         let finite3 = |v: [f64; 3]| v.iter().all(|x| x.is_finite());
@@ -124,10 +124,13 @@ impl Scene {
             .body_m
             .is_some_and(|b| !(finite3(b) && b.iter().all(|v| *v > 0.0)))
         {
-            return Err(bad("body_m", "length, width and height must be positive"));
+            return Err(bad(
+                FigureOption::Body,
+                "length, width and height must be positive",
+            ));
         }
         if !finite3(opts.lever_arm_m) {
-            return Err(bad("lever_arm_m", "must be finite"));
+            return Err(bad(FigureOption::LeverArm, "must be finite"));
         }
         let poses = poses(truth, source, opts.ned)?;
         let times: Vec<f64> = poses.iter().map(|p| p.t).collect();

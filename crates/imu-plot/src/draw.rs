@@ -7,7 +7,7 @@ use plotters::coord::{CoordTranslate, Shift};
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
-use crate::PlotError;
+use crate::{FigureOption, PlotError};
 
 /// The series colours (matplotlib's tab10 order).
 pub const COLORS: [RGBColor; 8] = [
@@ -232,16 +232,13 @@ impl FigureSize {
     /// # Errors
     /// [`PlotError::Invalid`] on `size` or `dpi`.
     pub fn new(size_in: Option<(f64, f64)>, dpi: Option<f64>) -> Result<Self, PlotError> {
-        let invalid = |field: &str, message: String| PlotError::Invalid {
-            field: field.into(),
-            message,
-        };
+        let invalid = |option, message: String| PlotError::Option { option, message };
         let (lo, hi) = Self::SIDE_IN;
         if let Some((w, h)) = size_in
             && !(w.is_finite() && h.is_finite() && (lo..=hi).contains(&w) && (lo..=hi).contains(&h))
         {
             return Err(invalid(
-                "size",
+                FigureOption::Size,
                 format!("{w} × {h} inches: each side must be from {lo} to {hi} inches"),
             ));
         }
@@ -249,7 +246,7 @@ impl FigureSize {
         let (dlo, dhi) = Self::DPI;
         if !(dpi.is_finite() && (dlo..=dhi).contains(&dpi)) {
             return Err(invalid(
-                "dpi",
+                FigureOption::Dpi,
                 format!("{dpi}: the resolution must be from {dlo} to {dhi} pixels per inch"),
             ));
         }
@@ -257,7 +254,7 @@ impl FigureSize {
             && w.max(h) * dpi > Self::MAX_SIDE_PX
         {
             return Err(invalid(
-                "dpi",
+                FigureOption::Dpi,
                 format!(
                     "{dpi} pixels per inch make a side of {:.0} pixels (at most {})",
                     w.max(h) * dpi,

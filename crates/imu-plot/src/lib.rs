@@ -44,10 +44,19 @@ pub enum PlotError {
     /// A table could not be read, or holds what cannot be drawn (file, row and column named).
     #[error(transparent)]
     Data(#[from] imukit::Error),
-    /// An option or a table value that cannot be drawn.
+    /// An option refused, named by its typed name ([`FigureOption`]): each front end spells
+    /// it its own way (Python's keyword, the command line's flag).
+    #[error("{}: {message}", option.key())]
+    Option {
+        /// The option.
+        option: FigureOption,
+        /// What is wrong.
+        message: String,
+    },
+    /// A table value that cannot be drawn, or a table that is not a figure's.
     #[error("{field}: {message}")]
     Invalid {
-        /// The option (`fps`, `body_m`, as named in [`animate::AnimateOptions`]) or the file and row.
+        /// The file and row, or the figure.
         field: String,
         /// What is wrong.
         message: String,
@@ -70,6 +79,69 @@ impl PlotError {
             self,
             Self::Data(imukit::Error::Io { .. }) | Self::Draw { .. }
         )
+    }
+}
+
+/// An option of a figure or an animation, as a refusal names it ([`PlotError::Option`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FigureOption {
+    /// The figure's width and height.
+    Size,
+    /// The figure's resolution.
+    Dpi,
+    /// An animation's frames per second.
+    Fps,
+    /// Seconds of motion per second of animation.
+    Speed,
+    /// The animated body box.
+    Body,
+    /// The lever arm of the animated IMU point.
+    LeverArm,
+}
+
+impl FigureOption {
+    /// Every option.
+    pub const ALL: [Self; 6] = [
+        Self::Size,
+        Self::Dpi,
+        Self::Fps,
+        Self::Speed,
+        Self::Body,
+        Self::LeverArm,
+    ];
+
+    /// The option's name in [`animate::AnimateOptions`] and in Python's keywords.
+    #[must_use]
+    pub const fn key(self) -> &'static str {
+        match self {
+            Self::Size => "size",
+            Self::Dpi => "dpi",
+            Self::Fps => "fps",
+            Self::Speed => "speed",
+            Self::Body => "body_m",
+            Self::LeverArm => "lever_arm_m",
+        }
+    }
+
+    /// The command line's flag that sets the option.
+    #[must_use]
+    pub const fn flag(self) -> &'static str {
+        match self {
+            Self::Size => "--size",
+            Self::Dpi => "--dpi",
+            Self::Fps => "--fps",
+            Self::Speed => "--speed",
+            Self::Body => "--body-m",
+            Self::LeverArm => "--lever-arm-m",
+        }
+    }
+}
+
+/// A refusal of the figure option `option`.
+pub(crate) fn refused(option: FigureOption, message: impl Into<String>) -> PlotError {
+    PlotError::Option {
+        option,
+        message: message.into(),
     }
 }
 

@@ -1,7 +1,7 @@
 //! What imukit draws for each kind of table, shared by the CLI (plotters) and Python
 //! (matplotlib): the kind of a CSV from its columns, the default panels of each kind, and the
 //! frame plan of an animation.
-use crate::{PlotError, invalid};
+use crate::{FigureOption, PlotError, invalid, refused};
 
 type Result<T> = std::result::Result<T, PlotError>;
 
@@ -354,10 +354,16 @@ pub const DEFAULT_FPS: f64 = 20.0;
 /// as row 1), `fps` or `speed` not positive.
 pub fn frame_plan(t_s: &[f64], fps: f64, speed: Option<f64>, source: &str) -> Result<FramePlan> {
     if !(fps.is_finite() && fps > 0.0) {
-        return Err(invalid("fps", format!("must be positive, got {fps}")));
+        return Err(refused(
+            FigureOption::Fps,
+            format!("must be positive, got {fps}"),
+        ));
     }
     if let Some(s) = speed.filter(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(invalid("speed", format!("must be positive, got {s}")));
+        return Err(refused(
+            FigureOption::Speed,
+            format!("must be positive, got {s}"),
+        ));
     }
     if t_s.len() < 2 {
         return Err(invalid(source, "an animation needs at least 2 samples"));
@@ -376,8 +382,8 @@ pub fn frame_plan(t_s: &[f64], fps: f64, speed: Option<f64>, source: &str) -> Re
     // Counted in floating point first: a huge rate must not reach an allocation.
     let frames = (duration / speed * fps).floor() + 1.0;
     if frames > MAX_FRAMES as f64 {
-        return Err(invalid(
-            "fps",
+        return Err(refused(
+            FigureOption::Fps,
             format!(
                 "{fps} frames/s at {speed}× real time over {duration} s would be {frames:e} frames, \
                  more than {MAX_FRAMES}: lower the frames per second or raise the speed"

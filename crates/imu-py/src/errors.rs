@@ -38,6 +38,10 @@ pub(crate) fn refused_figure(e: PlotError) -> PyErr {
     match e {
         PlotError::Data(e) => refused(e),
         PlotError::Invalid { field, message } => refused(imukit::Error::Invalid { field, message }),
+        PlotError::Option { option, message } => refused(imukit::Error::Invalid {
+            field: option.key().into(),
+            message,
+        }),
         other @ PlotError::Draw { .. } => ImuError::new_err(other.to_string()),
     }
 }

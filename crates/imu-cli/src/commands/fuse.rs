@@ -15,7 +15,6 @@ use imukit::navigate::{InitialState, NavAsked, NavRequest};
 use imukit::{Error, ScenarioSpec};
 
 use super::CliError;
-use crate::error::by_flag;
 
 /// The command's arguments.
 pub struct Args<'a> {
@@ -62,7 +61,7 @@ fn part_setup(a: &Args<'_>, model: &PartModel, imu: &imukit::Table) -> Result<Fu
         .setup_described(&a.asked, &described, imu)
         .map_err(|e| match e {
             e if e.data() == Some(Data::Imu) => e.relabelled(a.imu.display().to_string()),
-            other => by_flag(other),
+            other => other,
         })?)
 }
 
@@ -76,9 +75,7 @@ fn data_frame(a: &Args<'_>) -> Result<(NavFrameName, bool), CliError> {
         return Ok((scenario.nav_frame, on_earth));
     }
     let described = Described::read(&inputs_of(a))?;
-    let nav = NavRequest::default()
-        .with_described(&a.asked, &described)
-        .map_err(by_flag)?;
+    let nav = NavRequest::default().with_described(&a.asked, &described)?;
     Ok((nav.nav_frame, nav.earth == EarthName::Wgs84))
 }
 
@@ -151,13 +148,11 @@ fn setup_of<'s>(
             // scenario's are not the scenario's data.
             let described = Described::read(&inputs_of(a))?;
             let source = format!("the scenario {}", path.display());
-            described
-                .check_fixed(
-                    &scenario.description(None),
-                    &a.asked.as_description(),
-                    &source,
-                )
-                .map_err(by_flag)?;
+            described.check_fixed(
+                &scenario.description(None),
+                &a.asked.as_description(),
+                &source,
+            )?;
             Ok(request.setup(&scenario).map_err(|e| match e {
                 // The scenario decides the Earth: say which file.
                 Error::Request {
@@ -167,12 +162,12 @@ fn setup_of<'s>(
                     field: RequestOption::Earth.flag().into(),
                     message: format!("{message} ({})", path.display()),
                 },
-                other => by_flag(other),
+                other => other,
             })?)
         }
         (None, Some(model)) => {
             let setup = part_setup(a, model, imu)?;
-            Ok(request.apply(setup).map_err(by_flag)?)
+            Ok(request.apply(setup)?)
         }
         (None, None) => Err(Error::Invalid {
             field: "--scenario".into(),
@@ -234,7 +229,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
     let t0 = TimeWindow::first_time(&imu, &a.imu.display().to_string())?;
     let imu = cut(a, imu, t0, a.imu, 2)?;
     let initial = initial_of(a, t0)?;
-    let start = Start::of(initial.as_ref(), a.align).map_err(by_flag)?;
+    let start = Start::of(initial.as_ref(), a.align)?;
     let request = request_of(a, start.or_else(|| Start::when_not_given(a.gnss.is_some())));
     crate::report::warn_implausible_read(&imu, a.imu);
     let (setup, start) = setup_of(a, &request, &imu)?;

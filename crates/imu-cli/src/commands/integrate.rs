@@ -14,7 +14,7 @@ use imukit::navigate::{InitialState, NavAsked, NavRequest, NavSetup, integrate_c
 use imukit::planar::{EXERCISE_POSITION0_M, PlanarRequest, integrate, read_planar};
 use imukit::{Error, Table};
 
-use crate::{CliError, by_flag};
+use crate::CliError;
 
 /// Arguments shared by the planar and the 3D integration.
 pub struct Common<'a> {
@@ -85,7 +85,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
         }
     }
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
-    let initial = request.initial_state(t0).map_err(by_flag)?;
+    let initial = request.initial_state(t0)?;
     let nav = integrate(&samples, scheme, initial).map_err(|e| Error::Invalid {
         field: c.input.display().to_string(),
         message: e.to_string(),
@@ -157,9 +157,8 @@ pub fn three_d(
         barometer: o.baro.is_some(),
         ..*request
     }
-    .with_described(asked, &described)
-    .map_err(by_flag)?;
-    let setup = request.setup().map_err(by_flag)?;
+    .with_described(asked, &described)?;
+    let setup = request.setup()?;
     crate::report::warn_implausible(c.input);
     let initial = initial_of(c, o, &setup, &described)?;
     if let Some(baro) = o.baro {
@@ -247,8 +246,7 @@ fn initial_of(
     }
     let (lat, lon, h) = o.geodetic0;
     initial = initial
-        .with_geodetic0(lat, lon, h)
-        .map_err(by_flag)?
+        .with_geodetic0(lat, lon, h)?
         .at_origin(described.origin()?);
     // Checked here, so that a bad start is blamed on where it came from, not on the IMU file.
     // The start options are checked as they are read; what remains is the --init file's row.

@@ -110,7 +110,6 @@ impl crate::cli::WindowArgs {
     /// As [`TimeWindow::new`], naming `--start-s` or `--end-s`.
     pub fn window(&self) -> Result<TimeWindow, CliError> {
         TimeWindow::new(self.start_s, self.end_s)
-            .map_err(crate::error::by_flag)
             .map_err(CliError::from)
     }
 }

@@ -53,8 +53,7 @@ pub fn run(a: &Args<'_>) -> Result<(), CliError> {
         use_magnetometer: !no_mag,
         smooth,
     }
-    .with_described(&Described::read(&[input])?)
-    .map_err(crate::error::by_flag)?
+    .with_described(&Described::read(&[input])?)?
     .resolve();
     crate::report::warn_implausible(input);
     let s = orient_csv(input, &spec, nav, window, out).map_err(|e| match e {

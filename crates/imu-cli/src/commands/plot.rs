@@ -11,7 +11,6 @@ use imukit::io::rows::TimeWindow;
 
 use super::CliError;
 use crate::cli::FigureArgs;
-use crate::plot_by_flag;
 
 /// The frame positions are drawn in: `--nav-frame`, else what the files' descriptions say,
 /// else ENU; a flag or a file that contradicts another is refused.
@@ -20,7 +19,7 @@ pub fn described_frame(
     asked: Option<NavFrameName>,
 ) -> Result<NavFrameName, CliError> {
     Ok(Described::read(files)?.pick(
-        "--nav-frame",
+        imukit::error::RequestOption::NavFrame,
         asked,
         |d| d.nav_frame,
         NavFrameName::default(),
@@ -66,9 +65,7 @@ pub fn figure_size(args: &FigureArgs) -> Result<FigureSize, CliError> {
         .size
         .as_deref()
         .map(|s| (s[0], s.get(1).copied().unwrap_or(s[0])));
-    FigureSize::new(size_in, args.dpi)
-        .map_err(plot_by_flag)
-        .map_err(CliError::from)
+    FigureSize::new(size_in, args.dpi).map_err(CliError::from)
 }
 
 /// The animation options from the command line.
@@ -102,8 +99,7 @@ pub fn animate(
     let name = truth.display().to_string();
     let t0 = TimeWindow::first_time(&table, &name)?;
     let table = window.apply(table, t0, &name, 2)?;
-    let info = anim::animate(&table, &truth.display().to_string(), out, opts)
-        .map_err(crate::plot_by_flag)?;
+    let info = anim::animate(&table, &truth.display().to_string(), out, opts)?;
     crate::note!(
         "imukit: wrote {} ({} frames at {} frames/s, {}× real time)",
         out.display(),

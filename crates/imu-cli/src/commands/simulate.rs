@@ -54,8 +54,7 @@ pub fn bag_options(
         args.bag_topic.as_deref(),
         args.bag_frame_id.as_deref(),
         args.bag_start_s,
-    )
-    .map_err(crate::error::by_flag)?;
+    )?;
     Ok(Some(options))
 }
 

@@ -58,7 +58,7 @@ pub use writer::BagWriter;
 #[cfg(feature = "bags")]
 use crate::asl::stamp_ns;
 #[cfg(feature = "bags")]
-use crate::error::{Result, invalid};
+use crate::error::Result;
 
 #[cfg(not(feature = "bags"))]
 pub use without::{BagOptions, BagWriter, column_names, description, read_table, read_table_as};
@@ -127,8 +127,8 @@ impl BagOptions {
                     .skip(1)
                     .all(|part| !part.starts_with(|c: char| c.is_ascii_digit()));
             if !well_formed {
-                return Err(invalid(
-                    "bag_topic",
+                return Err(crate::error::refused(
+                    crate::error::RequestOption::BagTopic,
                     format!(
                         "{t:?} is not a ROS 2 topic name: `/` then letters, digits, `_` and `/` \
                          (no `//`, no part starting with a digit, no `/` at the end), such as /imu/data"
@@ -139,8 +139,8 @@ impl BagOptions {
         }
         if let Some(f) = frame_id {
             if f.is_empty() || !plain(f) {
-                return Err(invalid(
-                    "bag_frame_id",
+                return Err(crate::error::refused(
+                    crate::error::RequestOption::BagFrameId,
                     format!(
                         "{f:?} is not a frame id: letters, digits, `_` and `/`, such as imu_link"
                     ),
@@ -151,8 +151,8 @@ impl BagOptions {
         if let Some(s) = start_s {
             let ns = stamp_ns(s).filter(|&ns| ns >= 0 && ros::Time::from_ns(ns).is_some());
             o.start_ns = ns.ok_or_else(|| {
-                invalid(
-                    "bag_start_s",
+                crate::error::refused(
+                    crate::error::RequestOption::BagStart,
                     format!(
                         "{s} is not a ROS time stamp: seconds since 1970-01-01 UTC, from 0 to \
                          2147483647 (2038), such as 1700000000"
@@ -171,7 +171,7 @@ mod without {
 
     use super::Role;
     use crate::description::Description;
-    use crate::error::{Result, invalid};
+    use crate::error::Result;
     use crate::input::Input;
     use crate::table::Table;
 

@@ -50,14 +50,14 @@ pub const HDOP_COLUMN: &str = "hdop";
 /// A `uere_m` that is not positive and finite; fixes without `hdop`.
 pub fn with_uere(fixes: &Table, uere_m: f64) -> Result<Table> {
     if !(uere_m.is_finite() && uere_m > 0.0) {
-        return Err(crate::error::invalid(
-            "gnss_uere_m",
+        return Err(crate::error::refused(
+            crate::error::RequestOption::GnssUere,
             format!("must be a positive number of metres, got {uere_m}"),
         ));
     }
     let Some(hdop) = fixes.column(HDOP_COLUMN) else {
-        return Err(crate::error::invalid(
-            "gnss_uere_m",
+        return Err(crate::error::refused(
+            crate::error::RequestOption::GnssUere,
             "the fixes have no hdop column (an NMEA log's GGA gives it) to scale",
         ));
     };

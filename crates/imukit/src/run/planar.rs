@@ -7,7 +7,7 @@ use std::path::Path;
 
 use imu_core::strapdown::planar::{PlanarSample, PlanarScheme, PlanarState, dead_reckon};
 
-use crate::error::{Error, Result, invalid};
+use crate::error::{Error, RequestOption, Result, invalid};
 use crate::io::Input;
 use crate::io::columns::{PLANAR_COLUMNS, PLANAR_NAV_COLUMNS};
 use crate::io::output::write_atomically;
@@ -185,9 +185,12 @@ impl PlanarRequest {
     /// # Errors
     /// Non-finite start values, named.
     pub fn initial_state(&self, t0_s: f64) -> Result<PlanarState> {
-        finite_vec("position0_m", self.position0_m)?;
-        finite_vec("heading0_rad", [self.heading0_rad])?;
-        finite_vec("velocity0_m_s", self.velocity0_m_s)?;
+        finite_vec("position0_m", self.position0_m)
+            .map_err(|e| e.of_option(RequestOption::Position0))?;
+        finite_vec("heading0_rad", [self.heading0_rad])
+            .map_err(|e| e.of_option(RequestOption::Heading0))?;
+        finite_vec("velocity0_m_s", self.velocity0_m_s)
+            .map_err(|e| e.of_option(RequestOption::Velocity0))?;
         let (s, c) = self.heading0_rad.sin_cos();
         let v = self.velocity0_m_s;
         Ok(PlanarState {

@@ -378,8 +378,8 @@ fn next_state(
 /// # Errors
 /// [`crate::Error::Invalid`] naming the setting and both inputs.
 pub fn check_comparable(described: &crate::io::described::Described) -> Result<()> {
-    described.known("nav_frame", None, |d| d.nav_frame)?;
-    described.known("earth", None, |d| d.earth)?;
+    described.known(crate::error::RequestOption::NavFrame, None, |d| d.nav_frame)?;
+    described.known(crate::error::RequestOption::Earth, None, |d| d.earth)?;
     Ok(())
 }
 

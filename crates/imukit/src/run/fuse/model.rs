@@ -165,8 +165,8 @@ impl PartModel {
             Part::Preset(name) => (Some(name.clone()), None),
             Part::File(path) => (None, Some(path.clone())),
             Part::Learnt => {
-                return Err(invalid(
-                    "imu",
+                return Err(crate::error::refused(
+                    crate::error::RequestOption::Imu,
                     "a part learnt from the log needs the log: PartModel::setup_for",
                 ));
             }

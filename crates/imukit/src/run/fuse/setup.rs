@@ -7,7 +7,7 @@ use imu_core::fusion::process_noise::{FLICKER_FLOOR, eskf_noise};
 use imu_core::fusion::{EskfNoise, FixErrorModel, InitialSigma, SensorErrorSigma};
 
 use super::FuseModel;
-use crate::error::{Error, RequestOption, Result, invalid, refused};
+use crate::error::{Error, RequestOption, Result, refused};
 use crate::io::conventions::NavFrameName;
 
 /// How to fuse.
@@ -257,8 +257,8 @@ impl FuseSetup {
     /// A scenario without `[gnss]`.
     pub fn from_scenario(scenario: &crate::Scenario) -> Result<Self> {
         let gnss = scenario.gnss.as_ref().ok_or_else(|| {
-            invalid(
-                "scenario",
+            refused(
+                RequestOption::Scenario,
                 "has no [gnss] receiver: the filter takes the fixes' accuracy from it",
             )
         })?;

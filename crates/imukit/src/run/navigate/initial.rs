@@ -2,7 +2,7 @@
 use imu_core::earth::Geodetic;
 use imu_core::{Enu, EulerZyx, Rotation};
 
-use crate::error::{Result, invalid};
+use crate::error::{RequestOption, Result, invalid, refused};
 use crate::io::Input;
 use crate::io::columns::{GEODETIC_COLUMNS, Position, STATE_COLUMNS, Velocity};
 use crate::io::conventions::NavFrameName;
@@ -62,15 +62,18 @@ impl InitialState {
         quaternion: Option<[f64; 4]>,
         euler_rad: Option<[f64; 3]>,
     ) -> Result<Self> {
-        let position_m = finite_vec("position0_m", position_m.unwrap_or_default())?;
-        let velocity_m_s = finite_vec("velocity0_m_s", velocity_m_s.unwrap_or_default())?;
+        let position_m = finite_vec("position0_m", position_m.unwrap_or_default())
+            .map_err(|e| e.of_option(RequestOption::Position0))?;
+        let velocity_m_s = finite_vec("velocity0_m_s", velocity_m_s.unwrap_or_default())
+            .map_err(|e| e.of_option(RequestOption::Velocity0))?;
         match (quaternion, euler_rad) {
-            (Some(_), Some(_)) => Err(invalid(
-                "euler0_rad",
+            (Some(_), Some(_)) => Err(refused(
+                RequestOption::Euler0,
                 "give the attitude as a quaternion or as Euler angles, not both",
             )),
             (None, Some(e)) => {
-                let e = finite_vec("euler0_rad", e)?;
+                let e =
+                    finite_vec("euler0_rad", e).map_err(|e| e.of_option(RequestOption::Euler0))?;
                 Ok(Self::from_euler(
                     position_m,
                     velocity_m_s,
@@ -78,9 +81,10 @@ impl InitialState {
                 ))
             }
             (q, None) => {
-                let quaternion = finite_vec("quaternion0", q.unwrap_or([1.0, 0.0, 0.0, 0.0]))?;
+                let quaternion = finite_vec("quaternion0", q.unwrap_or([1.0, 0.0, 0.0, 0.0]))
+                    .map_err(|e| e.of_option(RequestOption::Quaternion0))?;
                 if quaternion.iter().all(|c| *c == 0.0) {
-                    return Err(invalid("quaternion0", "has zero norm"));
+                    return Err(refused(RequestOption::Quaternion0, "has zero norm"));
                 }
                 Ok(Self {
                     position_m,
@@ -104,9 +108,9 @@ impl InitialState {
         height0_m: Option<f64>,
     ) -> Result<Self> {
         let parts = [
-            ("lat0_deg", lat0_deg),
-            ("lon0_deg", lon0_deg),
-            ("height0_m", height0_m),
+            (RequestOption::Lat0, lat0_deg),
+            (RequestOption::Lon0, lon0_deg),
+            (RequestOption::Height0, height0_m),
         ];
         if parts.iter().all(|(_, v)| v.is_none()) {
             return Ok(self);
@@ -115,9 +119,9 @@ impl InitialState {
         for (k, &(name, v)) in parts.iter().enumerate() {
             values[k] = match v {
                 Some(x) if x.is_finite() => x,
-                Some(x) => return Err(invalid(name, format!("must be a finite number, got {x}"))),
+                Some(x) => return Err(refused(name, format!("must be a finite number, got {x}"))),
                 None => {
-                    return Err(invalid(
+                    return Err(refused(
                         name,
                         "missing: the starting latitude, longitude and height go together",
                     ));
@@ -125,8 +129,8 @@ impl InitialState {
             };
         }
         if values[0].abs() > 90.0 {
-            return Err(invalid(
-                "lat0_deg",
+            return Err(refused(
+                RequestOption::Lat0,
                 format!("must be within ±90°, got {}", values[0]),
             ));
         }

@@ -5,7 +5,7 @@ use imu_core::strapdown::{StrapdownOptions, VerticalChannel};
 
 use super::EarthNav;
 use crate::choice::{Choice, display_as_name};
-use crate::error::{Result, invalid};
+use crate::error::{RequestOption, Result, refused};
 use crate::io::conventions::{AccelSignName, EarthGravityName, EarthName, NavFrameName};
 use crate::io::described::Described;
 use crate::io::description::Description;
@@ -247,7 +247,7 @@ impl NavAsked {
     /// As [`Described::known`].
     pub fn accel_sign_of(&self, described: &Described) -> Result<Option<AccelSign>> {
         Ok(described
-            .known("accel_sign", self.accel_sign, |d| d.accel_sign)?
+            .known(RequestOption::AccelSign, self.accel_sign, |d| d.accel_sign)?
             .map(AccelSign::from)
             .or_else(|| {
                 self.conventions
@@ -289,32 +289,32 @@ impl NavRequest {
     pub fn with_described(self, asked: &NavAsked, described: &Described) -> Result<Self> {
         // A value that is no gravity at all is refused as such, before it is compared.
         if let Some(g) = asked.gravity_m_s2 {
-            check_gravity("gravity_m_s2", g)?;
+            check_gravity("gravity_m_s2", g).map_err(|e| e.of_option(RequestOption::Gravity))?;
         }
         let d = Self::default();
         let conventions = asked.conventions.unwrap_or_default();
         Ok(Self {
             nav_frame: described.pick(
-                "nav_frame",
+                RequestOption::NavFrame,
                 asked.nav_frame,
                 |x| x.nav_frame,
                 conventions.nav_frame(),
             )?,
             accel_sign: described.pick(
-                "accel_sign",
+                RequestOption::AccelSign,
                 asked.accel_sign,
                 |x| x.accel_sign,
                 conventions.accel_sign_name(),
             )?,
             gravity_m_s2: described.pick(
-                "gravity_m_s2",
+                RequestOption::Gravity,
                 asked.gravity_m_s2,
                 |x| x.gravity_m_s2,
                 d.gravity_m_s2,
             )?,
-            earth: described.pick("earth", asked.earth, |x| x.earth, d.earth)?,
+            earth: described.pick(RequestOption::Earth, asked.earth, |x| x.earth, d.earth)?,
             earth_gravity: described.pick(
-                "earth_gravity",
+                RequestOption::EarthGravity,
                 asked.earth_gravity,
                 |x| x.earth_gravity,
                 d.earth_gravity,
@@ -329,8 +329,8 @@ impl NavRequest {
     /// [`crate::Error::Invalid`] naming the field.
     pub fn setup(&self) -> Result<NavSetup> {
         if self.barometer && self.vertical != VerticalName::Baro {
-            return Err(invalid(
-                "baro",
+            return Err(refused(
+                RequestOption::Barometer,
                 "barometer readings feed the baro-damped vertical channel: use them with the \
                  WGS-84 Earth and the baro vertical channel",
             ));
@@ -341,7 +341,7 @@ impl NavRequest {
             SchemeName::Rk4 => NavScheme::Rk4 { substeps: 0 },
         }
         .with_substeps(self.substeps)
-        .map_err(|m| invalid("substeps", m))?;
+        .map_err(|m| refused(RequestOption::Substeps, m))?;
         Ok(NavSetup {
             nav_frame: self.nav_frame,
             accel_sign: self.accel_sign.into(),
@@ -351,7 +351,8 @@ impl NavRequest {
                 sculling: self.sculling,
                 vertical: VerticalChannel::Free,
             },
-            gravity_m_s2: check_gravity("gravity_m_s2", self.gravity_m_s2)?,
+            gravity_m_s2: check_gravity("gravity_m_s2", self.gravity_m_s2)
+                .map_err(|e| e.of_option(RequestOption::Gravity))?,
             earth: self.earth_nav()?,
         })
     }
@@ -365,8 +366,8 @@ impl NavRequest {
             VerticalName::Baro => {
                 let tau = self.baro_time_constant_s;
                 if !(tau.is_finite() && tau > 0.0) {
-                    return Err(invalid(
-                        "baro_time_constant_s",
+                    return Err(refused(
+                        RequestOption::BaroTimeConstant,
                         format!("must be a finite number > 0 s, got {tau}"),
                     ));
                 }
@@ -377,19 +378,20 @@ impl NavRequest {
         };
         let gravity = match self.earth_gravity {
             EarthGravityName::Normal => GravityModel::Normal,
-            EarthGravityName::Constant => {
-                GravityModel::Constant(check_gravity("gravity_m_s2", self.gravity_m_s2)?)
-            }
+            EarthGravityName::Constant => GravityModel::Constant(
+                check_gravity("gravity_m_s2", self.gravity_m_s2)
+                    .map_err(|e| e.of_option(RequestOption::Gravity))?,
+            ),
         };
         match self.earth {
             EarthName::Wgs84 => Ok(Some(EarthNav { vertical, gravity })),
-            EarthName::Flat if self.vertical != VerticalName::Free => Err(invalid(
-                "vertical",
+            EarthName::Flat if self.vertical != VerticalName::Free => Err(refused(
+                RequestOption::Vertical,
                 "chooses the vertical channel of the WGS-84 Earth (earth = wgs84); the flat \
                  Earth has none to choose",
             )),
-            EarthName::Flat if self.earth_gravity != EarthGravityName::Normal => Err(invalid(
-                "earth_gravity",
+            EarthName::Flat if self.earth_gravity != EarthGravityName::Normal => Err(refused(
+                RequestOption::EarthGravity,
                 "is for the WGS-84 Earth (earth = wgs84); the flat Earth takes gravity_m_s2",
             )),
             EarthName::Flat => Ok(None),

@@ -266,8 +266,16 @@ impl OrientRequest {
     /// the input's description.
     pub fn with_described(self, described: &Described) -> Result<Self> {
         Ok(Self {
-            nav_frame: described.known("nav_frame", self.nav_frame, |d| d.nav_frame)?,
-            accel_sign: described.known("accel_sign", self.accel_sign, |d| d.accel_sign)?,
+            nav_frame: described.known(
+                crate::error::RequestOption::NavFrame,
+                self.nav_frame,
+                |d| d.nav_frame,
+            )?,
+            accel_sign: described.known(
+                crate::error::RequestOption::AccelSign,
+                self.accel_sign,
+                |d| d.accel_sign,
+            )?,
             ..self
         })
     }
