@@ -361,7 +361,22 @@ fn bad_input_is_refused_with_what_and_where_and_no_file_written() {
         &["animate"],
         &[&d.join("imu.csv"), Path::new("--out"), &d.join("a.gif")],
     );
-    assert!(String::from_utf8_lossy(&o.stderr).contains("imu.csv: no pos_x_m column"));
+    // The file named as it is (not turned into a flag), a refused option by its flag.
+    let err = String::from_utf8_lossy(&o.stderr);
+    let named = format!("imukit: {}: no pos_x_m column", d.join("imu.csv").display());
+    assert!(err.starts_with(&named), "{err}");
+    let o = imukit(
+        &["animate"],
+        &[
+            &d.join("truth.csv"),
+            Path::new("--out"),
+            &d.join("a.gif"),
+            Path::new("--fps"),
+            Path::new("0"),
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.starts_with("imukit: --fps: must be positive"), "{err}");
     let o = imukit(
         &["animate"],
         &[&d.join("truth.csv"), Path::new("--out"), &d.join("a.mp4")],

@@ -109,8 +109,7 @@ impl crate::cli::WindowArgs {
     /// # Errors
     /// As [`TimeWindow::new`], naming `--start-s` or `--end-s`.
     pub fn window(&self) -> Result<TimeWindow, CliError> {
-        TimeWindow::new(self.start_s, self.end_s)
-            .map_err(CliError::from)
+        TimeWindow::new(self.start_s, self.end_s).map_err(CliError::from)
     }
 }
 
