@@ -75,13 +75,13 @@ mod tests {
             (RequestOption::Align, "--align"),
             (RequestOption::GnssLeverArm, "--gnss-lever-arm-m"),
         ] {
-            assert_eq!(named(imukit::error::refused(option, "m")), flag);
+            assert_eq!(named(imukit::error::refused(option, "m")).to_string(), flag);
         }
         let key = imukit::Error::Invalid {
             field: "imu.gyroscope.NoiseDensity".into(),
             message: "m".into(),
         };
-        assert_eq!(named(key), "imu.gyroscope.NoiseDensity");
+        assert_eq!(named(key).to_string(), "imu.gyroscope.NoiseDensity");
     }
 
     /// Every long flag of every command (aliases included).

@@ -188,7 +188,7 @@ impl ColumnMap {
         let spec: MapSpec = serde_path_to_error::deserialize(&mut json).map_err(|e| {
             let path = e.path().to_string();
             Error::Invalid {
-                field: format!("{origin}: {path}"),
+                field: format!("{origin}: {path}").into(),
                 message: e.into_inner().to_string(),
             }
         })?;

@@ -121,7 +121,7 @@ impl Described {
             match found {
                 Some((w, other)) if w != v => {
                     return Err(Error::Invalid {
-                        field: field.to_string(),
+                        field: field.to_string().into(),
                         message: format!("the inputs disagree: {other} says {w}, {path} says {v}"),
                     });
                 }

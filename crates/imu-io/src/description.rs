@@ -326,7 +326,7 @@ impl Description {
             let text = || match &value {
                 Value::Text(s) => Ok(s.clone()),
                 Value::Number(_) => Err(Error::Invalid {
-                    field: field.clone(),
+                    field: field.clone().into(),
                     message: "expected a name, got a number".into(),
                 }),
             };
@@ -334,7 +334,7 @@ impl Description {
                 match &value {
                     Value::Number(x) => Ok(*x),
                     Value::Text(s) => s.trim().parse::<f64>().map_err(|_| Error::Invalid {
-                        field: field.clone(),
+                        field: field.clone().into(),
                         message: format!("expected a number, got {s:?}"),
                     }),
                 }
@@ -343,7 +343,7 @@ impl Description {
                         Ok(x)
                     } else {
                         Err(Error::Invalid {
-                            field: field.clone(),
+                            field: field.clone().into(),
                             message: format!("expected a finite number, got {x}"),
                         })
                     }
@@ -371,7 +371,7 @@ impl Description {
             && !b.eq_ignore_ascii_case(body_frame(n))
         {
             return Err(Error::Invalid {
-                field: format!("{place}: key body_frame"),
+                field: format!("{place}: key body_frame").into(),
                 message: format!(
                     "{b} does not go with the navigation frame {} (its body frame is {})",
                     n.name(),
@@ -388,7 +388,7 @@ impl Description {
             (None, None, None) => None,
             _ => {
                 return Err(Error::Invalid {
-                    field: format!("{place}: key origin_latitude_deg"),
+                    field: format!("{place}: key origin_latitude_deg").into(),
                     message: "the origin needs its latitude, longitude and height together".into(),
                 });
             }

@@ -290,8 +290,8 @@ pub enum Error {
     /// A scenario key with an invalid value.
     #[error("{field}: {message}")]
     Invalid {
-        /// Dotted key, e.g. `trajectory.order`.
-        field: String,
+        /// Dotted key, e.g. `trajectory.order`, or the input by what it holds.
+        field: Subject,
         /// What is wrong.
         message: String,
     },
@@ -312,7 +312,7 @@ pub enum Error {
     #[error("{context}: {}{source}", row.map(|r| format!("row {r}: ")).unwrap_or_default())]
     Filter {
         /// The input or setting, e.g. `IMU data`, `sensor_error_sigma`.
-        context: String,
+        context: Subject,
         /// The 1-based row of the input (the header is row 1), when a sample was refused.
         row: Option<usize>,
         /// The core's error.
@@ -331,8 +331,8 @@ pub enum Error {
     /// or fixes rejected one after another): the estimate is not written.
     #[error("{context}: {message}")]
     Diverged {
-        /// The input and row where it was noticed, e.g. `GNSS data`.
-        context: String,
+        /// The input where it was noticed, e.g. `GNSS data`.
+        context: Subject,
         /// What happened.
         message: String,
     },
@@ -498,17 +498,68 @@ impl Data {
     }
 }
 
+/// What a refusal is about: an input by what it holds, or a key, option, file or argument by
+/// its name. Shown as the name, or as the input's [`Data::label`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Subject {
+    /// An input a job reads.
+    Data(Data),
+    /// A key, option, file or argument.
+    Named(String),
+}
+
+impl core::fmt::Display for Subject {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Data(d) => f.write_str(d.label()),
+            Self::Named(s) => f.write_str(s),
+        }
+    }
+}
+
+impl From<Data> for Subject {
+    fn from(d: Data) -> Self {
+        Self::Data(d)
+    }
+}
+
+impl From<String> for Subject {
+    fn from(s: String) -> Self {
+        Self::Named(s)
+    }
+}
+
+impl From<&str> for Subject {
+    fn from(s: &str) -> Self {
+        Self::Named(s.to_string())
+    }
+}
+
+impl From<&String> for Subject {
+    fn from(s: &String) -> Self {
+        Self::Named(s.clone())
+    }
+}
+
 impl Error {
-    /// The input this refusal is about, when it names one by its [`Data::label`].
+    /// The input this refusal is about, when it is about one ([`Subject::Data`]).
     #[must_use]
     pub fn data(&self) -> Option<Data> {
-        let named = match self {
-            Self::Invalid { field: f, .. }
-            | Self::Filter { context: f, .. }
-            | Self::Diverged { context: f, .. } => f,
-            _ => return None,
-        };
-        Data::ALL.into_iter().find(|d| d.label() == named)
+        match self {
+            Self::Invalid {
+                field: Subject::Data(d),
+                ..
+            }
+            | Self::Filter {
+                context: Subject::Data(d),
+                ..
+            }
+            | Self::Diverged {
+                context: Subject::Data(d),
+                ..
+            } => Some(*d),
+            _ => None,
+        }
     }
 
     /// This refusal with the input it names called `name` instead (the file it came from); other
@@ -517,16 +568,16 @@ impl Error {
     pub fn relabelled(self, name: String) -> Self {
         match self {
             Self::Invalid { message, .. } => Self::Invalid {
-                field: name,
+                field: name.into(),
                 message,
             },
             Self::Filter { row, source, .. } => Self::Filter {
-                context: name,
+                context: name.into(),
                 row,
                 source,
             },
             Self::Diverged { message, .. } => Self::Diverged {
-                context: name,
+                context: name.into(),
                 message,
             },
             other => other,
@@ -576,12 +627,13 @@ impl Error {
             Self::Scenario { .. } => Location::default(),
             Self::Request { option, .. } => field(option.key()),
             Self::Align { .. } => field(RequestOption::Align.key()),
-            Self::Invalid { field: f, .. }
-            | Self::ScenarioKey { field: f, .. }
+            Self::Invalid { field: f, .. } | Self::Diverged { context: f, .. } => {
+                field(&f.to_string())
+            }
+            Self::ScenarioKey { field: f, .. }
             | Self::UnknownChoice { field: f, .. }
             | Self::Expression { field: f, .. }
-            | Self::BadQuaternion { field: f }
-            | Self::Diverged { context: f, .. } => field(f),
+            | Self::BadQuaternion { field: f } => field(f),
             Self::CsvValue {
                 file: f,
                 row,
@@ -596,7 +648,7 @@ impl Error {
             Self::CsvFormat { file: f, .. } => file(f),
             Self::Filter { context, row, .. } => Location {
                 row: *row,
-                ..field(context)
+                ..field(&context.to_string())
             },
             Self::NotFinite {
                 what, row, column, ..
@@ -642,7 +694,7 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 /// [`Error::Invalid`]: the value of `field` (a key, an option, an argument) is wrong, `message`
 /// says why.
-pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Error {
+pub fn invalid(field: impl Into<Subject>, message: impl Into<String>) -> Error {
     Error::Invalid {
         field: field.into(),
         message: message.into(),
@@ -656,8 +708,14 @@ mod data_tests {
     #[test]
     fn a_refusal_about_an_input_is_named_by_the_file_a_front_end_knows() {
         for data in Data::ALL {
-            let e = invalid(data.label(), "row 3: times must increase");
+            let e = invalid(data, "row 3: times must increase");
             assert_eq!(e.data(), Some(data));
+            assert_eq!(
+                e.to_string(),
+                format!("{}: row 3: times must increase", data.label())
+            );
+            // A key spelt like an input's label is a key: nothing is matched by its text.
+            assert_eq!(invalid(data.label(), "m").data(), None);
             let renamed = e.relabelled("log.csv".into());
             assert_eq!(renamed.to_string(), "log.csv: row 3: times must increase");
             assert_eq!(renamed.data(), None);

@@ -23,7 +23,11 @@ pub fn max_memory_bytes() -> f64 {
 ///
 /// # Errors
 /// [`crate::Error::Invalid`] with the estimate, the limit and the ways around it.
-pub fn check_in_memory(samples: usize, bytes_per_sample: usize, field: &str) -> Result<()> {
+pub fn check_in_memory(
+    samples: usize,
+    bytes_per_sample: usize,
+    field: impl Into<crate::error::Subject>,
+) -> Result<()> {
     #[allow(clippy::cast_precision_loss)]
     let need = samples as f64 * bytes_per_sample as f64;
     let limit = max_memory_bytes();

@@ -232,7 +232,7 @@ pub fn median_interval(t_s: &[f64]) -> f64 {
 }
 
 /// The refusal of a time that does not increase, at file row `row`.
-pub fn not_increasing(what: &str, row: usize) -> crate::Error {
+pub fn not_increasing(what: impl Into<crate::error::Subject>, row: usize) -> crate::Error {
     invalid(
         what,
         format!("time at row {row} does not increase after row {}", row - 1),
@@ -243,7 +243,11 @@ pub fn not_increasing(what: &str, row: usize) -> crate::Error {
 ///
 /// # Errors
 /// [`crate::Error::Invalid`] naming the first row whose time does not increase (or is NaN).
-pub fn check_increasing(t_s: &[f64], what: &str, first_row: usize) -> Result<()> {
+pub fn check_increasing(
+    t_s: &[f64],
+    what: impl Into<crate::error::Subject>,
+    first_row: usize,
+) -> Result<()> {
     match (1..t_s.len()).find(|&i| t_s[i].is_nan() || t_s[i] <= t_s[i - 1]) {
         Some(i) => Err(not_increasing(what, i + first_row)),
         None => Ok(()),
@@ -472,7 +476,7 @@ impl TimedRows {
             if let Some(p) = self.skipped_t
                 && t <= p
             {
-                return Err(not_increasing(Data::Imu.label(), self.taken + 2));
+                return Err(not_increasing(Data::Imu, self.taken + 2));
             }
             if t >= self.window.0 {
                 if t > self.window.1 {
@@ -537,7 +541,7 @@ impl TimedRows {
             if let Some(p) = self.previous_t.or(self.skipped_t)
                 && t <= p
             {
-                return Err(not_increasing(Data::Imu.label(), line));
+                return Err(not_increasing(Data::Imu, line));
             }
             if t > self.window.1 {
                 return self.ended();

@@ -268,7 +268,7 @@ impl std::fmt::Display for At<'_> {
 fn tree_at(obj: &Bound<'_, PyAny>, at: &At<'_>, depth: usize) -> PyResult<ParamValue> {
     if depth > MAX_DEPTH {
         return Err(crate::errors::refused(imukit::Error::Invalid {
-            field: at.to_string(),
+            field: at.to_string().into(),
             message: format!("nested deeper than {MAX_DEPTH} levels"),
         }));
     }

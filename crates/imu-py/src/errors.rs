@@ -37,7 +37,10 @@ pub(crate) fn refused(e: imukit::Error) -> PyErr {
 pub(crate) fn refused_figure(e: PlotError) -> PyErr {
     match e {
         PlotError::Data(e) => refused(e),
-        PlotError::Invalid { field, message } => refused(imukit::Error::Invalid { field, message }),
+        PlotError::Invalid { field, message } => refused(imukit::Error::Invalid {
+            field: field.into(),
+            message,
+        }),
         PlotError::Option { option, message } => refused(imukit::Error::Invalid {
             field: option.key().into(),
             message,

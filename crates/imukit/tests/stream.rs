@@ -140,7 +140,7 @@ fn gathering_into_the_callers_memory_checks_the_shape_first() {
     let (mut truth, mut imu) = (vec![0.0; 151 * 23], vec![0.0; 151 * 10 - 1]);
     match sc.simulate_streamed_into(None, RunThreads::Two, Some(&mut truth), &mut imu) {
         Err(imukit::Error::Invalid { field, message }) => {
-            assert_eq!(field, "imu");
+            assert_eq!(field.to_string(), "imu");
             assert!(
                 message.contains("1509 values, expected 151 rows × 10"),
                 "{message}"

@@ -199,7 +199,7 @@ fn fixes_of(a: &Args<'_>, t0: f64) -> Result<imukit::Table, CliError> {
     Ok(
         imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
             Error::Invalid { message, .. } => Error::Invalid {
-                field: format!("--gnss-uere-m ({})", path.display()),
+                field: format!("--gnss-uere-m ({})", path.display()).into(),
                 message,
             },
             other => other,

@@ -75,7 +75,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
         samples.retain(|x| x.t_s >= lo && x.t_s <= hi);
         if samples.is_empty() {
             return Err(Error::Invalid {
-                field: c.input.display().to_string(),
+                field: c.input.display().to_string().into(),
                 message: format!(
                     "no sample lies in the window {} (seconds after the first sample)",
                     c.window.describe()
@@ -87,7 +87,7 @@ pub fn planar(c: &Common<'_>, scheme: Option<&str>, heading0_rad: f64) -> Result
     let t0 = samples.first().map_or(0.0, |x| x.t_s);
     let initial = request.initial_state(t0)?;
     let nav = integrate(&samples, scheme, initial).map_err(|e| Error::Invalid {
-        field: c.input.display().to_string(),
+        field: c.input.display().to_string().into(),
         message: e.to_string(),
     })?;
     nav.write(c.out)?;
@@ -168,7 +168,7 @@ pub fn three_d(
     let summary =
         integrate_csv(c.input, &initial, &setup, c.window, c.out).map_err(|e| match e {
             Error::Invalid { .. } | Error::Strapdown { .. } => Error::Invalid {
-                field: c.input.display().to_string(),
+                field: c.input.display().to_string().into(),
                 message: e.to_string(),
             },
             other => other,
@@ -278,7 +278,7 @@ fn with_baro(
         }
     })?;
     let nav = imukit::navigate::integrate(&joined, initial, setup).map_err(|e| Error::Invalid {
-        field: c.input.display().to_string(),
+        field: c.input.display().to_string().into(),
         message: e.to_string(),
     })?;
     nav.write_described(c.out, &setup.description())?;

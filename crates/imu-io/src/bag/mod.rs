@@ -215,7 +215,7 @@ mod without {
     }
 
     fn refused(path: &Path) -> crate::Error {
-        invalid(
+        crate::error::invalid(
             path.display().to_string(),
             "a ROS bag: this build of imu-io reads no bags (its `bags` feature is off)",
         )

@@ -268,7 +268,7 @@ impl Contents {
             }
         };
         self.values += row.len() + 1;
-        crate::memory::check_in_memory(self.values, 8, &self.path.display().to_string())?;
+        crate::memory::check_in_memory(self.values, 8, self.path.display().to_string())?;
         self.decoded[slot].stamps_ns.push(stamp);
         self.decoded[slot].rows.extend(row);
         Ok(())

@@ -188,7 +188,7 @@ impl AtomicFile {
             TableFormat::Mcap => return self.begin_bag(description),
             TableFormat::Nmea => {
                 return Err(Error::Invalid {
-                    field: self.path.display().to_string(),
+                    field: self.path.display().to_string().into(),
                     message: "NMEA logs are read, not written: write fixes as CSV, Parquet, \
                               .npy, .npz or a bag (.mcap)"
                         .into(),

@@ -66,7 +66,7 @@ pub fn allan_of_log(source: &Input, columns: &[String], window: TimeWindow) -> R
     let in_file = |column: String| format!("{file}, column {column}");
     let result = allan(&series, rate).map_err(|e| match e {
         Error::Invalid { field, message } => Error::Invalid {
-            field: in_file(field),
+            field: in_file(field.to_string()).into(),
             message,
         },
         Error::Allan { context, source } => Error::Allan {

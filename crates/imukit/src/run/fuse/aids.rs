@@ -28,14 +28,14 @@ pub(crate) fn aid_series(
 ) -> Result<(Vec<f64>, Vec<f64>)> {
     let (Some(t), Some(v)) = (table.column("t_s"), table.column(value)) else {
         return Err(invalid(
-            what.label(),
+            what,
             format!("missing column(s): needs t_s and {value}"),
         ));
     };
     for (k, (&tk, &vk)) in t.iter().zip(&v).enumerate() {
         if !tk.is_finite() || !vk.is_finite() || (k > 0 && tk <= t[k - 1]) {
             return Err(invalid(
-                what.label(),
+                what,
                 format!(
                     "row {}: times must be finite and increase, values finite",
                     k + 2
@@ -44,7 +44,7 @@ pub(crate) fn aid_series(
         }
         if tk < t0 || tk > t1 {
             return Err(invalid(
-                what.label(),
+                what,
                 format!(
                     "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
                     k + 2
@@ -90,7 +90,7 @@ impl AidStreams {
             (Some(table), Some(_)) => aid_series(table, Data::Odometer, "speed_m_s", span)?,
             (Some(_), None) => {
                 return Err(invalid(
-                    Data::Odometer.label(),
+                    Data::Odometer,
                     "given, but the scenario has no [odometer]: the filter takes its accuracy from it",
                 ));
             }
@@ -100,7 +100,7 @@ impl AidStreams {
             (Some(table), Some(_)) => aid_series(table, Data::Barometer, "baro_height_m", span)?,
             (Some(_), None) => {
                 return Err(invalid(
-                    Data::Barometer.label(),
+                    Data::Barometer,
                     "given, but the scenario has no [baro]: the filter takes its accuracy from it",
                 ));
             }
@@ -188,14 +188,14 @@ impl AidStreams {
             let rate = [0, 1, 2].map(|k| gyro_rad_s[k] - self.stance_bias[k]);
             filter
                 .update(&BodyVelocity::zero(STANCE_VELOCITY_SIGMA_M_S), Gate::Off)
-                .map_err(|e| filter_refusal("IMU (stance, zero velocity)", i, e))?;
+                .map_err(|e| filter_refusal("IMU (stance, zero velocity) data", i, e))?;
             filter
                 .update(&ZeroRate::rolling(self.rest.1, rate), Gate::Off)
-                .map_err(|e| filter_refusal("IMU (stance, zero rate)", i, e))?;
+                .map_err(|e| filter_refusal("IMU (stance, zero rate) data", i, e))?;
         } else if t_s < self.rest.0 {
             filter
                 .update(&BodyVelocity::zero(REST_VELOCITY_SIGMA_M_S), self.gate(3))
-                .map_err(|e| filter_refusal("IMU (at rest, zero velocity)", i, e))?;
+                .map_err(|e| filter_refusal("IMU (at rest, zero velocity) data", i, e))?;
             filter
                 .update(
                     &ZeroRate {
@@ -203,7 +203,7 @@ impl AidStreams {
                     },
                     self.gate(3),
                 )
-                .map_err(|e| filter_refusal("IMU (at rest, zero rate)", i, e))?;
+                .map_err(|e| filter_refusal("IMU (at rest, zero rate) data", i, e))?;
         }
         let (odo_t, odo_v) = (&self.odometer.0, &self.odometer.1);
         while self.next.0 < odo_t.len() && odo_t[self.next.0] <= t_s {
@@ -217,7 +217,7 @@ impl AidStreams {
             let odometer = BodyVelocity::odometer(speed, sigma, self.nhc_sigma_m_s);
             filter
                 .update(&odometer, self.gate(odometer.rows()))
-                .map_err(|e| filter_refusal("odometer", k, e))?;
+                .map_err(|e| filter_refusal(Data::Odometer, k, e))?;
             self.next.0 += 1;
         }
         if let Some(c) = self.nhc_sigma_m_s
@@ -226,7 +226,7 @@ impl AidStreams {
         {
             filter
                 .update(&BodyVelocity::nonholonomic(c), self.gate(2))
-                .map_err(|e| filter_refusal("constraint", i, e))?;
+                .map_err(|e| filter_refusal("constraint data", i, e))?;
             self.next_nhc_t = t_s + 1.0 / NHC_RATE_HZ;
         }
         let (baro_t, baro_h) = (&self.baro.0, &self.baro.1);
@@ -240,7 +240,7 @@ impl AidStreams {
                     },
                     self.gate(1),
                 )
-                .map_err(|e| filter_refusal("barometer", k, e))?;
+                .map_err(|e| filter_refusal(Data::Barometer, k, e))?;
             self.next.1 += 1;
         }
         Ok(())

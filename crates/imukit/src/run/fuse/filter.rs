@@ -21,7 +21,7 @@ use super::smooth::{SMOOTHING_GAP_S, smoothed_rows};
 use super::start::{ALIGN_ATTITUDE_ALLOWANCE_RAD, ALIGN_MIN_SPEED_M_S, Begin, begin};
 use super::{Fuse, FuseSetup, FuseSummary, Start};
 use crate::error::Data;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Subject};
 use crate::io::columns::FUSE_COLUMNS;
 use crate::io::table::Table;
 use crate::run::epochs::PackedEpochs;
@@ -66,7 +66,7 @@ pub(super) fn fuse_on<E: NavEarth, const S: usize>(
     for (i, &ti) in t.iter().enumerate().skip(begin.first) {
         filter
             .propagate(ti, inputs.w[i], inputs.f[i].map(|x| sign * x))
-            .map_err(|e| filter_error(Data::Imu.label(), e))?;
+            .map_err(|e| filter_error(Data::Imu, e))?;
         apply_fixes(
             &mut filter,
             (&inputs, &fixes),
@@ -183,7 +183,7 @@ fn mark_stances(
 }
 
 /// The filter's refusal of `context` (a setting or the IMU data), without a row.
-fn filter_error(context: &str, source: EskfError) -> Error {
+fn filter_error(context: impl Into<Subject>, source: EskfError) -> Error {
     Error::Filter {
         context: context.into(),
         row: None,
@@ -297,7 +297,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             if let Some(change) = noise_scale.observe(o.nis, rows) {
                 filter
                     .scale_fix_errors(change)
-                    .map_err(|e| filter_refusal("GNSS", k, e))?;
+                    .map_err(|e| filter_refusal(Data::Gnss, k, e))?;
             }
         }
         if acceptance.count(outcome, k, setup.gate)? {
@@ -311,7 +311,7 @@ fn apply_fixes<E: NavEarth, const S: usize>(
             });
             filter
                 .reset_to_gnss(&fix, heading)
-                .map_err(|e| filter_refusal("GNSS", k, e))?;
+                .map_err(|e| filter_refusal(Data::Gnss, k, e))?;
         }
         *next_fix += 1;
     }

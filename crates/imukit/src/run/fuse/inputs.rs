@@ -17,13 +17,13 @@ fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<
     for (k, &tk) in g_t.iter().enumerate() {
         if !tk.is_finite() || (k > 0 && tk <= g_t[k - 1]) {
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!("row {}: times must be finite and increase", k + 2),
             ));
         }
         if tk < t0 || tk > t1 {
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!(
                     "row {}: time {tk} s is outside the IMU's span [{t0}, {t1}] s",
                     k + 2
@@ -41,7 +41,7 @@ fn check_fix_times(g_t: &[f64], (t0, t1): (f64, f64), samples: usize) -> Result<
         );
         if fix_dt < imu_dt {
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!(
                     "fixes come every {fix_dt} s, more often than the IMU's samples (every \
                      {imu_dt} s): the filter applies fixes at IMU samples, so the IMU must be the \
@@ -104,10 +104,10 @@ impl FusionInputs {
     ) -> Result<Self> {
         let t = imu
             .column("t_s")
-            .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
+            .ok_or_else(|| invalid(Data::Imu, "missing column t_s"))?;
         let (Some(f), Some(w)) = (imu.triples(&ACCEL_COLUMNS), imu.triples(&GYRO_COLUMNS)) else {
             return Err(invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 "fusion needs rates: accel_x/y/z_m_s2 and gyro_x/y/z_rad_s",
             ));
         };
@@ -125,7 +125,7 @@ impl FusionInputs {
         };
         if t.len() < 2 {
             return Err(invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 format!("{} rows: fusion needs at least two samples", t.len()),
             ));
         }
@@ -170,7 +170,7 @@ impl FusionInputs {
                 ""
             };
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!("missing column(s) {}{hint}{other}", missing.join(", ")),
             ));
         }
@@ -234,7 +234,7 @@ fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 3]>>> 
         }
         (3, true) => {
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!(
                     "give the fixes' accuracy as {} or as {}, not both",
                     FIX_SIGMA_COLUMNS.join(", "),
@@ -250,7 +250,7 @@ fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 3]>>> 
                 .map(|(n, _)| *n)
                 .collect();
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!(
                     "per-axis accuracy needs all three of {}: missing {}",
                     FIX_SIGMA_COLUMNS.join(", "),
@@ -265,7 +265,7 @@ fn fix_accuracy(gnss: &Table, setup: [f64; 2]) -> Result<Option<Vec<[f64; 3]>>> 
         .find(|(_, s)| !s.iter().all(|v| v.is_finite() && *v > 0.0))
     {
         return Err(invalid(
-            Data::Gnss.label(),
+            Data::Gnss,
             format!(
                 "row {}: the fix's accuracy must be positive and finite, got {} m",
                 k + 2,
@@ -297,7 +297,7 @@ impl<E: NavEarth> Fixes<E> {
             .map(|(k, &p)| {
                 E::fix_position(p).ok_or_else(|| {
                     invalid(
-                        Data::Gnss.label(),
+                        Data::Gnss,
                         format!(
                             "row {}: the latitude must be within ±89.9° and the longitude and \
                              height finite",

@@ -110,7 +110,7 @@ impl PartModel {
         let median = crate::io::rows::Gaps::of_times(&t, 0).median_s;
         if median.is_nan() || median <= 0.0 {
             return Err(invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 "needs at least two samples with increasing t_s (the sample rate sets the noise)",
             ));
         }
@@ -127,13 +127,13 @@ impl PartModel {
             imu.triples(&crate::io::columns::GYRO_COLUMNS),
         ) else {
             return Err(invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 "needs accel_* and gyro_* columns to learn the sensor's noise from",
             ));
         };
         let quiet = super::learnt_noise(&f, &w, median, setup.gravity_m_s2).ok_or_else(|| {
             invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 format!(
                     "the log has too few quiet stretches ({} blocks of {} s still) to learn its \
                      sensor's noise from: name the part (a preset or a parameter file)",

@@ -5,12 +5,12 @@ use imu_core::fusion::EskfError;
 use imu_core::fusion::gate::Gate;
 
 use crate::error::Data;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Subject};
 
-/// The filter's refusal of reading `index` (0-based) of `what` (`GNSS`, `odometer`, …) as an
-/// error naming its row: a divergence as [`Error::Diverged`], bad input as invalid data.
-pub(crate) fn filter_refusal(what: &str, index: usize, e: EskfError) -> Error {
-    let (context, row) = (format!("{what} data"), index + 2);
+/// The filter's refusal of reading `index` (0-based) of `what` (GNSS data, odometer data, …)
+/// as an error naming its row: a divergence as [`Error::Diverged`], bad input as invalid data.
+pub(crate) fn filter_refusal(what: impl Into<Subject>, index: usize, e: EskfError) -> Error {
+    let (context, row) = (what.into(), index + 2);
     match e {
         EskfError::Diverged { .. } => Error::Diverged {
             context,
@@ -73,7 +73,7 @@ impl Acceptance {
                 Gate::Off => f64::INFINITY,
             };
             return Err(Error::Diverged {
-                context: Data::Gnss.label().into(),
+                context: Data::Gnss.into(),
                 message: format!(
                     "row {}: {MAX_REJECTED_IN_A_ROW} fixes in a row rejected by the innovation \
                      gate (the last with NIS {:.1} against {gate:.1}) after {MAX_RESETS_IN_A_ROW} \

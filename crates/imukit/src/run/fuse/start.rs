@@ -141,7 +141,7 @@ fn at_rest<E: NavEarth>(
     let used = g_t.partition_point(|&x| x <= t[i0]);
     if used == 0 {
         return Err(invalid(
-            Data::Gnss.label(),
+            Data::Gnss,
             format!(
                 "no fix in the first {duration_s} s: the static alignment takes its position \
                  from the fixes"
@@ -153,7 +153,7 @@ fn at_rest<E: NavEarth>(
         v[0].hypot(v[1]).hypot(v[2]) > STATIC_SPEED_M_S
     }) {
         return Err(invalid(
-            Data::Gnss.label(),
+            Data::Gnss,
             format!(
                 "row {}: the vehicle moves ({:.2} m/s) during the static alignment's first \
                  {duration_s} s",
@@ -267,7 +267,7 @@ fn level<E: NavEarth>(
         }
         None => {
             return Err(invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 "no fix by the end of the rest: on the WGS-84 Earth the levelled start takes \
                  its position from the fixes",
             ));
@@ -338,7 +338,7 @@ fn from_gnss<E: NavEarth>(
 fn first_fix_at_speed(inputs: &FusionInputs, latency_s: f64) -> Result<(usize, usize, f64)> {
     if inputs.velocities == FixVelocity::None {
         return Err(invalid(
-            Data::Gnss.label(),
+            Data::Gnss,
             "the fixes have no velocity (vel_* columns): the heading cannot be taken from \
              GNSS velocity (give the initial state, or --align static on the WGS-84 Earth)",
         ));
@@ -349,7 +349,7 @@ fn first_fix_at_speed(inputs: &FusionInputs, latency_s: f64) -> Result<(usize, u
         .position(|v| v[0].hypot(v[1]) >= ALIGN_MIN_SPEED_M_S)
         .ok_or_else(|| {
             invalid(
-                Data::Gnss.label(),
+                Data::Gnss,
                 format!(
                     "no fix with a horizontal speed of {ALIGN_MIN_SPEED_M_S} m/s or more: the \
                      heading cannot be taken from GNSS velocity (give the initial state \

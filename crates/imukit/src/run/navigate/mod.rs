@@ -109,13 +109,13 @@ impl EarthJob for Integrate<'_> {
         let options = strapdown_options(setup);
         let t = imu
             .column("t_s")
-            .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
-        check_increasing(&t, Data::Imu.label(), 2)?;
+            .ok_or_else(|| invalid(Data::Imu, "missing column t_s"))?;
+        check_increasing(&t, Data::Imu, 2)?;
         let (s0, origin) = nav_earth::start::<E>(initial, t.first().copied().unwrap_or(0.0))?;
         let baro = match options.vertical {
             VerticalChannel::Baro { .. } => Some(imu.column(BARO_COLUMN).ok_or_else(|| {
                 invalid(
-                    Data::Imu.label(),
+                    Data::Imu,
                     format!("the baro vertical channel needs a {BARO_COLUMN} column"),
                 )
             })?),
@@ -145,13 +145,13 @@ impl EarthJob for Integrate<'_> {
             {
                 if setup.scheme.for_input(false, corrections) != NavScheme::ConingSculling {
                     return Err(invalid(
-                        Data::Imu.label(),
+                        Data::Imu,
                         "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
                     ));
                 }
                 strapdown_increments(earth, &t, &dth, &flip(dv), baro, s0, options, &mut out)
             } else {
-                return Err(invalid(Data::Imu.label(), NEEDS_READINGS));
+                return Err(invalid(Data::Imu, NEEDS_READINGS));
             };
         result.map_err(|source| crate::Error::Strapdown {
             context: Data::Imu.label().into(),

@@ -113,7 +113,7 @@ pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
     // A CSV value takes at least 2 bytes; each becomes a number in the table, and about 30
     // numbers per row come out (the states and the table).
     let rows_at_most = usize::try_from(bytes / 14).unwrap_or(usize::MAX);
-    crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, Data::Imu.label())?;
+    crate::io::memory::check_in_memory(rows_at_most, 8 * 7 * 2 + 8 * 17 * 2, Data::Imu)?;
     crate::io::read::read_table(input)
 }
 
@@ -127,20 +127,20 @@ pub fn read_whole(input: impl Into<Input>) -> Result<Table> {
 pub fn with_baro_column(imu: &Table, baro: &Table) -> Result<Table> {
     let t = imu
         .column("t_s")
-        .ok_or_else(|| invalid(Data::Imu.label(), "missing column t_s"))?;
+        .ok_or_else(|| invalid(Data::Imu, "missing column t_s"))?;
     let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else {
-        return Err(invalid(Data::Imu.label(), "has no rows"));
+        return Err(invalid(Data::Imu, "has no rows"));
     };
     // The same rule as the fusion's aids: finite, increasing, within the IMU's span.
     let (tb, hb) =
         crate::run::fuse::aids::aid_series(baro, Data::Barometer, BARO_COLUMN, (t0, t1))?;
     if tb.is_empty() {
-        return Err(invalid(Data::Barometer.label(), "has no readings"));
+        return Err(invalid(Data::Barometer, "has no readings"));
     }
     let mut columns: Vec<&str> = imu.columns.iter().map(String::as_str).collect();
     if columns.contains(&BARO_COLUMN) {
         return Err(invalid(
-            Data::Imu.label(),
+            Data::Imu,
             format!("already has a {BARO_COLUMN} column; give the barometer once"),
         ));
     }
@@ -253,7 +253,7 @@ impl<E: EarthModel> Stepper<E> {
         let n = *seen;
         if n < NODES {
             return Err(invalid(
-                Data::Imu.label(),
+                Data::Imu,
                 format!("the rk4 scheme needs at least {NODES} samples, got {n}"),
             ));
         }
@@ -311,7 +311,7 @@ impl EarthJob for IntegrateCsv<'_> {
         } else if has_all(&DV_COLUMNS) && has_all(&DTHETA_COLUMNS) {
             (DV_COLUMNS, DTHETA_COLUMNS)
         } else {
-            return Err(invalid(Data::Imu.label(), NEEDS_READINGS));
+            return Err(invalid(Data::Imu, NEEDS_READINGS));
         };
         let mut columns = vec!["t_s"];
         columns.extend(force);
@@ -345,7 +345,7 @@ impl EarthJob for IntegrateCsv<'_> {
             },
             (NavScheme::Rk4 { .. }, false) => {
                 return Err(invalid(
-                    Data::Imu.label(),
+                    Data::Imu,
                     "the rk4 scheme needs rates (accel_*, gyro_*), not increments",
                 ));
             }

@@ -146,7 +146,7 @@ fn orient_csv_in<N: NavFrame>(
         }
         let estimate = filter
             .update(&sample)
-            .map_err(|e| invalid(Data::Imu.label(), format!("row {}: {e}", rows.last_row())))?;
+            .map_err(|e| invalid(Data::Imu, format!("row {}: {e}", rows.last_row())))?;
         if let Some(est) = estimate {
             let row = orient_row(r[0], &est.orientation, &mut last_yaw);
             match filter.status() {
@@ -266,7 +266,7 @@ fn write_smoothed<N: NavFrame>(
     };
     let inputs: Vec<FilterInput> = run.iter().map(|(_, s)| *s).collect();
     let smoothed = super::rows::smooth_inputs::<N>(*robust.params(), &inputs)
-        .map_err(|(i, e)| invalid(Data::Imu.label(), format!("sample {}: {e}", i + 1)))?;
+        .map_err(|(i, e)| invalid(Data::Imu, format!("sample {}: {e}", i + 1)))?;
     let mut last_yaw = None;
     for ((t, _), (estimate, status)) in run.iter().zip(&smoothed) {
         let row = orient_row(*t, &estimate.orientation, &mut last_yaw);
