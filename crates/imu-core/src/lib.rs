@@ -37,6 +37,7 @@ pub mod nav_frame;
 pub mod orientation;
 pub mod rotation;
 pub mod sensor;
+pub mod signal;
 pub mod stillness;
 pub mod strapdown;
 pub mod trig;

@@ -18,6 +18,7 @@ mod robust_motion;
 mod rotation;
 mod sensor;
 mod sensor_noise;
+mod signal;
 mod smoother;
 mod spherical_earth;
 mod stillness;

@@ -3,6 +3,7 @@ use crate::math;
 use crate::sensor::{
     BiasInstabilityModel, FilterBuffer, InlineBuffer, NoiseSource, ParamError, SensorParams,
 };
+use crate::signal::iir_step;
 
 /// Largest number of first-order sections of the flicker bias-instability model.
 pub const MAX_FLICKER_SECTIONS: usize = 16;
@@ -196,23 +197,6 @@ fn iir_step3<B: FilterBuffer>(
     z: &mut [FilterMemory<B>; 3],
 ) -> [f64; 3] {
     [0, 1, 2].map(|i| iir_step(b, a, x[i], z[i].iir(b.len())))
-}
-
-/// One step of `filter(b, a, ·)` in transposed direct form II (`b`, `a` of equal length,
-/// `a₀ = 1`) with memory `z` (`len − 1` values; a shorter memory shortens the filter, which
-/// [`FilterMemory::iir`] never gives).
-#[inline]
-fn iir_step(b: &[f64], a: &[f64], x: f64, z: &mut [f64]) -> f64 {
-    let n = b.len().min(a.len()).min(z.len() + 1);
-    if n == 0 {
-        return 0.0;
-    }
-    let y = b[0] * x + if n > 1 { z[0] } else { 0.0 };
-    for k in 1..n {
-        let next = if k + 1 < n { z[k] } else { 0.0 };
-        z[k - 1] = b[k] * x + next - a[k] * y;
-    }
-    y
 }
 
 /// One step of the flicker cascade (without its gain) on the inline memory: inputs in
