@@ -43,3 +43,7 @@ pub type FilterCoefficients = imu_core::sensor::FilterCoefficients<HeapBuffer>;
 pub type ImuModel<N> = imu_core::sensor::ImuModel<N, HeapBuffer>;
 /// What drifts in an IMU ([`imu_core::sensor::ImuState`]).
 pub type ImuState = imu_core::sensor::ImuState<HeapBuffer>;
+/// A signal chain whose filters are on the heap ([`HeapBuffer`]: long averages and FIR filters).
+pub type Chain = imu_core::signal::Chain<HeapBuffer>;
+/// The memory of a [`Chain`].
+pub type ChainState = imu_core::signal::ChainState<HeapBuffer>;

@@ -57,6 +57,7 @@ pub static FILES: &[ExampleFile] = shipped![
     "study/tunnel.toml",
     "study/tunnel_wheels.toml",
     "track.toml",
+    "vibration.toml",
     "walk.toml",
     "waypoints.toml",
 ];
@@ -131,6 +132,11 @@ pub static EXAMPLES: &[Example] = &[
         name: "earth_flight",
         what: "a climbing turn over the Alps on the rotating WGS-84 Earth, with the magnetic model",
         files: &["earth_flight.toml"],
+    },
+    Example {
+        name: "vibration",
+        what: "a body shaken at 1130 Hz read through a part's 8 kHz chain at 100 Hz: the alias",
+        files: &["vibration.toml"],
     },
     Example {
         name: "schuler",

@@ -171,6 +171,19 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
         )
     }
 
+    /// The ideal body-frame inputs of `truth` ([`ImuModel::measure`] applies the errors to
+    /// them): the specific force at the IMU (m/s², physical sign), the angular rate (rad/s) and
+    /// the magnetic field in body axes (µT). A signal chain filters these at its internal rate
+    /// before [`ImuModel::measure_ideal`] takes them.
+    #[must_use]
+    pub fn ideal(&self, truth: &Truth<N>) -> [Vec3<Body>; 3] {
+        [
+            self.mount.specific_force(truth),
+            truth.omega_b_rad_s,
+            self.field_in_body(&truth.attitude),
+        ]
+    }
+
     /// Readings from ideal body-frame inputs worked out elsewhere (the WGS-84 Earth model of
     /// [`crate::earth`]): the specific force at the IMU `f_b` (m/s², physical sign; the mount's
     /// sign convention is applied here), the angular rate `w_b` (rad/s), the magnetic field in

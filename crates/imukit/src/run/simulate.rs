@@ -427,8 +427,21 @@ impl Scenario {
         let mut t: Vec<f64> = Vec::new();
         let blank_report = sensors.report();
         let mut turn_rates: Vec<f64> = Vec::new();
-        let mut emit = |truth: &[Truth<N>]| -> Result<()> {
-            self.on_earth(truth, &mut sensors, &mut aids, truth_table, &mut stretch)?;
+        // With a signal chain, the samples it keeps of the motion at its internal rate.
+        let mut kept: Vec<Truth<N>> = Vec::new();
+        let mut emit = |motion: &[Truth<N>]| -> Result<()> {
+            let truth = self.on_earth(
+                motion,
+                &mut sensors,
+                &mut aids,
+                truth_table,
+                &mut stretch,
+                &mut kept,
+            )?;
+            if truth.is_empty() {
+                // A chunk of the motion shorter than the chain's decimation may keep no sample.
+                return Ok(());
+            }
             let readings = &stretch.readings;
             t.clear();
             t.extend(truth.iter().map(|s| s.t_s));
@@ -463,7 +476,8 @@ impl Scenario {
             chunk.odometer = stretch.odometer.take();
             sink(&chunk)
         };
-        let t_s = &self.t_s;
+        let motion_times = self.motion_times();
+        let t_s: &SampleTimes = &motion_times;
         let size = stream_chunk(t_s.len());
         let produce = |emit: Stage<'_, Truth<N>>| match &self.trajectory {
             Trajectory::Expression(m, o) => {

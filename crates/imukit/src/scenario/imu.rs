@@ -1,6 +1,6 @@
 //! The IMU of a scenario, resolved: mount, sensors and their seeded error model.
 
-use crate::sensor::{ImuModel, ImuState};
+use crate::sensor::{Chain, ChainState, ImuModel, ImuState};
 use imu_core::sensor::{ImuReading, SeededNormals, SensorSet};
 
 use crate::scenario::report::RunReport;
@@ -9,6 +9,7 @@ use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 use crate::error::{Error, Result};
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
+use crate::scenario::chain::ChainSetup;
 use crate::scenario::earth::TangentPlane;
 use crate::scenario::perturb::{drawn_part, perturbed};
 use crate::scenario::sensors::SensorSetup;
@@ -29,6 +30,8 @@ pub struct ImuSetup {
     pub magnetic_field_ut: Option<[f64; 3]>,
     /// Sensor errors, profile, seed, temperature (ideal by default).
     pub sensors: SensorSetup,
+    /// The signal chain (`None`: each reading is the motion at its instant).
+    pub chain: Option<ChainSetup>,
 }
 
 impl ImuSetup {
@@ -47,6 +50,7 @@ impl ImuSetup {
             accel_sign,
             magnetic_field_ut,
             sensors: SensorSetup::default(),
+            chain: None,
         }
     }
 
@@ -118,8 +122,20 @@ impl ImuSetup {
         if self.sensors.draw_parts {
             params = drawn_part(&params, seed, run)?;
         }
+        let chain = self
+            .chain
+            .as_ref()
+            .map(|c| {
+                c.chains(sample_rate_hz).map(|chains| ChainStage {
+                    chains,
+                    states: None,
+                    kept: Vec::new(),
+                })
+            })
+            .transpose()?;
         Ok(ReadingStream {
             report: RunReport::for_sensors(&params),
+            chain,
             model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
@@ -144,11 +160,23 @@ impl ImuSetup {
     }
 }
 
+/// The signal chain at work: each sensor's chain and memory, and the filtered ideal inputs of
+/// the samples kept, waiting for the error model.
+#[derive(Debug)]
+struct ChainStage {
+    chains: [Chain; 3],
+    /// Settled at the first sample's inputs when it comes.
+    states: Option<[ChainState; 3]>,
+    kept: Vec<[Vec3<imu_core::Body>; 3]>,
+}
+
 /// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
 #[derive(Debug)]
 pub struct ReadingStream<'a, N: NavFrame> {
     /// A report for these sensors (their ranges), nothing counted yet.
     report: RunReport,
+    /// The signal chain, when the IMU has one.
+    chain: Option<ChainStage>,
     model: ImuModel<N>,
     noise: SeededNormals,
     state: ImuState,
@@ -202,6 +230,43 @@ impl<N: NavFrame> ReadingStream<'_, N> {
             .collect()
     }
 
+    /// Whether the IMU has a signal chain (its motion sampled at the chain's internal rate).
+    #[must_use]
+    pub fn has_chain(&self) -> bool {
+        self.chain.is_some()
+    }
+
+    /// Runs the truth at the chain's internal rate, `internal`, through each sensor's chain
+    /// and puts the samples the chain keeps into `kept` (cleared first): those are the output
+    /// samples, whose filtered inputs [`Self::measure_into`] then takes. Without a chain every
+    /// sample is kept as it is. The chain starts settled at the first sample's inputs (as if
+    /// the part had been reading them forever).
+    pub fn decimate(&mut self, internal: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
+        kept.clear();
+        let Some(stage) = &mut self.chain else {
+            kept.extend_from_slice(internal);
+            return;
+        };
+        for s in internal {
+            let ideal = self.model.ideal(s).map(Vec3::to_array);
+            let states = stage.states.get_or_insert_with(|| {
+                [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
+            });
+            let mut filtered = [[0.0; 3]; 3];
+            let mut keep = false;
+            for k in 0..3 {
+                if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
+                    filtered[k] = y;
+                    keep = true;
+                }
+            }
+            if keep {
+                kept.push(*s);
+                stage.kept.push(filtered.map(Vec3::from_array));
+            }
+        }
+    }
+
     /// The readings of the next samples of truth.
     pub fn measure(&mut self, truth: &[Truth<N>]) -> Vec<ImuReading> {
         let mut readings = Vec::with_capacity(truth.len());
@@ -214,6 +279,25 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     pub fn measure_into(&mut self, truth: &[Truth<N>], readings: &mut Vec<ImuReading>) {
         readings.resize(truth.len(), ImuReading::default());
         let temperature = &self.setup.sensors.temperature;
+        if let Some(stage) = &mut self.chain {
+            // The inputs the chain kept for these samples ([`Self::decimate`]), in order.
+            for ((s, r), [f, w, m]) in truth
+                .iter()
+                .zip(readings.iter_mut())
+                .zip(stage.kept.drain(..))
+            {
+                *r = self.model.measure_ideal(
+                    f,
+                    w,
+                    m,
+                    s.acceleration_m_s2,
+                    &temperature.at(s.t_s),
+                    &mut self.state,
+                    &mut self.noise,
+                );
+            }
+            return;
+        }
         self.model.measure_many(
             truth,
             |s| temperature.at(s.t_s),

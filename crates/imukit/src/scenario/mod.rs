@@ -19,6 +19,7 @@
 //! ```
 pub mod aids;
 pub mod builtin;
+pub mod chain;
 pub mod earth;
 pub mod gnss;
 pub mod imu;
@@ -182,13 +183,21 @@ impl Scenario {
             IN_MEMORY_BYTES_PER_SAMPLE,
             "duration_s",
         )?;
-        let truth = self.trajectory.truth::<N>(&self.t_s.to_vec())?;
+        let motion = self.trajectory.truth::<N>(&self.motion_times().to_vec())?;
         let mut sensors =
             self.imu
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
         let mut aids = self.aids(run)?;
         let mut stretch = Stretch::default();
-        self.on_earth(&truth, &mut sensors, &mut aids, true, &mut stretch)?;
+        let mut kept = Vec::new();
+        let truth = self.on_earth(
+            &motion,
+            &mut sensors,
+            &mut aids,
+            true,
+            &mut stretch,
+            &mut kept,
+        )?;
         let Stretch {
             truth: truth_table,
             readings,
@@ -212,21 +221,47 @@ impl Scenario {
         Ok(simulation)
     }
 
+    /// The times the motion is sampled at: the sample times, or with a signal chain the
+    /// chain's internal instants from the first sample to the last ([`ReadingStream::decimate`]
+    /// keeps every `M`-th, the sample times).
+    #[must_use]
+    pub fn motion_times(&self) -> std::borrow::Cow<'_, SampleTimes> {
+        match (&self.imu.chain, &self.t_s) {
+            (Some(chain), SampleTimes::Regular { rate_hz, count }) => {
+                let m = chain.decimation(*rate_hz);
+                std::borrow::Cow::Owned(SampleTimes::Regular {
+                    rate_hz: rate_hz * m as f64,
+                    count: count.saturating_sub(1) * m + usize::from(*count > 0),
+                })
+            }
+            (_, t) => std::borrow::Cow::Borrowed(t),
+        }
+    }
+
     /// Tangent-plane (or flat) truth samples on the scenario's Earth: the truth table and the
     /// readings, the sensors' state carried on, written into `out` (on the flat Earth in the
     /// memory its truth table and readings already have: a streamed run reuses one; the truth
-    /// table left empty there unless `truth_table`).
+    /// table left empty there unless `truth_table`). `motion` is sampled at
+    /// [`Self::motion_times`]; with a signal chain the samples it keeps are put in `kept`, and
+    /// the samples written (the sample times') are returned.
     ///
     /// # Errors
     /// A sample off the Earth or beyond ±89.9° of latitude (WGS-84), with its time.
-    pub(crate) fn on_earth<N: NavFrame>(
+    pub(crate) fn on_earth<'t, N: NavFrame>(
         &self,
-        truth: &[Truth<N>],
+        motion: &'t [Truth<N>],
         sensors: &mut ReadingStream<'_, N>,
         aids: &mut Aids<'_>,
         truth_table: bool,
         out: &mut Stretch,
-    ) -> Result<()> {
+        kept: &'t mut Vec<Truth<N>>,
+    ) -> Result<&'t [Truth<N>]> {
+        let truth: &'t [Truth<N>] = if sensors.has_chain() {
+            sensors.decimate(motion, kept);
+            kept
+        } else {
+            motion
+        };
         match &self.earth {
             EarthSetup::Flat => {
                 if truth_table {
@@ -238,7 +273,7 @@ impl Scenario {
                 out.gnss = aids.gnss.as_mut().map(|r| r.measure_flat(truth));
                 out.baro = aids.baro.as_mut().map(|b| b.measure(truth, None));
                 out.odometer = aids.odometer.as_mut().map(|o| o.measure(truth, None));
-                Ok(())
+                Ok(truth)
             }
             EarthSetup::Wgs84(plane) => {
                 let earth = truth
@@ -262,7 +297,7 @@ impl Scenario {
                         .map(|b| b.measure(&local, Some(&heights))),
                     odometer: aids.odometer.as_mut().map(|o| o.measure(&local, None)),
                 };
-                Ok(())
+                Ok(truth)
             }
         }
     }

@@ -157,13 +157,19 @@ impl ScenarioSpec {
         if let EarthSetup::Wgs84(plane) = &mut earth {
             plane.magnetic = magnetic;
         }
-        let imu = imu_setup(spec, base_dir)?;
+        let mut imu = imu_setup(spec, base_dir)?;
         let (trajectory, t_s) = trajectory_of(spec, &earth, base_dir)?;
         let sample_rate_hz = match spec.rate_hz {
             Some(r) if !matches!(spec.trajectory, TrajectorySpec::Samples(_)) => r,
             _ if t_s.len() > 1 => (t_s.len() - 1) as f64 / (t_s.at(t_s.len() - 1) - t_s.at(0)),
             _ => spec.rate_hz.unwrap_or(1.0),
         };
+        imu.chain = spec
+            .imu
+            .chain
+            .as_ref()
+            .map(|c| chain_setup(c, &spec.trajectory, &t_s, &earth, sample_rate_hz))
+            .transpose()?;
         // The sensor model is checked now, at this sample rate, before any work.
         imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;
         let gnss = spec
@@ -244,7 +250,49 @@ fn imu_setup(spec: &ScenarioSpec, base_dir: &Path) -> Result<ImuSetup> {
             .map(|m| finite_vec("imu.magnetic_field_ut", m))
             .transpose()?,
         sensors,
+        // Checked once the scenario's rate is known.
+        chain: None,
     })
+}
+
+/// The signal chain of `[imu.chain]`: regular sample times at the scenario's rate on the flat
+/// Earth, the internal rate a whole multiple of it, every filter checked.
+fn chain_setup(
+    spec: &crate::scenario::chain::ChainSpec,
+    spec_trajectory: &TrajectorySpec,
+    t_s: &SampleTimes,
+    earth: &EarthSetup,
+    sample_rate_hz: f64,
+) -> Result<crate::scenario::chain::ChainSetup> {
+    if !matches!(t_s, SampleTimes::Regular { .. })
+        || matches!(spec_trajectory, TrajectorySpec::Samples(_))
+    {
+        return Err(invalid(
+            "imu.chain",
+            "the signal chain samples the motion at its internal rate: it needs the regular \
+             sample times of rate_hz, not a trajectory's own times",
+        ));
+    }
+    if matches!(earth, EarthSetup::Wgs84(_)) {
+        return Err(invalid(
+            "imu.chain",
+            "the signal chain is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 \
+             Earth it is not yet",
+        ));
+    }
+    // The motion is sampled at the internal rate: as many samples as a scenario may have.
+    let motion_samples =
+        t_s.len().saturating_sub(1) as f64 * spec.internal_rate_hz / sample_rate_hz;
+    if motion_samples > 1e9 {
+        return Err(invalid(
+            "imu.chain.internal_rate_hz",
+            format!(
+                "the motion sampled at this rate from the first sample to the last would be \
+                 {motion_samples:.2e} samples, more than 10⁹"
+            ),
+        ));
+    }
+    crate::scenario::chain::ChainSetup::resolve(spec, sample_rate_hz)
 }
 
 /// A key a trajectory type needs.

@@ -490,6 +490,9 @@ pub struct ImuSpec {
     pub magnetometer: Option<SensorTable>,
     /// Monte Carlo perturbations of parameters, drawn per run.
     pub perturbations: Option<Vec<PerturbationSpec>>,
+    /// The signal chain: internal rate, each sensor's digital low-pass, decimation to the
+    /// scenario's rate (default none: each reading is the motion at its instant).
+    pub chain: Option<crate::scenario::chain::ChainSpec>,
 }
 
 impl ImuSpec {
@@ -520,6 +523,7 @@ impl ImuSpec {
                 .magnetometer
                 .clone()
                 .or_else(|| other.magnetometer.clone()),
+            chain: self.chain.clone().or_else(|| other.chain.clone()),
             perturbations: self
                 .perturbations
                 .clone()

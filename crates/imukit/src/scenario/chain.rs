@@ -1,0 +1,148 @@
+//! The IMU's signal chain as a scenario gives it (`[imu.chain]`): the part samples at an
+//! internal rate, low-pass filters each sensor's signal digitally and keeps every `M`-th sample
+//! (the scenario's rate); the error model then applies at the output rate, as before. See
+//! [`imu_core::signal`] and docs/models.md.
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result, invalid};
+use crate::sensor::Chain;
+use imu_core::signal::LowPass;
+
+/// A sensor's digital low-pass, as a data sheet describes it (`filter = "…"` and its keys).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "filter", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LowPassSpec {
+    /// No filter: decimation alone.
+    None,
+    /// Butterworth of `order` (1–8) with its −3 dB point at `cutoff_hz`.
+    Butterworth {
+        /// Order.
+        order: usize,
+        /// −3 dB frequency, Hz.
+        cutoff_hz: f64,
+    },
+    /// The mean of the last `taps` internal samples.
+    MovingAverage {
+        /// Samples averaged.
+        taps: usize,
+    },
+    /// Two moving averages of `taps` in a row (a triangular window).
+    Bartlett {
+        /// Samples of each average.
+        taps: usize,
+    },
+    /// A finite impulse response, `h₀` first.
+    Fir {
+        /// The impulse response.
+        coefficients: Vec<f64>,
+    },
+    /// `b(z⁻¹)/a(z⁻¹)`.
+    Rational {
+        /// `b₀ … b_m`.
+        numerator: Vec<f64>,
+        /// `a₀ … a_n`.
+        denominator: Vec<f64>,
+    },
+}
+
+impl LowPassSpec {
+    /// The core's description of this filter.
+    #[must_use]
+    pub fn low_pass(&self) -> LowPass<'_> {
+        match self {
+            Self::None => LowPass::None,
+            Self::Butterworth { order, cutoff_hz } => LowPass::Butterworth {
+                order: *order,
+                cutoff_hz: *cutoff_hz,
+            },
+            Self::MovingAverage { taps } => LowPass::MovingAverage { taps: *taps },
+            Self::Bartlett { taps } => LowPass::Bartlett { taps: *taps },
+            Self::Fir { coefficients } => LowPass::Fir { coefficients },
+            Self::Rational {
+                numerator,
+                denominator,
+            } => LowPass::Rational {
+                numerator,
+                denominator,
+            },
+        }
+    }
+}
+
+/// The `[imu.chain]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChainSpec {
+    /// The rate the part samples at inside, Hz: a whole multiple of the scenario's rate.
+    pub internal_rate_hz: f64,
+    /// The accelerometer's low-pass (default none).
+    pub accelerometer: Option<LowPassSpec>,
+    /// The gyroscope's low-pass (default none).
+    pub gyroscope: Option<LowPassSpec>,
+    /// The magnetometer's low-pass (default none).
+    pub magnetometer: Option<LowPassSpec>,
+}
+
+/// The sensors in the order the chain keeps them, with their keys.
+const SENSORS: [&str; 3] = ["accelerometer", "gyroscope", "magnetometer"];
+
+/// A resolved signal chain: the internal rate and each sensor's filter, checked at the
+/// scenario's rate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChainSetup {
+    /// The internal rate, Hz.
+    pub internal_rate_hz: f64,
+    /// The accelerometer's, gyroscope's and magnetometer's low-pass.
+    pub low_pass: [LowPassSpec; 3],
+}
+
+impl ChainSetup {
+    /// The chain of `spec` for output at `rate_hz`, every filter checked.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] on the key (`imu.chain.internal_rate_hz`, `imu.chain.gyroscope`, …)
+    /// whose value the chain cannot take.
+    pub fn resolve(spec: &ChainSpec, rate_hz: f64) -> Result<Self> {
+        let low_pass = [&spec.accelerometer, &spec.gyroscope, &spec.magnetometer]
+            .map(|f| f.clone().unwrap_or(LowPassSpec::None));
+        let setup = Self {
+            internal_rate_hz: spec.internal_rate_hz,
+            low_pass,
+        };
+        setup.chains(rate_hz)?;
+        Ok(setup)
+    }
+
+    /// Each sensor's chain for output at `rate_hz`.
+    ///
+    /// # Errors
+    /// As [`ChainSetup::resolve`].
+    pub fn chains(&self, rate_hz: f64) -> Result<[Chain; 3]> {
+        let make = |k: usize| {
+            Chain::new(self.internal_rate_hz, rate_hz, &self.low_pass[k].low_pass())
+                .map_err(|e| chain_error(SENSORS[k], &e))
+        };
+        Ok([make(0)?, make(1)?, make(2)?])
+    }
+
+    /// Internal samples per output sample.
+    #[must_use]
+    pub fn decimation(&self, rate_hz: f64) -> usize {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let m = (self.internal_rate_hz / rate_hz).round() as usize;
+        m.max(1)
+    }
+}
+
+/// The core's refusal of a sensor's chain, on the key it came from.
+fn chain_error(sensor: &str, e: &imu_core::signal::SignalError) -> Error {
+    use imu_core::signal::SignalError as S;
+    let field = match e {
+        S::NotPositive { field, .. } if field.ends_with("rate_hz") => {
+            "imu.chain.internal_rate_hz".to_string()
+        }
+        S::NotWholeMultiple { .. } => "imu.chain.internal_rate_hz".to_string(),
+        _ => format!("imu.chain.{sensor}"),
+    };
+    invalid(field, e.to_string())
+}

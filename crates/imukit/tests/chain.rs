@@ -1,0 +1,171 @@
+//! A scenario's signal chain (`[imu.chain]`) end to end: a body shaking faster than the
+//! output's Nyquist frequency reads, at the output rate, the alias the chain's response gives;
+//! a rate below it passes with the response's gain and phase; the truth is the same rows with
+//! or without a chain; a run is the same streamed on one thread or two and whole; and the
+//! chains the scenario cannot have are refused by key.
+use core::f64::consts::PI;
+
+use imukit::run::pipeline::RunThreads;
+use imukit::scenario::chain::{ChainSetup, ChainSpec};
+use imukit::{Scenario, ScenarioSpec};
+
+/// A body yawing as `ω_z = W·sin(2πft)` (yaw `W/(2πf)·(1 − cos 2πft)`), 100 Hz for `seconds`,
+/// ideal sensors, with the `chain` table given.
+fn shaking(f: f64, seconds: f64, chain: &str) -> Scenario {
+    let text = format!(
+        "rate_hz = 100\nduration_s = {seconds}\n\
+         [trajectory]\ntype = \"expression\"\nconstants = {{ f = {f}, w = 0.5 }}\n\
+         position_m = [0, 0, 0]\nyaw_rad = \"w/(2*pi*f)*(1 - cos(2*pi*f*t))\"\n\
+         [imu]\nkind = \"accel-gyro\"\n{chain}"
+    );
+    ScenarioSpec::from_toml(&text, "shaking")
+        .unwrap()
+        .resolve(std::path::Path::new("."))
+        .unwrap()
+}
+
+const CHAIN: &str = "[imu.chain]\ninternal_rate_hz = 8000\n\
+                     gyroscope = { filter = \"butterworth\", order = 2, cutoff_hz = 200 }\n";
+
+/// Least-squares amplitude and phase of `y ≈ A·sin(2πft + φ)` at the times `t`.
+fn sine_fit(t: &[f64], y: &[f64], f: f64) -> (f64, f64) {
+    let (mut ss, mut sc, mut cc, mut ys, mut yc) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (&ti, &yi) in t.iter().zip(y) {
+        let (s, c) = (2.0 * PI * f * ti).sin_cos();
+        ss += s * s;
+        sc += s * c;
+        cc += c * c;
+        ys += yi * s;
+        yc += yi * c;
+    }
+    let det = ss * cc - sc * sc;
+    let (a, b) = ((ys * cc - yc * sc) / det, (yc * ss - ys * sc) / det);
+    (a.hypot(b), b.atan2(a))
+}
+
+/// The gyroscope's chain of [`CHAIN`] at 100 Hz.
+fn gyro_chain() -> imukit::sensor::Chain {
+    let spec: ChainSpec = toml::from_str(CHAIN.trim_start_matches("[imu.chain]\n")).unwrap();
+    let [_, gyro, _] = ChainSetup::resolve(&spec, 100.0)
+        .unwrap()
+        .chains(100.0)
+        .unwrap();
+    gyro
+}
+
+#[test]
+fn a_rate_above_the_output_nyquist_is_read_at_its_alias_with_the_chains_gain_and_phase() {
+    let chain = gyro_chain();
+    for f in [1130.0, 12.0] {
+        let sim = shaking(f, 4.0, CHAIN).simulate().unwrap();
+        let t = sim.imu.column("t_s").unwrap();
+        let gz = sim.imu.column("gyro_z_rad_s").unwrap();
+        assert_eq!(
+            t.len(),
+            401,
+            "the output rate's samples, not the internal rate's"
+        );
+        // Past the filter's start-up (its poles' time constant is about 1 ms).
+        let keep = t.iter().position(|&ti| ti >= 0.5).unwrap();
+        let (amplitude, phase) = sine_fit(&t[keep..], &gz[keep..], f);
+        let h = chain.response(f);
+        assert!(
+            (amplitude / (0.5 * h.gain) - 1.0).abs() < 1e-3,
+            "{f} Hz: {amplitude} vs {}",
+            0.5 * h.gain
+        );
+        assert!(
+            (phase - h.phase_rad).abs() < 1e-3,
+            "{f} Hz: {phase} vs {}",
+            h.phase_rad
+        );
+        if f > 50.0 {
+            // What a user sees: a 30 Hz wobble of 3 % of the motion's amplitude.
+            assert_eq!(chain.alias_hz(f), 30.0);
+            let (at_alias, _) = sine_fit(&t[keep..], &gz[keep..], 30.0);
+            assert!((at_alias / amplitude - 1.0).abs() < 1e-6);
+            assert!(h.gain < 0.04);
+        }
+    }
+    // Without a chain the same motion is read at its instants: samples of the 1130 Hz sine at
+    // 100 Hz, at full amplitude.
+    let plain = shaking(1130.0, 4.0, "").simulate().unwrap();
+    let (t, gz) = (
+        plain.imu.column("t_s").unwrap(),
+        plain.imu.column("gyro_z_rad_s").unwrap(),
+    );
+    let (amplitude, _) = sine_fit(&t, &gz, 1130.0);
+    assert!((amplitude / 0.5 - 1.0).abs() < 1e-9, "{amplitude}");
+}
+
+#[test]
+fn the_truth_is_the_same_with_a_chain_and_a_run_streamed_or_whole_is_the_same() {
+    let with = shaking(1130.0, 12.0, CHAIN);
+    let without = shaking(1130.0, 12.0, "");
+    let whole = with.simulate().unwrap();
+    assert!(
+        whole.truth == without.simulate().unwrap().truth,
+        "truth rows differ"
+    );
+    for threads in [RunThreads::One, RunThreads::Two] {
+        let gathered = with.simulate_streamed(None, threads).unwrap();
+        assert!(
+            gathered == whole,
+            "{threads:?}: streamed differs from whole"
+        );
+    }
+}
+
+#[test]
+fn a_chain_the_scenario_cannot_have_is_refused_by_its_key() {
+    let refused = |chain: &str, earth: &str| {
+        let text = format!(
+            "rate_hz = 100\nduration_s = 1\n{earth}\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n\
+             [imu]\n{chain}"
+        );
+        match ScenarioSpec::from_toml(&text, "s").and_then(|s| s.resolve(std::path::Path::new(".")))
+        {
+            Ok(_) => panic!("{chain} accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let e = refused("[imu.chain]\ninternal_rate_hz = 1e300\n", "");
+    assert!(
+        e.starts_with("imu.chain.internal_rate_hz: the motion sampled at this rate")
+            && e.contains("1.00e300 samples"),
+        "{e}"
+    );
+    let e = refused("[imu.chain]\ninternal_rate_hz = 1050\n", "");
+    assert!(
+        e.starts_with(
+            "imu.chain.internal_rate_hz: the internal rate 1050 Hz is not a whole multiple"
+        ),
+        "{e}"
+    );
+    let e = refused(
+        "[imu.chain]\ninternal_rate_hz = 1000\naccelerometer = { filter = \"butterworth\", order = 2, cutoff_hz = 600 }\n",
+        "",
+    );
+    assert!(
+        e.starts_with("imu.chain.accelerometer: cutoff_hz 600 must lie below"),
+        "{e}"
+    );
+    let e = refused(
+        "[imu.chain]\ninternal_rate_hz = 1000\ngyroscope = { filter = \"butterworth\", order = 2 }\n",
+        "",
+    );
+    assert!(e.contains("cutoff_hz"), "{e}");
+    let e = refused(
+        "[imu.chain]\ninternal_rate_hz = 1000\ngyroscope = { filter = \"boxcar\", taps = 3 }\n",
+        "",
+    );
+    assert!(e.contains("boxcar"), "{e}");
+    let e = refused(
+        "[imu.chain]\ninternal_rate_hz = 1000\n",
+        "earth = \"wgs84\"\norigin = [45, 7, 100]",
+    );
+    assert!(
+        e.starts_with("imu.chain: the signal chain is simulated on the flat Earth"),
+        "{e}"
+    );
+}
