@@ -261,7 +261,9 @@ fn truth_from_expressions<'py>(
         latitude_rad: None,
         longitude_rad: None,
         height_m: None,
-        attitude,
+        attitude: attitude
+            .map(|a| choice::<imukit::scenario::spec::AttitudeMode>("attitude", &a))
+            .transpose()?,
         yaw_rad: yaw_rad.map(Formula::Text),
         pitch_rad: pitch_rad.map(Formula::Text),
         roll_rad: roll_rad.map(Formula::Text),

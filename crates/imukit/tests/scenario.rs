@@ -217,6 +217,16 @@ fn errors_in_a_scenario_name_its_key_and_column() {
         dir,
     ));
     assert!(e.contains("rate_hz: missing"), "{e}");
+    // An attitude mode is one of two names, refused at its line with both.
+    let e = err_text(run_toml(
+        "rate_hz = 10.0\n[trajectory]\ntype = \"expression\"\nposition_m = [\"t\", 0, 0]\nattitude = \"along\"\n",
+        dir,
+    ));
+    assert!(
+        e.contains("line 5")
+            && e.contains("unknown variant `along`, expected `tangent` or `level`"),
+        "{e}"
+    );
 }
 
 #[test]

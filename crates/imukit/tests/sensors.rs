@@ -523,7 +523,10 @@ fn bad_perturbations_are_refused() {
         &p("parameter = \"gyroscope.constant_bias_rad_s\"\ndistribution = \"cauchy\"\n"),
         dir,
     );
-    assert!(e.contains("unknown distribution \"cauchy\""), "{e}");
+    assert!(
+        e.contains("line 11") && e.contains("unknown variant `cauchy`, expected one of `normal`"),
+        "{e}"
+    );
     let e = err(
         &p("parameter = \"gyroscope.constant_bias_rad_s\"\ndistribution = \"normal\"\nmean = 0\n"),
         dir,

@@ -15,6 +15,7 @@ use std::f64::consts::FRAC_PI_2;
 use crate::error::{Result, invalid};
 use crate::io::conventions::NavFrameName;
 use crate::motion::track::Segment;
+use crate::scenario::spec::AttitudeMode;
 use crate::scenario::{ExpressionSpec, Formula, ImuSpec, ScenarioSpec, TrackSpec, TrajectorySpec};
 
 /// Names of the built-in scenarios.
@@ -33,7 +34,7 @@ pub const DEMO: &str = "figure8";
 
 fn expression(
     position: [&str; 3],
-    attitude: Option<&str>,
+    attitude: Option<AttitudeMode>,
     angles: Option<[&str; 3]>,
 ) -> TrajectorySpec {
     let mut constants = BTreeMap::new();
@@ -44,7 +45,7 @@ fn expression(
         latitude_rad: None,
         longitude_rad: None,
         height_m: None,
-        attitude: attitude.map(str::to_string),
+        attitude,
         yaw_rad: angles.map(|a| a[0].into()),
         pitch_rad: angles.map(|a| a[1].into()),
         roll_rad: angles.map(|a| a[2].into()),
@@ -68,7 +69,7 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
                         "0.8*sin(2*pi*f*t)*cos(2*pi*f*t)",
                         "0.3*cos(2*pi*3*f*t)",
                     ],
-                    Some("tangent"),
+                    Some(AttitudeMode::Tangent),
                     None,
                 ),
             );
@@ -96,7 +97,7 @@ pub fn spec(name: &str) -> Result<ScenarioSpec> {
         "static" => base(
             100.0,
             Some(10.0),
-            expression(["0", "0", "0"], Some("level"), None),
+            expression(["0", "0", "0"], Some(AttitudeMode::Level), None),
         ),
         "platform-turn" => {
             let mut s = base(

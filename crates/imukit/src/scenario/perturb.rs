@@ -28,7 +28,7 @@ pub struct PerturbationSpec {
     /// `sensor.key`, e.g. `gyroscope.constant_bias_rad_s` (imukit's keys).
     pub parameter: String,
     /// `normal`, `truncated-normal`, `uniform` or `selection`.
-    pub distribution: String,
+    pub distribution: DistributionName,
     /// Mean (normal, truncated normal).
     pub mean: Option<f64>,
     /// Standard deviation (normal, truncated normal).
@@ -41,6 +41,20 @@ pub struct PerturbationSpec {
     pub values: Option<Vec<f64>>,
     /// Their probabilities (selection; equal when left out).
     pub probabilities: Option<Vec<f64>>,
+}
+
+/// A distribution as a scenario names it; its parameters are the perturbation's other keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DistributionName {
+    /// `mean`, `std`.
+    Normal,
+    /// `mean`, `std`, `lower`, `upper`.
+    TruncatedNormal,
+    /// `lower`, `upper`.
+    Uniform,
+    /// `values` (and `probabilities`).
+    Selection,
 }
 
 /// A distribution to draw a parameter from.
@@ -239,22 +253,22 @@ fn target_of(parameter: &str, at: &str) -> Result<(Sensor, Field)> {
 /// The distribution `spec` describes, its parameters checked; `at` locates it in messages.
 fn distribution_of(spec: &PerturbationSpec, at: &str) -> Result<Distribution> {
     let f = |name: &str| format!("{at}.{name}");
-    let distribution = match spec.distribution.as_str() {
-        "normal" => Distribution::Normal {
+    let distribution = match spec.distribution {
+        DistributionName::Normal => Distribution::Normal {
             mean: need(spec.mean, &f("mean"), "mean")?,
             std: need(spec.std, &f("std"), "std")?,
         },
-        "truncated-normal" => Distribution::TruncatedNormal {
+        DistributionName::TruncatedNormal => Distribution::TruncatedNormal {
             mean: need(spec.mean, &f("mean"), "mean")?,
             std: need(spec.std, &f("std"), "std")?,
             lower: need(spec.lower, &f("lower"), "lower")?,
             upper: need(spec.upper, &f("upper"), "upper")?,
         },
-        "uniform" => Distribution::Uniform {
+        DistributionName::Uniform => Distribution::Uniform {
             lower: need(spec.lower, &f("lower"), "lower")?,
             upper: need(spec.upper, &f("upper"), "upper")?,
         },
-        "selection" => {
+        DistributionName::Selection => {
             let values = spec
                 .values
                 .clone()
@@ -285,14 +299,6 @@ fn distribution_of(spec: &PerturbationSpec, at: &str) -> Result<Distribution> {
                 values,
                 cumulative: cumulative.collect(),
             }
-        }
-        other => {
-            return Err(invalid(
-                f("distribution"),
-                format!(
-                    "unknown distribution \"{other}\" (normal, truncated-normal, uniform, selection)"
-                ),
-            ));
         }
     };
     match distribution {

@@ -400,15 +400,14 @@ fn sampled_trajectory(
     earth: &EarthSetup,
     base_dir: &Path,
 ) -> Result<(Trajectory, SampleTimes)> {
-    let tangent = match s.attitude.as_deref() {
+    let tangent = match s.attitude {
         None => false,
-        Some("tangent") => true,
-        Some(other) => {
+        Some(crate::scenario::spec::AttitudeMode::Tangent) => true,
+        Some(crate::scenario::spec::AttitudeMode::Level) => {
             return Err(invalid(
                 "trajectory.attitude",
-                format!(
-                    "unknown attitude \"{other}\" for samples (use \"tangent\" or leave it out)"
-                ),
+                "\"level\" is not for samples: they give their attitude in their columns, or \
+                 \"tangent\" aligns it with the velocity",
             ));
         }
     };

@@ -366,7 +366,7 @@ pub struct ExpressionSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height_m: Option<Formula>,
     /// `"tangent"` or `"level"`; leave out when giving angles.
-    pub attitude: Option<String>,
+    pub attitude: Option<AttitudeMode>,
     /// Yaw formula, rad.
     pub yaw_rad: Option<Formula>,
     /// Pitch formula, rad.
@@ -375,6 +375,23 @@ pub struct ExpressionSpec {
     pub roll_rad: Option<Formula>,
     /// Standstill threshold of the tangent attitude, m/s.
     pub min_speed_m_s: Option<f64>,
+}
+
+/// How a trajectory's attitude follows its path when no angles are given.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AttitudeMode {
+    /// Nose along the velocity, no roll (yaw and pitch from the velocity).
+    Tangent,
+    /// Level, heading zero (an expression's default without angles).
+    #[default]
+    Level,
+}
+
+impl crate::choice::Choice for AttitudeMode {
+    const WHAT: &'static str = "attitude";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("tangent", Self::Tangent), ("level", Self::Level)];
 }
 
 /// `type = "samples"`.
@@ -387,7 +404,7 @@ pub struct SamplesSpec {
     /// Finite-difference order: 2 (MATLAB gradient), 4, 6 (default) or 8.
     pub order: Option<usize>,
     /// `"tangent"` to ignore attitude columns and align with the velocity.
-    pub attitude: Option<String>,
+    pub attitude: Option<AttitudeMode>,
     /// Standstill threshold of the tangent attitude, m/s.
     pub min_speed_m_s: Option<f64>,
 }
@@ -582,23 +599,15 @@ impl ExpressionSpec {
         };
         let angles = [&spec.yaw_rad, &spec.pitch_rad, &spec.roll_rad];
         let has_angles = angles.iter().any(|a| a.is_some());
-        let attitude = match (spec.attitude.as_deref(), has_angles) {
+        let attitude = match (spec.attitude, has_angles) {
             (Some(_), true) => {
                 return Err(invalid(
                     "trajectory.attitude",
                     "give either attitude = \"tangent\"/\"level\" or yaw_rad/pitch_rad/roll_rad, not both",
                 ));
             }
-            (Some("tangent"), false) => ExpressionAttitude::Tangent,
-            (Some("level") | None, false) => ExpressionAttitude::Level,
-            (Some(other), false) => {
-                return Err(invalid(
-                    "trajectory.attitude",
-                    format!(
-                        "unknown attitude \"{other}\" (use \"tangent\" or \"level\", or give angles)"
-                    ),
-                ));
-            }
+            (Some(AttitudeMode::Tangent), false) => ExpressionAttitude::Tangent,
+            (Some(AttitudeMode::Level) | None, false) => ExpressionAttitude::Level,
             (None, true) => {
                 let zero = Formula::Number(0.0);
                 let names = [
