@@ -5,7 +5,11 @@
 //! `imukit.simulate` returns them. Samples per second, on one thread; `two_threads` adds the
 //! truth a chunk ahead on a second one (what a single run does when a second core is free).
 //!
-//! Run: `cargo bench -p imu-benches --bench pipeline`.
+//! `chain` times the same job's readings with a signal chain (`[imu.chain]`: the motion at 20×
+//! the output rate, a second-order low-pass on each sensor, every 20th sample kept) beside the
+//! plain job, per output sample.
+//!
+//! Run: `cargo bench -p imu-benches --bench pipeline` (`-- chain` for the chain alone).
 #![allow(missing_docs)]
 
 use std::path::Path;
@@ -18,7 +22,13 @@ use imukit::{Scenario, ScenarioSpec};
 const JOB: &str = include_str!("../formula_job.toml");
 
 fn job(samples: usize) -> Scenario {
-    let mut spec = ScenarioSpec::from_toml(JOB, "formula_job.toml").expect("the job parses");
+    job_with(samples, "")
+}
+
+/// The job with `extra` TOML after it (a table of its own).
+fn job_with(samples: usize, extra: &str) -> Scenario {
+    let text = format!("{JOB}\n{extra}");
+    let mut spec = ScenarioSpec::from_toml(&text, "formula_job.toml").expect("the job parses");
     let rate = spec.rate_hz.expect("the job has a rate");
     spec.duration_s = Some((samples - 1) as f64 / rate);
     spec.resolve(Path::new(".")).expect("the job resolves")
@@ -78,5 +88,28 @@ fn bench_pipeline(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-criterion_group!(benches, bench_pipeline);
+/// The job's readings with and without a chain at 20× its rate, per output sample.
+fn bench_chain(c: &mut Criterion) {
+    let mut group = c.benchmark_group("chain");
+    group.sample_size(10);
+    let n = 50_000;
+    group.throughput(Throughput::Elements(n as u64));
+    let chain = "[imu.chain]\ninternal_rate_hz = 2000\n\
+                 accelerometer = { filter = \"butterworth\", order = 2, cutoff_hz = 40 }\n\
+                 gyroscope = { filter = \"butterworth\", order = 2, cutoff_hz = 40 }\n\
+                 magnetometer = { filter = \"butterworth\", order = 2, cutoff_hz = 40 }\n";
+    for (name, sc) in [("plain", job(n)), ("internal_20x", job_with(n, chain))] {
+        let columns = sc.gathered_shape().expect("a shape").imu_columns.len();
+        let mut readings = vec![0.0; n * columns];
+        group.bench_function(BenchmarkId::new("into_array", name), |b| {
+            b.iter(|| {
+                sc.simulate_streamed_into(None, RunThreads::One, None, &mut readings)
+                    .expect("simulated")
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_pipeline, bench_chain);
 criterion_main!(benches);
