@@ -135,7 +135,7 @@ pub static EXAMPLES: &[Example] = &[
     },
     Example {
         name: "vibration",
-        what: "a body shaken at 1130 Hz read through a part's 8 kHz chain at 100 Hz: the alias",
+        what: "a motor's 1130 Hz vibration read through a part's 8 kHz chain at 100 Hz: the alias",
         files: &["vibration.toml"],
     },
     Example {

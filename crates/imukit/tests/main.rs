@@ -23,4 +23,5 @@ mod scenario;
 mod sensors;
 mod stream;
 mod study;
+mod vibration;
 mod waypoints;

@@ -13,6 +13,7 @@ use crate::scenario::chain::ChainSetup;
 use crate::scenario::earth::TangentPlane;
 use crate::scenario::perturb::{drawn_part, perturbed};
 use crate::scenario::sensors::SensorSetup;
+use crate::scenario::vibration::{VibrationSource, VibrationSpec};
 use imu_core::earth::EarthTruth;
 
 /// The IMU of a scenario, resolved.
@@ -32,6 +33,8 @@ pub struct ImuSetup {
     pub sensors: SensorSetup,
     /// The signal chain (`None`: each reading is the motion at its instant).
     pub chain: Option<ChainSetup>,
+    /// The mount's vibration, checked (`None`: none).
+    pub vibration: Option<VibrationSpec>,
 }
 
 impl ImuSetup {
@@ -51,6 +54,7 @@ impl ImuSetup {
             magnetic_field_ut,
             sensors: SensorSetup::default(),
             chain: None,
+            vibration: None,
         }
     }
 
@@ -133,9 +137,18 @@ impl ImuSetup {
                 })
             })
             .transpose()?;
+        let motion_rate_hz = self
+            .chain
+            .as_ref()
+            .map_or(sample_rate_hz, |c| c.internal_rate_hz);
+        let vibration = self
+            .vibration
+            .as_ref()
+            .map(|v| v.source(motion_rate_hz, seed, run));
         Ok(ReadingStream {
             report: RunReport::for_sensors(&params),
             chain,
+            vibration,
             model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
@@ -177,6 +190,8 @@ pub struct ReadingStream<'a, N: NavFrame> {
     report: RunReport,
     /// The signal chain, when the IMU has one.
     chain: Option<ChainStage>,
+    /// The mount's vibration, when it has one.
+    vibration: Option<VibrationSource>,
     model: ImuModel<N>,
     noise: SeededNormals,
     state: ImuState,
@@ -236,6 +251,20 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         self.chain.is_some()
     }
 
+    /// The ideal inputs of `s` (specific force, rate, field; body axes) with the mount's
+    /// vibration at its instant added.
+    fn ideal(&mut self, s: &Truth<N>) -> [[f64; 3]; 3] {
+        let [mut f, mut w, m] = self.model.ideal(s).map(Vec3::to_array);
+        if let Some(v) = &mut self.vibration {
+            let (force, rate) = v.at(s.t_s);
+            for k in 0..3 {
+                f[k] += force[k];
+                w[k] += rate[k];
+            }
+        }
+        [f, w, m]
+    }
+
     /// Runs the truth at the chain's internal rate, `internal`, through each sensor's chain
     /// and puts the samples the chain keeps into `kept` (cleared first): those are the output
     /// samples, whose filtered inputs [`Self::measure_into`] then takes. Without a chain every
@@ -243,12 +272,15 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     /// the part had been reading them forever).
     pub fn decimate(&mut self, internal: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
         kept.clear();
-        let Some(stage) = &mut self.chain else {
+        if self.chain.is_none() {
             kept.extend_from_slice(internal);
             return;
-        };
+        }
         for s in internal {
-            let ideal = self.model.ideal(s).map(Vec3::to_array);
+            let ideal = self.ideal(s);
+            let Some(stage) = &mut self.chain else {
+                return;
+            };
             let states = stage.states.get_or_insert_with(|| {
                 [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
             });
@@ -292,6 +324,21 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                     m,
                     s.acceleration_m_s2,
                     &temperature.at(s.t_s),
+                    &mut self.state,
+                    &mut self.noise,
+                );
+            }
+            return;
+        }
+        if self.vibration.is_some() {
+            for (s, r) in truth.iter().zip(readings.iter_mut()) {
+                let [f, w, m] = self.ideal(s).map(Vec3::from_array);
+                *r = self.model.measure_ideal(
+                    f,
+                    w,
+                    m,
+                    s.acceleration_m_s2,
+                    &self.setup.sensors.temperature.at(s.t_s),
                     &mut self.state,
                     &mut self.noise,
                 );

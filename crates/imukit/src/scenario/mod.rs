@@ -29,6 +29,7 @@ pub mod resolve;
 pub mod sensors;
 pub mod spec;
 pub mod times;
+pub mod vibration;
 
 pub use earth::{EarthSetup, TangentPlane};
 pub use imu::{ImuSetup, ReadingStream};

@@ -170,6 +170,12 @@ impl ScenarioSpec {
             .as_ref()
             .map(|c| chain_setup(c, &spec.trajectory, &t_s, &earth, sample_rate_hz))
             .transpose()?;
+        imu.vibration = spec
+            .imu
+            .vibration
+            .as_ref()
+            .map(|v| vibration_setup(v, &imu, &t_s, &earth, sample_rate_hz))
+            .transpose()?;
         // The sensor model is checked now, at this sample rate, before any work.
         imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;
         let gnss = spec
@@ -252,6 +258,7 @@ fn imu_setup(spec: &ScenarioSpec, base_dir: &Path) -> Result<ImuSetup> {
         sensors,
         // Checked once the scenario's rate is known.
         chain: None,
+        vibration: None,
     })
 }
 
@@ -293,6 +300,38 @@ fn chain_setup(
         ));
     }
     crate::scenario::chain::ChainSetup::resolve(spec, sample_rate_hz)
+}
+
+/// The mount's vibration of `[imu.vibration]`, checked at the rate the motion is sampled at
+/// (the chain's internal rate, else the scenario's): on the flat Earth; random vibration needs
+/// the regular sample times of `rate_hz`.
+fn vibration_setup(
+    spec: &crate::scenario::vibration::VibrationSpec,
+    imu: &ImuSetup,
+    t_s: &SampleTimes,
+    earth: &EarthSetup,
+    sample_rate_hz: f64,
+) -> Result<crate::scenario::vibration::VibrationSpec> {
+    if matches!(earth, EarthSetup::Wgs84(_)) {
+        return Err(invalid(
+            "imu.vibration",
+            "vibration is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 Earth it \
+             is not yet",
+        ));
+    }
+    if !spec.random.is_empty() && !matches!(t_s, SampleTimes::Regular { .. }) {
+        return Err(invalid(
+            "imu.vibration.random",
+            "random vibration is made at a regular rate: it needs the regular sample times of \
+             rate_hz, not a trajectory's own times",
+        ));
+    }
+    let motion_rate_hz = imu
+        .chain
+        .as_ref()
+        .map_or(sample_rate_hz, |c| c.internal_rate_hz);
+    spec.check(motion_rate_hz)?;
+    Ok(spec.clone())
 }
 
 /// A key a trajectory type needs.

@@ -510,6 +510,9 @@ pub struct ImuSpec {
     /// The signal chain: internal rate, each sensor's digital low-pass, decimation to the
     /// scenario's rate (default none: each reading is the motion at its instant).
     pub chain: Option<crate::scenario::chain::ChainSpec>,
+    /// Vibration of the mount: sines and random vibration per body axis, added to the ideal
+    /// inputs at the motion's instants (default none).
+    pub vibration: Option<crate::scenario::vibration::VibrationSpec>,
 }
 
 impl ImuSpec {
@@ -541,6 +544,7 @@ impl ImuSpec {
                 .clone()
                 .or_else(|| other.magnetometer.clone()),
             chain: self.chain.clone().or_else(|| other.chain.clone()),
+            vibration: self.vibration.clone().or_else(|| other.vibration.clone()),
             perturbations: self
                 .perturbations
                 .clone()

@@ -1,0 +1,270 @@
+//! Vibration of the IMU's mount (`[imu.vibration]`): sines and random vibration from one-sided
+//! PSD tables, per body axis, linear (specific force, m/s²) and angular (rate, rad/s), added to
+//! the ideal inputs at the motion's instants — the signal chain's internal rate when the IMU has
+//! one, so the chain filters and aliases them as a part does. The truth stays the vehicle's
+//! motion; what the mount adds is the vibration.
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, invalid};
+use imu_core::sensor::{NoiseSource, SeededNormals};
+
+/// The noise stream of random vibration (beside the IMU's, the receiver's and the aids').
+const VIBRATION_STREAM: u64 = 4;
+
+/// Taps of a random vibration's shaping filter: its frequency resolution is the motion's rate
+/// over this.
+pub const RANDOM_TAPS: usize = 511;
+
+/// What a vibration moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VibrationKind {
+    /// The specific force, m/s² (an amplitude) or m²/s⁴/Hz (a density).
+    Acceleration,
+    /// The angular rate, rad/s or (rad/s)²/Hz.
+    AngularRate,
+}
+
+/// A body axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// Body x.
+    X,
+    /// Body y.
+    Y,
+    /// Body z.
+    Z,
+}
+
+impl Axis {
+    fn index(self) -> usize {
+        match self {
+            Self::X => 0,
+            Self::Y => 1,
+            Self::Z => 2,
+        }
+    }
+}
+
+/// A sine: `amplitude·sin(2π·frequency_hz·t + phase_rad)` on one axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineSpec {
+    /// What it moves.
+    pub kind: VibrationKind,
+    /// The body axis.
+    pub axis: Axis,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Amplitude (peak), m/s² or rad/s.
+    pub amplitude: f64,
+    /// Phase at t = 0, rad.
+    #[serde(default)]
+    pub phase_rad: f64,
+}
+
+/// Random vibration on one axis from a one-sided PSD table: `[frequency_hz, density]` rows,
+/// interpolated log-log between them, zero outside.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomSpec {
+    /// What it moves.
+    pub kind: VibrationKind,
+    /// The body axis.
+    pub axis: Axis,
+    /// `[frequency_hz, density]` rows, frequencies increasing, densities ≥ 0 (m²/s⁴/Hz or
+    /// (rad/s)²/Hz).
+    pub psd: Vec<[f64; 2]>,
+}
+
+/// The `[imu.vibration]` table.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VibrationSpec {
+    /// Sines.
+    #[serde(default)]
+    pub sines: Vec<SineSpec>,
+    /// Random vibration.
+    #[serde(default)]
+    pub random: Vec<RandomSpec>,
+}
+
+impl VibrationSpec {
+    /// The vibration checked for motion sampled at `motion_rate_hz`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] on the key (`imu.vibration.sines[0].frequency_hz`, …): values
+    /// that are not finite, frequencies ≤ 0, a PSD table out of order or reaching half the
+    /// motion's rate (the random vibration is made at that rate).
+    pub fn check(&self, motion_rate_hz: f64) -> Result<()> {
+        for (k, s) in self.sines.iter().enumerate() {
+            let at = |key: &str| format!("imu.vibration.sines[{k}].{key}");
+            if !(s.frequency_hz.is_finite() && s.frequency_hz > 0.0) {
+                return Err(invalid(at("frequency_hz"), "must be a finite number > 0"));
+            }
+            if !(s.amplitude.is_finite() && s.amplitude >= 0.0) {
+                return Err(invalid(at("amplitude"), "must be a finite number ≥ 0"));
+            }
+            if !s.phase_rad.is_finite() {
+                return Err(invalid(at("phase_rad"), "must be finite"));
+            }
+        }
+        let nyquist = motion_rate_hz / 2.0;
+        for (k, r) in self.random.iter().enumerate() {
+            let at = format!("imu.vibration.random[{k}].psd");
+            if r.psd.len() < 2 {
+                return Err(invalid(
+                    at,
+                    "needs at least two [frequency_hz, density] rows",
+                ));
+            }
+            for (i, [f, d]) in r.psd.iter().enumerate() {
+                if !(f.is_finite() && *f > 0.0 && d.is_finite() && *d >= 0.0) {
+                    return Err(invalid(
+                        format!("{at}[{i}]"),
+                        "a frequency > 0 Hz and a density ≥ 0, both finite",
+                    ));
+                }
+                if i > 0 && *f <= r.psd[i - 1][0] {
+                    return Err(invalid(format!("{at}[{i}]"), "frequencies must increase"));
+                }
+            }
+            let top = r.psd[r.psd.len() - 1][0];
+            if top >= nyquist {
+                return Err(invalid(
+                    at,
+                    format!(
+                        "reaches {top} Hz, at or above half the rate the motion is sampled at \
+                         ({nyquist} Hz): raise [imu.chain] internal_rate_hz, or rate_hz"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The vibration's source for motion at `motion_rate_hz`, its noise seeded from `seed` and
+    /// the Monte Carlo run (`None`: the single run).
+    #[must_use]
+    pub fn source(&self, motion_rate_hz: f64, seed: u64, run: Option<u64>) -> VibrationSource {
+        let mut noise = SeededNormals::for_sensor(seed, run, VIBRATION_STREAM);
+        let random = self
+            .random
+            .iter()
+            .map(|r| {
+                let taps = shaping_filter(&r.psd, motion_rate_hz);
+                // Stationary from the first sample: the filter's memory is full of noise.
+                let memory = (0..taps.len()).map(|_| noise.standard_normal()).collect();
+                Shaped {
+                    kind: r.kind,
+                    axis: r.axis.index(),
+                    taps,
+                    memory,
+                    next: 0,
+                }
+            })
+            .collect();
+        VibrationSource {
+            sines: self.sines.clone(),
+            random,
+            noise,
+        }
+    }
+}
+
+/// One random vibration: white noise through its shaping filter.
+#[derive(Clone, Debug)]
+struct Shaped {
+    kind: VibrationKind,
+    axis: usize,
+    taps: Vec<f64>,
+    /// The last `taps.len()` normals, a ring; `next` is the oldest.
+    memory: Vec<f64>,
+    next: usize,
+}
+
+/// The vibration at the motion's instants, in order ([`Self::at`] once per instant).
+#[derive(Clone, Debug)]
+pub struct VibrationSource {
+    sines: Vec<SineSpec>,
+    random: Vec<Shaped>,
+    noise: SeededNormals,
+}
+
+impl VibrationSource {
+    /// The vibration at the next instant `t_s`: what it adds to the specific force (m/s²) and
+    /// to the angular rate (rad/s), body axes. One normal per random vibration is drawn.
+    pub fn at(&mut self, t_s: f64) -> ([f64; 3], [f64; 3]) {
+        let (mut force, mut rate) = ([0.0; 3], [0.0; 3]);
+        let mut add = |kind: VibrationKind, axis: usize, v: f64| match kind {
+            VibrationKind::Acceleration => force[axis] += v,
+            VibrationKind::AngularRate => rate[axis] += v,
+        };
+        for s in &self.sines {
+            let phase = 2.0 * core::f64::consts::PI * s.frequency_hz * t_s + s.phase_rad;
+            add(s.kind, s.axis.index(), s.amplitude * phase.sin());
+        }
+        for r in &mut self.random {
+            r.memory[r.next] = self.noise.standard_normal();
+            r.next = (r.next + 1) % r.memory.len();
+            // Newest first: memory[next − 1], …
+            let n = r.memory.len();
+            let v: f64 = r
+                .taps
+                .iter()
+                .enumerate()
+                .map(|(k, h)| h * r.memory[(r.next + n - 1 - k) % n])
+                .sum();
+            add(r.kind, r.axis, v);
+        }
+        (force, rate)
+    }
+}
+
+/// The one-sided density of `psd` at `f`: log-log between rows, zero outside them.
+fn density(psd: &[[f64; 2]], f: f64) -> f64 {
+    let i = psd.partition_point(|row| row[0] <= f);
+    if i == 0 || i == psd.len() && f > psd[psd.len() - 1][0] {
+        return 0.0;
+    }
+    if i == psd.len() {
+        return psd[i - 1][1];
+    }
+    let ([f0, d0], [f1, d1]) = (psd[i - 1], psd[i]);
+    if d0 <= 0.0 || d1 <= 0.0 {
+        // A zero end: linear in frequency.
+        return d0 + (d1 - d0) * (f - f0) / (f1 - f0);
+    }
+    (d0.ln() + (d1.ln() - d0.ln()) * (f.ln() - f0.ln()) / (f1.ln() - f0.ln())).exp()
+}
+
+/// A symmetric FIR of [`RANDOM_TAPS`] whose response at the bins `k·fs/L` is
+/// `√(density·fs/2)`: unit white noise through it has the one-sided PSD `density` (the
+/// output's one-sided PSD is `2|H|²/fs` per unit variance). Frequency sampling, linear phase.
+fn shaping_filter(psd: &[[f64; 2]], fs: f64) -> Vec<f64> {
+    let l = RANDOM_TAPS;
+    let half = (l - 1) / 2;
+    #[allow(clippy::cast_precision_loss)]
+    let (lf, centre) = (l as f64, half as f64);
+    let amplitude: Vec<f64> = (0..=half)
+        .map(|k| {
+            #[allow(clippy::cast_precision_loss)]
+            let f = k as f64 * fs / lf;
+            (density(psd, f) * fs / 2.0).sqrt()
+        })
+        .collect();
+    (0..l)
+        .map(|n| {
+            #[allow(clippy::cast_precision_loss)]
+            let m = n as f64 - centre;
+            let mut h = amplitude[0];
+            for (k, a) in amplitude.iter().enumerate().skip(1) {
+                #[allow(clippy::cast_precision_loss)]
+                let w = 2.0 * core::f64::consts::PI * k as f64 * m / lf;
+                h += 2.0 * a * w.cos();
+            }
+            h / lf
+        })
+        .collect()
+}
