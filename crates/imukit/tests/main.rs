@@ -2,6 +2,7 @@
 //! `cargo test -p imukit --test integration MODULE::` runs one module's.
 mod asl;
 mod chain;
+mod clock;
 mod common;
 mod compiled_formulas;
 mod core_body_rates;

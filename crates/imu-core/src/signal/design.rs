@@ -1,6 +1,6 @@
 //! The low-pass filters data sheets describe, as rational sections at the internal rate.
+use super::FilterBuffer;
 use super::{MAX_SECTIONS, Section, SignalError};
-use crate::sensor::FilterBuffer;
 
 /// A digital low-pass as a data sheet names it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -12,15 +12,15 @@
 //! Coefficients and memory live in a [`FilterBuffer`] as the sensor model's do: the core's
 //! [`InlineBuffer`] holds up to 8 coefficients per section (a Butterworth of order 8, short
 //! averages); a crate with a heap supplies a longer buffer for long averages and FIR filters.
+mod buffer;
 mod design;
 mod response;
 
+pub use buffer::{FilterBuffer, InlineBuffer, MAX_FILTER_COEFFICIENTS};
 pub use design::LowPass;
 pub use response::Response;
 
 use core::fmt;
-
-use crate::sensor::{FilterBuffer, InlineBuffer};
 
 /// Most rational sections a chain's filter has (a Butterworth low-pass of order 2·this).
 pub const MAX_SECTIONS: usize = 4;

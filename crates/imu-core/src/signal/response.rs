@@ -1,7 +1,7 @@
 //! A chain's frequency response and group delay in closed form, from the coefficients that
 //! filter.
+use super::FilterBuffer;
 use super::Section;
-use crate::sensor::FilterBuffer;
 
 /// A filter's response at one frequency.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -429,6 +429,11 @@ impl Scenario {
         let mut turn_rates: Vec<f64> = Vec::new();
         // With a signal chain, the samples it keeps of the motion at its internal rate.
         let mut kept: Vec<Truth<N>> = Vec::new();
+        let mut clock = self
+            .imu
+            .clock
+            .as_ref()
+            .map(|c| c.source(self.imu.sensors.seed, run));
         let mut emit = |motion: &[Truth<N>]| -> Result<()> {
             let truth = self.on_earth(
                 motion,
@@ -468,6 +473,9 @@ impl Scenario {
                 }
             }
             previous = t.last().copied().zip(readings.last().copied());
+            if let Some(clock) = &mut clock {
+                clock.stamp_table(&mut chunk.imu);
+            }
             // The stretch's truth table becomes the chunk's; the chunk's last one is refilled
             // next time.
             std::mem::swap(&mut chunk.truth, &mut stretch.truth);

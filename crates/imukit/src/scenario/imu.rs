@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::scenario::chain::ChainSetup;
+use crate::scenario::clock::ClockSpec;
 use crate::scenario::earth::TangentPlane;
 use crate::scenario::perturb::{drawn_part, perturbed};
 use crate::scenario::sensors::SensorSetup;
@@ -35,6 +36,8 @@ pub struct ImuSetup {
     pub chain: Option<ChainSetup>,
     /// The mount's vibration, checked (`None`: none).
     pub vibration: Option<VibrationSpec>,
+    /// The logger's clock, checked (`None`: the readings stamped with their true times).
+    pub clock: Option<ClockSpec>,
 }
 
 impl ImuSetup {
@@ -55,6 +58,7 @@ impl ImuSetup {
             sensors: SensorSetup::default(),
             chain: None,
             vibration: None,
+            clock: None,
         }
     }
 

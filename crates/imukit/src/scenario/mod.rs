@@ -20,6 +20,7 @@
 pub mod aids;
 pub mod builtin;
 pub mod chain;
+pub mod clock;
 pub mod earth;
 pub mod gnss;
 pub mod imu;
@@ -207,7 +208,7 @@ impl Scenario {
             odometer,
         } = stretch;
         let t: Vec<f64> = truth.iter().map(|s| s.t_s).collect();
-        let simulation = Simulation {
+        let mut simulation = Simulation {
             gnss,
             baro,
             odometer,
@@ -217,6 +218,11 @@ impl Scenario {
                 ImuOutput::Increments => Table::from_increments(&t, &readings, self.imu.kind),
             },
         };
+        if let Some(clock) = &self.imu.clock {
+            clock
+                .source(self.imu.sensors.seed, run)
+                .stamp_table(&mut simulation.imu);
+        }
         simulation.truth.check_finite("truth")?;
         simulation.imu.check_finite("IMU readings")?;
         Ok(simulation)

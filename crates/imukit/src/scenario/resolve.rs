@@ -259,6 +259,12 @@ fn imu_setup(spec: &ScenarioSpec, base_dir: &Path) -> Result<ImuSetup> {
         // Checked once the scenario's rate is known.
         chain: None,
         vibration: None,
+        clock: spec
+            .imu
+            .clock
+            .as_ref()
+            .map(|c| c.check().map(|()| c.clone()))
+            .transpose()?,
     })
 }
 

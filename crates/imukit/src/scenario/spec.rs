@@ -513,6 +513,9 @@ pub struct ImuSpec {
     /// Vibration of the mount: sines and random vibration per body axis, added to the ideal
     /// inputs at the motion's instants (default none).
     pub vibration: Option<crate::scenario::vibration::VibrationSpec>,
+    /// The logger's clock that stamps the readings: offset, drift, jitter (default: true
+    /// times).
+    pub clock: Option<crate::scenario::clock::ClockSpec>,
 }
 
 impl ImuSpec {
@@ -545,6 +548,7 @@ impl ImuSpec {
                 .or_else(|| other.magnetometer.clone()),
             chain: self.chain.clone().or_else(|| other.chain.clone()),
             vibration: self.vibration.clone().or_else(|| other.vibration.clone()),
+            clock: self.clock.clone().or_else(|| other.clock.clone()),
             perturbations: self
                 .perturbations
                 .clone()
