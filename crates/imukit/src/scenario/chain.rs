@@ -5,6 +5,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
+use crate::scenario::earth::EarthSetup;
+use crate::scenario::spec::TrajectorySpec;
+use crate::scenario::times::SampleTimes;
 use crate::sensor::Chain;
 use imu_core::signal::LowPass;
 
@@ -111,6 +114,51 @@ impl ChainSetup {
         };
         setup.chains(rate_hz)?;
         Ok(setup)
+    }
+
+    /// The chain of a scenario's `[imu.chain]`: regular sample times at the scenario's rate
+    /// (`sample_rate_hz`) on the flat Earth, the motion at most 10⁹ samples, every filter
+    /// checked.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] on `imu.chain` or the key it names.
+    pub fn of_scenario(
+        spec: &ChainSpec,
+        trajectory: &TrajectorySpec,
+        t_s: &SampleTimes,
+        earth: &EarthSetup,
+        sample_rate_hz: f64,
+    ) -> Result<Self> {
+        if !matches!(t_s, SampleTimes::Regular { .. })
+            || matches!(trajectory, TrajectorySpec::Samples(_))
+        {
+            return Err(invalid(
+                "imu.chain",
+                "the signal chain samples the motion at its internal rate: it needs the regular \
+                 sample times of rate_hz, not a trajectory's own times",
+            ));
+        }
+        if matches!(earth, EarthSetup::Wgs84(_)) {
+            return Err(invalid(
+                "imu.chain",
+                "the signal chain is simulated on the flat Earth (earth = \"flat\"); on the \
+                 WGS-84 Earth it is not yet",
+            ));
+        }
+        // The motion is sampled at the internal rate: as many samples as a scenario may have.
+        #[allow(clippy::cast_precision_loss)]
+        let motion_samples =
+            t_s.len().saturating_sub(1) as f64 * spec.internal_rate_hz / sample_rate_hz;
+        if motion_samples > 1e9 {
+            return Err(invalid(
+                "imu.chain.internal_rate_hz",
+                format!(
+                    "the motion sampled at this rate from the first sample to the last would be \
+                     {motion_samples:.2e} samples, more than 10⁹"
+                ),
+            ));
+        }
+        Self::resolve(spec, sample_rate_hz)
     }
 
     /// Each sensor's chain for output at `rate_hz`.

@@ -18,6 +18,7 @@ use crate::motion::expression::GeodeticPlane;
 use crate::motion::track::{SpeedProfile, Track};
 use crate::motion::waypoints::Waypoints;
 use crate::motion::{BodyRatesData, SampledPath, Trajectory};
+use crate::scenario::chain::ChainSetup;
 use crate::scenario::earth::{EarthSetup, MagneticEnvironment, TangentPlane};
 use crate::scenario::sensors::{SensorSetup, TemperatureSpec};
 use crate::scenario::spec::*;
@@ -168,13 +169,13 @@ impl ScenarioSpec {
             .imu
             .chain
             .as_ref()
-            .map(|c| chain_setup(c, &spec.trajectory, &t_s, &earth, sample_rate_hz))
+            .map(|c| ChainSetup::of_scenario(c, &spec.trajectory, &t_s, &earth, sample_rate_hz))
             .transpose()?;
         imu.vibration = spec
             .imu
             .vibration
             .as_ref()
-            .map(|v| vibration_setup(v, &imu, &t_s, &earth, sample_rate_hz))
+            .map(|v| v.of_scenario(imu.chain.as_ref(), &t_s, &earth, sample_rate_hz))
             .transpose()?;
         // The sensor model is checked now, at this sample rate, before any work.
         imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;
@@ -266,78 +267,6 @@ fn imu_setup(spec: &ScenarioSpec, base_dir: &Path) -> Result<ImuSetup> {
             .map(|c| c.check().map(|()| c.clone()))
             .transpose()?,
     })
-}
-
-/// The signal chain of `[imu.chain]`: regular sample times at the scenario's rate on the flat
-/// Earth, the internal rate a whole multiple of it, every filter checked.
-fn chain_setup(
-    spec: &crate::scenario::chain::ChainSpec,
-    spec_trajectory: &TrajectorySpec,
-    t_s: &SampleTimes,
-    earth: &EarthSetup,
-    sample_rate_hz: f64,
-) -> Result<crate::scenario::chain::ChainSetup> {
-    if !matches!(t_s, SampleTimes::Regular { .. })
-        || matches!(spec_trajectory, TrajectorySpec::Samples(_))
-    {
-        return Err(invalid(
-            "imu.chain",
-            "the signal chain samples the motion at its internal rate: it needs the regular \
-             sample times of rate_hz, not a trajectory's own times",
-        ));
-    }
-    if matches!(earth, EarthSetup::Wgs84(_)) {
-        return Err(invalid(
-            "imu.chain",
-            "the signal chain is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 \
-             Earth it is not yet",
-        ));
-    }
-    // The motion is sampled at the internal rate: as many samples as a scenario may have.
-    let motion_samples =
-        t_s.len().saturating_sub(1) as f64 * spec.internal_rate_hz / sample_rate_hz;
-    if motion_samples > 1e9 {
-        return Err(invalid(
-            "imu.chain.internal_rate_hz",
-            format!(
-                "the motion sampled at this rate from the first sample to the last would be \
-                 {motion_samples:.2e} samples, more than 10⁹"
-            ),
-        ));
-    }
-    crate::scenario::chain::ChainSetup::resolve(spec, sample_rate_hz)
-}
-
-/// The mount's vibration of `[imu.vibration]`, checked at the rate the motion is sampled at
-/// (the chain's internal rate, else the scenario's): on the flat Earth; random vibration needs
-/// the regular sample times of `rate_hz`.
-fn vibration_setup(
-    spec: &crate::scenario::vibration::VibrationSpec,
-    imu: &ImuSetup,
-    t_s: &SampleTimes,
-    earth: &EarthSetup,
-    sample_rate_hz: f64,
-) -> Result<crate::scenario::vibration::VibrationSpec> {
-    if matches!(earth, EarthSetup::Wgs84(_)) {
-        return Err(invalid(
-            "imu.vibration",
-            "vibration is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 Earth it \
-             is not yet",
-        ));
-    }
-    if !spec.random.is_empty() && !matches!(t_s, SampleTimes::Regular { .. }) {
-        return Err(invalid(
-            "imu.vibration.random",
-            "random vibration is made at a regular rate: it needs the regular sample times of \
-             rate_hz, not a trajectory's own times",
-        ));
-    }
-    let motion_rate_hz = imu
-        .chain
-        .as_ref()
-        .map_or(sample_rate_hz, |c| c.internal_rate_hz);
-    spec.check(motion_rate_hz)?;
-    Ok(spec.clone())
 }
 
 /// A key a trajectory type needs.

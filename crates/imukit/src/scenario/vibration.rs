@@ -6,6 +6,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
+use crate::scenario::chain::ChainSetup;
+use crate::scenario::earth::EarthSetup;
+use crate::scenario::times::SampleTimes;
 use imu_core::sensor::{NoiseSource, SeededNormals};
 
 /// The noise stream of random vibration (beside the IMU's, the receiver's and the aids').
@@ -142,6 +145,37 @@ impl VibrationSpec {
             }
         }
         Ok(())
+    }
+
+    /// The vibration of a scenario's `[imu.vibration]`, checked at the rate the motion is
+    /// sampled at (the chain's internal rate, else the scenario's `sample_rate_hz`): on the
+    /// flat Earth; random vibration needs the regular sample times of `rate_hz`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] on `imu.vibration` or the key it names.
+    pub fn of_scenario(
+        &self,
+        chain: Option<&ChainSetup>,
+        t_s: &SampleTimes,
+        earth: &EarthSetup,
+        sample_rate_hz: f64,
+    ) -> Result<Self> {
+        if matches!(earth, EarthSetup::Wgs84(_)) {
+            return Err(invalid(
+                "imu.vibration",
+                "vibration is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 \
+                 Earth it is not yet",
+            ));
+        }
+        if !self.random.is_empty() && !matches!(t_s, SampleTimes::Regular { .. }) {
+            return Err(invalid(
+                "imu.vibration.random",
+                "random vibration is made at a regular rate: it needs the regular sample times \
+                 of rate_hz, not a trajectory's own times",
+            ));
+        }
+        self.check(chain.map_or(sample_rate_hz, |c| c.internal_rate_hz))?;
+        Ok(self.clone())
     }
 
     /// The vibration's source for motion at `motion_rate_hz`, its noise seeded from `seed` and
