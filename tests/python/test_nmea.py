@@ -96,7 +96,8 @@ def test_a_drive_s_fixes_as_nmea_read_back_and_fuse_as_the_csv_fixes(tmp_path):
     assert np.array_equal(python.values, imukit.read(tmp_path / "fused-uere-10.csv").values)
     done = subprocess.run([imukit_bin(), "fuse", files["imu"], files["gnss"], "--init", files["truth"],
                            "--scenario", scenario, "--gnss-uere-m", "1.875", "--out", out], capture_output=True, text=True)
-    assert done.returncode == 65 and "--gnss-uere-m" in done.stderr and "no hdop column" in done.stderr, done.stderr
+    assert done.returncode == 65 and f"--gnss-uere-m ({files['gnss']})" in done.stderr \
+        and "no hdop column" in done.stderr, done.stderr
     # A log whose checksum is wrong is refused by file and line; nothing is written.
     lines = (tmp_path / "fixes.nmea").read_text().splitlines()
     lines[7] = lines[7][:-2] + ("00" if not lines[7].endswith("00") else "01")

@@ -198,8 +198,12 @@ fn fixes_of(a: &Args<'_>, t0: f64) -> Result<imukit::Table, CliError> {
     };
     Ok(
         imukit::io::nmea::with_uere(&gnss, uere).map_err(|e| match e {
-            Error::Invalid { message, .. } => Error::Invalid {
-                field: format!("--gnss-uere-m ({})", path.display()).into(),
+            // The option named with the file it was applied to.
+            Error::Request {
+                option: option @ RequestOption::GnssUere,
+                message,
+            } => Error::Invalid {
+                field: format!("{} ({})", option.flag(), path.display()).into(),
                 message,
             },
             other => other,
