@@ -9,7 +9,7 @@ use crate::scenario::earth::EarthSetup;
 use crate::scenario::spec::TrajectorySpec;
 use crate::scenario::times::SampleTimes;
 use crate::sensor::Chain;
-use imu_core::signal::LowPass;
+use imu_core::signal::{LowPass, SignalError};
 
 /// A sensor's digital low-pass, as a data sheet describes it (`filter = "…"` and its keys).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -97,6 +97,8 @@ pub struct ChainSetup {
     pub internal_rate_hz: f64,
     /// The accelerometer's, gyroscope's and magnetometer's low-pass.
     pub low_pass: [LowPassSpec; 3],
+    /// Internal samples per output sample.
+    pub decimation: usize,
 }
 
 impl ChainSetup {
@@ -106,13 +108,23 @@ impl ChainSetup {
     /// [`Error::Invalid`] on the key (`imu.chain.internal_rate_hz`, `imu.chain.gyroscope`, …)
     /// whose value the chain cannot take.
     pub fn resolve(spec: &ChainSpec, rate_hz: f64) -> Result<Self> {
+        let rate = spec.internal_rate_hz;
+        if !(rate.is_finite() && rate > 0.0) {
+            let e = SignalError::NotPositive {
+                field: "internal_rate_hz",
+                value: rate,
+            };
+            return Err(invalid(INTERNAL_RATE_KEY, e.to_string()));
+        }
         let low_pass = [&spec.accelerometer, &spec.gyroscope, &spec.magnetometer]
             .map(|f| f.clone().unwrap_or(LowPassSpec::None));
-        let setup = Self {
-            internal_rate_hz: spec.internal_rate_hz,
+        let mut setup = Self {
+            internal_rate_hz: rate,
             low_pass,
+            decimation: 1,
         };
-        setup.chains(rate_hz)?;
+        let [accelerometer, _, _] = setup.chains(rate_hz)?;
+        setup.decimation = accelerometer.decimation();
         Ok(setup)
     }
 
@@ -151,7 +163,7 @@ impl ChainSetup {
             t_s.len().saturating_sub(1) as f64 * spec.internal_rate_hz / sample_rate_hz;
         if motion_samples > 1e9 {
             return Err(invalid(
-                "imu.chain.internal_rate_hz",
+                INTERNAL_RATE_KEY,
                 format!(
                     "the motion sampled at this rate from the first sample to the last would be \
                      {motion_samples:.2e} samples, more than 10⁹"
@@ -172,24 +184,17 @@ impl ChainSetup {
         };
         Ok([make(0)?, make(1)?, make(2)?])
     }
-
-    /// Internal samples per output sample.
-    #[must_use]
-    pub fn decimation(&self, rate_hz: f64) -> usize {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let m = (self.internal_rate_hz / rate_hz).round() as usize;
-        m.max(1)
-    }
 }
 
-/// The core's refusal of a sensor's chain, on the key it came from.
-fn chain_error(sensor: &str, e: &imu_core::signal::SignalError) -> Error {
-    use imu_core::signal::SignalError as S;
+/// The key of the internal rate.
+const INTERNAL_RATE_KEY: &str = "imu.chain.internal_rate_hz";
+
+/// The core's refusal of a sensor's chain, on the key it came from: the rates are checked
+/// before (the internal rate in [`ChainSetup::resolve`], the output rate with the scenario),
+/// so what remains is their ratio or the sensor's filter.
+fn chain_error(sensor: &str, e: &SignalError) -> Error {
     let field = match e {
-        S::NotPositive { field, .. } if field.ends_with("rate_hz") => {
-            "imu.chain.internal_rate_hz".to_string()
-        }
-        S::NotWholeMultiple { .. } => "imu.chain.internal_rate_hz".to_string(),
+        SignalError::NotWholeMultiple { .. } => INTERNAL_RATE_KEY.to_string(),
         _ => format!("imu.chain.{sensor}"),
     };
     invalid(field, e.to_string())

@@ -137,7 +137,6 @@ impl ImuSetup {
                 c.chains(sample_rate_hz).map(|chains| ChainStage {
                     chains,
                     states: None,
-                    kept: Vec::new(),
                 })
             })
             .transpose()?;
@@ -153,6 +152,7 @@ impl ImuSetup {
             report: RunReport::for_sensors(&params),
             chain,
             vibration,
+            inputs: Vec::new(),
             model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
@@ -177,14 +177,12 @@ impl ImuSetup {
     }
 }
 
-/// The signal chain at work: each sensor's chain and memory, and the filtered ideal inputs of
-/// the samples kept, waiting for the error model.
+/// The signal chain at work: each sensor's chain and memory.
 #[derive(Debug)]
 struct ChainStage {
     chains: [Chain; 3],
     /// Settled at the first sample's inputs when it comes.
     states: Option<[ChainState; 3]>,
-    kept: Vec<[Vec3<imu_core::Body>; 3]>,
 }
 
 /// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
@@ -196,6 +194,9 @@ pub struct ReadingStream<'a, N: NavFrame> {
     chain: Option<ChainStage>,
     /// The mount's vibration, when it has one.
     vibration: Option<VibrationSource>,
+    /// With a chain or vibration, the ideal inputs of the samples kept ([`Self::decimate`]),
+    /// waiting for the error model.
+    inputs: Vec<[Vec3<imu_core::Body>; 3]>,
     model: ImuModel<N>,
     noise: SeededNormals,
     state: ImuState,
@@ -249,10 +250,11 @@ impl<N: NavFrame> ReadingStream<'_, N> {
             .collect()
     }
 
-    /// Whether the IMU has a signal chain (its motion sampled at the chain's internal rate).
+    /// Whether the ideal inputs are worked out ahead of the error model ([`Self::decimate`]):
+    /// with a signal chain (the motion sampled at its internal rate) or vibration.
     #[must_use]
-    pub fn has_chain(&self) -> bool {
-        self.chain.is_some()
+    pub fn prepares_inputs(&self) -> bool {
+        self.chain.is_some() || self.vibration.is_some()
     }
 
     /// The ideal inputs of `s` (specific force, rate, field; body axes) with the mount's
@@ -269,36 +271,35 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         [f, w, m]
     }
 
-    /// Runs the truth at the chain's internal rate, `internal`, through each sensor's chain
-    /// and puts the samples the chain keeps into `kept` (cleared first): those are the output
-    /// samples, whose filtered inputs [`Self::measure_into`] then takes. Without a chain every
-    /// sample is kept as it is. The chain starts settled at the first sample's inputs (as if
-    /// the part had been reading them forever).
-    pub fn decimate(&mut self, internal: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
+    /// Works out the ideal inputs (vibration added) of the motion `motion`, runs them through
+    /// each sensor's chain when there is one, and puts the samples kept into `kept` (cleared
+    /// first): those are the output samples, whose inputs [`Self::measure_into`] then takes.
+    /// Without a chain every sample is kept. The chain starts settled at the first sample's
+    /// inputs (as if the part had been reading them forever).
+    pub fn decimate(&mut self, motion: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
         kept.clear();
-        if self.chain.is_none() {
-            kept.extend_from_slice(internal);
-            return;
-        }
-        for s in internal {
+        for s in motion {
             let ideal = self.ideal(s);
-            let Some(stage) = &mut self.chain else {
-                return;
-            };
-            let states = stage.states.get_or_insert_with(|| {
-                [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
-            });
-            let mut filtered = [[0.0; 3]; 3];
-            let mut keep = false;
-            for k in 0..3 {
-                if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
-                    filtered[k] = y;
-                    keep = true;
+            let filtered = match &mut self.chain {
+                None => Some(ideal),
+                Some(stage) => {
+                    let states = stage.states.get_or_insert_with(|| {
+                        [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
+                    });
+                    let mut filtered = [[0.0; 3]; 3];
+                    let mut keep = false;
+                    for k in 0..3 {
+                        if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
+                            filtered[k] = y;
+                            keep = true;
+                        }
+                    }
+                    keep.then_some(filtered)
                 }
-            }
-            if keep {
+            };
+            if let Some(inputs) = filtered {
                 kept.push(*s);
-                stage.kept.push(filtered.map(Vec3::from_array));
+                self.inputs.push(inputs.map(Vec3::from_array));
             }
         }
     }
@@ -315,12 +316,12 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     pub fn measure_into(&mut self, truth: &[Truth<N>], readings: &mut Vec<ImuReading>) {
         readings.resize(truth.len(), ImuReading::default());
         let temperature = &self.setup.sensors.temperature;
-        if let Some(stage) = &mut self.chain {
-            // The inputs the chain kept for these samples ([`Self::decimate`]), in order.
+        if self.prepares_inputs() {
+            // The inputs worked out for these samples ([`Self::decimate`]), in order.
             for ((s, r), [f, w, m]) in truth
                 .iter()
                 .zip(readings.iter_mut())
-                .zip(stage.kept.drain(..))
+                .zip(self.inputs.drain(..))
             {
                 *r = self.model.measure_ideal(
                     f,
@@ -328,21 +329,6 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                     m,
                     s.acceleration_m_s2,
                     &temperature.at(s.t_s),
-                    &mut self.state,
-                    &mut self.noise,
-                );
-            }
-            return;
-        }
-        if self.vibration.is_some() {
-            for (s, r) in truth.iter().zip(readings.iter_mut()) {
-                let [f, w, m] = self.ideal(s).map(Vec3::from_array);
-                *r = self.model.measure_ideal(
-                    f,
-                    w,
-                    m,
-                    s.acceleration_m_s2,
-                    &self.setup.sensors.temperature.at(s.t_s),
                     &mut self.state,
                     &mut self.noise,
                 );

@@ -235,7 +235,7 @@ impl Scenario {
     pub fn motion_times(&self) -> std::borrow::Cow<'_, SampleTimes> {
         match (&self.imu.chain, &self.t_s) {
             (Some(chain), SampleTimes::Regular { rate_hz, count }) => {
-                let m = chain.decimation(*rate_hz);
+                let m = chain.decimation;
                 std::borrow::Cow::Owned(SampleTimes::Regular {
                     rate_hz: rate_hz * m as f64,
                     count: count.saturating_sub(1) * m + usize::from(*count > 0),
@@ -249,8 +249,8 @@ impl Scenario {
     /// readings, the sensors' state carried on, written into `out` (on the flat Earth in the
     /// memory its truth table and readings already have: a streamed run reuses one; the truth
     /// table left empty there unless `truth_table`). `motion` is sampled at
-    /// [`Self::motion_times`]; with a signal chain the samples it keeps are put in `kept`, and
-    /// the samples written (the sample times') are returned.
+    /// [`Self::motion_times`]; with a signal chain or vibration the samples kept are put in
+    /// `kept`, and the samples written (the sample times') are returned.
     ///
     /// # Errors
     /// A sample off the Earth or beyond ±89.9° of latitude (WGS-84), with its time.
@@ -263,7 +263,7 @@ impl Scenario {
         out: &mut Stretch,
         kept: &'t mut Vec<Truth<N>>,
     ) -> Result<&'t [Truth<N>]> {
-        let truth: &'t [Truth<N>] = if sensors.has_chain() {
+        let truth: &'t [Truth<N>] = if sensors.prepares_inputs() {
             sensors.decimate(motion, kept);
             kept
         } else {
