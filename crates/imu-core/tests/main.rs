@@ -3,6 +3,7 @@
 mod aids;
 mod align;
 mod allan;
+mod coning;
 mod earth;
 mod earth_frames;
 mod earth_strapdown;
@@ -13,6 +14,7 @@ mod gnss;
 mod orientation;
 mod planar;
 mod process_noise;
+mod rectification;
 mod robust;
 mod robust_motion;
 mod rotation;

@@ -320,6 +320,26 @@ pub fn to_toml(file: &ParamFile) -> String {
         if p.quantization_carry {
             s += "quantization_carry = true\n";
         }
+        // The element's nonlinear terms only when the part has them (files of parts without
+        // them read as before).
+        if p.scale_factor_nonlinearity != [0.0; 3] {
+            s += &format!(
+                "scale_factor_nonlinearity_per_{u} = {}\n",
+                fmt3(p.scale_factor_nonlinearity)
+            );
+        }
+        if p.scale_factor_asymmetry_pct != [0.0; 3] {
+            s += &format!(
+                "scale_factor_asymmetry_pct = {}\n",
+                fmt3(p.scale_factor_asymmetry_pct)
+            );
+        }
+        if *sensor == Sensor::Gyroscope && p.acceleration_squared_bias != [0.0; 3] {
+            s += &format!(
+                "acceleration_squared_bias_rad_s_per_m2_s4 = {}\n",
+                fmt3(p.acceleration_squared_bias)
+            );
+        }
     }
     s
 }

@@ -205,6 +205,28 @@ def test_parameter_classes_mirror_matlabs_accelparams():
         imukit.ImuSensor(accelerometer=[1, 2, 3])
 
 
+def test_vibration_rectifies_through_the_elements_nonlinearity():
+    # A 2 g shake along x, 40 Hz sampled at 1 kHz for 100 whole periods: an accelerometer with
+    # K₂ = 1e-3 /(m/s²) reads a mean K₂A²/2 on x (MATLAB's sign flips the shake, not the square),
+    # a gyroscope with g²-sensitivity k a mean kA²/2; asymmetry ε reads u(1 ± ε/2).
+    n, a = 2500, 19.62
+    t = np.arange(n) / 1000.0
+    acc = np.zeros((n, 3))
+    acc[:, 0] = a * np.sin(2 * np.pi * 40 * t)
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    imu = imukit.ImuSensor("accel-gyro", sample_rate=1000,
+                           accelerometer=imukit.AccelParams(scale_factor_nonlinearity=[1e-3, 0, 0]),
+                           gyroscope=imukit.GyroParams(acceleration_squared_bias=[2e-6, 0, 0]))
+    accel, gyro = imu(acc, np.zeros((n, 3)), quat)
+    assert abs(accel[:, 0].mean() / (1e-3 * a * a / 2) - 1) < 1e-9
+    assert abs(gyro[:, 0].mean() / (2e-6 * a * a / 2) - 1) < 1e-9
+    skew = imukit.ImuSensor("accel-gyro", accelerometer=imukit.AccelParams(scale_factor_asymmetry=2.0))
+    reading, _ = skew(np.array([[-3.0, 3.0, 0.0]]), np.zeros((1, 3)), quat[:1])
+    np.testing.assert_allclose(reading[0, :2], [3.0 * 1.01, -3.0 * 0.99], rtol=1e-15)
+    with pytest.raises(ImuError, match="scale_factor_asymmetry"):
+        imukit.ImuSensor(accelerometer=imukit.AccelParams(scale_factor_asymmetry=120.0))
+
+
 def test_an_infinite_measurement_range_reaches_rust_as_infinity():
     # Parameter objects are handed over typed (no JSON text, which has no infinity): an
     # infinite range means no saturation, so a reading far beyond any finite range passes.

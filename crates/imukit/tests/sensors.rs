@@ -213,10 +213,13 @@ fn parameter_files_round_trip_through_toml() {
         random_walk: [1e-5; 3],
         temperature_bias: [1e-3, 2e-3, 3e-3],
         temperature_scale_factor_pct: [0.01; 3],
+        scale_factor_nonlinearity: [1e-4, -2e-4, 3e-5],
+        scale_factor_asymmetry_pct: [0.2; 3],
         ..SensorParams::default()
     };
     file.params.gyroscope = SensorParams {
         acceleration_bias: [1e-4; 3],
+        acceleration_squared_bias: [1e-7, 0.0, -2e-7],
         resolution: 1e-4,
         quantization_carry: true,
         bias_instability_model: BiasInstabilityModel::GaussMarkov {

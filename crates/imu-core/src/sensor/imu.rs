@@ -7,8 +7,8 @@ use crate::kinematics::Truth;
 use crate::nav_frame::NavFrame;
 use crate::rotation::Rotation;
 use crate::sensor::{
-    Environment, FilterBuffer, InlineBuffer, NoiseSource, ParamError, SensorModel, SensorParams,
-    SensorState,
+    Environment, FilterBuffer, InlineBuffer, NoiseSource, Nonlinearity, ParamError, SensorModel,
+    SensorParams, SensorState,
 };
 use crate::vector::Vec3;
 
@@ -107,6 +107,42 @@ impl core::error::Error for ImuParamError {
     }
 }
 
+/// The sensing elements' nonlinearities of an IMU, taken out of its model
+/// ([`ImuModel::take_sensing_element`]) to act on the ideal inputs before a signal chain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensingElement {
+    accel_sign: AccelSign,
+    gyro_acceleration: GyroAccelerationInput,
+    nonlinearity: [Option<Nonlinearity>; 3],
+}
+
+impl SensingElement {
+    /// The ideal inputs `[f_b, w_b, m_b]` (specific force with its physical sign, rate, field;
+    /// body axes) as the elements make them, the accelerometer's in the sign it reports, the
+    /// gyroscope's g²-sensitivity on the acceleration the model's gyroscope input names
+    /// (`f_b`, or the navigation-frame acceleration `acceleration_n`).
+    #[must_use]
+    pub fn apply(&self, inputs: [[f64; 3]; 3], acceleration_n: [f64; 3]) -> [[f64; 3]; 3] {
+        let [f, w, m] = inputs;
+        let sign = match self.accel_sign {
+            AccelSign::SpecificForce => 1.0,
+            AccelSign::Matlab => -1.0,
+        };
+        let g_input = match self.gyro_acceleration {
+            GyroAccelerationInput::BodySpecificForce => f,
+            GyroAccelerationInput::NavAcceleration => acceleration_n,
+        };
+        let [na, nw, nm] = &self.nonlinearity;
+        [
+            na.map_or(f, |n| {
+                n.apply(f.map(|x| sign * x), [0.0; 3]).map(|x| sign * x)
+            }),
+            nw.map_or(w, |n| n.apply(w, g_input)),
+            nm.map_or(m, |n| n.apply(m, [0.0; 3])),
+        ]
+    }
+}
+
 /// A validated IMU error model in navigation frame `N`.
 #[derive(Clone, Debug, PartialEq)]
 /// `B` stores the bias-instability filters (see [`FilterBuffer`]).
@@ -143,6 +179,25 @@ impl<N: NavFrame, B: FilterBuffer> ImuModel<N, B> {
             gyro: build("gyroscope", params[1])?,
             mag: build("magnetometer", params[2])?,
         })
+    }
+
+    /// Takes the sensing elements' nonlinearities out of the model, for a signal chain to apply
+    /// at its internal rate before its filters ([`SensingElement::apply`]); `None` when the
+    /// parts have none (the model is then unchanged).
+    pub fn take_sensing_element(&mut self) -> Option<SensingElement> {
+        let nonlinearity = [
+            self.accel.take_nonlinearity(),
+            self.gyro.take_nonlinearity(),
+            self.mag.take_nonlinearity(),
+        ];
+        nonlinearity
+            .iter()
+            .any(Option::is_some)
+            .then_some(SensingElement {
+                accel_sign: self.mount.accel_sign,
+                gyro_acceleration: self.gyro_acceleration,
+                nonlinearity,
+            })
     }
 
     /// The sensors present.

@@ -23,11 +23,11 @@ mod params;
 
 pub use error::ParamError;
 pub use imu::{
-    GyroAccelerationInput, ImuModel, ImuParamError, ImuReading, ImuState, MEASURE_BLOCK, SensorSet,
-    Temperatures,
+    GyroAccelerationInput, ImuModel, ImuParamError, ImuReading, ImuState, MEASURE_BLOCK,
+    SensingElement, SensorSet, Temperatures,
 };
 pub use model::MAX_FLICKER_SECTIONS;
-pub use model::{Environment, SensorModel, SensorState};
+pub use model::{Environment, Nonlinearity, SensorModel, SensorState};
 pub use noise::{NoNoise, NoiseSource, SeededNormals};
 pub use params::{
     BiasInstabilityModel, FilterBuffer, FilterCoefficients, InlineBuffer, MAX_FILTER_COEFFICIENTS,

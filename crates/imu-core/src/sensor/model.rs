@@ -311,6 +311,44 @@ impl Default for Environment {
     }
 }
 
+/// The sensing element's memoryless nonlinearity of one triad: each axis reads
+/// `u + K₂u² + |u|·ε/2 + k·a²` of its input `u` and the acceleration `a` along it (the
+/// [`Environment`]'s), before the error model's misalignment, bias and noise — and, in a part
+/// with a signal chain, before the chain, at its internal rate, which is where vibration
+/// rectifies into a bias ([`SensorParams::scale_factor_nonlinearity`],
+/// [`SensorParams::scale_factor_asymmetry_pct`], [`SensorParams::acceleration_squared_bias`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Nonlinearity {
+    square: [f64; 3],
+    half_asymmetry: [f64; 3],
+    acceleration_squared: [f64; 3],
+}
+
+impl Nonlinearity {
+    /// The terms of `params`; `None` when all are zero (the reading is then `u` itself).
+    #[must_use]
+    pub fn of<B: FilterBuffer>(params: &SensorParams<B>) -> Option<Self> {
+        let n = Self {
+            square: params.scale_factor_nonlinearity,
+            half_asymmetry: params.scale_factor_asymmetry_pct.map(|e| e / 200.0),
+            acceleration_squared: params.acceleration_squared_bias,
+        };
+        (n != Self::default()).then_some(n)
+    }
+
+    /// What the element makes of input `u` under acceleration `acceleration` (per axis).
+    #[inline]
+    #[must_use]
+    pub fn apply(&self, u: [f64; 3], acceleration: [f64; 3]) -> [f64; 3] {
+        core::array::from_fn(|i| {
+            let (x, a) = (u[i], acceleration[i]);
+            x + self.square[i] * x * x
+                + self.half_asymmetry[i] * math::abs(x)
+                + self.acceleration_squared[i] * a * a
+        })
+    }
+}
+
 /// What drifts over time: the bias-instability filter state and the random-walk value, per axis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SensorState<B: FilterBuffer = InlineBuffer> {
@@ -354,6 +392,7 @@ pub struct SensorModel<B: FilterBuffer = InlineBuffer> {
     temperature_bias: Axes,
     temperature_scale: Axes,
     acceleration_bias: Axes,
+    nonlinearity: Option<Nonlinearity>,
     range: f64,
     resolution: f64,
     quantization_carry: bool,
@@ -387,6 +426,7 @@ impl<B: FilterBuffer> SensorModel<B> {
             temperature_bias: Axes::of(params.temperature_bias),
             temperature_scale: Axes::of(params.temperature_scale_factor_pct.map(|s| s / 100.0)),
             acceleration_bias: Axes::of(params.acceleration_bias),
+            nonlinearity: Nonlinearity::of(params),
             range: params.measurement_range,
             resolution: params.resolution,
             quantization_carry: params.quantization_carry,
@@ -416,6 +456,12 @@ impl<B: FilterBuffer> SensorModel<B> {
             });
         }
         Ok(model)
+    }
+
+    /// Takes the sensing element's nonlinearity out of the model (a signal chain applies it at
+    /// its internal rate, before its filter); the model then reads its input as it is.
+    pub fn take_nonlinearity(&mut self) -> Option<Nonlinearity> {
+        self.nonlinearity.take()
     }
 
     /// One reading from the ideal input `u` (sensor frame); advances `state`; draws exactly nine
@@ -451,6 +497,10 @@ impl<B: FilterBuffer> SensorModel<B> {
         let n_white = Axes([normals[3], normals[4], normals[5], 0.0]);
         let n_rw = Axes([normals[6], normals[7], normals[8], 0.0]);
         let dt_c = env.temperature_c - 25.0;
+        let u = match &self.nonlinearity {
+            Some(n) => n.apply(u, env.acceleration_m_s2),
+            None => u,
+        };
         // `M u + b`, each row's sum in the order `m₀u₀ + m₁u₁ + m₂u₂ + b`.
         let [c0, c1, c2] = self.misalignment_columns;
         let y = c0 * u[0] + c1 * u[1] + c2 * u[2] + self.bias;

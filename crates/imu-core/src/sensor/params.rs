@@ -168,6 +168,18 @@ pub struct SensorParams<B: FilterBuffer = InlineBuffer> {
     pub temperature_scale_factor_pct: [f64; 3],
     /// Gyroscope only: bias per unit acceleration, `(rad/s)/(m/s²)`.
     pub acceleration_bias: [f64; 3],
+    /// Second-order scale-factor nonlinearity `K₂`, `1/[u]`: each axis reads `u + K₂u²` of
+    /// its input `u` (the sensing element's, before the signal chain and the misalignment), so
+    /// a vibration of amplitude `A` along the axis rectifies into a bias `K₂A²/2`.
+    pub scale_factor_nonlinearity: [f64; 3],
+    /// Scale-factor asymmetry, percent, in [−100, 100]: the scale factor for positive inputs
+    /// exceeds the one for negative inputs by this share of their mean (`u ± |u|·ε/2`), so a
+    /// vibration of amplitude `A` rectifies into `εA/π`.
+    pub scale_factor_asymmetry_pct: [f64; 3],
+    /// Gyroscope only: bias per squared acceleration along the same axis (g²-sensitivity),
+    /// `(rad/s)/(m/s²)²`, of the acceleration [`acceleration_bias`](Self::acceleration_bias)
+    /// takes; a vibration of amplitude `A` rectifies into `kA²/2`.
+    pub acceleration_squared_bias: [f64; 3],
     /// Carry each sample's quantisation residual into the next (sigma-delta style), so sums of
     /// readings track sums of inputs to within one LSB; off in MATLAB.
     pub quantization_carry: bool,
@@ -188,6 +200,9 @@ impl<B: FilterBuffer> Default for SensorParams<B> {
             temperature_bias: [0.0; 3],
             temperature_scale_factor_pct: [0.0; 3],
             acceleration_bias: [0.0; 3],
+            scale_factor_nonlinearity: [0.0; 3],
+            scale_factor_asymmetry_pct: [0.0; 3],
+            acceleration_squared_bias: [0.0; 3],
             quantization_carry: false,
         }
     }
@@ -281,6 +296,25 @@ impl<B: FilterBuffer> SensorParams<B> {
             });
         }
         finite("acceleration_bias", &self.acceleration_bias)?;
+        finite("scale_factor_nonlinearity", &self.scale_factor_nonlinearity)?;
+        finite("acceleration_squared_bias", &self.acceleration_squared_bias)?;
+        finite(
+            "scale_factor_asymmetry_pct",
+            &self.scale_factor_asymmetry_pct,
+        )?;
+        if let Some(index) = self
+            .scale_factor_asymmetry_pct
+            .iter()
+            .position(|c| !(-100.0..=100.0).contains(c))
+        {
+            return Err(ParamError::OutOfRange {
+                field: "scale_factor_asymmetry_pct",
+                index,
+                value: self.scale_factor_asymmetry_pct[index],
+                min: -100.0,
+                max: 100.0,
+            });
+        }
         if let BiasInstabilityModel::GaussMarkov { correlation_time_s } =
             self.bias_instability_model
             && !(correlation_time_s.is_finite() && correlation_time_s > 0.0)

@@ -21,11 +21,16 @@
 //! | `temperature_scale_factor_pct_per_c` | scale factor per °C, % | number or 3-vector |
 //! | `acceleration_bias_rad_s_per_m_s2` | gyroscope g-sensitivity | number or 3-vector |
 //! | `quantization_carry` | carry quantisation residuals to the next sample | `true`/`false` |
+//! | `scale_factor_nonlinearity_per_U` | second-order nonlinearity `K₂` (reads `u + K₂u²`), 1/U | number or 3-vector |
+//! | `scale_factor_asymmetry_pct` | scale factor for `u > 0` over `u < 0`, % of the mean | number or 3-vector |
+//! | `acceleration_squared_bias_rad_s_per_m2_s4` | gyroscope g²-sensitivity | number or 3-vector |
 //!
 //! MATLAB's names (`MeasurementRange`, `Resolution`, `ConstantBias`, `AxesMisalignment`,
 //! `NoiseDensity`, `BiasInstability`, `BiasInstabilityCoefficients` with `Numerator` and
 //! `Denominator`, `RandomWalk`, `NoiseType`, `TemperatureBias`, `TemperatureScaleFactor`,
-//! `AccelerationBias`) are accepted in the same tables, in SI units as MATLAB takes them.
+//! `AccelerationBias`) are accepted in the same tables, in SI units as MATLAB takes them, and
+//! in the same style the terms MATLAB lacks (`ScaleFactorNonlinearity`, `ScaleFactorAsymmetry`
+//! in %, `AccelerationSquaredBias`).
 use std::collections::BTreeMap;
 
 use imu_core::AccelSign;

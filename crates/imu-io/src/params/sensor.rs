@@ -153,6 +153,9 @@ pub(crate) fn parse_sensor_keys(
         "temperature_scale_factor_pct_per_c".into(),
         "acceleration_bias_rad_s_per_m_s2".into(),
         "quantization_carry".into(),
+        format!("scale_factor_nonlinearity_per_{u}"),
+        "scale_factor_asymmetry_pct".into(),
+        "acceleration_squared_bias_rad_s_per_m2_s4".into(),
     ];
     for (k, v) in map {
         let field = format!("{prefix}.{k}");
@@ -194,6 +197,15 @@ pub(crate) fn parse_sensor_keys(
             }
             (Some(14), _) | (_, "AccelerationBias") if sensor == Sensor::Gyroscope => {
                 p.acceleration_bias = triple(v, &field)?;
+            }
+            (Some(16), _) | (_, "ScaleFactorNonlinearity") => {
+                p.scale_factor_nonlinearity = triple(v, &field)?;
+            }
+            (Some(17), _) | (_, "ScaleFactorAsymmetry") => {
+                p.scale_factor_asymmetry_pct = triple(v, &field)?;
+            }
+            (Some(18), _) | (_, "AccelerationSquaredBias") if sensor == Sensor::Gyroscope => {
+                p.acceleration_squared_bias = triple(v, &field)?;
             }
             _ => {
                 if let Some(list) = skipped.as_deref_mut() {

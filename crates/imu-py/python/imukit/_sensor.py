@@ -25,7 +25,10 @@ def _matlab_name(field: str) -> str:
 class _SensorParams:
     """MATLAB's accelparams/gyroparams/magparams properties (SI units); ``None`` leaves a property
     at its neutral value. ``axes_misalignment`` takes MATLAB's forms (scalar, 3-vector, 3×3, %);
-    ``bias_instability_coefficients`` is ``(numerator, denominator)``."""
+    ``bias_instability_coefficients`` is ``(numerator, denominator)``. Beyond MATLAB, the sensing
+    element's ``scale_factor_nonlinearity`` (K₂ in 1/unit: an axis reads ``u + K₂u²``) and
+    ``scale_factor_asymmetry`` (%: positive inputs read ``(1 + ε/2)u``, negative ``(1 − ε/2)u``),
+    which rectify vibration into a bias."""
 
     measurement_range: Optional[float] = None
     resolution: Optional[float] = None
@@ -38,6 +41,8 @@ class _SensorParams:
     noise_type: Optional[str] = None
     temperature_bias: Optional[object] = None
     temperature_scale_factor: Optional[object] = None
+    scale_factor_nonlinearity: Optional[object] = None
+    scale_factor_asymmetry: Optional[object] = None
 
     def to_dict(self) -> dict:
         """The parameters under MATLAB's property names (what ``ImuSensor`` and scenario files take)."""
@@ -61,9 +66,11 @@ class AccelParams(_SensorParams):
 @dataclass
 class GyroParams(_SensorParams):
     """Gyroscope parameters, MATLAB's ``gyroparams`` (rad/s units), with ``acceleration_bias``
-    in (rad/s)/(m/s²)."""
+    in (rad/s)/(m/s²) and the g²-sensitivity ``acceleration_squared_bias`` in (rad/s)/(m/s²)²
+    (on the acceleration along the same axis)."""
 
     acceleration_bias: Optional[object] = None
+    acceleration_squared_bias: Optional[object] = None
 
 @dataclass
 class MagParams(_SensorParams):

@@ -1,7 +1,7 @@
 //! The IMU of a scenario, resolved: mount, sensors and their seeded error model.
 
 use crate::sensor::{Chain, ChainState, ImuModel, ImuState};
-use imu_core::sensor::{ImuReading, SeededNormals, SensorSet};
+use imu_core::sensor::{ImuReading, SeededNormals, SensingElement, SensorSet};
 
 use crate::scenario::report::RunReport;
 use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
@@ -148,12 +148,17 @@ impl ImuSetup {
             .vibration
             .as_ref()
             .map(|v| v.source(motion_rate_hz, seed, run));
+        let mut model = self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?;
+        // With a chain the sensing elements' nonlinearity acts at the internal rate, before the
+        // filters (where vibration rectifies), not on the filtered output.
+        let element = chain.as_ref().and_then(|_| model.take_sensing_element());
         Ok(ReadingStream {
             report: RunReport::for_sensors(&params),
             chain,
+            element,
             vibration,
             inputs: Vec::new(),
-            model: self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?,
+            model,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
                 |r| SeededNormals::for_run(seed, r),
@@ -192,6 +197,8 @@ pub struct ReadingStream<'a, N: NavFrame> {
     report: RunReport,
     /// The signal chain, when the IMU has one.
     chain: Option<ChainStage>,
+    /// With a chain, the sensing elements' nonlinearity, applied before it.
+    element: Option<SensingElement>,
     /// The mount's vibration, when it has one.
     vibration: Option<VibrationSource>,
     /// With a chain or vibration, the ideal inputs of the samples kept ([`Self::decimate`]),
@@ -258,7 +265,7 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     }
 
     /// The ideal inputs of `s` (specific force, rate, field; body axes) with the mount's
-    /// vibration at its instant added.
+    /// vibration at its instant added, as the sensing elements make them when a chain follows.
     fn ideal(&mut self, s: &Truth<N>) -> [[f64; 3]; 3] {
         let [mut f, mut w, m] = self.model.ideal(s).map(Vec3::to_array);
         if let Some(v) = &mut self.vibration {
@@ -268,7 +275,10 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                 w[k] += rate[k];
             }
         }
-        [f, w, m]
+        match &self.element {
+            Some(e) => e.apply([f, w, m], s.acceleration_m_s2.to_array()),
+            None => [f, w, m],
+        }
     }
 
     /// Works out the ideal inputs (vibration added) of the motion `motion`, runs them through
