@@ -26,6 +26,7 @@ compile_error!("imu-core needs float math: enable the `std` or the `libm` featur
 
 pub mod aiding;
 pub mod allan;
+pub mod calibration;
 pub mod cpu;
 pub mod earth;
 pub mod frame;

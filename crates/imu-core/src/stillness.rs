@@ -376,6 +376,32 @@ pub fn stance_threshold(statistics: &[f64]) -> Option<f64> {
     }
 }
 
+/// The sample variance of a block of rows pooled over its three axes (`3(W − 1)` degrees of
+/// freedom); NaN for fewer than two rows.
+pub(crate) fn pooled_variance(rows: &[[f64; 3]]) -> f64 {
+    let w = rows.len() as f64;
+    let mut sum = 0.0;
+    for k in 0..3 {
+        let mean = rows.iter().map(|r| r[k]).sum::<f64>() / w;
+        sum += rows
+            .iter()
+            .map(|r| (r[k] - mean) * (r[k] - mean))
+            .sum::<f64>();
+    }
+    sum / (3.0 * (w - 1.0))
+}
+
+/// The largest pooled variance of a still block of `window` rows, over the white noise's
+/// (`χ²_{3(W−1)}` quantile at `1 − FALSE_ALARM`, over `3(W − 1)`); `None` for a window under 2.
+pub(crate) fn quiet_variance_limit(window: usize) -> Option<f64> {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    if window < 2 {
+        return None;
+    }
+    let dof = 3.0 * (window - 1) as f64;
+    Some(ChiSquared::new(dof).ok()?.inverse_cdf(1.0 - FALSE_ALARM) / dof)
+}
+
 /// What the quiet stretches of a log say about its sensor ([`quiet_noise`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuietStretches {
@@ -440,19 +466,8 @@ pub fn quiet_noise(
     let dof = 3.0 * (w - 1.0);
     let chi = ChiSquared::new(dof).ok()?;
     let chi2 = ChiSquared::new(dof + 2.0).ok()?;
-    let limit = chi.inverse_cdf(1.0 - FALSE_ALARM) / dof;
+    let limit = quiet_variance_limit(window)?;
     let truncation = chi2.cdf(dof * limit) / chi.cdf(dof * limit);
-    let pooled = |rows: &[[f64; 3]]| -> f64 {
-        let mut sum = 0.0;
-        for k in 0..3 {
-            let mean = rows.iter().map(|r| r[k]).sum::<f64>() / w;
-            sum += rows
-                .iter()
-                .map(|r| (r[k] - mean) * (r[k] - mean))
-                .sum::<f64>();
-        }
-        sum / (3.0 * (w - 1.0))
-    };
     // Per block: accelerometer and gyroscope variances, and the mean specific force's norm.
     for (b, row) in stats.iter_mut().enumerate() {
         let range = b * window..(b + 1) * window;
@@ -466,7 +481,7 @@ pub fn quiet_noise(
             && norm_of_mean(g) <= QUIET_MAX_RATE_RAD_S;
         // A block that cannot be still gets an infinite variance: never quiet.
         *row = if still {
-            [pooled(a), pooled(g), force]
+            [pooled_variance(a), pooled_variance(g), force]
         } else {
             [f64::INFINITY, f64::INFINITY, force]
         };

@@ -3,6 +3,7 @@
 mod aids;
 mod align;
 mod allan;
+mod calibration;
 mod coning;
 mod earth;
 mod earth_frames;
