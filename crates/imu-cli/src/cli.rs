@@ -54,6 +54,10 @@ pub struct MapArg {
     /// axes in the body frame (docs/formats.md).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
+    /// A part's calibration (`imukit calibrate --out`): each sensor's readings corrected as
+    /// `matrix · (reading − bias)` as they are read.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
 }
 
 /// What the data's axes and accelerometer sign are (`--nav-frame`, `--accel-sign`,
@@ -234,6 +238,13 @@ pub enum Command {
     /// 95 % interval or, not resolved, its bound and the record that would resolve it; an imukit
     /// parameter file, a Kalibr imu.yaml, the fusion filter's noise.
     Identify(IdentifyArgs),
+    /// Calibrates a part from the log of a procedure, without equipment: set down in 7 to 24
+    /// orientations and turned between them (accelerometer bias, scale and misalignment from
+    /// gravity's magnitude at the rests; gyroscope bias from the rests, scale and misalignment
+    /// from the turns), and a magnetometer turned through all directions (hard and soft iron,
+    /// the field's strength); each term with its standard deviation. Writes a calibration file
+    /// that `--calibration FILE` applies wherever readings are read.
+    Calibrate(CalibrateArgs),
     /// Runs a built-in scenario (default: the figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
     /// and a summary into a folder.
@@ -732,6 +743,28 @@ pub struct AllanArgs {
     /// The figure's size and resolution.
     #[command(flatten)]
     pub figure: FigureArgs,
+}
+
+/// The arguments of `imukit calibrate`.
+#[derive(Args, Debug)]
+pub struct CalibrateArgs {
+    /// IMU readings of the procedure (with `t_s`).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// Local gravity, m/s² (the accelerometer is scaled to read it at rest).
+    #[arg(long, default_value_t = imukit::core::DEFAULT_GRAVITY_M_S2)]
+    pub gravity_m_s2: f64,
+    /// Where to write the calibration (TOML).
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// What `imukit presets NAME` prints.

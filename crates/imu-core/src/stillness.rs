@@ -456,6 +456,28 @@ pub fn quiet_noise(
     gravity_m_s2: f64,
     blocks: &mut [[f64; 3]],
 ) -> Option<QuietStretches> {
+    quiet_noise_below(
+        accel,
+        gyro,
+        window,
+        gravity_m_s2,
+        QUIET_MAX_RATE_RAD_S,
+        blocks,
+    )
+}
+
+/// [`quiet_noise`] with the largest mean rate of a quiet block `max_rate_rad_s` instead of
+/// [`QUIET_MAX_RATE_RAD_S`] (a calibration, whose rests hold still but whose gyroscope may read
+/// a consumer part's bias of tens of degrees a second).
+#[must_use]
+pub fn quiet_noise_below(
+    accel: &[[f64; 3]],
+    gyro: &[[f64; 3]],
+    window: usize,
+    gravity_m_s2: f64,
+    max_rate_rad_s: f64,
+    blocks: &mut [[f64; 3]],
+) -> Option<QuietStretches> {
     use statrs::distribution::{ChiSquared, ContinuousCDF};
     let n = accel.len().min(gyro.len());
     if window < 2 || n < MIN_QUIET_BLOCKS * window || blocks.len() < n / window {
@@ -478,7 +500,7 @@ pub fn quiet_noise(
         };
         let force = norm_of_mean(a);
         let still = math::abs(force - gravity_m_s2) <= QUIET_GRAVITY_TOLERANCE * gravity_m_s2
-            && norm_of_mean(g) <= QUIET_MAX_RATE_RAD_S;
+            && norm_of_mean(g) <= max_rate_rad_s;
         // A block that cannot be still gets an infinite variance: never quiet.
         *row = if still {
             [pooled_variance(a), pooled_variance(g), force]

@@ -1,5 +1,6 @@
 //! A file to read and how to read it: the column map of a vendor's CSV (`--map`, Python's
-//! `map_path=`/`map_json=`) and the topics and clock of a ROS bag (`--topic`, `--receive-time`).
+//! `map_path=`/`map_json=`), the topics and clock of a ROS bag (`--topic`, `--receive-time`) and
+//! the part's calibration applied to its readings (`--calibration`).
 //!
 //! They travel with the path as one argument, [`Input`], to every reader of that file: a job
 //! that reads an input twice (its header, then its rows) reads it the same way both times, and
@@ -8,6 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::calibration::CalibrationFile;
 use crate::column_map::ColumnMap;
 
 /// Which time a message of a bag is read at.
@@ -36,6 +38,7 @@ pub struct Input {
     path: PathBuf,
     map: Option<Arc<ColumnMap>>,
     selection: Selection,
+    calibration: Option<Arc<CalibrationFile>>,
 }
 
 impl Input {
@@ -55,6 +58,20 @@ impl Input {
     pub fn with_map(mut self, map: ColumnMap) -> Self {
         self.map = Some(Arc::new(map));
         self
+    }
+
+    /// Read with the readings corrected by `calibration` (each sensor's three columns, after
+    /// any column map).
+    #[must_use]
+    pub fn with_calibration(mut self, calibration: CalibrationFile) -> Self {
+        self.calibration = Some(Arc::new(calibration));
+        self
+    }
+
+    /// The calibration its readings are corrected by, if any.
+    #[must_use]
+    pub fn calibration(&self) -> Option<&CalibrationFile> {
+        self.calibration.as_deref()
     }
 
     /// Read with `selection`: a bag's topics to choose among and whose stamps.

@@ -26,6 +26,7 @@ pub mod sensor;
 
 pub mod asl;
 pub mod bag;
+pub mod calibration;
 pub mod column_map;
 pub mod columns;
 pub mod conventions;

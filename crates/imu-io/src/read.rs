@@ -6,7 +6,10 @@ use std::collections::HashMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
+use imu_core::calibration::Correction;
+
 use crate::TableFormat;
+use crate::calibration::CalibrationFile;
 use crate::column_map::{ColumnMap, Source, TimeUnit};
 use crate::error::{Error, Result};
 use crate::input::Input;
@@ -249,16 +252,22 @@ fn csv_error_after(path: &Path, e: &csv::Error, comments: usize) -> Error {
 pub fn read_table(input: impl Into<Input>) -> Result<Table> {
     let input = input.into();
     let path = input.path();
-    match TableFormat::of(path) {
-        TableFormat::Parquet => return crate::parquet::read_table(path),
-        TableFormat::Npz => return crate::npz::read_table(path),
-        TableFormat::Mcap => return crate::bag::read_table(&input, &[]),
-        TableFormat::Nmea => return crate::nmea::read_table(path),
-        TableFormat::Npy | TableFormat::Csv => {}
+    let whole = match TableFormat::of(path) {
+        TableFormat::Parquet => crate::parquet::read_table(path),
+        TableFormat::Npz => crate::npz::read_table(path),
+        TableFormat::Mcap => crate::bag::read_table(&input, &[]),
+        TableFormat::Nmea => crate::nmea::read_table(path),
+        TableFormat::Npy | TableFormat::Csv => {
+            let header = read_header(&input)?;
+            let names: Vec<&str> = header.iter().map(String::as_str).collect();
+            return read_table_columns(&input, &names, "");
+        }
+    };
+    let mut table = whole?;
+    if let Some(c) = input.calibration() {
+        c.apply_to_table(&mut table);
     }
-    let header = read_header(&input)?;
-    let names: Vec<&str> = header.iter().map(String::as_str).collect();
-    read_table_columns(&input, &names, "")
+    Ok(table)
 }
 
 /// [`read_table`], a bag's topic chosen among those of `role` (other formats hold one table).
@@ -268,7 +277,13 @@ pub fn read_table(input: impl Into<Input>) -> Result<Table> {
 pub fn read_table_as(input: impl Into<Input>, role: crate::bag::Role) -> Result<Table> {
     let input = input.into();
     match TableFormat::of(input.path()) {
-        TableFormat::Mcap => crate::bag::read_table_as(&input, role),
+        TableFormat::Mcap => {
+            let mut table = crate::bag::read_table_as(&input, role)?;
+            if let Some(c) = input.calibration() {
+                c.apply_to_table(&mut table);
+            }
+            Ok(table)
+        }
         _ => read_table(input),
     }
 }
@@ -330,6 +345,42 @@ pub fn read_columns(input: impl Into<Input>, required: &[&str], hint: &str) -> R
     })
 }
 
+/// Where the columns of each sensor the calibration `c` corrects sit among `wanted`, the ones
+/// not requested added to it: a sensor counts when one of its columns is requested, and then
+/// needs all three.
+fn calibrated_columns(
+    c: &CalibrationFile,
+    index: &HashMap<&str, usize>,
+    wanted: &mut Vec<(usize, String)>,
+    path: &Path,
+) -> Result<Vec<(Correction, [usize; 3])>> {
+    let mut out = Vec::new();
+    for (correction, columns) in c.columns() {
+        if !columns.iter().any(|n| wanted.iter().any(|(_, w)| w == n)) {
+            continue;
+        }
+        let mut at = [0; 3];
+        for (slot, name) in at.iter_mut().zip(columns) {
+            let Some(&field) = index.get(name) else {
+                return Err(Error::MissingColumns {
+                    file: path.into(),
+                    missing: vec![name.to_string()],
+                    hint: format!("the calibration corrects {} together", columns.join(", ")),
+                });
+            };
+            *slot = match wanted.iter().position(|(_, w)| w == name) {
+                Some(k) => k,
+                None => {
+                    wanted.push((field, name.to_string()));
+                    wanted.len() - 1
+                }
+            };
+        }
+        out.push((*correction, at));
+    }
+    Ok(out)
+}
+
 /// Where [`CsvRows`] reads: a CSV file, a Parquet file's rows or a `.npy` file's records.
 #[derive(Debug)]
 enum RowSource {
@@ -364,6 +415,11 @@ pub struct CsvRows {
     /// Per requested column: an empty or NaN cell is a missing value, given as NaN
     /// ([`CsvRows::allowing_missing`]).
     missing_ok: Vec<bool>,
+    /// The part's calibration: each sensor's correction and where its three columns are in
+    /// `wanted` (those not requested read after the requested ones).
+    calibration: Vec<(Correction, [usize; 3])>,
+    /// A row of every column read, when the calibration reads more than was requested.
+    scratch: Vec<f64>,
 }
 
 impl CsvRows {
@@ -458,10 +514,14 @@ impl CsvRows {
                 hint,
             });
         }
-        let wanted = required
+        let mut wanted: Vec<(usize, String)> = required
             .iter()
             .map(|c| (index.get(*c).copied().unwrap_or(0), (*c).to_string()))
             .collect();
+        let calibration = match input.calibration() {
+            Some(c) => calibrated_columns(c, &index, &mut wanted, path)?,
+            None => Vec::new(),
+        };
         let reader = match TableFormat::of(path) {
             TableFormat::Parquet => RowSource::Parquet(crate::parquet::ParquetRows::open(path)?.1),
             TableFormat::Npy => RowSource::Npy(crate::npy::NpyRows::open(path)?.1),
@@ -487,6 +547,8 @@ impl CsvRows {
             file_names: layout.file_names,
             window: None,
             missing_ok: Vec::new(),
+            calibration,
+            scratch: Vec::new(),
         })
     }
 
@@ -503,7 +565,7 @@ impl CsvRows {
     /// Values that are not finite numbers (file, row, column), malformed rows.
     pub fn next_row(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
         loop {
-            let row = self.next_row_any(out)?;
+            let row = self.next_row_calibrated(out)?;
             let (Some(line), Some((k, lo, hi))) = (row, self.window) else {
                 return Ok(row);
             };
@@ -513,6 +575,25 @@ impl CsvRows {
                 _ => return Ok(Some(line)),
             }
         }
+    }
+
+    /// The next row, whatever its time, its readings corrected by the part's calibration.
+    fn next_row_calibrated(&mut self, out: &mut [f64]) -> Result<Option<usize>> {
+        if self.calibration.is_empty() {
+            return self.next_row_any(out);
+        }
+        let mut row = std::mem::take(&mut self.scratch);
+        row.resize(self.wanted.len(), 0.0);
+        let line = self.next_row_any(&mut row);
+        if let Ok(Some(_)) = line {
+            for (c, [x, y, z]) in &self.calibration {
+                [row[*x], row[*y], row[*z]] = c.apply([row[*x], row[*y], row[*z]]);
+            }
+            let n = out.len();
+            out.copy_from_slice(&row[..n]);
+        }
+        self.scratch = row;
+        line
     }
 
     /// The next row, whatever its time.

@@ -109,8 +109,8 @@ pub use scenario::{Scenario, ScenarioSpec, Simulation};
 // The jobs at the crate's root, where programs and the front ends name them
 // (`imukit::fuse::fuse_with`, `imukit::orient::orient_csv`): `run` only groups them.
 pub use run::{
-    allan, arrays, compare, epochs, fuse, identify, imu_sensor, navigate, orient, pipeline, planar,
-    reference, simulate, study,
+    allan, arrays, calibrate, compare, epochs, fuse, identify, imu_sensor, navigate, orient,
+    pipeline, planar, reference, simulate, study,
 };
 
 /// The README's Rust examples, compiled and run as doctests.

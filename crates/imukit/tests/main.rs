@@ -1,6 +1,7 @@
 //! imukit's integration tests, one binary (each binary would link every format again): each module is one job's or one concept's tests.
 //! `cargo test -p imukit --test integration MODULE::` runs one module's.
 mod asl;
+mod calibrate;
 mod chain;
 mod clock;
 mod common;

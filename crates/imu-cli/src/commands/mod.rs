@@ -1,5 +1,6 @@
 //! One module per subcommand, and the CLI's error type.
 mod allan;
+mod calibrate;
 mod compare;
 mod demo;
 mod example;
@@ -73,6 +74,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Allan(a) => allan_command(a),
         Command::Identify(a) => identify_command(a),
+        Command::Calibrate(a) => calibrate_command(a),
         Command::Plot {
             files,
             window,
@@ -180,8 +182,13 @@ impl crate::cli::MapArg {
 
     /// [`Self::input`] for the option named `flag`.
     fn input_for(&self, input: &std::path::Path, flag: &str) -> Result<Input, CliError> {
+        let read = Input::new(input);
+        let read = match &self.calibration {
+            Some(c) => read.with_calibration(imukit::io::calibration::CalibrationFile::read(c)?),
+            None => read,
+        };
         let Some(m) = &self.map else {
-            return Ok(Input::new(input));
+            return Ok(read);
         };
         let format = imukit::io::TableFormat::of(input);
         if format != imukit::io::TableFormat::Csv {
@@ -194,7 +201,7 @@ impl crate::cli::MapArg {
             }
             .into());
         }
-        Ok(Input::new(input).with_map(imukit::io::column_map::ColumnMap::read(m)?))
+        Ok(read.with_map(imukit::io::column_map::ColumnMap::read(m)?))
     }
 }
 
@@ -345,9 +352,15 @@ fn fuse_command(a: crate::cli::FuseArgs) -> Result<(), CliError> {
     bag.check(&[Some(&imu), gnss.as_deref(), init.as_deref()])?;
     let imu = bag.input(mapped);
     let gnss = match gnss {
-        Some(p) => {
-            Some(bag.input(crate::cli::MapArg { map: gnss_map }.input_for(&p, "--gnss-map")?))
-        }
+        Some(p) => Some(
+            bag.input(
+                crate::cli::MapArg {
+                    map: gnss_map,
+                    calibration: None,
+                }
+                .input_for(&p, "--gnss-map")?,
+            ),
+        ),
         None => None,
     };
     let init = init.map(|p| bag.input(Input::new(p)));
@@ -488,4 +501,19 @@ fn allan_command(a: crate::cli::AllanArgs) -> Result<(), CliError> {
         plot.as_deref(),
         plot::figure_size(&figure)?,
     )
+}
+
+/// `imukit calibrate`.
+fn calibrate_command(a: crate::cli::CalibrateArgs) -> Result<(), CliError> {
+    let crate::cli::CalibrateArgs {
+        input,
+        map,
+        bag,
+        window,
+        gravity_m_s2,
+        out,
+    } = a;
+    let mapped = map.input(&input)?;
+    bag.check(&[Some(&input)])?;
+    calibrate::run(&bag.input(mapped), gravity_m_s2, window.window()?, &out)
 }

@@ -22,8 +22,12 @@ pub struct AccelCalibration {
     pub correction: Correction,
     /// Standard deviation of each entry of `A` (zero where the model fixes it).
     pub matrix_sigma: [[f64; 3]; 3],
-    /// Standard deviation of `b`, m/s².
+    /// Standard deviation of `b`, m/s²: the fit's, and the bias's wander over the procedure
+    /// (the rests' scatter beyond their white noise).
     pub bias_sigma: [f64; 3],
+    /// The wander of the bias over the procedure, m/s²: the rests' scatter beyond their white
+    /// noise (zero when the white noise explains it).
+    pub wander_m_s2: f64,
     /// Whether the misalignments were fitted (else `A` is diagonal).
     pub full: bool,
     /// RMS of `|A(ā_k − b)| − g` over the rests, m/s².
@@ -136,10 +140,20 @@ fn fit<const P: usize>(
         matrix_sigma[i][j] = sigma[k];
     }
     let n = entries.len();
+    // A bias that wanders during the procedure (bias instability) scatters the rests beyond
+    // their white noise; the procedure's mean bias is then uncertain by that wander too.
+    let scatter = solution.normal.cost / (solution.normal.count - P) as f64;
+    let wander = (scatter - floor * floor).max(0.0);
+    let with_wander = |s: f64| math::sqrt(s * s + wander);
     Ok(AccelCalibration {
         correction: Correction::of(&a, &b),
         matrix_sigma,
-        bias_sigma: [sigma[n], sigma[n + 1], sigma[n + 2]],
+        bias_sigma: [
+            with_wander(sigma[n]),
+            with_wander(sigma[n + 1]),
+            with_wander(sigma[n + 2]),
+        ],
+        wander_m_s2: math::sqrt(wander),
         full: P == 9,
         residual_rms_m_s2: math::sqrt(solution.normal.cost / means.len() as f64),
         rests: means.len(),

@@ -25,7 +25,8 @@ pub struct GyroCalibration {
     pub correction: Correction,
     /// Standard deviation of each entry of `A`.
     pub matrix_sigma: [[f64; 3]; 3],
-    /// Standard deviation of `b`, rad/s (the scatter of the rests' means over their number).
+    /// Standard deviation of `b`, rad/s: the scatter of the rests' means over their number, and
+    /// the bias's wander over the procedure (that scatter beyond the white noise).
     pub bias_sigma: [f64; 3],
     /// RMS of the gravity direction's residual components after the rotations, rad.
     pub residual_rms_rad: f64,
@@ -88,7 +89,7 @@ pub fn calibrate(inputs: &GyroInputs<'_>) -> Result<GyroCalibration, Calibration
     if (0..rests.len()).any(|k| unit(calibrated(k)).is_none()) {
         return Err(CalibrationError::Degenerate("a rest reads no gravity"));
     }
-    let bias = rest_bias(gyro, rests);
+    let bias = rest_bias(gyro, rests, inputs.noise.gyro);
     let fit = Fit {
         inputs,
         bias: bias.0,
@@ -197,7 +198,8 @@ impl Fit<'_, '_> {
     }
 
     /// The terms' covariance from the noise of what the fit takes as given (see
-    /// [`calibrate`]), by the implicit-function rule `dθ = −N⁻¹ Σ J_kᵀ dr_k`.
+    /// [`calibrate`]; a rest's accelerometer mean has its white noise and the bias's wander,
+    /// [`AccelCalibration::wander_m_s2`]), by the implicit-function rule `dθ = −N⁻¹ Σ J_kᵀ dr_k`.
     fn propagated(
         &self,
         p: &SVector<f64, 9>,
@@ -237,7 +239,8 @@ impl Fit<'_, '_> {
         for k in 0..rests.len() {
             // A rest's mean: its own direction and, through the accelerometer's terms, all.
             let l = m_of(k)? * influence.matrix() + w * influence.of_rest(&i.accel_means[k]);
-            let s2 = i.noise.accel * i.noise.accel / rests[k].len() as f64;
+            let s2 = i.noise.accel * i.noise.accel / rests[k].len() as f64
+                + i.accel.wander_m_s2 * i.accel.wander_m_s2;
             cov += l * l.transpose() * s2;
             if k < k_last {
                 let j = jac(k)?;
@@ -271,8 +274,11 @@ impl Fit<'_, '_> {
 type Matrix3x9 = nalgebra::SMatrix<f64, 3, 9>;
 
 /// The mean reading over the rests (each weighted by its length) and its standard deviation:
-/// the scatter of the rests' means over the square root of their number.
-fn rest_bias(gyro: &[[f64; 3]], rests: &[Rest]) -> (Vector3<f64>, Vector3<f64>) {
+/// the scatter `s` of the rests' means over the square root of their number, and the bias's
+/// wander over the procedure — what `s²` holds beyond the white noise `white` of a rest's mean
+/// (`s² − σ²/n`) — so that a bias that drifts (bias instability) is not taken for a constant
+/// known from the rests' average.
+fn rest_bias(gyro: &[[f64; 3]], rests: &[Rest], white: f64) -> (Vector3<f64>, Vector3<f64>) {
     let total: usize = rests.iter().map(Rest::len).sum();
     let mut sum = Vector3::zeros();
     for r in rests {
@@ -284,7 +290,11 @@ fn rest_bias(gyro: &[[f64; 3]], rests: &[Rest]) -> (Vector3<f64>, Vector3<f64>) 
         let d = Vector3::from(r.mean(gyro)) - mean;
         acc + d.component_mul(&d)
     }) / (k - 1.0);
-    (mean, spread.map(|v| math::sqrt(v / k)))
+    let mean_white2 = white * white * k / total as f64;
+    (
+        mean,
+        spread.map(|v| math::sqrt(v / k + (v - mean_white2).max(0.0))),
+    )
 }
 
 /// The attitude change from sample `from` to sample `to` (body then to body now: a vector

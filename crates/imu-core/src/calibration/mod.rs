@@ -28,6 +28,10 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::stillness::{ReadingNoise, pooled_variance, quiet_variance_limit};
 
+/// The largest mean rate a rest may read, rad/s (about 115 °/s: above any MEMS part's bias; the
+/// rests are found by their variance, [`rests`]).
+pub const MAX_REST_RATE_RAD_S: f64 = 2.0;
+
 /// A triad's calibration: the calibrated value is `matrix · (reading − bias)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Correction {

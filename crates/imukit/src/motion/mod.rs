@@ -6,6 +6,7 @@ pub mod body_rates;
 pub mod compiled;
 pub mod expr;
 pub mod expression;
+pub mod positions;
 pub mod sampled;
 pub mod track;
 pub mod walk;
@@ -38,6 +39,8 @@ pub enum Trajectory {
     BodyRates(BodyRatesData),
     /// A walking foot.
     Walk(walk::WalkMotion),
+    /// A multi-position calibration procedure.
+    Positions(positions::PositionsMotion),
 }
 
 /// Exact truth of an analytic motion, with the time of a refused sample in the error.
@@ -74,6 +77,9 @@ impl Trajectory {
             Self::Samples(s) => s.truth(),
             Self::Walk(w) => {
                 analytic_truth(w, t_s, AnalyticOptions::default(), "trajectory (walk)")
+            }
+            Self::Positions(p) => {
+                analytic_truth(p, t_s, AnalyticOptions::default(), "trajectory (positions)")
             }
             Self::Waypoints(w) => {
                 analytic_truth(w, t_s, AnalyticOptions::default(), "trajectory (waypoints)")

@@ -10,6 +10,7 @@
 //! `−foot_pitch·sin²(πp)` (toes down mid-swing). The path is a straight line along
 //! `heading_rad`, or with `radius_m` a circle turning left, the foot's yaw along it — a walk
 //! that comes back to where it started after every `2π·radius/stride` strides.
+use crate::error::{Result, invalid};
 use crate::motion::analytic::{Motion, Scalar};
 
 /// The walk's parameters (see the module documentation).
@@ -36,6 +37,55 @@ pub struct WalkMotion {
 }
 
 impl WalkMotion {
+    /// The walk's figures, each named where it is out of range.
+    ///
+    /// # Errors
+    /// A figure out of range, named by its key.
+    pub fn check(&self) -> Result<()> {
+        let w = self;
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(invalid(
+                    format!("trajectory.{name}"),
+                    format!("must be a finite number > 0, got {v}"),
+                ))
+            }
+        };
+        positive("cadence_hz", w.cadence_hz)?;
+        positive("stride_m", w.stride_m)?;
+        if let Some(r) = w.radius_m {
+            positive("radius_m", r)?;
+        }
+        if !(w.stance_fraction > 0.0 && w.stance_fraction < 1.0) {
+            return Err(invalid(
+                "trajectory.stance_fraction",
+                format!("must be in (0, 1), got {}", w.stance_fraction),
+            ));
+        }
+        for (name, v) in [
+            ("lift_m", w.lift_m),
+            ("foot_pitch_rad", w.foot_pitch_rad),
+            ("start_s", w.start_s),
+            ("heading_rad", w.heading_rad),
+        ] {
+            if !v.is_finite() || (name != "heading_rad" && v < 0.0) {
+                return Err(invalid(
+                    format!("trajectory.{name}"),
+                    format!(
+                        "must be a finite number{}, got {v}",
+                        if name == "heading_rad" { "" } else { " ≥ 0" }
+                    ),
+                ));
+            }
+        }
+        if w.start_m.iter().any(|v| !v.is_finite()) {
+            return Err(invalid("trajectory.start_m", "must be finite"));
+        }
+        Ok(())
+    }
+
     /// Distance along the path, height and swing progress at `t` (the progress is 0 at rest).
     fn along<D: Scalar>(&self, t: D) -> (D, D, D) {
         let zero = D::from(0.0);

@@ -4,6 +4,7 @@
 //! outage ([`study`]). A streamed run may use two threads ([`pipeline`]).
 pub mod allan;
 pub mod arrays;
+pub mod calibrate;
 pub mod compare;
 pub mod epochs;
 pub mod fuse;

@@ -515,6 +515,14 @@ impl Scenario {
                 "trajectory (walk)",
                 emit,
             ),
+            Trajectory::Positions(p) => motion_chunks(
+                p,
+                AnalyticOptions::default(),
+                t_s,
+                size,
+                "trajectory (positions)",
+                emit,
+            ),
             Trajectory::Samples(path) => path.truth_chunks(size, emit),
             Trajectory::BodyRates(_) => {
                 let truth = self.trajectory.truth::<N>(&t_s.to_vec())?;

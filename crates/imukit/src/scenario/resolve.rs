@@ -294,12 +294,23 @@ fn trajectory_of(
                 heading_rad: w.heading_rad.unwrap_or(0.0),
                 start_m: w.start_m.unwrap_or([0.0; 3]),
             };
-            check_walk(&walk)?;
+            walk.check()?;
             let t = regular_times(
                 need(spec.rate_hz, "rate_hz")?,
                 need(spec.duration_s, "duration_s")?,
             )?;
             (Trajectory::Walk(walk), t)
+        }
+        TrajectorySpec::Positions(p) => {
+            let m = crate::motion::positions::PositionsMotion::new(
+                p.count,
+                p.rest_s.unwrap_or(5.0),
+                p.turn_s.unwrap_or(3.0),
+                p.position_m.unwrap_or([0.0; 3]),
+            )?;
+            let duration = spec.duration_s.unwrap_or_else(|| m.duration_s());
+            let t = regular_times(need(spec.rate_hz, "rate_hz")?, duration)?;
+            (Trajectory::Positions(m), t)
         }
         TrajectorySpec::Track(k) => {
             let speed = match k.accel_m_s2 {
@@ -746,49 +757,4 @@ fn angle_warnings(trajectory: &TrajectorySpec) -> Vec<String> {
         _ => {}
     }
     out
-}
-
-/// A walk's figures, each named where it is out of range.
-fn check_walk(w: &crate::motion::walk::WalkMotion) -> Result<()> {
-    let positive = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(invalid(
-                format!("trajectory.{name}"),
-                format!("must be a finite number > 0, got {v}"),
-            ))
-        }
-    };
-    positive("cadence_hz", w.cadence_hz)?;
-    positive("stride_m", w.stride_m)?;
-    if let Some(r) = w.radius_m {
-        positive("radius_m", r)?;
-    }
-    if !(w.stance_fraction > 0.0 && w.stance_fraction < 1.0) {
-        return Err(invalid(
-            "trajectory.stance_fraction",
-            format!("must be in (0, 1), got {}", w.stance_fraction),
-        ));
-    }
-    for (name, v) in [
-        ("lift_m", w.lift_m),
-        ("foot_pitch_rad", w.foot_pitch_rad),
-        ("start_s", w.start_s),
-        ("heading_rad", w.heading_rad),
-    ] {
-        if !v.is_finite() || (name != "heading_rad" && v < 0.0) {
-            return Err(invalid(
-                format!("trajectory.{name}"),
-                format!(
-                    "must be a finite number{}, got {v}",
-                    if name == "heading_rad" { "" } else { " ≥ 0" }
-                ),
-            ));
-        }
-    }
-    if w.start_m.iter().any(|v| !v.is_finite()) {
-        return Err(invalid("trajectory.start_m", "must be finite"));
-    }
-    Ok(())
 }

@@ -188,6 +188,22 @@ pub enum TrajectorySpec {
     Builtin(BuiltinSpec),
     /// A walking foot: stance, swing, at a cadence and stride length.
     Walk(WalkSpec),
+    /// A multi-position calibration procedure.
+    Positions(PositionsSpec),
+}
+
+/// `type = "positions"` (see `motion::positions`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PositionsSpec {
+    /// Orientations the part is set down in, 6 to 24.
+    pub count: usize,
+    /// Time still in each, s (default 5).
+    pub rest_s: Option<f64>,
+    /// Time of each turn, s (default 3).
+    pub turn_s: Option<f64>,
+    /// Where the part stands, navigation frame, m (default the origin).
+    pub position_m: Option<[f64; 3]>,
 }
 
 /// `type = "walk"` (see `motion::walk`).
@@ -215,7 +231,7 @@ pub struct WalkSpec {
 }
 
 /// The trajectory types by their `type` name.
-const TRAJECTORY_TYPES: [&str; 7] = [
+const TRAJECTORY_TYPES: [&str; 8] = [
     "expression",
     "samples",
     "track",
@@ -223,6 +239,7 @@ const TRAJECTORY_TYPES: [&str; 7] = [
     "waypoints",
     "builtin",
     "walk",
+    "positions",
 ];
 
 impl<'de> Deserialize<'de> for TrajectorySpec {
@@ -298,6 +315,7 @@ impl TrajectorySpec {
             "waypoints" => Self::Waypoints(WaypointsSpec::deserialize(keys)?),
             "builtin" => Self::Builtin(BuiltinSpec::deserialize(keys)?),
             "walk" => Self::Walk(WalkSpec::deserialize(keys)?),
+            "positions" => Self::Positions(PositionsSpec::deserialize(keys)?),
             other => return Err(D::Error::unknown_variant(other, &TRAJECTORY_TYPES)),
         })
     }
