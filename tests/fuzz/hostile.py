@@ -53,6 +53,14 @@ TIME_LIMIT_S = 30.0
 ALLOWED_EXITS = {0, 2, 65, 74}
 SIGNAL_EXITS = {signal.SIGINT: 130, signal.SIGTERM: 143, signal.SIGHUP: 129}
 
+CALIBRATION = """[accelerometer]
+matrix = [[1.01, 0.002, -0.001], [0, 0.99, 0.003], [0, 0, 1.002]]
+bias_m_s2 = [0.05, -0.02, 0.1]
+[gyroscope]
+matrix = [[1.0, 0.01, 0], [0.002, 1.0, 0], [0, 0, 1.0]]
+bias_rad_s = [0.001, 0, -0.002]
+"""
+
 SCENARIO = """rate_hz = 100.0
 duration_s = 0.5
 nav_frame = "ENU"
@@ -303,7 +311,9 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                        cwd=work, check=True, capture_output=True)
         subprocess.run([imukit_bin(), "allan", "imu.csv", "--out", "allan.csv"], cwd=work, check=True, capture_output=True)
         (work / "p.json").write_text(PARAMS)
-        valid = {name: (work / name).read_bytes() for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv")}
+        (work / "cal.toml").write_text(CALIBRATION)
+        valid = {name: (work / name).read_bytes()
+                 for name in ("s.toml", "imu.csv", "truth.csv", "p.json", "allan.csv", "cal.toml")}
         per = max(1, cases // 7)
         # The classes that run a process for a second or so: a quarter of the others' cases.
         slow = process_cases or max(1, per // 4)
@@ -319,18 +329,21 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                                        ["orient", bad.name, "--out", "o.csv"],
                                        ["orient", bad.name, "--smooth", "--out", "o.csv"],
                                        ["allan", bad.name, "--out", "o.csv"],
+                                       ["calibrate", bad.name, "--out", "o.toml"],
                                        ["plot", bad.name, "--out", "o.svg"]]),
                 "truth.csv": rng.choice([["compare", bad.name, "truth.csv"], ["plot", bad.name, "--out", "o.svg"],
                                          ["compare", bad.name, "truth.csv", "--align-heading"],
                                          ["animate", bad.name, "--out", "o.html"]]),
                 "p.json": ["simulate", "ps.toml", "--out", "o.csv"],
                 "allan.csv": ["plot", bad.name, "--out", rng.choice(["o.svg", "o.png"])],
+                "cal.toml": rng.choice([["orient", "imu.csv", "--calibration", bad.name, "--out", "o.csv"],
+                                        ["allan", "imu.csv", "--calibration", bad.name, "--out", "o.csv"]]),
             }[name]
             if name == "p.json":
                 (work / "ps.toml").write_text(f'[trajectory]\ntype = "builtin"\nname = "static"\n[imu]\nparams = "{bad.name}"\n')
             run_cli(r, work, args, [bad.name, "imu.csv", "truth.csv", "s.toml"], f"case {k}")
             bad.unlink()
-            for leftover in ("o.svg", "o.png", "o.html"):
+            for leftover in ("o.svg", "o.png", "o.html", "o.toml"):
                 (work / leftover).unlink(missing_ok=True)
         runs.append(r)
 
@@ -791,6 +804,7 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 (["integrate", "imu.csv", "--init", "truth.csv", "--out", out], ["imu.csv", "truth.csv"]),
                 (["compare", "truth.csv", "truth.csv", "--out", out], ["truth.csv"]),
                 (["allan", "imu.csv", "--out", out, "--plot", rng.choice(["a.svg", "a.txt", out])], ["imu.csv"]),
+                (["calibrate", "imu.csv", "--out", out], ["imu.csv"]),
             ])
             run_cli(r, work, args, inputs, f"case {k}")
             for leftover in ("truth2.csv", long, "a.svg"):

@@ -6,7 +6,7 @@ fn imukit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_imukit"))
 }
 
-const SUBCOMMANDS: [&str; 16] = [
+const SUBCOMMANDS: [&str; 17] = [
     "simulate",
     "integrate",
     "fuse",
@@ -16,6 +16,7 @@ const SUBCOMMANDS: [&str; 16] = [
     "exercise",
     "convert",
     "allan",
+    "calibrate",
     "presets",
     "demo",
     "scenario",

@@ -166,7 +166,11 @@ impl CalibrationFile {
     }
 
     /// Applies the corrections to the rows of `table` that have their sensor's columns.
-    pub fn apply_to_table(&self, table: &mut crate::table::Table) {
+    ///
+    /// # Errors
+    /// A corrected value that is not finite (a reading near the largest number times the
+    /// matrix), naming `source`, the row (the header is row 1) and the column.
+    pub fn apply_to_table(&self, table: &mut crate::table::Table, source: &str) -> Result<()> {
         for (c, cols) in self.columns() {
             let Some(idx) = cols
                 .iter()
@@ -176,13 +180,27 @@ impl CalibrationFile {
                 continue;
             };
             let width = table.columns.len();
-            for row in table.data.chunks_exact_mut(width) {
+            for (r, row) in table.data.chunks_exact_mut(width).enumerate() {
                 let out = c.apply([row[idx[0]], row[idx[1]], row[idx[2]]]);
+                if let Some(k) = out.iter().position(|v| !v.is_finite()) {
+                    return Err(not_finite(source, r + 2, cols[k], out[k]));
+                }
                 for (k, v) in idx.iter().zip(out) {
                     row[*k] = v;
                 }
             }
         }
+        Ok(())
+    }
+}
+
+/// The refusal of a corrected reading that is not finite.
+pub(crate) fn not_finite(source: &str, row: usize, column: &str, value: f64) -> Error {
+    Error::CsvValue {
+        file: source.into(),
+        row,
+        column: column.into(),
+        message: format!("{value} once corrected by the calibration: not a reading"),
     }
 }
 

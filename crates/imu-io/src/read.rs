@@ -265,7 +265,7 @@ pub fn read_table(input: impl Into<Input>) -> Result<Table> {
     };
     let mut table = whole?;
     if let Some(c) = input.calibration() {
-        c.apply_to_table(&mut table);
+        c.apply_to_table(&mut table, &path.display().to_string())?;
     }
     Ok(table)
 }
@@ -280,7 +280,7 @@ pub fn read_table_as(input: impl Into<Input>, role: crate::bag::Role) -> Result<
         TableFormat::Mcap => {
             let mut table = crate::bag::read_table_as(&input, role)?;
             if let Some(c) = input.calibration() {
-                c.apply_to_table(&mut table);
+                c.apply_to_table(&mut table, &input.path().display().to_string())?;
             }
             Ok(table)
         }
@@ -585,9 +585,22 @@ impl CsvRows {
         let mut row = std::mem::take(&mut self.scratch);
         row.resize(self.wanted.len(), 0.0);
         let line = self.next_row_any(&mut row);
-        if let Ok(Some(_)) = line {
+        if let Ok(Some(at)) = line {
             for (c, [x, y, z]) in &self.calibration {
-                [row[*x], row[*y], row[*z]] = c.apply([row[*x], row[*y], row[*z]]);
+                let v = c.apply([row[*x], row[*y], row[*z]]);
+                // A missing cell (NaN) stays missing; anything else must stay a number.
+                for (k, (&i, value)) in [*x, *y, *z].iter().zip(v).enumerate() {
+                    if value.is_infinite() || (value.is_nan() && !row[i].is_nan()) {
+                        let column = &self.wanted[[*x, *y, *z][k]].1;
+                        return Err(crate::calibration::not_finite(
+                            &self.path.display().to_string(),
+                            at,
+                            column,
+                            value,
+                        ));
+                    }
+                }
+                [row[*x], row[*y], row[*z]] = v;
             }
             let n = out.len();
             out.copy_from_slice(&row[..n]);

@@ -47,3 +47,42 @@ fn readings_are_read_corrected_one_axis_asked_for_or_all() {
     .to_string();
     assert!(e.contains("gyro_y_rad_s") && e.contains("corrects"), "{e}");
 }
+
+#[test]
+fn a_correction_that_overflows_a_reading_is_refused_by_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("imu.csv");
+    std::fs::write(
+        &path,
+        "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n0,0,0,0\n0.01,1e10,0,0\n",
+    )
+    .unwrap();
+    let file = CalibrationFile {
+        corrections: [
+            None,
+            Some(Correction {
+                matrix: [[1e300, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                bias: [0.0; 3],
+            }),
+            None,
+        ],
+    };
+    let input = imu_io::input::Input::new(&path).with_calibration(file);
+    let e = imu_io::read::read_columns(input.clone(), &["t_s", "gyro_y_rad_s"], "")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 3")
+            && e.contains("gyro_x_rad_s")
+            && e.contains("corrected by the calibration"),
+        "{e}"
+    );
+    let mut table = imu_io::read::read_table(imu_io::input::Input::new(&path)).unwrap();
+    let e = input
+        .calibration()
+        .unwrap()
+        .apply_to_table(&mut table, "imu.csv")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("imu.csv, row 3, column gyro_x_rad_s"), "{e}");
+}

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use imukit::Table;
 use imukit::io::Input;
+use imukit::io::calibration::CalibrationFile;
 use imukit::io::column_map::ColumnMap;
 use imukit::io::description::Description;
 use imukit::io::read::read_table;
@@ -36,9 +37,10 @@ fn read_csv<'py>(py: Python<'py>, path: &str) -> PyResult<DescribedOut<'py>> {
 }
 
 /// Every column of a table file, its format by its extension (`.parquet`, else CSV); a CSV
-/// file through a column map when one is given (a TOML file's path, or JSON text).
+/// file through a column map when one is given (a TOML file's path, or JSON text); the readings
+/// corrected by a calibration file when one is given.
 #[pyfunction]
-#[pyo3(signature = (path, map_path = None, map_json = None, topic = None, receive_time = false))]
+#[pyo3(signature = (path, map_path = None, map_json = None, topic = None, receive_time = false, calibration_path = None))]
 fn read_table_file<'py>(
     py: Python<'py>,
     path: &str,
@@ -46,6 +48,7 @@ fn read_table_file<'py>(
     map_json: Option<&str>,
     topic: Option<String>,
     receive_time: bool,
+    calibration_path: Option<&str>,
 ) -> PyResult<DescribedOut<'py>> {
     use imukit::io::input::{Clock, Selection};
     let mut input = Input::new(path);
@@ -59,6 +62,9 @@ fn read_table_file<'py>(
             topics: topic.into_iter().collect(),
             clock,
         });
+    }
+    if let Some(c) = calibration_path {
+        input = input.with_calibration(CalibrationFile::read(Path::new(c)).map_err(refused)?);
     }
     let map = match (map_path, map_json) {
         (Some(p), _) => Some(ColumnMap::read(Path::new(p)).map_err(refused)?),

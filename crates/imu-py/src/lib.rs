@@ -3,6 +3,7 @@
 //! `imu-plot` for figure specs), convert back; refusals become `imukit.ImuError` with the field,
 //! file, row and column they name ([`errors`]). No numerics here.
 #![forbid(unsafe_code)]
+mod calibration;
 mod cli;
 mod convert;
 mod defaults;
@@ -43,6 +44,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     io::register(m)?;
     figures::register(m)?;
     study::register(m)?;
+    calibration::register(m)?;
     cli::register(m)?;
     Ok(())
 }

@@ -33,6 +33,7 @@ pub static FILES: &[ExampleFile] = shipped![
     "allan_study.py",
     "body_rates.toml",
     "builtin.toml",
+    "calibration.toml",
     "car_tunnel.toml",
     "data/euroc/mav0/imu0/data.csv",
     "data/euroc/mav0/state_groundtruth_estimate0/data.csv",
@@ -132,6 +133,11 @@ pub static EXAMPLES: &[Example] = &[
         name: "earth_flight",
         what: "a climbing turn over the Alps on the rotating WGS-84 Earth, with the magnetic model",
         files: &["earth_flight.toml"],
+    },
+    Example {
+        name: "calibration",
+        what: "a consumer part set down in 18 orientations, its magnetometer with hard and soft iron: imukit calibrate",
+        files: &["calibration.toml"],
     },
     Example {
         name: "vibration",

@@ -17,7 +17,7 @@ unknown).
 
 The package is split by area as the compiled core is: ``_truth`` (scenarios and truth),
 ``_rotations``, ``_sensor`` (``ImuSensor``, parameters, presets, Allan), ``_navigation``,
-``_orientation``, ``_monte_carlo``, ``_study``, ``_examples`` (the shipped examples), ``plot``,
+``_orientation``, ``_calibration``, ``_monte_carlo``, ``_study``, ``_examples`` (the shipped examples), ``plot``,
 ``compat``; this file only re-exports.
 """
 from __future__ import annotations
@@ -61,6 +61,7 @@ from ._sensor import (
     presets,
 )
 from ._navigation import Comparison, compare, fuse, planar_dead_reckon, read_planar, strapdown
+from ._calibration import Calibration, calibrate
 from ._examples import example, examples
 from ._monte_carlo import MonteCarlo, monte_carlo
 from ._study import PresetSummary, StudyResult, study
@@ -98,6 +99,8 @@ __all__ = [
     "allan_deviation",
     "identify",
     "Identification",
+    "calibrate",
+    "Calibration",
     "presets",
     "convert",
     "preset_params",

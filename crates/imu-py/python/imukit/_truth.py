@@ -71,7 +71,8 @@ def read_csv(path: Union[str, os.PathLike]) -> Table:
     return _table(_core.read_csv(str(path)))
 
 def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_time: bool = False,
-         map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None) -> Table:
+         map: Optional[Union[str, os.PathLike, Mapping[str, Any]]] = None,
+         calibration: Optional[Union[str, os.PathLike]] = None) -> Table:
     """A table file as a :class:`Table`, its format by its extension: ``.csv``, ``.parquet``
     (float64 columns, as ``imukit simulate --out x.parquet`` writes them), ``.npy`` (a structured
     array of float64 fields) or ``.npz`` (one float64 array per column, as ``numpy.savez`` writes
@@ -91,6 +92,10 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_
                                     "accel": {"columns": ["AccX", "AccY", "AccZ"], "unit": "g"},
                                     "gyro": {"columns": ["GyrX", "GyrY", "GyrZ"], "unit": "deg/s"},
                                     "axes": ["x", "-y", "-z"]})
+
+    ``calibration`` corrects the readings as they are read with a part's calibration file (as
+    ``imukit calibrate --out`` writes it and ``--calibration FILE`` reads it): each calibrated
+    sensor's three columns, after the map.
     """
     suffix = Path(path).suffix.lower()
     if Path(path).is_dir() and (Path(path) / "metadata.yaml").is_file():
@@ -98,19 +103,20 @@ def read(path: Union[str, os.PathLike], *, topic: Optional[str] = None, receive_
     if suffix not in TABLE_FORMATS:
         raise ImuError(f"{path}: cannot read {suffix or 'a file without an extension'!r} tables "
                        f"(read: {', '.join(TABLE_FORMATS)})")
+    cal = None if calibration is None else str(calibration)
     if topic is not None or receive_time:
         if suffix not in (".mcap", ".db3", ".bag"):
             raise ImuError(f"{path}: topic= and receive_time= are a ROS bag's (.mcap, .db3, .bag), not a {suffix} file's")
         if map is not None:
             raise ImuError(f"{path}: map= reads a vendor's CSV; a bag's topics have their own columns")
         return _table(_core.read_table_file(str(path), topic=None if topic is None else str(topic),
-                                            receive_time=bool(receive_time)))
+                                            receive_time=bool(receive_time), calibration_path=cal))
     if map is None:
-        table = _table(_core.read_table_file(str(path)))
+        table = _table(_core.read_table_file(str(path), calibration_path=cal))
     elif isinstance(map, Mapping):
-        table = _table(_core.read_table_file(str(path), map_json=json.dumps(dict(map))))
+        table = _table(_core.read_table_file(str(path), map_json=json.dumps(dict(map)), calibration_path=cal))
     else:
-        table = _table(_core.read_table_file(str(path), map_path=str(map)))
+        table = _table(_core.read_table_file(str(path), map_path=str(map), calibration_path=cal))
     # Readings that look like a unit slip (g as m/s², °/s as rad/s, ms as s) are warned about.
     _emit(_core.implausible(list(table.columns), table.values, str(path)))
     return table
