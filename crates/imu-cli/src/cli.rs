@@ -765,6 +765,12 @@ pub struct CalibrateArgs {
     /// Where to write the calibration (TOML).
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw the residuals, raw and calibrated, into this figure (`.svg` or `.png`).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// The figure's size and resolution.
+    #[command(flatten)]
+    pub figure: FigureArgs,
 }
 
 /// What `imukit presets NAME` prints.

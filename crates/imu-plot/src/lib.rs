@@ -9,7 +9,7 @@
 //! * [`scene`]: the animated body box (corners, edges, nose face) and the NED → ENU turn of poses,
 //!   defined once and handed as data to the HTML page and to Python.
 //! * [`plot_files`] (the default figure of imukit CSV files, SVG or PNG by extension),
-//!   [`allan_figure`], [`trajectories_figure`], [`animate::animate`] (GIF or a self-contained HTML
+//!   [`allan_figure`], [`calibration_figure`], [`trajectories_figure`], [`animate::animate`] (GIF or a self-contained HTML
 //!   page).
 //!
 //! Every file is written to a temporary name and renamed when complete.
@@ -24,6 +24,7 @@
 #![forbid(unsafe_code)]
 mod allan;
 pub mod animate;
+mod calibration;
 mod draw;
 mod figures;
 mod panels;
@@ -32,6 +33,7 @@ pub mod spec;
 mod study;
 
 pub use allan::allan_figure;
+pub use calibration::calibration_figure;
 pub use draw::{COLORS, FigureFormat, FigureSize, check_figure_path, rasterise, write_figure};
 pub use figures::{plot_files, plot_tables};
 pub use panels::{Trace, trajectories_figure};

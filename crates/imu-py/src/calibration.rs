@@ -13,8 +13,15 @@ use crate::convert::{TableOut, table_in, table_out};
 use crate::errors::refused;
 
 /// What a calibration found: the calibration file's text, the rests (start, end sample), the
-/// warnings, and the white noise learnt (accelerometer m/s², gyroscope rad/s a sample).
-type Calibrated = (String, Vec<(usize, usize)>, Vec<String>, Option<(f64, f64)>);
+/// warnings, the white noise learnt (accelerometer m/s², gyroscope rad/s a sample) and the
+/// residuals by name (`imukit::calibrate::Residuals`'s fields).
+type Calibrated = (
+    String,
+    Vec<(usize, usize)>,
+    Vec<String>,
+    Option<(f64, f64)>,
+    Vec<(&'static str, Vec<f64>)>,
+);
 
 /// Calibrates from the readings `values` with `columns` (`t_s` and the sensors' columns).
 #[pyfunction]
@@ -29,11 +36,24 @@ fn calibrate(
     let r = py
         .detach(|| calibrate_table(&t, gravity_m_s2, source))
         .map_err(refused)?;
+    let x = r.residuals.clone();
+    let residuals = vec![
+        ("rest_t_s", x.rest_t_s),
+        ("accel_raw_m_s2", x.accel_raw_m_s2),
+        ("accel_m_s2", x.accel_m_s2),
+        ("rotation_t_s", x.rotation_t_s),
+        ("gyro_raw_rad", x.gyro_raw_rad),
+        ("gyro_rad", x.gyro_rad),
+        ("mag_t_s", x.mag_t_s),
+        ("mag_raw", x.mag_raw),
+        ("mag", x.mag),
+    ];
     Ok((
         r.to_toml(),
         r.rests.iter().map(|x| (x.start, x.end)).collect(),
         r.warnings.clone(),
         r.noise.map(|n| (n.accel, n.gyro)),
+        residuals,
     ))
 }
 

@@ -97,3 +97,20 @@ def test_refusals_name_what_and_where(tmp_path):
                              "imu": {"kind": "accel-gyro", "preset": "mpu-6050", "seed": 1}}).imu
     with pytest.raises(ImuError, match=r"calibrates no sensor: .*static intervals found, the fit needs at least 7"):
         imukit.calibrate(still)
+
+
+def test_the_residuals_fall_to_the_noise_and_are_drawn(tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import imukit.plot
+
+    cal = imukit.calibrate(tumble())
+    r = cal.residuals
+    # The magnetometer alone: its readings' distance from the sphere, raw (hard and soft iron:
+    # tens of per cent) against calibrated (the readings' noise, about 1 %).
+    assert len(r["mag_t_s"]) == len(r["mag"]) == len(r["mag_raw"]) > 1000
+    assert np.sqrt(np.mean(r["mag"] ** 2)) < 0.02 < np.sqrt(np.mean(r["mag_raw"] ** 2))
+    assert len(r["rest_t_s"]) == 0  # a tumble has no rests
+    fig = imukit.plot.calibration(cal)
+    assert [a.get_title().split(":")[0] for a in fig.axes] == ["Magnetometer, distance from the sphere"]
+    fig.savefig(tmp_path / "residuals.png")

@@ -512,8 +512,20 @@ fn calibrate_command(a: crate::cli::CalibrateArgs) -> Result<(), CliError> {
         window,
         gravity_m_s2,
         out,
+        plot,
+        figure,
     } = a;
     let mapped = map.input(&input)?;
     bag.check(&[Some(&input)])?;
-    calibrate::run(&bag.input(mapped), gravity_m_s2, window.window()?, &out)
+    let plot = match plot.as_deref() {
+        Some(p) => Some((p, plot::figure_size(&figure)?)),
+        None => None,
+    };
+    calibrate::run(
+        &bag.input(mapped),
+        gravity_m_s2,
+        window.window()?,
+        &out,
+        plot,
+    )
 }

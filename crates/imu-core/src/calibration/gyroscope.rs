@@ -329,3 +329,34 @@ fn attitude_change(
     }
     UnitQuaternion::new_unchecked(q)
 }
+
+/// The angle, rad, by which each rotation `k` (from rest `k` to rest `k + 1`) misses the gravity
+/// direction measured at rest `k + 1` when the readings are corrected by `accel` (the rests'
+/// means `accel_means`) and `gyro`: what a calibration leaves, or, with [`Correction::identity`],
+/// what the raw readings miss. Handed to `out` with `k`; rests outside the readings are skipped.
+pub fn rotation_residuals(
+    t_s: &[f64],
+    gyro_readings: &[[f64; 3]],
+    rests: &[Rest],
+    accel_means: &[[f64; 3]],
+    accel: &Correction,
+    gyro: &Correction,
+    mut out: impl FnMut(usize, f64),
+) {
+    let n = t_s.len().min(gyro_readings.len());
+    let a = Matrix3::from_fn(|i, j| gyro.matrix[i][j]);
+    let b = Vector3::from(gyro.bias);
+    let unit = |k: usize| {
+        let u = Vector3::from(accel.apply(accel_means[k]));
+        u / u.norm()
+    };
+    for k in 0..rests.len().min(accel_means.len()).saturating_sub(1) {
+        let (from, to) = (rests[k].end.saturating_sub(1), rests[k + 1].start);
+        if rests[k].is_empty() || to >= n || from >= to {
+            continue;
+        }
+        let q = attitude_change(t_s, gyro_readings, &a, &b, from, to);
+        let predicted = q.inverse() * unit(k);
+        out(k, predicted.angle(&unit(k + 1)));
+    }
+}

@@ -33,12 +33,18 @@ class Calibration:
     ``residual_rms_m_s2``, ``rotations``, ``residual_rms_rad``, ``field_ut``, ``fit_error``.
     ``rests`` lists the static intervals found as ``(start, end)`` sample ranges, ``noise`` the
     white noise learnt from the log's quiet stretches (accelerometer m/s², gyroscope rad/s a
-    sample), ``warnings`` what could not be calibrated and why. :meth:`apply` corrects readings,
+    sample), ``warnings`` what could not be calibrated and why, ``residuals`` what the
+    calibration leaves of each residual beside the raw readings' (arrays: ``rest_t_s``,
+    ``accel_m_s2``/``accel_raw_m_s2`` — gravity's magnitude less each rest's mean reading;
+    ``rotation_t_s``, ``gyro_rad``/``gyro_raw_rad`` — the angle by which each turn misses the
+    next rest's gravity; ``mag_t_s``, ``mag``/``mag_raw`` — the distance from the fitted sphere,
+    a fraction; drawn by :func:`imukit.plot.calibration`). :meth:`apply` corrects readings,
     :meth:`save` writes the file ``--calibration`` reads, :meth:`load` reads one.
     """
 
     def __init__(self, text: str, rests: Optional[list] = None, warnings: Optional[list] = None,
-                 noise: Optional[tuple] = None, origin: Optional[str] = None) -> None:
+                 noise: Optional[tuple] = None, origin: Optional[str] = None,
+                 residuals: Optional[dict] = None) -> None:
         self.text = text
         self._origin = origin or "calibration"  # how a message names a calibration not read from a file
         doc = _toml_to_dict(text)
@@ -48,6 +54,7 @@ class Calibration:
         self.rests: list[tuple[int, int]] = list(rests or [])
         self.warnings: list[str] = list(warnings or [])
         self.noise: Optional[tuple[float, float]] = noise
+        self.residuals: dict[str, np.ndarray] = {k: np.asarray(v, dtype=float) for k, v in (residuals or {}).items()}
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Calibration":
@@ -89,6 +96,6 @@ def calibrate(readings: Union[TableLike, str, os.PathLike], *,
     else:
         source = "readings"
         table = Table.of(readings, "readings")
-    text, rests, warnings, noise = _core.calibrate(*_table_args("readings", table),
-                                                   float(gravity_m_s2), source)
-    return Calibration(text, rests, warnings, noise)
+    text, rests, warnings, noise, residuals = _core.calibrate(*_table_args("readings", table),
+                                                              float(gravity_m_s2), source)
+    return Calibration(text, rests, warnings, noise, residuals=dict(residuals))

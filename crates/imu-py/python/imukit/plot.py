@@ -11,6 +11,7 @@ Tables, CSV paths and dicts of NumPy arrays keyed by imukit's column names are a
   IMU readings, navigation output, Allan table, errors); later ones dashed, dotted, … (truth vs estimate).
 * :func:`trajectory` — paths in the plane (equal scales) or in 3D, start ● and end ✕ marked.
 * :func:`allan` — Allan deviation on log axes.
+* :func:`calibration` — a calibration's residuals, as ``imukit calibrate --plot`` draws them.
 * :func:`animate` — the body as a box moving and turning along its path, the reference point and
   the IMU point at the lever arm marked, the trail drawn.
 
@@ -34,7 +35,7 @@ from ._table import TableLike
 
 _D = _core.DEFAULTS  # the library's request defaults, shared with the command line
 
-__all__ = ["figure", "trajectory", "allan", "animate", "kind"]
+__all__ = ["figure", "trajectory", "allan", "calibration", "animate", "kind"]
 
 #: A table (anything :data:`imukit.TableLike`) or the path of a CSV file.
 TableOrPath = Union[TableLike, str, os.PathLike]
@@ -184,6 +185,34 @@ def allan(tau_s: Union[TableOrPath, np.ndarray], adev: Optional[np.ndarray] = No
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     return ax.figure
+
+
+def calibration(cal: Any, *, size_in: Optional[Tuple[float, float]] = None,
+                dpi: Optional[float] = None) -> Any:
+    """The residuals of an :class:`imukit.Calibration` (from :func:`imukit.calibrate`), as
+    ``imukit calibrate --plot`` draws them: per rest, gravity's magnitude less the calibrated
+    mean reading; per turn, the angle by which the calibrated rate misses the next rest's
+    gravity; per magnetometer reading, its distance from the fitted sphere — each panel titled
+    with its RMS and the raw readings'. Returns the figure."""
+    r = cal.residuals
+    panels = [(title, unit, scale, t, raw, done) for title, unit, scale, t, raw, done in (
+        ("Accelerometer at the rests, |a| − g", "m/s²", 1.0, "rest_t_s", "accel_raw_m_s2", "accel_m_s2"),
+        ("Gyroscope over the turns, gravity missed by", "°", 180.0 / np.pi, "rotation_t_s", "gyro_raw_rad", "gyro_rad"),
+        ("Magnetometer, distance from the sphere", "%", 100.0, "mag_t_s", "mag_raw", "mag"),
+    ) if len(r.get(t, ())) > 0]
+    if not panels:
+        raise ImuError("calibration(): the calibration has no residuals to draw")
+    plt = _pyplot()
+    fig = plt.figure(figsize=size_in or (9.0, 3.0 * len(panels)), dpi=dpi, layout="constrained")
+    for k, (title, unit, scale, t, raw, done) in enumerate(panels):
+        ax = fig.add_subplot(len(panels), 1, k + 1)
+        rms = lambda v: float(np.sqrt(np.mean(np.square(v)))) * scale  # noqa: E731
+        ax.plot(r[t], r[done] * scale, "-", color="C0", label="calibrated")
+        ax.set_title(f"{title}: RMS {rms(r[done]):.3e} {unit} (raw {rms(r[raw]):.3e})")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(unit)
+        ax.grid(True, alpha=0.3)
+    return fig
 
 
 def _study(table: Table, size_in: Optional[Tuple[float, float]], dpi: Optional[float]) -> Any:

@@ -5,9 +5,9 @@
 //! sensor the log cannot calibrate is said and left out; the calibration file
 //! ([`crate::io::calibration`]) holds the others.
 use imu_core::calibration::accelerometer::{self, AccelCalibration};
-use imu_core::calibration::gyroscope::{self, GyroCalibration, GyroInputs};
+use imu_core::calibration::gyroscope::{self, GyroCalibration, GyroInputs, rotation_residuals};
 use imu_core::calibration::magnetometer::{self, MagCalibration};
-use imu_core::calibration::{MAX_REST_RATE_RAD_S, Rest, rests};
+use imu_core::calibration::{Correction, MAX_REST_RATE_RAD_S, Rest, rests};
 use imu_core::stillness::{ReadingNoise, quiet_noise_below};
 
 use crate::error::{Result, invalid};
@@ -38,6 +38,8 @@ pub struct CalibrateResult {
     pub noise: Option<ReadingNoise>,
     /// What could not be calibrated and why, each naming the file.
     pub warnings: Vec<String>,
+    /// What the calibration leaves of each residual, beside the raw readings'.
+    pub residuals: Residuals,
 }
 
 impl CalibrateResult {
@@ -117,6 +119,7 @@ pub fn calibrate_table(table: &Table, gravity_m_s2: f64, source: &str) -> Result
         rests: Vec::new(),
         noise: None,
         warnings: Vec::new(),
+        residuals: Residuals::default(),
     };
     if inertial {
         inertial_fits(table, &t, gravity_m_s2, file, &mut result);
@@ -136,6 +139,7 @@ pub fn calibrate_table(table: &Table, gravity_m_s2: f64, source: &str) -> Result
             format!("calibrates no sensor: {}", result.warnings.join("; ")),
         ));
     }
+    result.residuals = residuals(table, gravity_m_s2, &result);
     Ok(result)
 }
 
@@ -201,6 +205,91 @@ fn triples(table: &Table, names: &[&str; 3]) -> Vec<[f64; 3]> {
         .zip(&z)
         .map(|((a, b), c)| [*a, *b, *c])
         .collect()
+}
+
+/// What a calibration leaves of each sensor's residual, beside what the raw readings have: the
+/// figure of `imukit calibrate --plot` and Python's `Calibration.residuals`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Residuals {
+    /// The middle of each rest, s.
+    pub rest_t_s: Vec<f64>,
+    /// `|ā| − g` at each rest, raw and calibrated, m/s².
+    pub accel_raw_m_s2: Vec<f64>,
+    /// The same, calibrated.
+    pub accel_m_s2: Vec<f64>,
+    /// The end of each rotation (the start of the rest it turns into), s.
+    pub rotation_t_s: Vec<f64>,
+    /// The angle by which the integrated rate misses the next rest's gravity direction, raw
+    /// (accelerometer calibrated, gyroscope not) and calibrated, rad.
+    pub gyro_raw_rad: Vec<f64>,
+    /// The same, calibrated.
+    pub gyro_rad: Vec<f64>,
+    /// Every magnetometer reading's time, s (at most [`MAX_MAG_POINTS`], evenly picked).
+    pub mag_t_s: Vec<f64>,
+    /// `|m|` over its mean, less one, raw; calibrated, `|C(m − b)|/B − 1`.
+    pub mag_raw: Vec<f64>,
+    /// The same, calibrated.
+    pub mag: Vec<f64>,
+}
+
+/// The most magnetometer readings [`Residuals`] keeps.
+pub const MAX_MAG_POINTS: usize = 5000;
+
+/// The residuals of `result` on the readings `table` it was made from.
+#[must_use]
+pub fn residuals(table: &Table, gravity_m_s2: f64, result: &CalibrateResult) -> Residuals {
+    let t = column(table, "t_s");
+    let mut r = Residuals::default();
+    if let Some(a) = &result.accelerometer {
+        let accel = triples(table, &ACCEL_COLUMNS);
+        let means: Vec<[f64; 3]> = result.rests.iter().map(|x| x.mean(&accel)).collect();
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        for (x, m) in result.rests.iter().zip(&means) {
+            r.rest_t_s.push(0.5 * (t[x.start] + t[x.end - 1]));
+            r.accel_raw_m_s2.push(norm(*m) - gravity_m_s2);
+            r.accel_m_s2
+                .push(norm(a.correction.apply(*m)) - gravity_m_s2);
+        }
+        if let Some(g) = &result.gyroscope {
+            let gyro = triples(table, &GYRO_COLUMNS);
+            let at = |k: usize| t[result.rests[k + 1].start];
+            rotation_residuals(
+                &t,
+                &gyro,
+                &result.rests,
+                &means,
+                &a.correction,
+                &Correction::identity(),
+                |k, e| {
+                    r.rotation_t_s.push(at(k));
+                    r.gyro_raw_rad.push(e);
+                },
+            );
+            rotation_residuals(
+                &t,
+                &gyro,
+                &result.rests,
+                &means,
+                &a.correction,
+                &g.correction,
+                |_, e| {
+                    r.gyro_rad.push(e);
+                },
+            );
+        }
+    }
+    if let Some(m) = &result.magnetometer {
+        let mag = triples(table, &MAG_COLUMNS);
+        let step = mag.len().div_ceil(MAX_MAG_POINTS).max(1);
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let mean = mag.iter().map(|v| norm(*v)).sum::<f64>() / mag.len().max(1) as f64;
+        for (k, v) in mag.iter().enumerate().step_by(step) {
+            r.mag_t_s.push(t[k]);
+            r.mag_raw.push(norm(*v) / mean - 1.0);
+            r.mag.push(norm(m.correction.apply(*v)) / m.field_ut - 1.0);
+        }
+    }
+    r
 }
 
 /// The summary printed after a calibration: each sensor's terms with their uncertainties.
