@@ -350,6 +350,39 @@ fn load_params_toml(path: &str, part: Option<&str>) -> PyResult<(String, Vec<Str
     Ok((to_toml(&file), file.warnings))
 }
 
+/// A signal chain's response (`imukit.chain_response`): `chain` the `[imu.chain]` table as a
+/// dict, the output at `rate_hz`, a row per frequency (`imukit::scenario::chain::RESPONSE_COLUMNS`).
+#[pyfunction]
+fn chain_response<'py>(
+    py: Python<'py>,
+    chain: &Bound<'py, PyAny>,
+    rate_hz: f64,
+    frequencies_hz: Vec<f64>,
+) -> PyResult<crate::convert::TableOut<'py>> {
+    use imukit::scenario::chain::{ChainSetup, ChainSpec};
+    let tree = crate::convert::value_tree(chain, "chain")?;
+    let spec: ChainSpec = imukit::io::value_tree::read(&tree).map_err(|e| {
+        refused(imukit::Error::Invalid {
+            field: if e.path.is_empty() {
+                "imu.chain".into()
+            } else {
+                format!("imu.chain.{}", e.path).into()
+            },
+            message: e.message,
+        })
+    })?;
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(refused(imukit::Error::Invalid {
+            field: "rate_hz".into(),
+            message: format!("{rate_hz} is not a rate (finite, > 0)"),
+        }));
+    }
+    let t = ChainSetup::resolve(&spec, rate_hz)
+        .and_then(|c| c.response_table(rate_hz, &frequencies_hz))
+        .map_err(refused)?;
+    crate::convert::table_out(py, t)
+}
+
 /// Adds this module's classes and functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyImuSensor>()?;
@@ -360,5 +393,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(preset_kalibr_yaml, m)?)?;
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(chain_response, m)?)?;
     Ok(())
 }

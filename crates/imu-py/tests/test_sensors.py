@@ -358,3 +358,23 @@ def test_filters_longer_than_4096_coefficients_are_refused_with_the_bound_named(
         imukit.ImuSensor("accel-gyro", gyroscope=imukit.GyroParams(
             bias_instability=0.01, bias_instability_coefficients=fractalcoef(4096)))
     assert e.value.field.endswith("bias_instability_coefficients")
+
+def test_a_chains_response_is_the_one_the_simulation_reads():
+    # A gyroscope shaken at 1130 Hz behind an 8 kHz chain reads, at 100 Hz, a sine at the alias
+    # the response gives with its gain (the Rust tests check the phase and delay to 1e-6).
+    chain = {"internal_rate_hz": 8000, "gyroscope": {"filter": "butterworth", "order": 2, "cutoff_hz": 200}}
+    r = imukit.chain_response(chain, 100, [1130.0])
+    sim = imukit.simulate({"rate_hz": 100, "duration_s": 4,
+                           "trajectory": {"type": "expression", "position_m": [0, 0, 0]},
+                           "imu": {"kind": "accel-gyro", "chain": chain,
+                                   "vibration": {"sines": [{"kind": "angular-rate", "axis": "z",
+                                                            "frequency_hz": 1130, "amplitude": 0.5}]}}})
+    t, gz = sim.imu["t_s"][50:], sim.imu["gyro_z_rad_s"][50:]
+    f = r["alias_hz"][0]
+    design = np.column_stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t)])
+    amplitude = np.hypot(*np.linalg.lstsq(design, gz, rcond=None)[0])
+    assert f == 30.0 and abs(amplitude / (0.5 * r["gyro_gain"][0]) - 1) < 1e-3
+    assert r["accel_gain"][0] == 1.0  # no filter: decimated alone
+    with pytest.raises(ImuError, match=r"imu.chain.gyroscope"):
+        imukit.chain_response({"internal_rate_hz": 8000, "gyroscope": {"filter": "butterworth", "order": 2,
+                                                                      "cutoff_hz": 5000}}, 100, [1.0])

@@ -211,3 +211,29 @@ fn vibration_rectifies_in_the_sensing_element_before_the_chain_filters_it() {
         );
     }
 }
+
+#[test]
+fn the_response_table_is_each_chains_closed_form_and_refuses_a_negative_frequency() {
+    let spec: ChainSpec = toml::from_str(CHAIN.trim_start_matches("[imu.chain]\n")).unwrap();
+    let setup = ChainSetup::resolve(&spec, 100.0).unwrap();
+    let t = setup.response_table(100.0, &[0.0, 12.0, 1130.0]).unwrap();
+    let gyro = gyro_chain();
+    for (k, f) in [0.0, 12.0, 1130.0].into_iter().enumerate() {
+        let h = gyro.response(f);
+        assert_eq!(t.column("gyro_gain").unwrap()[k], h.gain);
+        assert_eq!(t.column("gyro_phase_rad").unwrap()[k], h.phase_rad);
+        assert_eq!(t.column("gyro_delay_s").unwrap()[k], gyro.group_delay_s(f));
+        assert_eq!(t.column("alias_hz").unwrap()[k], gyro.alias_hz(f));
+        // No accelerometer filter: decimated alone, gain 1 and no delay.
+        assert_eq!(t.column("accel_gain").unwrap()[k], 1.0);
+        assert_eq!(t.column("accel_delay_s").unwrap()[k], 0.0);
+    }
+    let e = setup
+        .response_table(100.0, &[1.0, -3.0])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("frequencies_hz[1]: -3 is not a frequency"),
+        "{e}"
+    );
+}

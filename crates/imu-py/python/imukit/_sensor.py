@@ -324,3 +324,22 @@ def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dic
     for what in skipped:  # MATLAB's loadparams skips these too
         warnings.warn(what, stacklevel=2)
     return _toml_to_dict(text)
+
+
+def chain_response(chain: Mapping[str, Any], rate_hz: float, frequencies_hz) -> "Table":
+    """A part's signal chain in closed form (docs/sensors.md, "The signal chain"): ``chain`` the
+    ``[imu.chain]`` table as a dict (``internal_rate_hz`` and each sensor's low-pass), read at
+    ``rate_hz``; a row per frequency of ``frequencies_hz`` (Hz) with the alias it appears at in
+    the output (``alias_hz``) and per sensor the filter's gain, phase (rad) and group delay (s):
+    ``accel_gain``, ``accel_phase_rad``, ``accel_delay_s``, ``gyro_…``, ``mag_…``.
+
+    >>> t = chain_response({"internal_rate_hz": 8000,
+    ...                     "gyroscope": {"filter": "butterworth", "order": 2, "cutoff_hz": 200}},
+    ...                    100, [40.0, 200.0, 1130.0])
+    >>> [round(float(g), 4) for g in t["gyro_gain"]], [float(f) for f in t["alias_hz"]]
+    ([0.9992, 0.7071, 0.0274], [40.0, 0.0, 30.0])
+    """
+    from ._table import Table
+    columns, values = _core.chain_response(dict(chain), float(rate_hz),
+                                           [float(f) for f in np.atleast_1d(frequencies_hz)])
+    return Table(columns, values)

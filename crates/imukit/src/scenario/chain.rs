@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
+use crate::io::table::Table;
 use crate::scenario::earth::EarthSetup;
 use crate::scenario::spec::TrajectorySpec;
 use crate::scenario::times::SampleTimes;
@@ -183,6 +184,52 @@ impl ChainSetup {
                 .map_err(|e| chain_error(SENSORS[k], &e))
         };
         Ok([make(0)?, make(1)?, make(2)?])
+    }
+}
+
+/// The columns of [`ChainSetup::response_table`].
+pub const RESPONSE_COLUMNS: [&str; 11] = [
+    "frequency_hz",
+    "alias_hz",
+    "accel_gain",
+    "accel_phase_rad",
+    "accel_delay_s",
+    "gyro_gain",
+    "gyro_phase_rad",
+    "gyro_delay_s",
+    "mag_gain",
+    "mag_phase_rad",
+    "mag_delay_s",
+];
+
+impl ChainSetup {
+    /// The chain's response at each of `frequencies_hz` for output at `rate_hz`: where a sine
+    /// of that frequency appears in the output (its alias), and per sensor the filter's gain,
+    /// phase and group delay there ([`RESPONSE_COLUMNS`]).
+    ///
+    /// # Errors
+    /// As [`ChainSetup::chains`]; a frequency that is negative or not finite, by its index.
+    pub fn response_table(&self, rate_hz: f64, frequencies_hz: &[f64]) -> Result<Table> {
+        if let Some(k) = frequencies_hz
+            .iter()
+            .position(|f| !(f.is_finite() && *f >= 0.0))
+        {
+            return Err(invalid(
+                format!("frequencies_hz[{k}]"),
+                format!("{} is not a frequency (finite, ≥ 0)", frequencies_hz[k]),
+            ));
+        }
+        let chains = self.chains(rate_hz)?;
+        let mut t = Table::new(&RESPONSE_COLUMNS);
+        for &f in frequencies_hz {
+            let mut row = vec![f, chains[0].alias_hz(f)];
+            for c in &chains {
+                let h = c.response(f);
+                row.extend([h.gain, h.phase_rad, c.group_delay_s(f)]);
+            }
+            t.push_row(&row);
+        }
+        Ok(t)
     }
 }
 
