@@ -330,6 +330,7 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                                        ["orient", bad.name, "--smooth", "--out", "o.csv"],
                                        ["allan", bad.name, "--out", "o.csv"],
                                        ["calibrate", bad.name, "--out", "o.toml"],
+                                       ["spectrum", bad.name, "--out", "o.csv", "--plot", "o.svg"],
                                        ["plot", bad.name, "--out", "o.svg"]]),
                 "truth.csv": rng.choice([["compare", bad.name, "truth.csv"], ["plot", bad.name, "--out", "o.svg"],
                                          ["compare", bad.name, "truth.csv", "--align-heading"],
@@ -805,6 +806,8 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 (["compare", "truth.csv", "truth.csv", "--out", out], ["truth.csv"]),
                 (["allan", "imu.csv", "--out", out, "--plot", rng.choice(["a.svg", "a.txt", out])], ["imu.csv"]),
                 (["calibrate", "imu.csv", "--out", out], ["imu.csv"]),
+                (["spectrum", "imu.csv", "--segment-s", rng.choice(["0.1", "1e300", "-1", "nan"]), "--out", out],
+                 ["imu.csv"]),
             ])
             run_cli(r, work, args, inputs, f"case {k}")
             for leftover in ("truth2.csv", long, "a.svg"):

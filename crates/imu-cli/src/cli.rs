@@ -245,6 +245,10 @@ pub enum Command {
     /// the field's strength); each term with its standard deviation. Writes a calibration file
     /// that `--calibration FILE` applies wherever readings are read.
     Calibrate(CalibrateArgs),
+    /// Power spectral density of readings (Welch: Hann-windowed segments, half overlapping,
+    /// one-sided): `frequency_hz, psd_<column>…`; with the scenario that made a simulated log,
+    /// the figure marks where each vibration sine lands (its alias) and draws the chain's gain.
+    Spectrum(SpectrumArgs),
     /// Runs a built-in scenario (default: the figure-8 with its lever arm) and writes the
     /// scenario, truth, IMU readings, figures (truth.png, imu.png), an animation (animation.html)
     /// and a summary into a folder.
@@ -766,6 +770,42 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Also draw the residuals, raw and calibrated, into this figure (`.svg` or `.png`).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// The figure's size and resolution.
+    #[command(flatten)]
+    pub figure: FigureArgs,
+}
+
+/// The arguments of `imukit spectrum`.
+#[derive(Args, Debug)]
+pub struct SpectrumArgs {
+    /// IMU readings (with `t_s`).
+    pub input: PathBuf,
+    /// How a vendor's CSV maps to imukit's columns.
+    #[command(flatten)]
+    pub map: MapArg,
+    /// Which topics of a ROS bag, on which clock.
+    #[command(flatten)]
+    pub bag: BagArgs,
+    /// The stretch of the run to read.
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// Columns to analyse (default: every gyro and accel column present).
+    #[arg(long = "column")]
+    pub columns: Vec<String>,
+    /// Length of the segments averaged, s (the resolution is its inverse).
+    #[arg(long, default_value_t = imukit::spectrum::DEFAULT_SEGMENT_S)]
+    pub segment_s: f64,
+    /// The scenario that made the readings: the figure marks its vibration's aliases and draws
+    /// the first column's chain.
+    #[arg(long)]
+    pub scenario: Option<PathBuf>,
+    /// Where to write `frequency_hz, psd_<column>…` (CSV, or by extension `.parquet`, `.npy`,
+    /// `.npz`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also draw the densities into this figure (`.svg` or `.png`).
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// The figure's size and resolution.

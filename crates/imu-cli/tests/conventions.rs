@@ -6,7 +6,7 @@ fn imukit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_imukit"))
 }
 
-const SUBCOMMANDS: [&str; 17] = [
+const SUBCOMMANDS: [&str; 18] = [
     "simulate",
     "integrate",
     "fuse",
@@ -17,6 +17,7 @@ const SUBCOMMANDS: [&str; 17] = [
     "convert",
     "allan",
     "calibrate",
+    "spectrum",
     "presets",
     "demo",
     "scenario",

@@ -96,11 +96,13 @@ pub enum RequestOption {
     Imu,
     /// The scenario that made the data.
     Scenario,
+    /// The length of a spectrum's segments.
+    SegmentS,
 }
 
 impl RequestOption {
     /// Every option.
-    pub const ALL: [Self; 41] = [
+    pub const ALL: [Self; 42] = [
         Self::RateHz,
         Self::Threads,
         Self::UseMagnetometer,
@@ -142,6 +144,7 @@ impl RequestOption {
         Self::GnssUere,
         Self::Imu,
         Self::Scenario,
+        Self::SegmentS,
     ];
 
     /// The option's name in the library's requests and in Python's keywords.
@@ -189,6 +192,7 @@ impl RequestOption {
             Self::GnssUere => "gnss_uere_m",
             Self::Imu => "imu",
             Self::Scenario => "scenario",
+            Self::SegmentS => "segment_s",
         }
     }
 
@@ -237,6 +241,7 @@ impl RequestOption {
             Self::GnssUere => "--gnss-uere-m",
             Self::Imu => "--imu",
             Self::Scenario => "--scenario",
+            Self::SegmentS => "--segment-s",
         }
     }
 }

@@ -9,7 +9,7 @@
 //! * [`scene`]: the animated body box (corners, edges, nose face) and the NED → ENU turn of poses,
 //!   defined once and handed as data to the HTML page and to Python.
 //! * [`plot_files`] (the default figure of imukit CSV files, SVG or PNG by extension),
-//!   [`allan_figure`], [`calibration_figure`], [`trajectories_figure`], [`animate::animate`] (GIF or a self-contained HTML
+//!   [`allan_figure`], [`calibration_figure`], [`spectrum_figure`], [`trajectories_figure`], [`animate::animate`] (GIF or a self-contained HTML
 //!   page).
 //!
 //! Every file is written to a temporary name and renamed when complete.
@@ -30,6 +30,7 @@ mod figures;
 mod panels;
 pub mod scene;
 pub mod spec;
+mod spectrum;
 mod study;
 
 pub use allan::allan_figure;
@@ -38,6 +39,7 @@ pub use draw::{COLORS, FigureFormat, FigureSize, check_figure_path, rasterise, w
 pub use figures::{plot_files, plot_tables};
 pub use panels::{Trace, trajectories_figure};
 pub use spec::{FramePlan, PanelSpec, TableKind};
+pub use spectrum::spectrum_figure;
 pub use study::study_figure;
 
 /// What went wrong while drawing; `Display` says what and where.

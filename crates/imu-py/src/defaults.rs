@@ -28,6 +28,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     d.set_item("conventions", Conventions::default_name())?;
     d.set_item("filter", FilterKind::default_name())?;
     d.set_item("imu_type", ImuKind::default_name())?;
+    d.set_item("segment_s", imukit::spectrum::DEFAULT_SEGMENT_S)?;
     d.set_item("kalibr_rate_hz", imukit::io::kalibr::DEFAULT_RATE_HZ)?;
     d.set_item("kalibr_topic", imukit::io::kalibr::DEFAULT_TOPIC)?;
     d.set_item("kalibr_inflation", imukit::io::kalibr::DEFAULT_INFLATION)?;

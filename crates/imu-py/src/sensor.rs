@@ -1,5 +1,6 @@
 //! Realistic sensors: MATLAB's `imuSensor` (`imukit.ImuSensor`), presets, parameter files,
-//! datasheet units, and Allan deviation with noise identification.
+//! datasheet units, Allan deviation with noise identification, the readings' spectrum and a
+//! signal chain's response.
 use std::path::Path;
 
 use imukit::allan;
@@ -383,6 +384,23 @@ fn chain_response<'py>(
     crate::convert::table_out(py, t)
 }
 
+/// The power spectral density of `names` of the readings (`imukit.spectrum`).
+#[pyfunction]
+fn spectrum<'py>(
+    py: Python<'py>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+    names: Vec<String>,
+    segment_s: f64,
+    source: &str,
+) -> PyResult<crate::convert::TableOut<'py>> {
+    let t: imukit::Table = crate::convert::table_in("readings", columns, &values)?;
+    let psd = py
+        .detach(|| imukit::spectrum::spectrum_table(&t, &names, segment_s, source))
+        .map_err(refused)?;
+    crate::convert::table_out(py, psd)
+}
+
 /// Adds this module's classes and functions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyImuSensor>()?;
@@ -394,5 +412,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(preset_kalibr_yaml, m)?)?;
     m.add_function(wrap_pyfunction!(load_params_toml, m)?)?;
     m.add_function(wrap_pyfunction!(chain_response, m)?)?;
+    m.add_function(wrap_pyfunction!(spectrum, m)?)?;
     Ok(())
 }

@@ -1,6 +1,8 @@
 """imukit.ImuSensor (MATLAB-shaped), Allan analysis, presets and parameter files from Python."""
 import json
 import math
+import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -378,3 +380,22 @@ def test_a_chains_response_is_the_one_the_simulation_reads():
     with pytest.raises(ImuError, match=r"imu.chain.gyroscope"):
         imukit.chain_response({"internal_rate_hz": 8000, "gyroscope": {"filter": "butterworth", "order": 2,
                                                                       "cutoff_hz": 5000}}, 100, [1.0])
+
+
+def test_the_spectrum_integrates_to_the_variance_and_the_command_writes_the_same(tmp_path):
+    t = np.arange(20000) / 100.0
+    x = 2.0 * np.sin(2 * np.pi * 7.3 * t) + 0.5 * np.cos(2 * np.pi * 31.0 * t)
+    table = imukit.Table.of({"t_s": t, "gyro_x_rad_s": x})
+    psd = imukit.spectrum(table, ["gyro_x_rad_s"], segment_s=10.0)
+    f, p = psd["frequency_hz"], psd["psd_gyro_x_rad_s"]
+    assert abs(p.sum() * (f[1] - f[0]) / x.var() - 1) < 1e-3
+    assert abs(f[np.argmax(p)] - 7.3) <= f[1] - f[0]
+    log = tmp_path / "x.csv"
+    table.write(log)
+    out = tmp_path / "psd.csv"
+    done = subprocess.run([os.environ.get("IMUKIT_BIN", "imukit"), "spectrum", str(log), "--segment-s", "10",
+                           "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    np.testing.assert_allclose(imukit.read(out)["psd_gyro_x_rad_s"], p, rtol=1e-12)
+    with pytest.raises(ImuError, match="segment_s"):
+        imukit.spectrum(table, ["gyro_x_rad_s"], segment_s=-1.0)

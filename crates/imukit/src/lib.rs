@@ -110,7 +110,7 @@ pub use scenario::{Scenario, ScenarioSpec, Simulation};
 // (`imukit::fuse::fuse_with`, `imukit::orient::orient_csv`): `run` only groups them.
 pub use run::{
     allan, arrays, calibrate, compare, epochs, fuse, identify, imu_sensor, navigate, orient,
-    pipeline, planar, reference, simulate, study,
+    pipeline, planar, reference, simulate, spectrum, study,
 };
 
 /// The README's Rust examples, compiled and run as doctests.

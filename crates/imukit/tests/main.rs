@@ -23,6 +23,7 @@ mod presets;
 mod requests;
 mod scenario;
 mod sensors;
+mod spectrum;
 mod stream;
 mod study;
 mod vibration;

@@ -14,6 +14,7 @@ mod plot;
 mod presets;
 mod scenario;
 mod simulate;
+mod spectrum;
 mod study;
 
 use imukit::choice::Choice;
@@ -75,6 +76,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Allan(a) => allan_command(a),
         Command::Identify(a) => identify_command(a),
         Command::Calibrate(a) => calibrate_command(a),
+        Command::Spectrum(a) => spectrum::run(a),
         Command::Plot {
             files,
             window,

@@ -343,3 +343,28 @@ def chain_response(chain: Mapping[str, Any], rate_hz: float, frequencies_hz) -> 
     columns, values = _core.chain_response(dict(chain), float(rate_hz),
                                            [float(f) for f in np.atleast_1d(frequencies_hz)])
     return Table(columns, values)
+
+
+def spectrum(readings: Any, columns: Optional[list] = None, *,
+             segment_s: float = _core.DEFAULTS["segment_s"]) -> "Table":
+    """The power spectral density of readings, as ``imukit spectrum`` computes it (Welch:
+    segments of ``segment_s`` half overlapping, each less its mean under a periodic Hann window,
+    one-sided, so the density integrates to the variance): a Table ``frequency_hz,
+    psd_<column>…`` in the column's unit squared per Hz. ``columns`` defaults to every
+    gyroscope and accelerometer column; ``readings`` is a table with ``t_s`` or a file's path.
+    :func:`imukit.chain_response` says where a part's chain puts a vibration."""
+    if isinstance(readings, (str, os.PathLike)):
+        from ._truth import read
+        source, table = str(readings), read(readings)
+    else:
+        from ._table import Table
+        source, table = "readings", Table.of(readings, "readings")
+    names = list(columns) if columns is not None else [
+        c for c in ("gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s", "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2")
+        if c in table.columns]
+    if not names:
+        raise _core.ImuError(f"{source}: no gyro_* or accel_* columns: name the columns")
+    from ._convert import _table_args
+    from ._table import Table as _Table
+    out_columns, values = _core.spectrum(*_table_args("readings", table), names, float(segment_s), source)
+    return _Table(out_columns, values)

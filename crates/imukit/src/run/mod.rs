@@ -17,4 +17,5 @@ pub mod pipeline;
 pub mod planar;
 pub mod reference;
 pub mod simulate;
+pub mod spectrum;
 pub mod study;
