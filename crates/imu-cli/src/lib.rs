@@ -8,6 +8,7 @@
 #![forbid(unsafe_code)]
 #[doc(hidden)]
 pub mod cli;
+pub mod cli_characterise;
 #[doc(hidden)]
 pub mod commands;
 mod entry;
