@@ -6,7 +6,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
-use crate::scenario::earth::EarthSetup;
 use crate::scenario::spec::TrajectorySpec;
 use crate::scenario::times::SampleTimes;
 use crate::sensor::Chain;
@@ -130,8 +129,7 @@ impl ChainSetup {
     }
 
     /// The chain of a scenario's `[imu.chain]`: regular sample times at the scenario's rate
-    /// (`sample_rate_hz`) on the flat Earth, the motion at most 10⁹ samples, every filter
-    /// checked.
+    /// (`sample_rate_hz`), the motion at most 10⁹ samples, every filter checked.
     ///
     /// # Errors
     /// [`Error::Invalid`] on `imu.chain` or the key it names.
@@ -139,7 +137,6 @@ impl ChainSetup {
         spec: &ChainSpec,
         trajectory: &TrajectorySpec,
         t_s: &SampleTimes,
-        earth: &EarthSetup,
         sample_rate_hz: f64,
     ) -> Result<Self> {
         if !matches!(t_s, SampleTimes::Regular { .. })
@@ -149,13 +146,6 @@ impl ChainSetup {
                 "imu.chain",
                 "the signal chain samples the motion at its internal rate: it needs the regular \
                  sample times of rate_hz, not a trajectory's own times",
-            ));
-        }
-        if matches!(earth, EarthSetup::Wgs84(_)) {
-            return Err(invalid(
-                "imu.chain",
-                "the signal chain is simulated on the flat Earth (earth = \"flat\"); on the \
-                 WGS-84 Earth it is not yet",
             ));
         }
         // The motion is sampled at the internal rate: as many samples as a scenario may have.

@@ -229,10 +229,27 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         earth: &[EarthTruth],
         local: &[Truth<N>],
     ) -> Result<Vec<ImuReading>> {
+        if self.prepares_inputs() {
+            // The inputs worked out for these samples ([`Self::decimate_earth`]), in order.
+            let temperature = &self.setup.sensors.temperature;
+            return Ok(local
+                .iter()
+                .zip(self.inputs.drain(..))
+                .map(|(s, [f, w, m])| {
+                    self.model.measure_ideal(
+                        f,
+                        w,
+                        m,
+                        s.acceleration_m_s2,
+                        &temperature.at(s.t_s),
+                        &mut self.state,
+                        &mut self.noise,
+                    )
+                })
+                .collect());
+        }
         let lever = Vec3::from_array(self.setup.lever_arm_m);
-        let constant = N::from_ned()
-            .inverse()
-            .apply(self.model.mount.magnetic_field_ut);
+        let constant = self.constant_field_ned();
         let measure_field = self.setup.kind.has_mag();
         earth
             .iter()
@@ -264,19 +281,25 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         self.chain.is_some() || self.vibration.is_some()
     }
 
-    /// The ideal inputs of `s` (specific force, rate, field; body axes) with the mount's
-    /// vibration at its instant added, as the sensing elements make them when a chain follows.
-    fn ideal(&mut self, s: &Truth<N>) -> [[f64; 3]; 3] {
-        let [mut f, mut w, m] = self.model.ideal(s).map(Vec3::to_array);
+    /// The ideal inputs `base` (specific force, rate, field; body axes) of a motion sample at
+    /// `t_s` with the navigation-frame acceleration `acceleration`, with the mount's vibration
+    /// at its instant added, as the sensing elements make them when a chain follows.
+    fn sensed(
+        &mut self,
+        base: [Vec3<imu_core::Body>; 3],
+        t_s: f64,
+        acceleration: Vec3<N>,
+    ) -> [[f64; 3]; 3] {
+        let [mut f, mut w, m] = base.map(Vec3::to_array);
         if let Some(v) = &mut self.vibration {
-            let (force, rate) = v.at(s.t_s);
+            let (force, rate) = v.at(t_s);
             for k in 0..3 {
                 f[k] += force[k];
                 w[k] += rate[k];
             }
         }
         match &self.element {
-            Some(e) => e.apply([f, w, m], s.acceleration_m_s2.to_array()),
+            Some(e) => e.apply([f, w, m], acceleration.to_array()),
             None => [f, w, m],
         }
     }
@@ -289,28 +312,80 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     pub fn decimate(&mut self, motion: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
         kept.clear();
         for s in motion {
-            let ideal = self.ideal(s);
-            let filtered = match &mut self.chain {
-                None => Some(ideal),
-                Some(stage) => {
-                    let states = stage.states.get_or_insert_with(|| {
-                        [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
-                    });
-                    let mut filtered = [[0.0; 3]; 3];
-                    let mut keep = false;
-                    for k in 0..3 {
-                        if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
-                            filtered[k] = y;
-                            keep = true;
-                        }
-                    }
-                    keep.then_some(filtered)
-                }
+            let base = self.model.ideal(s);
+            self.push_inputs(s, base, s.acceleration_m_s2, kept);
+        }
+    }
+
+    /// [`Self::decimate`] on the WGS-84 Earth: each motion sample of the tangent plane is placed
+    /// on the Earth and read there ([`TangentPlane::ideal`], the field the magnetic model's at
+    /// each position and time or the IMU's constant one); [`Self::measure_earth`] then takes the
+    /// inputs of the samples kept.
+    ///
+    /// # Errors
+    /// A sample off the Earth or beyond ±89.9° of latitude, the magnetic model's refusal, with
+    /// the time.
+    pub fn decimate_earth(
+        &mut self,
+        plane: &TangentPlane,
+        motion: &[Truth<N>],
+        kept: &mut Vec<Truth<N>>,
+    ) -> Result<()> {
+        kept.clear();
+        let lever = Vec3::from_array(self.setup.lever_arm_m);
+        let constant = self.constant_field_ned();
+        for s in motion {
+            let e = plane.to_earth(s)?;
+            let field = match &plane.magnetic {
+                Some(m) if self.setup.kind.has_mag() => m.field_ned_ut(&e)?,
+                _ => constant,
             };
-            if let Some(inputs) = filtered {
-                kept.push(*s);
-                self.inputs.push(inputs.map(Vec3::from_array));
+            let ideal = plane.ideal::<N>(&e, lever, field);
+            let local = TangentPlane::local(s, &e);
+            let base = [ideal.accel_m_s2, ideal.gyro_rad_s, ideal.mag_ut];
+            self.push_inputs(s, base, local.acceleration_m_s2, kept);
+        }
+        Ok(())
+    }
+
+    /// The IMU's constant field in local NED, µT.
+    fn constant_field_ned(&self) -> Vec3<imu_core::Ned> {
+        N::from_ned()
+            .inverse()
+            .apply(self.model.mount.magnetic_field_ut)
+    }
+
+    /// One motion sample `s` whose ideal inputs are `base`: vibration and the sensing element
+    /// applied, through the chain; when the chain keeps it, `s` goes to `kept` and its inputs
+    /// wait for the error model.
+    fn push_inputs(
+        &mut self,
+        s: &Truth<N>,
+        base: [Vec3<imu_core::Body>; 3],
+        acceleration: Vec3<N>,
+        kept: &mut Vec<Truth<N>>,
+    ) {
+        let ideal = self.sensed(base, s.t_s, acceleration);
+        let filtered = match &mut self.chain {
+            None => Some(ideal),
+            Some(stage) => {
+                let states = stage.states.get_or_insert_with(|| {
+                    [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
+                });
+                let mut filtered = [[0.0; 3]; 3];
+                let mut keep = false;
+                for k in 0..3 {
+                    if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
+                        filtered[k] = y;
+                        keep = true;
+                    }
+                }
+                keep.then_some(filtered)
             }
+        };
+        if let Some(inputs) = filtered {
+            kept.push(*s);
+            self.inputs.push(inputs.map(Vec3::from_array));
         }
     }
 

@@ -263,14 +263,14 @@ impl Scenario {
         out: &mut Stretch,
         kept: &'t mut Vec<Truth<N>>,
     ) -> Result<&'t [Truth<N>]> {
-        let truth: &'t [Truth<N>] = if sensors.prepares_inputs() {
-            sensors.decimate(motion, kept);
-            kept
-        } else {
-            motion
-        };
         match &self.earth {
             EarthSetup::Flat => {
+                let truth: &'t [Truth<N>] = if sensors.prepares_inputs() {
+                    sensors.decimate(motion, kept);
+                    kept
+                } else {
+                    motion
+                };
                 if truth_table {
                     out.truth.refill_truth(truth);
                 } else {
@@ -283,6 +283,12 @@ impl Scenario {
                 Ok(truth)
             }
             EarthSetup::Wgs84(plane) => {
+                let truth: &'t [Truth<N>] = if sensors.prepares_inputs() {
+                    sensors.decimate_earth(plane, motion, kept)?;
+                    kept
+                } else {
+                    motion
+                };
                 let earth = truth
                     .iter()
                     .map(|s| plane.to_earth(s))

@@ -169,13 +169,13 @@ impl ScenarioSpec {
             .imu
             .chain
             .as_ref()
-            .map(|c| ChainSetup::of_scenario(c, &spec.trajectory, &t_s, &earth, sample_rate_hz))
+            .map(|c| ChainSetup::of_scenario(c, &spec.trajectory, &t_s, sample_rate_hz))
             .transpose()?;
         imu.vibration = spec
             .imu
             .vibration
             .as_ref()
-            .map(|v| v.of_scenario(imu.chain.as_ref(), &t_s, &earth, sample_rate_hz))
+            .map(|v| v.of_scenario(imu.chain.as_ref(), &t_s, sample_rate_hz))
             .transpose()?;
         // The sensor model is checked now, at this sample rate, before any work.
         imu.model::<imu_core::Enu>(gravity_m_s2, sample_rate_hz)?;

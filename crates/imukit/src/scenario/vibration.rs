@@ -7,7 +7,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
 use crate::scenario::chain::ChainSetup;
-use crate::scenario::earth::EarthSetup;
 use crate::scenario::times::SampleTimes;
 use imu_core::sensor::{NoiseSource, SeededNormals};
 
@@ -148,8 +147,8 @@ impl VibrationSpec {
     }
 
     /// The vibration of a scenario's `[imu.vibration]`, checked at the rate the motion is
-    /// sampled at (the chain's internal rate, else the scenario's `sample_rate_hz`): on the
-    /// flat Earth; random vibration needs the regular sample times of `rate_hz`.
+    /// sampled at (the chain's internal rate, else the scenario's `sample_rate_hz`), on any
+    /// Earth; random vibration needs the regular sample times of `rate_hz`.
     ///
     /// # Errors
     /// [`crate::Error::Invalid`] on `imu.vibration` or the key it names.
@@ -157,16 +156,8 @@ impl VibrationSpec {
         &self,
         chain: Option<&ChainSetup>,
         t_s: &SampleTimes,
-        earth: &EarthSetup,
         sample_rate_hz: f64,
     ) -> Result<Self> {
-        if matches!(earth, EarthSetup::Wgs84(_)) {
-            return Err(invalid(
-                "imu.vibration",
-                "vibration is simulated on the flat Earth (earth = \"flat\"); on the WGS-84 \
-                 Earth it is not yet",
-            ));
-        }
         if !self.random.is_empty() && !matches!(t_s, SampleTimes::Regular { .. }) {
             return Err(invalid(
                 "imu.vibration.random",
