@@ -27,6 +27,7 @@ pub mod sensor;
 pub mod asl;
 pub mod bag;
 pub mod calibration;
+pub mod chain;
 pub mod column_map;
 pub mod columns;
 pub mod conventions;

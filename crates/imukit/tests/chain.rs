@@ -136,8 +136,8 @@ fn a_chain_the_scenario_cannot_have_is_refused_by_its_key() {
     };
     let e = refused("[imu.chain]\ninternal_rate_hz = 1e300\n", "");
     assert!(
-        e.starts_with("imu.chain.internal_rate_hz: the motion sampled at this rate")
-            && e.contains("1.00e300 samples"),
+        e.starts_with("imu.chain.internal_rate_hz: the motion sampled at these rates")
+            && e.contains("3.00e300 samples"),
         "{e}"
     );
     let e = refused("[imu.chain]\ninternal_rate_hz = 1050\n", "");
@@ -280,4 +280,72 @@ fn the_response_table_is_each_chains_closed_form_and_refuses_a_negative_frequenc
         e.starts_with("frequencies_hz[1]: -3 is not a frequency"),
         "{e}"
     );
+}
+
+/// A part whose accelerometer samples inside at 4 kHz and averages 10 ms, and whose gyroscope
+/// samples at `gyro_hz` and averages 5 ms (the SBG Pulse-40 states 4 kHz and 6.6 kHz), read at
+/// 100 Hz, shaken along z at 1130 Hz and by random vibration along x.
+fn two_rates(gyro_hz: u32) -> String {
+    format!(
+        "[imu.chain]\naccelerometer_internal_rate_hz = 4000\ngyroscope_internal_rate_hz = {gyro_hz}\n\
+         accelerometer = {{ filter = \"moving_average\", taps = 40 }}\n\
+         gyroscope = {{ filter = \"moving_average\", taps = {} }}\n\
+         [imu.vibration]\nsines = [{{ kind = \"acceleration\", axis = \"z\", frequency_hz = 1130, amplitude = 10 }}]\n\
+         random = [{{ kind = \"acceleration\", axis = \"x\", psd = [[20, 1e-2], [1500, 1e-2]] }}]\n",
+        gyro_hz / 200
+    )
+}
+
+#[test]
+fn each_sensor_samples_at_its_own_internal_rate_and_reads_through_its_own_chain() {
+    let scenario = shaking(1130.0, 4.0, &two_rates(6600));
+    let setup = scenario.imu.chain.as_ref().unwrap();
+    assert_eq!(setup.decimations, [40, 66, 1]);
+    // One period holds the gyroscope's 66 instants and the accelerometer's 40: j/66 = i/40 only
+    // where both are a whole number of halves, 0 and 1/2.
+    let pattern = setup.motion_pattern();
+    assert_eq!(pattern.offsets.len(), 66 + 40 - 2);
+    assert_eq!(pattern.sampled[0], [true; 3]);
+    let sampled = |k: usize| pattern.sampled.iter().filter(|s| s[k]).count();
+    assert_eq!([sampled(0), sampled(1), sampled(2)], [40, 66, 1]);
+
+    let sim = scenario.simulate().unwrap();
+    let t = sim.imu.column("t_s").unwrap();
+    assert_eq!(t.len(), 401);
+    let [accel, gyro, _] = setup.chains(100.0).unwrap();
+    let keep = t.iter().position(|&ti| ti >= 0.5).unwrap();
+    let centred = |name: &str| {
+        let y = &sim.imu.column(name).unwrap()[keep..];
+        let mean = y.iter().sum::<f64>() / y.len() as f64;
+        y.iter().map(|v| v - mean).collect::<Vec<_>>()
+    };
+    // The yaw shake through the gyroscope's 66-sample average at 6.6 kHz, the z shake
+    // through the accelerometer's 40-sample average at 4 kHz: each at its own chain's gain.
+    for (column, amplitude, chain) in [("gyro_z_rad_s", 0.5, &gyro), ("accel_z_m_s2", 10.0, &accel)]
+    {
+        let h = chain.response(1130.0);
+        let (fitted, phase) = sine_fit(&t[keep..], &centred(column), 1130.0);
+        assert!(
+            (fitted / (amplitude * h.gain) - 1.0).abs() < 1e-3,
+            "{column}: {fitted} vs {}",
+            amplitude * h.gain
+        );
+        assert!((phase - h.phase_rad).abs() < 1e-3, "{column}: {phase}");
+    }
+    assert!((accel.response(1130.0).gain - gyro.response(1130.0).gain).abs() > 0.01);
+
+    // The accelerometer's readings, its random vibration included, do not depend on the
+    // gyroscope's rate: it draws its noise at its own instants only.
+    let same_rates = shaking(1130.0, 4.0, &two_rates(4000));
+    let other = same_rates.simulate().unwrap();
+    for column in ["accel_x_m_s2", "accel_z_m_s2"] {
+        assert_eq!(
+            sim.imu.column(column).unwrap(),
+            other.imu.column(column).unwrap(),
+            "{column}"
+        );
+    }
+    // Streamed on two threads, the same numbers.
+    let streamed = scenario.simulate_streamed(None, RunThreads::Two).unwrap();
+    assert!(streamed == sim);
 }

@@ -328,7 +328,7 @@ def loadparams(path: Union[str, os.PathLike], part: Optional[str] = None) -> dic
 
 def chain_response(chain: Mapping[str, Any], rate_hz: float, frequencies_hz) -> "Table":
     """A part's signal chain in closed form (docs/sensors.md, "The signal chain"): ``chain`` the
-    ``[imu.chain]`` table as a dict (``internal_rate_hz`` and each sensor's low-pass), read at
+    ``[imu.chain]`` table as a dict (``internal_rate_hz`` or a rate per sensor, each low-pass), read at
     ``rate_hz``; a row per frequency of ``frequencies_hz`` (Hz) with the alias it appears at in
     the output (``alias_hz``) and per sensor the filter's gain, phase (rad) and group delay (s):
     ``accel_gain``, ``accel_phase_rad``, ``accel_delay_s``, ``gyro_…``, ``mag_…``.

@@ -2,129 +2,73 @@
 //! internal rate, low-pass filters each sensor's signal digitally and keeps every `M`-th sample
 //! (the scenario's rate); the error model then applies at the output rate, as before. See
 //! [`imu_core::signal`] and docs/models.md.
-use serde::{Deserialize, Serialize};
-
 use crate::error::{Error, Result, invalid};
 use crate::io::table::Table;
 use crate::scenario::spec::TrajectorySpec;
 use crate::scenario::times::SampleTimes;
 use crate::sensor::Chain;
-use imu_core::signal::{LowPass, SignalError};
+use imu_core::signal::SignalError;
+pub use imu_io::chain::{ChainSpec, LowPassSpec, SENSORS};
 
-/// A sensor's digital low-pass, as a data sheet describes it (`filter = "…"` and its keys).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "filter", rename_all = "snake_case", deny_unknown_fields)]
-pub enum LowPassSpec {
-    /// No filter: decimation alone.
-    None,
-    /// Butterworth of `order` (1–8) with its −3 dB point at `cutoff_hz`.
-    Butterworth {
-        /// Order.
-        order: usize,
-        /// −3 dB frequency, Hz.
-        cutoff_hz: f64,
-    },
-    /// The mean of the last `taps` internal samples.
-    MovingAverage {
-        /// Samples averaged.
-        taps: usize,
-    },
-    /// Two moving averages of `taps` in a row (a triangular window).
-    Bartlett {
-        /// Samples of each average.
-        taps: usize,
-    },
-    /// A finite impulse response, `h₀` first.
-    Fir {
-        /// The impulse response.
-        coefficients: Vec<f64>,
-    },
-    /// `b(z⁻¹)/a(z⁻¹)`.
-    Rational {
-        /// `b₀ … b_m`.
-        numerator: Vec<f64>,
-        /// `a₀ … a_n`.
-        denominator: Vec<f64>,
-    },
-}
+/// Most internal samples per output sample a sensor's chain may take.
+pub const MAX_DECIMATION: usize = 1_000_000;
 
-impl LowPassSpec {
-    /// The core's description of this filter.
-    #[must_use]
-    pub fn low_pass(&self) -> LowPass<'_> {
-        match self {
-            Self::None => LowPass::None,
-            Self::Butterworth { order, cutoff_hz } => LowPass::Butterworth {
-                order: *order,
-                cutoff_hz: *cutoff_hz,
-            },
-            Self::MovingAverage { taps } => LowPass::MovingAverage { taps: *taps },
-            Self::Bartlett { taps } => LowPass::Bartlett { taps: *taps },
-            Self::Fir { coefficients } => LowPass::Fir { coefficients },
-            Self::Rational {
-                numerator,
-                denominator,
-            } => LowPass::Rational {
-                numerator,
-                denominator,
-            },
-        }
-    }
-}
-
-/// The `[imu.chain]` table.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ChainSpec {
-    /// The rate the part samples at inside, Hz: a whole multiple of the scenario's rate.
-    pub internal_rate_hz: f64,
-    /// The accelerometer's low-pass (default none).
-    pub accelerometer: Option<LowPassSpec>,
-    /// The gyroscope's low-pass (default none).
-    pub gyroscope: Option<LowPassSpec>,
-    /// The magnetometer's low-pass (default none).
-    pub magnetometer: Option<LowPassSpec>,
-}
-
-/// The sensors in the order the chain keeps them, with their keys.
-const SENSORS: [&str; 3] = ["accelerometer", "gyroscope", "magnetometer"];
-
-/// A resolved signal chain: the internal rate and each sensor's filter, checked at the
-/// scenario's rate.
+/// A resolved signal chain: each sensor's internal rate and filter, checked at the scenario's
+/// rate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChainSetup {
-    /// The internal rate, Hz.
-    pub internal_rate_hz: f64,
+    /// The accelerometer's, gyroscope's and magnetometer's internal rate, Hz.
+    pub internal_rates_hz: [f64; 3],
     /// The accelerometer's, gyroscope's and magnetometer's low-pass.
     pub low_pass: [LowPassSpec; 3],
-    /// Internal samples per output sample.
-    pub decimation: usize,
+    /// Each sensor's internal samples per output sample.
+    pub decimations: [usize; 3],
+}
+
+/// The instants one output period holds when the sensors sample inside at rates of their own:
+/// the union of each sensor's `j/M` (fractions of the period), in order, with the sensors that
+/// sample at each. The period's first instant is every sensor's and the output sample's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionPattern {
+    /// Each instant's offset in the period, fractions of it, from 0.
+    pub offsets: Vec<f64>,
+    /// Which of the accelerometer, gyroscope and magnetometer sample at each instant.
+    pub sampled: Vec<[bool; 3]>,
 }
 
 impl ChainSetup {
-    /// The chain of `spec` for output at `rate_hz`, every filter checked.
+    /// The chain of `spec` for output at `rate_hz`, every rate and filter checked.
     ///
     /// # Errors
     /// [`Error::Invalid`] on the key (`imu.chain.internal_rate_hz`, `imu.chain.gyroscope`, …)
     /// whose value the chain cannot take.
     pub fn resolve(spec: &ChainSpec, rate_hz: f64) -> Result<Self> {
-        let rate = spec.internal_rate_hz;
-        if !(rate.is_finite() && rate > 0.0) {
-            let e = SignalError::NotPositive {
-                field: "internal_rate_hz",
-                value: rate,
-            };
-            return Err(invalid(INTERNAL_RATE_KEY, e.to_string()));
+        let mut internal_rates_hz = [rate_hz; 3];
+        for (k, (key, rate)) in spec.internal_rates().into_iter().enumerate() {
+            let Some(rate) = rate else { continue };
+            if !(rate.is_finite() && rate > 0.0) {
+                let e = SignalError::NotPositive {
+                    field: "internal_rate_hz",
+                    value: rate,
+                };
+                return Err(invalid(format!("imu.chain.{key}"), e.to_string()));
+            }
+            if rate / rate_hz > MAX_DECIMATION as f64 {
+                return Err(invalid(
+                    format!("imu.chain.{key}"),
+                    format!(
+                        "{rate} Hz is more than {MAX_DECIMATION} times the output rate                          ({rate_hz} Hz)"
+                    ),
+                ));
+            }
+            internal_rates_hz[k] = rate;
         }
-        let low_pass = [&spec.accelerometer, &spec.gyroscope, &spec.magnetometer]
-            .map(|f| f.clone().unwrap_or(LowPassSpec::None));
         let mut setup = Self {
-            internal_rate_hz: rate,
-            low_pass,
-            decimation: 1,
+            internal_rates_hz,
+            low_pass: spec.low_passes(),
+            decimations: [1; 3],
         };
-        let [accelerometer, _, _] = setup.chains(rate_hz)?;
-        setup.decimation = accelerometer.decimation();
+        setup.decimations = setup.chains(rate_hz)?.map(|c| c.decimation());
         Ok(setup)
     }
 
@@ -148,16 +92,20 @@ impl ChainSetup {
                  sample times of rate_hz, not a trajectory's own times",
             ));
         }
-        // The motion is sampled at the internal rate: as many samples as a scenario may have.
+        // The motion is sampled at each sensor's instants: as many as a scenario may have.
+        let per_period: f64 = spec
+            .internal_rates()
+            .iter()
+            .map(|(_, r)| r.unwrap_or(sample_rate_hz) / sample_rate_hz)
+            .sum();
         #[allow(clippy::cast_precision_loss)]
-        let motion_samples =
-            t_s.len().saturating_sub(1) as f64 * spec.internal_rate_hz / sample_rate_hz;
-        if motion_samples > 1e9 {
+        let motion_samples = t_s.len().saturating_sub(1) as f64 * per_period;
+        if motion_samples > 1e9 || !motion_samples.is_finite() {
             return Err(invalid(
                 INTERNAL_RATE_KEY,
                 format!(
-                    "the motion sampled at this rate from the first sample to the last would be \
-                     {motion_samples:.2e} samples, more than 10⁹"
+                    "the motion sampled at these rates from the first sample to the last would \
+                     be {motion_samples:.2e} samples, more than 10⁹"
                 ),
             ));
         }
@@ -170,11 +118,64 @@ impl ChainSetup {
     /// As [`ChainSetup::resolve`].
     pub fn chains(&self, rate_hz: f64) -> Result<[Chain; 3]> {
         let make = |k: usize| {
-            Chain::new(self.internal_rate_hz, rate_hz, &self.low_pass[k].low_pass())
-                .map_err(|e| chain_error(SENSORS[k], &e))
+            Chain::new(
+                self.internal_rates_hz[k],
+                rate_hz,
+                &self.low_pass[k].low_pass(),
+            )
+            .map_err(|e| chain_error(SENSORS[k], &e))
         };
         Ok([make(0)?, make(1)?, make(2)?])
     }
+
+    /// The highest of the sensors' internal rates, Hz.
+    #[must_use]
+    pub fn fastest_rate_hz(&self) -> f64 {
+        self.internal_rates_hz.into_iter().fold(0.0, f64::max)
+    }
+
+    /// The instants of one output period at which the motion is sampled: each sensor's
+    /// `j/M_k`, `j = 0..M_k`, merged (equal fractions once).
+    #[must_use]
+    pub fn motion_pattern(&self) -> MotionPattern {
+        // (numerator, denominator, sensor) in lowest terms, sorted by value.
+        let mut fractions: Vec<(u64, u64, usize)> = Vec::new();
+        for (k, &m) in self.decimations.iter().enumerate() {
+            let m = m as u64;
+            for j in 0..m {
+                let g = gcd(j, m);
+                fractions.push((j / g, m / g, k));
+            }
+        }
+        fractions.sort_by(|a, b| {
+            (u128::from(a.0) * u128::from(b.1)).cmp(&(u128::from(b.0) * u128::from(a.1)))
+        });
+        let mut pattern = MotionPattern {
+            offsets: Vec::new(),
+            sampled: Vec::new(),
+        };
+        let mut last: Option<(u64, u64)> = None;
+        for (j, m, k) in fractions {
+            if last != Some((j, m)) {
+                #[allow(clippy::cast_precision_loss)]
+                pattern.offsets.push(j as f64 / m as f64);
+                pattern.sampled.push([false; 3]);
+                last = Some((j, m));
+            }
+            if let Some(s) = pattern.sampled.last_mut() {
+                s[k] = true;
+            }
+        }
+        pattern
+    }
+}
+
+/// The greatest common divisor (`gcd(0, m) = m`).
+fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
 }
 
 /// The columns of [`ChainSetup::response_table`].

@@ -137,17 +137,19 @@ impl ImuSetup {
                 c.chains(sample_rate_hz).map(|chains| ChainStage {
                     chains,
                     states: None,
+                    sampled: c.motion_pattern().sampled,
+                    position: 0,
                 })
             })
             .transpose()?;
-        let motion_rate_hz = self
+        let rates_hz = self
             .chain
             .as_ref()
-            .map_or(sample_rate_hz, |c| c.internal_rate_hz);
+            .map_or([sample_rate_hz; 3], |c| c.internal_rates_hz);
         let vibration = self
             .vibration
             .as_ref()
-            .map(|v| v.source(motion_rate_hz, seed, run));
+            .map(|v| v.source(rates_hz, seed, run));
         let mut model = self.model_with::<N>(&params, gravity_m_s2, sample_rate_hz)?;
         // With a chain the sensing elements' nonlinearity acts at the internal rate, before the
         // filters (where vibration rectifies), not on the filtered output.
@@ -188,6 +190,11 @@ struct ChainStage {
     chains: [Chain; 3],
     /// Settled at the first sample's inputs when it comes.
     states: Option<[ChainState; 3]>,
+    /// The sensors sampling at each instant of an output period
+    /// ([`ChainSetup::motion_pattern`]).
+    sampled: Vec<[bool; 3]>,
+    /// Where the next motion sample falls in that period.
+    position: usize,
 }
 
 /// The sensor model of an [`ImuSetup`] with its state and seeded noise stream.
@@ -291,8 +298,11 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         acceleration: Vec3<N>,
     ) -> [[f64; 3]; 3] {
         let [mut f, mut w, m] = base.map(Vec3::to_array);
+        let sampled = self.chain.as_ref().map_or([true; 3], |c| {
+            c.sampled.get(c.position).copied().unwrap_or([true; 3])
+        });
         if let Some(v) = &mut self.vibration {
-            let (force, rate) = v.at(t_s);
+            let (force, rate) = v.at(t_s, sampled);
             for k in 0..3 {
                 f[k] += force[k];
                 w[k] += rate[k];
@@ -372,9 +382,16 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                 let states = stage.states.get_or_insert_with(|| {
                     [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
                 });
+                let sampled = stage
+                    .sampled
+                    .get(stage.position)
+                    .copied()
+                    .unwrap_or([true; 3]);
+                stage.position = (stage.position + 1) % stage.sampled.len().max(1);
+                // Each sensor filters its own instants; all keep the period's first.
                 let mut filtered = [[0.0; 3]; 3];
                 let mut keep = false;
-                for k in 0..3 {
+                for k in (0..3).filter(|&k| sampled[k]) {
                     if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
                         filtered[k] = y;
                         keep = true;

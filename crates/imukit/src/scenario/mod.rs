@@ -228,17 +228,17 @@ impl Scenario {
         Ok(simulation)
     }
 
-    /// The times the motion is sampled at: the sample times, or with a signal chain the
-    /// chain's internal instants from the first sample to the last ([`ReadingStream::decimate`]
-    /// keeps every `M`-th, the sample times).
+    /// The times the motion is sampled at: the sample times, or with a signal chain every
+    /// sensor's internal instants from the first sample to the last
+    /// ([`chain::ChainSetup::motion_pattern`]; [`ReadingStream::decimate`] keeps the sample times).
     #[must_use]
     pub fn motion_times(&self) -> std::borrow::Cow<'_, SampleTimes> {
         match (&self.imu.chain, &self.t_s) {
             (Some(chain), SampleTimes::Regular { rate_hz, count }) => {
-                let m = chain.decimation;
-                std::borrow::Cow::Owned(SampleTimes::Regular {
-                    rate_hz: rate_hz * m as f64,
-                    count: count.saturating_sub(1) * m + usize::from(*count > 0),
+                std::borrow::Cow::Owned(SampleTimes::Repeated {
+                    rate_hz: *rate_hz,
+                    count: *count,
+                    offsets: chain.motion_pattern().offsets,
                 })
             }
             (_, t) => std::borrow::Cow::Borrowed(t),

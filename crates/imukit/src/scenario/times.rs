@@ -52,6 +52,18 @@ pub enum SampleTimes {
     },
     /// Times read from a file, s.
     Listed(Vec<f64>),
+    /// A pattern repeated every output period: `(k + offsets[j]) / rate_hz` for
+    /// `k = 0..count − 1` and every `j`, then `k = count − 1` with `j = 0` alone (the last
+    /// sample's instant). `offsets` starts at 0 and increases below 1 (a signal chain's
+    /// internal instants, [`crate::scenario::chain::MotionPattern`]).
+    Repeated {
+        /// Output rate, Hz.
+        rate_hz: f64,
+        /// Output samples.
+        count: usize,
+        /// The instants of one period, fractions of it.
+        offsets: Vec<f64>,
+    },
 }
 
 impl SampleTimes {
@@ -61,6 +73,9 @@ impl SampleTimes {
         match self {
             Self::Regular { count, .. } => *count,
             Self::Listed(t) => t.len(),
+            Self::Repeated { count, offsets, .. } => {
+                count.saturating_sub(1) * offsets.len() + usize::from(*count > 0)
+            }
         }
     }
 
@@ -77,6 +92,13 @@ impl SampleTimes {
             #[allow(clippy::cast_precision_loss)]
             Self::Regular { rate_hz, .. } => k as f64 / rate_hz,
             Self::Listed(t) => t[k],
+            #[allow(clippy::cast_precision_loss)]
+            Self::Repeated {
+                rate_hz, offsets, ..
+            } => {
+                let n = offsets.len().max(1);
+                ((k / n) as f64 + offsets.get(k % n).copied().unwrap_or(0.0)) / rate_hz
+            }
         }
     }
 

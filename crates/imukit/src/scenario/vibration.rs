@@ -27,6 +27,18 @@ pub enum VibrationKind {
     AngularRate,
 }
 
+impl VibrationKind {
+    /// The sensor that reads it: 0 the accelerometer, 1 the gyroscope (the order of
+    /// [`crate::scenario::chain::SENSORS`]).
+    #[must_use]
+    pub fn sensor(self) -> usize {
+        match self {
+            Self::Acceleration => 0,
+            Self::AngularRate => 1,
+        }
+    }
+}
+
 /// A body axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -93,13 +105,14 @@ pub struct VibrationSpec {
 }
 
 impl VibrationSpec {
-    /// The vibration checked for motion sampled at `motion_rate_hz`.
+    /// The vibration checked for sensors sampling at `rates_hz` (accelerometer, gyroscope,
+    /// magnetometer: their internal rates, or the output rate).
     ///
     /// # Errors
     /// [`crate::Error::Invalid`] on the key (`imu.vibration.sines[0].frequency_hz`, …): values
     /// that are not finite, frequencies ≤ 0, a PSD table out of order or reaching half the
-    /// motion's rate (the random vibration is made at that rate).
-    pub fn check(&self, motion_rate_hz: f64) -> Result<()> {
+    /// rate of the sensor that reads it (the random vibration is made at that rate).
+    pub fn check(&self, rates_hz: [f64; 3]) -> Result<()> {
         for (k, s) in self.sines.iter().enumerate() {
             let at = |key: &str| format!("imu.vibration.sines[{k}].{key}");
             if !(s.frequency_hz.is_finite() && s.frequency_hz > 0.0) {
@@ -112,8 +125,8 @@ impl VibrationSpec {
                 return Err(invalid(at("phase_rad"), "must be finite"));
             }
         }
-        let nyquist = motion_rate_hz / 2.0;
         for (k, r) in self.random.iter().enumerate() {
+            let nyquist = rates_hz[r.kind.sensor()] / 2.0;
             let at = format!("imu.vibration.random[{k}].psd");
             if r.psd.len() < 2 {
                 return Err(invalid(
@@ -137,8 +150,10 @@ impl VibrationSpec {
                 return Err(invalid(
                     at,
                     format!(
-                        "reaches {top} Hz, at or above half the rate the motion is sampled at \
-                         ({nyquist} Hz): raise [imu.chain] internal_rate_hz, or rate_hz"
+                        "reaches {top} Hz, at or above half the rate the {sensor} samples at \
+                         ({nyquist} Hz): raise [imu.chain] internal_rate_hz (or \
+                         {sensor}_internal_rate_hz), or rate_hz",
+                        sensor = crate::scenario::chain::SENSORS[r.kind.sensor()]
                     ),
                 ));
             }
@@ -165,20 +180,21 @@ impl VibrationSpec {
                  of rate_hz, not a trajectory's own times",
             ));
         }
-        self.check(chain.map_or(sample_rate_hz, |c| c.internal_rate_hz))?;
+        self.check(chain.map_or([sample_rate_hz; 3], |c| c.internal_rates_hz))?;
         Ok(self.clone())
     }
 
-    /// The vibration's source for motion at `motion_rate_hz`, its noise seeded from `seed` and
-    /// the Monte Carlo run (`None`: the single run).
+    /// The vibration's source for sensors sampling at `rates_hz` (each random vibration made
+    /// at the rate of the sensor that reads it), its noise seeded from `seed` and the Monte
+    /// Carlo run (`None`: the single run).
     #[must_use]
-    pub fn source(&self, motion_rate_hz: f64, seed: u64, run: Option<u64>) -> VibrationSource {
+    pub fn source(&self, rates_hz: [f64; 3], seed: u64, run: Option<u64>) -> VibrationSource {
         let mut noise = SeededNormals::for_sensor(seed, run, VIBRATION_STREAM);
         let random = self
             .random
             .iter()
             .map(|r| {
-                let taps = shaping_filter(&r.psd, motion_rate_hz);
+                let taps = shaping_filter(&r.psd, rates_hz[r.kind.sensor()]);
                 // Stationary from the first sample: the filter's memory is full of noise.
                 let memory = (0..taps.len()).map(|_| noise.standard_normal()).collect();
                 Shaped {
@@ -187,6 +203,7 @@ impl VibrationSpec {
                     taps,
                     memory,
                     next: 0,
+                    value: 0.0,
                 }
             })
             .collect();
@@ -207,6 +224,8 @@ struct Shaped {
     /// The last `taps.len()` normals, a ring; `next` is the oldest.
     memory: Vec<f64>,
     next: usize,
+    /// The last value made.
+    value: f64,
 }
 
 /// The vibration at the motion's instants, in order ([`Self::at`] once per instant).
@@ -218,9 +237,11 @@ pub struct VibrationSource {
 }
 
 impl VibrationSource {
-    /// The vibration at the next instant `t_s`: what it adds to the specific force (m/s²) and
-    /// to the angular rate (rad/s), body axes. One normal per random vibration is drawn.
-    pub fn at(&mut self, t_s: f64) -> ([f64; 3], [f64; 3]) {
+    /// The vibration at the next instant `t_s`, at which the sensors `sampled` (accelerometer,
+    /// gyroscope, magnetometer) sample: what it adds to the specific force (m/s²) and to the
+    /// angular rate (rad/s), body axes. A random vibration draws one normal when the sensor
+    /// that reads it samples, and holds its value between.
+    pub fn at(&mut self, t_s: f64, sampled: [bool; 3]) -> ([f64; 3], [f64; 3]) {
         let (mut force, mut rate) = ([0.0; 3], [0.0; 3]);
         let mut add = |kind: VibrationKind, axis: usize, v: f64| match kind {
             VibrationKind::Acceleration => force[axis] += v,
@@ -231,6 +252,10 @@ impl VibrationSource {
             add(s.kind, s.axis.index(), s.amplitude * phase.sin());
         }
         for r in &mut self.random {
+            if !sampled[r.kind.sensor()] {
+                add(r.kind, r.axis, r.value);
+                continue;
+            }
             r.memory[r.next] = self.noise.standard_normal();
             r.next = (r.next + 1) % r.memory.len();
             // Newest first: memory[next − 1], …
@@ -241,6 +266,7 @@ impl VibrationSource {
                 .enumerate()
                 .map(|(k, h)| h * r.memory[(r.next + n - 1 - k) % n])
                 .sum();
+            r.value = v;
             add(r.kind, r.axis, v);
         }
         (force, rate)
