@@ -396,11 +396,21 @@ def cli_cases(rng: random.Random, cases: int, process_cases: int = 0) -> list:
                 f"outages = [{{ start_s = {x()}, duration_s = {x()} }}]\n",
                 f"[baro]\nrate_hz = {rng.choice(['5.0', x()])}\nnoise_m = {x()}\n[odometer]\nscale_factor_error = {x()}\n",
             ])
+            # A part's signal chain and the mount's vibration, read on either Earth.
+            chain = rng.choice([
+                "",
+                f'[imu]\npreset = "mpu-6050"\n[imu.chain]\nsetting = {rng.choice(["3", "0", "9", "-1", chr(34) + "x" + chr(34)])}\n',
+                f'[imu.chain]\ngyroscope_internal_rate_hz = {rng.choice(["40.0", "1e5", x()])}\n'
+                f'accelerometer_internal_rate_hz = {rng.choice(["20.0", x()])}\n'
+                f'accelerometer = {{ filter = "bandwidth_delay", bandwidth_hz = {x()}, delay_s = {x()} }}\n'
+                f'[imu.vibration]\nsines = [{{ kind = "angular-rate", axis = "x", frequency_hz = {x()}, amplitude = {x()} }}]\n'
+                f'random = [{{ kind = "acceleration", axis = "z", psd = [[1, {x()}], [{x()}, 1]] }}]\n',
+            ])
             (work / "e.toml").write_text(
                 f'rate_hz = 10.0\nduration_s = {rng.choice(["1", "5", "0"])}\nnav_frame = "{rng.choice(["NED", "ENU"])}"\n'
                 f'earth = "{rng.choice(["wgs84", "wgs84", "flat"])}"\n'
                 f'origin = {{ latitude_deg = {x()}, longitude_deg = {x()}, height_m = {x()} }}\n{extra}'
-                f'[trajectory]\ntype = "expression"\n{motion}\n{aid}')
+                f'[trajectory]\ntype = "expression"\n{motion}\n{aid}{chain}')
             extra_out = (["--gnss", "eg.csv"] if "[gnss]" in aid else []) + \
                 (["--baro", "eb.csv", "--odometer", "eod.csv"] if "[baro]" in aid else [])
             run_cli(r, work, ["simulate", "e.toml", "--out", "eo.csv", "--truth", "et.csv", *extra_out], ["e.toml"],

@@ -375,3 +375,78 @@ fn a_chain_it_cannot_be_is_refused_with_what_is_wrong() {
         SignalError::BadCoefficients { .. }
     ));
 }
+
+#[test]
+fn a_data_sheets_bandwidth_and_delay_are_the_filters_own() {
+    // The MPU-6050's DLPF_CFG rows (bandwidth Hz, delay s, internal rate Hz): the gyroscope's
+    // 256 Hz at 8 kHz, the rest at 1 kHz, from no delay to 19 ms.
+    let rows = [
+        (260.0, 0.0, 1000.0),
+        (256.0, 0.98e-3, 8000.0),
+        (184.0, 2.0e-3, 1000.0),
+        (94.0, 3.0e-3, 1000.0),
+        (44.0, 4.9e-3, 1000.0),
+        (21.0, 8.5e-3, 1000.0),
+        (10.0, 13.8e-3, 1000.0),
+        (5.0, 19.0e-3, 1000.0),
+    ];
+    for (bandwidth_hz, delay_s, fs) in rows {
+        let design = LowPass::BandwidthDelay {
+            bandwidth_hz,
+            delay_s,
+        };
+        let chain: Chain = Chain::new(fs, 100.0, &design).unwrap();
+        assert!((chain.dc_gain() - 1.0).abs() < 1e-12);
+        let gain = chain.response(bandwidth_hz).gain;
+        assert!(
+            (gain - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-9,
+            "{bandwidth_hz} Hz: gain {gain}"
+        );
+        assert!(
+            (chain.group_delay_s(0.0) - delay_s).abs() < 1e-12,
+            "{bandwidth_hz} Hz: delay {} s",
+            chain.group_delay_s(0.0)
+        );
+        // In time: a ramp comes out late by the delay.
+        let (t, y) = run(&chain, |t| 3.0 * t, 2.0);
+        let keep = t.iter().position(|&ti| ti >= 1.5).unwrap();
+        for (ti, yi) in t[keep..].iter().zip(&y[keep..]) {
+            assert!(
+                (yi - 3.0 * (ti - delay_s)).abs() < 1e-9,
+                "{bandwidth_hz} Hz"
+            );
+        }
+        // A low-pass: nothing at half the internal rate (the bilinear transform's zero there),
+        // and nowhere more than 1.3 (the zero lifts the no-delay row's response below its
+        // bandwidth by up to 27 %).
+        assert!(chain.response(fs / 2.0).gain < 1e-9, "{bandwidth_hz} Hz");
+        let peak = (0..=500)
+            .map(|i| chain.response(fs / 2.0 * f64::from(i) / 500.0).gain)
+            .fold(0.0, f64::max);
+        assert!(peak < 1.3, "{bandwidth_hz} Hz: peak {peak}");
+    }
+    let refused = |bandwidth_hz: f64, delay_s: f64| {
+        Chain::<imu_core::signal::InlineBuffer>::new(
+            1000.0,
+            100.0,
+            &LowPass::BandwidthDelay {
+                bandwidth_hz,
+                delay_s,
+            },
+        )
+        .unwrap_err()
+    };
+    assert!(matches!(
+        refused(500.0, 0.0),
+        SignalError::CutoffAboveNyquist { .. }
+    ));
+    assert!(matches!(refused(0.0, 0.0), SignalError::NotPositive { .. }));
+    assert!(matches!(
+        refused(50.0, -1e-3),
+        SignalError::BadCoefficients { .. }
+    ));
+    assert!(matches!(
+        refused(50.0, f64::NAN),
+        SignalError::BadCoefficients { .. }
+    ));
+}

@@ -21,6 +21,8 @@ pub struct ParamFile {
     pub info: BTreeMap<String, String>,
     /// The part's data-sheet figures (`[datasheet.<sensor>]`), when the file gives them.
     pub datasheet: Option<crate::datasheet::Datasheet>,
+    /// The part's signal-chain settings (`[chain]`), when the file gives them.
+    pub chain: Option<crate::chain::PartChains>,
     /// What was skipped in a MATLAB file (keys MATLAB's `loadparams` ignores), for the front end
     /// to show as warnings.
     pub warnings: Vec<String>,
@@ -80,6 +82,8 @@ fn parse_document(
                 v,
                 &format!("{origin}: datasheet"),
             )?);
+        } else if k == "chain" && !matlab {
+            out.chain = Some(crate::chain::PartChains::parse(v, origin)?);
         } else if INFO_KEYS.contains(&k.as_str()) {
             out.info.insert(
                 k.clone(),
@@ -92,7 +96,7 @@ fn parse_document(
         } else {
             return Err(invalid(
                 format!("{origin}: {k}"),
-                "unknown key (expected accelerometer, gyroscope, magnetometer, name, grade, source, notes, datasheet)",
+                "unknown key (expected accelerometer, gyroscope, magnetometer, name, grade, source, notes, datasheet, chain)",
             ));
         }
     }
@@ -339,6 +343,17 @@ pub fn to_toml(file: &ParamFile) -> String {
                 "acceleration_squared_bias_rad_s_per_m2_s4 = {}\n",
                 fmt3(p.acceleration_squared_bias)
             );
+        }
+    }
+    if let Some(chain) = &file.chain {
+        #[derive(serde::Serialize)]
+        struct Part<'a> {
+            chain: &'a crate::chain::PartChains,
+        }
+        // Numbers and text only: serialising cannot fail.
+        if let Ok(t) = toml::to_string(&Part { chain }) {
+            s += "\n";
+            s += &t;
         }
     }
     s

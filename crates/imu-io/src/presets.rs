@@ -131,6 +131,34 @@ mod tests {
         }
     }
 
+    /// A part file written back ([`crate::part_file::to_toml`]) keeps its chain settings, and a
+    /// setting that names a setting is refused by its key.
+    #[test]
+    fn chain_settings_survive_a_round_trip_and_nest_no_further() {
+        let part = load("mpu-6050").unwrap();
+        let written = crate::part_file::to_toml(&part);
+        let doc: crate::params::ParamValue = toml::from_str(&written).unwrap();
+        let back = parse_param_document(&doc, "written", Profile::Default).unwrap();
+        assert_eq!(back.chain, part.chain);
+        assert_eq!(back.chain.unwrap().settings.len(), 7);
+        let nested = text("mpu-6050")
+            .unwrap()
+            .replace("delay_s = 0.0186 }", "delay_s = 0.0186 }\nsetting = 5");
+        let doc: crate::params::ParamValue = toml::from_str(&nested).unwrap();
+        let e = parse_param_document(&doc, "nested", Profile::Default)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("nested: chain.settings.6.setting"), "{e}");
+        let typo = text("mpu-6050")
+            .unwrap()
+            .replace("register = ", "regster = ");
+        let doc: crate::params::ParamValue = toml::from_str(&typo).unwrap();
+        let e = parse_param_document(&doc, "typo", Profile::Default)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("typo: chain") && e.contains("regster"), "{e}");
+    }
+
     /// The check is not vacuous: the STIM300's bias range, put back as its turn-on bias, is
     /// refused as a bound.
     #[test]

@@ -41,6 +41,7 @@ pub static FILES: &[ExampleFile] = shipped![
     "data/vendor.map.toml",
     "data/vendor_log.csv",
     "differentiation_error_study.py",
+    "drone_dlpf.toml",
     "earth_flight.toml",
     "expression.toml",
     "gyrocompass.py",
@@ -143,6 +144,11 @@ pub static EXAMPLES: &[Example] = &[
         name: "vibration",
         what: "a motor's 1130 Hz vibration read through a part's 8 kHz chain at 100 Hz: the alias",
         files: &["vibration.toml"],
+    },
+    Example {
+        name: "drone_dlpf",
+        what: "an MPU-6050 shaken at 180 Hz by propellers, read through its DLPF_CFG = 3 filter at 100 Hz",
+        files: &["drone_dlpf.toml"],
     },
     Example {
         name: "schuler",

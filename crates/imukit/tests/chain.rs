@@ -349,3 +349,104 @@ fn each_sensor_samples_at_its_own_internal_rate_and_reads_through_its_own_chain(
     let streamed = scenario.simulate_streamed(None, RunThreads::Two).unwrap();
     assert!(streamed == sim);
 }
+
+#[test]
+fn a_preset_carries_its_data_sheets_filter_settings_and_a_scenario_chooses_one() {
+    // Every DLPF_CFG row of the MPU-6050 preset has the table's bandwidth and delay.
+    let part = imukit::io::presets::load("mpu-6050").unwrap();
+    let chains = part.chain.expect("the preset's [chain] table");
+    assert_eq!(chains.register, "DLPF_CFG");
+    assert!(chains.line.contains("register 26"));
+    let table = [
+        // (accelerometer Hz, s), (gyroscope Hz, s), gyroscope's internal rate
+        ((260.0, 0.0), (256.0, 0.98e-3), 8000.0),
+        ((184.0, 2.0e-3), (188.0, 1.9e-3), 1000.0),
+        ((94.0, 3.0e-3), (98.0, 2.8e-3), 1000.0),
+        ((44.0, 4.9e-3), (42.0, 4.8e-3), 1000.0),
+        ((21.0, 8.5e-3), (20.0, 8.3e-3), 1000.0),
+        ((10.0, 13.8e-3), (10.0, 13.4e-3), 1000.0),
+        ((5.0, 19.0e-3), (5.0, 18.6e-3), 1000.0),
+    ];
+    assert_eq!(chains.settings.len(), table.len());
+    for (k, (accel, gyro, gyro_rate)) in table.into_iter().enumerate() {
+        let setup = ChainSetup::resolve(&chains.settings[&k.to_string()], 100.0).unwrap();
+        // The part has no magnetometer: it takes internal_rate_hz where the row gives one.
+        let mag_rate = if k == 0 { 100.0 } else { 1000.0 };
+        assert_eq!(
+            setup.internal_rates_hz,
+            [1000.0, gyro_rate, mag_rate],
+            "DLPF_CFG {k}"
+        );
+        let [a, g, _] = setup.chains(100.0).unwrap();
+        for (chain, (bandwidth_hz, delay_s)) in [(&a, accel), (&g, gyro)] {
+            assert!((chain.response(bandwidth_hz).gain - 0.5f64.sqrt()).abs() < 1e-9);
+            assert!((chain.group_delay_s(0.0) - delay_s).abs() < 1e-12);
+        }
+    }
+
+    // A scenario chooses a setting: a 12 Hz yaw read through DLPF_CFG = 3 lags by about the
+    // table's 4.8 ms, exactly as that chain's response says.
+    let scenario = |chain: &str| {
+        let text = format!(
+            "rate_hz = 100\nduration_s = 4\n\
+             [trajectory]\ntype = \"expression\"\nconstants = {{ f = 12, w = 0.5 }}\n\
+             position_m = [0, 0, 0]\nyaw_rad = \"w/(2*pi*f)*(1 - cos(2*pi*f*t))\"\n\
+             [imu]\npreset = \"mpu-6050\"\n{chain}"
+        );
+        ScenarioSpec::from_toml(&text, "dlpf").and_then(|s| s.resolve(std::path::Path::new(".")))
+    };
+    let sc = scenario("[imu.chain]\nsetting = 3\n").unwrap();
+    let [_, gyro, _] = sc.imu.chain.as_ref().unwrap().chains(100.0).unwrap();
+    let sim = sc.simulate().unwrap();
+    let t = sim.imu.column("t_s").unwrap();
+    let keep = t.iter().position(|&ti| ti >= 0.5).unwrap();
+    let gz = &sim.imu.column("gyro_z_rad_s").unwrap()[keep..];
+    let mean = gz.iter().sum::<f64>() / gz.len() as f64;
+    let centred: Vec<f64> = gz.iter().map(|v| v - mean).collect();
+    let (amplitude, phase) = sine_fit(&t[keep..], &centred, 12.0);
+    let h = gyro.response(12.0);
+    // The part's noise (0.005 °/s/√Hz) and resolution leave about 1e-4 of the amplitude.
+    assert!(
+        (amplitude / (0.5 * h.gain) - 1.0).abs() < 2e-3,
+        "{amplitude}"
+    );
+    assert!(
+        (phase - h.phase_rad).abs() < 2e-3,
+        "{phase} vs {}",
+        h.phase_rad
+    );
+    let lag_s = -phase / (2.0 * PI * 12.0);
+    assert!((lag_s / 4.8e-3 - 1.0).abs() < 0.05, "lag {lag_s} s");
+
+    // A key given beside the setting takes its place; a setting the part lacks, or a setting
+    // without a part that has them, is refused by its key with what would do.
+    let own =
+        scenario("[imu.chain]\nsetting = \"3\"\ngyroscope = { filter = \"none\" }\n").unwrap();
+    let setup = own.imu.chain.unwrap();
+    assert_eq!(
+        setup.low_pass[1],
+        imukit::scenario::chain::LowPassSpec::None
+    );
+    assert_eq!(setup.internal_rates_hz[1], 1000.0);
+    let e = scenario("[imu.chain]\nsetting = 7\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("imu.chain.setting: preset mpu-6050's DLPF_CFG has no setting 7 (it has 0, 1, 2, 3, 4, 5, 6)"),
+        "{e}"
+    );
+    let e = ScenarioSpec::from_toml(
+        "rate_hz = 100\nduration_s = 1\n[trajectory]\ntype = \"builtin\"\nname = \"figure8\"\n\
+         [imu.chain]\nsetting = 3\n",
+        "s",
+    )
+    .and_then(|s| s.resolve(std::path::Path::new(".")))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with(
+            "imu.chain.setting: the IMU without a preset or params has no chain settings"
+        ) && e.contains("preset = \"mpu-6050\""),
+        "{e}"
+    );
+}

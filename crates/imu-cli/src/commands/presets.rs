@@ -30,6 +30,15 @@ pub fn run(
                 if !missing.is_empty() {
                     crate::out_line!("{:<26} not given: {missing}", "");
                 }
+                if let Some(c) = &file.chain {
+                    let settings: Vec<&str> = c.settings.keys().map(String::as_str).collect();
+                    crate::out_line!(
+                        "{:<26} chain: {} {} ([imu.chain] setting = …)",
+                        "",
+                        c.register,
+                        settings.join(", ")
+                    );
+                }
             }
         }
         Some(n) => match format {

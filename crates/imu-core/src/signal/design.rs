@@ -28,6 +28,18 @@ pub enum LowPass<'a> {
         /// Samples of each of the two averages.
         taps: usize,
     },
+    /// The two figures a data sheet gives for a filter whose structure it does not publish:
+    /// the −3 dB `bandwidth_hz` and the `delay_s` (the group delay at zero frequency). Realised
+    /// as the one second-order section with a Butterworth denominator and one zero,
+    /// `ω_n²(1 + κs)/(s² + √2ω_n s + ω_n²)`, that has both, by the bilinear transform with the
+    /// bandwidth prewarped (both figures exact at the internal rate). Between and beyond them
+    /// the response is this section's, not the part's.
+    BandwidthDelay {
+        /// The −3 dB frequency, Hz.
+        bandwidth_hz: f64,
+        /// The group delay at zero frequency, s (≥ 0).
+        delay_s: f64,
+    },
     /// A finite impulse response given by its coefficients (`h₀` first), used as given.
     Fir {
         /// The impulse response.
@@ -56,6 +68,10 @@ pub(super) fn sections<B: FilterBuffer>(
             take(average(taps)?)?;
             take(average(taps)?)
         }
+        LowPass::BandwidthDelay {
+            bandwidth_hz,
+            delay_s,
+        } => take(bandwidth_delay(bandwidth_hz, delay_s, fs)?),
         LowPass::Fir { coefficients } => take(Section::new(coefficients, &[1.0])?),
         LowPass::Rational {
             numerator,
@@ -133,4 +149,74 @@ fn butterworth<B: FilterBuffer>(
         take(Section::new(&[wc, wc], &[c + wc, wc - c])?)?;
     }
     Ok(())
+}
+
+/// The section of [`LowPass::BandwidthDelay`] at rate `fs`. With `ω_b = 2fs·tan(πB/fs)` (the
+/// bandwidth prewarped) and `y = ω_b/ω_n`, `t = ω_b·τ`, the group delay at zero frequency
+/// `√2/ω_n − κ = τ` gives `κω_b = √2y − t`, and `|H(jω_b)|² = 1/2` gives
+/// `g(y) = 1 + 2(√2y − t)² − y⁴ = 0`: `g(0) > 0` and `g → −∞`, so a root lies between; the
+/// smallest positive one is taken (bisection). The bilinear transform `s = 2fs(1 − z⁻¹)/(1 + z⁻¹)`
+/// keeps the gain at `B` and the delay at zero frequency.
+fn bandwidth_delay<B: FilterBuffer>(
+    bandwidth_hz: f64,
+    delay_s: f64,
+    fs: f64,
+) -> Result<Section<B>, SignalError> {
+    if !(bandwidth_hz.is_finite() && bandwidth_hz > 0.0) {
+        return Err(SignalError::NotPositive {
+            field: "bandwidth_hz",
+            value: bandwidth_hz,
+        });
+    }
+    if bandwidth_hz >= fs / 2.0 {
+        return Err(SignalError::CutoffAboveNyquist {
+            cutoff_hz: bandwidth_hz,
+            nyquist_hz: fs / 2.0,
+        });
+    }
+    if !(delay_s.is_finite() && delay_s >= 0.0 && delay_s * fs <= 1e6) {
+        return Err(SignalError::BadCoefficients {
+            reason: "delay_s must be a finite number ≥ 0 (and at most 10⁶ internal samples)",
+        });
+    }
+    let k = 2.0 * fs;
+    let wb = k * crate::math::tan(core::f64::consts::PI * bandwidth_hz / fs);
+    let t = wb * delay_s;
+    let r2 = core::f64::consts::SQRT_2;
+    let g = |y: f64| 1.0 + 2.0 * (r2 * y - t) * (r2 * y - t) - y * y * y * y;
+    let mut hi = 1.0;
+    while g(hi) >= 0.0 {
+        hi *= 2.0;
+    }
+    // The first sign change on a fine grid, then bisection.
+    const STEPS: u32 = 1000;
+    let mut lo = 0.0;
+    for i in 1..=STEPS {
+        let y = hi * f64::from(i) / f64::from(STEPS);
+        if g(y) < 0.0 {
+            hi = y;
+            break;
+        }
+        lo = y;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let y = 0.5 * (lo + hi);
+    let wn = wb / y;
+    let kappa = (r2 * y - t) / wb;
+    let w2 = wn * wn;
+    Section::new(
+        &[w2 * (1.0 + kappa * k), 2.0 * w2, w2 * (1.0 - kappa * k)],
+        &[
+            k * k + r2 * wn * k + w2,
+            2.0 * (w2 - k * k),
+            k * k - r2 * wn * k + w2,
+        ],
+    )
 }

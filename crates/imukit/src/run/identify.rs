@@ -323,6 +323,7 @@ pub fn param_file(result: &AllanResult, source: &str) -> Result<ParamFile> {
         info,
         warnings: Vec::new(),
         datasheet: None,
+        chain: None,
     })
 }
 

@@ -169,7 +169,11 @@ impl ScenarioSpec {
             .imu
             .chain
             .as_ref()
-            .map(|c| ChainSetup::of_scenario(c, &spec.trajectory, &t_s, sample_rate_hz))
+            .map(|c| {
+                let (part, name) = &imu.sensors.part_chains;
+                let c = c.with_setting(part.as_ref(), name)?;
+                ChainSetup::of_scenario(&c, &spec.trajectory, &t_s, sample_rate_hz)
+            })
             .transpose()?;
         imu.vibration = spec
             .imu

@@ -22,6 +22,7 @@ use imu_core::sensor::{GyroAccelerationInput, ImuReading, Temperatures};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
+use crate::io::chain::PartChains;
 use crate::io::params::{ImuParams, Profile, Sensor, parse_sensor};
 use crate::io::part_file::read_param_file;
 use crate::io::presets;
@@ -165,6 +166,9 @@ pub struct SensorSetup {
     pub draw_parts: bool,
     /// What a MATLAB parameter file had that was skipped, for the front end to show.
     pub warnings: Vec<String>,
+    /// The part's signal-chain settings (its file's `[chain]`), when it has them, and what the
+    /// part is (`preset mpu-6050`, `params my_imu.toml`) for messages.
+    pub part_chains: (Option<PartChains>, String),
 }
 
 impl Default for SensorSetup {
@@ -178,6 +182,7 @@ impl Default for SensorSetup {
             perturbations: Vec::new(),
             draw_parts: false,
             warnings: Vec::new(),
+            part_chains: (None, "the ideal IMU".into()),
         }
     }
 }
@@ -254,6 +259,14 @@ impl SensorSetup {
                 .map(|(i, p)| Perturbation::from_spec(p, i))
                 .collect::<Result<_>>()?,
             draw_parts: false,
+            part_chains: (
+                file.as_ref().and_then(|f| f.chain.clone()),
+                match (keys.preset.as_deref(), keys.params.as_deref()) {
+                    (Some(name), _) => format!("preset {name}"),
+                    (_, Some(path)) => format!("params {}", path.display()),
+                    _ => "the IMU without a preset or params".into(),
+                },
+            ),
             warnings: file.map(|f| f.warnings).unwrap_or_default(),
         })
     }
