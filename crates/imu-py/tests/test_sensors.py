@@ -382,6 +382,22 @@ def test_a_chains_response_is_the_one_the_simulation_reads():
                                                                       "cutoff_hz": 5000}}, 100, [1.0])
 
 
+def test_a_data_sheets_filter_and_a_parts_setting_from_python():
+    # A filter given as a data sheet gives it: its bandwidth and delay are the chain's.
+    r = imukit.chain_response({"gyroscope_internal_rate_hz": 1000,
+                               "gyroscope": {"filter": "bandwidth_delay", "bandwidth_hz": 42, "delay_s": 0.0048}},
+                              100, [0.0, 42.0])
+    assert abs(r["gyro_gain"][1] - 2 ** -0.5) < 1e-9 and abs(r["gyro_delay_s"][0] - 0.0048) < 1e-12
+    # A preset's setting, chosen in a scenario dict; one it lacks is refused by its key.
+    scenario = {"rate_hz": 100, "duration_s": 2, "trajectory": {"type": "expression", "position_m": [0, 0, 0]},
+                "imu": {"preset": "mpu-6050", "chain": {"setting": 3}}}
+    sim = imukit.simulate(scenario)
+    assert sim.imu["t_s"].shape[0] == 201
+    scenario["imu"]["chain"]["setting"] = 9
+    with pytest.raises(ImuError, match=r"imu.chain.setting: preset mpu-6050's DLPF_CFG has no setting 9"):
+        imukit.simulate(scenario)
+
+
 def test_the_spectrum_integrates_to_the_variance_and_the_command_writes_the_same(tmp_path):
     t = np.arange(20000) / 100.0
     x = 2.0 * np.sin(2 * np.pi * 7.3 * t) + 0.5 * np.cos(2 * np.pi * 31.0 * t)
