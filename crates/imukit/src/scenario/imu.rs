@@ -238,35 +238,16 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     ) -> Result<Vec<ImuReading>> {
         if self.prepares_inputs() {
             // The inputs worked out for these samples ([`Self::decimate_earth`]), in order.
-            let temperature = &self.setup.sensors.temperature;
-            return Ok(local
-                .iter()
-                .zip(self.inputs.drain(..))
-                .map(|(s, [f, w, m])| {
-                    self.model.measure_ideal(
-                        f,
-                        w,
-                        m,
-                        s.acceleration_m_s2,
-                        &temperature.at(s.t_s),
-                        &mut self.state,
-                        &mut self.noise,
-                    )
-                })
-                .collect());
+            let mut readings = Vec::with_capacity(local.len());
+            self.measure_into(local, &mut readings);
+            return Ok(readings);
         }
-        let lever = Vec3::from_array(self.setup.lever_arm_m);
         let constant = self.constant_field_ned();
-        let measure_field = self.setup.kind.has_mag();
         earth
             .iter()
             .zip(local)
             .map(|(e, s)| {
-                let field = match &plane.magnetic {
-                    Some(m) if measure_field => m.field_ned_ut(e)?,
-                    _ => constant,
-                };
-                let ideal = plane.ideal::<N>(e, lever, field);
+                let ideal = self.ideal_on_earth(plane, e, constant)?;
                 let temperatures = self.setup.sensors.temperature.at(s.t_s);
                 Ok(self.model.measure_ideal(
                     ideal.accel_m_s2,
@@ -290,17 +271,16 @@ impl<N: NavFrame> ReadingStream<'_, N> {
 
     /// The ideal inputs `base` (specific force, rate, field; body axes) of a motion sample at
     /// `t_s` with the navigation-frame acceleration `acceleration`, with the mount's vibration
-    /// at its instant added, as the sensing elements make them when a chain follows.
+    /// at its instant added (the sensors `sampled` there), as the sensing elements make them
+    /// when a chain follows.
     fn sensed(
         &mut self,
         base: [Vec3<imu_core::Body>; 3],
         t_s: f64,
         acceleration: Vec3<N>,
+        sampled: [bool; 3],
     ) -> [[f64; 3]; 3] {
         let [mut f, mut w, m] = base.map(Vec3::to_array);
-        let sampled = self.chain.as_ref().map_or([true; 3], |c| {
-            c.sampled.get(c.position).copied().unwrap_or([true; 3])
-        });
         if let Some(v) = &mut self.vibration {
             let (force, rate) = v.at(t_s, sampled);
             for k in 0..3 {
@@ -342,20 +322,35 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         kept: &mut Vec<Truth<N>>,
     ) -> Result<()> {
         kept.clear();
-        let lever = Vec3::from_array(self.setup.lever_arm_m);
         let constant = self.constant_field_ned();
         for s in motion {
             let e = plane.to_earth(s)?;
-            let field = match &plane.magnetic {
-                Some(m) if self.setup.kind.has_mag() => m.field_ned_ut(&e)?,
-                _ => constant,
-            };
-            let ideal = plane.ideal::<N>(&e, lever, field);
+            let ideal = self.ideal_on_earth(plane, &e, constant)?;
             let local = TangentPlane::local(s, &e);
             let base = [ideal.accel_m_s2, ideal.gyro_rad_s, ideal.mag_ut];
             self.push_inputs(s, base, local.acceleration_m_s2, kept);
         }
         Ok(())
+    }
+
+    /// The ideal reading at the Earth sample `e` ([`TangentPlane::ideal`] at the IMU's lever
+    /// arm): in the magnetic model's field at its position and time when the IMU has a
+    /// magnetometer and the scenario a model, else in the field `constant` (local NED, µT).
+    ///
+    /// # Errors
+    /// The magnetic model's refusal, with the time.
+    fn ideal_on_earth(
+        &self,
+        plane: &TangentPlane,
+        e: &EarthTruth,
+        constant: Vec3<imu_core::Ned>,
+    ) -> Result<imu_core::IdealReading> {
+        let field = match &plane.magnetic {
+            Some(m) if self.setup.kind.has_mag() => m.field_ned_ut(e)?,
+            _ => constant,
+        };
+        let lever = Vec3::from_array(self.setup.lever_arm_m);
+        Ok(plane.ideal::<N>(e, lever, field))
     }
 
     /// The IMU's constant field in local NED, µT.
@@ -375,19 +370,23 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         acceleration: Vec3<N>,
         kept: &mut Vec<Truth<N>>,
     ) {
-        let ideal = self.sensed(base, s.t_s, acceleration);
+        // The sensors that sample at this instant of the chain's pattern (all without one).
+        let sampled = self.chain.as_mut().map_or([true; 3], |stage| {
+            let sampled = stage
+                .sampled
+                .get(stage.position)
+                .copied()
+                .unwrap_or([true; 3]);
+            stage.position = (stage.position + 1) % stage.sampled.len().max(1);
+            sampled
+        });
+        let ideal = self.sensed(base, s.t_s, acceleration, sampled);
         let filtered = match &mut self.chain {
             None => Some(ideal),
             Some(stage) => {
                 let states = stage.states.get_or_insert_with(|| {
                     [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
                 });
-                let sampled = stage
-                    .sampled
-                    .get(stage.position)
-                    .copied()
-                    .unwrap_or([true; 3]);
-                stage.position = (stage.position + 1) % stage.sampled.len().max(1);
                 // Each sensor filters its own instants; all keep the period's first.
                 let mut filtered = [[0.0; 3]; 3];
                 let mut keep = false;
