@@ -35,9 +35,10 @@ def test_runs_do_not_depend_on_threads_and_equal_single_runs():
 def test_runs_write_their_readings_into_the_gathered_array():
     # What monte_carlo does locally: the shape first, then each run into its slot.
     from imukit import _core
-    rows, columns = _core.simulation_shape(SCENARIO, format="dict", origin="test", base_dir=".")
+    rows, columns, by_run = _core.simulation_shape(SCENARIO, format="dict", origin="test", base_dir=".")
     whole = imukit.simulate(SCENARIO, run=3)
     assert (rows, tuple(columns)) == (whole.imu.values.shape[0], whole.imu.columns)
+    assert by_run == []  # no random vibration: the truth is the same in every run
     gathered = np.full((2, rows, len(columns)), np.nan)
     _, (names, filled, description), *_ = _core.simulate_dict(SCENARIO, run=3, truth=False, imu_out=gathered[1])
     assert description["kind"] == "readings"

@@ -353,7 +353,8 @@ pub struct SimulateArgs {
     /// ROS 2 bag `.mcap` holds the truth and the fixes too).
     #[arg(long)]
     pub out: PathBuf,
-    /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`).
+    /// Where to write the truth (CSV, or by extension `.parquet`, `.npy`, `.npz`; with --runs
+    /// once, or one per run when the mount's vibration is random and so differs by run).
     #[arg(long)]
     pub truth: Option<PathBuf>,
     /// Where to write the GNSS fixes of the scenario's `[gnss]` receiver (CSV; with --runs,

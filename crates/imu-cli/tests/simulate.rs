@@ -388,3 +388,75 @@ fn simulate_writes_gnss_fixes_beside_the_imu_per_run_and_refuses_collisions() {
     assert_eq!(code, Some(65), "{err}");
     assert!(err.contains("--gnss") && err.contains("--out"), "{err}");
 }
+
+#[test]
+fn a_random_vibration_writes_the_truth_per_run_and_sines_once() {
+    let dir = temp_dir("vibration-runs");
+    let dir = dir.path();
+    let scenario = |vibration: &str| {
+        format!(
+            "rate_hz = 100.0\nduration_s = 1.0\n[trajectory]\ntype = \"builtin\"\nname = \"static\"\n\
+             [imu]\nkind = \"accel-gyro\"\n[imu.vibration]\n{vibration}\n"
+        )
+    };
+    std::fs::write(
+        dir.join("random.toml"),
+        scenario(
+            "random = [{ kind = \"angular-rate\", axis = \"x\", psd = [[5, 1e-4], [40, 1e-4]] }]",
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("sine.toml"),
+        scenario("sines = [{ kind = \"angular-rate\", axis = \"x\", frequency_hz = 7, amplitude = 0.2 }]"),
+    )
+    .unwrap();
+    let args = |s: &'static str, out: &'static str, truth: &'static str| {
+        ["simulate", s, "--out", out, "--truth", truth, "--runs", "2"]
+    };
+    let (code, err) = run_in(dir, &args("random.toml", "r.csv", "rt.csv"));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("rt_run0000.csv … rt_run0001.csv"), "{err}");
+    assert!(!dir.join("rt.csv").exists());
+    let column = |file: &str, name: &str| {
+        let t = ::imukit::io::read::read_table(dir.join(file)).unwrap();
+        t.column(name).unwrap()
+    };
+    // Each run's truth says what its own vibration did: the gyroscope (ideal, at rest) reads it.
+    for r in 0..2 {
+        let (reading, shaken) = (
+            column(&format!("r_run000{r}.csv"), "gyro_x_rad_s"),
+            column(&format!("rt_run000{r}.csv"), "vib_gyro_x_rad_s"),
+        );
+        assert!(
+            reading
+                .iter()
+                .zip(&shaken)
+                .all(|(a, b)| (a - b).abs() < 1e-9),
+            "run {r}"
+        );
+    }
+    assert!(
+        column("rt_run0000.csv", "vib_gyro_x_rad_s")
+            != column("rt_run0001.csv", "vib_gyro_x_rad_s")
+    );
+    // Sines are the same in every run: one truth file.
+    let (code, err) = run_in(dir, &args("sine.toml", "s.csv", "st.csv"));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(dir.join("st.csv").exists() && !dir.join("st_run0000.csv").exists());
+    // A truth per run may not overwrite another output.
+    let (code, err) = run_in(
+        dir,
+        &[
+            "simulate",
+            "random.toml",
+            "--out",
+            "x.csv",
+            "--truth",
+            "x.csv",
+            "--runs",
+            "2",
+        ],
+    );
+    assert_eq!(code, Some(65), "{err}");
+}

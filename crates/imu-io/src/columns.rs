@@ -72,6 +72,22 @@ pub const EARTH_TRUTH_COLUMNS: [&str; 6] = [
     "lat_rad", "lon_rad", "height_m", "ecef_x_m", "ecef_y_m", "ecef_z_m",
 ];
 
+/// The truth columns added when the IMU's mount vibrates, after the others: what the vibration
+/// added to the accelerometer's and gyroscope's inputs (through the signal chain when there is
+/// one, sensor axes) and the sensor's turn against the vehicle's body axes (a rotation vector:
+/// the sensor's attitude is `q ⊗ exp(mount_rot)`).
+pub const VIBRATION_TRUTH_COLUMNS: [&str; 9] = [
+    "vib_accel_x_m_s2",
+    "vib_accel_y_m_s2",
+    "vib_accel_z_m_s2",
+    "vib_gyro_x_rad_s",
+    "vib_gyro_y_rad_s",
+    "vib_gyro_z_rad_s",
+    "mount_rot_x_rad",
+    "mount_rot_y_rad",
+    "mount_rot_z_rad",
+];
+
 /// GNSS columns on the flat Earth.
 pub const GNSS_COLUMNS: [&str; 7] = [
     "t_s",

@@ -282,6 +282,33 @@ impl Table {
         self.data.extend_from_slice(row);
     }
 
+    /// Appends the columns `names` after this table's, row `i` of them `values[i]`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] on `table` when `values` has not one row per row of the table.
+    pub fn append_columns<const W: usize>(
+        &mut self,
+        names: &[&str; W],
+        values: &[[f64; W]],
+    ) -> Result<()> {
+        let rows = self.rows();
+        if values.len() != rows {
+            return Err(crate::error::invalid(
+                "table",
+                format!("{} rows of {names:?} for {rows} rows", values.len()),
+            ));
+        }
+        let width = self.columns.len();
+        let mut data = Vec::with_capacity(rows * (width + W));
+        for (row, more) in self.data.chunks_exact(width.max(1)).zip(values) {
+            data.extend_from_slice(row);
+            data.extend_from_slice(more);
+        }
+        self.data = data;
+        self.columns.extend(names.iter().map(|c| (*c).to_string()));
+        Ok(())
+    }
+
     /// Truth samples as a table with [`TRUTH_COLUMNS`].
     #[must_use]
     pub fn from_truth<N: NavFrame>(truth: &[Truth<N>]) -> Self {
@@ -496,6 +523,21 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn appended_columns_extend_each_row_and_a_wrong_count_is_refused() {
+        let mut t = Table::new(&["t_s", "a"]);
+        t.push_row(&[0.0, 1.0]);
+        t.push_row(&[0.5, 2.0]);
+        t.append_columns(&["b", "c"], &[[3.0, 4.0], [5.0, 6.0]])
+            .unwrap();
+        assert_eq!(t.columns, ["t_s", "a", "b", "c"]);
+        assert_eq!(t.data, [0.0, 1.0, 3.0, 4.0, 0.5, 2.0, 5.0, 6.0]);
+        assert_eq!(t.column("c"), Some(vec![4.0, 6.0]));
+        let e = t.append_columns(&["d"], &[[7.0]]).unwrap_err().to_string();
+        assert!(e.contains("1 rows of [\"d\"] for 2 rows"), "{e}");
+        assert_eq!(t.columns.len(), 4, "a refused append leaves the table");
     }
 
     #[test]

@@ -244,3 +244,53 @@ fn allan_from_tables(
         size,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use imukit::io::columns::{TRUTH_COLUMNS, VIBRATION_TRUTH_COLUMNS};
+
+    #[test]
+    fn a_truth_with_vibration_gets_its_panels_and_a_plain_one_does_not() {
+        let columns: Vec<&str> = TRUTH_COLUMNS
+            .iter()
+            .chain(&VIBRATION_TRUTH_COLUMNS)
+            .copied()
+            .collect();
+        let mut shaken = Table::new(&columns);
+        for t in [0.0, 0.01] {
+            let mut row = vec![t; columns.len()];
+            row[columns.len() - 3] = 0.01; // mount_rot_x_rad
+            shaken.push_row(&row);
+        }
+        let titles = |table: Table| -> Vec<String> {
+            let files = [("t".to_string(), table)];
+            TableKind::Truth
+                .panels()
+                .iter()
+                .filter_map(|spec| panel(&files, spec))
+                .map(|p| p.title)
+                .collect()
+        };
+        let with = titles(shaken.clone());
+        assert_eq!(
+            with[with.len() - 3..],
+            [
+                "Vibration: accelerometer input",
+                "Vibration: gyroscope input",
+                "Sensor's turn on its mount"
+            ]
+        );
+        let files = [("t".to_string(), shaken)];
+        let panels = TableKind::Truth.panels();
+        let spec = panels
+            .iter()
+            .find(|s| s.title == "Sensor's turn on its mount")
+            .unwrap();
+        let turn = panel(&files, spec).unwrap();
+        assert!((turn.series[0].points[0].1 - 0.01_f64.to_degrees()).abs() < 1e-12);
+        let mut plain = Table::new(&TRUTH_COLUMNS);
+        plain.push_row(&[0.0; TRUTH_COLUMNS.len()]);
+        assert_eq!(titles(plain).len(), with.len() - 3);
+    }
+}

@@ -177,6 +177,24 @@ impl TableKind {
                     1.0,
                     &[("body_vel_x_m_s", "forward"), ("body_vel_y_m_s", "left")].map(own),
                 ),
+                p(
+                    "Vibration: accelerometer input",
+                    "specific force (m/s²)",
+                    1.0,
+                    &xyz("vib_accel", "m_s2"),
+                ),
+                p(
+                    "Vibration: gyroscope input",
+                    "angular rate (rad/s)",
+                    1.0,
+                    &xyz("vib_gyro", "rad_s"),
+                ),
+                p(
+                    "Sensor's turn on its mount",
+                    "rotation vector (deg)",
+                    DEG,
+                    &xyz("mount_rot", "rad"),
+                ),
             ],
             Self::Imu => vec![
                 p(

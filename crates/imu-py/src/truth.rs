@@ -213,8 +213,8 @@ fn write_run(
 }
 
 /// The rows and IMU columns one run of a scenario makes (TOML or JSON text, or a dict with
-/// `format = "dict"`), refused as a run would be, without running it: what a caller allocates
-/// for many runs' readings.
+/// `format = "dict"`), and the truth columns that differ by run, refused as a run would be,
+/// without running it: what a caller allocates for many runs' readings.
 #[pyfunction]
 #[pyo3(signature = (scenario, *, format, origin, base_dir))]
 fn simulation_shape(
@@ -223,18 +223,25 @@ fn simulation_shape(
     format: &str,
     origin: &str,
     base_dir: &str,
-) -> PyResult<(usize, Vec<String>)> {
+) -> PyResult<(usize, Vec<String>, Vec<String>)> {
     let spec = if format == "dict" {
         dict_spec(scenario, origin)?
     } else {
         text_spec(&scenario.extract::<String>()?, format, origin)?
     };
     let base = base_dir.to_string();
-    let shape = py
-        .detach(move || spec.resolve(Path::new(&base))?.gathered_shape())
+    let (shape, by_run) = py
+        .detach(move || {
+            let scenario = spec.resolve(Path::new(&base))?;
+            Ok::<_, imukit::Error>((
+                scenario.gathered_shape()?,
+                scenario.truth_columns_of_each_run(),
+            ))
+        })
         .map_err(refused)?;
     let columns = shape.imu_columns.into_iter().map(str::to_string).collect();
-    Ok((shape.rows, columns))
+    let by_run = by_run.iter().map(|c| (*c).to_string()).collect();
+    Ok((shape.rows, columns, by_run))
 }
 
 /// Exact truth from formula strings at the times `t_s`.

@@ -415,3 +415,28 @@ def test_the_spectrum_integrates_to_the_variance_and_the_command_writes_the_same
     np.testing.assert_allclose(imukit.read(out)["psd_gyro_x_rad_s"], p, rtol=1e-12)
     with pytest.raises(ImuError, match="segment_s"):
         imukit.spectrum(table, ["gyro_x_rad_s"], segment_s=-1.0)
+
+
+def test_the_truth_says_what_the_vibration_did_and_monte_carlo_keeps_what_all_runs_share():
+    # A roll shake of 0.2 rad/s at 7 Hz turns the sensor by 0.2/ω·(1 − cos ωt) about x; at rest
+    # the ideal gyroscope reads the shake alone, and the truth holds both.
+    shake = {"sines": [{"kind": "angular-rate", "axis": "x", "frequency_hz": 7, "amplitude": 0.2}]}
+    scenario = {"rate_hz": 100, "duration_s": 2,
+                "trajectory": {"type": "expression", "position_m": [0, 0, 0]},
+                "imu": {"kind": "accel-gyro", "vibration": shake}}
+    sim = imukit.simulate(scenario)
+    t, omega = sim.truth["t_s"], 2 * np.pi * 7
+    np.testing.assert_allclose(sim.truth["mount_rot_x_rad"], 0.2 / omega * (1 - np.cos(omega * t)),
+                               rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(sim.truth["vib_gyro_x_rad_s"], sim.imu["gyro_x_rad_s"])
+    np.testing.assert_allclose(sim.truth["vib_accel_y_m_s2"], sim.imu["accel_y_m_s2"], rtol=0, atol=1e-15)
+    assert imukit.monte_carlo(scenario, runs=2).truth.columns == sim.truth.columns
+    # A random shake differs by run: Monte Carlo's common truth leaves its columns out, and
+    # each run's own truth has them.
+    scenario["imu"]["vibration"] = {"random": [{"kind": "angular-rate", "axis": "x", "psd": [[5, 1e-4], [40, 1e-4]]}]}
+    mc = imukit.monte_carlo(scenario, runs=2)
+    assert "t_s" in mc.truth and not any(c.startswith(("vib_", "mount_")) for c in mc.truth.columns)
+    runs = [imukit.simulate(scenario, run=r) for r in (0, 1)]
+    for k, r in enumerate(runs):
+        np.testing.assert_array_equal(r.truth["vib_gyro_x_rad_s"], mc.imu[k][:, mc.columns.index("gyro_x_rad_s")])
+    assert not np.array_equal(runs[0].truth["mount_rot_x_rad"], runs[1].truth["mount_rot_x_rad"])

@@ -5,6 +5,7 @@
 //! chains the scenario cannot have are refused by key.
 use core::f64::consts::PI;
 
+use imukit::io::columns::VIBRATION_TRUTH_COLUMNS;
 use imukit::run::pipeline::RunThreads;
 use imukit::scenario::chain::{ChainSetup, ChainSpec};
 use imukit::{Scenario, ScenarioSpec};
@@ -202,11 +203,30 @@ fn on_the_wgs84_earth_the_chain_reads_the_alias_and_the_vibration_is_filtered_as
     // its alias.
     let (amplitude, _) = sine_fit(&t[keep..], &centred("accel_z_m_s2"), f);
     assert!((amplitude / 10.0 - 1.0).abs() < 1e-3, "{amplitude}");
-    // The truth is the WGS-84 truth of the scenario's rows.
+    // The truth is the WGS-84 truth of the scenario's rows, and then what the vibration did:
+    // the shake itself at each row (the accelerometer has no filter), nothing else.
     let plain = shaking_on("earth = \"wgs84\"\norigin = [45, 7, 100]", f, 4.0, "")
         .simulate()
         .unwrap();
-    assert!(sim.truth == plain.truth, "truth rows differ");
+    let width = plain.truth.columns.len();
+    assert_eq!(sim.truth.columns[..width], plain.truth.columns[..]);
+    assert_eq!(sim.truth.columns[width..], VIBRATION_TRUTH_COLUMNS[..]);
+    for (row, motion) in sim
+        .truth
+        .data
+        .chunks_exact(width + 9)
+        .zip(plain.truth.data.chunks_exact(width))
+    {
+        assert!(row[..width] == *motion, "truth rows differ");
+        let shake = 10.0 * (2.0 * PI * f * row[0]).sin();
+        assert!((row[width + 2] - shake).abs() < 1e-9, "{row:?}");
+        assert!(
+            row[width..]
+                .iter()
+                .enumerate()
+                .all(|(k, v)| k == 2 || *v == 0.0)
+        );
+    }
     let streamed = scenario.simulate_streamed(None, RunThreads::Two).unwrap();
     assert!(
         streamed == sim,

@@ -1,10 +1,15 @@
-//! The mount's vibration (`[imu.vibration]`): sines added to the ideal inputs exactly, random
-//! vibration with the PSD of its table (Welch), the same through a signal chain times the
-//! chain's |H|² summed over the aliases, the truth left the vehicle's motion, runs seeded, and
-//! the tables the scenario cannot have refused by key.
+//! The mount's vibration (`[imu.vibration]`): sines added to the ideal inputs exactly in the
+//! sensor's turned axes, the turn of coning as its closed form and a strapdown following the
+//! sensor, random vibration with the PSD of its table (Welch), the same through a signal chain
+//! times the chain's |H|² summed over the aliases, the truth the vehicle's motion and what the
+//! vibration did (through the chain as the part reads it), runs seeded, and the tables the
+//! scenario cannot have refused by key.
 use core::f64::consts::PI;
 
+use imukit::io::columns::VIBRATION_TRUTH_COLUMNS;
+use imukit::run::navigate::{InitialState, NavScheme, NavSetup, integrate};
 use imukit::{Scenario, ScenarioSpec, Simulation};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// A body at rest, level, at `rate_hz` for `seconds`, ideal accelerometer and gyroscope, with
 /// `extra` TOML after the `[imu]` table.
@@ -48,33 +53,167 @@ fn welch(x: &[f64], fs: f64, n: usize, f: f64) -> (f64, usize) {
 }
 
 #[test]
-fn sines_are_added_to_the_ideal_inputs_and_the_truth_stays_the_motion() {
+fn sines_are_added_in_the_sensors_axes_and_the_truth_says_what_they_did() {
+    // Rolling at 0.1·sin(2π·3t) rad/s turns the sensor by θ(t) = 0.1/(6π)·(1 − cos 6πt) about
+    // x: its accelerometer reads gravity in its own axes, (0, g sin θ, g cos θ), plus its shake.
     let sines = "[imu.vibration]\nsines = [\
                  { kind = \"acceleration\", axis = \"z\", frequency_hz = 7, amplitude = 2, phase_rad = 0.3 },\
                  { kind = \"angular-rate\", axis = \"x\", frequency_hz = 3, amplitude = 0.1 }]\n";
     let sim = at_rest(100.0, 3.0, sines).simulate().unwrap();
     let t = column(&sim, "t_s");
-    let (az, gx, ax) = (
-        column(&sim, "accel_z_m_s2"),
-        column(&sim, "gyro_x_rad_s"),
-        column(&sim, "accel_x_m_s2"),
-    );
+    let [ax, ay, az, gx] = [
+        "accel_x_m_s2",
+        "accel_y_m_s2",
+        "accel_z_m_s2",
+        "gyro_x_rad_s",
+    ]
+    .map(|name| column(&sim, name));
+    let truth = |name: &str| sim.truth.column(name).unwrap();
+    let [vx, vy, vz, wx, turn] = [
+        "vib_accel_x_m_s2",
+        "vib_accel_y_m_s2",
+        "vib_accel_z_m_s2",
+        "vib_gyro_x_rad_s",
+        "mount_rot_x_rad",
+    ]
+    .map(truth);
+    let g = 9.81;
     for i in 0..t.len() {
-        let expect_az = 9.81 + 2.0 * (2.0 * PI * 7.0 * t[i] + 0.3).sin();
+        let theta = 0.1 / (6.0 * PI) * (1.0 - (6.0 * PI * t[i]).cos());
+        let shake = 2.0 * (2.0 * PI * 7.0 * t[i] + 0.3).sin();
+        let expect = [0.0, g * theta.sin(), g * theta.cos() + shake];
+        for (got, want) in [ax[i], ay[i], az[i]].iter().zip(expect) {
+            assert!((got - want).abs() < 1e-12, "t = {}: {got} vs {want}", t[i]);
+        }
+        assert!((gx[i] - 0.1 * (6.0 * PI * t[i]).sin()).abs() < 1e-12);
+        // The truth: the sensor's turn, and the inputs less the vehicle's (0, 0, g).
         assert!(
-            (az[i] - expect_az).abs() < 1e-12,
-            "t = {}: {} vs {expect_az}",
+            (turn[i] - theta).abs() < 1e-14,
+            "t = {}: {} vs {theta}",
             t[i],
-            az[i]
+            turn[i]
         );
-        assert!((gx[i] - 0.1 * (2.0 * PI * 3.0 * t[i]).sin()).abs() < 1e-12);
-        assert_eq!(ax[i], 0.0);
+        assert!(vx[i] == 0.0 && (vy[i] - ay[i]).abs() < 1e-15);
+        assert!((vz[i] - (az[i] - g)).abs() < 1e-14 && wx[i] == gx[i]);
     }
     let plain = at_rest(100.0, 3.0, "").simulate().unwrap();
-    assert!(
-        sim.truth == plain.truth,
-        "the truth is the motion, without the vibration"
+    let width = plain.truth.columns.len();
+    assert_eq!(sim.truth.columns[width..], VIBRATION_TRUTH_COLUMNS);
+    for (row, motion) in sim
+        .truth
+        .data
+        .chunks_exact(width + 9)
+        .zip(plain.truth.data.chunks_exact(width))
+    {
+        assert!(
+            row[..width] == *motion,
+            "the vehicle's motion, without the vibration"
+        );
+    }
+}
+
+/// θ, Ω of the coning below: rates `θΩ·(0, cos Ωt, sin Ωt)`, 10 Hz.
+const THETA: f64 = 0.01;
+const CONE_HZ: f64 = 10.0;
+
+/// The sensor's axes against the vehicle's under that coning, closed form:
+/// `exp((w₀ + Ωx̂)t) ⊗ exp(−Ωt x̂)`, `w₀ = (0, θΩ, 0)` (`imu-core/tests/coning.rs`).
+fn coned(t: f64) -> UnitQuaternion<f64> {
+    let omega = 2.0 * PI * CONE_HZ;
+    UnitQuaternion::from_scaled_axis(Vector3::new(omega, THETA * omega, 0.0) * t)
+        * UnitQuaternion::from_scaled_axis(Vector3::new(-omega * t, 0.0, 0.0))
+}
+
+#[test]
+fn coning_turns_the_sensor_as_the_closed_form_and_a_strapdown_follows_the_sensor() {
+    let a = THETA * 2.0 * PI * CONE_HZ;
+    let cone = format!(
+        "[imu.vibration]\nsines = [\
+         {{ kind = \"angular-rate\", axis = \"y\", frequency_hz = {CONE_HZ}, amplitude = {a}, phase_rad = {} }},\
+         {{ kind = \"angular-rate\", axis = \"z\", frequency_hz = {CONE_HZ}, amplitude = {a} }}]\n",
+        PI / 2.0
     );
+    let seconds = 60.0;
+    let sim = at_rest(400.0, seconds, &cone).simulate().unwrap();
+    let t = column(&sim, "t_s");
+    let turn = sim
+        .truth
+        .triples(&["mount_rot_x_rad", "mount_rot_y_rad", "mount_rot_z_rad"])
+        .unwrap();
+    let accel = sim
+        .imu
+        .triples(&["accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"])
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for ((&ti, r), f) in t.iter().zip(&turn).zip(&accel) {
+        let mount = UnitQuaternion::from_scaled_axis(Vector3::from(*r));
+        worst = worst.max(mount.angle_to(&coned(ti)));
+        // The accelerometer reads gravity in the sensor's turned axes.
+        let up = mount.inverse() * Vector3::new(0.0, 0.0, 9.81);
+        assert!((Vector3::from(*f) - up).norm() < 1e-12, "t = {ti}");
+    }
+    // The turn about x after 60 s is θ²Ω/2·T = 0.188 rad.
+    let drift = THETA * THETA * 2.0 * PI * CONE_HZ / 2.0 * seconds;
+    let last = turn[turn.len() - 1];
+    assert!((last[0] / drift - 1.0).abs() < 1e-3, "{last:?} vs {drift}");
+    assert!(
+        worst < 1e-9,
+        "the truth's turn departs from the closed form by {worst} rad"
+    );
+    // The readings integrated (fourth order) follow the sensor, not the vehicle, which is at
+    // rest: the attitude is the truth's ⊗ the mount's turn, and the position stays put.
+    let init = InitialState::from_table(&sim.truth).unwrap();
+    let setup = NavSetup {
+        scheme: NavScheme::Rk4 { substeps: 4 },
+        ..NavSetup::default()
+    };
+    let nav = integrate(&sim.imu, &init, &setup).unwrap();
+    let n = nav.rows() - 1;
+    let q = ["q_w", "q_x", "q_y", "q_z"].map(|c| nav.column(c).unwrap()[n]);
+    let estimate = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+    let sensor = UnitQuaternion::from_scaled_axis(Vector3::from(last));
+    assert!(
+        estimate.angle_to(&sensor) < 1e-7,
+        "{}",
+        estimate.angle_to(&sensor)
+    );
+    assert!((estimate.angle() / drift - 1.0).abs() < 1e-3);
+    let p = ["pos_x_m", "pos_y_m", "pos_z_m"].map(|c| nav.column(c).unwrap()[n]);
+    assert!(p.iter().all(|v| v.abs() < 1e-3), "{p:?}");
+}
+
+#[test]
+fn through_a_chain_the_truth_has_the_shake_as_the_chain_reads_it() {
+    // A 1130 Hz yaw shake through the gyroscope's 200 Hz low-pass at 8 kHz, read at 100 Hz.
+    let text = "[imu.chain]\ninternal_rate_hz = 8000\n\
+                gyroscope = { filter = \"butterworth\", order = 2, cutoff_hz = 200 }\n\
+                [imu.vibration]\nsines = [\
+                { kind = \"angular-rate\", axis = \"z\", frequency_hz = 1130, amplitude = 0.5 }]\n";
+    let sc = at_rest(100.0, 4.0, text);
+    let sim = sc.simulate().unwrap();
+    let [_, gyro, _] = sc.imu.chain.as_ref().unwrap().chains(100.0).unwrap();
+    let h = gyro.response(1130.0);
+    let t = column(&sim, "t_s");
+    let (gz, shaken, turn) = (
+        column(&sim, "gyro_z_rad_s"),
+        sim.truth.column("vib_gyro_z_rad_s").unwrap(),
+        sim.truth.column("mount_rot_z_rad").unwrap(),
+    );
+    let omega = 2.0 * PI * 1130.0;
+    for i in 0..t.len() {
+        // The vehicle is at rest: all the gyroscope reads is the shake.
+        assert_eq!(gz[i], shaken[i]);
+        assert!((turn[i] - 0.5 / omega * (1.0 - (omega * t[i]).cos())).abs() < 1e-13);
+        if t[i] >= 0.5 {
+            let expect = 0.5 * h.gain * (omega * t[i] + h.phase_rad).sin();
+            assert!(
+                (shaken[i] - expect).abs() < 1e-6,
+                "t = {}: {} vs {expect}",
+                t[i],
+                shaken[i]
+            );
+        }
+    }
 }
 
 #[test]

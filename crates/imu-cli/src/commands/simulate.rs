@@ -64,6 +64,7 @@ fn check_files(
     spec: &ScenarioSpec,
     o: &Outputs<'_>,
     runs: Option<u64>,
+    sc: &Scenario,
 ) -> Result<(), CliError> {
     let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let files = spec.input_files(base);
@@ -81,7 +82,12 @@ fn check_files(
     let odometer_files = o.odometer.map(per_run).unwrap_or_default();
     let mut outputs: Vec<(&str, &Path)> =
         run_files.iter().map(|p| ("--out", p.as_path())).collect();
-    outputs.extend(o.truth.map(|t| ("--truth", t)));
+    // The truth once, or per run when it differs by run.
+    let truth_files = match (o.truth, runs) {
+        (Some(t), Some(_)) if !sc.truth_columns_of_each_run().is_empty() => per_run(t),
+        (t, _) => t.map(Path::to_path_buf).into_iter().collect(),
+    };
+    outputs.extend(truth_files.iter().map(|p| ("--truth", p.as_path())));
     outputs.extend(gnss_files.iter().map(|p| ("--gnss", p.as_path())));
     outputs.extend(baro_files.iter().map(|p| ("--baro", p.as_path())));
     outputs.extend(odometer_files.iter().map(|p| ("--odometer", p.as_path())));
@@ -99,9 +105,9 @@ pub fn run(
     // One run's stages, or the runs at a time: refused before anything is read if below 1.
     let run_threads = RunThreads::at_most(threads, "--threads")?;
     let spec = ScenarioSpec::from_file(scenario)?;
-    check_files(scenario, &spec, o, runs)?;
     let base = scenario.parent().unwrap_or_else(|| Path::new("."));
     let sc = spec.resolve(base)?;
+    check_files(scenario, &spec, o, runs, &sc)?;
     for w in &sc.warnings {
         crate::report::warn(w);
     }
@@ -150,7 +156,7 @@ fn one_run(
 }
 
 /// `runs` seeded runs at a time (every core, or at most `threads`), each on one thread, each
-/// run's files named by [`run_path`]; the truth once.
+/// run's files named by [`run_path`]; the truth once (per run when it differs by run).
 fn many_runs(
     sc: &Scenario,
     o: &Outputs<'_>,
@@ -184,6 +190,12 @@ fn many_runs(
             .into_par_iter()
             .try_for_each(|r| -> Result<(), CliError> {
                 let per = |p: Option<&Path>| p.map(|p| run_path(p, r, runs));
+                // The truth once, unless it differs by run (random vibration): then per run.
+                let truth_file = if sc.truth_columns_of_each_run().is_empty() {
+                    o.truth.filter(|_| r == 0).map(Path::to_path_buf)
+                } else {
+                    per(o.truth)
+                };
                 let (imu_file, gnss_file, baro_file, odometer_file) = (
                     run_path(o.out, r, runs),
                     per(o.gnss),
@@ -195,7 +207,7 @@ fn many_runs(
                     RunThreads::One,
                     &StreamOutputs {
                         imu: Some(&imu_file),
-                        truth: o.truth.filter(|_| r == 0),
+                        truth: truth_file.as_deref(),
                         gnss: gnss_file.as_deref(),
                         baro: baro_file.as_deref(),
                         odometer: odometer_file.as_deref(),
@@ -218,8 +230,19 @@ fn many_runs(
             crate::report::warn(&format!("over the {runs} runs, {w}"));
         }
     }
+    let truth = match o.truth {
+        Some(t) if sc.truth_columns_of_each_run().is_empty() => {
+            format!("; truth in {}", t.display())
+        }
+        Some(t) => format!(
+            "; truth (its vibration differs by run) in {} … {}",
+            run_path(t, 0, runs).display(),
+            run_path(t, runs - 1, runs).display()
+        ),
+        None => String::new(),
+    };
     crate::note!(
-        "imukit: {} runs of {} samples; IMU readings in {} … {}",
+        "imukit: {} runs of {} samples; IMU readings in {} … {}{truth}",
         done.load(Ordering::Relaxed),
         sc.t_s.len(),
         run_path(o.out, 0, runs).display(),

@@ -23,8 +23,10 @@ from ._warning import _emit
 @dataclass(frozen=True, repr=False)
 class MonteCarlo:
     """Gathered Monte Carlo results: ``imu[k]`` is run ``runs[k]`` with columns ``columns``
-    (shape (runs, samples, columns)); ``truth`` is common to every run, and so is
-    ``description``, what every run's readings hold (:attr:`imukit.Table.description`)."""
+    (shape (runs, samples, columns)); ``truth`` is common to every run (the columns that differ
+    by run, what a random vibration did, are left out: ``imukit.simulate(scenario, run=k)`` has
+    run k's), and so is ``description``, what every run's readings hold
+    (:attr:`imukit.Table.description`)."""
 
     runs: np.ndarray
     columns: tuple
@@ -135,11 +137,11 @@ def monte_carlo(
         Path(target).parent.mkdir(parents=True, exist_ok=True)
     with_truth = [k == 0 for k in range(runs)]
     slots: List[Optional[np.ndarray]] = [None] * runs
+    text, fmt, origin, base_dir = spec
+    rows, imu_columns, by_run = _core.simulation_shape(text, format=fmt, origin=origin, base_dir=base_dir)
     if client is None and target is None:
         # Each run writes its readings straight into its slot of the gathered array: no copy,
         # and no second array of every run's readings at the end.
-        text, fmt, origin, base_dir = spec
-        rows, imu_columns = _core.simulation_shape(text, format=fmt, origin=origin, base_dir=base_dir)
         gathered = np.empty((runs, rows, len(imu_columns)))
         slots = list(gathered)
     if client is None:
@@ -159,6 +161,10 @@ def monte_carlo(
 
     columns, _, description = results[0][0]
     imu = gathered if client is None else np.stack([values for (_, values, _), _ in results])
-    truth = Table(*results[0][1])  # run 0 kept its truth table
+    # The first run kept its truth table; what differs by run (random vibration) is left out.
+    truth = Table(*results[0][1])
+    if by_run:
+        kept = [c for c in truth.columns if c not in by_run]
+        truth = Table(kept, truth.values[:, [truth.columns.index(c) for c in kept]], truth.description)
     return MonteCarlo(runs=np.array(ids), columns=tuple(columns), imu=imu, truth=truth,
                       description=description)

@@ -68,7 +68,7 @@ pub struct Chunk {
 pub struct GatheredShape {
     /// Samples (rows of each table).
     pub rows: usize,
-    /// Truth columns ([`crate::scenario::EarthSetup::truth_columns`]).
+    /// Truth columns ([`Scenario::truth_columns`]).
     pub truth_columns: Vec<&'static str>,
     /// IMU columns ([`ImuOutput::columns`]).
     pub imu_columns: Vec<&'static str>,
@@ -317,7 +317,7 @@ impl Scenario {
     /// [`crate::Error::Invalid`] on `duration_s` when the tables are too large.
     pub fn gathered_shape(&self) -> Result<GatheredShape> {
         let rows = self.t_s.len();
-        let truth_columns = self.earth.truth_columns();
+        let truth_columns = self.truth_columns();
         let imu_columns = self.imu.output.columns(self.imu.kind);
         let bytes_per_sample =
             core::mem::size_of::<f64>() * (truth_columns.len() + imu_columns.len());

@@ -7,6 +7,7 @@ use crate::scenario::report::RunReport;
 use imu_core::{AccelSign, ImuMount, NavFrame, Truth, Vec3};
 
 use crate::error::{Error, Result};
+use crate::io::columns::VIBRATION_TRUTH_COLUMNS;
 use crate::io::params::ImuParams;
 use crate::io::table::{ImuKind, ImuOutput};
 use crate::scenario::chain::ChainSetup;
@@ -16,6 +17,7 @@ use crate::scenario::perturb::{drawn_part, perturbed};
 use crate::scenario::sensors::SensorSetup;
 use crate::scenario::vibration::{VibrationSource, VibrationSpec};
 use imu_core::earth::EarthTruth;
+use nalgebra::Vector3;
 
 /// The IMU of a scenario, resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,6 +162,8 @@ impl ImuSetup {
             element,
             vibration,
             inputs: Vec::new(),
+            shaken: Vec::new(),
+            motion_states: None,
             model,
             noise: run.map_or_else(
                 || SeededNormals::new(seed),
@@ -182,6 +186,18 @@ impl ImuSetup {
                 .map_or_else(N::default_magnetic_field_ut, Vec3::from_array),
         }
     }
+}
+
+/// The ideal inputs of the three sensors at one instant: specific force (m/s²), rate (rad/s),
+/// field (µT), sensor axes.
+type Inputs = [[f64; 3]; 3];
+
+/// A motion sample's inputs had the mount not vibrated (the vehicle's alone), and the mount's
+/// turn then.
+struct Unshaken {
+    inputs: Inputs,
+    /// The sensor's axes against the vehicle's, a rotation vector, rad.
+    turn_rad: [f64; 3],
 }
 
 /// The signal chain at work: each sensor's chain and memory.
@@ -211,6 +227,11 @@ pub struct ReadingStream<'a, N: NavFrame> {
     /// With a chain or vibration, the ideal inputs of the samples kept ([`Self::decimate`]),
     /// waiting for the error model.
     inputs: Vec<[Vec3<imu_core::Body>; 3]>,
+    /// With vibration, what it did at each sample kept (the truth's
+    /// [`VIBRATION_TRUTH_COLUMNS`]), waiting for the truth table.
+    shaken: Vec<[f64; VIBRATION_TRUTH_COLUMNS.len()]>,
+    /// With vibration and a chain, each sensor's chain fed the vehicle's motion alone.
+    motion_states: Option<[ChainState; 3]>,
     model: ImuModel<N>,
     noise: SeededNormals,
     state: ImuState,
@@ -269,29 +290,49 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         self.chain.is_some() || self.vibration.is_some()
     }
 
-    /// The ideal inputs `base` (specific force, rate, field; body axes) of a motion sample at
-    /// `t_s` with the navigation-frame acceleration `acceleration`, with the mount's vibration
-    /// at its instant added (the sensors `sampled` there), as the sensing elements make them
-    /// when a chain follows.
+    /// The ideal inputs `base` (specific force, rate, field; the vehicle's body axes) of a motion
+    /// sample at `t_s` with the navigation-frame acceleration `acceleration`, as the sensing
+    /// elements make them when a chain follows: with the mount's vibration at its instant (the
+    /// sensors `sampled` there), the inputs in the sensor's axes with the vibration added, and
+    /// beside them the vehicle's alone and the mount's turn (a rotation vector, rad).
     fn sensed(
         &mut self,
         base: [Vec3<imu_core::Body>; 3],
         t_s: f64,
         acceleration: Vec3<N>,
         sampled: [bool; 3],
-    ) -> [[f64; 3]; 3] {
-        let [mut f, mut w, m] = base.map(Vec3::to_array);
-        if let Some(v) = &mut self.vibration {
-            let (force, rate) = v.at(t_s, sampled);
-            for k in 0..3 {
-                f[k] += force[k];
-                w[k] += rate[k];
+    ) -> (Inputs, Option<Unshaken>) {
+        let element = self.element.as_ref();
+        let sense = |x: [[f64; 3]; 3]| match element {
+            Some(e) => e.apply(x, acceleration.to_array()),
+            None => x,
+        };
+        let plain = base.map(Vec3::to_array);
+        let Some(v) = &mut self.vibration else {
+            return (sense(plain), None);
+        };
+        let shake = v.at(t_s, sampled);
+        let back = shake.mount.inverse();
+        let turned = |x: [f64; 3]| -> [f64; 3] {
+            if v.turns() {
+                (back * Vector3::from(x)).into()
+            } else {
+                x
             }
+        };
+        let [mut f, mut w, m] = plain.map(turned);
+        for k in 0..3 {
+            f[k] += shake.force_m_s2[k];
+            w[k] += shake.rate_rad_s[k];
         }
-        match &self.element {
-            Some(e) => e.apply([f, w, m], acceleration.to_array()),
-            None => [f, w, m],
-        }
+        let turn = shake.mount.scaled_axis().into();
+        (
+            sense([f, w, m]),
+            Some(Unshaken {
+                inputs: sense(plain),
+                turn_rad: turn,
+            }),
+        )
     }
 
     /// Works out the ideal inputs (vibration added) of the motion `motion`, runs them through
@@ -380,29 +421,63 @@ impl<N: NavFrame> ReadingStream<'_, N> {
             stage.position = (stage.position + 1) % stage.sampled.len().max(1);
             sampled
         });
-        let ideal = self.sensed(base, s.t_s, acceleration, sampled);
-        let filtered = match &mut self.chain {
-            None => Some(ideal),
-            Some(stage) => {
-                let states = stage.states.get_or_insert_with(|| {
-                    [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
-                });
-                // Each sensor filters its own instants; all keep the period's first.
-                let mut filtered = [[0.0; 3]; 3];
-                let mut keep = false;
-                for k in (0..3).filter(|&k| sampled[k]) {
-                    if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
-                        filtered[k] = y;
-                        keep = true;
-                    }
-                }
-                keep.then_some(filtered)
-            }
+        let (ideal, motion) = self.sensed(base, s.t_s, acceleration, sampled);
+        let filtered = self.filter(ideal, sampled, false);
+        // The vehicle's motion alone through its own chains, in step with the inputs'.
+        let alone = motion.map(|m| (self.filter(m.inputs, sampled, true), m.turn_rad));
+        let Some(filtered) = filtered else {
+            return;
         };
-        if let Some(inputs) = filtered {
-            kept.push(*s);
-            self.inputs.push(inputs.map(Vec3::from_array));
+        if let Some((Some(alone), turn)) = alone {
+            // What the vibration did: the inputs less the vehicle's alone; the mount's turn.
+            let mut row = [0.0; VIBRATION_TRUTH_COLUMNS.len()];
+            for k in 0..3 {
+                row[k] = filtered[0][k] - alone[0][k];
+                row[3 + k] = filtered[1][k] - alone[1][k];
+                row[6 + k] = turn[k];
+            }
+            self.shaken.push(row);
         }
+        kept.push(*s);
+        self.inputs.push(filtered.map(Vec3::from_array));
+    }
+
+    /// The ideal inputs `ideal` of one motion sample, the sensors `sampled` there, through the
+    /// chain (its second set of states, fed the vehicle's motion alone, when `alone`): the output
+    /// sample's inputs when the chain keeps it (every sample without one).
+    fn filter(
+        &mut self,
+        ideal: [[f64; 3]; 3],
+        sampled: [bool; 3],
+        alone: bool,
+    ) -> Option<[[f64; 3]; 3]> {
+        let Some(stage) = &mut self.chain else {
+            return Some(ideal);
+        };
+        let states = if alone {
+            &mut self.motion_states
+        } else {
+            &mut stage.states
+        };
+        let states = states.get_or_insert_with(|| {
+            [0, 1, 2].map(|k| ChainState::settled(&stage.chains[k], ideal[k]))
+        });
+        // Each sensor filters its own instants; all keep the period's first.
+        let mut filtered = [[0.0; 3]; 3];
+        let mut keep = false;
+        for k in (0..3).filter(|&k| sampled[k]) {
+            if let Some(y) = stage.chains[k].push(&mut states[k], ideal[k]) {
+                filtered[k] = y;
+                keep = true;
+            }
+        }
+        keep.then_some(filtered)
+    }
+
+    /// What the mount's vibration did at each sample kept since the last call, in order
+    /// ([`VIBRATION_TRUTH_COLUMNS`]; empty without vibration).
+    pub fn take_shaken(&mut self) -> Vec<[f64; VIBRATION_TRUTH_COLUMNS.len()]> {
+        std::mem::take(&mut self.shaken)
     }
 
     /// The readings of the next samples of truth.

@@ -40,6 +40,7 @@ pub use spec::{
 };
 pub use times::{SampleTimes, regular_times, sample_times};
 
+use crate::io::columns::VIBRATION_TRUTH_COLUMNS;
 use crate::io::conventions::{AccelSignName, EarthName, NavFrameName};
 use std::path::Path;
 
@@ -104,7 +105,7 @@ pub(crate) struct Stretch {
 /// Truth and ideal IMU readings of a scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
-    /// Truth, [`crate::io::columns::TRUTH_COLUMNS`].
+    /// Truth, [`Scenario::truth_columns`].
     pub truth: Table,
     /// IMU readings, columns per [`ImuKind::columns`](crate::io::table::ImuKind::columns).
     pub imu: Table,
@@ -156,6 +157,28 @@ impl Scenario {
             }),
             sensor: Some(sensor),
             scenario: text,
+        }
+    }
+
+    /// The truth table's columns: [`EarthSetup::truth_columns`], then, when the IMU's mount
+    /// vibrates, [`VIBRATION_TRUTH_COLUMNS`].
+    #[must_use]
+    pub fn truth_columns(&self) -> Vec<&'static str> {
+        let mut columns = self.earth.truth_columns();
+        if self.imu.vibration.is_some() {
+            columns.extend(VIBRATION_TRUTH_COLUMNS);
+        }
+        columns
+    }
+
+    /// The truth columns that differ from one Monte Carlo run to the next: what the vibration
+    /// did, when some of it is random (each run draws its own); none otherwise (the truth is
+    /// the same in every run).
+    #[must_use]
+    pub fn truth_columns_of_each_run(&self) -> &'static [&'static str] {
+        match &self.imu.vibration {
+            Some(v) if !v.random.is_empty() => &VIBRATION_TRUTH_COLUMNS,
+            _ => &[],
         }
     }
 
@@ -271,8 +294,13 @@ impl Scenario {
                 } else {
                     motion
                 };
+                let shaken = sensors.take_shaken();
                 if truth_table {
                     out.truth.refill_truth(truth);
+                    if self.imu.vibration.is_some() {
+                        out.truth
+                            .append_columns(&VIBRATION_TRUTH_COLUMNS, &shaken)?;
+                    }
                 } else {
                     out.truth.refill_truth::<N>(&[]);
                 }
@@ -300,8 +328,12 @@ impl Scenario {
                     .collect();
                 let readings = sensors.measure_earth(plane, &earth, &local)?;
                 let heights: Vec<f64> = earth.iter().map(|e| e.position.height_m).collect();
+                let mut table = earth::earth_truth_table(&local, &earth);
+                if self.imu.vibration.is_some() {
+                    table.append_columns(&VIBRATION_TRUTH_COLUMNS, &sensors.take_shaken())?;
+                }
                 *out = Stretch {
-                    truth: earth::earth_truth_table(&local, &earth),
+                    truth: table,
                     readings,
                     gnss: aids.gnss.as_mut().map(|r| r.measure_earth::<N>(&earth)),
                     baro: aids
