@@ -328,3 +328,37 @@ fn vibration_the_scenario_cannot_have_is_refused_by_its_key() {
     );
     assert!(e.starts_with("imu.vibration.sines[0].frequency_hz"), "{e}");
 }
+
+#[test]
+fn readings_of_given_samples_shake_as_a_simulation_and_a_chain_is_refused() {
+    let shake = "[imu.vibration]\nsines = [\
+                 { kind = \"angular-rate\", axis = \"y\", frequency_hz = 4, amplitude = 0.3 },\
+                 { kind = \"acceleration\", axis = \"x\", frequency_hz = 9, amplitude = 1.5 }]\n";
+    let sc = at_rest(100.0, 2.0, shake);
+    let sim = sc.simulate().unwrap();
+    let truth = sc
+        .trajectory
+        .truth::<imukit::core::Enu>(&sc.t_s.to_vec())
+        .unwrap();
+    let readings = sc
+        .imu
+        .readings(&truth, sc.gravity_m_s2, sc.sample_rate_hz, None)
+        .unwrap();
+    let table = imukit::Table::from_readings(&column(&sim, "t_s"), &readings, sc.imu.kind);
+    assert!(table == sim.imu);
+    let chained = at_rest(
+        100.0,
+        1.0,
+        "[imu.chain]\ninternal_rate_hz = 1000\n\
+         accelerometer = { filter = \"moving_average\", taps = 10 }\n",
+    );
+    let e = chained
+        .imu
+        .readings(&truth, chained.gravity_m_s2, 100.0, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("imu.chain: a chain reads the motion at its internal rate"),
+        "{e}"
+    );
+}

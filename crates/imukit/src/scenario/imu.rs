@@ -102,8 +102,11 @@ impl ImuSetup {
     /// Sensor readings for `truth`: the single run (`run = None`, stream `SeededNormals::new(seed)`)
     /// or Monte Carlo run `r` (`SeededNormals::for_run(seed, r)`).
     ///
+    /// The mount's vibration is read at the samples of `truth`.
+    ///
     /// # Errors
-    /// Invalid parameters.
+    /// Invalid parameters; a signal chain (it needs the motion at its internal rate, which
+    /// [`crate::Scenario::simulate`] samples).
     pub fn readings<N: NavFrame>(
         &self,
         truth: &[Truth<N>],
@@ -111,9 +114,20 @@ impl ImuSetup {
         sample_rate_hz: f64,
         run: Option<u64>,
     ) -> Result<Vec<ImuReading>> {
-        Ok(self
-            .reading_stream(gravity_m_s2, sample_rate_hz, run)?
-            .measure(truth))
+        if self.chain.is_some() {
+            return Err(crate::error::invalid(
+                "imu.chain",
+                "a chain reads the motion at its internal rate, not the samples given: \
+                 simulate the scenario",
+            ));
+        }
+        let mut stream = self.reading_stream(gravity_m_s2, sample_rate_hz, run)?;
+        if stream.prepares_inputs() {
+            let mut kept = Vec::with_capacity(truth.len());
+            stream.decimate(truth, &mut kept);
+            return Ok(stream.measure(&kept));
+        }
+        Ok(stream.measure(truth))
     }
 
     /// The sensors as a stream: [`ReadingStream::measure`] over consecutive chunks of truth
