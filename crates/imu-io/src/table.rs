@@ -298,13 +298,14 @@ impl Table {
                 format!("{} rows of {names:?} for {rows} rows", values.len()),
             ));
         }
-        let width = self.columns.len();
-        let mut data = Vec::with_capacity(rows * (width + W));
-        for (row, more) in self.data.chunks_exact(width.max(1)).zip(values) {
-            data.extend_from_slice(row);
-            data.extend_from_slice(more);
+        // Widened in place, last row first: each row moves to a place at or after its own,
+        // past every row still to move (the table's memory is kept, as a refilled one's is).
+        let (width, wider) = (self.columns.len(), self.columns.len() + W);
+        self.data.resize(rows * wider, 0.0);
+        for (i, more) in values.iter().enumerate().rev() {
+            self.data.copy_within(i * width..(i + 1) * width, i * wider);
+            self.data[i * wider + width..(i + 1) * wider].copy_from_slice(more);
         }
-        self.data = data;
         self.columns.extend(names.iter().map(|c| (*c).to_string()));
         Ok(())
     }

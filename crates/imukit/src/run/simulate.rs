@@ -415,6 +415,9 @@ impl Scenario {
         let mut sensors =
             self.imu
                 .reading_stream::<N>(self.gravity_m_s2, self.sample_rate_hz, run)?;
+        if !truth_table {
+            sensors = sensors.without_vibration_truth();
+        }
         let kind = self.imu.kind;
         let output = self.imu.output;
         // The last reading of the previous chunk: increments integrate across the boundary.

@@ -121,7 +121,9 @@ impl ImuSetup {
                  simulate the scenario",
             ));
         }
-        let mut stream = self.reading_stream(gravity_m_s2, sample_rate_hz, run)?;
+        let mut stream = self
+            .reading_stream(gravity_m_s2, sample_rate_hz, run)?
+            .without_vibration_truth();
         if stream.prepares_inputs() {
             let mut kept = Vec::with_capacity(truth.len());
             stream.decimate(truth, &mut kept);
@@ -176,7 +178,7 @@ impl ImuSetup {
             element,
             vibration,
             inputs: Vec::new(),
-            shaken: Vec::new(),
+            shaken: self.vibration.as_ref().map(|_| Vec::new()),
             motion_states: None,
             model,
             noise: run.map_or_else(
@@ -241,9 +243,10 @@ pub struct ReadingStream<'a, N: NavFrame> {
     /// With a chain or vibration, the ideal inputs of the samples kept ([`Self::decimate`]),
     /// waiting for the error model.
     inputs: Vec<[Vec3<imu_core::Body>; 3]>,
-    /// With vibration, what it did at each sample kept (the truth's
-    /// [`VIBRATION_TRUTH_COLUMNS`]), waiting for the truth table.
-    shaken: Vec<[f64; VIBRATION_TRUTH_COLUMNS.len()]>,
+    /// With vibration, what it did at each sample the last [`Self::decimate`] kept (the truth's
+    /// [`VIBRATION_TRUTH_COLUMNS`]); `None` without vibration or when no truth wants it
+    /// ([`Self::without_vibration_truth`]).
+    shaken: Option<Vec<[f64; VIBRATION_TRUTH_COLUMNS.len()]>>,
     /// With vibration and a chain, each sensor's chain fed the vehicle's motion alone.
     motion_states: Option<[ChainState; 3]>,
     model: ImuModel<N>,
@@ -339,14 +342,11 @@ impl<N: NavFrame> ReadingStream<'_, N> {
             f[k] += shake.force_m_s2[k];
             w[k] += shake.rate_rad_s[k];
         }
-        let turn = shake.mount.scaled_axis().into();
-        (
-            sense([f, w, m]),
-            Some(Unshaken {
-                inputs: sense(plain),
-                turn_rad: turn,
-            }),
-        )
+        let unshaken = self.shaken.is_some().then(|| Unshaken {
+            inputs: sense(plain),
+            turn_rad: shake.mount.scaled_axis().into(),
+        });
+        (sense([f, w, m]), unshaken)
     }
 
     /// Works out the ideal inputs (vibration added) of the motion `motion`, runs them through
@@ -356,6 +356,9 @@ impl<N: NavFrame> ReadingStream<'_, N> {
     /// inputs (as if the part had been reading them forever).
     pub fn decimate(&mut self, motion: &[Truth<N>], kept: &mut Vec<Truth<N>>) {
         kept.clear();
+        if let Some(shaken) = &mut self.shaken {
+            shaken.clear();
+        }
         for s in motion {
             let base = self.model.ideal(s);
             self.push_inputs(s, base, s.acceleration_m_s2, kept);
@@ -377,6 +380,9 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         kept: &mut Vec<Truth<N>>,
     ) -> Result<()> {
         kept.clear();
+        if let Some(shaken) = &mut self.shaken {
+            shaken.clear();
+        }
         let constant = self.constant_field_ned();
         for s in motion {
             let e = plane.to_earth(s)?;
@@ -450,7 +456,9 @@ impl<N: NavFrame> ReadingStream<'_, N> {
                 row[3 + k] = filtered[1][k] - alone[1][k];
                 row[6 + k] = turn[k];
             }
-            self.shaken.push(row);
+            if let Some(shaken) = &mut self.shaken {
+                shaken.push(row);
+            }
         }
         kept.push(*s);
         self.inputs.push(filtered.map(Vec3::from_array));
@@ -488,10 +496,20 @@ impl<N: NavFrame> ReadingStream<'_, N> {
         keep.then_some(filtered)
     }
 
-    /// What the mount's vibration did at each sample kept since the last call, in order
-    /// ([`VIBRATION_TRUTH_COLUMNS`]; empty without vibration).
-    pub fn take_shaken(&mut self) -> Vec<[f64; VIBRATION_TRUTH_COLUMNS.len()]> {
-        std::mem::take(&mut self.shaken)
+    /// What the mount's vibration did at each sample the last [`Self::decimate`] kept, in order
+    /// ([`VIBRATION_TRUTH_COLUMNS`]; empty without vibration or after
+    /// [`Self::without_vibration_truth`]).
+    #[must_use]
+    pub fn shaken(&self) -> &[[f64; VIBRATION_TRUTH_COLUMNS.len()]] {
+        self.shaken.as_deref().unwrap_or_default()
+    }
+
+    /// This stream without [`Self::shaken`]: for readings whose truth nobody tabulates (the
+    /// vehicle's motion is then not run through a second copy of the chains).
+    #[must_use]
+    pub fn without_vibration_truth(mut self) -> Self {
+        self.shaken = None;
+        self
     }
 
     /// The readings of the next samples of truth.

@@ -294,12 +294,11 @@ impl Scenario {
                 } else {
                     motion
                 };
-                let shaken = sensors.take_shaken();
                 if truth_table {
                     out.truth.refill_truth(truth);
                     if self.imu.vibration.is_some() {
                         out.truth
-                            .append_columns(&VIBRATION_TRUTH_COLUMNS, &shaken)?;
+                            .append_columns(&VIBRATION_TRUTH_COLUMNS, sensors.shaken())?;
                     }
                 } else {
                     out.truth.refill_truth::<N>(&[]);
@@ -329,8 +328,8 @@ impl Scenario {
                 let readings = sensors.measure_earth(plane, &earth, &local)?;
                 let heights: Vec<f64> = earth.iter().map(|e| e.position.height_m).collect();
                 let mut table = earth::earth_truth_table(&local, &earth);
-                if self.imu.vibration.is_some() {
-                    table.append_columns(&VIBRATION_TRUTH_COLUMNS, &sensors.take_shaken())?;
+                if truth_table && self.imu.vibration.is_some() {
+                    table.append_columns(&VIBRATION_TRUTH_COLUMNS, sensors.shaken())?;
                 }
                 *out = Stretch {
                     truth: table,
