@@ -220,40 +220,29 @@ impl VibrationSpec {
             })
             .collect();
         // About one axis the turn is exact in one step (the rates commute): no sine needs more.
-        let mut axes = self
+        let angular: Vec<(Axis, f64)> = self
             .sines
             .iter()
             .filter(|s| s.kind == VibrationKind::AngularRate)
-            .map(|s| s.axis)
+            .map(|s| (s.axis, s.frequency_hz))
             .chain(
                 self.random
                     .iter()
                     .filter(|r| r.kind == VibrationKind::AngularRate)
-                    .map(|r| r.axis),
-            );
-        let first = axes.next();
-        let angular_hz = if axes.all(|a| Some(a) == first) {
+                    .map(|r| (r.axis, 0.0)),
+            )
+            .collect();
+        let angular_hz = if angular.windows(2).all(|w| w[0].0 == w[1].0) {
             0.0
         } else {
-            self.sines
-                .iter()
-                .filter(|s| s.kind == VibrationKind::AngularRate)
-                .map(|s| s.frequency_hz)
-                .fold(0.0, f64::max)
+            angular.iter().map(|a| a.1).fold(0.0, f64::max)
         };
         VibrationSource {
             sines: self.sines.clone(),
             random,
             noise,
             angular_hz,
-            turns: self
-                .sines
-                .iter()
-                .any(|s| s.kind == VibrationKind::AngularRate)
-                || self
-                    .random
-                    .iter()
-                    .any(|r| r.kind == VibrationKind::AngularRate),
+            turns: !angular.is_empty(),
             mount: UnitQuaternion::identity(),
             last_t_s: None,
         }
@@ -354,18 +343,16 @@ impl VibrationSource {
         self.turns
     }
 
-    /// The angular vibration at `t_s` between two instants: the sines there, each random
-    /// vibration held at its last value.
-    fn rate_between(&self, t_s: f64) -> Vector3<f64> {
-        let mut w = Vector3::zeros();
-        for s in self
-            .sines
+    /// The angular sines.
+    fn angular_sines(&self) -> impl Iterator<Item = &SineSpec> {
+        self.sines
             .iter()
             .filter(|s| s.kind == VibrationKind::AngularRate)
-        {
-            let phase = 2.0 * core::f64::consts::PI * s.frequency_hz * t_s + s.phase_rad;
-            w[s.axis.index()] += s.amplitude * phase.sin();
-        }
+    }
+
+    /// The angular random vibration, each held at its last value, rad/s.
+    fn held_rate(&self) -> Vector3<f64> {
+        let mut w = Vector3::zeros();
         for r in self
             .random
             .iter()
@@ -376,37 +363,31 @@ impl VibrationSource {
         w
     }
 
-    /// The angle the angular vibration turns through from `t0` to `t1` (`∫ω dt` per axis, the
-    /// sines' in closed form, each random vibration held at its last value).
-    fn angle_between(&self, t0: f64, t1: f64) -> Vector3<f64> {
-        let mut angle = Vector3::zeros();
-        for s in self
-            .sines
-            .iter()
-            .filter(|s| s.kind == VibrationKind::AngularRate)
-        {
-            let omega = 2.0 * core::f64::consts::PI * s.frequency_hz;
-            let (c0, c1) = (
-                (omega * t0 + s.phase_rad).cos(),
-                (omega * t1 + s.phase_rad).cos(),
-            );
-            angle[s.axis.index()] += s.amplitude / omega * (c0 - c1);
+    /// The angular sines' rate at `t_s`, rad/s.
+    fn sine_rate(&self, t_s: f64) -> Vector3<f64> {
+        let mut w = Vector3::zeros();
+        for s in self.angular_sines() {
+            let phase = 2.0 * core::f64::consts::PI * s.frequency_hz * t_s + s.phase_rad;
+            w[s.axis.index()] += s.amplitude * phase.sin();
         }
-        for r in self
-            .random
-            .iter()
-            .filter(|r| r.kind == VibrationKind::AngularRate)
-        {
-            angle[r.axis] += r.value * (t1 - t0);
+        w
+    }
+
+    /// An antiderivative of [`Self::sine_rate`] at `t_s`, rad: `−A/ω·cos(ωt + φ)` per sine.
+    fn sine_angle(&self, t_s: f64) -> Vector3<f64> {
+        let mut angle = Vector3::zeros();
+        for s in self.angular_sines() {
+            let omega = 2.0 * core::f64::consts::PI * s.frequency_hz;
+            angle[s.axis.index()] -= s.amplitude / omega * (omega * t_s + s.phase_rad).cos();
         }
         angle
     }
 
-    /// Turns the mount from `t0` to `t1` by the angular vibration between them, in steps of
-    /// the fourth-order Magnus integrator: `φ = ∫ω dt + √3/12·h²·(ω₁ × ω₂)` with `ω₁, ω₂` at the
-    /// step's two Gauss points and the integral exact, `q ← q ⊗ exp(φ)` (exact about one axis
-    /// and for a constant rate, unit length by construction), as many as the fastest angular
-    /// sine needs.
+    /// Turns the mount from `t0` to `t1` by the angular vibration between them (the sines, each
+    /// random vibration held at its last value), in steps of the fourth-order Magnus
+    /// integrator: `φ = ∫ω dt + √3/12·h²·(ω₁ × ω₂)` with `ω₁, ω₂` at the step's two Gauss points
+    /// and the integral exact, `q ← q ⊗ exp(φ)` (exact about one axis and for a constant rate,
+    /// unit length by construction), as many as the fastest angular sine needs.
     fn turn_mount(&mut self, t0: f64, t1: f64) {
         let span = t1 - t0;
         if !span.is_finite() || span <= 0.0 {
@@ -422,16 +403,19 @@ impl VibrationSource {
         #[allow(clippy::cast_precision_loss)]
         let h = span / steps as f64;
         let gauss = 3.0_f64.sqrt() / 6.0;
-        let mut start = t0;
+        let held = self.held_rate();
+        let (mut start, mut angle_at_start) = (t0, self.sine_angle(t0));
         for k in 1..=steps {
             #[allow(clippy::cast_precision_loss)]
             let end = if k == steps { t1 } else { t0 + h * k as f64 };
-            let w1 = self.rate_between(start + (0.5 - gauss) * h);
-            let w2 = self.rate_between(start + (0.5 + gauss) * h);
-            let phi =
-                self.angle_between(start, end) + w1.cross(&w2) * (3.0_f64.sqrt() / 12.0 * h * h);
+            let angle_at_end = self.sine_angle(end);
+            let w1 = self.sine_rate(start + (0.5 - gauss) * h) + held;
+            let w2 = self.sine_rate(start + (0.5 + gauss) * h) + held;
+            let phi = angle_at_end - angle_at_start
+                + held * (end - start)
+                + w1.cross(&w2) * (3.0_f64.sqrt() / 12.0 * h * h);
             self.mount *= UnitQuaternion::from_scaled_axis(phi);
-            start = end;
+            (start, angle_at_start) = (end, angle_at_end);
         }
         self.mount.renormalize_fast();
     }
